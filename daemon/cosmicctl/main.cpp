@@ -1,0 +1,28 @@
+// cosmicctl: inspect and steer a running cosmicd, or check a configuration offline.
+#include <iostream>
+#include <vector>
+
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"cosmicctl: control and inspect the cosmic-gateway daemon"};
+  app.require_subcommand(1);
+  app.fallthrough();
+  cosmicctl::GlobalOptions options;
+  app.add_flag("--json", options.json, "Machine-readable JSON output");
+  std::vector<cosmicctl::CommandRunner> commands;
+  commands.push_back(cosmicctl::add_check_command(app, options));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return cosmicctl::kExitUsage;
+  }
+  for (const auto& run : commands) {
+    const int code = run();
+    if (code >= 0) return code;
+  }
+  return cosmicctl::kExitUsage;
+}

@@ -1,0 +1,45 @@
+// YAML configuration: schema, units and strict validation. Every problem of a document is
+// collected (never the first only) with its file:line:column and key path.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cosmic/model.hpp"
+
+namespace cosmic {
+
+struct ConfigError {
+  std::string file;
+  int line = 0;    // 1-based
+  int column = 0;  // 1-based
+  std::string path;     // key path, e.g. channels[2].period
+  std::string message;  // what is wrong
+  std::string valid;    // what would be valid (may be empty)
+  // "FILE:LINE:COL: key.path: what is wrong (what would be valid)"
+  std::string to_string() const;
+};
+
+struct ConfigResult {
+  Config config;  // meaningful only when errors is empty
+  std::vector<ConfigError> errors;
+  bool ok() const { return errors.empty(); }
+};
+
+struct ChannelsResult {
+  std::vector<ChannelSpec> channels;
+  std::vector<ConfigError> errors;
+  bool ok() const { return errors.empty(); }
+};
+
+// Parses a whole gateway configuration. `file_name` only labels the errors.
+ConfigResult parse_config(std::string_view text, const std::string& file_name);
+// Reads and parses a file; an unreadable file is one error at 0:0.
+ConfigResult load_config_file(const std::string& path);
+
+// Parses channel definitions for a runtime bind: a document with a `channels:` list, a list of
+// channel maps, or one channel map, validated against the segments of `running`.
+ChannelsResult parse_channels(std::string_view text, const std::string& file_name, const Config& running);
+
+}  // namespace cosmic

@@ -1,0 +1,458 @@
+#include "cosmic/config_loader.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "cosmic/admission.hpp"
+#include "yaml_reader.hpp"
+
+namespace cosmic {
+namespace {
+
+using config_detail::YamlReader;
+
+constexpr std::uint64_t kMaxPayload = 1 << 20;
+constexpr std::uint64_t kClassicCanMaxBitrate = 1'000'000;
+constexpr std::uint64_t kFdMaxDataBitrate = 8'000'000;
+
+std::string indexed(const std::string& path, std::size_t index) { return path + "[" + std::to_string(index) + "]"; }
+std::string key(const std::string& path, const char* name) { return path + "." + name; }
+
+// Present and not explicitly null.
+bool has(const YAML::Node& map, const char* name) { return map.IsMap() && map[name] && !map[name].IsNull(); }
+
+class ConfigParser {
+ public:
+  explicit ConfigParser(std::string file) : reader_(std::move(file)) {}
+
+  ConfigResult parse_document(std::string_view text) {
+    ConfigResult result;
+    const auto root = load(text);
+    if (!root) {
+      result.errors = reader_.take_errors();
+      return result;
+    }
+    if (reader_.check_map(*root, "", {"gateway", "segments", "channels"})) {
+      if (has(*root, "gateway")) parse_gateway((*root)["gateway"]);
+      if (require(*root, "", "segments", "a list of segments (type can, dds or lcm)")) parse_segments((*root)["segments"]);
+      if (require(*root, "", "channels", "a list of channels")) parse_channel_list((*root)["channels"], "channels");
+    }
+    result.config = std::move(config_);
+    result.errors = reader_.take_errors();
+    return result;
+  }
+
+  ChannelsResult parse_bind_document(std::string_view text, const Config& running) {
+    ChannelsResult result;
+    config_.segments = running.segments;
+    for (const auto& s : config_.segments) segment_names_.insert(s.name);
+    const auto root = load(text);
+    if (root) {
+      if (root->IsMap() && (*root)["channels"]) {
+        if (reader_.check_map(*root, "", {"channels"})) parse_channel_list((*root)["channels"], "channels");
+      } else if (root->IsSequence()) {
+        parse_channel_list(*root, "channels");
+      } else if (root->IsMap()) {
+        parse_channel_entry(*root, "channel");
+      } else {
+        reader_.error_at(*root, "", "expected channel definitions", "a 'channels:' list, a list of channels or one channel map");
+      }
+      if (config_.channels.empty() && reader_.error_count() == 0) {
+        reader_.error_at(*root, "channels", "no channel to bind", "at least one channel definition");
+      }
+    }
+    result.channels = std::move(config_.channels);
+    result.errors = reader_.take_errors();
+    return result;
+  }
+
+ private:
+  std::optional<YAML::Node> load(std::string_view text) {
+    try {
+      YAML::Node root = YAML::Load(std::string(text));
+      if (!root || root.IsNull()) {
+        reader_.error(YAML::Mark(), "", "the document is empty", "a map with gateway, segments and channels");
+        return std::nullopt;
+      }
+      return root;
+    } catch (const YAML::ParserException& e) {
+      reader_.error(e.mark, "", "YAML syntax error: " + e.msg, "well-formed YAML");
+      return std::nullopt;
+    }
+  }
+
+  bool require(const YAML::Node& map, const std::string& path, const char* name, const char* valid) {
+    if (has(map, name)) return true;
+    reader_.error_at(map, path.empty() ? name : key(path, name), std::string("missing required key '") + name + "'", valid);
+    return false;
+  }
+
+  void parse_gateway(const YAML::Node& node) {
+    const std::string path = "gateway";
+    if (!reader_.check_map(node, path, {"name", "can_node_id", "residence_bound", "control_socket"})) return;
+    GatewaySpec& g = config_.gateway;
+    if (has(node, "name")) {
+      if (auto v = reader_.name(node["name"], key(path, "name"))) g.name = *v;
+    }
+    if (has(node, "can_node_id")) {
+      if (auto v = reader_.unsigned_int(node["can_node_id"], key(path, "can_node_id"), 0, 127)) {
+        g.can_node_id = static_cast<std::uint8_t>(*v);
+      }
+    }
+    if (has(node, "residence_bound")) {
+      if (auto v = reader_.duration(node["residence_bound"], key(path, "residence_bound"), false)) g.residence_bound = *v;
+    }
+    if (has(node, "control_socket")) {
+      if (auto v = reader_.string(node["control_socket"], key(path, "control_socket"))) {
+        if (v->front() != '/') {
+          reader_.error_at(node["control_socket"], key(path, "control_socket"), "'" + *v + "' is not an absolute path",
+                           "an absolute path such as /run/cosmicd/control.sock");
+        } else if (v->size() > 100) {
+          reader_.error_at(node["control_socket"], key(path, "control_socket"), "path is too long for a Unix socket",
+                           "at most 100 characters");
+        } else {
+          g.control_socket = *v;
+        }
+      }
+    }
+  }
+
+  void parse_segments(const YAML::Node& node) {
+    if (!reader_.is_list(node, "segments")) return;
+    std::map<std::string, YAML::Mark> first_seen;
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      const std::string path = indexed("segments", i);
+      auto segment = parse_segment(node[i], path);
+      if (!segment) continue;
+      if (!first_seen.emplace(segment->name, node[i].Mark()).second) {
+        reader_.error_at(node[i]["name"], key(path, "name"), "duplicate segment name '" + segment->name + "'",
+                         "a name not used by another segment (first at line " +
+                             std::to_string(first_seen[segment->name].line + 1) + ")");
+        continue;
+      }
+      segment_names_.insert(segment->name);
+      config_.segments.push_back(std::move(*segment));
+    }
+  }
+
+  std::optional<SegmentSpec> parse_segment(const YAML::Node& node, const std::string& path) {
+    if (!node.IsMap()) {
+      reader_.error_at(node, path, "expected a segment map", "keys name, type and the keys of that type");
+      return std::nullopt;
+    }
+    const std::size_t errors_before = reader_.error_count();
+    SegmentSpec s;
+    std::optional<std::size_t> type;
+    if (require(node, path, "type", "type: can, dds or lcm")) type = reader_.choice(node["type"], key(path, "type"), {"can", "dds", "lcm"});
+    if (require(node, path, "name", "a segment name")) {
+      if (auto v = reader_.name(node["name"], key(path, "name"))) s.name = *v;
+    }
+    if (!type) {
+      reader_.check_map(node, path, {"name", "type", "interface", "bitrate", "fd", "data_bitrate", "errors", "max_utilization",
+                                     "domain", "latency_bound", "bandwidth", "reliability", "realtime", "max_message_size",
+                                     "interfaces", "discovery_server", "url"});
+      return std::nullopt;
+    }
+    s.type = static_cast<SegmentType>(*type);
+    if (has(node, "max_utilization")) {
+      if (auto v = reader_.percent(node["max_utilization"], key(path, "max_utilization"))) s.max_utilization = *v;
+    }
+    switch (s.type) {
+      case SegmentType::can: parse_can(node, path, s); break;
+      case SegmentType::dds: parse_dds(node, path, s); break;
+      case SegmentType::lcm: parse_lcm(node, path, s); break;
+    }
+    if (reader_.error_count() != errors_before) return std::nullopt;
+    return s;
+  }
+
+  void parse_can(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
+    reader_.check_map(node, path, {"name", "type", "interface", "bitrate", "fd", "data_bitrate", "errors", "max_utilization"});
+    CanSegmentProperties& can = s.can;
+    if (require(node, path, "interface", "a network interface such as can0")) {
+      if (auto v = reader_.string(node["interface"], key(path, "interface"))) {
+        if (v->size() >= 16) {
+          reader_.error_at(node["interface"], key(path, "interface"), "interface name '" + *v + "' is too long",
+                           "at most 15 characters");
+        }
+        can.interface = *v;
+      }
+    }
+    if (has(node, "fd")) can.fd = reader_.boolean(node["fd"], key(path, "fd")).value_or(false);
+    if (require(node, path, "bitrate", "the nominal bit rate, e.g. 500kbit/s")) {
+      if (auto v = reader_.bitrate(node["bitrate"], key(path, "bitrate"))) {
+        if (v->bits_per_second > kClassicCanMaxBitrate) {
+          reader_.error_at(node["bitrate"], key(path, "bitrate"), "CAN nominal bit rate above 1Mbit/s",
+                           "at most 1Mbit/s; use fd: true with data_bitrate for faster data phases");
+        }
+        can.bitrate = *v;
+      }
+    }
+    can.data_bitrate = can.bitrate;
+    if (has(node, "data_bitrate")) {
+      const std::string p = key(path, "data_bitrate");
+      if (!can.fd) {
+        reader_.error_at(node["data_bitrate"], p, "data_bitrate needs fd: true", "remove it, or set fd: true");
+      } else if (auto v = reader_.bitrate(node["data_bitrate"], p)) {
+        if (*v < can.bitrate || v->bits_per_second > kFdMaxDataBitrate) {
+          reader_.error_at(node["data_bitrate"], p, "data bit rate out of range", "from the nominal bitrate up to 8Mbit/s");
+        }
+        can.data_bitrate = *v;
+      }
+    }
+    if (has(node, "errors")) parse_fault_hypothesis(node["errors"], key(path, "errors"), can.errors);
+  }
+
+  void parse_fault_hypothesis(const YAML::Node& node, const std::string& path, CanFaultHypothesis& errors) {
+    if (!reader_.check_map(node, path, {"max_per_window", "window"})) return;
+    if (require(node, path, "max_per_window", "a whole number of error frames, 0 for an error-free bus")) {
+      if (auto v = reader_.unsigned_int(node["max_per_window"], key(path, "max_per_window"), 0, 1000)) {
+        errors.max_per_window = static_cast<std::uint32_t>(*v);
+      }
+    }
+    if (errors.max_per_window > 0 && require(node, path, "window", "the window length, e.g. 10ms")) {
+      if (auto v = reader_.duration(node["window"], key(path, "window"), false)) errors.window = *v;
+    } else if (has(node, "window")) {
+      reader_.duration(node["window"], key(path, "window"), false);
+    }
+  }
+
+  void parse_ip_common(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
+    if (has(node, "latency_bound")) {
+      if (auto v = reader_.duration(node["latency_bound"], key(path, "latency_bound"), false)) s.latency_bound = *v;
+    }
+    if (has(node, "bandwidth")) {
+      if (auto v = reader_.bitrate(node["bandwidth"], key(path, "bandwidth"))) s.bandwidth = *v;
+    }
+    if (has(node, "realtime")) {
+      if (auto v = reader_.boolean(node["realtime"], key(path, "realtime"))) s.realtime = *v;
+    }
+    if (has(node, "max_message_size")) {
+      if (auto v = reader_.size(node["max_message_size"], key(path, "max_message_size"), 64ull << 20)) {
+        if (*v <= kIpMinMessage) {
+          reader_.error_at(node["max_message_size"], key(path, "max_message_size"), "too small",
+                           "more than " + std::to_string(kIpMinMessage) + "B");
+        }
+        s.max_message_size = *v;
+      }
+    }
+  }
+
+  void parse_dds(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
+    reader_.check_map(node, path, {"name", "type", "domain", "latency_bound", "bandwidth", "reliability", "realtime",
+                                   "max_message_size", "interfaces", "discovery_server", "max_utilization"});
+    parse_ip_common(node, path, s);
+    if (has(node, "domain")) {
+      if (auto v = reader_.unsigned_int(node["domain"], key(path, "domain"), 0, 232)) s.dds.domain = static_cast<std::uint32_t>(*v);
+    }
+    if (has(node, "reliability")) {
+      if (auto v = reader_.choice(node["reliability"], key(path, "reliability"), {"reliable", "best_effort"})) {
+        s.reliability = static_cast<Reliability>(*v);
+      }
+    }
+    if (has(node, "interfaces")) {
+      if (auto v = reader_.string_list(node["interfaces"], key(path, "interfaces"))) s.dds.interfaces = *v;
+    }
+    if (has(node, "discovery_server")) {
+      if (auto v = reader_.string(node["discovery_server"], key(path, "discovery_server"))) {
+        const auto colon = v->rfind(':');
+        if (colon == std::string::npos || colon == 0 || colon + 1 == v->size()) {
+          reader_.error_at(node["discovery_server"], key(path, "discovery_server"), "'" + *v + "' is not IP:PORT",
+                           "an IPv4 address and port, e.g. 127.0.0.1:11811");
+        }
+        s.dds.discovery_server = *v;
+      }
+    }
+  }
+
+  void parse_lcm(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
+    reader_.check_map(node, path, {"name", "type", "url", "latency_bound", "bandwidth", "realtime", "max_message_size",
+                                   "max_utilization"});
+    s.reliability = Reliability::best_effort;
+    parse_ip_common(node, path, s);
+    if (has(node, "url")) {
+      if (auto v = reader_.string(node["url"], key(path, "url"))) {
+        if (v->rfind("udpm://", 0) != 0 && v->rfind("memq://", 0) != 0) {
+          reader_.error_at(node["url"], key(path, "url"), "unsupported LCM URL '" + *v + "'",
+                           "udpm://GROUP:PORT?ttl=N or memq://");
+        }
+        s.lcm.url = *v;
+      }
+    }
+  }
+
+  void parse_channel_list(const YAML::Node& node, const std::string& path) {
+    if (!reader_.is_list(node, path)) return;
+    for (std::size_t i = 0; i < node.size(); ++i) parse_channel_entry(node[i], indexed(path, i));
+  }
+
+  void parse_channel_entry(const YAML::Node& node, const std::string& path) {
+    auto channel = parse_channel(node, path);
+    if (!channel) return;
+    if (!check_unique(node, path, *channel)) return;
+    config_.channels.push_back(std::move(*channel));
+  }
+
+  bool check_unique(const YAML::Node& node, const std::string& path, const ChannelSpec& c) {
+    bool ok = true;
+    if (const auto [it, fresh] = channel_names_.emplace(c.name, node["name"].Mark().line + 1); !fresh) {
+      reader_.error_at(node["name"], key(path, "name"), "duplicate channel name '" + c.name + "'",
+                       "a name not used by another channel (first at line " + std::to_string(it->second) + ")");
+      ok = false;
+    }
+    if (const auto [it, fresh] = subjects_.emplace(c.subject, c.name); !fresh) {
+      reader_.error_at(node["subject"], key(path, "subject"), "subject already used by channel '" + it->second + "'",
+                       "one channel per subject");
+      ok = false;
+    }
+    if (c.etag) {
+      if (const auto [it, fresh] = etags_.emplace(*c.etag, c.name); !fresh) {
+        reader_.error_at(node["etag"], key(path, "etag"), "etag already used by channel '" + it->second + "'",
+                         "a distinct etag per channel, or none (assigned)");
+        ok = false;
+      }
+    }
+    return ok;
+  }
+
+  std::optional<ChannelSpec> parse_channel(const YAML::Node& node, const std::string& path) {
+    if (!reader_.check_map(node, path, {"name", "subject", "class", "period", "max_rate", "reaction_time", "omission_degree",
+                                        "temp_validity", "payload", "etag", "encoding", "publishers", "subscribers"})) {
+      return std::nullopt;
+    }
+    const std::size_t errors_before = reader_.error_count();
+    ChannelSpec c;
+    if (require(node, path, "name", "a channel name")) c.name = reader_.name(node["name"], key(path, "name")).value_or("");
+    if (require(node, path, "subject", "a 64-bit subject UID, e.g. 0x0000000100000042")) {
+      c.subject = reader_.unsigned_int(node["subject"], key(path, "subject"), 1, UINT64_MAX).value_or(0);
+    }
+    if (require(node, path, "class", "class: hrt, srt or nrt")) {
+      c.cls = static_cast<ChannelClass>(reader_.choice(node["class"], key(path, "class"), {"hrt", "srt", "nrt"}).value_or(2));
+    }
+    parse_timing(node, path, c);
+    if (has(node, "omission_degree")) {
+      c.omission_degree = static_cast<std::uint32_t>(
+          reader_.unsigned_int(node["omission_degree"], key(path, "omission_degree"), 0, 1'000'000).value_or(0));
+    }
+    if (has(node, "payload")) c.payload = reader_.size(node["payload"], key(path, "payload"), kMaxPayload).value_or(0);
+    if (has(node, "etag")) {
+      if (auto v = reader_.unsigned_int(node["etag"], key(path, "etag"), 101, 16383)) c.etag = static_cast<std::uint16_t>(*v);
+    }
+    if (has(node, "encoding")) {
+      c.lcm_encoding = static_cast<LcmEncoding>(reader_.choice(node["encoding"], key(path, "encoding"), {"envelope", "raw"}).value_or(0));
+    }
+    parse_bindings(node, path, c);
+    if (reader_.error_count() != errors_before) return std::nullopt;
+    return c;
+  }
+
+  void parse_timing(const YAML::Node& node, const std::string& path, ChannelSpec& c) {
+    const bool realtime = c.cls != ChannelClass::nrt;
+    if (has(node, "period") && has(node, "max_rate")) {
+      reader_.error_at(node["max_rate"], key(path, "max_rate"), "period and max_rate both given", "one of them");
+    } else if (has(node, "period")) {
+      c.period = reader_.duration(node["period"], key(path, "period"), false);
+    } else if (has(node, "max_rate")) {
+      if (auto hz = reader_.frequency(node["max_rate"], key(path, "max_rate"))) {
+        // Minimum inter-arrival time, rounded down: a conservative (higher) load.
+        c.period = Nanos(std::max<std::int64_t>(1, static_cast<std::int64_t>(1e9 / *hz)));
+      }
+    } else if (realtime) {
+      reader_.error_at(node, key(path, "period"), "an hrt or srt channel needs period or max_rate",
+                       "period: 10ms or max_rate: 100Hz");
+    }
+    if (has(node, "reaction_time")) {
+      c.reaction_time = reader_.duration(node["reaction_time"], key(path, "reaction_time"), false);
+    } else if (realtime) {
+      reader_.error_at(node, key(path, "reaction_time"), "an hrt or srt channel needs reaction_time",
+                       "the end-to-end latency bound, e.g. reaction_time: 5ms");
+    }
+    if (has(node, "temp_validity")) c.temp_validity = reader_.duration(node["temp_validity"], key(path, "temp_validity"), false);
+  }
+
+  void parse_bindings(const YAML::Node& node, const std::string& path, ChannelSpec& c) {
+    std::set<std::string> publishers;
+    for (const char* role : {"publishers", "subscribers"}) {
+      const std::string p = key(path, role);
+      if (!require(node, path, role, "a non-empty list of segment names")) continue;
+      auto names = reader_.string_list(node[role], p);
+      if (!names) continue;
+      if (names->empty()) {
+        reader_.error_at(node[role], p, "no segment listed",
+                         "at least one segment name");
+        continue;
+      }
+      std::set<std::string> seen;
+      for (std::size_t i = 0; i < names->size(); ++i) {
+        const std::string& name = (*names)[i];
+        const YAML::Node item = node[role][i];
+        const std::string ip = indexed(p, i);
+        if (!segment_names_.count(name)) {
+          reader_.error_at(item, ip, "unknown segment '" + name + "'", "one of the segments: " + segment_list());
+        } else if (!seen.insert(name).second) {
+          reader_.error_at(item, ip, "segment '" + name + "' listed twice", "each segment once");
+        } else if (std::string(role) == "subscribers" && publishers.count(name)) {
+          reader_.error_at(item, ip, "segment '" + name + "' is both publisher and subscriber of this channel",
+                           "a segment is either P or S of a channel");
+        }
+      }
+      if (std::string(role) == "publishers") {
+        publishers = seen;
+        c.publishers = *names;
+      } else {
+        c.subscribers = *names;
+      }
+    }
+  }
+
+  std::string segment_list() const {
+    std::string out;
+    for (const auto& name : segment_names_) out += (out.empty() ? "" : ", ") + name;
+    return out.empty() ? "(none defined)" : out;
+  }
+
+  static constexpr std::uint64_t kIpMinMessage = kIpOverheadBytes;
+
+  YamlReader reader_;
+  Config config_;
+  std::set<std::string> segment_names_;
+  std::map<std::string, int> channel_names_;
+  std::map<std::uint64_t, std::string> subjects_;
+  std::map<std::uint16_t, std::string> etags_;
+};
+
+}  // namespace
+
+std::string ConfigError::to_string() const {
+  std::string out = file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": ";
+  if (!path.empty()) out += path + ": ";
+  out += message;
+  if (!valid.empty()) out += " (" + valid + ")";
+  return out;
+}
+
+ConfigResult parse_config(std::string_view text, const std::string& file_name) {
+  return ConfigParser(file_name).parse_document(text);
+}
+
+ConfigResult load_config_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) {
+    ConfigResult result;
+    result.errors.push_back(ConfigError{path, 0, 0, "", "cannot read the file", "a readable YAML file"});
+    return result;
+  }
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return parse_config(buffer.str(), path);
+}
+
+ChannelsResult parse_channels(std::string_view text, const std::string& file_name, const Config& running) {
+  return ConfigParser(file_name).parse_bind_document(text, running);
+}
+
+}  // namespace cosmic

@@ -1,0 +1,56 @@
+// Helpers that read typed values out of yaml-cpp nodes and record every problem with its
+// location. Internal to the config library.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstdint>
+#include <functional>
+#include <initializer_list>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cosmic/config_loader.hpp"
+#include "cosmic/units.hpp"
+
+namespace cosmic::config_detail {
+
+class YamlReader {
+ public:
+  explicit YamlReader(std::string file) : file_(std::move(file)) {}
+
+  void error(const YAML::Mark& mark, const std::string& path, std::string message, std::string valid = {});
+  void error_at(const YAML::Node& node, const std::string& path, std::string message, std::string valid = {});
+  std::vector<ConfigError> take_errors() { return std::move(errors_); }
+  std::size_t error_count() const { return errors_.size(); }
+
+  // True when `node` is a map; reports unknown and duplicate keys against `allowed`.
+  bool check_map(const YAML::Node& node, const std::string& path, std::initializer_list<const char*> allowed);
+  bool is_list(const YAML::Node& node, const std::string& path);
+
+  std::optional<std::string> string(const YAML::Node& node, const std::string& path);
+  std::optional<bool> boolean(const YAML::Node& node, const std::string& path);
+  std::optional<std::uint64_t> unsigned_int(const YAML::Node& node, const std::string& path, std::uint64_t min,
+                                            std::uint64_t max);
+  std::optional<Nanos> duration(const YAML::Node& node, const std::string& path, bool allow_zero);
+  std::optional<BitRate> bitrate(const YAML::Node& node, const std::string& path);
+  std::optional<std::uint64_t> size(const YAML::Node& node, const std::string& path, std::uint64_t max);
+  std::optional<double> percent(const YAML::Node& node, const std::string& path);
+  std::optional<double> frequency(const YAML::Node& node, const std::string& path);
+  // One of `choices`, returned as its index.
+  std::optional<std::size_t> choice(const YAML::Node& node, const std::string& path,
+                                    std::initializer_list<const char*> choices);
+  std::optional<std::vector<std::string>> string_list(const YAML::Node& node, const std::string& path);
+  // A name usable as DDS topic and LCM channel: [A-Za-z0-9_.-], 1..64 characters.
+  std::optional<std::string> name(const YAML::Node& node, const std::string& path);
+
+ private:
+  std::optional<std::string> scalar(const YAML::Node& node, const std::string& path, const char* expected);
+  std::string file_;
+  std::vector<ConfigError> errors_;
+};
+
+std::string join(std::initializer_list<const char*> words);
+
+}  // namespace cosmic::config_detail

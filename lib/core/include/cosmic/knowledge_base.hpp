@@ -1,0 +1,82 @@
+// The knowledge base: what each attached network can deliver (declared properties and live
+// health) and every channel reservation on it. Binding is incremental: a channel is admitted only
+// if the whole set stays acceptable; a newcomer never breaks an admitted HRT channel, and a
+// rejected channel changes nothing.
+//
+// Not thread-safe: one owner (the daemon's control thread, or cosmicctl check) calls it.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "cosmic/admission.hpp"
+#include "cosmic/model.hpp"
+
+namespace cosmic {
+
+enum class SegmentHealth { up, degraded, down };
+const char* to_string(SegmentHealth value);
+
+struct SegmentState {
+  SegmentSpec spec;
+  SegmentHealth health = SegmentHealth::up;
+  std::string health_detail;
+};
+
+struct BindOutcome {
+  ChannelReport report;  // the channel's verdict with its numbers
+  bool bound() const { return report.verdict != Verdict::rejected; }
+};
+
+class KnowledgeBase {
+ public:
+  // `reserved_etags`: static etags declared anywhere in the configuration, never handed out
+  // dynamically even while their channel is not bound.
+  KnowledgeBase(GatewaySpec gateway, std::vector<SegmentSpec> segments, std::set<std::uint16_t> reserved_etags = {});
+
+  // Tries to bind `channel` (its segments must exist). On rejection nothing changes.
+  BindOutcome bind(const ChannelSpec& channel);
+  // Frees the channel's reservations and etag. False when no such channel is bound.
+  bool unbind(const std::string& name);
+  // What admission would answer for `channel` on top of the current set, without binding it.
+  ChannelReport probe(const ChannelSpec& channel) const;
+
+  void set_health(const std::string& segment, SegmentHealth health, std::string detail);
+
+  // Verdicts of the bound set (live health applied) and the load of every segment.
+  AdmissionReport report() const;
+
+  const GatewaySpec& gateway() const { return gateway_; }
+  const std::vector<SegmentState>& segments() const { return segments_; }
+  const std::vector<ChannelSpec>& bound_channels() const { return bound_; }
+  const ChannelSpec* find_bound(const std::string& name) const;
+  std::optional<std::uint16_t> etag_of(const std::string& channel) const;
+
+ private:
+  struct Trial {
+    Evaluation evaluation;
+    ChannelReport report;  // the newcomer's report, including "would break" reasons
+    EtagMap etags;
+    std::vector<ChannelSpec> channels;
+  };
+  Trial trial(const ChannelSpec& channel) const;
+  std::optional<std::uint16_t> allocate_etag(const EtagMap& in_use) const;
+  std::vector<SegmentSpec> segment_specs() const;
+  bool touches_can(const ChannelSpec& channel) const;
+
+  GatewaySpec gateway_;
+  std::vector<SegmentState> segments_;
+  std::set<std::uint16_t> reserved_etags_;
+  std::vector<ChannelSpec> bound_;
+  EtagMap etags_;
+  Evaluation current_;
+};
+
+// Binds every channel of `config` in order and reports the final set; each rejected channel is
+// reported as evaluated on top of the final set.
+AdmissionReport admit_all(const Config& config);
+
+}  // namespace cosmic

@@ -1,0 +1,96 @@
+// The domain model of COSMIC event channels (Kaiser et al., sections 3-4) as the gateway sees it:
+// segments (attached networks with their declared properties) and channels (subject, class,
+// temporal attributes, publisher and subscriber segments). Plain values, owned by whoever holds
+// the Config; no I/O.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cosmic/units.hpp"
+
+namespace cosmic {
+
+enum class ChannelClass { hrt, srt, nrt };
+enum class SegmentType { can, dds, lcm };
+enum class Reliability { reliable, best_effort };
+enum class LcmEncoding { envelope, raw };
+
+const char* to_string(ChannelClass value);
+const char* to_string(SegmentType value);
+const char* to_string(Reliability value);
+
+// Fault hypothesis of a CAN bus: at most `max_per_window` error frames in any interval of length
+// `window`. max_per_window == 0 means an error-free bus.
+struct CanFaultHypothesis {
+  std::uint32_t max_per_window = 0;
+  Nanos window{Nanos::zero()};
+};
+
+struct CanSegmentProperties {
+  std::string interface;
+  BitRate bitrate{500'000};
+  bool fd = false;
+  BitRate data_bitrate{0};  // FD data phase; equals bitrate when not FD or not given
+  CanFaultHypothesis errors;
+};
+
+struct DdsSegmentProperties {
+  std::uint32_t domain = 0;
+  std::vector<std::string> interfaces;  // allow-list of IPv4 addresses or interface names
+  std::string discovery_server;         // "IP:PORT", empty for simple discovery
+};
+
+struct LcmSegmentProperties {
+  std::string url = "udpm://239.255.76.67:7667?ttl=0";
+};
+
+struct SegmentSpec {
+  std::string name;
+  SegmentType type = SegmentType::dds;
+  double max_utilization = 0.7;  // share of the bandwidth the gateway may reserve
+  // IP segments: declared network properties. CAN derives them from the bit rate.
+  BitRate bandwidth{100'000'000};
+  Nanos latency_bound{Nanos(10'000'000)};
+  Reliability reliability = Reliability::reliable;
+  bool realtime = false;                 // network guarantees latency_bound (e.g. TSN)
+  std::uint64_t max_message_size = 65000;  // largest event the network carries in one message
+  CanSegmentProperties can;
+  DdsSegmentProperties dds;
+  LcmSegmentProperties lcm;
+};
+
+struct ChannelSpec {
+  std::string name;
+  std::uint64_t subject = 0;
+  ChannelClass cls = ChannelClass::nrt;
+  std::optional<Nanos> period;          // minimum inter-arrival time (from period or max_rate)
+  std::optional<Nanos> reaction_time;   // end-to-end latency bound
+  std::uint32_t omission_degree = 0;    // consecutive losses tolerated
+  std::optional<Nanos> temp_validity;   // event is stale after this age
+  std::uint64_t payload = 8;            // maximum payload bytes
+  std::optional<std::uint16_t> etag;    // static CAN etag, otherwise assigned
+  LcmEncoding lcm_encoding = LcmEncoding::envelope;
+  std::vector<std::string> publishers;   // P segments
+  std::vector<std::string> subscribers;  // S segments
+};
+
+struct GatewaySpec {
+  std::string name = "cosmicd";
+  std::uint8_t can_node_id = 1;
+  Nanos residence_bound{Nanos(1'000'000)};  // worst-case time an event spends inside the gateway
+  std::string control_socket = "/run/cosmicd/control.sock";
+};
+
+struct Config {
+  GatewaySpec gateway;
+  std::vector<SegmentSpec> segments;
+  std::vector<ChannelSpec> channels;
+
+  const SegmentSpec* find_segment(const std::string& name) const;
+  const ChannelSpec* find_channel(const std::string& name) const;
+};
+
+}  // namespace cosmic

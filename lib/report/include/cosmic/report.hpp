@@ -1,0 +1,22 @@
+// Renders admission reports for people (a table) and for programs (the JSON contract of
+// `cosmicctl check --json`, documented in docs/control-protocol.md). Pure: returns values.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "cosmic/admission.hpp"
+#include "cosmic/config_loader.hpp"
+
+namespace cosmic {
+
+nlohmann::json to_json(const ChannelReport& channel);
+nlohmann::json to_json(const SegmentLoad& segment);
+nlohmann::json to_json(const AdmissionReport& report);
+nlohmann::json to_json(const std::vector<ConfigError>& errors);
+
+std::string render_text(const AdmissionReport& report);
+// One channel with every hop and every check.
+std::string render_channel_text(const ChannelReport& channel);
+
+}  // namespace cosmic

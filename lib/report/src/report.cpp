@@ -1,0 +1,160 @@
+#include "cosmic/report.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace cosmic {
+namespace {
+
+nlohmann::json number_or_null(double value) {
+  if (std::isinf(value) || std::isnan(value)) return nullptr;
+  return value;
+}
+
+nlohmann::json seconds_or_null(const std::optional<Nanos>& value) {
+  if (!value) return nullptr;
+  return to_seconds(*value);
+}
+
+nlohmann::json to_json(const Check& check) {
+  return {{"check", check.check}, {"value", number_or_null(check.value)}, {"limit", number_or_null(check.limit)},
+          {"unit", check.unit},   {"relation", check.relation},             {"ok", check.ok}};
+}
+
+nlohmann::json to_json(const HopReport& hop) {
+  nlohmann::json out{{"segment", hop.segment}, {"role", to_string(hop.role)}, {"latency_s", seconds_or_null(hop.latency)}};
+  if (hop.can) {
+    const CanHopPlan& can = *hop.can;
+    out["can"] = {{"priority", can.priority},
+                  {"can_id", can.can_id},
+                  {"etag", can.etag},
+                  {"frame_bytes", can.frame_bytes},
+                  {"frames_per_event", can.frames_per_event},
+                  {"transmission_time_s", to_seconds(can.transmission)},
+                  {"jitter_s", to_seconds(can.jitter)},
+                  {"response_time_s", seconds_or_null(can.response_time)}};
+  }
+  out["checks"] = nlohmann::json::array();
+  for (const auto& check : hop.checks) out["checks"].push_back(to_json(check));
+  return out;
+}
+
+std::string percent(double ratio) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.1f%%", ratio * 100.0);
+  return buffer;
+}
+
+std::string pad(const std::string& text, std::size_t width) {
+  return text.size() >= width ? text + " " : text + std::string(width - text.size(), ' ');
+}
+
+std::string check_value_text(const Check& check) {
+  if (check.unit == "s") return format_seconds(check.value);
+  if (check.unit == "ratio") return percent(check.value);
+  if (check.unit == "B") return std::to_string(static_cast<long long>(check.value)) + " B";
+  if (check.unit == "bool") return check.value >= 1.0 ? "yes" : "no";
+  return std::to_string(static_cast<long long>(check.value));
+}
+
+std::string limit_text(const Check& check) {
+  Check limit = check;
+  limit.value = check.limit;
+  return check_value_text(limit);
+}
+
+}  // namespace
+
+nlohmann::json to_json(const ChannelReport& channel) {
+  nlohmann::json out{{"name", channel.name}, {"class", to_string(channel.cls)}, {"verdict", to_string(channel.verdict)},
+                     {"reasons", channel.reasons}};
+  out["hops"] = nlohmann::json::array();
+  for (const auto& hop : channel.hops) out["hops"].push_back(to_json(hop));
+  const EndToEnd& e2e = channel.end_to_end;
+  out["end_to_end"] = {{"latency_s", seconds_or_null(e2e.latency)},
+                       {"reaction_time_s", seconds_or_null(e2e.reaction_time)},
+                       {"temp_validity_s", seconds_or_null(e2e.temp_validity)},
+                       {"latency_ok", e2e.latency_ok},
+                       {"validity_ok", e2e.validity_ok},
+                       {"ok", e2e.ok()}};
+  return out;
+}
+
+nlohmann::json to_json(const SegmentLoad& segment) {
+  return {{"name", segment.name},
+          {"type", to_string(segment.type)},
+          {"utilization", segment.utilization},
+          {"max_utilization", segment.max_utilization}};
+}
+
+nlohmann::json to_json(const AdmissionReport& report) {
+  nlohmann::json out{{"segments", nlohmann::json::array()}, {"channels", nlohmann::json::array()}};
+  for (const auto& s : report.segments) out["segments"].push_back(to_json(s));
+  for (const auto& c : report.channels) out["channels"].push_back(to_json(c));
+  return out;
+}
+
+nlohmann::json to_json(const std::vector<ConfigError>& errors) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& e : errors) {
+    out.push_back({{"file", e.file}, {"line", e.line}, {"column", e.column}, {"path", e.path}, {"message", e.message},
+                   {"valid", e.valid}, {"text", e.to_string()}});
+  }
+  return out;
+}
+
+std::string render_text(const AdmissionReport& report) {
+  std::ostringstream out;
+  out << pad("SEGMENT", 16) << pad("TYPE", 6) << pad("UTILIZATION", 13) << "LIMIT\n";
+  for (const auto& s : report.segments) {
+    out << pad(s.name, 16) << pad(to_string(s.type), 6) << pad(percent(s.utilization), 13) << percent(s.max_utilization)
+        << "\n";
+  }
+  out << "\n" << pad("CHANNEL", 20) << pad("CLASS", 6) << pad("VERDICT", 10) << pad("END-TO-END", 12) << "DETAILS\n";
+  for (const auto& c : report.channels) {
+    const std::string e2e = c.end_to_end.latency ? format_duration(*c.end_to_end.latency) : "unbounded";
+    std::string details;
+    if (c.end_to_end.reaction_time) details = "<= " + format_duration(*c.end_to_end.reaction_time) + " required";
+    out << pad(c.name, 20) << pad(to_string(c.cls), 6) << pad(to_string(c.verdict), 10) << pad(e2e, 12) << details << "\n";
+    for (const auto& reason : c.reasons) out << "    - " << reason << "\n";
+  }
+  std::size_t bound = 0;
+  std::size_t degraded = 0;
+  std::size_t rejected = 0;
+  for (const auto& c : report.channels) {
+    if (c.verdict == Verdict::bound) ++bound;
+    if (c.verdict == Verdict::degraded) ++degraded;
+    if (c.verdict == Verdict::rejected) ++rejected;
+  }
+  out << "\n" << bound << " bound, " << degraded << " degraded, " << rejected << " rejected\n";
+  return out.str();
+}
+
+std::string render_channel_text(const ChannelReport& channel) {
+  std::ostringstream out;
+  out << channel.name << " (" << to_string(channel.cls) << "): " << to_string(channel.verdict) << "\n";
+  for (const auto& reason : channel.reasons) out << "  - " << reason << "\n";
+  for (const auto& hop : channel.hops) {
+    out << "  " << to_string(hop.role) << " " << hop.segment;
+    if (hop.can) {
+      char id[16];
+      std::snprintf(id, sizeof id, "0x%08X", hop.can->can_id);
+      out << "  id " << id << " prio " << static_cast<int>(hop.can->priority) << " etag " << hop.can->etag << " C "
+          << format_duration(hop.can->transmission) << " x" << hop.can->frames_per_event;
+    }
+    out << "\n";
+    for (const auto& check : hop.checks) {
+      out << "    " << (check.ok ? "ok   " : "FAIL ") << pad(check.check, 14) << check_value_text(check) << " "
+          << check.relation << " " << limit_text(check) << "\n";
+    }
+  }
+  const EndToEnd& e2e = channel.end_to_end;
+  out << "  end-to-end " << (e2e.latency ? format_duration(*e2e.latency) : std::string("unbounded"));
+  if (e2e.reaction_time) out << ", reaction_time " << format_duration(*e2e.reaction_time);
+  if (e2e.temp_validity) out << ", temp_validity " << format_duration(*e2e.temp_validity);
+  out << (e2e.ok() ? "  ok" : "  FAIL") << "\n";
+  return out.str();
+}
+
+}  // namespace cosmic
