@@ -1,10 +1,12 @@
 // cosmicctl subcommands. Each registers itself on the CLI11 app and runs when selected.
 // Exit codes: 0 success, 1 a channel was rejected or the daemon refused, 2 configuration
-// errors, 64 usage errors, 69 daemon unreachable.
+// errors, 64 usage errors, 69 daemon unreachable, 77 permission denied.
 #pragma once
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <string>
+#include <vector>
 
 namespace cosmicctl {
 
@@ -13,13 +15,16 @@ inline constexpr int kExitRejected = 1;
 inline constexpr int kExitConfigError = 2;
 inline constexpr int kExitUsage = 64;
 inline constexpr int kExitUnavailable = 69;
+inline constexpr int kExitNoPermission = 77;
 
 using CommandRunner = std::function<int()>;
 
 struct GlobalOptions {
   bool json = false;
+  std::string socket = "/run/cosmicd/control.sock";
 };
 
 CommandRunner add_check_command(CLI::App& app, const GlobalOptions& options);
+std::vector<CommandRunner> add_daemon_commands(CLI::App& app, const GlobalOptions& options);
 
 }  // namespace cosmicctl

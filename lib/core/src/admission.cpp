@@ -260,7 +260,10 @@ class Evaluator {
     for (const HopReport& h : reports_[c].hops) {
       if (!h.latency) return std::nullopt;
       Nanos& worst = h.role == HopRole::publisher ? worst_publisher : worst_subscriber;
-      worst = std::max(worst, *h.latency);
+      // A subscriber-side CAN response time already contains its release jitter (upstream
+      // latency + residence): count only what the hop adds after the gateway releases the frame.
+      const Nanos added = h.can && h.role == HopRole::subscriber ? *h.latency - h.can->jitter : *h.latency;
+      worst = std::max(worst, added);
     }
     return worst_publisher + gateway_.residence_bound + worst_subscriber;
   }

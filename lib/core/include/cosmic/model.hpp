@@ -27,6 +27,7 @@ const char* to_string(Reliability value);
 struct CanFaultHypothesis {
   std::uint32_t max_per_window = 0;
   Nanos window{Nanos::zero()};
+  friend bool operator==(const CanFaultHypothesis&, const CanFaultHypothesis&) = default;
 };
 
 struct CanSegmentProperties {
@@ -35,16 +36,19 @@ struct CanSegmentProperties {
   bool fd = false;
   BitRate data_bitrate{0};  // FD data phase; equals bitrate when not FD or not given
   CanFaultHypothesis errors;
+  friend bool operator==(const CanSegmentProperties&, const CanSegmentProperties&) = default;
 };
 
 struct DdsSegmentProperties {
   std::uint32_t domain = 0;
   std::vector<std::string> interfaces;  // allow-list of IPv4 addresses or interface names
   std::string discovery_server;         // "IP:PORT", empty for simple discovery
+  friend bool operator==(const DdsSegmentProperties&, const DdsSegmentProperties&) = default;
 };
 
 struct LcmSegmentProperties {
   std::string url = "udpm://239.255.76.67:7667?ttl=0";
+  friend bool operator==(const LcmSegmentProperties&, const LcmSegmentProperties&) = default;
 };
 
 struct SegmentSpec {
@@ -60,6 +64,7 @@ struct SegmentSpec {
   CanSegmentProperties can;
   DdsSegmentProperties dds;
   LcmSegmentProperties lcm;
+  friend bool operator==(const SegmentSpec&, const SegmentSpec&) = default;
 };
 
 struct ChannelSpec {
@@ -75,6 +80,7 @@ struct ChannelSpec {
   LcmEncoding lcm_encoding = LcmEncoding::envelope;
   std::vector<std::string> publishers;   // P segments
   std::vector<std::string> subscribers;  // S segments
+  friend bool operator==(const ChannelSpec&, const ChannelSpec&) = default;
 };
 
 struct GatewaySpec {
@@ -82,6 +88,7 @@ struct GatewaySpec {
   std::uint8_t can_node_id = 1;
   Nanos residence_bound{Nanos(1'000'000)};  // worst-case time an event spends inside the gateway
   std::string control_socket = "/run/cosmicd/control.sock";
+  friend bool operator==(const GatewaySpec&, const GatewaySpec&) = default;
 };
 
 struct Config {

@@ -1,0 +1,206 @@
+// cosmicctl commands that talk to a running cosmicd over its control socket.
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "commands.hpp"
+#include "control_client.hpp"
+
+namespace cosmicctl {
+namespace {
+
+using Json = nlohmann::json;
+
+std::string pad(const std::string& text, std::size_t width) {
+  return text.size() >= width ? text + " " : text + std::string(width - text.size(), ' ');
+}
+
+std::string percent(double ratio) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.1f%%", ratio * 100.0);
+  return buffer;
+}
+
+std::string micros(double seconds) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.0fus", seconds * 1e6);
+  return buffer;
+}
+
+std::string text(const Json& value) { return value.is_string() ? value.get<std::string>() : value.dump(); }
+
+void print_errors(const Json& response) {
+  std::cerr << "cosmicctl: " << text(response["error"].value("message", Json("request failed"))) << "\n";
+  if (response.contains("errors")) {
+    for (const auto& e : response["errors"]) std::cerr << text(e["text"]) << "\n";
+  }
+}
+
+int exit_code_for_failure(const Json& response) {
+  const std::string code = response["error"].value("code", "");
+  if (code == "permission_denied") return kExitNoPermission;
+  if (code == "config_error") return kExitConfigError;
+  if (code == "bad_request" || code == "unknown_command") return kExitUsage;
+  return kExitRejected;
+}
+
+void print_verdicts(const Json& channels) {
+  for (const auto& c : channels) {
+    std::cout << pad(text(c["name"]), 20) << pad(text(c["class"]), 5) << text(c["verdict"]) << "\n";
+    for (const auto& r : c["reasons"]) std::cout << "    - " << text(r) << "\n";
+    for (const auto& hop : c["hops"]) {
+      for (const auto& check : hop["checks"]) {
+        if (check["check"] == "response_time" || check["check"] == "latency") {
+          std::cout << "    " << text(hop["segment"]) << ": " << text(check["check"]) << " "
+                    << (check["value"].is_null() ? std::string("unbounded") : micros(check["value"].get<double>())) << " "
+                    << text(check["relation"]) << " " << micros(check["limit"].get<double>()) << "\n";
+        }
+      }
+    }
+  }
+}
+
+void print_status(const Json& r) {
+  const Json& g = r["gateway"];
+  std::cout << text(g["name"]) << " (id " << text(g["id"]) << "), up " << static_cast<long>(g["uptime_s"].get<double>()) << " s\n"
+            << "segments: " << r["segments"]["up"] << "/" << r["segments"]["total"] << " up\n"
+            << "channels: " << r["channels"]["bound"] << " bound, " << r["channels"]["degraded"] << " degraded\n"
+            << "router:   " << r["router"]["queued"] << " queued, " << r["router"]["progress"] << " events handled\n";
+}
+
+void print_segments(const Json& r) {
+  std::cout << pad("SEGMENT", 14) << pad("TYPE", 5) << pad("HEALTH", 9) << pad("UTIL", 7) << pad("LIMIT", 7) << pad("CHANNELS", 9)
+            << pad("RX", 9) << pad("TX", 9) << pad("ERRORS", 7) << pad("OVERFLOW", 9) << "DETAIL\n";
+  for (const auto& s : r["segments"]) {
+    const Json& a = s["adapter"];
+    std::cout << pad(text(s["name"]), 14) << pad(text(s["type"]), 5) << pad(text(s["health"]), 9)
+              << pad(percent(s["utilization"].get<double>()), 7) << pad(percent(s["max_utilization"].get<double>()), 7)
+              << pad(text(s["channels"]), 9) << pad(text(a["received"]), 9) << pad(text(a["sent"]), 9)
+              << pad(std::to_string(a["receive_errors"].get<std::uint64_t>() + a["send_errors"].get<std::uint64_t>()), 7)
+              << pad(text(a["overflow_drops"]), 9) << text(s["detail"]) << "\n";
+  }
+}
+
+std::string drops_text(const Json& dropped) {
+  std::string out;
+  for (const auto& [reason, count] : dropped.items()) {
+    if (count.get<std::uint64_t>() == 0) continue;
+    out += (out.empty() ? "" : " ") + reason + "=" + count.dump();
+  }
+  return out.empty() ? "-" : out;
+}
+
+void print_channels(const Json& r) {
+  std::cout << pad("CHANNEL", 16) << pad("CLASS", 6) << pad("VERDICT", 9) << pad("ETAG", 6) << pad("SEGMENT", 12) << pad("ROLE", 4)
+            << pad("RX", 9) << pad("TX", 9) << pad("RESIDENCE p50/p99", 19) << "DROPPED\n";
+  for (const auto& c : r["channels"]) {
+    bool first = true;
+    const std::string residence =
+        micros(c["residence"]["p50_s"].get<double>()) + "/" + micros(c["residence"]["p99_s"].get<double>());
+    for (const auto& s : c["segments"]) {
+      std::cout << pad(first ? text(c["name"]) : "", 16) << pad(first ? text(c["class"]) : "", 6)
+                << pad(first ? text(c["verdict"]) : "", 9) << pad(first && c.contains("etag") ? text(c["etag"]) : "", 6)
+                << pad(text(s["segment"]), 12) << pad(s["role"] == "publisher" ? "P" : "S", 4) << pad(text(s["rx"]), 9)
+                << pad(text(s["tx"]), 9) << pad(first ? residence : "", 19) << drops_text(s["dropped"]) << "\n";
+      first = false;
+    }
+    for (const auto& reason : c["reasons"]) std::cout << "    - " << text(reason) << "\n";
+  }
+}
+
+void print_channel(const Json& r) {
+  const Json& c = r["channel"];
+  print_channels(Json{{"channels", Json::array({c})}});
+  std::cout << "\nadmission:\n";
+  for (const auto& hop : c["admission"]["hops"]) {
+    std::cout << "  " << text(hop["role"]) << " " << text(hop["segment"]);
+    if (hop.contains("can")) {
+      char id[16];
+      std::snprintf(id, sizeof id, "0x%08X", hop["can"]["can_id"].get<unsigned>());
+      std::cout << "  can_id " << id << " priority " << hop["can"]["priority"] << " etag " << hop["can"]["etag"];
+    }
+    std::cout << "\n";
+    for (const auto& check : hop["checks"]) {
+      std::cout << "    " << (check["ok"].get<bool>() ? "ok   " : "FAIL ") << pad(text(check["check"]), 14) << text(check["value"])
+                << " " << text(check["relation"]) << " " << text(check["limit"]) << " " << text(check["unit"]) << "\n";
+    }
+  }
+}
+
+// Registers a subcommand that sends one request and prints the answer.
+template <typename Build, typename Print>
+CommandRunner add_request_command(CLI::App& app, const GlobalOptions& options, CLI::App* command, Build build, Print print) {
+  (void)app;
+  return [command, &options, build, print]() -> int {
+    if (!command->parsed()) return -1;
+    Json req;
+    if (const int code = build(req); code != kExitOk) return code;
+    const ClientResult result = request(options.socket, req);
+    if (!result.response) {
+      std::cerr << "cosmicctl: " << result.error << "\n";
+      return kExitUnavailable;
+    }
+    const Json& response = *result.response;
+    if (options.json) std::cout << response.dump(2) << "\n";
+    if (!response.value("ok", false)) {
+      if (!options.json) {
+        if (response.contains("channels")) print_verdicts(response["channels"]);
+        print_errors(response);
+      }
+      return exit_code_for_failure(response);
+    }
+    if (!options.json) print(response);
+    return kExitOk;
+  };
+}
+
+}  // namespace
+
+std::vector<CommandRunner> add_daemon_commands(CLI::App& app, const GlobalOptions& options) {
+  std::vector<CommandRunner> runners;
+  auto simple = [&](const char* name, const char* help, auto print) {
+    auto* command = app.add_subcommand(name, help);
+    runners.push_back(add_request_command(app, options, command, [name](Json& req) { req = {{"command", name}}; return kExitOk; }, print));
+  };
+  simple("status", "Show the gateway's state in one screen", print_status);
+  simple("segments", "List segments with health, load and counters", print_segments);
+  simple("channels", "List channels with verdict, counters and drops by reason", print_channels);
+  simple("reload", "Re-read the daemon's configuration file (validated before it is swapped in)",
+         [](const Json& r) { std::cout << "reloaded\n"; print_verdicts(r["channels"]); });
+
+  auto* channel = app.add_subcommand("channel", "Show one channel with its admission numbers");
+  auto channel_name = std::make_shared<std::string>();
+  channel->add_option("NAME", *channel_name, "Channel name")->required();
+  runners.push_back(add_request_command(app, options, channel, [channel_name](Json& req) {
+    req = {{"command", "channel"}, {"name", *channel_name}};
+    return kExitOk;
+  }, print_channel));
+
+  auto* unbind = app.add_subcommand("unbind", "Unbind a channel and free its reservations");
+  auto unbind_name = std::make_shared<std::string>();
+  unbind->add_option("NAME", *unbind_name, "Channel name")->required();
+  runners.push_back(add_request_command(app, options, unbind, [unbind_name](Json& req) {
+    req = {{"command", "unbind"}, {"name", *unbind_name}};
+    return kExitOk;
+  }, [](const Json& r) { std::cout << "unbound " << text(r["unbound"]) << "\n"; }));
+
+  auto* bind = app.add_subcommand("bind", "Bind channel definitions from a YAML file (admission decides)");
+  auto bind_file = std::make_shared<std::string>();
+  bind->add_option("FILE", *bind_file, "YAML with channel definitions")->required();
+  runners.push_back(add_request_command(app, options, bind, [bind_file](Json& req) {
+    std::ifstream in(*bind_file);
+    if (!in) {
+      std::cerr << "cosmicctl: cannot read " << *bind_file << "\n";
+      return kExitConfigError;
+    }
+    std::stringstream content;
+    content << in.rdbuf();
+    req = {{"command", "bind"}, {"yaml", content.str()}, {"file", *bind_file}};
+    return kExitOk;
+  }, [](const Json& r) { print_verdicts(r["channels"]); }));
+  return runners;
+}
+
+}  // namespace cosmicctl

@@ -1,0 +1,37 @@
+// cosmicd's Logger: spdlog to stderr. Under systemd (JOURNAL_STREAM set) every line starts with
+// a syslog priority prefix "<N>" that journald understands, and the timestamp is left to the
+// journal. Identical messages repeated within a second are folded into one "repeated N times"
+// line so a flapping bus cannot flood the journal.
+#pragma once
+
+#include <chrono>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "cosmic/log.hpp"
+
+namespace spdlog {
+class logger;
+}
+
+namespace cosmicd {
+
+class DaemonLogger final : public cosmic::Logger {
+ public:
+  explicit DaemonLogger(cosmic::LogLevel threshold);
+  void log(cosmic::LogLevel level, std::string_view message) override;
+
+ private:
+  struct Repeat {
+    std::chrono::steady_clock::time_point window_start;
+    std::uint64_t suppressed = 0;
+  };
+  cosmic::LogLevel threshold_;
+  std::shared_ptr<spdlog::logger> sink_;
+  std::mutex mutex_;
+  std::map<std::string, Repeat, std::less<>> recent_;
+};
+
+}  // namespace cosmicd

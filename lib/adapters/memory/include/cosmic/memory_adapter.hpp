@@ -1,0 +1,58 @@
+// An in-memory segment for tests of the router and the gateway runtime: events are injected by
+// the test as if they arrived from the network, and what the gateway sends is recorded.
+// Thread-safe: inject() may run on any thread (it stands for the adapter's receive thread).
+#pragma once
+
+#include <condition_variable>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "cosmic/segment_adapter.hpp"
+
+namespace cosmic {
+
+struct RecordedEvent {
+  std::string channel;
+  EventHeader header;
+  std::vector<std::uint8_t> payload;
+};
+
+class MemoryAdapter final : public SegmentAdapter {
+ public:
+  explicit MemoryAdapter(std::string segment_name) : segment_name_(std::move(segment_name)) {}
+
+  Status start(EventSink& sink) override;
+  Status configure(std::span<const ChannelBinding> bindings) override;
+  SendStatus send(const OutboundEvent& event) override;
+  HealthReport health() const override;
+  AdapterStatistics statistics() const override;
+  void stop() override;
+
+  // Delivers an event on `channel` as if received from the network. False when the channel is
+  // not bound here as publisher (the event is then reported to the router as unknown).
+  bool inject(const std::string& channel, std::vector<std::uint8_t> payload, EventHeader header = {});
+  // Delivers bytes that fail to decode.
+  void inject_garbage(const std::string& channel);
+  std::vector<RecordedEvent> sent() const;
+  // Waits until at least `count` events were sent, or the deadline passes; returns the count.
+  std::size_t wait_sent(std::size_t count, std::chrono::milliseconds timeout) const;
+  void set_health(SegmentHealth state, std::string detail);
+  // Makes send() answer queue_full (a congested network).
+  void set_congested(bool congested);
+  std::vector<ChannelBinding> bindings() const;
+
+ private:
+  const ChannelBinding* find(const std::string& name) const;
+  std::string segment_name_;
+  mutable std::mutex mutex_;
+  mutable std::condition_variable sent_changed_;
+  EventSink* sink_ = nullptr;
+  std::vector<ChannelBinding> bindings_;
+  std::vector<RecordedEvent> sent_;
+  HealthReport health_;
+  AdapterStatistics stats_;
+  bool congested_ = false;
+};
+
+}  // namespace cosmic

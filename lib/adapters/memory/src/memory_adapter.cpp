@@ -1,0 +1,117 @@
+#include "cosmic/memory_adapter.hpp"
+
+#include <algorithm>
+
+#include "cosmic/router.hpp"
+
+namespace cosmic {
+
+Status MemoryAdapter::start(EventSink& sink) {
+  std::lock_guard lock(mutex_);
+  sink_ = &sink;
+  return Status::success();
+}
+
+Status MemoryAdapter::configure(std::span<const ChannelBinding> bindings) {
+  std::lock_guard lock(mutex_);
+  bindings_.assign(bindings.begin(), bindings.end());
+  return Status::success();
+}
+
+const ChannelBinding* MemoryAdapter::find(const std::string& name) const {
+  const auto it = std::find_if(bindings_.begin(), bindings_.end(), [&](const auto& b) { return b.spec.name == name; });
+  return it == bindings_.end() ? nullptr : &*it;
+}
+
+SendStatus MemoryAdapter::send(const OutboundEvent& event) {
+  std::lock_guard lock(mutex_);
+  const auto it = std::find_if(bindings_.begin(), bindings_.end(), [&](const auto& b) {
+    return b.id == event.channel && b.role == HopRole::subscriber;
+  });
+  if (it == bindings_.end()) {
+    ++stats_.send_errors;
+    return SendStatus::failed;
+  }
+  if (congested_) return SendStatus::queue_full;
+  sent_.push_back(RecordedEvent{it->spec.name, event.header, {event.payload.begin(), event.payload.end()}});
+  ++stats_.sent;
+  sent_changed_.notify_all();
+  return SendStatus::sent;
+}
+
+bool MemoryAdapter::inject(const std::string& channel, std::vector<std::uint8_t> payload, EventHeader header) {
+  EventSink* sink = nullptr;
+  ChannelId id = kNoChannel;
+  {
+    std::lock_guard lock(mutex_);
+    const ChannelBinding* binding = find(channel);
+    sink = sink_;
+    ++stats_.received;
+    if (binding && binding->role == HopRole::publisher) {
+      id = binding->id;
+      if (header.subject == 0) header.subject = binding->spec.subject;
+    }
+  }
+  if (!sink) return false;
+  if (id == kNoChannel) {
+    sink->on_problem(kNoChannel, InboundProblem::unknown_channel);
+    return false;
+  }
+  sink->on_event(InboundEvent{id, header, payload, steady_now()});
+  return true;
+}
+
+void MemoryAdapter::inject_garbage(const std::string& channel) {
+  EventSink* sink = nullptr;
+  ChannelId id = kNoChannel;
+  {
+    std::lock_guard lock(mutex_);
+    sink = sink_;
+    ++stats_.receive_errors;
+    if (const ChannelBinding* binding = find(channel)) id = binding->id;
+  }
+  if (sink) sink->on_problem(id, InboundProblem::decode_error);
+}
+
+std::vector<RecordedEvent> MemoryAdapter::sent() const {
+  std::lock_guard lock(mutex_);
+  return sent_;
+}
+
+std::size_t MemoryAdapter::wait_sent(std::size_t count, std::chrono::milliseconds timeout) const {
+  std::unique_lock lock(mutex_);
+  sent_changed_.wait_for(lock, timeout, [&] { return sent_.size() >= count; });
+  return sent_.size();
+}
+
+HealthReport MemoryAdapter::health() const {
+  std::lock_guard lock(mutex_);
+  return health_;
+}
+
+AdapterStatistics MemoryAdapter::statistics() const {
+  std::lock_guard lock(mutex_);
+  return stats_;
+}
+
+void MemoryAdapter::stop() {
+  std::lock_guard lock(mutex_);
+  sink_ = nullptr;
+}
+
+void MemoryAdapter::set_health(SegmentHealth state, std::string detail) {
+  std::lock_guard lock(mutex_);
+  health_ = HealthReport{state, std::move(detail)};
+}
+
+void MemoryAdapter::set_congested(bool congested) {
+  std::lock_guard lock(mutex_);
+  congested_ = congested;
+}
+
+std::vector<ChannelBinding> MemoryAdapter::bindings() const {
+  std::lock_guard lock(mutex_);
+  return bindings_;
+}
+
+}  // namespace cosmic

@@ -1,0 +1,61 @@
+#include "cosmic/router_stats.hpp"
+
+#include <bit>
+
+namespace cosmic {
+
+const char* to_string(DropReason reason) {
+  switch (reason) {
+    case DropReason::expired: return "expired";
+    case DropReason::rate: return "rate";
+    case DropReason::queue_full: return "queue_full";
+    case DropReason::duplicate: return "duplicate";
+    case DropReason::decode_error: return "decode_error";
+    case DropReason::no_route: return "no_route";
+    case DropReason::send_failed: return "send_failed";
+  }
+  return "?";
+}
+
+std::size_t LatencyHistogram::bucket_of(std::uint64_t ns) {
+  if (ns < 4) return static_cast<std::size_t>(ns);
+  const unsigned exponent = 63u - static_cast<unsigned>(std::countl_zero(ns));  // >= 2
+  const std::uint64_t mantissa = (ns >> (exponent - 2)) & 0x3;
+  const std::size_t bucket = 4 * (exponent - 1) + mantissa;
+  return bucket < kBuckets ? bucket : kBuckets - 1;
+}
+
+std::uint64_t LatencyHistogram::upper_bound_of(std::size_t bucket) {
+  if (bucket < 4) return bucket;
+  const std::size_t exponent = bucket / 4 + 1;
+  const std::uint64_t mantissa = bucket % 4;
+  return ((4 + mantissa + 1) << (exponent - 2)) - 1;
+}
+
+void LatencyHistogram::record(Nanos value) {
+  const std::int64_t ns = value.count() < 0 ? 0 : value.count();
+  buckets_[bucket_of(static_cast<std::uint64_t>(ns))].fetch_add(1, std::memory_order_relaxed);
+  std::int64_t seen = max_.load(std::memory_order_relaxed);
+  while (ns > seen && !max_.compare_exchange_weak(seen, ns, std::memory_order_relaxed)) {
+  }
+}
+
+std::uint64_t LatencyHistogram::count() const {
+  std::uint64_t total = 0;
+  for (const auto& b : buckets_) total += b.load(std::memory_order_relaxed);
+  return total;
+}
+
+Nanos LatencyHistogram::quantile(double q) const {
+  const std::uint64_t total = count();
+  if (total == 0) return Nanos(0);
+  const auto rank = static_cast<std::uint64_t>(q * static_cast<double>(total - 1)) + 1;
+  std::uint64_t seen = 0;
+  for (std::size_t i = 0; i < kBuckets; ++i) {
+    seen += buckets_[i].load(std::memory_order_relaxed);
+    if (seen >= rank) return Nanos(static_cast<std::int64_t>(std::min<std::uint64_t>(upper_bound_of(i), max_.load())));
+  }
+  return max();
+}
+
+}  // namespace cosmic

@@ -1,0 +1,248 @@
+// Router policies end to end through in-memory adapters, driven without the router thread so
+// every ordering is deterministic.
+#include <gtest/gtest.h>
+
+#include "cosmic/memory_adapter.hpp"
+#include "cosmic/router.hpp"
+
+namespace cosmic {
+namespace {
+
+constexpr std::uint64_t kSelf = 0xAAAA;
+
+ChannelSpec channel(const std::string& name, ChannelClass cls, std::optional<Nanos> period = std::nullopt,
+                    std::optional<Nanos> validity = std::nullopt) {
+  ChannelSpec c;
+  c.name = name;
+  c.subject = std::hash<std::string>{}(name);
+  c.cls = cls;
+  c.period = period;
+  c.temp_validity = validity;
+  c.publishers = {"in"};
+  c.subscribers = {"out"};
+  return c;
+}
+
+class RouterTest : public ::testing::Test {
+ protected:
+  RouterTest() : router(GatewayIdentity{kSelf, "test"}, 2, limits()) {
+    router.set_segment(0, "in", &in);
+    router.set_segment(1, "out", &out);
+    in.start(router.inbox(0));
+    out.start(router.inbox(1));
+  }
+
+  static RouterLimits limits() {
+    RouterLimits l;
+    l.nrt_queue = 4;
+    return l;
+  }
+
+  void bind(std::vector<ChannelSpec> specs) {
+    std::vector<Route> routes;
+    std::vector<ChannelBinding> in_bindings;
+    std::vector<ChannelBinding> out_bindings;
+    ChannelId id = 1;
+    for (auto& spec : specs) {
+      routes.push_back(Route{id, spec, {0}, {1}});
+      in_bindings.push_back(ChannelBinding{id, spec, HopRole::publisher, std::nullopt});
+      out_bindings.push_back(ChannelBinding{id, spec, HopRole::subscriber, std::nullopt});
+      ++id;
+    }
+    in.configure(in_bindings);
+    out.configure(out_bindings);
+    router.apply(std::move(routes));
+  }
+
+  // Delivers straight into the router with a chosen receive time.
+  void deliver(ChannelId id, EventHeader header, Nanos at, std::vector<std::uint8_t> payload = {1, 2, 3}) {
+    router.inbox(0).on_event(InboundEvent{id, header, payload, at});
+  }
+
+  const SegmentCountersSnapshot& counters(const std::string& channel, const std::string& segment) {
+    snapshot = router.snapshot();
+    for (const auto& c : snapshot) {
+      if (c.name != channel) continue;
+      for (const auto& s : c.segments) {
+        if (s.segment == segment) return s;
+      }
+    }
+    throw std::runtime_error("no counters for " + channel + "/" + segment);
+  }
+
+  std::uint64_t dropped(const std::string& ch, DropReason reason) {
+    return counters(ch, "in").dropped[static_cast<std::size_t>(reason)];
+  }
+
+  MemoryAdapter in{"in"};
+  MemoryAdapter out{"out"};
+  Router router;
+  std::vector<ChannelStatsSnapshot> snapshot;
+};
+
+TEST_F(RouterTest, ForwardsFromPublisherToSubscriberAndStampsOrigin) {
+  bind({channel("a", ChannelClass::srt)});
+  ASSERT_TRUE(in.inject("a", {7, 8, 9}));
+  EXPECT_EQ(router.run_once(10), 1u);
+  const auto sent = out.sent();
+  ASSERT_EQ(sent.size(), 1u);
+  EXPECT_EQ(sent[0].payload, (std::vector<std::uint8_t>{7, 8, 9}));
+  EXPECT_EQ(sent[0].header.origin, kSelf);  // a native event gets this gateway as origin
+  EXPECT_EQ(sent[0].header.sequence, 1u);
+  EXPECT_EQ(sent[0].header.hop_count, 1u);
+  EXPECT_EQ(counters("a", "in").rx, 1u);
+  EXPECT_EQ(counters("a", "out").tx, 1u);
+}
+
+TEST_F(RouterTest, ForeignOriginAndSequenceAreKeptAndAgeGrows) {
+  bind({channel("a", ChannelClass::srt)});
+  EventHeader h{42, 0xBBBB, 17, 1, 0, 5'000};
+  deliver(1, h, steady_now());
+  router.run_once(10);
+  const auto sent = out.sent();
+  ASSERT_EQ(sent.size(), 1u);
+  EXPECT_EQ(sent[0].header.origin, 0xBBBBu);
+  EXPECT_EQ(sent[0].header.sequence, 17u);
+  EXPECT_EQ(sent[0].header.hop_count, 2u);
+  EXPECT_GE(sent[0].header.age_ns, 5'000);
+}
+
+TEST_F(RouterTest, ExpiredEventsAreDroppedAndCounted) {
+  bind({channel("a", ChannelClass::srt, std::nullopt, Nanos(1'000'000))});
+  EventHeader old_event{};
+  old_event.age_ns = 1'000'000;  // exactly temp_validity: stale
+  deliver(1, old_event, steady_now());
+  EventHeader fresh{};
+  fresh.age_ns = 10;
+  deliver(1, fresh, steady_now());
+  router.run_once(10);
+  EXPECT_EQ(out.sent().size(), 1u);
+  EXPECT_EQ(dropped("a", DropReason::expired), 1u);
+}
+
+TEST_F(RouterTest, EventsThatExpireWhileQueuedAreDropped) {
+  bind({channel("a", ChannelClass::srt, std::nullopt, Nanos(1'000'000))});
+  deliver(1, EventHeader{}, steady_now() - Nanos(2'000'000));  // received 2 ms ago
+  router.run_once(10);
+  EXPECT_TRUE(out.sent().empty());
+  EXPECT_EQ(dropped("a", DropReason::expired), 1u);
+}
+
+TEST_F(RouterTest, RateLimitHoldsTheReservedRateWithASmallBurst) {
+  bind({channel("a", ChannelClass::srt, Nanos(10'000'000))});  // one event per 10 ms, burst 3
+  const Nanos t0 = steady_now();
+  for (int i = 0; i < 10; ++i) deliver(1, EventHeader{}, t0);  // a babbling source: 10 at once
+  deliver(1, EventHeader{}, t0 + Nanos(10'000'000));            // one period later: one token back
+  router.run_once(100);
+  EXPECT_EQ(out.sent().size(), 4u);
+  EXPECT_EQ(dropped("a", DropReason::rate), 7u);
+}
+
+TEST_F(RouterTest, DuplicatesOwnEchoesAndLoopsAreCut) {
+  bind({channel("a", ChannelClass::srt)});
+  const Nanos now = steady_now();
+  deliver(1, EventHeader{1, 0xBBBB, 5, 1, 0, 0}, now);
+  deliver(1, EventHeader{1, 0xBBBB, 5, 1, 0, 0}, now);        // same origin + sequence
+  deliver(1, EventHeader{1, kSelf, 9, 2, 0, 0}, now);         // our own event came back
+  deliver(1, EventHeader{1, 0xCCCC, 1, kMaxHops, 0, 0}, now);  // circled too long
+  deliver(1, EventHeader{1, 0xBBBB, 4, 1, 0, 0}, now);        // older but unseen: delivered
+  router.run_once(10);
+  EXPECT_EQ(out.sent().size(), 2u);
+  EXPECT_EQ(dropped("a", DropReason::duplicate), 3u);
+}
+
+TEST_F(RouterTest, HardRealTimeNeverWaitsBehindNonRealTime) {
+  bind({channel("bulk", ChannelClass::nrt), channel("brake", ChannelClass::hrt), channel("speed", ChannelClass::srt)});
+  in.inject("bulk", {1});
+  in.inject("speed", {2});
+  in.inject("bulk", {3});
+  in.inject("brake", {4});
+  router.run_once(10);
+  const auto sent = out.sent();
+  ASSERT_EQ(sent.size(), 4u);
+  EXPECT_EQ(sent[0].channel, "brake");
+  EXPECT_EQ(sent[1].channel, "speed");
+  EXPECT_EQ(sent[2].channel, "bulk");
+  EXPECT_EQ(sent[3].channel, "bulk");
+}
+
+TEST_F(RouterTest, QueuesAreBoundedAndOverflowIsCounted) {
+  bind({channel("bulk", ChannelClass::nrt), channel("brake", ChannelClass::hrt)});
+  for (int i = 0; i < 10; ++i) in.inject("bulk", {static_cast<std::uint8_t>(i)});
+  in.inject("brake", {99});  // HRT has its own queue: never starved by a full NRT queue
+  EXPECT_EQ(router.queued(), 5u);
+  router.run_once(100);
+  EXPECT_EQ(out.sent().size(), 5u);
+  EXPECT_EQ(dropped("bulk", DropReason::queue_full), 6u);
+}
+
+TEST_F(RouterTest, EventsOnASubscriberOnlySegmentHaveNoRoute) {
+  bind({channel("a", ChannelClass::srt)});
+  router.inbox(1).on_event(InboundEvent{1, EventHeader{}, {}, steady_now()});
+  router.inbox(0).on_event(InboundEvent{77, EventHeader{}, {}, steady_now()});  // unknown channel
+  router.run_once(10);
+  EXPECT_TRUE(out.sent().empty());
+  EXPECT_EQ(counters("a", "out").dropped[static_cast<std::size_t>(DropReason::no_route)], 1u);
+  EXPECT_EQ(router.unrouted(0), 1u);
+}
+
+TEST_F(RouterTest, DecodeErrorsAreCountedPerChannel) {
+  bind({channel("a", ChannelClass::srt)});
+  in.inject_garbage("a");
+  EXPECT_EQ(dropped("a", DropReason::decode_error), 1u);
+}
+
+TEST_F(RouterTest, CongestedSubscriberCountsQueueFull) {
+  bind({channel("a", ChannelClass::srt)});
+  out.set_congested(true);
+  in.inject("a", {1});
+  router.run_once(10);
+  EXPECT_EQ(counters("a", "out").dropped[static_cast<std::size_t>(DropReason::queue_full)], 1u);
+}
+
+TEST_F(RouterTest, ReapplyKeepsCountersOfKeptChannels) {
+  bind({channel("a", ChannelClass::srt)});
+  in.inject("a", {1});
+  router.run_once(10);
+  std::vector<Route> routes{Route{1, channel("a", ChannelClass::srt), {0}, {1}}, Route{2, channel("b", ChannelClass::srt), {0}, {1}}};
+  router.apply(routes);
+  EXPECT_EQ(counters("a", "out").tx, 1u);
+  EXPECT_EQ(counters("b", "out").tx, 0u);
+}
+
+TEST_F(RouterTest, ResidenceIsMeasured) {
+  bind({channel("a", ChannelClass::srt)});
+  for (int i = 0; i < 100; ++i) in.inject("a", {1});
+  router.run_once(1000);
+  const auto snap = router.snapshot();
+  ASSERT_EQ(snap.size(), 1u);
+  EXPECT_EQ(snap[0].forwarded, 100u);
+  EXPECT_GT(snap[0].residence_p50.count(), 0);
+  EXPECT_LE(snap[0].residence_p50, snap[0].residence_p99);
+  EXPECT_LE(snap[0].residence_p99, snap[0].residence_max);
+}
+
+TEST(LatencyHistogramTest, QuantilesBracketTheRecordedValues) {
+  LatencyHistogram h;
+  for (int i = 1; i <= 100; ++i) h.record(Nanos(i * 1000));
+  EXPECT_EQ(h.count(), 100u);
+  // Buckets are 4 per power of two: at most 25 % above the true value.
+  EXPECT_GE(h.quantile(0.5).count(), 50'000);
+  EXPECT_LE(h.quantile(0.5).count(), 62'500);
+  EXPECT_GE(h.quantile(0.99).count(), 99'000);
+  EXPECT_EQ(h.max().count(), 100'000);
+}
+
+TEST(DuplicateFilterTest, SlidingWindowPerOrigin) {
+  DuplicateFilter f;
+  EXPECT_FALSE(f.seen(1, 10));
+  EXPECT_TRUE(f.seen(1, 10));
+  EXPECT_FALSE(f.seen(2, 10));  // another origin has its own window
+  EXPECT_FALSE(f.seen(1, 100));
+  EXPECT_TRUE(f.seen(1, 20));   // fell out of the 64-event window: treated as seen
+  EXPECT_FALSE(f.seen(1, 99));
+  EXPECT_TRUE(f.seen(1, 99));
+}
+
+}  // namespace
+}  // namespace cosmic
