@@ -92,7 +92,9 @@ int main(int argc, char** argv) {
 
   auto reload_source = [&] { return cosmic::load_config_file(options.config); };
   cosmic::ControlProtocol protocol(gateway, reload_source, cosmic::AccessPolicy{}, log);
-  cosmic::ControlServer server(cosmic::ControlServerOptions{socket_path},
+  cosmic::ControlServerOptions server_options;
+  server_options.path = socket_path;
+  cosmic::ControlServer server(server_options,
                                [&](std::string_view line, const cosmic::PeerCredentials& peer) { return protocol.handle(line, peer); });
   bool running = true;
   server.watch(signal_fd, [&] {
