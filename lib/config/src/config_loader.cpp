@@ -87,6 +87,7 @@ class ConfigParser {
 
   bool require(const YAML::Node& map, const std::string& path, const char* name, const char* valid) {
     if (has(map, name)) return true;
+    if (map.IsMap() && map[name]) return false;  // present without a value: check_map reports it
     reader_.error_at(map, path.empty() ? name : key(path, name), std::string("missing required key '") + name + "'", valid);
     return false;
   }
@@ -127,7 +128,12 @@ class ConfigParser {
     for (std::size_t i = 0; i < node.size(); ++i) {
       const std::string path = indexed("segments", i);
       auto segment = parse_segment(node[i], path);
-      if (!segment) continue;
+      if (!segment) {
+        // Known by name even when invalid: channels naming it must not read "unknown segment".
+        const YAML::Node name = node[i].IsMap() ? node[i]["name"] : YAML::Node();
+        if (name && name.IsScalar()) segment_names_.insert(name.Scalar());
+        continue;
+      }
       if (!first_seen.emplace(segment->name, node[i].Mark()).second) {
         reader_.error_at(node[i]["name"], key(path, "name"), "duplicate segment name '" + segment->name + "'",
                          "a name not used by another segment (first at line " +
@@ -361,13 +367,13 @@ class ConfigParser {
         // Minimum inter-arrival time, rounded down: a conservative (higher) load.
         c.period = Nanos(std::max<std::int64_t>(1, static_cast<std::int64_t>(1e9 / *hz)));
       }
-    } else if (realtime) {
+    } else if (realtime && !node["period"] && !node["max_rate"]) {  // a key without value: check_map said so
       reader_.error_at(node, key(path, "period"), "an hrt or srt channel needs period or max_rate",
                        "period: 10ms or max_rate: 100Hz");
     }
     if (has(node, "reaction_time")) {
       c.reaction_time = reader_.duration(node["reaction_time"], key(path, "reaction_time"), false);
-    } else if (realtime) {
+    } else if (realtime && !node["reaction_time"]) {
       reader_.error_at(node, key(path, "reaction_time"), "an hrt or srt channel needs reaction_time",
                        "the end-to-end latency bound, e.g. reaction_time: 5ms");
     }

@@ -43,6 +43,8 @@ bool YamlReader::check_map(const YAML::Node& node, const std::string& path, std:
       error_at(entry.first, key_path, "unknown key '" + key + "'", "valid keys here: " + join(allowed));
     } else if (!seen.insert(key).second) {
       error_at(entry.first, key_path, "duplicate key '" + key + "'", "each key once");
+    } else if (entry.second.IsNull()) {
+      error_at(entry.first, key_path, "value is missing", "a value after '" + key + ":', or remove the key");
     }
   }
   return true;
@@ -123,6 +125,12 @@ template <typename T>
 std::optional<T> report(YamlReader& reader, const YAML::Node& node, const std::string& path, const Parsed<T>& parsed,
                         const char* valid) {
   if (parsed.value) return parsed.value;
+  // Unit parse errors carry their own "(what would be valid)": do not add a second one.
+  const auto open = parsed.error.rfind(" (");
+  if (open != std::string::npos && parsed.error.back() == ')') {
+    reader.error_at(node, path, parsed.error.substr(0, open), parsed.error.substr(open + 2, parsed.error.size() - open - 3));
+    return std::nullopt;
+  }
   reader.error_at(node, path, parsed.error, valid);
   return std::nullopt;
 }

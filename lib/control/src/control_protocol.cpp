@@ -28,11 +28,12 @@ Json bind_answer(const BindResult& result) {
 }  // namespace
 
 ControlProtocol::ControlProtocol(Gateway& gateway, std::function<ConfigResult()> reload_source, AccessPolicy policy,
-                                 Logger& log)
+                                 Logger& log, ChangeObserver on_change)
     : gateway_(gateway),
       reload_source_(std::move(reload_source)),
       policy_(std::move(policy)),
       log_(log),
+      on_change_(std::move(on_change)),
       started_(std::chrono::steady_clock::now()) {}
 
 bool ControlProtocol::is_mutating(std::string_view command) {
@@ -72,9 +73,11 @@ Json ControlProtocol::dispatch(const Json& request, const PeerCredentials& peer)
   if (command == "segments") return segments();
   if (command == "channels") return channels();
   if (command == "channel") return channel(request);
-  if (command == "bind") return bind(request);
-  if (command == "unbind") return unbind(request);
-  if (command == "reload") return reload();
+  if (mutating) {
+    Json answer = command == "bind" ? bind(request) : command == "unbind" ? unbind(request) : reload();
+    if (answer.value("ok", false) && on_change_) on_change_(command, request);
+    return answer;
+  }
   return failure("unknown_command", "unknown command '" + command +
                                         "' (status, segments, channels, channel, bind, unbind, reload)");
 }

@@ -43,3 +43,11 @@ ConfigResult load_config_file(const std::string& path);
 ChannelsResult parse_channels(std::string_view text, const std::string& file_name, const Config& running);
 
 }  // namespace cosmic
+
+namespace cosmic {
+
+// One channel as a YAML flow map that parse_channels() reads back to an equal ChannelSpec
+// (durations in ns, sizes in B, subject in hex).
+std::string channel_to_yaml(const ChannelSpec& channel);
+
+}  // namespace cosmic

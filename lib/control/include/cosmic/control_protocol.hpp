@@ -27,10 +27,14 @@ struct AccessPolicy {
   std::function<bool(const PeerCredentials&)> may_modify = [](const PeerCredentials&) { return true; };
 };
 
+// Told about every mutating command that changed the gateway (e.g. to persist it).
+using ChangeObserver = std::function<void(const std::string& command, const nlohmann::json& request)>;
+
 class ControlProtocol {
  public:
   // `reload_source` re-reads the daemon's configuration file.
-  ControlProtocol(Gateway& gateway, std::function<ConfigResult()> reload_source, AccessPolicy policy, Logger& log);
+  ControlProtocol(Gateway& gateway, std::function<ConfigResult()> reload_source, AccessPolicy policy, Logger& log,
+                  ChangeObserver on_change = {});
 
   std::string handle(std::string_view request_line, const PeerCredentials& peer);
 
@@ -52,6 +56,7 @@ class ControlProtocol {
   std::function<ConfigResult()> reload_source_;
   AccessPolicy policy_;
   Logger& log_;
+  ChangeObserver on_change_;
   std::chrono::steady_clock::time_point started_;
 };
 

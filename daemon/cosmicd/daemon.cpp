@@ -1,0 +1,219 @@
+#include "daemon.hpp"
+
+#include <grp.h>
+#include <sys/signalfd.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <csignal>
+#include <cstdlib>
+#include <random>
+
+#include "adapter_factory.hpp"
+#include "binding_store.hpp"
+#include "cosmic/config_loader.hpp"
+#include "cosmic/control_server.hpp"
+#include "daemon_logger.hpp"
+#include "service_notifier.hpp"
+
+namespace cosmicd {
+namespace {
+
+std::uint64_t random_gateway_id() {
+  std::random_device device;
+  std::uint64_t id = 0;
+  while (id == 0) id = (static_cast<std::uint64_t>(device()) << 32) ^ device();
+  return id;
+}
+
+cosmic::LogLevel parse_level(const std::string& text) {
+  if (text == "debug") return cosmic::LogLevel::debug;
+  if (text == "notice") return cosmic::LogLevel::notice;
+  if (text == "warning") return cosmic::LogLevel::warning;
+  if (text == "error") return cosmic::LogLevel::error;
+  return cosmic::LogLevel::info;
+}
+
+std::string default_state_file() {
+  const char* directory = std::getenv("STATE_DIRECTORY");  // set by systemd's StateDirectory=
+  const std::string base = directory ? std::string(directory).substr(0, std::string(directory).find(':')) : "/var/lib/cosmicd";
+  return base + "/bindings.json";
+}
+
+void log_verdicts(cosmic::Logger& log, const std::vector<cosmic::ChannelReport>& channels) {
+  for (const auto& channel : channels) {
+    std::string line = "channel " + channel.name + " (" + cosmic::to_string(channel.cls) + "): " + cosmic::to_string(channel.verdict);
+    for (const auto& reason : channel.reasons) line += "; " + reason;
+    log.log(channel.verdict == cosmic::Verdict::bound ? cosmic::LogLevel::info : cosmic::LogLevel::warning, line);
+  }
+}
+
+// Blocks the termination and reload signals in every thread and returns a signalfd for them.
+int signal_descriptor() {
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGHUP);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  std::signal(SIGPIPE, SIG_IGN);
+  return signalfd(-1, &signals, SFD_NONBLOCK | SFD_CLOEXEC);
+}
+
+class Daemon {
+ public:
+  explicit Daemon(const DaemonOptions& options)
+      : options_(options),
+        log_(parse_level(options.log_level)),
+        state_file_(options.state_file.empty() ? default_state_file() : options.state_file),
+        gateway_(make_adapter, log_, random_gateway_id()) {}
+
+  int run() {
+    const int signal_fd = signal_descriptor();
+    const auto loaded = cosmic::load_config_file(options_.config);
+    if (!loaded.ok()) {
+      for (const auto& error : loaded.errors) log_.log(cosmic::LogLevel::error, error.to_string());
+      return kExitConfigError;
+    }
+    if (!start(loaded.config)) return kExitStartFailure;
+    cosmic::ControlProtocol protocol(
+        gateway_, [this] { return cosmic::load_config_file(options_.config); }, make_access_policy(options_.groups), log_,
+        [this](const std::string& command, const nlohmann::json& request) { remember(command, request); });
+    cosmic::ControlServerOptions server_options;
+    server_options.path = options_.socket.empty() ? loaded.config.gateway.control_socket : options_.socket;
+    if (const ::group* g = ::getgrnam(options_.groups.read_group.c_str())) server_options.socket_group = g->gr_gid;
+    cosmic::ControlServer server(server_options, [&](std::string_view line, const cosmic::PeerCredentials& peer) {
+      return protocol.handle(line, peer);
+    });
+    server.watch(signal_fd, [&] { on_signals(signal_fd); });
+    if (const auto opened = server.open(); !opened.ok) {
+      log_.log(cosmic::LogLevel::error, "control socket: " + opened.error);
+      gateway_.stop();
+      return kExitStartFailure;
+    }
+    log_.log(cosmic::LogLevel::notice, "cosmicd " + loaded.config.gateway.name + " running; control socket " + server_options.path);
+    loop(server);
+    notifier_.stopping();
+    server.close_all();
+    gateway_.stop();
+    log_.log(cosmic::LogLevel::notice, "cosmicd stopped");
+    return kExitOk;
+  }
+
+ private:
+  bool start(cosmic::Config config) {
+    const LoadedState persisted = load_binding_state(state_file_);
+    if (!persisted.error.empty()) {
+      log_.log(cosmic::LogLevel::error, persisted.error + "; starting from the configuration alone");
+    }
+    state_ = persisted.state;
+    std::erase_if(config.channels, [&](const cosmic::ChannelSpec& c) {
+      return std::find(state_.unbound.begin(), state_.unbound.end(), c.name) != state_.unbound.end();
+    });
+    const auto started = gateway_.start(config);
+    if (!started.applied) {
+      log_.log(cosmic::LogLevel::error, started.error);
+      return false;
+    }
+    log_verdicts(log_, started.channels);
+    restore_runtime_bindings();
+    return true;
+  }
+
+  void restore_runtime_bindings() {
+    std::vector<RuntimeBinding> kept;
+    for (const auto& binding : state_.bound) {
+      const auto parsed = cosmic::parse_channels(binding.yaml, state_file_, gateway_.config());
+      const auto result = parsed.ok() ? gateway_.bind(parsed.channels) : cosmic::BindResult{};
+      if (result.applied) {
+        log_.log(cosmic::LogLevel::notice, "restored runtime binding of channel " + binding.name);
+        kept.push_back(binding);
+      } else {
+        log_.log(cosmic::LogLevel::warning, "runtime binding of channel " + binding.name + " could not be restored; dropped");
+      }
+    }
+    if (kept.size() != state_.bound.size()) {
+      state_.bound = std::move(kept);
+      persist();
+    }
+  }
+
+  void remember(const std::string& command, const nlohmann::json& request) {
+    if (command == "reload") {
+      state_ = {};  // the file is the truth again
+    } else if (command == "bind") {
+      const auto parsed = cosmic::parse_channels(request["yaml"].get<std::string>(), "bind", gateway_.config());
+      for (const auto& channel : parsed.channels) {
+        std::erase(state_.unbound, channel.name);
+        if (!gateway_.config().find_channel(channel.name) || !(*gateway_.config().find_channel(channel.name) == channel)) {
+          state_.bound.push_back({channel.name, cosmic::channel_to_yaml(channel)});
+        }
+      }
+    } else if (command == "unbind") {
+      const std::string name = request["name"].get<std::string>();
+      const auto before = state_.bound.size();
+      std::erase_if(state_.bound, [&](const RuntimeBinding& b) { return b.name == name; });
+      if (before == state_.bound.size() && gateway_.config().find_channel(name)) state_.unbound.push_back(name);
+    }
+    persist();
+  }
+
+  void persist() {
+    if (const std::string error = save_binding_state(state_file_, state_); !error.empty()) {
+      log_.log(cosmic::LogLevel::error, "cannot save runtime bindings: " + error);
+    }
+  }
+
+  void on_signals(int signal_fd) {
+    signalfd_siginfo info{};
+    while (read(signal_fd, &info, sizeof info) == sizeof info) {
+      if (info.ssi_signo == SIGHUP) {
+        reload();
+      } else {
+        log_.log(cosmic::LogLevel::notice, "signal " + std::to_string(info.ssi_signo) + ": shutting down");
+        running_ = false;
+      }
+    }
+  }
+
+  void reload() {
+    notifier_.reloading();
+    log_.log(cosmic::LogLevel::notice, "SIGHUP: reloading " + options_.config);
+    const auto loaded = cosmic::load_config_file(options_.config);
+    if (!loaded.ok()) {
+      for (const auto& error : loaded.errors) log_.log(cosmic::LogLevel::error, error.to_string());
+      log_.log(cosmic::LogLevel::error, "reload refused; the running configuration is unchanged");
+    } else {
+      log_verdicts(log_, gateway_.reload(loaded.config).channels);
+      state_ = {};
+      persist();
+    }
+    notifier_.reloaded(gateway_);
+  }
+
+  void loop(cosmic::ControlServer& server) {
+    auto last_health = std::chrono::steady_clock::now() - std::chrono::seconds(1);
+    while (running_) {
+      server.run_for(std::chrono::milliseconds(100));
+      if (std::chrono::steady_clock::now() - last_health >= std::chrono::milliseconds(250)) {
+        gateway_.refresh_health();
+        notifier_.tick(gateway_);
+        last_health = std::chrono::steady_clock::now();
+      }
+    }
+  }
+
+  DaemonOptions options_;
+  DaemonLogger log_;
+  std::string state_file_;
+  cosmic::Gateway gateway_;
+  ServiceNotifier notifier_;
+  BindingState state_;
+  bool running_ = true;
+};
+
+}  // namespace
+
+int run_daemon(const DaemonOptions& options) { return Daemon(options).run(); }
+
+}  // namespace cosmicd

@@ -1,0 +1,39 @@
+// Talks to the service manager (sd_notify): READY=1 once every segment is up (or after a grace
+// period, with the missing ones named in STATUS), STATUS= with a one-line summary, and
+// WATCHDOG=1 only while the router makes progress (or has nothing to do).
+// Called from the control thread only. Without NOTIFY_SOCKET every call is a no-op.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+
+#include "cosmic/gateway.hpp"
+
+namespace cosmicd {
+
+class ServiceNotifier {
+ public:
+  explicit ServiceNotifier(std::chrono::milliseconds ready_grace = std::chrono::seconds(10));
+  // Call periodically from the control loop.
+  void tick(const cosmic::Gateway& gateway);
+  void reloading();
+  void reloaded(const cosmic::Gateway& gateway);
+  void stopping();
+
+  static std::string summary(const cosmic::Gateway& gateway);
+
+ private:
+  bool router_alive(const cosmic::Gateway& gateway);
+
+  std::chrono::steady_clock::time_point started_;
+  std::chrono::milliseconds ready_grace_;
+  std::chrono::microseconds watchdog_interval_{0};
+  std::chrono::steady_clock::time_point last_ping_{};
+  bool ready_sent_ = false;
+  std::string last_status_;
+  std::uint64_t last_progress_ = 0;
+  std::size_t last_queued_ = 0;
+};
+
+}  // namespace cosmicd

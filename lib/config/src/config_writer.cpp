@@ -1,0 +1,33 @@
+#include <yaml-cpp/yaml.h>
+
+#include <cstdio>
+
+#include "cosmic/config_loader.hpp"
+
+namespace cosmic {
+namespace {
+std::string nanos(Nanos value) { return std::to_string(value.count()) + "ns"; }
+}  // namespace
+
+std::string channel_to_yaml(const ChannelSpec& channel) {
+  YAML::Emitter out;
+  out << YAML::Flow << YAML::BeginMap;
+  out << YAML::Key << "name" << YAML::Value << channel.name;
+  char subject[24];
+  std::snprintf(subject, sizeof subject, "0x%016llx", static_cast<unsigned long long>(channel.subject));
+  out << YAML::Key << "subject" << YAML::Value << subject;
+  out << YAML::Key << "class" << YAML::Value << to_string(channel.cls);
+  if (channel.period) out << YAML::Key << "period" << YAML::Value << nanos(*channel.period);
+  if (channel.reaction_time) out << YAML::Key << "reaction_time" << YAML::Value << nanos(*channel.reaction_time);
+  out << YAML::Key << "omission_degree" << YAML::Value << channel.omission_degree;
+  if (channel.temp_validity) out << YAML::Key << "temp_validity" << YAML::Value << nanos(*channel.temp_validity);
+  out << YAML::Key << "payload" << YAML::Value << (std::to_string(channel.payload) + "B");
+  if (channel.etag) out << YAML::Key << "etag" << YAML::Value << *channel.etag;
+  out << YAML::Key << "encoding" << YAML::Value << (channel.lcm_encoding == LcmEncoding::raw ? "raw" : "envelope");
+  out << YAML::Key << "publishers" << YAML::Value << channel.publishers;
+  out << YAML::Key << "subscribers" << YAML::Value << channel.subscribers;
+  out << YAML::EndMap;
+  return out.c_str();
+}
+
+}  // namespace cosmic
