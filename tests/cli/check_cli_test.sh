@@ -1,2 +1,148 @@
-#!/bin/sh
-exit 0
+#!/usr/bin/env bash
+# `cosmicctl check` end to end: exit codes 0/1/2, the --json contract, FILE:LINE:COL errors.
+# Usage: check_cli_test.sh PATH_TO_cosmicctl PROJECT_SOURCE_DIR
+set -u
+
+CTL=${1:?path to cosmicctl}
+SRC=${2:?project source dir}
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+FAILURES=0
+
+fail() {
+  echo "FAIL: $*" >&2
+  FAILURES=$((FAILURES + 1))
+}
+
+# run NAME EXPECTED_EXIT ARGS...: runs cosmicctl, keeps stdout/stderr in $WORK/NAME.{out,err}.
+run() {
+  local name=$1 expected=$2
+  shift 2
+  "$CTL" "$@" >"$WORK/$name.out" 2>"$WORK/$name.err"
+  local code=$?
+  if [ "$code" -ne "$expected" ]; then
+    fail "$name: exit $code, expected $expected (cosmicctl $*)"
+    sed 's/^/    /' "$WORK/$name.out" "$WORK/$name.err" >&2
+  fi
+}
+
+# json_check NAME PYTHON_EXPRESSIONS: every line of the script must hold for `d`, the parsed output.
+json_check() {
+  local name=$1 script=$2
+  if ! python3 -c '
+import json, sys
+d = json.load(open(sys.argv[1]))
+for line in sys.argv[2].strip().splitlines():
+    line = line.strip()
+    if line and not eval(line, {"d": d, "all": all, "any": any, "set": set, "len": len, "isinstance": isinstance}):
+        sys.exit("does not hold: " + line)
+' "$WORK/$name.out" "$script"; then
+    fail "$name: JSON check"
+  fi
+}
+
+contains() {  # contains NAME out|err TEXT
+  if ! grep -qF -- "$3" "$WORK/$1.$2"; then
+    fail "$1: $2 lacks '$3'"
+    sed 's/^/    /' "$WORK/$1.$2" >&2
+  fi
+}
+
+# 1. The bundled robot: every channel bound, exit 0, JSON in the documented shape.
+run robot_json 0 check "$SRC/config/robot.yaml" --json
+json_check robot_json '
+  set(d) == {"segments", "channels"}
+  len(d["channels"]) == 8
+  all(c["verdict"] == "bound" for c in d["channels"])
+  all(c["reasons"] == [] for c in d["channels"])
+  all({"name", "type", "utilization", "max_utilization"} <= set(s) for s in d["segments"])
+  all({"name", "class", "verdict", "reasons", "hops", "end_to_end"} <= set(c) for c in d["channels"])
+  all({"latency_s", "reaction_time_s", "ok"} <= set(c["end_to_end"]) for c in d["channels"])
+  all({"segment", "role", "checks"} <= set(h) for c in d["channels"] for h in c["hops"])
+  all(h["role"] in ("publisher", "subscriber") for c in d["channels"] for h in c["hops"])
+  all(("can" in h) == (h["segment"] == "body-can") for c in d["channels"] for h in c["hops"])
+  all({"priority", "can_id", "etag", "frame_bytes", "transmission_time_s", "response_time_s"} <= set(h["can"]) for c in d["channels"] for h in c["hops"] if "can" in h)
+  all(h["can"]["can_id"] < 2**29 for c in d["channels"] for h in c["hops"] if "can" in h)
+  all({"check", "value", "limit", "unit", "ok"} <= set(k) for c in d["channels"] for h in c["hops"] for k in h["checks"])
+  all(k["ok"] for c in d["channels"] for h in c["hops"] for k in h["checks"])
+  all(s["utilization"] <= s["max_utilization"] for s in d["segments"])
+'
+run robot_text 0 check "$SRC/config/robot.yaml"
+contains robot_text out "8 bound, 0 degraded, 0 rejected"
+
+# 2. The overloaded example: each kind of rejection and mismatch, exit 1.
+run overloaded_json 1 check "$SRC/config/overloaded.yaml" --json
+json_check overloaded_json '
+  {c["name"] for c in d["channels"] if c["verdict"] == "rejected"} == {"collision_warning", "emergency_stop", "camera_status", "arm_torque"}
+  {c["name"] for c in d["channels"] if c["verdict"] == "degraded"} == {"trailer_axle_load", "obstacle_map", "joint_state", "speed_plot"}
+  {c["name"] for c in d["channels"] if c["verdict"] == "bound"} == {"brake_pressure", "wheel_speed", "battery", "diagnostics"}
+  [c["verdict"] for c in d["channels"]][-4:] == ["rejected"] * 4
+'
+run overloaded_text 1 check "$SRC/config/overloaded.yaml"
+contains overloaded_text out "would break hrt channel brake_pressure: end-to-end latency 5.34 ms > reaction_time 5 ms"
+contains overloaded_text out "R = 2 ms > reaction_time 1.5 ms on body-can"
+contains overloaded_text out "payload 12 B > frame 8 B on body-can"
+contains overloaded_text out "utilization 64.0% > max_utilization 50.0% on trailer-can"
+contains overloaded_text out "hrt on office, which declares no real-time guarantee"
+contains overloaded_text out "end-to-end latency 5.5 ms > reaction_time 5 ms"
+contains overloaded_text out ">= temp_validity 5 ms: events would arrive stale"
+contains overloaded_text out "omission_degree 0 < 1 on viz, which does not retransmit"
+contains overloaded_text out "4 bound, 4 degraded, 4 rejected"
+
+# 3. A deployment asking more than a 125 kbit/s bus can give: rejected channels, R against
+#    reaction_time, exit 1. Four HRT 8 B frames (1.28 ms each) every 5 ms, 3 ms reaction time
+#    (equal deadlines: the subject orders them). front and rear: R = 1.28 (blocking) + 1.28 =
+#    2.56 ms, bound; side, roof: R = 1.28 + 1.28 (front, rear) + 1.28 = 3.84 ms > 3 ms, rejected.
+cat >"$WORK/slow_bus.yaml" <<'EOF'
+gateway: {residence_bound: 100us}
+segments:
+  - {name: slow-can, type: can, interface: vcan0, bitrate: 125kbit/s, max_utilization: 90%}
+  - {name: lan, type: dds, realtime: true, latency_bound: 100us}
+channels:
+  - {name: front, subject: 1, class: hrt, period: 5ms, reaction_time: 3ms, payload: 8B, publishers: [slow-can], subscribers: [lan]}
+  - {name: rear, subject: 2, class: hrt, period: 5ms, reaction_time: 3ms, payload: 8B, publishers: [slow-can], subscribers: [lan]}
+  - {name: side, subject: 3, class: hrt, period: 5ms, reaction_time: 3ms, payload: 8B, publishers: [slow-can], subscribers: [lan]}
+  - {name: roof, subject: 4, class: hrt, period: 5ms, reaction_time: 3ms, payload: 8B, publishers: [slow-can], subscribers: [lan]}
+EOF
+run slow_bus_json 1 check "$WORK/slow_bus.yaml" --json
+json_check slow_bus_json '
+  [c["verdict"] for c in d["channels"]] == ["bound", "bound", "rejected", "rejected"]
+  [c["name"] for c in d["channels"]] == ["front", "rear", "side", "roof"]
+  all(any(k["check"] == "response_time" and not k["ok"] and k["value"] > k["limit"] == 0.003 for h in c["hops"] for k in h["checks"]) for c in d["channels"][2:])
+  all(abs(c["hops"][0]["can"]["response_time_s"] - 0.00384) < 1e-12 for c in d["channels"][2:])
+  all(abs(c["hops"][0]["can"]["response_time_s"] - 0.00256) < 1e-12 for c in d["channels"][:2])
+'
+run slow_bus_text 1 check "$WORK/slow_bus.yaml"
+contains slow_bus_text out "R = 3.84 ms > reaction_time 3 ms on slow-can"
+contains slow_bus_text out "2 bound, 0 degraded, 2 rejected"
+
+# 4. A broken file: every error as FILE:LINE:COL on stderr, exit 2, nothing on stdout.
+BROKEN="$SRC/tests/unit/bad_configs/several_errors.yaml"
+run broken 2 check "$BROKEN"
+contains broken err "$BROKEN:2:16: gateway.can_node_id: '300' is out of range"
+contains broken err "$BROKEN:7:14: segments[0].bitrate:"
+contains broken err "$BROKEN:10:5: segments[1].colour: unknown key 'colour'"
+contains broken err "$BROKEN:23:19: channels[1].subscribers[0]:"
+contains broken err "7 error(s) in $BROKEN"
+[ -s "$WORK/broken.out" ] && fail "broken: unexpected stdout"
+run broken_json 2 check "$BROKEN" --json
+json_check broken_json '
+  len(d["errors"]) == 7
+  all({"file", "line", "column", "path", "message", "valid", "text"} <= set(e) for e in d["errors"])
+  d["errors"][0]["line"] == 2 and d["errors"][0]["column"] == 16
+'
+run syntax 2 check "$SRC/tests/unit/bad_configs/yaml_syntax_error.yaml"
+contains syntax err "yaml_syntax_error.yaml:7:10: YAML syntax error"
+
+# 5. A missing file: exit 2, named on stderr.
+run missing 2 check "$WORK/no-such-file.yaml"
+contains missing err "$WORK/no-such-file.yaml:0:0: cannot read the file"
+
+# 6. Usage errors are not configuration errors.
+run usage 64 check
+
+if [ "$FAILURES" -ne 0 ]; then
+  echo "$FAILURES check(s) failed" >&2
+  exit 1
+fi
+echo "all cosmicctl check tests passed"

@@ -24,7 +24,8 @@ const ChannelBinding* MemoryAdapter::find(const std::string& name) const {
 }
 
 SendStatus MemoryAdapter::send(const OutboundEvent& event) {
-  std::lock_guard lock(mutex_);
+  std::unique_lock lock(mutex_);
+  released_.wait(lock, [&] { return !held_; });
   const auto it = std::find_if(bindings_.begin(), bindings_.end(), [&](const auto& b) {
     return b.id == event.channel && b.role == HopRole::subscriber;
   });
@@ -102,6 +103,12 @@ void MemoryAdapter::stop() {
 void MemoryAdapter::set_health(SegmentHealth state, std::string detail) {
   std::lock_guard lock(mutex_);
   health_ = HealthReport{state, std::move(detail)};
+}
+
+void MemoryAdapter::hold_sends(bool hold) {
+  std::lock_guard lock(mutex_);
+  held_ = hold;
+  released_.notify_all();
 }
 
 void MemoryAdapter::set_congested(bool congested) {

@@ -40,6 +40,8 @@ class MemoryAdapter final : public SegmentAdapter {
   void set_health(SegmentHealth state, std::string detail);
   // Makes send() answer queue_full (a congested network).
   void set_congested(bool congested);
+  // While held, send() blocks (a stuck network driver): the router stalls.
+  void hold_sends(bool hold);
   std::vector<ChannelBinding> bindings() const;
 
  private:
@@ -53,6 +55,8 @@ class MemoryAdapter final : public SegmentAdapter {
   HealthReport health_;
   AdapterStatistics stats_;
   bool congested_ = false;
+  bool held_ = false;
+  mutable std::condition_variable released_;
 };
 
 }  // namespace cosmic

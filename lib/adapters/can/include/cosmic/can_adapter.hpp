@@ -1,0 +1,19 @@
+// The CAN segment adapter on Linux SocketCAN (CAN_RAW, classic and FD, 29-bit identifiers in the
+// COSMIC layout; docs/can-wire-format.md). One receive thread per segment owns the socket: it
+// reads frames, reassembles fragmented events, answers GET_ETAG binding requests, drains the
+// send backlog and watches the interface (down, missing, bus-off), reopening the socket when the
+// interface comes back so traffic resumes by itself.
+#pragma once
+
+#include <memory>
+
+#include "cosmic/log.hpp"
+#include "cosmic/model.hpp"
+#include "cosmic/segment_adapter.hpp"
+
+namespace cosmic {
+
+// Never null. start() succeeds even when the interface is down or missing (health says so).
+std::unique_ptr<SegmentAdapter> make_can_adapter(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log);
+
+}  // namespace cosmic

@@ -1,0 +1,713 @@
+// The DDS segment adapter on Fast DDS 2.9. The mapping is documented in cosmic/dds_adapter.hpp.
+//
+// Threads and locks:
+// - control_mutex_ serialises start/configure/stop (control thread).
+// - writers_mutex_ (shared_mutex) guards the channel -> writer table: send() (router thread)
+//   takes it shared, configure()/stop() exclusive only to swap entries in or out. DDS entities
+//   are created before and deleted after that exclusive section, so the router never waits for
+//   Fast DDS discovery work.
+// - Each writer has its own envelope sample, reused for every send (its payload vector keeps its
+//   capacity: no allocation per event in steady state), guarded by the writer's mutex.
+// - Each reader has its own envelope sample and mutex; Fast DDS calls on_data_available on its
+//   receive threads. A reader is retired by clearing its `active` flag under its mutex (after
+//   which it never calls the sink) before Fast DDS deletes it; its listener object is kept until
+//   stop() so a late callback never touches freed memory.
+#include "cosmic/dds_adapter.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <exception>
+#include <map>
+#include <mutex>
+#include <set>
+#include <shared_mutex>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/log/Log.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include <cosmic_dds_idl/EnvelopePubSubTypes.h>
+
+#include "dds_qos.hpp"
+
+namespace cosmic {
+
+std::string dds_topic_name(std::string_view channel_name) {
+  std::string name = "cosmic/";
+  name.append(channel_name);
+  return name;
+}
+
+namespace {
+
+namespace dds = eprosima::fastdds::dds;
+namespace rtps = eprosima::fastrtps::rtps;
+using dds_detail::EndpointShape;
+using eprosima::fastrtps::types::ReturnCode_t;
+
+constexpr const char* kTypeName = "cosmic::Envelope";
+
+const char* policy_name(dds::QosPolicyId_t id) {
+  switch (id) {
+    case dds::RELIABILITY_QOS_POLICY_ID: return "reliability";
+    case dds::DURABILITY_QOS_POLICY_ID: return "durability";
+    case dds::DEADLINE_QOS_POLICY_ID: return "deadline";
+    case dds::LATENCYBUDGET_QOS_POLICY_ID: return "latency_budget";
+    case dds::LIVELINESS_QOS_POLICY_ID: return "liveliness";
+    case dds::OWNERSHIP_QOS_POLICY_ID: return "ownership";
+    case dds::PARTITION_QOS_POLICY_ID: return "partition";
+    case dds::DATAREPRESENTATION_QOS_POLICY_ID: return "data_representation";
+    default: return "other";
+  }
+}
+
+// ---- Fast DDS log -> cosmic::Logger ------------------------------------------------------------
+// Fast DDS logs through a process-wide singleton that prints to stdout by default. The first
+// adapter replaces that with one consumer forwarding to the Loggers of the running adapters
+// (each distinct Logger once): the library never prints.
+class LogRouter {
+ public:
+  static LogRouter& instance() {
+    static LogRouter* router = new LogRouter();  // leaked: Fast DDS's log thread may outlive us
+    return *router;
+  }
+  void attach(Logger& log) {
+    std::lock_guard lock(mutex_);
+    if (!installed_) {
+      installed_ = true;
+      dds::Log::ClearConsumers();
+      dds::Log::RegisterConsumer(std::make_unique<Consumer>());
+      dds::Log::SetVerbosity(dds::Log::Warning);
+    }
+    ++loggers_[&log];
+  }
+  void detach(Logger& log) {
+    std::lock_guard lock(mutex_);
+    auto it = loggers_.find(&log);
+    if (it != loggers_.end() && --it->second == 0) {
+      loggers_.erase(it);
+    }
+  }
+
+ private:
+  class Consumer : public dds::LogConsumer {
+   public:
+    void Consume(const dds::Log::Entry& entry) override {
+      LogRouter::instance().forward(entry);
+    }
+  };
+  void forward(const dds::Log::Entry& entry) {
+    const LogLevel level = entry.kind == dds::Log::Error     ? LogLevel::error
+                           : entry.kind == dds::Log::Warning ? LogLevel::warning
+                                                             : LogLevel::debug;
+    std::string text = "fastdds";
+    if (entry.context.category != nullptr) {
+      text += " [";
+      text += entry.context.category;
+      text += "]";
+    }
+    text += ": ";
+    text += entry.message;
+    std::lock_guard lock(mutex_);
+    for (auto& [log, count] : loggers_) {
+      log->log(level, text);
+    }
+  }
+  std::mutex mutex_;
+  bool installed_ = false;
+  std::map<Logger*, int> loggers_;
+};
+
+// ---- the adapter -------------------------------------------------------------------------------
+
+class DdsAdapter;
+
+struct WriterEntry : dds::DataWriterListener {
+  WriterEntry(DdsAdapter& owner, ChannelId id, const ChannelSpec& spec)
+      : owner(owner), id(id), spec(spec), shape(dds_detail::shape_of(spec)) {}
+  void on_offered_incompatible_qos(dds::DataWriter*,
+                                   const dds::OfferedIncompatibleQosStatus& status) override;
+
+  DdsAdapter& owner;
+  ChannelId id;
+  ChannelSpec spec;
+  EndpointShape shape;
+  dds::Topic* topic = nullptr;
+  dds::DataWriter* writer = nullptr;
+  std::mutex sample_mutex;
+  cosmic::Envelope sample;
+};
+
+struct ReaderEntry : dds::DataReaderListener {
+  ReaderEntry(DdsAdapter& owner, ChannelId id, const ChannelSpec& spec)
+      : owner(owner), id(id), spec(spec), shape(dds_detail::shape_of(spec)) {}
+  void on_data_available(dds::DataReader* reader) override;
+  void on_requested_incompatible_qos(dds::DataReader*,
+                                     const dds::RequestedIncompatibleQosStatus& status) override;
+  void on_sample_lost(dds::DataReader*, const dds::SampleLostStatus& status) override;
+
+  DdsAdapter& owner;
+  ChannelId id;
+  ChannelSpec spec;
+  EndpointShape shape;
+  dds::Topic* topic = nullptr;
+  dds::DataReader* reader = nullptr;
+  std::mutex mutex;     // serialises callbacks; guards `active` and `sample`
+  bool active = false;  // false: never calls the sink
+  cosmic::Envelope sample;
+};
+
+class DdsAdapter final : public DdsSegmentAdapter {
+ public:
+  DdsAdapter(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log)
+      : segment_(segment), self_(self), log_(log) {
+    health_.state = SegmentHealth::down;
+    health_.detail = "not started";
+  }
+  ~DdsAdapter() override { stop(); }
+
+  Status start(EventSink& sink) override;
+  Status configure(std::span<const ChannelBinding> bindings) override;
+  SendStatus send(const OutboundEvent& event) override;
+  HealthReport health() const override {
+    std::lock_guard lock(health_mutex_);
+    return health_;
+  }
+  AdapterStatistics statistics() const override {
+    AdapterStatistics out;
+    out.received = received_.load(std::memory_order_relaxed);
+    out.sent = sent_.load(std::memory_order_relaxed);
+    out.receive_errors = receive_errors_.load(std::memory_order_relaxed);
+    out.send_errors = send_errors_.load(std::memory_order_relaxed);
+    out.overflow_drops = overflow_drops_.load(std::memory_order_relaxed);
+    return out;
+  }
+  void stop() override;
+  std::size_t matched_endpoints(ChannelId channel, HopRole role) const override;
+
+  // Reader callbacks (Fast DDS threads, reader mutex held).
+  void deliver(ReaderEntry& entry, const dds::SampleInfo& info);
+  void count_receive_error(ReaderEntry& entry) {
+    receive_errors_.fetch_add(1, std::memory_order_relaxed);
+    if (sink_ != nullptr) {
+      sink_->on_problem(entry.id, InboundProblem::decode_error);
+    }
+  }
+  void count_lost(std::uint64_t n) { overflow_drops_.fetch_add(n, std::memory_order_relaxed); }
+  void warn(const std::string& text) { log_.log(LogLevel::warning, prefix() + text); }
+
+ private:
+  std::string prefix() const { return "dds segment " + segment_.name + ": "; }
+  void set_health(SegmentHealth state, std::string detail) {
+    std::lock_guard lock(health_mutex_);
+    health_.state = state;
+    health_.detail = std::move(detail);
+  }
+  dds::Topic* acquire_topic(const std::string& name);
+  void release_topic(dds::Topic* topic);
+  std::unique_ptr<WriterEntry> create_writer(const ChannelBinding& binding, std::string& error);
+  std::unique_ptr<ReaderEntry> create_reader(const ChannelBinding& binding, std::string& error);
+  void destroy_writer(std::unique_ptr<WriterEntry> entry);
+  void deactivate(ReaderEntry& entry);
+  void destroy_reader(std::unique_ptr<ReaderEntry> entry);
+  void teardown();
+
+  const SegmentSpec segment_;
+  const GatewayIdentity self_;
+  Logger& log_;
+
+  std::mutex control_mutex_;
+  EventSink* sink_ = nullptr;
+  dds::DomainParticipant* participant_ = nullptr;
+  dds::Publisher* publisher_ = nullptr;
+  dds::Subscriber* subscriber_ = nullptr;
+  rtps::GuidPrefix_t own_prefix_;
+  bool log_attached_ = false;
+  struct TopicRef {
+    dds::Topic* topic = nullptr;
+    int users = 0;
+  };
+  std::map<std::string, TopicRef> topics_;
+
+  mutable std::shared_mutex writers_mutex_;
+  std::unordered_map<ChannelId, std::unique_ptr<WriterEntry>> writers_;
+  // Readers: only the control thread changes this table; matched_endpoints() reads it shared.
+  mutable std::shared_mutex readers_mutex_;
+  std::unordered_map<ChannelId, std::unique_ptr<ReaderEntry>> readers_;
+  std::vector<std::unique_ptr<ReaderEntry>> retired_readers_;
+
+  mutable std::mutex health_mutex_;
+  HealthReport health_;
+
+  std::atomic<std::uint64_t> received_{0};
+  std::atomic<std::uint64_t> sent_{0};
+  std::atomic<std::uint64_t> receive_errors_{0};
+  std::atomic<std::uint64_t> send_errors_{0};
+  std::atomic<std::uint64_t> overflow_drops_{0};
+};
+
+void WriterEntry::on_offered_incompatible_qos(dds::DataWriter*,
+                                              const dds::OfferedIncompatibleQosStatus& status) {
+  owner.warn("a reader of " + shape.topic + " requests incompatible QoS (" +
+             policy_name(status.last_policy_id) + "); not matched");
+}
+
+void ReaderEntry::on_requested_incompatible_qos(
+    dds::DataReader*, const dds::RequestedIncompatibleQosStatus& status) {
+  owner.warn("a writer of " + shape.topic + " offers incompatible QoS (" +
+             policy_name(status.last_policy_id) + "); not matched");
+}
+
+void ReaderEntry::on_sample_lost(dds::DataReader*, const dds::SampleLostStatus& status) {
+  if (status.total_count_change > 0) {
+    owner.count_lost(static_cast<std::uint64_t>(status.total_count_change));
+  }
+}
+
+void ReaderEntry::on_data_available(dds::DataReader* dr) {
+  std::lock_guard lock(mutex);
+  if (!active) {
+    return;
+  }
+  dds::SampleInfo info;
+  for (;;) {
+    ReturnCode_t rc = ReturnCode_t::RETCODE_ERROR;
+    try {
+      rc = dr->take_next_sample(&sample, &info);
+    } catch (...) {
+      owner.count_receive_error(*this);
+      return;
+    }
+    if (rc == ReturnCode_t::RETCODE_NO_DATA) {
+      return;
+    }
+    if (rc != ReturnCode_t::RETCODE_OK) {
+      owner.count_receive_error(*this);
+      return;
+    }
+    if (info.valid_data) {
+      owner.deliver(*this, info);
+    }
+  }
+}
+
+void DdsAdapter::deliver(ReaderEntry& entry, const dds::SampleInfo& info) {
+  received_.fetch_add(1, std::memory_order_relaxed);
+  const cosmic::Envelope& env = entry.sample;
+  if (info.sample_identity.writer_guid().guidPrefix == own_prefix_ || env.origin() == self_.id) {
+    sink_->on_problem(entry.id, InboundProblem::own_echo);
+    return;
+  }
+  if (env.payload().size() > segment_.max_message_size) {
+    count_receive_error(entry);
+    return;
+  }
+  InboundEvent event;
+  event.channel = entry.id;
+  event.header.subject = env.subject();
+  event.header.origin = env.origin();
+  event.header.sequence = env.sequence();
+  event.header.hop_count = env.hop_count();
+  event.header.created_ns = env.created_ns();
+  event.header.age_ns = env.age_ns();
+  event.payload = std::span<const std::uint8_t>(env.payload().data(), env.payload().size());
+  event.received_at =
+      std::chrono::duration_cast<Nanos>(std::chrono::steady_clock::now().time_since_epoch());
+  sink_->on_event(event);
+}
+
+Status DdsAdapter::start(EventSink& sink) {
+  std::lock_guard control(control_mutex_);
+  if (participant_ != nullptr) {
+    return Status::failure("DDS segment " + segment_.name + " already started");
+  }
+  auto fail = [&](std::string why) {
+    set_health(SegmentHealth::down, why);
+    log_.log(LogLevel::error, prefix() + why);
+    teardown();
+    return Status::failure(std::move(why));
+  };
+  if (segment_.type != SegmentType::dds) {
+    return fail("segment is not of type dds");
+  }
+  if (segment_.dds.domain > dds_detail::kMaxDomainId) {
+    return fail("DDS domain " + std::to_string(segment_.dds.domain) + " is out of range 0.." +
+                std::to_string(dds_detail::kMaxDomainId));
+  }
+  if (!log_attached_) {
+    LogRouter::instance().attach(log_);
+    log_attached_ = true;
+  }
+  try {
+    dds::DomainParticipantQos qos;
+    const std::string name =
+        (self_.name.empty() ? std::string("cosmicd") : self_.name) + "/" + segment_.name;
+    if (Status st = dds_detail::participant_qos(segment_, name, qos); !st.ok) {
+      return fail(st.error);
+    }
+    participant_ = dds::DomainParticipantFactory::get_instance()->create_participant(
+        static_cast<dds::DomainId_t>(segment_.dds.domain), qos);
+    if (participant_ == nullptr) {
+      return fail("cannot create a DDS participant in domain " +
+                  std::to_string(segment_.dds.domain));
+    }
+    dds::TypeSupport type(new cosmic::EnvelopePubSubType());
+    if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK) {
+      return fail("cannot register type cosmic::Envelope");
+    }
+    publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+    subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+    if (publisher_ == nullptr || subscriber_ == nullptr) {
+      return fail("cannot create the DDS publisher/subscriber");
+    }
+    own_prefix_ = participant_->guid().guidPrefix;
+  } catch (const std::exception& e) {
+    return fail(std::string("Fast DDS: ") + e.what());
+  } catch (...) {
+    return fail("Fast DDS failed to start");
+  }
+  sink_ = &sink;
+  set_health(SegmentHealth::up, "domain " + std::to_string(segment_.dds.domain));
+  log_.log(LogLevel::info, prefix() + "participant up in domain " +
+                               std::to_string(segment_.dds.domain));
+  return Status::success();
+}
+
+dds::Topic* DdsAdapter::acquire_topic(const std::string& name) {
+  auto it = topics_.find(name);
+  if (it != topics_.end()) {
+    ++it->second.users;
+    return it->second.topic;
+  }
+  dds::Topic* topic = participant_->create_topic(name, kTypeName, dds::TOPIC_QOS_DEFAULT);
+  if (topic != nullptr) {
+    topics_[name] = TopicRef{topic, 1};
+  }
+  return topic;
+}
+
+void DdsAdapter::release_topic(dds::Topic* topic) {
+  for (auto it = topics_.begin(); it != topics_.end(); ++it) {
+    if (it->second.topic == topic) {
+      if (--it->second.users == 0) {
+        participant_->delete_topic(topic);
+        topics_.erase(it);
+      }
+      return;
+    }
+  }
+}
+
+std::unique_ptr<WriterEntry> DdsAdapter::create_writer(const ChannelBinding& binding,
+                                                       std::string& error) {
+  auto entry = std::make_unique<WriterEntry>(*this, binding.id, binding.spec);
+  entry->topic = acquire_topic(entry->shape.topic);
+  if (entry->topic == nullptr) {
+    error = "cannot create topic " + entry->shape.topic;
+    return nullptr;
+  }
+  entry->writer = publisher_->create_datawriter(entry->topic,
+                                                dds_detail::writer_qos(segment_, binding.spec),
+                                                entry.get(), dds::StatusMask::offered_incompatible_qos());
+  if (entry->writer == nullptr) {
+    release_topic(entry->topic);
+    error = "cannot create a DataWriter on " + entry->shape.topic;
+    return nullptr;
+  }
+  entry->sample.payload().reserve(std::min<std::uint64_t>(binding.spec.payload, segment_.max_message_size));
+  return entry;
+}
+
+std::unique_ptr<ReaderEntry> DdsAdapter::create_reader(const ChannelBinding& binding,
+                                                       std::string& error) {
+  auto entry = std::make_unique<ReaderEntry>(*this, binding.id, binding.spec);
+  entry->topic = acquire_topic(entry->shape.topic);
+  if (entry->topic == nullptr) {
+    error = "cannot create topic " + entry->shape.topic;
+    return nullptr;
+  }
+  entry->active = true;  // before the reader exists: no callback can race with this
+  entry->sample.payload().reserve(std::min<std::uint64_t>(binding.spec.payload, segment_.max_message_size));
+  const dds::StatusMask mask = dds::StatusMask::data_available() <<
+                               dds::StatusMask::requested_incompatible_qos() <<
+                               dds::StatusMask::sample_lost();
+  entry->reader = subscriber_->create_datareader(
+      entry->topic, dds_detail::reader_qos(segment_, binding.spec), entry.get(), mask);
+  if (entry->reader == nullptr) {
+    release_topic(entry->topic);
+    error = "cannot create a DataReader on " + entry->shape.topic;
+    return nullptr;
+  }
+  return entry;
+}
+
+void DdsAdapter::destroy_writer(std::unique_ptr<WriterEntry> entry) {
+  if (entry->writer != nullptr && publisher_->delete_datawriter(entry->writer) != ReturnCode_t::RETCODE_OK) {
+    warn("cannot delete the DataWriter of " + entry->shape.topic);
+  }
+  release_topic(entry->topic);
+}
+
+void DdsAdapter::deactivate(ReaderEntry& entry) {
+  std::lock_guard lock(entry.mutex);  // waits for a callback in progress
+  entry.active = false;
+}
+
+void DdsAdapter::destroy_reader(std::unique_ptr<ReaderEntry> entry) {
+  deactivate(*entry);
+  if (entry->reader != nullptr &&
+      subscriber_->delete_datareader(entry->reader) != ReturnCode_t::RETCODE_OK) {
+    warn("cannot delete the DataReader of " + entry->shape.topic);
+  }
+  entry->reader = nullptr;
+  release_topic(entry->topic);
+  entry->sample.payload() = {};  // release the buffer; the listener object itself stays
+  retired_readers_.push_back(std::move(entry));
+}
+
+Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
+  std::lock_guard control(control_mutex_);
+  if (participant_ == nullptr) {
+    return Status::failure("DDS segment " + segment_.name + " is not started");
+  }
+  // Validate and index the wanted endpoints.
+  std::map<ChannelId, const ChannelBinding*> want_writers;
+  std::map<ChannelId, const ChannelBinding*> want_readers;
+  for (const ChannelBinding& b : bindings) {
+    if (b.id == kNoChannel) {
+      return Status::failure("binding of channel '" + b.spec.name + "' has no channel id");
+    }
+    if (b.spec.name.empty()) {
+      return Status::failure("binding " + std::to_string(b.id) + " has an empty channel name");
+    }
+    auto& table = b.role == HopRole::subscriber ? want_writers : want_readers;
+    if (!table.emplace(b.id, &b).second) {
+      return Status::failure("channel '" + b.spec.name + "' is bound twice in the same role");
+    }
+  }
+
+  // 1. Create what is new or changed, before touching anything that runs: a failure leaves the
+  //    running configuration as it was.
+  std::vector<std::unique_ptr<WriterEntry>> new_writers;
+  std::vector<std::unique_ptr<ReaderEntry>> new_readers;
+  std::vector<ReaderEntry*> replaced_readers;  // deactivated while their successor is created
+  std::string error;
+  auto rollback = [&]() {
+    for (auto& w : new_writers) destroy_writer(std::move(w));
+    for (auto& r : new_readers) destroy_reader(std::move(r));
+    for (ReaderEntry* r : replaced_readers) {
+      std::lock_guard lock(r->mutex);
+      r->active = true;
+    }
+    log_.log(LogLevel::error, prefix() + error);
+    return Status::failure(error);
+  };
+  try {
+    for (const auto& [id, b] : want_writers) {
+      auto it = writers_.find(id);  // only this (control) thread changes writers_
+      if (it != writers_.end() && it->second->shape == dds_detail::shape_of(b->spec)) {
+        continue;
+      }
+      auto entry = create_writer(*b, error);
+      if (!entry) return rollback();
+      new_writers.push_back(std::move(entry));
+    }
+    for (const auto& [id, b] : want_readers) {
+      auto it = readers_.find(id);
+      if (it != readers_.end()) {
+        if (it->second->shape == dds_detail::shape_of(b->spec)) {
+          continue;
+        }
+        // Changed QoS: stop the old reader first so that an event is never delivered twice.
+        deactivate(*it->second);
+        replaced_readers.push_back(it->second.get());
+      }
+      auto entry = create_reader(*b, error);
+      if (!entry) return rollback();
+      new_readers.push_back(std::move(entry));
+    }
+  } catch (const std::exception& e) {
+    error = std::string("Fast DDS: ") + e.what();
+    return rollback();
+  }
+
+  // 2. Swap: the router sees the new writer table at once.
+  std::vector<std::unique_ptr<WriterEntry>> old_writers;
+  {
+    std::unique_lock lock(writers_mutex_);
+    for (auto it = writers_.begin(); it != writers_.end();) {
+      if (want_writers.count(it->first) == 0) {
+        old_writers.push_back(std::move(it->second));
+        it = writers_.erase(it);
+      } else {
+        ++it;
+      }
+    }
+    for (auto& w : new_writers) {
+      auto& slot = writers_[w->id];
+      if (slot) old_writers.push_back(std::move(slot));
+      slot = std::move(w);
+    }
+  }
+  std::vector<std::unique_ptr<ReaderEntry>> old_readers;
+  {
+    std::unique_lock lock(readers_mutex_);
+    for (auto it = readers_.begin(); it != readers_.end();) {
+      if (want_readers.count(it->first) == 0) {
+        old_readers.push_back(std::move(it->second));
+        it = readers_.erase(it);
+      } else {
+        ++it;
+      }
+    }
+    for (auto& r : new_readers) {
+      auto& slot = readers_[r->id];
+      if (slot) old_readers.push_back(std::move(slot));
+      slot = std::move(r);
+    }
+  }
+
+  // 3. Delete what is gone (no send() can still use these writers).
+  for (auto& w : old_writers) destroy_writer(std::move(w));
+  for (auto& r : old_readers) destroy_reader(std::move(r));
+  return Status::success();
+}
+
+SendStatus DdsAdapter::send(const OutboundEvent& event) {
+  try {
+    std::shared_lock lock(writers_mutex_);
+    auto it = writers_.find(event.channel);
+    if (it == writers_.end() || event.payload.size() > segment_.max_message_size) {
+      send_errors_.fetch_add(1, std::memory_order_relaxed);
+      return SendStatus::failed;
+    }
+    WriterEntry& w = *it->second;
+    std::lock_guard sample_lock(w.sample_mutex);
+    cosmic::Envelope& env = w.sample;
+    env.subject(event.header.subject);
+    env.origin(event.header.origin);
+    env.sequence(event.header.sequence);
+    env.hop_count(event.header.hop_count);
+    env.created_ns(event.header.created_ns);
+    env.age_ns(event.header.age_ns);
+    env.payload().assign(event.payload.begin(), event.payload.end());  // reuses capacity
+    const ReturnCode_t rc = w.writer->write(&env, dds::HANDLE_NIL);
+    if (rc == ReturnCode_t::RETCODE_OK) {
+      sent_.fetch_add(1, std::memory_order_relaxed);
+      return SendStatus::sent;
+    }
+    send_errors_.fetch_add(1, std::memory_order_relaxed);
+    if (rc == ReturnCode_t::RETCODE_TIMEOUT || rc == ReturnCode_t::RETCODE_OUT_OF_RESOURCES) {
+      return SendStatus::queue_full;
+    }
+    return SendStatus::failed;
+  } catch (...) {
+    send_errors_.fetch_add(1, std::memory_order_relaxed);
+    return SendStatus::failed;
+  }
+}
+
+std::size_t DdsAdapter::matched_endpoints(ChannelId channel, HopRole role) const {
+  try {
+    if (role == HopRole::subscriber) {
+      std::shared_lock lock(writers_mutex_);
+      auto it = writers_.find(channel);
+      dds::PublicationMatchedStatus status;
+      if (it == writers_.end() ||
+          it->second->writer->get_publication_matched_status(status) != ReturnCode_t::RETCODE_OK) {
+        return 0;
+      }
+      return static_cast<std::size_t>(std::max(0, status.current_count));
+    }
+    std::shared_lock lock(readers_mutex_);
+    auto it = readers_.find(channel);
+    dds::SubscriptionMatchedStatus status;
+    if (it == readers_.end() ||
+        it->second->reader->get_subscription_matched_status(status) != ReturnCode_t::RETCODE_OK) {
+      return 0;
+    }
+    return static_cast<std::size_t>(std::max(0, status.current_count));
+  } catch (...) {
+    return 0;
+  }
+}
+
+void DdsAdapter::teardown() {
+  // Readers first: after deactivation no callback reaches the sink any more.
+  {
+    std::shared_lock lock(readers_mutex_);
+    for (auto& [id, r] : readers_) deactivate(*r);
+  }
+  std::unordered_map<ChannelId, std::unique_ptr<WriterEntry>> writers;
+  {
+    std::unique_lock lock(writers_mutex_);
+    writers.swap(writers_);
+  }
+  std::unordered_map<ChannelId, std::unique_ptr<ReaderEntry>> readers;
+  {
+    std::unique_lock lock(readers_mutex_);
+    readers.swap(readers_);
+  }
+  try {
+    if (participant_ != nullptr) {
+      for (auto& [id, w] : writers) destroy_writer(std::move(w));
+      for (auto& [id, r] : readers) destroy_reader(std::move(r));
+      if (publisher_ != nullptr) participant_->delete_publisher(publisher_);
+      if (subscriber_ != nullptr) participant_->delete_subscriber(subscriber_);
+      for (auto& [name, ref] : topics_) participant_->delete_topic(ref.topic);
+      if (dds::DomainParticipantFactory::get_instance()->delete_participant(participant_) !=
+          ReturnCode_t::RETCODE_OK) {
+        warn("cannot delete the DDS participant");
+      }
+    }
+  } catch (...) {
+    warn("Fast DDS threw while stopping");
+  }
+  topics_.clear();
+  retired_readers_.clear();
+  publisher_ = nullptr;
+  subscriber_ = nullptr;
+  participant_ = nullptr;
+  sink_ = nullptr;
+  if (log_attached_) {
+    LogRouter::instance().detach(log_);
+    log_attached_ = false;
+  }
+}
+
+void DdsAdapter::stop() {
+  std::lock_guard control(control_mutex_);
+  if (participant_ == nullptr) {
+    return;
+  }
+  teardown();
+  set_health(SegmentHealth::down, "stopped");
+  log_.log(LogLevel::info, prefix() + "stopped");
+}
+
+}  // namespace
+
+std::unique_ptr<DdsSegmentAdapter> make_dds_segment_adapter(const SegmentSpec& segment,
+                                                            const GatewayIdentity& self,
+                                                            Logger& log) {
+  return std::make_unique<DdsAdapter>(segment, self, log);
+}
+
+std::unique_ptr<SegmentAdapter> make_dds_adapter(const SegmentSpec& segment,
+                                                 const GatewayIdentity& self, Logger& log) {
+  return make_dds_segment_adapter(segment, self, log);
+}
+
+}  // namespace cosmic

@@ -1,0 +1,209 @@
+#include "dds_qos.hpp"
+
+#include <arpa/inet.h>
+#include <ifaddrs.h>
+#include <net/if.h>
+#include <netinet/in.h>
+
+#include <algorithm>
+#include <charconv>
+#include <memory>
+#include <set>
+#include <vector>
+
+#include <fastdds/rtps/attributes/ServerAttributes.h>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/transport/shared_mem/SharedMemTransportDescriptor.h>
+#include <fastrtps/utils/IPLocator.h>
+
+#include "cosmic/dds_adapter.hpp"
+
+namespace cosmic::dds_detail {
+
+namespace dds = eprosima::fastdds::dds;
+namespace rtps = eprosima::fastrtps::rtps;
+
+namespace {
+
+eprosima::fastrtps::Duration_t to_duration(Nanos value) {
+  const std::int64_t ns = std::max<std::int64_t>(0, value.count());
+  const std::int64_t seconds = ns / 1'000'000'000;
+  if (seconds >= 0x7fffffff) {
+    return eprosima::fastrtps::c_TimeInfinite;
+  }
+  return eprosima::fastrtps::Duration_t(static_cast<std::int32_t>(seconds),
+                                        static_cast<std::uint32_t>(ns % 1'000'000'000));
+}
+
+dds::ReliabilityQosPolicyKind reliability_of(const SegmentSpec& segment) {
+  return segment.reliability == Reliability::reliable ? dds::RELIABLE_RELIABILITY_QOS
+                                                      : dds::BEST_EFFORT_RELIABILITY_QOS;
+}
+
+// Local IPv4 addresses by interface name, and the set of all of them.
+struct LocalAddresses {
+  std::vector<std::pair<std::string, std::string>> by_name;
+  std::set<std::string> all;
+};
+
+LocalAddresses local_ipv4_addresses() {
+  LocalAddresses out;
+  ifaddrs* list = nullptr;
+  if (getifaddrs(&list) != 0) {
+    return out;
+  }
+  for (const ifaddrs* it = list; it != nullptr; it = it->ifa_next) {
+    if (it->ifa_addr == nullptr || it->ifa_addr->sa_family != AF_INET) {
+      continue;
+    }
+    char text[INET_ADDRSTRLEN] = {};
+    const auto* in = reinterpret_cast<const sockaddr_in*>(it->ifa_addr);
+    if (inet_ntop(AF_INET, &in->sin_addr, text, sizeof text) == nullptr) {
+      continue;
+    }
+    out.by_name.emplace_back(it->ifa_name, text);
+    out.all.insert(text);
+  }
+  freeifaddrs(list);
+  return out;
+}
+
+bool is_ipv4(const std::string& text) {
+  in_addr addr{};
+  return inet_pton(AF_INET, text.c_str(), &addr) == 1;
+}
+
+}  // namespace
+
+std::int32_t history_depth(std::uint32_t omission_degree) {
+  const std::uint64_t depth = static_cast<std::uint64_t>(omission_degree) + 1;
+  return static_cast<std::int32_t>(
+      std::min<std::uint64_t>(std::max<std::uint64_t>(depth, 1), kMaxHistoryDepth));
+}
+
+EndpointShape shape_of(const ChannelSpec& channel) {
+  EndpointShape shape;
+  shape.topic = dds_topic_name(channel.name);
+  shape.depth = history_depth(channel.omission_degree);
+  shape.period = channel.period;
+  shape.validity = channel.temp_validity;
+  shape.reaction_time = channel.reaction_time;
+  return shape;
+}
+
+dds::DataWriterQos writer_qos(const SegmentSpec& segment, const ChannelSpec& channel) {
+  dds::DataWriterQos qos = dds::DATAWRITER_QOS_DEFAULT;
+  qos.reliability().kind = reliability_of(segment);
+  qos.reliability().max_blocking_time = to_duration(Nanos(kMaxBlockingNs));
+  qos.durability().kind = dds::VOLATILE_DURABILITY_QOS;
+  qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  qos.history().depth = history_depth(channel.omission_degree);
+  if (channel.period && channel.period->count() > 0) {
+    qos.deadline().period = to_duration(*channel.period);
+  }
+  if (channel.temp_validity && channel.temp_validity->count() > 0) {
+    qos.lifespan().duration = to_duration(*channel.temp_validity);
+  }
+  if (channel.reaction_time) {
+    qos.latency_budget().duration = to_duration(*channel.reaction_time);
+  }
+  // Heartbeats announce what a reliable writer has, so a reader can ask for what it lost; the
+  // last event of a burst is only repaired at the next one. Fast DDS's default period (3 s) is
+  // far beyond a real-time channel: half the reaction time, within [5 ms, 100 ms].
+  Nanos heartbeat(kMaxHeartbeatNs);
+  if (channel.reaction_time) {
+    heartbeat = std::clamp(*channel.reaction_time / 2, Nanos(kMinHeartbeatNs),
+                           Nanos(kMaxHeartbeatNs));
+  }
+  qos.reliable_writer_qos().times.heartbeatPeriod = to_duration(heartbeat);
+  // Synchronous publication: write() hands the sample to the transport on the router thread,
+  // which keeps the added latency minimal for small events.
+  qos.publish_mode().kind = dds::SYNCHRONOUS_PUBLISH_MODE;
+  qos.endpoint().history_memory_policy = rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+  return qos;
+}
+
+dds::DataReaderQos reader_qos(const SegmentSpec& segment, const ChannelSpec& channel) {
+  dds::DataReaderQos qos = dds::DATAREADER_QOS_DEFAULT;
+  qos.reliability().kind = reliability_of(segment);
+  qos.durability().kind = dds::VOLATILE_DURABILITY_QOS;
+  qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+  qos.history().depth = history_depth(channel.omission_degree);
+  if (channel.reaction_time) {
+    qos.latency_budget().duration = to_duration(*channel.reaction_time);
+  }
+  // No deadline (a requested deadline refuses every writer not offering one) and no lifespan
+  // (needs synchronised clocks): validity is the router's business, from the envelope's age.
+  qos.endpoint().history_memory_policy = rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+  return qos;
+}
+
+Status participant_qos(const SegmentSpec& segment, const std::string& participant_name,
+                       dds::DomainParticipantQos& qos) {
+  qos = dds::PARTICIPANT_QOS_DEFAULT;
+  qos.name(participant_name);
+  // Fast DDS >= 2.10 stops matching this participant's own readers and writers; 2.9 ignores
+  // the property and the adapter filters by GUID prefix on reception.
+  qos.properties().properties().emplace_back("fastdds.ignore_local_endpoints", "true");
+
+  if (!segment.dds.interfaces.empty()) {
+    const LocalAddresses local = local_ipv4_addresses();
+    auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+    for (const std::string& entry : segment.dds.interfaces) {
+      if (is_ipv4(entry)) {
+        if (local.all.count(entry) == 0) {
+          return Status::failure("DDS interface " + entry + " is not an address of this host");
+        }
+        udp->interfaceWhiteList.push_back(entry);
+        continue;
+      }
+      bool found = false;
+      for (const auto& [name, address] : local.by_name) {
+        if (name == entry) {
+          udp->interfaceWhiteList.push_back(address);
+          found = true;
+        }
+      }
+      if (!found) {
+        return Status::failure("DDS interface " + entry +
+                               " is neither an IPv4 address nor an interface with one");
+      }
+    }
+    qos.transport().use_builtin_transports = false;
+    qos.transport().user_transports.push_back(udp);
+    // Shared memory stays: it only reaches participants on this host.
+    qos.transport().user_transports.push_back(
+        std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+  }
+
+  if (!segment.dds.discovery_server.empty()) {
+    const std::string& text = segment.dds.discovery_server;
+    const auto colon = text.rfind(':');
+    if (colon == std::string::npos) {
+      return Status::failure("DDS discovery_server '" + text + "' is not IP:PORT");
+    }
+    const std::string ip = text.substr(0, colon);
+    const std::string port_text = text.substr(colon + 1);
+    unsigned port = 0;
+    const auto [end, ec] =
+        std::from_chars(port_text.data(), port_text.data() + port_text.size(), port);
+    if (!is_ipv4(ip) || ec != std::errc() || end != port_text.data() + port_text.size() ||
+        port == 0 || port > 65535) {
+      return Status::failure("DDS discovery_server '" + text + "' is not IPv4:PORT");
+    }
+    rtps::Locator_t locator;
+    locator.kind = LOCATOR_KIND_UDPv4;
+    eprosima::fastrtps::rtps::IPLocator::setIPv4(locator, ip);
+    locator.port = port;
+    eprosima::fastdds::rtps::RemoteServerAttributes server;
+    server.metatrafficUnicastLocatorList.push_back(locator);
+    // The server's default GUID prefix for id 0 (`fastdds discovery -i 0`).
+    eprosima::fastdds::rtps::get_server_client_default_guidPrefix(0, server.guidPrefix);
+    auto& discovery = qos.wire_protocol().builtin.discovery_config;
+    discovery.discoveryProtocol = rtps::DiscoveryProtocol_t::CLIENT;
+    discovery.m_DiscoveryServers.push_back(server);
+  }
+  return Status::success();
+}
+
+}  // namespace cosmic::dds_detail

@@ -1,0 +1,61 @@
+// How a segment and a channel become Fast DDS QoS (internal to the DDS adapter).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+
+#include "cosmic/model.hpp"
+#include "cosmic/segment_adapter.hpp"
+
+namespace cosmic::dds_detail {
+
+// Largest history depth of a channel endpoint.
+inline constexpr std::int32_t kMaxHistoryDepth = 32;
+
+// Longest time DataWriter::write() may block the router thread (reliable writers only; with
+// KEEP_LAST it only waits for the writer's own mutex, never for acknowledgements). On timeout
+// send() answers queue_full instead of stalling every other channel behind this one.
+inline constexpr std::int64_t kMaxBlockingNs = 2'000'000;
+
+// Heartbeat period of reliable writers: reaction_time / 2 within these bounds.
+inline constexpr std::int64_t kMinHeartbeatNs = 5'000'000;
+inline constexpr std::int64_t kMaxHeartbeatNs = 100'000'000;
+
+// KEEP_LAST depth of a channel: max(1, omission_degree + 1), capped at kMaxHistoryDepth.
+// A channel that tolerates `omission_degree` consecutive losses is served by keeping that many
+// samples plus the newest one: a reliable writer can still repair a burst of that length, while
+// anything older is superseded for a real-time channel (re-sending it would only delay newer
+// events). The cap bounds the per-endpoint history memory (omission_degree is a 32-bit number
+// from the configuration) and the repair traffic a single channel can cause.
+std::int32_t history_depth(std::uint32_t omission_degree);
+
+// The QoS-relevant shape of one endpoint: two bindings with equal shapes can share an endpoint.
+struct EndpointShape {
+  std::string topic;
+  std::int32_t depth = 1;
+  std::optional<Nanos> period;
+  std::optional<Nanos> validity;
+  std::optional<Nanos> reaction_time;
+  bool operator==(const EndpointShape&) const = default;
+};
+EndpointShape shape_of(const ChannelSpec& channel);
+
+eprosima::fastdds::dds::DataWriterQos writer_qos(const SegmentSpec& segment,
+                                                 const ChannelSpec& channel);
+eprosima::fastdds::dds::DataReaderQos reader_qos(const SegmentSpec& segment,
+                                                 const ChannelSpec& channel);
+
+// Transports (interface allow-list) and discovery (simple or discovery-server client) of the
+// segment's participant. Fails for an unknown interface or a malformed "IP:PORT".
+Status participant_qos(const SegmentSpec& segment, const std::string& participant_name,
+                       eprosima::fastdds::dds::DomainParticipantQos& qos);
+
+// Largest DDS domain id whose RTPS ports fit in 16 bits with the default port parameters.
+inline constexpr std::uint32_t kMaxDomainId = 232;
+
+}  // namespace cosmic::dds_detail

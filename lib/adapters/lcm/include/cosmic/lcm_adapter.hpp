@@ -1,0 +1,24 @@
+// LCM segment adapter: one lcm_t per segment (SegmentSpec::lcm.url) with its own receive thread.
+//
+// LCM channel name = COSMIC channel name. Per channel (ChannelSpec::lcm_encoding):
+//   envelope  the cosmic::envelope type (lib/adapters/lcm/lcmtypes/cosmic_envelope.lcm, generated
+//             by lcm-gen at build time) carrying the event header and the payload;
+//   raw       the payload bytes unchanged, so native LCM programs, lcm-logger and lcm-spy see
+//             their own type; inbound raw messages become events with origin 0, sequence 0,
+//             age 0 and the channel's subject.
+// The adapter never delivers its own publications (EventSink::on_problem(own_echo) instead).
+#pragma once
+
+#include <memory>
+
+#include "cosmic/log.hpp"
+#include "cosmic/model.hpp"
+#include "cosmic/segment_adapter.hpp"
+
+namespace cosmic {
+
+// Never throws for a bad specification: errors surface through start()/configure() and health().
+std::unique_ptr<SegmentAdapter> make_lcm_adapter(const SegmentSpec& segment,
+                                                 const GatewayIdentity& self, Logger& log);
+
+}  // namespace cosmic

@@ -1,0 +1,73 @@
+// Persistence of runtime bindings: round trip, atomic replacement, corrupted files.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "binding_store.hpp"
+#include "cosmic/config_loader.hpp"
+
+namespace {
+
+class BindingStoreTest : public ::testing::Test {
+ protected:
+  BindingStoreTest() : dir(std::filesystem::temp_directory_path() / ("cosmic-state-" + std::to_string(::getpid()))) {
+    std::filesystem::remove_all(dir);
+    path = (dir / "bindings.json").string();
+  }
+  ~BindingStoreTest() override { std::filesystem::remove_all(dir); }
+  void write(const std::string& text) {
+    std::filesystem::create_directories(dir);
+    std::ofstream(path) << text;
+  }
+  std::filesystem::path dir;
+  std::string path;
+};
+
+TEST_F(BindingStoreTest, MissingFileIsAnEmptyState) {
+  const auto loaded = cosmicd::load_binding_state(path);
+  EXPECT_TRUE(loaded.error.empty());
+  EXPECT_TRUE(loaded.state.bound.empty());
+}
+
+TEST_F(BindingStoreTest, RoundTripAndNoTemporaryLeftBehind) {
+  cosmicd::BindingState state;
+  state.bound.push_back({"extra", "{name: extra}"});
+  state.unbound.push_back("speed");
+  ASSERT_EQ(cosmicd::save_binding_state(path, state), "");
+  EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
+  const auto loaded = cosmicd::load_binding_state(path);
+  EXPECT_TRUE(loaded.error.empty());
+  ASSERT_EQ(loaded.state.bound.size(), 1u);
+  EXPECT_EQ(loaded.state.bound[0].name, "extra");
+  EXPECT_EQ(loaded.state.unbound, std::vector<std::string>{"speed"});
+}
+
+TEST_F(BindingStoreTest, CorruptedFilesGiveAClearErrorNotACrash) {
+  for (const char* text : {"{not json", "[]", R"({"version":99,"bound":[],"unbound":[]})",
+                           R"({"version":1,"bound":[{"name":1}],"unbound":[]})", ""}) {
+    write(text);
+    const auto loaded = cosmicd::load_binding_state(path);
+    EXPECT_FALSE(loaded.error.empty()) << text;
+    EXPECT_NE(loaded.error.find(path), std::string::npos);
+    EXPECT_TRUE(loaded.state.bound.empty());
+  }
+}
+
+TEST(ChannelYamlTest, ChannelSurvivesTheRoundTripThroughYaml) {
+  const auto config = cosmic::parse_config(R"(
+segments: [{name: a, type: dds}, {name: b, type: lcm}]
+channels:
+  - {name: c, subject: 0x42, class: srt, max_rate: 300Hz, reaction_time: 5ms, omission_degree: 2,
+     temp_validity: 1s, payload: 12B, etag: 200, encoding: raw, publishers: [a], subscribers: [b]}
+)", "t.yaml");
+  ASSERT_TRUE(config.ok());
+  const std::string yaml = cosmic::channel_to_yaml(config.config.channels[0]);
+  const auto back = cosmic::parse_channels(yaml, "state", config.config);
+  ASSERT_TRUE(back.ok()) << back.errors[0].to_string();
+  ASSERT_EQ(back.channels.size(), 1u);
+  EXPECT_EQ(back.channels[0], config.config.channels[0]);
+}
+
+}  // namespace

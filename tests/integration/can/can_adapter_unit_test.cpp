@@ -1,0 +1,145 @@
+// Pieces of the CAN adapter that need no CAN bus: the binding frames (byte-level, as in
+// docs/can-wire-format.md), the backlog's priority order, and the adapter's behaviour when its
+// interface does not exist (runs on any Linux host, with or without AF_CAN).
+#include <gtest/gtest.h>
+
+#include <array>
+#include <chrono>
+#include <thread>
+
+#include "can_binding.hpp"
+#include "cosmic/can_adapter.hpp"
+#include "cosmic/can_wire.hpp"
+#include "frame_backlog.hpp"
+
+namespace cosmic {
+namespace {
+
+TEST(CanBinding, GetEtagRequestCarriesTheSubjectBigEndian) {
+  // cansend vcan0 1FA8C002#0000000100000042 : priority 0xFD, TxNode 0x23, etag 2
+  const std::uint32_t id = encode_can_id(CanIdentifier{0xFD, 0x23, kEtagGetEtag});
+  EXPECT_EQ(id, 0x1FA8C002u);
+  const std::array<std::uint8_t, 8> data{0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x42};
+  const auto request = can_binding::decode_get_etag(id, data);
+  ASSERT_TRUE(request.has_value());
+  EXPECT_EQ(request->requester, 0x23);
+  EXPECT_EQ(request->subject, 0x0000000100000042u);
+  EXPECT_EQ(can_binding::get_etag_data(0x0000000100000042u), data);
+  EXPECT_FALSE(can_binding::decode_get_etag(id, std::span(data).first(7)).has_value());
+  EXPECT_FALSE(can_binding::decode_get_etag(encode_can_id(CanIdentifier{0xFD, 0x23, 200}), data).has_value());
+}
+
+TEST(CanBinding, SupplyEtagIsTwoFramesWithSubjectHalves) {
+  const auto frames = can_binding::supply_etag_data(0x23, 0x3FFF, 0x0102030405060708u);
+  EXPECT_EQ(frames[0], (std::array<std::uint8_t, 8>{0x23, 0x00, 0x3F, 0xFF, 0x01, 0x02, 0x03, 0x04}));
+  EXPECT_EQ(frames[1], (std::array<std::uint8_t, 8>{0x23, 0x01, 0x3F, 0xFF, 0x05, 0x06, 0x07, 0x08}));
+  // Gateway TxNode 1: priority 0xFD | TxNode 1 | etag 3.
+  EXPECT_EQ(can_binding::supply_etag_id(1), 0x1FA04003u);
+  const auto decoded = can_binding::decode_supply_etag(frames[1]);
+  ASSERT_TRUE(decoded.has_value());
+  EXPECT_EQ(decoded->requester, 0x23);
+  EXPECT_EQ(decoded->part, 1);
+  EXPECT_EQ(decoded->etag, 0x3FFF);
+}
+
+canfd_frame frame_with(std::uint32_t id, std::uint8_t tag) {
+  canfd_frame f{};
+  f.can_id = id | CAN_EFF_FLAG;
+  f.len = 1;
+  f.data[0] = tag;
+  return f;
+}
+
+TEST(CanBacklog, LowestIdentifierFirstAndFifoWithinOneIdentifier) {
+  FrameBacklog backlog(5);
+  ASSERT_TRUE(backlog.push(frame_with(0x1E000100, 1), false));  // NRT
+  ASSERT_TRUE(backlog.push(frame_with(0x00004101, 2), false));  // HRT
+  ASSERT_TRUE(backlog.push(frame_with(0x1E000100, 3), false));  // NRT, after 1
+  ASSERT_TRUE(backlog.push(frame_with(0x02004102, 4), false));  // SRT
+  ASSERT_TRUE(backlog.push(frame_with(0x1E000100, 5), false));
+  EXPECT_FALSE(backlog.push(frame_with(0x00000001, 6), false));  // full
+  EXPECT_FALSE(backlog.room_for(1));
+  std::vector<int> order;
+  while (!backlog.empty()) {
+    order.push_back(backlog.top().frame.data[0]);
+    backlog.pop();
+  }
+  EXPECT_EQ(order, (std::vector<int>{2, 4, 1, 3, 5}));
+}
+
+class NullSink final : public EventSink {
+ public:
+  void on_event(const InboundEvent&) override { ++events; }
+  void on_problem(ChannelId, InboundProblem) override { ++problems; }
+  int events = 0;
+  int problems = 0;
+};
+
+class NullLogger final : public Logger {
+ public:
+  void log(LogLevel, std::string_view) override {}
+};
+
+SegmentSpec can_segment(const std::string& interface) {
+  SegmentSpec spec;
+  spec.name = "bus";
+  spec.type = SegmentType::can;
+  spec.can.interface = interface;
+  return spec;
+}
+
+TEST(CanAdapterWithoutBus, StartsAndReportsAMissingInterface) {
+  NullLogger log;
+  NullSink sink;
+  auto adapter = make_can_adapter(can_segment("nosuchcan7"), GatewayIdentity{1, "gw"}, log);
+  ASSERT_TRUE(adapter);
+  EXPECT_EQ(adapter->health().state, SegmentHealth::down);
+  ASSERT_TRUE(adapter->start(sink).ok);
+  const HealthReport health = adapter->health();
+  EXPECT_EQ(health.state, SegmentHealth::down);
+  EXPECT_EQ(health.detail, "no such interface nosuchcan7");
+  // Sending while the bus is missing fails cleanly and is counted.
+  ChannelBinding binding;
+  binding.id = 5;
+  binding.spec.name = "c";
+  binding.spec.subject = 0x42;
+  binding.spec.payload = 4;
+  binding.role = HopRole::subscriber;
+  binding.can = CanHopPlan{};
+  binding.can->etag = 200;
+  binding.can->can_id = encode_can_id(CanIdentifier{0x10, 1, 200});
+  EXPECT_TRUE(adapter->configure(std::span(&binding, 1)).ok);
+  const std::array<std::uint8_t, 4> payload{1, 2, 3, 4};
+  EXPECT_EQ(adapter->send(OutboundEvent{5, {}, payload}), SendStatus::failed);
+  EXPECT_EQ(adapter->statistics().send_errors, 1u);
+  adapter->stop();
+  adapter->stop();  // idempotent
+}
+
+TEST(CanAdapterWithoutBus, RejectsBindingsItCannotCarry) {
+  NullLogger log;
+  auto adapter = make_can_adapter(can_segment("nosuchcan7"), GatewayIdentity{1, "gw"}, log);
+  ChannelBinding reserved;
+  reserved.spec.name = "reserved";
+  reserved.can = CanHopPlan{};
+  reserved.can->etag = 3;
+  ChannelBinding no_plan;
+  no_plan.spec.name = "noplan";
+  const std::array bindings{reserved, no_plan};
+  const Status status = adapter->configure(bindings);
+  EXPECT_FALSE(status.ok);
+  EXPECT_NE(status.error.find("reserved"), std::string::npos);
+  EXPECT_NE(status.error.find("no CAN plan"), std::string::npos);
+}
+
+TEST(CanAdapterWithoutBus, ANonCanInterfaceIsReported) {
+  NullLogger log;
+  NullSink sink;
+  auto adapter = make_can_adapter(can_segment("lo"), GatewayIdentity{1, "gw"}, log);
+  ASSERT_TRUE(adapter->start(sink).ok);
+  EXPECT_EQ(adapter->health().detail, "interface lo is not a CAN interface");
+  adapter->stop();
+}
+
+}  // namespace
+}  // namespace cosmic
