@@ -146,6 +146,8 @@ Json ControlProtocol::channel_entry(const ChannelReport& verdict, const ChannelS
   if (const auto etag = gateway_.knowledge_base().etag_of(verdict.name)) entry["etag"] = *etag;
   for (const auto& hop : verdict.hops) {
     Json seg{{"segment", hop.segment}, {"role", to_string(hop.role)}, {"rx", 0}, {"tx", 0}, {"dropped", Json::object()}};
+    const auto matched = gateway_.matched_peers(hop.segment, verdict.name);
+    seg["matched"] = matched ? Json(*matched) : Json(nullptr);
     for (std::size_t r = 0; r < kDropReasonCount; ++r) seg["dropped"][to_string(static_cast<DropReason>(r))] = 0;
     if (stats) {
       for (const auto& counters : stats->segments) {

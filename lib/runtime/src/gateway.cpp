@@ -199,6 +199,13 @@ void Gateway::refresh_health() {
   }
 }
 
+std::optional<std::size_t> Gateway::matched_peers(const std::string& segment, const std::string& channel) const {
+  const auto slot = slots_.find(segment);
+  const auto id = channel_ids_.find(channel);
+  if (slot == slots_.end() || id == channel_ids_.end()) return std::nullopt;
+  return slot->second.adapter->matched_peers(id->second.second);
+}
+
 bool Gateway::all_segments_up() const {
   return std::all_of(slots_.begin(), slots_.end(),
                      [](const auto& s) { return s.second.adapter->health().state == SegmentHealth::up; });

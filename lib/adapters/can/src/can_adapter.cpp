@@ -68,6 +68,7 @@ class CanAdapter final : public SegmentAdapter {
   SendStatus send(const OutboundEvent& event) override;
   HealthReport health() const override;
   AdapterStatistics statistics() const override;
+  std::optional<std::size_t> matched_peers(ChannelId) const override { return std::nullopt; }  // broadcast bus
   void stop() override;
 
  private:

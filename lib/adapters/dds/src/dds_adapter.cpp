@@ -196,6 +196,10 @@ class DdsAdapter final : public DdsSegmentAdapter {
   }
   void stop() override;
   std::size_t matched_endpoints(ChannelId channel, HopRole role) const override;
+  std::optional<std::size_t> matched_peers(ChannelId channel) const override {
+    // A channel is either written or read on one segment: the other count is 0.
+    return matched_endpoints(channel, HopRole::subscriber) + matched_endpoints(channel, HopRole::publisher);
+  }
 
   // Reader callbacks (Fast DDS threads, reader mutex held).
   void deliver(ReaderEntry& entry, const dds::SampleInfo& info);

@@ -327,6 +327,8 @@ class LcmAdapter final : public SegmentAdapter {
     return health_;
   }
 
+  std::optional<std::size_t> matched_peers(ChannelId) const override { return std::nullopt; }  // multicast: unknowable
+
   AdapterStatistics statistics() const override {
     AdapterStatistics s;
     s.received = received_.load(std::memory_order_relaxed);

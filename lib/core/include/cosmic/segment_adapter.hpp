@@ -74,6 +74,9 @@ class SegmentAdapter {
   virtual SendStatus send(const OutboundEvent& event) = 0;
   virtual HealthReport health() const = 0;
   virtual AdapterStatistics statistics() const = 0;
+  // Remote endpoints discovered for `channel` here, for transports with discovery (DDS);
+  // nullopt where the transport cannot know its peers (LCM multicast, CAN broadcast).
+  virtual std::optional<std::size_t> matched_peers(ChannelId channel) const = 0;
   virtual void stop() = 0;
 };
 

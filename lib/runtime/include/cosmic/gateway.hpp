@@ -71,6 +71,8 @@ class Gateway {
   std::vector<ChannelStatsSnapshot> channel_stats() const { return router_->snapshot(); }
   const Router& router() const { return *router_; }
   bool all_segments_up() const;
+  // Discovered remote endpoints of a bound channel on a segment (see SegmentAdapter).
+  std::optional<std::size_t> matched_peers(const std::string& segment, const std::string& channel) const;
 
  private:
   struct SegmentSlot {

@@ -27,6 +27,7 @@ class MemoryAdapter final : public SegmentAdapter {
   SendStatus send(const OutboundEvent& event) override;
   HealthReport health() const override;
   AdapterStatistics statistics() const override;
+  std::optional<std::size_t> matched_peers(ChannelId) const override { return std::nullopt; }
   void stop() override;
 
   // Delivers an event on `channel` as if received from the network. False when the channel is

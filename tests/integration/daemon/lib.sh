@@ -1,0 +1,100 @@
+# Shared helpers of the cosmicd end-to-end tests: start daemons, read their counters, wait on
+# conditions with deadlines. Sourced by the test scripts; expects COSMICD, COSMICCTL, WORK.
+
+PIDS=()
+FAILED=0
+
+cleanup() {
+  for pid in "${PIDS[@]}"; do kill "$pid" 2>/dev/null || true; done
+  for pid in "${PIDS[@]}"; do wait "$pid" 2>/dev/null || true; done
+}
+
+log() { printf '%s\n' "$*" >&2; }
+
+fail() {
+  log "FAIL: $*"
+  FAILED=1
+  SCENARIO_FAILED=1
+  return 1
+}
+
+# wait_until TIMEOUT_S DESCRIPTION CMD...: polls CMD until it succeeds or the deadline passes.
+wait_until() {
+  local timeout=$1 what=$2
+  shift 2
+  local deadline=$((SECONDS + timeout))
+  until "$@" >/dev/null 2>&1; do
+    if [ "$SECONDS" -ge "$deadline" ]; then
+      fail "timed out after ${timeout}s waiting for: $what"
+      return 1
+    fi
+    sleep 0.05
+  done
+}
+
+ctl() {
+  local name=$1
+  shift
+  "$COSMICCTL" --socket "$WORK/$name.sock" "$@"
+}
+
+# start_daemon NAME CONFIG: runs cosmicd in the background and waits until it answers.
+start_daemon() {
+  local name=$1 config=$2
+  "$COSMICD" --config "$config" --socket "$WORK/$name.sock" --state-file "$WORK/$name.state" \
+    --log-level debug 2>"$WORK/$name.log" &
+  PIDS+=($!)
+  eval "PID_${name//-/_}=$!"
+  wait_until 30 "cosmicd $name answering" ctl "$name" status
+}
+
+# channel_field NAME CHANNEL SEGMENT FIELD: a per-segment counter from `channels --json`
+# (FIELD is rx, tx, matched, or dropped.REASON).
+channel_field() {
+  ctl "$1" --json channels | python3 -c '
+import json, sys
+channel, segment, field = sys.argv[1:4]
+for c in json.load(sys.stdin)["channels"]:
+    if c["name"] != channel:
+        continue
+    for s in c["segments"]:
+        if s["segment"] == segment:
+            value = s["dropped"][field.split(".")[1]] if field.startswith("dropped.") else s[field]
+            print(0 if value is None else value)
+            sys.exit(0)
+print(-1)' "$2" "$3" "$4"
+}
+
+# field_at_least NAME CHANNEL SEGMENT FIELD MIN
+field_at_least() { [ "$(channel_field "$1" "$2" "$3" "$4")" -ge "$5" ]; }
+# field_equals NAME CHANNEL SEGMENT FIELD VALUE
+field_equals() { [ "$(channel_field "$1" "$2" "$3" "$4")" -eq "$5" ]; }
+
+expect_field() {
+  local actual
+  actual=$(channel_field "$1" "$2" "$3" "$4")
+  [ "$actual" -eq "$5" ] || fail "$1 $2 $3 $4 = $actual, expected $5"
+}
+
+channel_count() { ctl "$1" --json channels | python3 -c 'import json,sys; print(len(json.load(sys.stdin)["channels"]))'; }
+
+# The counters of a gateway stop moving (every event in flight has been handled).
+settled() {
+  local name=$1 before after
+  before=$(ctl "$name" --json channels | python3 -c 'import json,sys; print(json.dumps([c["segments"] for c in json.load(sys.stdin)["channels"]]))')
+  sleep 0.3
+  after=$(ctl "$name" --json channels | python3 -c 'import json,sys; print(json.dumps([c["segments"] for c in json.load(sys.stdin)["channels"]]))')
+  [ "$before" = "$after" ]
+}
+
+# stderr_has FILE TEXT
+stderr_has() { grep -q -- "$2" "$1"; }
+
+scenario() {
+  SCENARIO=$1
+  SCENARIO_FAILED=0
+  log "--- $SCENARIO"
+}
+
+# Ends a scenario: PASS unless one of its checks failed.
+passed() { [ "$SCENARIO_FAILED" = 0 ] && log "PASS: $SCENARIO"; }
