@@ -53,9 +53,11 @@ void print_verdicts(const Json& channels) {
     for (const auto& hop : c["hops"]) {
       for (const auto& check : hop["checks"]) {
         if (check["check"] == "response_time" || check["check"] == "latency") {
+          const bool ok = check["ok"].get<bool>();
           std::cout << "    " << text(hop["segment"]) << ": " << text(check["check"]) << " "
                     << (check["value"].is_null() ? std::string("unbounded") : micros(check["value"].get<double>())) << " "
-                    << text(check["relation"]) << " " << micros(check["limit"].get<double>()) << "\n";
+                    << (ok ? text(check["relation"]) : std::string(">")) << " " << micros(check["limit"].get<double>())
+                    << (ok ? "" : "  FAIL") << "\n";
         }
       }
     }
