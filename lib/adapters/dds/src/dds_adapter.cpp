@@ -14,6 +14,8 @@
 //   stop() so a late callback never touches freed memory.
 #include "cosmic/dds_adapter.hpp"
 
+#include "cosmic/adapter_counters.hpp"
+
 #include <atomic>
 #include <chrono>
 #include <exception>
@@ -185,15 +187,7 @@ class DdsAdapter final : public DdsSegmentAdapter {
     std::lock_guard lock(health_mutex_);
     return health_;
   }
-  AdapterStatistics statistics() const override {
-    AdapterStatistics out;
-    out.received = received_.load(std::memory_order_relaxed);
-    out.sent = sent_.load(std::memory_order_relaxed);
-    out.receive_errors = receive_errors_.load(std::memory_order_relaxed);
-    out.send_errors = send_errors_.load(std::memory_order_relaxed);
-    out.overflow_drops = overflow_drops_.load(std::memory_order_relaxed);
-    return out;
-  }
+  AdapterStatistics statistics() const override { return counters_.snapshot(); }
   void stop() override;
   std::size_t matched_endpoints(ChannelId channel, HopRole role) const override;
   std::optional<std::size_t> matched_peers(ChannelId channel) const override {
@@ -204,12 +198,12 @@ class DdsAdapter final : public DdsSegmentAdapter {
   // Reader callbacks (Fast DDS threads, reader mutex held).
   void deliver(ReaderEntry& entry, const dds::SampleInfo& info);
   void count_receive_error(ReaderEntry& entry) {
-    receive_errors_.fetch_add(1, std::memory_order_relaxed);
+    counters_.receive_errors.fetch_add(1, std::memory_order_relaxed);
     if (sink_ != nullptr) {
       sink_->on_problem(entry.id, InboundProblem::decode_error);
     }
   }
-  void count_lost(std::uint64_t n) { overflow_drops_.fetch_add(n, std::memory_order_relaxed); }
+  void count_lost(std::uint64_t n) { counters_.overflow_drops.fetch_add(n, std::memory_order_relaxed); }
   void warn(const std::string& text) { log_.log(LogLevel::warning, prefix() + text); }
 
  private:
@@ -253,13 +247,9 @@ class DdsAdapter final : public DdsSegmentAdapter {
   std::vector<std::unique_ptr<ReaderEntry>> retired_readers_;
 
   mutable std::mutex health_mutex_;
+  AdapterCounters counters_;
   HealthReport health_;
 
-  std::atomic<std::uint64_t> received_{0};
-  std::atomic<std::uint64_t> sent_{0};
-  std::atomic<std::uint64_t> receive_errors_{0};
-  std::atomic<std::uint64_t> send_errors_{0};
-  std::atomic<std::uint64_t> overflow_drops_{0};
 };
 
 void WriterEntry::on_offered_incompatible_qos(dds::DataWriter*,
@@ -308,7 +298,7 @@ void ReaderEntry::on_data_available(dds::DataReader* dr) {
 }
 
 void DdsAdapter::deliver(ReaderEntry& entry, const dds::SampleInfo& info) {
-  received_.fetch_add(1, std::memory_order_relaxed);
+  counters_.received.fetch_add(1, std::memory_order_relaxed);
   const cosmic::Envelope& env = entry.sample;
   if (info.sample_identity.writer_guid().guidPrefix == own_prefix_ || env.origin() == self_.id) {
     sink_->on_problem(entry.id, InboundProblem::own_echo);
@@ -594,7 +584,7 @@ SendStatus DdsAdapter::send(const OutboundEvent& event) {
     std::shared_lock lock(writers_mutex_);
     auto it = writers_.find(event.channel);
     if (it == writers_.end() || event.payload.size() > segment_.max_message_size) {
-      send_errors_.fetch_add(1, std::memory_order_relaxed);
+      counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
       return SendStatus::failed;
     }
     WriterEntry& w = *it->second;
@@ -609,16 +599,16 @@ SendStatus DdsAdapter::send(const OutboundEvent& event) {
     env.payload().assign(event.payload.begin(), event.payload.end());  // reuses capacity
     const ReturnCode_t rc = w.writer->write(&env, dds::HANDLE_NIL);
     if (rc == ReturnCode_t::RETCODE_OK) {
-      sent_.fetch_add(1, std::memory_order_relaxed);
+      counters_.sent.fetch_add(1, std::memory_order_relaxed);
       return SendStatus::sent;
     }
-    send_errors_.fetch_add(1, std::memory_order_relaxed);
+    counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
     if (rc == ReturnCode_t::RETCODE_TIMEOUT || rc == ReturnCode_t::RETCODE_OUT_OF_RESOURCES) {
       return SendStatus::queue_full;
     }
     return SendStatus::failed;
   } catch (...) {
-    send_errors_.fetch_add(1, std::memory_order_relaxed);
+    counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
     return SendStatus::failed;
   }
 }

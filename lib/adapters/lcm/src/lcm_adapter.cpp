@@ -16,6 +16,8 @@
 // queues it) and not call back into this adapter.
 #include "cosmic/lcm_adapter.hpp"
 
+#include "cosmic/adapter_counters.hpp"
+
 #include <lcm/lcm.h>
 
 #include <algorithm>
@@ -286,7 +288,7 @@ class LcmAdapter final : public SegmentAdapter {
     std::shared_lock table(table_mutex_);
     const auto it = channels_.find(event.channel);
     if (lcm_ == nullptr || it == channels_.end() || !it->second.tx) {
-      send_errors_.fetch_add(1, std::memory_order_relaxed);
+      counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
       return SendStatus::failed;
     }
     const Channel& channel = it->second;
@@ -317,7 +319,7 @@ class LcmAdapter final : public SegmentAdapter {
       rc = lcm_publish(lcm_, channel.name.c_str(), encode_buffer_.data(), static_cast<unsigned>(size));
     }
     if (rc != 0) return send_failed(channel, "lcm_publish failed");
-    sent_.fetch_add(1, std::memory_order_relaxed);
+    counters_.sent.fetch_add(1, std::memory_order_relaxed);
     send_failing_.store(false, std::memory_order_relaxed);
     return SendStatus::sent;
   }
@@ -329,14 +331,7 @@ class LcmAdapter final : public SegmentAdapter {
 
   std::optional<std::size_t> matched_peers(ChannelId) const override { return std::nullopt; }  // multicast: unknowable
 
-  AdapterStatistics statistics() const override {
-    AdapterStatistics s;
-    s.received = received_.load(std::memory_order_relaxed);
-    s.sent = sent_.load(std::memory_order_relaxed);
-    s.receive_errors = receive_errors_.load(std::memory_order_relaxed);
-    s.send_errors = send_errors_.load(std::memory_order_relaxed);
-    return s;
-  }
+  AdapterStatistics statistics() const override { return counters_.snapshot(); }
 
   void stop() override {
     std::lock_guard control(control_mutex_);
@@ -439,7 +434,7 @@ class LcmAdapter final : public SegmentAdapter {
     const auto it = by_name_.find(std::string_view(channel_name));
     if (it == by_name_.end() || !it->second->rx || sink_ == nullptr) return;  // no longer bound
     const Channel& channel = *it->second;
-    received_.fetch_add(1, std::memory_order_relaxed);
+    counters_.received.fetch_add(1, std::memory_order_relaxed);
     const std::span<const std::uint8_t> bytes(static_cast<const std::uint8_t*>(rbuf.data),
                                               rbuf.data_size);
     InboundEvent event;
@@ -459,7 +454,7 @@ class LcmAdapter final : public SegmentAdapter {
     }
 
     if (!decode_envelope(bytes)) {
-      receive_errors_.fetch_add(1, std::memory_order_relaxed);
+      counters_.receive_errors.fetch_add(1, std::memory_order_relaxed);
       sink_->on_problem(channel.id, InboundProblem::decode_error);
       return;
     }
@@ -493,7 +488,7 @@ class LcmAdapter final : public SegmentAdapter {
   }
 
   SendStatus send_failed(const Channel& channel, const char* why) {
-    send_errors_.fetch_add(1, std::memory_order_relaxed);
+    counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
     // Log the first failure of a run of failures, not every event.
     if (!send_failing_.exchange(true, std::memory_order_relaxed))
       log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": send on channel " +
@@ -533,12 +528,9 @@ class LcmAdapter final : public SegmentAdapter {
   EchoFilter echo_;
 
   mutable std::mutex health_mutex_;
+  AdapterCounters counters_;
   HealthReport health_;
 
-  std::atomic<std::uint64_t> received_{0};
-  std::atomic<std::uint64_t> sent_{0};
-  std::atomic<std::uint64_t> receive_errors_{0};
-  std::atomic<std::uint64_t> send_errors_{0};
   std::atomic<bool> send_failing_{false};
 };
 
