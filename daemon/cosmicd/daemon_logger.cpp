@@ -9,7 +9,6 @@
 namespace cosmicd {
 namespace {
 
-constexpr std::chrono::seconds kRepeatWindow{1};
 constexpr std::size_t kMaxTrackedMessages = 256;
 
 // "%*" in the pattern: the syslog priority of the level, as sd-daemon(3) prefixes expect.
@@ -45,8 +44,8 @@ spdlog::level::level_enum to_spdlog(cosmic::LogLevel level) {
 
 }  // namespace
 
-DaemonLogger::DaemonLogger(cosmic::LogLevel threshold)
-    : threshold_(threshold), sink_(std::make_shared<spdlog::logger>("cosmicd", std::make_shared<spdlog::sinks::stderr_sink_mt>())) {
+DaemonLogger::DaemonLogger(cosmic::LogLevel threshold, std::chrono::milliseconds repeat_window)
+    : threshold_(threshold), repeat_window_(repeat_window), sink_(std::make_shared<spdlog::logger>("cosmicd", std::make_shared<spdlog::sinks::stderr_sink_mt>())) {
   auto formatter = std::make_unique<spdlog::pattern_formatter>();
   if (std::getenv("JOURNAL_STREAM") != nullptr) {
     formatter->add_flag<PriorityFlag>('*').set_pattern("%*%v");
@@ -65,7 +64,7 @@ void DaemonLogger::log(cosmic::LogLevel level, std::string_view message) {
   {
     std::lock_guard lock(mutex_);
     auto it = recent_.find(message);
-    if (it != recent_.end() && now - it->second.window_start < kRepeatWindow) {
+    if (it != recent_.end() && now - it->second.window_start < repeat_window_) {
       ++it->second.suppressed;
       return;
     }

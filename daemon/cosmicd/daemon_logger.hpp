@@ -20,7 +20,7 @@ namespace cosmicd {
 
 class DaemonLogger final : public cosmic::Logger {
  public:
-  explicit DaemonLogger(cosmic::LogLevel threshold);
+  explicit DaemonLogger(cosmic::LogLevel threshold, std::chrono::milliseconds repeat_window = std::chrono::seconds(1));
   void log(cosmic::LogLevel level, std::string_view message) override;
 
  private:
@@ -29,6 +29,7 @@ class DaemonLogger final : public cosmic::Logger {
     std::uint64_t suppressed = 0;
   };
   cosmic::LogLevel threshold_;
+  std::chrono::milliseconds repeat_window_;
   std::shared_ptr<spdlog::logger> sink_;
   std::mutex mutex_;
   std::map<std::string, Repeat, std::less<>> recent_;
