@@ -142,7 +142,7 @@ CommandRunner add_request_command(CLI::App& app, const GlobalOptions& options, C
     const ClientResult result = request(options.socket, req);
     if (!result.response) {
       std::cerr << "cosmicctl: " << result.error << "\n";
-      return kExitUnavailable;
+      return result.permission_denied ? kExitNoPermission : kExitUnavailable;
     }
     const Json& response = *result.response;
     if (options.json) std::cout << response.dump(2) << "\n";

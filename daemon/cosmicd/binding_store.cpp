@@ -32,8 +32,13 @@ bool write_all(int fd, const std::string& data) {
 
 LoadedState load_binding_state(const std::string& path) {
   LoadedState out;
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return out;
   std::ifstream in(path);
-  if (!in) return out;
+  if (!in) {
+    out.error = path + ": cannot be read";
+    return out;
+  }
   std::stringstream buffer;
   buffer << in.rdbuf();
   const Json doc = Json::parse(buffer.str(), nullptr, false);

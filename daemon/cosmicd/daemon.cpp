@@ -102,6 +102,7 @@ class Daemon {
 
  private:
   bool start(cosmic::Config config) {
+    file_config_ = config;  // before the channels unbound at run time are taken out
     const LoadedState persisted = load_binding_state(state_file_);
     if (!persisted.error.empty()) {
       log_.log(cosmic::LogLevel::error, persisted.error + "; starting from the configuration alone");
@@ -141,19 +142,23 @@ class Daemon {
   void remember(const std::string& command, const nlohmann::json& request) {
     if (command == "reload") {
       state_ = {};  // the file is the truth again
+      file_config_ = gateway_.config();
     } else if (command == "bind") {
       const auto parsed = cosmic::parse_channels(request["yaml"].get<std::string>(), "bind", gateway_.config());
       for (const auto& channel : parsed.channels) {
+        std::erase_if(state_.bound, [&](const RuntimeBinding& b) { return b.name == channel.name; });
         std::erase(state_.unbound, channel.name);
-        if (!gateway_.config().find_channel(channel.name) || !(*gateway_.config().find_channel(channel.name) == channel)) {
-          state_.bound.push_back({channel.name, cosmic::channel_to_yaml(channel)});
-        }
+        const cosmic::ChannelSpec* in_file = file_config_.find_channel(channel.name);
+        if (in_file && *in_file == channel) continue;  // the file's own definition again
+        if (in_file) state_.unbound.push_back(channel.name);  // replaces the file's definition
+        state_.bound.push_back({channel.name, cosmic::channel_to_yaml(channel)});
       }
     } else if (command == "unbind") {
       const std::string name = request["name"].get<std::string>();
-      const auto before = state_.bound.size();
       std::erase_if(state_.bound, [&](const RuntimeBinding& b) { return b.name == name; });
-      if (before == state_.bound.size() && gateway_.config().find_channel(name)) state_.unbound.push_back(name);
+      if (file_config_.find_channel(name) && std::find(state_.unbound.begin(), state_.unbound.end(), name) == state_.unbound.end()) {
+        state_.unbound.push_back(name);
+      }
     }
     persist();
   }
@@ -185,6 +190,7 @@ class Daemon {
       log_.log(cosmic::LogLevel::error, "reload refused; the running configuration is unchanged");
     } else {
       log_verdicts(log_, gateway_.reload(loaded.config).channels);
+      file_config_ = loaded.config;
       state_ = {};
       persist();
     }
@@ -209,6 +215,7 @@ class Daemon {
   cosmic::Gateway gateway_;
   ServiceNotifier notifier_;
   BindingState state_;
+  cosmic::Config file_config_;  // the configuration file as last loaded
   bool running_ = true;
 };
 

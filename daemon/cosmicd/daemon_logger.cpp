@@ -1,6 +1,5 @@
 #include "daemon_logger.hpp"
 
-#include <spdlog/pattern_formatter.h>
 #include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
 
@@ -11,25 +10,17 @@ namespace {
 
 constexpr std::size_t kMaxTrackedMessages = 256;
 
-// "%*" in the pattern: the syslog priority of the level, as sd-daemon(3) prefixes expect.
-class PriorityFlag final : public spdlog::custom_flag_formatter {
- public:
-  void format(const spdlog::details::log_msg& msg, const std::tm&, spdlog::memory_buf_t& dest) override {
-    int priority = 6;
-    switch (msg.level) {
-      case spdlog::level::trace:
-      case spdlog::level::debug: priority = 7; break;
-      case spdlog::level::info: priority = 6; break;
-      case spdlog::level::warn: priority = 4; break;
-      case spdlog::level::err: priority = 3; break;
-      case spdlog::level::critical: priority = 2; break;
-      default: priority = 5; break;
-    }
-    const char text[] = {'<', static_cast<char>('0' + priority), '>'};
-    dest.append(text, text + 3);
+// syslog priority of a level, as sd-daemon(3) prefixes expect ("<5>" for notice).
+char syslog_priority(cosmic::LogLevel level) {
+  switch (level) {
+    case cosmic::LogLevel::debug: return '7';
+    case cosmic::LogLevel::info: return '6';
+    case cosmic::LogLevel::notice: return '5';
+    case cosmic::LogLevel::warning: return '4';
+    case cosmic::LogLevel::error: return '3';
   }
-  std::unique_ptr<custom_flag_formatter> clone() const override { return std::make_unique<PriorityFlag>(); }
-};
+  return '6';
+}
 
 spdlog::level::level_enum to_spdlog(cosmic::LogLevel level) {
   switch (level) {
@@ -45,14 +36,12 @@ spdlog::level::level_enum to_spdlog(cosmic::LogLevel level) {
 }  // namespace
 
 DaemonLogger::DaemonLogger(cosmic::LogLevel threshold, std::chrono::milliseconds repeat_window)
-    : threshold_(threshold), repeat_window_(repeat_window), sink_(std::make_shared<spdlog::logger>("cosmicd", std::make_shared<spdlog::sinks::stderr_sink_mt>())) {
-  auto formatter = std::make_unique<spdlog::pattern_formatter>();
-  if (std::getenv("JOURNAL_STREAM") != nullptr) {
-    formatter->add_flag<PriorityFlag>('*').set_pattern("%*%v");
-  } else {
-    formatter->set_pattern("%Y-%m-%d %H:%M:%S.%e %^%l%$ %v");
-  }
-  sink_->set_formatter(std::move(formatter));
+    : threshold_(threshold),
+      repeat_window_(repeat_window),
+      journald_(std::getenv("JOURNAL_STREAM") != nullptr),
+      sink_(std::make_shared<spdlog::logger>("cosmicd", std::make_shared<spdlog::sinks::stderr_sink_mt>())) {
+  // Under journald the prefix carries the priority and the journal adds the timestamp.
+  sink_->set_pattern(journald_ ? "%v" : "%Y-%m-%d %H:%M:%S.%e %^%l%$ %v");
   sink_->set_level(spdlog::level::debug);
   sink_->flush_on(spdlog::level::debug);
 }
@@ -76,8 +65,12 @@ void DaemonLogger::log(cosmic::LogLevel level, std::string_view message) {
       recent_.emplace(std::string(message), Repeat{now, 0});
     }
   }
-  if (folded > 0) sink_->log(to_spdlog(level), "{} (repeated {} more times)", message, folded);
-  else sink_->log(to_spdlog(level), "{}", message);
+  const std::string prefix = journald_ ? std::string{'<', syslog_priority(level), '>'} : std::string();
+  if (folded > 0) {
+    sink_->log(to_spdlog(level), "{}{} (repeated {} more times)", prefix, message, folded);
+  } else {
+    sink_->log(to_spdlog(level), "{}{}", prefix, message);
+  }
 }
 
 }  // namespace cosmicd

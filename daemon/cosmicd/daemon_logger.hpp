@@ -30,6 +30,7 @@ class DaemonLogger final : public cosmic::Logger {
   };
   cosmic::LogLevel threshold_;
   std::chrono::milliseconds repeat_window_;
+  bool journald_;
   std::shared_ptr<spdlog::logger> sink_;
   std::mutex mutex_;
   std::map<std::string, Repeat, std::less<>> recent_;

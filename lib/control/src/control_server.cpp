@@ -52,6 +52,10 @@ Status ControlServer::open() {
       return Status::failure("cannot create " + directory.string() + ": " + ec.message());
     }
     ::chmod(directory.c_str(), options_.directory_mode);
+    // The socket's group must be able to reach it: the directory gets the same group.
+    if (options_.socket_group && ::chown(directory.c_str(), static_cast<uid_t>(-1), *options_.socket_group) != 0) {
+      return Status::failure(errno_text("chown " + directory.string()));
+    }
   }
   if (someone_listens(address)) return Status::failure("another cosmicd is listening on " + options_.path);
   ::unlink(options_.path.c_str());

@@ -13,6 +13,7 @@ COSMICD=${1:?path to cosmicd}
 COSMICCTL=${2:?path to cosmicctl}
 DOMAIN=74
 LCM_PORT=7774
+# shellcheck source=lib.sh
 . "$(dirname "$0")/lib.sh"
 in_netns_or_skip
 

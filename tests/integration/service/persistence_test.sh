@@ -11,6 +11,7 @@ COSMICD=${1:?path to cosmicd}
 COSMICCTL=${2:?path to cosmicctl}
 DOMAIN=73
 LCM_PORT=7773
+# shellcheck source=lib.sh
 . "$(dirname "$0")/lib.sh"
 in_netns_or_skip
 
@@ -48,7 +49,8 @@ note "a fresh start: no state file, the configuration alone, nothing written"
 start_daemon "${ARGS[@]}" || finish
 expect_channels "fresh start" "speed status"
 [ -e "$STATE" ] && fail "cosmicd wrote $STATE without any runtime change"
-log_lacks "error"
+log_lacks "$STATE"
+log_lacks "starting from the configuration alone"
 
 note "bind at run time, restart: still bound"
 ctl bind_plot 0 bind "$WORK/plot.yaml"

@@ -10,6 +10,7 @@ COSMICD=${1:?path to cosmicd}
 COSMICCTL=${2:?path to cosmicctl}
 DOMAIN=72
 LCM_PORT=7772
+# shellcheck source=lib.sh
 . "$(dirname "$0")/lib.sh"
 in_netns_or_skip
 
@@ -18,7 +19,7 @@ chmod 0755 "$WORK"
 cleanup() {
   kill_daemon
   remove_accounts
-  rm -rf "$WORK"
+  [ -n "${KEEP_WORK:-}" ] || rm -rf "$WORK"
 }
 trap cleanup EXIT
 trap 'exit 130' INT TERM
@@ -41,7 +42,7 @@ got=$(stat -c '%G' "$WORK/run/cosmicd")
 note "who gets through"
 ctl reader_status 0 as "$READER" status
 ctl admin_channels 0 as "$ADMIN" channels
-ctl other_status 69 as "$OTHER" status
+ctl other_status 69,77 as "$OTHER" status
 contains other_status err "Permission denied"
 ctl root_status 0 status
 

@@ -126,6 +126,10 @@ if systemd-sysusers --root="$SROOT" cosmic.conf >"$WORK/sysusers.out" 2>&1; then
   for g in cosmic cosmic-admin; do
     grep -qE "^$g:x:[0-9]+:" "$SROOT/etc/group" || fail "no group $g"
   done
+  # ExecReload= runs `cosmicctl reload` as User=: that user must be in the admin group, or
+  # `systemctl reload cosmicd` is refused with permission_denied.
+  grep -qE "^cosmic-admin:x:[0-9]+:(.*,)?$user(,|\$)" "$SROOT/etc/group" ||
+    fail "User=$user is not a member of cosmic-admin: ExecReload= (cosmicctl reload) would be refused"
 else
   fail "systemd-sysusers --root failed"
   sed 's/^/    /' "$WORK/sysusers.out" >&2
