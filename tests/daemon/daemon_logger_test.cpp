@@ -48,6 +48,7 @@ TEST(DaemonLoggerTest, JournaldGetsPriorityPrefixes) {
     cosmicd::DaemonLogger log(cosmic::LogLevel::debug);
     log.log(cosmic::LogLevel::error, "bus off");
     log.log(cosmic::LogLevel::warning, "degraded");
+    log.log(cosmic::LogLevel::notice, "audit: bind");
     log.log(cosmic::LogLevel::info, "bound");
     log.log(cosmic::LogLevel::debug, "detail");
   }
@@ -55,6 +56,7 @@ TEST(DaemonLoggerTest, JournaldGetsPriorityPrefixes) {
   const std::string text = capture.text();
   EXPECT_NE(text.find("<3>bus off\n"), std::string::npos) << text;
   EXPECT_NE(text.find("<4>degraded\n"), std::string::npos);
+  EXPECT_NE(text.find("<5>audit: bind\n"), std::string::npos);
   EXPECT_NE(text.find("<6>bound\n"), std::string::npos);
   EXPECT_NE(text.find("<7>detail\n"), std::string::npos);
 }
