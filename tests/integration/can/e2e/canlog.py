@@ -1,150 +1,126 @@
-#!/usr/bin/env python3
-"""CAN frame helpers for the end-to-end test, written from docs/can-wire-format.md alone.
+"""CAN frame helpers of the end-to-end test, written from docs/can-wire-format.md alone.
 
-    canlog.py id PRIO NODE ETAG                 29-bit identifier (section 1), 8 hex digits
-    canlog.py payload KIND SIZE [K]             test payload as hex:
-                                                  lcm K: byte i = (K*31 + i) & 0xff (cosmic-lcm-peer)
-                                                  dds K: byte i = (K + i) & 0xff    (cosmic-dds-peer)
-                                                  dev K: byte i = (K*7 + 3*i) & 0xff (our CAN device)
-    canlog.py fragment ID SEQ HEX [IFACE]       canplayer log of one event as classic fragments
-                                                (section 6, sender rules)
-    canlog.py frames LOG [ID]                   "ID DATA" per data frame of a candump -L log
-                                                (optionally only identifier ID; 11-bit frames and
-                                                the test's sync marker are skipped)
-    canlog.py reassemble LOG ID FIRST_SEQ       checks that the frames of ID in LOG follow the
-                                                classic-CAN sender rules of section 6 strictly and
-                                                prints each event's bytes as hex, one per line
-    canlog.py pass-filter LOG ETAG[,ETAG...]    number of frames in LOG that a receive filter on
-                                                these etags (29-bit data or remote frames) passes
+As a module: can_id, payload, fragments, fragment_lines (canplayer input), read_frames (candump -L
+output), reassemble (the classic-CAN sender rules of section 6, strictly). As a command, for
+poking at the bus by hand:
+
+    python3 canlog.py id PRIO NODE ETAG            the 29-bit identifier, 8 hex digits
+    python3 canlog.py fragment ID SEQ HEX          canplayer input for one fragmented event
+    python3 canlog.py reassemble LOG ID SEQ        events of ID in a candump -L log, as hex
 """
+import collections
 import re
 import sys
 
-LINE = re.compile(r"^\((?P<ts>[0-9.]+)\)\s+(?P<ifc>\S+)\s+(?P<id>[0-9A-Fa-f]+)#(?P<rest>.*)$")
-CLASSIC_FRAGMENT_DATA = 6
-
-
-def die(msg):
-    print("canlog.py: " + msg, file=sys.stderr)
-    sys.exit(1)
+CLASSIC_FRAGMENT_DATA = 6  # event bytes per classic fragment (8 - 2 header bytes)
+# One frame of a candump -L log; fd_flags is None for a classic frame, else the FD flags nibble
+# (BRS = 1, ESI = 2, FDF = 4 on newer kernels).
+Frame = collections.namedtuple("Frame", "id eff rtr fd_flags data")
+_LINE = re.compile(r"^\((?P<ts>[0-9.]+)\)\s+(?P<ifc>\S+)\s+(?P<id>[0-9A-Fa-f]+)#(?P<rest>.*)$")
 
 
 def can_id(prio, node, etag):
-    assert 0 <= prio <= 0xFF and 0 <= node <= 0x7F and 0 <= etag <= 0x3FFF
+    """Section 1: priority (8 bits) | TxNode (7 bits) | etag (14 bits)."""
+    if not (0 <= prio <= 0xFF and 0 <= node <= 0x7F and 0 <= etag <= 0x3FFF):
+        raise ValueError("field out of range: priority %r, TxNode %r, etag %r" % (prio, node, etag))
     return (prio << 21) | (node << 14) | etag
 
 
-def payload(kind, size, k):
+def payload(kind, size, k=1):
+    """Test payloads: lcm = cosmic-lcm-peer's message k, dds = cosmic-dds-peer's event k, dev = ours."""
     if kind == "lcm":
         return bytes((k * 31 + i) & 0xFF for i in range(size))
     if kind == "dds":
         return bytes((k + i) & 0xFF for i in range(size))
     if kind == "dev":
         return bytes((k * 7 + 3 * i) & 0xFF for i in range(size))
-    die("unknown payload kind " + kind)
-    return b""
+    raise ValueError("unknown payload kind " + kind)
 
 
 def fragments(data, seq):
-    """Section 6: 2-byte header (seq << 12 | last << 11 | index), then up to 6 bytes."""
+    """Section 6: big-endian header sequence (4 bits) | last (1) | index (11), then up to 6 bytes;
+    every fragment full but the last; an empty event is one header-only fragment."""
     chunks = [data[i:i + CLASSIC_FRAGMENT_DATA] for i in range(0, len(data), CLASSIC_FRAGMENT_DATA)] or [b""]
     out = []
     for index, chunk in enumerate(chunks):
-        last = index == len(chunks) - 1
-        header = ((seq & 0xF) << 12) | (0x800 if last else 0) | index
+        header = ((seq & 0xF) << 12) | (0x800 if index == len(chunks) - 1 else 0) | index
         out.append(header.to_bytes(2, "big") + chunk)
     return out
 
 
+def fragment_lines(ident, seq, data, iface="vcan0"):
+    """canplayer input (candump -L format) sending one event as fragments on identifier IDENT."""
+    return ["(%d.%06d) %s %08X#%s" % (n // 1000, (n % 1000) * 1000, iface, ident, f.hex().upper())
+            for n, f in enumerate(fragments(data, seq))]
+
+
 def read_frames(path):
-    """Data and remote frames of a candump -L log: (id, is_eff, is_rtr, is_fd, data)."""
+    """Frames of a candump -L log (Frame tuples), in order."""
     frames = []
-    with open(path, encoding="ascii", errors="replace") as f:
+    try:
+        f = open(path, encoding="ascii", errors="replace")
+    except FileNotFoundError:
+        return frames
+    with f:
         for line in f:
-            m = LINE.match(line.strip())
+            m = _LINE.match(line.strip())
             if not m:
                 continue
-            ident = m.group("id")
-            rest = m.group("rest")
-            eff = len(ident) == 8
-            value = int(ident, 16)
-            if rest.startswith("R"):
-                frames.append((value, eff, True, False, b""))
-            elif rest.startswith("#"):  # CAN FD: ##<flags nibble><data>
-                frames.append((value, eff, False, True, bytes.fromhex(rest[2:])))
-            else:
-                frames.append((value, eff, False, False, bytes.fromhex(rest)))
+            ident, rest = m.group("id"), m.group("rest")
+            value, eff = int(ident, 16), len(ident) == 8
+            try:
+                if rest.startswith("R"):
+                    frames.append(Frame(value, eff, True, None, b""))
+                elif rest.startswith("#"):  # CAN FD: ##<flags nibble><data>
+                    frames.append(Frame(value, eff, False, int(rest[1], 16), bytes.fromhex(rest[2:])))
+                else:
+                    frames.append(Frame(value, eff, False, None, bytes.fromhex(rest)))
+            except (ValueError, IndexError):
+                pass  # a line still being written
     return frames
 
 
-def cmd_frames(path, ident=None):
-    for value, eff, rtr, fd, data in read_frames(path):
-        if not eff:
-            continue
-        if ident is not None and value != ident:
-            continue
-        print("%08X %s%s" % (value, "R" if rtr else "", data.hex().upper()))
-
-
-def cmd_reassemble(path, ident, first_seq):
-    frames = [(data, rtr, fd) for value, eff, rtr, fd, data in read_frames(path) if eff and value == ident]
-    if not frames:
-        die("no frame with identifier %08X" % ident)
-    seq = first_seq & 0xF
-    expect_index = 0
-    event = bytearray()
-    for n, (data, rtr, fd) in enumerate(frames):
-        where = "frame %d of %08X (%s)" % (n, ident, data.hex().upper())
-        if rtr or fd:
-            die(where + ": remote or FD frame on a classic fragmented channel")
+def reassemble(datas, first_seq):
+    """Events carried by consecutive classic fragments (the data of each frame, in order), checked
+    against the sender rules of section 6: sequences first_seq, first_seq + 1, ... (mod 16),
+    indexes 0, 1, ... with the last bit on the final one, all but the last fragment full.
+    Raises ValueError naming the first violation."""
+    seq, expect_index, event, events = first_seq & 0xF, 0, bytearray(), []
+    for n, data in enumerate(datas):
+        where = "fragment %d (%s)" % (n, data.hex().upper())
         if len(data) < 2:
-            die(where + ": shorter than the 2-byte fragment header")
+            raise ValueError(where + ": shorter than the 2-byte header")
         header = int.from_bytes(data[:2], "big")
-        f_seq, f_last, f_index = header >> 12, bool(header & 0x800), header & 0x7FF
-        body = data[2:]
+        f_seq, last, index, body = header >> 12, bool(header & 0x800), header & 0x7FF, data[2:]
         if f_seq != seq:
-            die(where + ": sequence %d, expected %d" % (f_seq, seq))
-        if f_index != expect_index:
-            die(where + ": index %d, expected %d" % (f_index, expect_index))
-        if not f_last and len(body) != CLASSIC_FRAGMENT_DATA:
-            die(where + ": a fragment before the last must carry %d bytes" % CLASSIC_FRAGMENT_DATA)
+            raise ValueError(where + ": sequence %d, expected %d" % (f_seq, seq))
+        if index != expect_index:
+            raise ValueError(where + ": index %d, expected %d" % (index, expect_index))
+        if not last and len(body) != CLASSIC_FRAGMENT_DATA:
+            raise ValueError(where + ": a fragment before the last carries %d bytes, not %d"
+                             % (len(body), CLASSIC_FRAGMENT_DATA))
         event += body
-        if f_last:
-            print(event.hex())
-            event = bytearray()
-            expect_index = 0
-            seq = (seq + 1) & 0xF
+        if last:
+            events.append(bytes(event))
+            seq, expect_index, event = (seq + 1) & 0xF, 0, bytearray()
         else:
             expect_index += 1
-    if expect_index != 0:
-        die("the last event of %08X is incomplete (%d fragments, no last bit)" % (ident, expect_index))
-
-
-def cmd_pass_filter(path, etags):
-    wanted = {int(e, 0) for e in etags.split(",")}
-    print(sum(1 for value, eff, rtr, fd, data in read_frames(path) if eff and not fd and (value & 0x3FFF) in wanted))
+    if expect_index:
+        raise ValueError("the last event is incomplete (%d fragments, no last bit)" % expect_index)
+    return events
 
 
 def main(argv):
-    if len(argv) < 2:
-        print(__doc__, file=sys.stderr)
-        return 64
-    cmd, args = argv[1], argv[2:]
+    cmd, args = (argv[1], argv[2:]) if len(argv) > 1 else ("", [])
     if cmd == "id" and len(args) == 3:
         print("%08X" % can_id(*(int(a, 0) for a in args)))
-    elif cmd == "payload" and len(args) in (2, 3):
-        print(payload(args[0], int(args[1], 0), int(args[2], 0) if len(args) == 3 else 1).hex())
-    elif cmd == "fragment" and len(args) in (3, 4):
-        ident, seq, data = int(args[0], 16), int(args[1], 0), bytes.fromhex(args[2])
-        iface = args[3] if len(args) == 4 else "vcan0"
-        for n, frame in enumerate(fragments(data, seq)):
-            print("(%d.%06d) %s %08X#%s" % (n // 1000, (n % 1000) * 1000, iface, ident, frame.hex().upper()))
-    elif cmd == "frames" and len(args) in (1, 2):
-        cmd_frames(args[0], int(args[1], 16) if len(args) == 2 else None)
+    elif cmd == "fragment" and len(args) == 3:
+        print("\n".join(fragment_lines(int(args[0], 16), int(args[1], 0), bytes.fromhex(args[2]))))
     elif cmd == "reassemble" and len(args) == 3:
-        cmd_reassemble(args[0], int(args[1], 16), int(args[2], 0))
-    elif cmd == "pass-filter" and len(args) == 2:
-        cmd_pass_filter(args[0], args[1])
+        ident = int(args[1], 16)
+        datas = [f.data for f in read_frames(args[0]) if f.eff and f.id == ident]
+        for event in reassemble(datas, int(args[2], 0)):
+            print(event.hex())
     else:
         print(__doc__, file=sys.stderr)
         return 64
