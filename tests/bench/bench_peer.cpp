@@ -7,7 +7,7 @@
 //   cosmic-bench-peer lcm-sub --url U --channel C --count N [--timeout S] [--idle S] [--envelope]
 //                             [--dump FILE]
 //   cosmic-bench-peer dds-pub --domain D --topic T --count N --size B [--rate HZ] [--warmup W]
-//                             [--keep-last DEPTH] [--wait-go] [--match-timeout S]
+//                             [--keep-last DEPTH] [--wait-go] [--match-timeout S] [--stall S]
 //   cosmic-bench-peer dds-sub --domain D --topic T --count N [--timeout S] [--idle S] [--dump FILE]
 //
 // Payload of every event (size >= 16): bytes 0..7 = CLOCK_MONOTONIC ns when the publisher hands
@@ -29,11 +29,13 @@
 // any event once measured events flow (default 1.5 s), or at --timeout (default 60 s).
 //
 // Each program ends with one line on stdout: "RESULT key=value ...".
-//   pub: sent failed seconds rate (measured events only)
+//   pub: sent failed seconds rate (measured events only) stalled (dds-pub: 1 when the reader side
+//        stopped accepting events for --stall seconds, default 5; the run then ends, exit 5)
 //   sub: expected received lost duplicates malformed p50_us p90_us p99_us p999_us max_us mean_us
 //        span_s rate (measured events per second between the first and the last arrival)
 //        warmup_received
-// Exit 0 on success; 1 when a receiver got no measured event, 2 no match, 3 setup failure.
+// Exit 0 on success; 1 when a receiver got no measured event, 2 no match, 3 setup failure,
+// 4 a send failed, 5 dds-pub stalled.
 #include <lcm/lcm.h>
 #include <signal.h>
 #include <time.h>
@@ -81,6 +83,9 @@ constexpr std::size_t kMinSize = 16;
 
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
+// Set by a publisher whose transport stopped taking events (dds-pub: no write succeeded for
+// --stall seconds): the run ends early and says so.
+bool g_stalled = false;
 
 std::int64_t mono_ns() {
   timespec ts{};
@@ -124,7 +129,7 @@ int publish_all(std::uint64_t count, std::uint64_t size, double rate, std::uint6
   std::vector<std::uint8_t> payload(std::max<std::uint64_t>(size, kMinSize));
   const double warm_rate = rate > 0 ? std::min(rate, 5000.0) : 5000.0;
   std::int64_t start = mono_ns();
-  for (std::uint64_t k = 1; k <= warmup && !g_stop; ++k) {
+  for (std::uint64_t k = 1; k <= warmup && !g_stop && !g_stalled; ++k) {
     sleep_until_ns(start + static_cast<std::int64_t>(static_cast<double>(k - 1) * 1e9 / warm_rate));
     fill(payload, kWarmupBit | static_cast<std::uint32_t>(k));
     stamp(payload);
@@ -134,7 +139,7 @@ int publish_all(std::uint64_t count, std::uint64_t size, double rate, std::uint6
   std::uint64_t sent = 0;
   std::uint64_t failed = 0;
   start = mono_ns();
-  for (std::uint64_t k = 1; k <= count && !g_stop; ++k) {
+  for (std::uint64_t k = 1; k <= count && !g_stop && !g_stalled; ++k) {
     if (rate > 0) sleep_until_ns(start + static_cast<std::int64_t>(static_cast<double>(k - 1) * 1e9 / rate));
     fill(payload, static_cast<std::uint32_t>(k));
     stamp(payload);
@@ -145,9 +150,10 @@ int publish_all(std::uint64_t count, std::uint64_t size, double rate, std::uint6
     }
   }
   const double seconds = static_cast<double>(mono_ns() - start) / 1e9;
-  std::printf("RESULT sent=%" PRIu64 " failed=%" PRIu64 " seconds=%.6f rate=%.0f\n", sent, failed, seconds,
-              seconds > 0 ? static_cast<double>(sent) / seconds : 0.0);
+  std::printf("RESULT sent=%" PRIu64 " failed=%" PRIu64 " seconds=%.6f rate=%.0f stalled=%d\n", sent, failed,
+              seconds, seconds > 0 ? static_cast<double>(sent) / seconds : 0.0, g_stalled ? 1 : 0);
   std::fflush(stdout);
+  if (g_stalled) return 5;
   return failed == 0 && !g_stop ? 0 : 4;
 }
 
@@ -382,6 +388,7 @@ struct DdsOptions {
   int keep_last = 0;  // 0: KEEP_ALL
   bool wait_go = false;
   double match_timeout = 20;
+  double stall = 5;
   double timeout = 60;
   double idle = 1.5;
   std::string dump;
@@ -495,15 +502,24 @@ int dds_pub(const DdsOptions& o) {
     env.created_ns(static_cast<std::int64_t>(get_le(payload.data(), 8)));
     env.payload() = payload;
     ReturnCode_t r = writer->write(&env, fdds::HANDLE_NIL);
-    for (int tries = 0; tries < 100 && !g_stop &&
-                        (r == ReturnCode_t::RETCODE_TIMEOUT || r == ReturnCode_t::RETCODE_OUT_OF_RESOURCES);
-         ++tries) {
+    // A reliable KEEP_ALL writer blocks (max_blocking_time 1 s) while its history is full of
+    // unacknowledged samples; retry until --stall seconds pass without success.
+    const std::int64_t give_up = mono_ns() + static_cast<std::int64_t>(o.stall * 1e9);
+    while (!g_stop && (r == ReturnCode_t::RETCODE_TIMEOUT || r == ReturnCode_t::RETCODE_OUT_OF_RESOURCES)) {
+      if (mono_ns() >= give_up) {
+        g_stalled = true;
+        char text[160];
+        std::snprintf(text, sizeof text, "STALLED: no write accepted for %.1f s at event index %u%s", o.stall,
+                      env.sequence() & ~kWarmupBit, (env.sequence() & kWarmupBit) != 0 ? " (warm-up)" : "");
+        err_line(text);
+        return false;
+      }
       ++retries;
       r = writer->write(&env, fdds::HANDLE_NIL);
     }
     return r == ReturnCode_t::RETCODE_OK;
   });
-  writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0));
+  if (!g_stalled) writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0));
   if (retries > 0) err_line("write retries: " + std::to_string(retries));
   return rc;
 }
@@ -599,6 +615,7 @@ int main(int argc, char** argv) {
   dp->add_option("--keep-last", dd.keep_last, "KEEP_LAST depth (default KEEP_ALL)");
   dp->add_flag("--wait-go", dd.wait_go, "after matching, wait for a line on stdin");
   dp->add_option("--match-timeout", dd.match_timeout, "seconds to wait for a reader");
+  dp->add_option("--stall", dd.stall, "give up (exit 5) when no write succeeds for this many seconds");
   CLI::App* ds = app.add_subcommand("dds-sub", "receive on DDS");
   dds_common(ds);
   ds->add_option("--timeout", dd.timeout, "seconds");
