@@ -123,12 +123,17 @@ dds::DataWriterQos writer_qos(const SegmentSpec& segment, const ChannelSpec& cha
   return qos;
 }
 
+constexpr std::int32_t kReaderBufferDepth = 256;
+
 dds::DataReaderQos reader_qos(const SegmentSpec& segment, const ChannelSpec& channel) {
   dds::DataReaderQos qos = dds::DATAREADER_QOS_DEFAULT;
   qos.reliability().kind = reliability_of(segment);
   qos.durability().kind = dds::VOLATILE_DURABILITY_QOS;
   qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-  qos.history().depth = history_depth(channel.omission_degree);
+  // The reader's history only buffers between Fast DDS's receive thread and our listener's
+  // take(): deeper than the channel's own depth so a burst does not fill it. A full reliable
+  // reader rejects samples and stalls a KEEP_ALL writer until it gives up (seen under overload).
+  qos.history().depth = std::max<std::int32_t>(history_depth(channel.omission_degree), kReaderBufferDepth);
   if (channel.reaction_time) {
     qos.latency_budget().duration = to_duration(*channel.reaction_time);
   }

@@ -8,7 +8,8 @@
 //   publisher (the gateway receives there) a DataReader.
 // - QoS of the channel's endpoints (see src/dds_qos.hpp for the details and the reasons):
 //     reliability    RELIABLE if segment.reliability == reliable, else BEST_EFFORT (both ends)
-//     history        KEEP_LAST, depth max(1, omission_degree + 1) capped at 32 (both ends)
+//     history        KEEP_LAST, writer depth max(1, omission_degree + 1) capped at 32; the reader
+//                    buffers at least 256 samples between Fast DDS and our take()
 //     durability     VOLATILE (both ends)
 //     deadline       channel period         (writer only, when set)
 //     lifespan       channel temp_validity  (writer only, when set)
