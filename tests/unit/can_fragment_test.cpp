@@ -36,7 +36,10 @@ std::vector<Frame> fragment(const std::vector<std::uint8_t>& event, std::uint32_
 
 Frame fragment_frame(std::uint8_t seq, bool last, std::uint16_t index, std::vector<std::uint8_t> data) {
   const std::uint16_t h = encode_fragment_header(FragmentHeader{seq, last, index});
-  Frame f{static_cast<std::uint8_t>(h >> 8), static_cast<std::uint8_t>(h & 0xFF)};
+  Frame f;
+  f.reserve(2 + data.size());
+  f.push_back(static_cast<std::uint8_t>(h >> 8));
+  f.push_back(static_cast<std::uint8_t>(h & 0xFF));
   f.insert(f.end(), data.begin(), data.end());
   return f;
 }
