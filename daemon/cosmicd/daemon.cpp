@@ -189,7 +189,13 @@ class Daemon {
       for (const auto& error : loaded.errors) log_.log(cosmic::LogLevel::error, error.to_string());
       log_.log(cosmic::LogLevel::error, "reload refused; the running configuration is unchanged");
     } else {
-      log_verdicts(log_, gateway_.reload(loaded.config).channels);
+      const auto result = gateway_.reload(loaded.config);
+      if (!result.applied) {
+        log_.log(cosmic::LogLevel::error, "reload failed: " + result.error);
+        notifier_.reloaded(gateway_);
+        return;
+      }
+      log_verdicts(log_, result.channels);
       file_config_ = loaded.config;
       state_ = {};
       persist();

@@ -95,6 +95,7 @@ class ControlTest : public ::testing::Test {
     options.path = socket_path;
     options.max_request_bytes = 4096;
     options.max_clients = max_clients;
+    options.max_pending_output = 8192;
     server = std::make_unique<ControlServer>(options, [this](std::string_view line, const PeerCredentials& peer) {
       return protocol->handle(line, peer);
     });
@@ -200,6 +201,21 @@ TEST_F(ControlTest, OversizedRequestIsRefusedAndClosed) {
   EXPECT_EQ(Json::parse(client.read_line(), nullptr, false)["error"]["code"], "too_large");
   Client other(socket_path);
   EXPECT_EQ(other.call({{"command", "status"}})["ok"], true);
+}
+
+TEST_F(ControlTest, PipelinedRequestsAreAllAnsweredWhileOutputStaysBounded) {
+  serve();
+  Client greedy(socket_path);
+  std::string burst;
+  constexpr int kRequests = 3000;  // about 2 MB of answers against an 8 KiB output allowance
+  for (int i = 0; i < kRequests; ++i) burst += R"({"command":"channels"})" "\n";
+  std::thread sender([&] { greedy.send_raw(burst); });
+  Client other(socket_path);  // the server keeps serving others while the greedy one is paused
+  EXPECT_EQ(other.call({{"command", "status"}})["ok"], true);
+  int answers = 0;
+  while (answers < kRequests && Json::parse(greedy.read_line(), nullptr, false).value("ok", false)) ++answers;
+  sender.join();
+  EXPECT_EQ(answers, kRequests);
 }
 
 TEST_F(ControlTest, ManyClientsAtOnceAndALimit) {

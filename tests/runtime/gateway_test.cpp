@@ -143,6 +143,28 @@ TEST_F(GatewayTest, ReloadWithChangedSegmentReplacesItsAdapter) {
   expect_flow("speed", "lan", "viz");
 }
 
+TEST_F(GatewayTest, SegmentSlotsStayDistinctAcrossReloads) {
+  gateway.start(parse(kConfig));
+  std::string changed = kConfig;
+  changed.replace(changed.find("latency_bound: 2ms"), 18, "latency_bound: 3ms");  // viz moves to a new slot
+  ASSERT_TRUE(gateway.reload(parse(changed)).applied);
+  std::string grown = changed;
+  grown.replace(grown.find("channels:"), 9, R"(  - {name: x, type: lcm, url: "udpm://239.255.76.67:7001?ttl=0"}
+  - {name: y, type: lcm, url: "udpm://239.255.76.67:7002?ttl=0"}
+channels:
+  - {name: to-x, subject: 20, class: nrt, publishers: [lan], subscribers: [x]}
+  - {name: to-y, subject: 21, class: nrt, publishers: [lan], subscribers: [y]})");
+  ASSERT_TRUE(gateway.reload(parse(grown)).applied);
+  expect_flow("speed", "lan", "viz");
+  expect_flow("to-x", "lan", "x");
+  expect_flow("to-y", "lan", "y");
+  for (const char* segment : {"viz", "x", "y"}) {
+    for (const auto& sent : adapters[segment]->sent()) {
+      EXPECT_EQ(sent.channel, std::string(segment) == "viz" ? "speed" : std::string("to-") + segment) << segment;
+    }
+  }
+}
+
 TEST_F(GatewayTest, SegmentHealthDegradesItsChannels) {
   gateway.start(parse(kConfig));
   adapters["viz"]->set_health(SegmentHealth::down, "interface gone");

@@ -21,7 +21,9 @@ const ChannelStatsSnapshot* find_stats(const std::vector<ChannelStatsSnapshot>& 
 Json bind_answer(const BindResult& result) {
   Json out{{"ok", result.applied}, {"applied", result.applied}, {"channels", Json::array()}};
   for (const auto& c : result.channels) out["channels"].push_back(to_json(c));
-  if (!result.applied) out["error"] = {{"code", "rejected"}, {"message", result.error}};
+  const bool rejected = std::any_of(result.channels.begin(), result.channels.end(),
+                                    [](const ChannelReport& c) { return c.verdict == Verdict::rejected; });
+  if (!result.applied) out["error"] = {{"code", rejected ? "rejected" : "bind_failed"}, {"message", result.error}};
   return out;
 }
 
@@ -50,11 +52,14 @@ std::string ControlProtocol::handle(std::string_view request_line, const PeerCre
   } else {
     try {
       response = dispatch(request, peer);
-    } catch (const std::exception& e) {
+    } catch (const Json::exception& e) {
       response = failure("bad_request", std::string("malformed request: ") + e.what());
+    } catch (const std::exception& e) {
+      response = failure("internal_error", e.what());
     }
   }
-  return response.dump() + "\n";
+  // Texts quoted from files or interfaces may hold invalid UTF-8: replace it, never throw.
+  return response.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n";
 }
 
 Json ControlProtocol::dispatch(const Json& request, const PeerCredentials& peer) {

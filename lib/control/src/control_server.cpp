@@ -155,14 +155,9 @@ void ControlServer::on_client(int fd, std::uint32_t events) {
       if (n < 0 && errno == EINTR) continue;
       break;
     }
-    std::size_t newline;
-    while (!client.in.empty() && (newline = client.in.find('\n')) != std::string::npos) {
-      if (newline > options_.max_request_bytes) break;
-      const std::string line = client.in.substr(0, newline);
-      client.in.erase(0, newline + 1);
-      if (!line.empty()) client.out += handler_(line, client.peer);
-    }
-    if (client.in.size() > options_.max_request_bytes) {
+    answer_requests(client);
+    const std::size_t newline = client.in.find('\n');
+    if ((newline == std::string::npos ? client.in.size() : newline) > options_.max_request_bytes) {
       client.out += kTooLarge;
       client.in.clear();
       client.closing = true;
@@ -176,27 +171,50 @@ void ControlServer::on_client(int fd, std::uint32_t events) {
   flush(fd, client);
 }
 
+void ControlServer::answer_requests(Client& client) {
+  std::size_t newline;
+  while (client.out.size() < options_.max_pending_output && (newline = client.in.find('\n')) != std::string::npos &&
+         newline <= options_.max_request_bytes) {
+    const std::string line = client.in.substr(0, newline);
+    client.in.erase(0, newline + 1);
+    if (!line.empty()) client.out += handler_(line, client.peer);
+  }
+}
+
 void ControlServer::flush(int fd, Client& client) {
-  while (!client.out.empty()) {
-    const ssize_t n = ::send(fd, client.out.data(), client.out.size(), MSG_NOSIGNAL);
-    if (n > 0) {
-      client.out.erase(0, static_cast<std::size_t>(n));
-      continue;
+  while (true) {
+    while (!client.out.empty()) {
+      const ssize_t n = ::send(fd, client.out.data(), client.out.size(), MSG_NOSIGNAL);
+      if (n > 0) {
+        client.out.erase(0, static_cast<std::size_t>(n));
+        continue;
+      }
+      if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+        update_interest(fd, client);  // the rest when the socket drains (EPOLLOUT)
+        return;
+      }
+      drop(fd);
+      return;
     }
-    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) break;
-    drop(fd);
+    if (client.in.find('\n') != std::string::npos) {
+      answer_requests(client);  // requests held back while the output was full
+      if (!client.out.empty()) continue;
+    }
+    if (client.closing) {
+      drop(fd);
+      return;
+    }
+    update_interest(fd, client);
     return;
   }
-  if (client.out.empty() && client.closing) {
-    drop(fd);
-    return;
-  }
-  update_interest(fd, client);
 }
 
 void ControlServer::update_interest(int fd, const Client& client) {
   epoll_event event{};
-  event.events = EPOLLIN | EPOLLRDHUP | (client.out.empty() ? 0u : static_cast<std::uint32_t>(EPOLLOUT));
+  // A client with a full output buffer is not read until it reads its answers.
+  const bool room = client.out.size() < options_.max_pending_output;
+  event.events = EPOLLRDHUP | (room ? static_cast<std::uint32_t>(EPOLLIN) : 0u) |
+                 (client.out.empty() ? 0u : static_cast<std::uint32_t>(EPOLLOUT));
   event.data.fd = fd;
   ::epoll_ctl(epoll_fd_, EPOLL_CTL_MOD, fd, &event);
 }

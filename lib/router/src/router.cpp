@@ -106,9 +106,9 @@ Router::Router(GatewayIdentity self, std::size_t segment_capacity, RouterLimits 
       clock_(clock),
       adapters_(segment_names_.size(), nullptr),
       unrouted_(new std::atomic<std::uint64_t>[segment_names_.size()]()),
-      hrt_(std::make_unique<ClassQueue>(limits.hrt_queue, SIZE_MAX)),
-      srt_(std::make_unique<ClassQueue>(limits.srt_queue, SIZE_MAX)),
-      nrt_(std::make_unique<ClassQueue>(limits.nrt_queue, limits.nrt_queue_bytes)),
+      hrt_(std::make_unique<ClassQueue>(limits.hrt_queue, limits.queue_bytes)),
+      srt_(std::make_unique<ClassQueue>(limits.srt_queue, limits.queue_bytes)),
+      nrt_(std::make_unique<ClassQueue>(limits.nrt_queue, limits.queue_bytes)),
       scratch_(std::make_unique<Slot>()) {
   for (std::size_t i = 0; i < segment_names_.size(); ++i) inboxes_.push_back(std::make_unique<SegmentInbox>(*this, i));
 }
@@ -130,8 +130,9 @@ void Router::apply(std::vector<Route> routes) {
     std::shared_lock lock(table_mutex_);
     for (auto& route : routes) {
       auto existing = std::find_if(table_.begin(), table_.end(), [&](const auto& s) { return s->route.id == route.id; });
-      if (existing != table_.end() && (*existing)->route.spec.period == route.spec.period) {
-        (*existing)->route = std::move(route);
+      // A route is never changed in place: adapter threads and the router thread read it
+      // without the table lock. A changed route gets a fresh state (and fresh counters).
+      if (existing != table_.end() && (*existing)->route == route) {
         table.push_back(*existing);
       } else {
         table.push_back(std::make_shared<ChannelState>(std::move(route), segment_names_.size(), limits_.rate_burst));

@@ -18,9 +18,10 @@ std::unique_ptr<KnowledgeBase> Gateway::knowledge_base_for(const Config& config)
   return std::make_unique<KnowledgeBase>(config.gateway, config.segments, reserved);
 }
 
-std::size_t Gateway::free_slot() const {
+std::size_t Gateway::free_slot(const std::set<std::size_t>& also_taken) const {
   for (std::size_t i = 0; i < kMaxSegments; ++i) {
-    const bool used = std::any_of(slots_.begin(), slots_.end(), [&](const auto& s) { return s.second.index == i; });
+    const bool used = also_taken.count(i) > 0 ||
+                      std::any_of(slots_.begin(), slots_.end(), [&](const auto& s) { return s.second.index == i; });
     if (!used) return i;
   }
   return kMaxSegments;
@@ -142,8 +143,9 @@ BindResult Gateway::reload(const Config& config) {
   for (const auto& spec : config.segments) {
     const auto running = slots_.find(spec.name);
     if (running != slots_.end() && running->second.spec == spec) continue;
-    std::size_t index = free_slot();
-    for (const auto& [n, s] : fresh) index = std::max(index, s.index + 1);
+    std::set<std::size_t> taken;
+    for (const auto& [n, s] : fresh) taken.insert(s.index);
+    const std::size_t index = free_slot(taken);
     SegmentSlot slot{index, spec, index < kMaxSegments ? factory_(spec, identity_, log_) : nullptr};
     if (!slot.adapter) {
       for (auto& [n, s] : fresh) {
@@ -169,10 +171,15 @@ BindResult Gateway::reload(const Config& config) {
     it = slots_.erase(it);
   }
   for (auto& [name, slot] : fresh) slots_.emplace(name, std::move(slot));
+  if (config.gateway.control_socket != config_.gateway.control_socket) {
+    log_.log(LogLevel::warning, "gateway.control_socket changes take effect at the next start");
+  }
   config_ = config;
+  identity_.name = config.gateway.name;
   kb_ = std::move(next_kb);
-  apply_routes();
+  // As in bind(): adapters carry the new channels before the router sends to them.
   if (auto error = configure_adapters()) log_.log(LogLevel::error, *error);
+  apply_routes();
   for (auto& slot : retired) {
     router_->set_segment(slot.index, "", nullptr);
     slot.adapter->stop();

@@ -19,6 +19,7 @@ struct ControlServerOptions {
   std::string path;
   std::size_t max_request_bytes = 64 * 1024;
   std::size_t max_clients = 32;
+  std::size_t max_pending_output = 1u << 20;  // a client that does not read its answers is paused
   std::chrono::milliseconds idle_timeout{30'000};
   mode_t socket_mode = 0660;
   mode_t directory_mode = 0750;      // for a directory the server has to create
@@ -54,6 +55,8 @@ class ControlServer {
   void accept_clients();
   void on_client(int fd, std::uint32_t events);
   void flush(int fd, Client& client);
+  // Answers the complete request lines buffered for `client` while its output has room.
+  void answer_requests(Client& client);
   void drop(int fd);
   void expire_idle();
   void update_interest(int fd, const Client& client);

@@ -33,13 +33,14 @@ struct Route {
   ChannelSpec spec;
   std::vector<std::size_t> publishers;   // segment indices
   std::vector<std::size_t> subscribers;  // segment indices
+  friend bool operator==(const Route&, const Route&) = default;
 };
 
 struct RouterLimits {
   std::size_t hrt_queue = 256;
   std::size_t srt_queue = 1024;
   std::size_t nrt_queue = 1024;
-  std::size_t nrt_queue_bytes = 16u << 20;  // NRT events may be large: bounded by bytes too
+  std::size_t queue_bytes = 16u << 20;  // each class queue is also bounded by bytes (large events)
   std::uint32_t rate_burst = 3;              // events a channel may bank beyond its rate
 };
 
@@ -61,8 +62,8 @@ class Router {
   void set_segment(std::size_t index, std::string name, SegmentAdapter* adapter);
   std::size_t segment_capacity() const { return segment_names_.size(); }
 
-  // Replaces the route table. Channels whose id is kept keep their counters, rate and duplicate
-  // state; queued events of removed channels are dropped silently.
+  // Replaces the route table. Channels whose route is unchanged keep their counters, rate and
+  // duplicate state; queued events of removed or changed channels are dropped silently.
   void apply(std::vector<Route> routes);
 
   // Router thread: dispatches queued events until none is left or `budget` were handled;

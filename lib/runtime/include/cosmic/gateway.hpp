@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -84,7 +85,8 @@ class Gateway {
   std::optional<std::string> configure_adapters();
   void apply_routes();
   ChannelId id_for(const ChannelSpec& spec);
-  std::size_t free_slot() const;
+  // Lowest slot index used neither by a running segment nor by one in `also_taken`.
+  std::size_t free_slot(const std::set<std::size_t>& also_taken = {}) const;
   static std::unique_ptr<KnowledgeBase> knowledge_base_for(const Config& config);
 
   AdapterFactory factory_;
