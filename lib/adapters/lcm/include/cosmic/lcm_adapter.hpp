@@ -1,7 +1,7 @@
 // LCM segment adapter: one lcm_t per segment (SegmentSpec::lcm.url) with its own receive thread.
 //
 // LCM channel name = COSMIC channel name. Per channel (ChannelSpec::lcm_encoding):
-//   envelope  the cosmic::envelope type (lib/adapters/lcm/lcmtypes/cosmic_envelope.lcm, generated
+//   envelope  the cosmic::envelope type (lib/adapters/lcm/types/cosmic_envelope.lcm, generated
 //             by lcm-gen at build time) carrying the event header and the payload;
 //   raw       the payload bytes unchanged, so native LCM programs, lcm-logger and lcm-spy see
 //             their own type; inbound raw messages become events with origin 0, sequence 0,
