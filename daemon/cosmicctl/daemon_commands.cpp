@@ -7,21 +7,17 @@
 
 #include "commands.hpp"
 #include "control_client.hpp"
+#include "cosmic/report.hpp"
+#include "cosmic/units.hpp"
 
 namespace cosmicctl {
 namespace {
 
 using Json = nlohmann::json;
+using cosmic::format_percent;
+using cosmic::pad_column;
 
-std::string pad(const std::string& text, std::size_t width) {
-  return text.size() >= width ? text + " " : text + std::string(width - text.size(), ' ');
-}
 
-std::string percent(double ratio) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.1f%%", ratio * 100.0);
-  return buffer;
-}
 
 std::string micros(double seconds) {
   char buffer[32];
@@ -48,7 +44,7 @@ int exit_code_for_failure(const Json& response) {
 
 void print_verdicts(const Json& channels) {
   for (const auto& c : channels) {
-    std::cout << pad(text(c["name"]), 20) << pad(text(c["class"]), 5) << text(c["verdict"]) << "\n";
+    std::cout << pad_column(text(c["name"]), 20) << pad_column(text(c["class"]), 5) << text(c["verdict"]) << "\n";
     for (const auto& r : c["reasons"]) std::cout << "    - " << text(r) << "\n";
     for (const auto& hop : c["hops"]) {
       for (const auto& check : hop["checks"]) {
@@ -73,15 +69,15 @@ void print_status(const Json& r) {
 }
 
 void print_segments(const Json& r) {
-  std::cout << pad("SEGMENT", 14) << pad("TYPE", 5) << pad("HEALTH", 9) << pad("UTIL", 7) << pad("LIMIT", 7) << pad("CHANNELS", 9)
-            << pad("RX", 9) << pad("TX", 9) << pad("ERRORS", 7) << pad("OVERFLOW", 9) << "DETAIL\n";
+  std::cout << pad_column("SEGMENT", 14) << pad_column("TYPE", 5) << pad_column("HEALTH", 9) << pad_column("UTIL", 7) << pad_column("LIMIT", 7) << pad_column("CHANNELS", 9)
+            << pad_column("RX", 9) << pad_column("TX", 9) << pad_column("ERRORS", 7) << pad_column("OVERFLOW", 9) << "DETAIL\n";
   for (const auto& s : r["segments"]) {
     const Json& a = s["adapter"];
-    std::cout << pad(text(s["name"]), 14) << pad(text(s["type"]), 5) << pad(text(s["health"]), 9)
-              << pad(percent(s["utilization"].get<double>()), 7) << pad(percent(s["max_utilization"].get<double>()), 7)
-              << pad(text(s["channels"]), 9) << pad(text(a["received"]), 9) << pad(text(a["sent"]), 9)
-              << pad(std::to_string(a["receive_errors"].get<std::uint64_t>() + a["send_errors"].get<std::uint64_t>()), 7)
-              << pad(text(a["overflow_drops"]), 9) << text(s["detail"]) << "\n";
+    std::cout << pad_column(text(s["name"]), 14) << pad_column(text(s["type"]), 5) << pad_column(text(s["health"]), 9)
+              << pad_column(format_percent(s["utilization"].get<double>()), 7) << pad_column(format_percent(s["max_utilization"].get<double>()), 7)
+              << pad_column(text(s["channels"]), 9) << pad_column(text(a["received"]), 9) << pad_column(text(a["sent"]), 9)
+              << pad_column(std::to_string(a["receive_errors"].get<std::uint64_t>() + a["send_errors"].get<std::uint64_t>()), 7)
+              << pad_column(text(a["overflow_drops"]), 9) << text(s["detail"]) << "\n";
   }
 }
 
@@ -95,17 +91,17 @@ std::string drops_text(const Json& dropped) {
 }
 
 void print_channels(const Json& r) {
-  std::cout << pad("CHANNEL", 16) << pad("CLASS", 6) << pad("VERDICT", 9) << pad("ETAG", 6) << pad("SEGMENT", 12) << pad("ROLE", 4)
-            << pad("RX", 9) << pad("TX", 9) << pad("RESIDENCE p50/p99", 19) << "DROPPED\n";
+  std::cout << pad_column("CHANNEL", 16) << pad_column("CLASS", 6) << pad_column("VERDICT", 9) << pad_column("ETAG", 6) << pad_column("SEGMENT", 12) << pad_column("ROLE", 4)
+            << pad_column("RX", 9) << pad_column("TX", 9) << pad_column("RESIDENCE p50/p99", 19) << "DROPPED\n";
   for (const auto& c : r["channels"]) {
     bool first = true;
     const std::string residence =
         micros(c["residence"]["p50_s"].get<double>()) + "/" + micros(c["residence"]["p99_s"].get<double>());
     for (const auto& s : c["segments"]) {
-      std::cout << pad(first ? text(c["name"]) : "", 16) << pad(first ? text(c["class"]) : "", 6)
-                << pad(first ? text(c["verdict"]) : "", 9) << pad(first && c.contains("etag") ? text(c["etag"]) : "", 6)
-                << pad(text(s["segment"]), 12) << pad(s["role"] == "publisher" ? "P" : "S", 4) << pad(text(s["rx"]), 9)
-                << pad(text(s["tx"]), 9) << pad(first ? residence : "", 19) << drops_text(s["dropped"]) << "\n";
+      std::cout << pad_column(first ? text(c["name"]) : "", 16) << pad_column(first ? text(c["class"]) : "", 6)
+                << pad_column(first ? text(c["verdict"]) : "", 9) << pad_column(first && c.contains("etag") ? text(c["etag"]) : "", 6)
+                << pad_column(text(s["segment"]), 12) << pad_column(s["role"] == "publisher" ? "P" : "S", 4) << pad_column(text(s["rx"]), 9)
+                << pad_column(text(s["tx"]), 9) << pad_column(first ? residence : "", 19) << drops_text(s["dropped"]) << "\n";
       first = false;
     }
     for (const auto& reason : c["reasons"]) std::cout << "    - " << text(reason) << "\n";
@@ -125,7 +121,7 @@ void print_channel(const Json& r) {
     }
     std::cout << "\n";
     for (const auto& check : hop["checks"]) {
-      std::cout << "    " << (check["ok"].get<bool>() ? "ok   " : "FAIL ") << pad(text(check["check"]), 14) << text(check["value"])
+      std::cout << "    " << (check["ok"].get<bool>() ? "ok   " : "FAIL ") << pad_column(text(check["check"]), 14) << text(check["value"])
                 << " " << text(check["relation"]) << " " << text(check["limit"]) << " " << text(check["unit"]) << "\n";
     }
   }

@@ -28,11 +28,6 @@ struct HopRef {
 
 double seconds_or_infinity(const std::optional<Nanos>& value) { return value ? to_seconds(*value) : kInfinity; }
 
-std::string percent(double ratio) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.1f%%", ratio * 100.0);
-  return buffer;
-}
 
 Nanos deadline_key(const ChannelSpec& channel) {
   if (channel.reaction_time) return *channel.reaction_time;
@@ -276,7 +271,7 @@ class Evaluator {
              std::to_string(static_cast<long long>(check.limit)) + " B" + on;
     }
     if (check.check == "utilization") {
-      return "utilization " + percent(check.value) + " > max_utilization " + percent(check.limit) + on;
+      return "utilization " + format_percent(check.value) + " > max_utilization " + format_percent(check.limit) + on;
     }
     if (check.check == "response_time") {
       return "R = " + format_seconds(check.value) + " > reaction_time " + format_seconds(check.limit) + on;

@@ -143,6 +143,12 @@ std::string format_seconds(double seconds) {
 
 std::string format_duration(Nanos value) { return format_seconds(to_seconds(value)); }
 
+std::string format_percent(double ratio) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.1f%%", ratio * 100.0);
+  return buffer;
+}
+
 std::string format_bitrate(BitRate value) {
   char buffer[64];
   const double bps = static_cast<double>(value.bits_per_second);

@@ -40,19 +40,11 @@ nlohmann::json to_json(const HopReport& hop) {
   return out;
 }
 
-std::string percent(double ratio) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.1f%%", ratio * 100.0);
-  return buffer;
-}
 
-std::string pad(const std::string& text, std::size_t width) {
-  return text.size() >= width ? text + " " : text + std::string(width - text.size(), ' ');
-}
 
 std::string check_value_text(const Check& check) {
   if (check.unit == "s") return format_seconds(check.value);
-  if (check.unit == "ratio") return percent(check.value);
+  if (check.unit == "ratio") return format_percent(check.value);
   if (check.unit == "B") return std::to_string(static_cast<long long>(check.value)) + " B";
   if (check.unit == "bool") return check.value >= 1.0 ? "yes" : "no";
   return std::to_string(static_cast<long long>(check.value));
@@ -65,6 +57,10 @@ std::string limit_text(const Check& check) {
 }
 
 }  // namespace
+
+std::string pad_column(const std::string& text, std::size_t width) {
+  return text.size() >= width ? text + " " : text + std::string(width - text.size(), ' ');
+}
 
 nlohmann::json to_json(const ChannelReport& channel) {
   nlohmann::json out{{"name", channel.name}, {"class", to_string(channel.cls)}, {"verdict", to_string(channel.verdict)},
@@ -106,17 +102,17 @@ nlohmann::json to_json(const std::vector<ConfigError>& errors) {
 
 std::string render_text(const AdmissionReport& report) {
   std::ostringstream out;
-  out << pad("SEGMENT", 16) << pad("TYPE", 6) << pad("UTILIZATION", 13) << "LIMIT\n";
+  out << pad_column("SEGMENT", 16) << pad_column("TYPE", 6) << pad_column("UTILIZATION", 13) << "LIMIT\n";
   for (const auto& s : report.segments) {
-    out << pad(s.name, 16) << pad(to_string(s.type), 6) << pad(percent(s.utilization), 13) << percent(s.max_utilization)
+    out << pad_column(s.name, 16) << pad_column(to_string(s.type), 6) << pad_column(format_percent(s.utilization), 13) << format_percent(s.max_utilization)
         << "\n";
   }
-  out << "\n" << pad("CHANNEL", 20) << pad("CLASS", 6) << pad("VERDICT", 10) << pad("END-TO-END", 12) << "DETAILS\n";
+  out << "\n" << pad_column("CHANNEL", 20) << pad_column("CLASS", 6) << pad_column("VERDICT", 10) << pad_column("END-TO-END", 12) << "DETAILS\n";
   for (const auto& c : report.channels) {
     const std::string e2e = c.end_to_end.latency ? format_duration(*c.end_to_end.latency) : "unbounded";
     std::string details;
     if (c.end_to_end.reaction_time) details = "<= " + format_duration(*c.end_to_end.reaction_time) + " required";
-    out << pad(c.name, 20) << pad(to_string(c.cls), 6) << pad(to_string(c.verdict), 10) << pad(e2e, 12) << details << "\n";
+    out << pad_column(c.name, 20) << pad_column(to_string(c.cls), 6) << pad_column(to_string(c.verdict), 10) << pad_column(e2e, 12) << details << "\n";
     for (const auto& reason : c.reasons) out << "    - " << reason << "\n";
   }
   std::size_t bound = 0;
@@ -145,7 +141,7 @@ std::string render_channel_text(const ChannelReport& channel) {
     }
     out << "\n";
     for (const auto& check : hop.checks) {
-      out << "    " << (check.ok ? "ok   " : "FAIL ") << pad(check.check, 14) << check_value_text(check) << " "
+      out << "    " << (check.ok ? "ok   " : "FAIL ") << pad_column(check.check, 14) << check_value_text(check) << " "
           << check.relation << " " << limit_text(check) << "\n";
     }
   }

@@ -40,6 +40,8 @@ Parsed<double> parse_frequency(std::string_view text);
 std::string format_duration(Nanos value);
 std::string format_seconds(double seconds);
 std::string format_bitrate(BitRate value);
+// 0.7 -> "70.0%"
+std::string format_percent(double ratio);
 
 double to_seconds(Nanos value);
 

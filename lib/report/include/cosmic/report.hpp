@@ -15,6 +15,9 @@ nlohmann::json to_json(const SegmentLoad& segment);
 nlohmann::json to_json(const AdmissionReport& report);
 nlohmann::json to_json(const std::vector<ConfigError>& errors);
 
+// `text` left-aligned in a column of `width` characters (at least one space after it).
+std::string pad_column(const std::string& text, std::size_t width);
+
 std::string render_text(const AdmissionReport& report);
 // One channel with every hop and every check.
 std::string render_channel_text(const ChannelReport& channel);
