@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
@@ -23,6 +24,7 @@
 #include <vector>
 
 #include "can_binding.hpp"
+#include "cosmic/arrival_clock.hpp"
 #include "cosmic/can_fragment.hpp"
 #include "cosmic/can_timing.hpp"
 #include "cosmic/can_wire.hpp"
@@ -42,6 +44,7 @@ constexpr Nanos kLinkCheckWhileDown = milliseconds(200);
 constexpr Nanos kLinkCheckWhileUp = milliseconds(1000);
 constexpr Nanos kEnobufsRetry = milliseconds(1);
 constexpr int kFramesPerWakeup = 256;
+constexpr std::size_t kReadBatch = 32;  // frames per recvmmsg
 constexpr std::size_t kFdPaddingSlack = 15;  // 48 -> 64 is the largest step between FD lengths
 constexpr can_err_mask_t kErrorMask = CAN_ERR_CRTL | CAN_ERR_BUSOFF | CAN_ERR_RESTARTED;
 
@@ -105,6 +108,8 @@ class CanAdapter final : public SegmentAdapter {
   bool open_socket(int ifindex);
   void close_socket();
   void read_frames();
+  void handle_read_error(int err);
+  void handle_datagram(canfd_frame& frame, msghdr& msg, std::size_t bytes);
   void handle_frame(const canfd_frame& frame, bool fd_frame, Nanos now);
   void handle_error_frame(const canfd_frame& frame);
   void handle_get_etag(const canfd_frame& frame, std::size_t len);
@@ -424,6 +429,7 @@ bool CanAdapter::open_socket(int ifindex) {
     return fail("CAN_RAW_ERR_FILTER");
   }
   if (::setsockopt(s, SOL_SOCKET, SO_RXQ_OVFL, &on, sizeof on) != 0) return fail("SO_RXQ_OVFL");
+  if (::setsockopt(s, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on) != 0) return fail("SO_TIMESTAMPNS");
 
   // Filters go on before bind: no frame of an unbound etag is ever queued to this socket. A
   // configure() racing with this is caught below by the generation check.
@@ -558,52 +564,76 @@ void CanAdapter::run() {
   }
 }
 
+// Reads what the socket holds in batches of kReadBatch frames per system call (recvmmsg), each
+// with its kernel arrival time (SO_TIMESTAMPNS) and the socket's drop count (SO_RXQ_OVFL).
 void CanAdapter::read_frames() {
   const int s = sock_;  // only this thread changes sock_
-  for (int i = 0; i < kFramesPerWakeup && s >= 0 && sock_ == s; ++i) {
-    canfd_frame frame{};
-    iovec iov{&frame, sizeof frame};
-    alignas(cmsghdr) char control[CMSG_SPACE(sizeof(std::uint32_t))];
-    msghdr msg{};
-    msg.msg_iov = &iov;
-    msg.msg_iovlen = 1;
-    msg.msg_control = control;
-    msg.msg_controllen = sizeof control;
-    const ssize_t n = ::recvmsg(s, &msg, MSG_DONTWAIT);
+  constexpr std::size_t kControlBytes = CMSG_SPACE(sizeof(timespec)) + CMSG_SPACE(sizeof(std::uint32_t));
+  struct Slot {
+    canfd_frame frame;
+    iovec iov;
+    alignas(cmsghdr) char control[kControlBytes];
+  };
+  std::array<Slot, kReadBatch> slots;
+  std::array<mmsghdr, kReadBatch> messages;
+  for (int round = 0; round < kFramesPerWakeup / static_cast<int>(kReadBatch) && s >= 0 && sock_ == s; ++round) {
+    for (std::size_t i = 0; i < kReadBatch; ++i) {
+      slots[i].iov = iovec{&slots[i].frame, sizeof(canfd_frame)};
+      messages[i] = mmsghdr{};
+      messages[i].msg_hdr.msg_iov = &slots[i].iov;
+      messages[i].msg_hdr.msg_iovlen = 1;
+      messages[i].msg_hdr.msg_control = slots[i].control;
+      messages[i].msg_hdr.msg_controllen = kControlBytes;
+    }
+    const int n = ::recvmmsg(s, messages.data(), kReadBatch, MSG_DONTWAIT, nullptr);
     if (n < 0) {
-      const int err = errno;
-      if (err == EAGAIN || err == EWOULDBLOCK || err == EINTR) return;
-      if (err == ENETDOWN) {
-        set_link(Link::down, "interface " + segment_.can.interface + " is down");
-        next_link_check_ = steady_now() + kLinkCheckWhileDown;
-        return;
-      }
-      if (err == ENODEV) {
-        close_socket();
-        set_link(Link::down, "no such interface " + segment_.can.interface);
-        next_link_check_ = steady_now() + kLinkCheckWhileDown;
-        return;
-      }
-      ++receive_errors_;
-      log_.log(LogLevel::warning, "segment " + segment_.name + ": recvmsg: " + errno_text(err));
+      handle_read_error(errno);
       return;
     }
-    for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c)) {
-      if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_RXQ_OVFL) {
-        std::uint32_t drops = 0;
-        std::memcpy(&drops, CMSG_DATA(c), sizeof drops);
-        overflow_socket_ = drops;
-      }
+    for (int i = 0; i < n; ++i) handle_datagram(slots[i].frame, messages[i].msg_hdr, messages[i].msg_len);
+    if (static_cast<std::size_t>(n) < kReadBatch) return;  // drained
+  }
+}
+
+void CanAdapter::handle_read_error(int err) {
+  if (err == EAGAIN || err == EWOULDBLOCK || err == EINTR) return;
+  if (err == ENETDOWN) {
+    set_link(Link::down, "interface " + segment_.can.interface + " is down");
+    next_link_check_ = steady_now() + kLinkCheckWhileDown;
+    return;
+  }
+  if (err == ENODEV) {
+    close_socket();
+    set_link(Link::down, "no such interface " + segment_.can.interface);
+    next_link_check_ = steady_now() + kLinkCheckWhileDown;
+    return;
+  }
+  ++receive_errors_;
+  log_.log(LogLevel::warning, "segment " + segment_.name + ": recvmmsg: " + errno_text(err));
+}
+
+void CanAdapter::handle_datagram(canfd_frame& frame, msghdr& msg, std::size_t bytes) {
+  std::int64_t arrival_ns = 0;
+  for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c)) {
+    if (c->cmsg_level != SOL_SOCKET) continue;
+    if (c->cmsg_type == SO_RXQ_OVFL) {
+      std::uint32_t drops = 0;
+      std::memcpy(&drops, CMSG_DATA(c), sizeof drops);
+      overflow_socket_ = drops;
+    } else if (c->cmsg_type == SO_TIMESTAMPNS) {
+      timespec ts{};
+      std::memcpy(&ts, CMSG_DATA(c), sizeof ts);
+      arrival_ns = static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
     }
-    const Nanos now = steady_now();
-    if (static_cast<std::size_t>(n) == CAN_MTU) {
-      frame.flags = 0;  // the byte is padding in struct can_frame
-      handle_frame(frame, false, now);
-    } else if (static_cast<std::size_t>(n) == CANFD_MTU) {
-      handle_frame(frame, true, now);
-    } else {
-      problem(kNoChannel, InboundProblem::decode_error);
-    }
+  }
+  const Nanos arrival = steady_arrival_now(arrival_ns);
+  if (bytes == CAN_MTU) {
+    frame.flags = 0;  // the byte is padding in struct can_frame
+    handle_frame(frame, false, arrival);
+  } else if (bytes == CANFD_MTU) {
+    handle_frame(frame, true, arrival);
+  } else {
+    problem(kNoChannel, InboundProblem::decode_error);
   }
 }
 
@@ -806,9 +836,10 @@ void CanAdapter::drain_backlog() {
 
 SendStatus CanAdapter::send(const OutboundEvent& event) {
   try {
-    std::lock_guard lock(io_mutex_);
-    const auto it = table_->tx.find(event.channel);
-    if (it == table_->tx.end() || !started_ || !link_up_ || sock_ < 0 || event.payload.size() > it->second.payload) {
+    std::unique_lock lock(io_mutex_);
+    const std::shared_ptr<const Table> table = table_;  // kept alive while the lock is given up
+    const auto it = table->tx.find(event.channel);
+    if (it == table->tx.end() || !started_ || !link_up_ || sock_ < 0 || event.payload.size() > it->second.payload) {
       ++send_errors_;
       return SendStatus::failed;
     }
@@ -844,11 +875,18 @@ SendStatus CanAdapter::send(const OutboundEvent& event) {
     std::uint8_t& sequence = tx_sequence_[channel.etag];
     Fragmenter fragments(event.payload, capacity_, sequence);
     sequence = static_cast<std::uint8_t>((sequence + 1) % kFragmentSequenceModulo);
+    // The lock is given up between fragments, so a higher class sending on this bus from its own
+    // thread waits for at most one frame write, not for a whole fragmented event.
     while (!fragments.done()) {
       const std::size_t len = fragments.next(std::span<std::uint8_t>(frame.data, capacity_));
       finish(len);
       const WriteResult r = submit(frame, fd);
       if (r == WriteResult::failed || r == WriteResult::full) return SendStatus::failed;
+      if (!fragments.done()) {
+        lock.unlock();
+        lock.lock();
+        if (sock_ < 0) return SendStatus::failed;
+      }
     }
     return SendStatus::sent;
   } catch (...) {
