@@ -64,7 +64,8 @@ void print_status(const Json& r) {
   const Json& g = r["gateway"];
   std::cout << text(g["name"]) << " (id " << text(g["id"]) << "), up " << static_cast<long>(g["uptime_s"].get<double>()) << " s\n"
             << "segments: " << r["segments"]["up"] << "/" << r["segments"]["total"] << " up\n"
-            << "channels: " << r["channels"]["bound"] << " bound, " << r["channels"]["degraded"] << " degraded\n"
+            << "channels: " << r["channels"]["bound"] << " bound, " << r["channels"]["degraded"] << " degraded, "
+            << r["channels"].value("violated", 0) << " violated at run time\n"
             << "router:   " << r["router"]["queued"] << " queued, " << r["router"]["progress"] << " events handled\n";
 }
 
@@ -91,15 +92,18 @@ std::string drops_text(const Json& dropped) {
 }
 
 void print_channels(const Json& r) {
-  std::cout << pad_column("CHANNEL", 16) << pad_column("CLASS", 6) << pad_column("VERDICT", 9) << pad_column("ETAG", 6) << pad_column("SEGMENT", 12) << pad_column("ROLE", 4)
-            << pad_column("RX", 9) << pad_column("TX", 9) << pad_column("RESIDENCE p50/p99", 19) << "DROPPED\n";
+  std::cout << pad_column("CHANNEL", 16) << pad_column("CLASS", 6) << pad_column("VERDICT", 9) << pad_column("RUNTIME", 9) << pad_column("ETAG", 6)
+            << pad_column("SEGMENT", 12) << pad_column("ROLE", 4) << pad_column("RX", 9) << pad_column("TX", 9) << pad_column("RESIDENCE p50/p99", 19)
+            << "DROPPED\n";
   for (const auto& c : r["channels"]) {
     bool first = true;
     const std::string residence =
         micros(c["residence"]["p50_s"].get<double>()) + "/" + micros(c["residence"]["p99_s"].get<double>());
+    const std::string runtime = c.value("runtime_state", "bound") == "violated" ? "VIOLATED" : "ok";
     for (const auto& s : c["segments"]) {
       std::cout << pad_column(first ? text(c["name"]) : "", 16) << pad_column(first ? text(c["class"]) : "", 6)
-                << pad_column(first ? text(c["verdict"]) : "", 9) << pad_column(first && c.contains("etag") ? text(c["etag"]) : "", 6)
+                << pad_column(first ? text(c["verdict"]) : "", 9) << pad_column(first ? runtime : "", 9)
+                << pad_column(first && c.contains("etag") ? text(c["etag"]) : "", 6)
                 << pad_column(text(s["segment"]), 12) << pad_column(s["role"] == "publisher" ? "P" : "S", 4) << pad_column(text(s["rx"]), 9)
                 << pad_column(text(s["tx"]), 9) << pad_column(first ? residence : "", 19) << drops_text(s["dropped"]) << "\n";
       first = false;
@@ -108,9 +112,30 @@ void print_channels(const Json& r) {
   }
 }
 
+// Admission's prediction next to what the gateway measured, per egress hop.
+void print_runtime(const Json& c) {
+  std::cout << "\nruntime: " << c.value("runtime_state", "bound") << " (" << c.value("violations", 0)
+            << " violation episodes), residence bound " << micros(c["residence"]["bound_s"].get<double>());
+  if (c.contains("predicted_end_to_end_s"))
+    std::cout << ", end-to-end predicted " << micros(c["predicted_end_to_end_s"].get<double>());
+  if (c.contains("reaction_time_s")) std::cout << " <= reaction_time " << micros(c["reaction_time_s"].get<double>());
+  std::cout << "\n";
+  for (const auto& s : c["segments"]) {
+    if (!s.contains("runtime")) continue;
+    const Json& h = s["runtime"];
+    std::cout << "  to " << pad_column(text(s["segment"]), 12) << "predicted hop "
+              << pad_column(h["predicted_latency_s"].is_null() ? "unbounded" : micros(h["predicted_latency_s"].get<double>()), 10)
+              << "measured residence p50 " << micros(h["residence_p50_s"].get<double>()) << " p99 "
+              << micros(h["residence_p99_s"].get<double>()) << " p99.9 " << micros(h["residence_p999_s"].get<double>()) << " max "
+              << micros(h["residence_max_s"].get<double>()) << "  misses: residence " << h["residence_miss"] << ", deadline "
+              << h["deadline_miss"] << "\n";
+  }
+}
+
 void print_channel(const Json& r) {
   const Json& c = r["channel"];
   print_channels(Json{{"channels", Json::array({c})}});
+  print_runtime(c);
   std::cout << "\nadmission:\n";
   for (const auto& hop : c["admission"]["hops"]) {
     std::cout << "  " << text(hop["role"]) << " " << text(hop["segment"]);

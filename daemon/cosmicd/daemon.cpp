@@ -1,11 +1,14 @@
 #include "daemon.hpp"
 
 #include <grp.h>
+#include <sys/mman.h>
 #include <sys/signalfd.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <csignal>
+#include <cstring>
 #include <cstdlib>
 #include <random>
 
@@ -117,8 +120,29 @@ class Daemon {
       return false;
     }
     log_verdicts(log_, started.channels);
+    report_realtime(config.gateway.realtime);
     restore_runtime_bindings();
     return true;
+  }
+
+  // gateway.realtime: memory locking is process-wide and done here; the thread priorities are
+  // applied by each thread as it starts (their problems arrive through take_thread_problems()).
+  void report_realtime(const cosmic::RealtimeSpec& realtime) {
+    if (!realtime.requested()) {
+      log_.log(cosmic::LogLevel::info, "realtime: not configured; forwarding threads run time-shared (NRT lanes at nice 10)");
+      return;
+    }
+    if (realtime.lock_memory) {
+      if (::mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
+        log_.log(cosmic::LogLevel::info, "realtime: memory locked (mlockall)");
+      } else {
+        log_.log(cosmic::LogLevel::warning, std::string("realtime: mlockall failed: ") + std::strerror(errno) +
+                                                 "; pages may be swapped out (raise LimitMEMLOCK or grant CAP_IPC_LOCK)");
+      }
+    }
+    log_.log(cosmic::LogLevel::info, "realtime: SCHED_FIFO priorities hrt " + std::to_string(realtime.hrt_priority) + ", srt " +
+                                         std::to_string(realtime.srt_priority) + ", nrt " + std::to_string(realtime.nrt_priority) +
+                                         ", receive " + std::to_string(realtime.receive_priority));
   }
 
   void restore_runtime_bindings() {
@@ -209,6 +233,8 @@ class Daemon {
       server.run_for(std::chrono::milliseconds(100));
       if (std::chrono::steady_clock::now() - last_health >= std::chrono::milliseconds(250)) {
         gateway_.refresh_health();
+        gateway_.refresh_runtime(std::chrono::duration_cast<cosmic::Nanos>(std::chrono::steady_clock::now().time_since_epoch()));
+        for (const auto& problem : gateway_.take_thread_problems()) log_.log(cosmic::LogLevel::warning, "realtime: " + problem);
         notifier_.tick(gateway_);
         last_health = std::chrono::steady_clock::now();
       }

@@ -30,6 +30,8 @@ std::string ServiceNotifier::summary(const cosmic::Gateway& gateway) {
   std::string line = std::to_string(up) + "/" + std::to_string(segments.size()) + " segments up, " + std::to_string(bound) +
                      " channels bound, " + std::to_string(degraded) + " degraded, " +
                      std::to_string(gateway.router().progress()) + " events handled";
+  if (const std::size_t violated = gateway.violated_channels(); violated > 0)
+    line += ", " + std::to_string(violated) + " VIOLATED (measured beyond admitted bounds)";
   if (!down.empty()) line += " (" + down + ")";
   return line;
 }

@@ -45,12 +45,15 @@ class CountingAdapter final : public SegmentAdapter {
 TEST(RouterAllocationTest, SteadyStateForwardingDoesNotAllocate) {
   CountingAdapter in;
   CountingAdapter out;
-  Router router(GatewayIdentity{1, "gw"}, 2);
+  RouterLimits limits;
+  limits.threaded = false;  // run_once() below does the lanes' work on this thread
+  Router router(GatewayIdentity{1, "gw"}, 2, limits);
   router.set_segment(0, "in", &in);
   router.set_segment(1, "out", &out);
   ChannelSpec spec;
   spec.name = "speed";
   spec.subject = 5;
+  spec.payload = 64;
   spec.cls = ChannelClass::srt;
   spec.temp_validity = Nanos(1'000'000'000);
   spec.publishers = {"in"};
@@ -61,13 +64,14 @@ TEST(RouterAllocationTest, SteadyStateForwardingDoesNotAllocate) {
   auto pump = [&](int events) {
     for (int i = 0; i < events; ++i) {
       EventHeader header;
+      header.subject = spec.subject;
       header.origin = 77;
       header.sequence = ++sequence;
       router.inbox(0).on_event(InboundEvent{1, header, payload, steady_now()});
       router.run_once(8);
     }
   };
-  pump(2000);  // warm-up: queue slots grow their buffers once
+  pump(2000);  // warm-up: pooled payload buffers grow once
   const std::size_t before = allocations.load();
   pump(10'000);
   EXPECT_EQ(allocations.load() - before, 0u);

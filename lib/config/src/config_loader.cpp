@@ -1,13 +1,17 @@
 #include "cosmic/config_loader.hpp"
 
+#include <arpa/inet.h>
 #include <yaml-cpp/yaml.h>
 
+#include <charconv>
 #include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
 
 #include "cosmic/admission.hpp"
+#include "realtime_loader.hpp"
+#include "segment_overlap.hpp"
 #include "yaml_reader.hpp"
 
 namespace cosmic {
@@ -24,6 +28,49 @@ std::string key(const std::string& path, const char* name) { return path + "." +
 
 // Present and not explicitly null.
 bool has(const YAML::Node& map, const char* name) { return map.IsMap() && map[name] && !map[name].IsNull(); }
+
+struct ListenAddress {
+  std::string host;
+  std::uint16_t port = 0;
+  bool loopback = false;
+  std::string error;  // why the text is not HOST:PORT
+};
+
+ListenAddress invalid_listen(std::string why) {
+  ListenAddress out;
+  out.error = std::move(why);
+  return out;
+}
+
+// "127.0.0.1:9877", "[::1]:9877" or "localhost:9877": an IP literal (never a name to resolve,
+// so what is checked is what gets bound) and a port.
+ListenAddress parse_listen_address(const std::string& text) {
+  ListenAddress out;
+  const auto colon = text.rfind(':');
+  if (colon == std::string::npos) return invalid_listen("has no port");
+  std::string host = text.substr(0, colon);
+  const std::string port = text.substr(colon + 1);
+  unsigned value = 0;
+  const auto [end, ec] = std::from_chars(port.data(), port.data() + port.size(), value);
+  if (port.empty() || ec != std::errc() || end != port.data() + port.size() || value == 0 || value > 65535) {
+    return invalid_listen("has no port from 1 to 65535");
+  }
+  out.port = static_cast<std::uint16_t>(value);
+  const bool bracketed = host.size() >= 2 && host.front() == '[' && host.back() == ']';
+  if (bracketed) host = host.substr(1, host.size() - 2);
+  if (host == "localhost") host = "127.0.0.1";
+  in_addr v4{};
+  in6_addr v6{};
+  if (!bracketed && inet_pton(AF_INET, host.c_str(), &v4) == 1) {
+    out.loopback = (ntohl(v4.s_addr) >> 24) == 127;
+  } else if (bracketed && inet_pton(AF_INET6, host.c_str(), &v6) == 1) {
+    out.loopback = IN6_IS_ADDR_LOOPBACK(&v6);
+  } else {
+    return invalid_listen("has no IP address as host (IPv6 goes in brackets)");
+  }
+  out.host = host;
+  return out;
+}
 
 class ConfigParser {
  public:
@@ -94,7 +141,7 @@ class ConfigParser {
 
   void parse_gateway(const YAML::Node& node) {
     const std::string path = "gateway";
-    if (!reader_.check_map(node, path, {"name", "can_node_id", "residence_bound", "control_socket"})) return;
+    if (!reader_.check_map(node, path, {"name", "can_node_id", "residence_bound", "clean_interval", "realtime", "control_socket", "metrics"})) return;
     GatewaySpec& g = config_.gateway;
     if (has(node, "name")) {
       if (auto v = reader_.name(node["name"], key(path, "name"))) g.name = *v;
@@ -107,6 +154,10 @@ class ConfigParser {
     if (has(node, "residence_bound")) {
       if (auto v = reader_.duration(node["residence_bound"], key(path, "residence_bound"), false)) g.residence_bound = *v;
     }
+    if (has(node, "clean_interval")) {
+      if (auto v = reader_.duration(node["clean_interval"], key(path, "clean_interval"), false)) g.clean_interval = *v;
+    }
+    if (has(node, "realtime")) parse_realtime(reader_, node["realtime"], key(path, "realtime"), g.realtime);
     if (has(node, "control_socket")) {
       if (auto v = reader_.string(node["control_socket"], key(path, "control_socket"))) {
         if (v->front() != '/') {
@@ -119,6 +170,33 @@ class ConfigParser {
           g.control_socket = *v;
         }
       }
+    }
+    if (has(node, "metrics")) parse_metrics(node["metrics"], key(path, "metrics"));
+  }
+
+  // A host outside loopback shows the gateway's channels and load to the network, so it needs
+  // an explicit allow_remote: true.
+  void parse_metrics(const YAML::Node& node, const std::string& path) {
+    if (!reader_.check_map(node, path, {"listen", "allow_remote"})) return;
+    MetricsSpec metrics;
+    if (has(node, "allow_remote")) {
+      if (auto v = reader_.boolean(node["allow_remote"], key(path, "allow_remote"))) metrics.allow_remote = *v;
+    }
+    if (!require(node, path, "listen", "HOST:PORT, e.g. 127.0.0.1:9877")) return;
+    const auto text = reader_.string(node["listen"], key(path, "listen"));
+    if (!text) return;
+    const ListenAddress listen = parse_listen_address(*text);
+    if (!listen.error.empty()) {
+      reader_.error_at(node["listen"], key(path, "listen"), "'" + *text + "' " + listen.error,
+                       "IP:PORT such as 127.0.0.1:9877 or [::1]:9877");
+    } else if (!listen.loopback && !metrics.allow_remote) {
+      reader_.error_at(node["listen"], key(path, "listen"), "'" + *text + "' is not a loopback address",
+                       "127.0.0.1:PORT or [::1]:PORT, or allow_remote: true to serve other hosts");
+    } else {
+      metrics.enabled = true;
+      metrics.host = listen.host;
+      metrics.port = listen.port;
+      config_.gateway.metrics = metrics;
     }
   }
 
@@ -140,6 +218,7 @@ class ConfigParser {
                              std::to_string(first_seen[segment->name].line + 1) + ")");
         continue;
       }
+      config_detail::check_segment_overlap(node, i, *segment, config_.segments, reader_);
       segment_names_.insert(segment->name);
       config_.segments.push_back(std::move(*segment));
     }

@@ -13,6 +13,50 @@ Json failure(const std::string& code, const std::string& message) {
   return Json{{"ok", false}, {"error", {{"code", code}, {"message", message}}}};
 }
 
+// Texts quoted from files or interfaces may hold invalid UTF-8: replace it, never throw.
+std::string render(const Json& response) { return response.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n"; }
+
+// True when no array or object in `text` nests deeper than `limit`, judged without parsing (a
+// linear scan that skips strings) so a hostile request never reaches a recursive walk.
+bool nesting_within(std::string_view text, int limit) {
+  int depth = 0;
+  bool in_string = false;
+  bool escaped = false;
+  for (const char c : text) {
+    if (in_string) {
+      if (escaped) {
+        escaped = false;
+      } else if (c == '\\') {
+        escaped = true;
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > limit) return false;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return true;
+}
+
+// A client-chosen text fit for one log line: printable ASCII, at most kMaxLoggedText characters.
+std::string printable(std::string_view text) {
+  std::string out;
+  for (const char c : text.substr(0, kMaxLoggedText)) out += (c >= 0x20 && c < 0x7f) ? c : '?';
+  if (text.size() > kMaxLoggedText) out += "...(" + std::to_string(text.size()) + " bytes)";
+  return out;
+}
+
+std::string names_of(const std::vector<ChannelSpec>& channels) {
+  std::string out;
+  for (std::size_t i = 0; i < channels.size() && i < 3; ++i) out += (i ? ", " : "") + channels[i].name;
+  if (channels.size() > 3) out += " and " + std::to_string(channels.size() - 3) + " more";
+  return out;
+}
+
 const ChannelStatsSnapshot* find_stats(const std::vector<ChannelStatsSnapshot>& stats, const std::string& name) {
   const auto it = std::find_if(stats.begin(), stats.end(), [&](const auto& s) { return s.name == name; });
   return it == stats.end() ? nullptr : &*it;
@@ -30,61 +74,121 @@ Json bind_answer(const BindResult& result) {
 }  // namespace
 
 ControlProtocol::ControlProtocol(Gateway& gateway, std::function<ConfigResult()> reload_source, AccessPolicy policy,
-                                 Logger& log, ChangeObserver on_change)
+                                 Logger& log, ChangeObserver on_change, Offload offload)
     : gateway_(gateway),
       reload_source_(std::move(reload_source)),
       policy_(std::move(policy)),
       log_(log),
       on_change_(std::move(on_change)),
+      offload_(std::move(offload)),
       started_(std::chrono::steady_clock::now()) {}
 
 bool ControlProtocol::is_mutating(std::string_view command) {
   return command == "bind" || command == "unbind" || command == "reload";
 }
 
-std::string ControlProtocol::handle(std::string_view request_line, const PeerCredentials& peer) {
-  Json response;
-  const Json request = Json::parse(request_line, nullptr, false);
-  if (request.is_discarded() || !request.is_object()) {
+std::optional<std::string> ControlProtocol::handle(std::string_view request_line, const PeerCredentials& peer,
+                                                   Reply later) {
+  Answer response;
+  const bool shallow = nesting_within(request_line, kMaxRequestNesting);
+  const Json request = shallow ? Json::parse(request_line, nullptr, false) : Json(Json::value_t::discarded);
+  if (!shallow) {
+    response = failure("bad_request", "the request nests deeper than " + std::to_string(kMaxRequestNesting) + " levels");
+  } else if (request.is_discarded() || !request.is_object()) {
     response = failure("bad_request", "the request is not a JSON object");
   } else if (!request.contains("command") || !request["command"].is_string()) {
     response = failure("bad_request", "the request has no \"command\" string");
   } else {
     try {
-      response = dispatch(request, peer);
+      response = dispatch(request, peer, later);
     } catch (const Json::exception& e) {
       response = failure("bad_request", std::string("malformed request: ") + e.what());
     } catch (const std::exception& e) {
       response = failure("internal_error", e.what());
     }
   }
-  // Texts quoted from files or interfaces may hold invalid UTF-8: replace it, never throw.
-  return response.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n";
+  if (!response) return std::nullopt;
+  return render(*response);
 }
 
-Json ControlProtocol::dispatch(const Json& request, const PeerCredentials& peer) {
+std::string ControlProtocol::handle(std::string_view request_line, const PeerCredentials& peer) {
+  return *handle(request_line, peer, Reply{});  // no Reply: admission runs inline
+}
+
+// "denied #7: uid 1000 pid 4242": the number makes every line distinct, so a logger that folds
+// repeated lines never hides one, and the pid says which process asked.
+std::string ControlProtocol::next_log_tag(const char* kind, const PeerCredentials& peer) {
+  return std::string(kind) + " #" + std::to_string(++log_sequence_) + ": uid " + std::to_string(peer.uid) + " pid " +
+         std::to_string(peer.pid);
+}
+
+ControlProtocol::Answer ControlProtocol::dispatch(const Json& request, const PeerCredentials& peer, const Reply& later) {
   const std::string command = request["command"].get<std::string>();
   const bool mutating = is_mutating(command);
   if (!(mutating ? policy_.may_modify(peer) : policy_.may_read(peer))) {
-    log_.log(LogLevel::warning, "denied " + command + " to uid " + std::to_string(peer.uid) + " pid " + std::to_string(peer.pid));
+    log_.log(LogLevel::warning, next_log_tag("denied", peer) + " may not run " + printable(command));
     return failure("permission_denied", std::string("uid ") + std::to_string(peer.uid) + " may not " +
                                             (mutating ? "change the gateway (" + command + ")" : "read gateway state"));
-  }
-  if (mutating) {
-    log_.log(LogLevel::notice, "audit: uid " + std::to_string(peer.uid) + " pid " + std::to_string(peer.pid) + " runs " +
-                                   command + (request.contains("name") ? " " + request["name"].dump() : ""));
   }
   if (command == "status") return status();
   if (command == "segments") return segments();
   if (command == "channels") return channels();
   if (command == "channel") return channel(request);
-  if (mutating) {
-    Json answer = command == "bind" ? bind(request) : command == "unbind" ? unbind(request) : reload();
-    if (answer.value("ok", false) && on_change_) on_change_(command, request);
-    return answer;
-  }
-  return failure("unknown_command", "unknown command '" + command +
+  if (mutating) return mutate(command, request, peer, later);
+  return failure("unknown_command", "unknown command '" + printable(command) +
                                         "' (status, segments, channels, channel, bind, unbind, reload)");
+}
+
+ControlProtocol::Answer ControlProtocol::mutate(const std::string& command, const Json& request, const PeerCredentials& peer,
+                                                const Reply& later) {
+  std::string audit = next_log_tag("audit", peer) + " runs " + command;
+  if (request.contains("name") && request["name"].is_string()) audit += " " + printable(request["name"].get<std::string>());
+  log_.log(LogLevel::notice, audit);
+  if (admission_running()) {
+    return failure("busy", "an admission is running (" + running_ + "); " + command + " refused, try again when it finishes");
+  }
+  if (command == "bind") return bind(request, later);
+  if (command == "reload") return reload(later);
+  return finish(command, request, unbind(request));
+}
+
+// A change that is active but could not be saved is not `ok`: it would be lost at restart.
+Json ControlProtocol::finish(const std::string& command, const Json& request, Json answer) {
+  if (!answer.value("ok", false) || !on_change_) return answer;
+  const std::string error = on_change_(command, request);
+  if (error.empty()) return answer;
+  answer["ok"] = false;
+  answer["error"] = {{"code", "not_persisted"},
+                     {"message", "the change is active but was not saved and will not survive a restart: " + error}};
+  return answer;
+}
+
+ControlProtocol::Answer ControlProtocol::run_admission(std::string what, std::function<void()> work,
+                                                       std::function<Json()> done, const Reply& later) {
+  if (!offload_ || !later) {
+    work();
+    return done();
+  }
+  running_ = std::move(what);
+  auto failed = std::make_shared<std::string>();
+  auto guarded = [work = std::move(work), failed] {
+    try {
+      work();
+    } catch (const std::exception& e) {
+      *failed = e.what();
+    }
+  };
+  offload_(std::move(guarded), [this, done = std::move(done), later, failed] {
+    running_.clear();
+    Json answer;
+    try {
+      answer = failed->empty() ? done() : failure("internal_error", "admission failed: " + *failed);
+    } catch (const std::exception& e) {
+      answer = failure("internal_error", e.what());
+    }
+    later(render(answer));
+  });
+  return std::nullopt;
 }
 
 Json ControlProtocol::status() const {
@@ -104,7 +208,7 @@ Json ControlProtocol::status() const {
   return Json{{"ok", true},
               {"gateway", {{"name", gateway_.identity().name}, {"id", id}, {"uptime_s", uptime}}},
               {"segments", {{"total", segments.size()}, {"up", up}}},
-              {"channels", {{"bound", bound}, {"degraded", degraded}}},
+              {"channels", {{"bound", bound}, {"degraded", degraded}, {"violated", gateway_.violated_channels()}}},
               {"router", {{"queued", gateway_.router().queued()}, {"progress", gateway_.router().progress()}}}};
 }
 
@@ -139,6 +243,20 @@ Json ControlProtocol::segments() const {
   return Json{{"ok", true}, {"segments", list}};
 }
 
+namespace {
+// Predicted (admission) next to measured (the lane) for one egress hop.
+Json hop_runtime(const HopReport& hop, const HopRuntimeSnapshot& measured) {
+  return Json{{"predicted_latency_s", hop.latency ? Json(to_seconds(*hop.latency)) : Json(nullptr)},
+              {"events", measured.events},
+              {"residence_p50_s", to_seconds(measured.residence_p50)},
+              {"residence_p99_s", to_seconds(measured.residence_p99)},
+              {"residence_p999_s", to_seconds(measured.residence_p999)},
+              {"residence_max_s", to_seconds(measured.residence_max)},
+              {"residence_miss", measured.residence_miss},
+              {"deadline_miss", measured.deadline_miss}};
+}
+}  // namespace
+
 Json ControlProtocol::channel_entry(const ChannelReport& verdict, const ChannelStatsSnapshot* stats) const {
   const ChannelSpec* spec = gateway_.knowledge_base().find_bound(verdict.name);
   Json entry{{"name", verdict.name}, {"class", to_string(verdict.cls)}, {"verdict", to_string(verdict.verdict)},
@@ -162,6 +280,7 @@ Json ControlProtocol::channel_entry(const ChannelReport& verdict, const ChannelS
         for (std::size_t r = 0; r < kDropReasonCount; ++r) {
           seg["dropped"][to_string(static_cast<DropReason>(r))] = counters.dropped[r];
         }
+        if (counters.egress && hop.role == HopRole::subscriber) seg["runtime"] = hop_runtime(hop, *counters.egress);
       }
     }
     entry["segments"].push_back(std::move(seg));
@@ -169,7 +288,15 @@ Json ControlProtocol::channel_entry(const ChannelReport& verdict, const ChannelS
   entry["forwarded"] = stats ? stats->forwarded : 0;
   entry["residence"] = {{"p50_s", stats ? to_seconds(stats->residence_p50) : 0.0},
                         {"p99_s", stats ? to_seconds(stats->residence_p99) : 0.0},
-                        {"max_s", stats ? to_seconds(stats->residence_max) : 0.0}};
+                        {"p999_s", stats ? to_seconds(stats->residence_p999) : 0.0},
+                        {"max_s", stats ? to_seconds(stats->residence_max) : 0.0},
+                        {"bound_s", to_seconds(gateway_.config().gateway.residence_bound)}};
+  entry["runtime_state"] = to_string(stats ? stats->runtime_state : RuntimeState::bound);
+  entry["violations"] = stats ? stats->violations : 0;
+  entry["residence_miss"] = stats ? stats->residence_miss : 0;
+  entry["deadline_miss"] = stats ? stats->deadline_miss : 0;
+  if (verdict.end_to_end.latency) entry["predicted_end_to_end_s"] = to_seconds(*verdict.end_to_end.latency);
+  if (verdict.end_to_end.reaction_time) entry["reaction_time_s"] = to_seconds(*verdict.end_to_end.reaction_time);
   return entry;
 }
 
@@ -192,18 +319,22 @@ Json ControlProtocol::channel(const Json& request) const {
   return Json{{"ok", true}, {"channel", entry}};
 }
 
-Json ControlProtocol::bind(const Json& request) {
+ControlProtocol::Answer ControlProtocol::bind(const Json& request, const Reply& later) {
   if (!request.contains("yaml") || !request["yaml"].is_string()) {
     return failure("bad_request", "\"yaml\" (string with channel definitions) is required");
   }
   const std::string file = request.contains("file") && request["file"].is_string() ? request["file"].get<std::string>() : "request";
-  const ChannelsResult parsed = parse_channels(request["yaml"].get<std::string>(), file, gateway_.config());
+  ChannelsResult parsed = parse_channels(request["yaml"].get<std::string>(), file, gateway_.config());
   if (!parsed.ok()) {
     Json out = failure("config_error", std::to_string(parsed.errors.size()) + " error(s) in the channel definitions");
     out["errors"] = to_json(parsed.errors);
     return out;
   }
-  return bind_answer(gateway_.bind(parsed.channels));
+  const std::string what = "bind of " + names_of(parsed.channels);
+  auto plan = std::make_shared<BindPlan>(gateway_.bind_plan_input(std::move(parsed.channels)));
+  return run_admission(
+      what, [plan] { Gateway::plan_bind(*plan); },
+      [this, plan, request] { return finish("bind", request, bind_answer(gateway_.commit_bind(std::move(*plan)))); }, later);
 }
 
 Json ControlProtocol::unbind(const Json& request) {
@@ -213,18 +344,27 @@ Json ControlProtocol::unbind(const Json& request) {
   return Json{{"ok", true}, {"unbound", name}};
 }
 
-Json ControlProtocol::reload() {
-  const ConfigResult loaded = reload_source_();
-  if (!loaded.ok()) {
-    Json out = failure("config_error", std::to_string(loaded.errors.size()) +
-                                           " error(s) in the configuration; the running configuration is unchanged");
-    out["errors"] = to_json(loaded.errors);
-    return out;
-  }
-  const BindResult result = gateway_.reload(loaded.config);
-  Json out = bind_answer(result);
-  if (!result.applied) out["error"] = {{"code", "reload_failed"}, {"message", result.error}};
-  return out;
+// Loading the file and admission both run off the control thread; the swap runs on it.
+ControlProtocol::Answer ControlProtocol::reload(const Reply& later) {
+  auto loaded = std::make_shared<ConfigResult>();
+  auto plan = std::make_shared<ReloadPlan>();
+  auto work = [this, loaded, plan] {
+    *loaded = reload_source_();
+    if (loaded->ok()) *plan = Gateway::plan_reload(loaded->config);
+  };
+  auto done = [this, loaded, plan] {
+    if (!loaded->ok()) {
+      Json out = failure("config_error", std::to_string(loaded->errors.size()) +
+                                             " error(s) in the configuration; the running configuration is unchanged");
+      out["errors"] = to_json(loaded->errors);
+      return out;
+    }
+    const BindResult result = gateway_.commit_reload(std::move(*plan));
+    Json out = bind_answer(result);
+    if (!result.applied) out["error"] = {{"code", "reload_failed"}, {"message", result.error}};
+    return finish("reload", Json{{"command", "reload"}}, std::move(out));
+  };
+  return run_admission("reload", std::move(work), std::move(done), later);
 }
 
 }  // namespace cosmic

@@ -2,6 +2,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <utility>
+
+#include "channel_state.hpp"
+#include "cosmic/ingress_check.hpp"
+#include "egress_lane.hpp"
+#include "payload_pool.hpp"
 
 namespace cosmic {
 
@@ -13,79 +19,17 @@ namespace {
 std::int64_t wall_clock_ns() {
   return std::chrono::duration_cast<Nanos>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
-// Slots that once held a large event give its memory back, so a burst of big NRT events does not
-// pin queue-depth times their size.
-constexpr std::size_t kRetainedSlotBytes = 64 * 1024;
+// Buffers that once held a large event give its memory back, so a burst of big NRT events does
+// not pin lane-depth times their size.
+constexpr std::size_t kRetainedPayloadBytes = 64 * 1024;
+constexpr std::size_t kClassCount = 3;
+const char* const kClassPrefix[kClassCount] = {"hrt:", "srt:", "nrt:"};
+
+std::size_t class_index(ChannelClass cls) { return static_cast<std::size_t>(cls); }
 }  // namespace
 
-struct Router::ChannelState {
-  ChannelState(Route r, std::size_t segment_count, std::uint32_t burst)
-      : route(std::move(r)), bucket(route.spec.period.value_or(Nanos(0)), burst), counters(segment_count) {}
-  Route route;
-  std::mutex policy_mutex;  // guards bucket and dedup (adapter threads of several segments)
-  TokenBucket bucket;
-  DuplicateFilter dedup;
-  std::vector<SegmentCounters> counters;  // indexed by segment
-  LatencyHistogram residence;
-  std::atomic<std::uint32_t> next_sequence{0};
-  std::atomic<std::uint64_t> forwarded{0};
-  std::atomic<bool> removed{false};
-};
-
-struct Router::Slot {
-  std::shared_ptr<ChannelState> channel;
-  EventHeader header;
-  Nanos received{0};
-  std::size_t segment = 0;
-  std::vector<std::uint8_t> payload;  // capacity is reused; size is the event's size
-};
-
-class Router::ClassQueue {
- public:
-  ClassQueue(std::size_t depth, std::size_t byte_budget) : slots_(depth), byte_budget_(byte_budget) {}
-
-  bool push(const std::shared_ptr<ChannelState>& channel, std::size_t segment, const InboundEvent& event) {
-    std::lock_guard lock(mutex_);
-    if (count_ == slots_.size() || bytes_ + event.payload.size() > byte_budget_) return false;
-    Slot& slot = slots_[(head_ + count_) % slots_.size()];
-    slot.channel = channel;
-    slot.header = event.header;
-    slot.received = event.received_at;
-    slot.segment = segment;
-    slot.payload.assign(event.payload.begin(), event.payload.end());
-    bytes_ += event.payload.size();
-    ++count_;
-    return true;
-  }
-
-  // Moves the oldest event into `out` (swapping buffers, no allocation).
-  bool pop(Slot& out) {
-    std::lock_guard lock(mutex_);
-    if (count_ == 0) return false;
-    Slot& slot = slots_[head_];
-    out.channel = std::move(slot.channel);
-    out.header = slot.header;
-    out.received = slot.received;
-    out.segment = slot.segment;
-    out.payload.swap(slot.payload);
-    bytes_ -= out.payload.size();
-    head_ = (head_ + 1) % slots_.size();
-    --count_;
-    return true;
-  }
-
-  std::size_t size() const {
-    std::lock_guard lock(mutex_);
-    return count_;
-  }
-
- private:
-  mutable std::mutex mutex_;
-  std::vector<Slot> slots_;
-  std::size_t head_ = 0;
-  std::size_t count_ = 0;
-  std::size_t bytes_ = 0;
-  std::size_t byte_budget_;
+struct Router::Table {
+  std::vector<std::shared_ptr<ChannelState>> channels;  // sorted by route id
 };
 
 class Router::SegmentInbox final : public EventSink {
@@ -102,66 +46,79 @@ class Router::SegmentInbox final : public EventSink {
 Router::Router(GatewayIdentity self, std::size_t segment_capacity, RouterLimits limits, SteadyClock clock)
     : self_(std::move(self)),
       segment_names_(segment_capacity),
-      limits_(limits),
+      limits_(std::move(limits)),
       clock_(clock),
-      adapters_(segment_names_.size(), nullptr),
       unrouted_(new std::atomic<std::uint64_t>[segment_names_.size()]()),
-      hrt_(std::make_unique<ClassQueue>(limits.hrt_queue, limits.queue_bytes)),
-      srt_(std::make_unique<ClassQueue>(limits.srt_queue, limits.queue_bytes)),
-      nrt_(std::make_unique<ClassQueue>(limits.nrt_queue, limits.queue_bytes)),
-      scratch_(std::make_unique<Slot>()) {
-  for (std::size_t i = 0; i < segment_names_.size(); ++i) inboxes_.push_back(std::make_unique<SegmentInbox>(*this, i));
+      table_(std::make_shared<const Table>()),
+      pool_(std::make_unique<PayloadPool>(4 * (limits_.hrt_queue + limits_.srt_queue + limits_.nrt_queue),
+                                          kRetainedPayloadBytes)) {
+  lane_context_ = std::make_unique<LaneContext>(LaneContext{
+      clock_, limits_.residence_bound, *pool_, progress_, [this](const std::vector<std::string>& problems) {
+        std::lock_guard lock(problems_mutex_);
+        thread_problems_.insert(thread_problems_.end(), problems.begin(), problems.end());
+      }});
+  const std::size_t depth[kClassCount] = {limits_.hrt_queue, limits_.srt_queue, limits_.nrt_queue};
+  for (std::size_t i = 0; i < segment_names_.size(); ++i) {
+    inboxes_.push_back(std::make_unique<SegmentInbox>(*this, i));
+    for (std::size_t c = 0; c < kClassCount; ++c)
+      lanes_.push_back(std::make_unique<EgressLane>(*lane_context_, i, depth[c], limits_.queue_bytes));
+  }
 }
 
-Router::~Router() = default;
+Router::~Router() { stop(); }
 
 EventSink& Router::inbox(std::size_t index) { return *inboxes_.at(index); }
 
+EgressLane& Router::lane(std::size_t segment, ChannelClass cls) {
+  return *lanes_[segment * kClassCount + class_index(cls)];
+}
+
 void Router::set_segment(std::size_t index, std::string name, SegmentAdapter* adapter) {
-  std::unique_lock lock(table_mutex_);
+  for (std::size_t c = 0; c < kClassCount; ++c) {
+    EgressLane& l = *lanes_.at(index * kClassCount + c);
+    if (adapter == nullptr) {
+      l.deactivate();
+      continue;
+    }
+    ThreadPolicy policy = limits_.lane_threads[c];
+    policy.name = kClassPrefix[c] + name;
+    l.activate(adapter, policy, limits_.threaded);
+  }
   segment_names_.at(index) = std::move(name);
-  adapters_.at(index) = adapter;
 }
 
 void Router::apply(std::vector<Route> routes) {
-  std::vector<std::shared_ptr<ChannelState>> table;
-  table.reserve(routes.size());
-  {
-    std::shared_lock lock(table_mutex_);
-    for (auto& route : routes) {
-      auto existing = std::find_if(table_.begin(), table_.end(), [&](const auto& s) { return s->route.id == route.id; });
-      // A route is never changed in place: adapter threads and the router thread read it
-      // without the table lock. A changed route gets a fresh state (and fresh counters).
-      if (existing != table_.end() && (*existing)->route == route) {
-        table.push_back(*existing);
-      } else {
-        table.push_back(std::make_shared<ChannelState>(std::move(route), segment_names_.size(), limits_.rate_burst));
-      }
+  std::lock_guard serial(apply_mutex_);
+  const std::shared_ptr<const Table> current = table_.load();
+  auto next = std::make_shared<Table>();
+  next->channels.reserve(routes.size());
+  for (auto& route : routes) {
+    const auto existing = std::lower_bound(current->channels.begin(), current->channels.end(), route.id,
+                                           [](const auto& s, ChannelId v) { return s->route.id < v; });
+    // A route is never changed in place: ingress and lane threads read it without any lock. A
+    // changed route gets a fresh state (and fresh counters).
+    if (existing != current->channels.end() && (*existing)->route == route) {
+      next->channels.push_back(*existing);
+    } else {
+      next->channels.push_back(std::make_shared<ChannelState>(std::move(route), segment_names_.size(), limits_.rate_burst));
     }
   }
-  std::sort(table.begin(), table.end(), [](const auto& a, const auto& b) { return a->route.id < b->route.id; });
-  std::unique_lock lock(table_mutex_);
-  for (auto& old : table_) {
-    const bool kept = std::any_of(table.begin(), table.end(), [&](const auto& s) { return s == old; });
-    if (!kept) old->removed.store(true);
+  std::sort(next->channels.begin(), next->channels.end(), [](const auto& a, const auto& b) { return a->route.id < b->route.id; });
+  for (const auto& old : current->channels) {
+    const auto kept = std::lower_bound(next->channels.begin(), next->channels.end(), old->route.id,
+                                       [](const auto& s, ChannelId v) { return s->route.id < v; });
+    if (kept == next->channels.end() || *kept != old) old->removed.store(true);
   }
-  table_.swap(table);
+  // Readers holding the old snapshot keep it alive until they let go (their last event of it).
+  table_.store(std::move(next));
 }
 
-std::shared_ptr<Router::ChannelState> Router::find(ChannelId id) const {
-  std::shared_lock lock(table_mutex_);
-  const auto it = std::lower_bound(table_.begin(), table_.end(), id, [](const auto& s, ChannelId v) { return s->route.id < v; });
-  if (it == table_.end() || (*it)->route.id != id) return nullptr;
+std::shared_ptr<ChannelState> Router::find(ChannelId id) const {
+  const std::shared_ptr<const Table> table = table_.load();
+  const auto it = std::lower_bound(table->channels.begin(), table->channels.end(), id,
+                                   [](const auto& s, ChannelId v) { return s->route.id < v; });
+  if (it == table->channels.end() || (*it)->route.id != id) return nullptr;
   return *it;
-}
-
-Router::ClassQueue& Router::queue_for(ChannelClass cls) {
-  switch (cls) {
-    case ChannelClass::hrt: return *hrt_;
-    case ChannelClass::srt: return *srt_;
-    case ChannelClass::nrt: return *nrt_;
-  }
-  return *nrt_;
 }
 
 void Router::receive(std::size_t segment, const InboundEvent& event) {
@@ -177,34 +134,66 @@ void Router::receive(std::size_t segment, const InboundEvent& event) {
     return;
   }
   counters.rx.fetch_add(1, std::memory_order_relaxed);
-  const EventHeader& header = event.header;
-  const ChannelSpec& spec = channel->route.spec;
-  {
-    std::lock_guard lock(channel->policy_mutex);
-    if (header.hop_count >= kMaxHops || (header.origin != 0 && header.origin == self_.id) ||
-        (header.origin != 0 && channel->dedup.seen(header.origin, header.sequence))) {
-      counters.drop(DropReason::duplicate);
-      return;
-    }
-    if (spec.temp_validity && Nanos(header.age_ns) >= *spec.temp_validity) {
-      counters.drop(DropReason::expired);
-      return;
-    }
-    if (!channel->bucket.admit(event.received_at)) {
-      counters.drop(DropReason::rate);
-      return;
-    }
-  }
-  if (!queue_for(spec.cls).push(channel, segment, event)) {
-    counters.drop(DropReason::queue_full);
+  if (const IngressFault fault = ingress_check(event, channel->route.spec, self_); fault != IngressFault::none) {
+    counters.drop(drop_reason(fault));
     return;
   }
-  // Wake the router only when it sleeps; the fences pair with run() so no wake-up is lost.
-  std::atomic_thread_fence(std::memory_order_seq_cst);
-  if (sleeping_.load(std::memory_order_seq_cst)) {
-    std::lock_guard lock(wake_mutex_);
-    wake_.notify_one();
+  if (!admit(*channel, counters, event)) return;
+  enqueue(channel, segment, event);
+}
+
+// Duplicate, validity and rate policies; counts what it refuses.
+bool Router::admit(ChannelState& channel, SegmentCounters& counters, const InboundEvent& event) {
+  const EventHeader& header = event.header;
+  const ChannelSpec& spec = channel.route.spec;
+  std::lock_guard lock(channel.policy_mutex);
+  if (header.origin != 0 && channel.dedup.seen(header.origin, header.sequence)) {
+    counters.drop(DropReason::duplicate);
+    return false;
   }
+  if (spec.temp_validity && Nanos(header.age_ns) >= *spec.temp_validity) {
+    counters.drop(DropReason::expired);
+    return false;
+  }
+  if (!channel.bucket.admit(event.received_at)) {
+    counters.drop(DropReason::rate);
+    return false;
+  }
+  return true;
+}
+
+// Copies the payload once and queues the event on the lane of each subscriber segment.
+void Router::enqueue(const std::shared_ptr<ChannelState>& channel, std::size_t ingress, const InboundEvent& event) {
+  (void)ingress;
+  const Route& route = channel->route;
+  if (route.subscribers.empty()) return;
+  EventHeader header = event.header;
+  header.hop_count = static_cast<std::uint8_t>(header.hop_count + 1);
+  if (header.origin == 0) {
+    // This gateway is the first to forward it: every copy carries the same origin and sequence.
+    header.origin = self_.id;
+    header.sequence = channel->next_sequence.fetch_add(1, std::memory_order_relaxed) + 1;
+    header.created_ns = wall_clock_ns() - header.age_ns;
+  }
+  const auto fanout = static_cast<std::uint32_t>(route.subscribers.size());
+  PayloadBuffer* buffer = pool_->acquire(event.payload, fanout);
+  if (buffer == nullptr) {
+    for (const std::size_t s : route.subscribers) channel->counters[s].drop(DropReason::queue_full);
+    return;
+  }
+  // Counted before the lanes can send it (see EgressLane::forward), taken back if none took it.
+  channel->forwarded.fetch_add(1, std::memory_order_relaxed);
+  bool queued = false;
+  for (std::uint32_t hop = 0; hop < fanout; ++hop) {
+    const std::size_t s = route.subscribers[hop];
+    if (lane(s, route.spec.cls).push(LaneItem{channel, buffer, header, event.received_at, hop, 0})) {
+      queued = true;
+    } else {
+      channel->counters[s].drop(DropReason::queue_full);
+      pool_->release(buffer);
+    }
+  }
+  if (!queued) channel->forwarded.fetch_sub(1, std::memory_order_relaxed);
 }
 
 void Router::problem(std::size_t segment, ChannelId channel_id, InboundProblem what) {
@@ -217,89 +206,79 @@ void Router::problem(std::size_t segment, ChannelId channel_id, InboundProblem w
   channel->counters[segment].drop(what == InboundProblem::decode_error ? DropReason::decode_error : DropReason::no_route);
 }
 
-void Router::dispatch(Slot& slot) {
-  ChannelState& channel = *slot.channel;
-  progress_.fetch_add(1, std::memory_order_relaxed);
-  if (channel.removed.load(std::memory_order_relaxed)) return;
-  const ChannelSpec& spec = channel.route.spec;
-  const Nanos age = Nanos(slot.header.age_ns) + (clock_() - slot.received);
-  if (spec.temp_validity && age >= *spec.temp_validity) {
-    channel.counters[slot.segment].drop(DropReason::expired);
-    return;
-  }
-  OutboundEvent out{channel.route.id, slot.header, slot.payload};
-  out.header.age_ns = age.count();
-  out.header.hop_count = static_cast<std::uint8_t>(slot.header.hop_count + 1);
-  if (out.header.origin == 0) {
-    out.header.origin = self_.id;
-    out.header.sequence = channel.next_sequence.fetch_add(1, std::memory_order_relaxed) + 1;
-    out.header.created_ns = wall_clock_ns() - age.count();
-  }
-  {
-    std::shared_lock lock(table_mutex_);
-    for (const std::size_t s : channel.route.subscribers) {
-      SegmentAdapter* adapter = adapters_[s];
-      const SendStatus status = adapter ? adapter->send(out) : SendStatus::failed;
-      if (status == SendStatus::sent) {
-        channel.counters[s].tx.fetch_add(1, std::memory_order_relaxed);
-      } else {
-        channel.counters[s].drop(status == SendStatus::queue_full ? DropReason::queue_full : DropReason::send_failed);
-      }
-    }
-  }
-  channel.forwarded.fetch_add(1, std::memory_order_relaxed);
-  channel.residence.record(clock_() - slot.received);
-}
-
 std::size_t Router::run_once(std::size_t budget) {
   std::size_t handled = 0;
-  Slot& slot = *scratch_;
-  while (handled < budget && (hrt_->pop(slot) || srt_->pop(slot) || nrt_->pop(slot))) {
-    dispatch(slot);
-    slot.channel.reset();
-    if (slot.payload.capacity() > kRetainedSlotBytes) std::vector<std::uint8_t>().swap(slot.payload);
-    ++handled;
+  for (std::size_t c = 0; c < kClassCount; ++c) {
+    for (std::size_t s = 0; s < segment_names_.size() && handled < budget; ++s)
+      handled += lanes_[s * kClassCount + c]->run_once(budget - handled);
   }
   return handled;
 }
 
-std::size_t Router::queued() const { return hrt_->size() + srt_->size() + nrt_->size(); }
-
-void Router::run() {
-  while (!stopping_.load()) {
-    if (run_once(64) > 0) continue;
-    std::unique_lock lock(wake_mutex_);
-    sleeping_.store(true, std::memory_order_seq_cst);
-    std::atomic_thread_fence(std::memory_order_seq_cst);
-    wake_.wait_for(lock, std::chrono::milliseconds(200), [&] { return stopping_.load() || queued() > 0; });
-    sleeping_.store(false, std::memory_order_seq_cst);
-  }
+void Router::stop() {
+  for (auto& l : lanes_) l->deactivate();
 }
 
-void Router::stop() {
-  stopping_.store(true);
-  std::lock_guard lock(wake_mutex_);
-  wake_.notify_all();
+std::size_t Router::queued() const {
+  std::size_t total = 0;
+  for (const auto& l : lanes_) total += l->size();
+  return total;
+}
+
+std::vector<std::string> Router::take_thread_problems() {
+  std::lock_guard lock(problems_mutex_);
+  return std::exchange(thread_problems_, {});
 }
 
 std::uint64_t Router::unrouted(std::size_t segment) const { return unrouted_[segment].load(std::memory_order_relaxed); }
 
+namespace {
+HopRuntimeSnapshot hop_snapshot(const EgressStats& stats) {
+  HopRuntimeSnapshot hop;
+  const LatencyHistogram& h = stats.residence;
+  hop.events = h.count();
+  hop.residence_p50 = h.quantile(0.50);
+  hop.residence_p99 = h.quantile(0.99);
+  hop.residence_p999 = h.quantile(0.999);
+  hop.residence_max = h.max();
+  hop.residence_miss = stats.residence_miss.load(std::memory_order_relaxed);
+  hop.deadline_miss = stats.deadline_miss.load(std::memory_order_relaxed);
+  std::size_t last = 0;
+  for (std::size_t i = 0; i < LatencyHistogram::kBuckets; ++i) {
+    if (h.bucket_count(i) != 0) last = i + 1;
+  }
+  hop.residence_buckets.resize(last);
+  for (std::size_t i = 0; i < last; ++i) hop.residence_buckets[i] = h.bucket_count(i);
+  return hop;
+}
+
+SegmentCountersSnapshot counters_snapshot(const std::string& name, const SegmentCounters& c) {
+  SegmentCountersSnapshot seg{name, c.rx.load(), c.tx.load(), {}, std::nullopt};
+  for (std::size_t r = 0; r < kDropReasonCount; ++r) seg.dropped[r] = c.dropped[r].load();
+  return seg;
+}
+}  // namespace
+
 std::vector<ChannelStatsSnapshot> Router::snapshot() const {
-  std::shared_lock lock(table_mutex_);
+  const std::shared_ptr<const Table> table = table_.load();
   std::vector<ChannelStatsSnapshot> out;
-  for (const auto& state : table_) {
+  out.reserve(table->channels.size());
+  for (const auto& state : table->channels) {
     ChannelStatsSnapshot snap;
     snap.name = state->route.spec.name;
-    auto add = [&](std::size_t s) {
-      const SegmentCounters& c = state->counters[s];
-      SegmentCountersSnapshot seg{segment_names_[s], c.rx.load(), c.tx.load(), {}};
-      for (std::size_t r = 0; r < kDropReasonCount; ++r) seg.dropped[r] = c.dropped[r].load();
-      snap.segments.push_back(seg);
-    };
-    for (const std::size_t s : state->route.publishers) add(s);
-    for (const std::size_t s : state->route.subscribers) add(s);
+    for (const std::size_t s : state->route.publishers)
+      snap.segments.push_back(counters_snapshot(segment_names_[s], state->counters[s]));
+    for (std::size_t hop = 0; hop < state->route.subscribers.size(); ++hop) {
+      const std::size_t s = state->route.subscribers[hop];
+      SegmentCountersSnapshot seg = counters_snapshot(segment_names_[s], state->counters[s]);
+      seg.egress = hop_snapshot(state->egress[hop]);
+      snap.residence_miss += seg.egress->residence_miss;
+      snap.deadline_miss += seg.egress->deadline_miss;
+      snap.segments.push_back(std::move(seg));
+    }
     snap.residence_p50 = state->residence.quantile(0.50);
     snap.residence_p99 = state->residence.quantile(0.99);
+    snap.residence_p999 = state->residence.quantile(0.999);
     snap.residence_max = state->residence.max();
     snap.forwarded = state->forwarded.load();
     out.push_back(std::move(snap));

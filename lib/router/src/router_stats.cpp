@@ -13,9 +13,13 @@ const char* to_string(DropReason reason) {
     case DropReason::decode_error: return "decode_error";
     case DropReason::no_route: return "no_route";
     case DropReason::send_failed: return "send_failed";
+    case DropReason::invalid: return "invalid";
+    case DropReason::oversize: return "oversize";
   }
   return "?";
 }
+
+const char* to_string(RuntimeState state) { return state == RuntimeState::violated ? "violated" : "bound"; }
 
 std::size_t LatencyHistogram::bucket_of(std::uint64_t ns) {
   if (ns < 4) return static_cast<std::size_t>(ns);

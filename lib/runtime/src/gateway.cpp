@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <set>
+#include <string_view>
+#include <unordered_map>
 
 namespace cosmic {
 
@@ -35,9 +37,27 @@ ChannelId Gateway::id_for(const ChannelSpec& spec) {
   return id;
 }
 
+namespace {
+RouterLimits router_limits(const GatewaySpec& gateway) {
+  RouterLimits limits;
+  limits.residence_bound = gateway.residence_bound;
+  const RealtimeSpec& rt = gateway.realtime;
+  const int priority[3] = {rt.hrt_priority, rt.srt_priority, rt.nrt_priority};
+  for (std::size_t c = 0; c < 3; ++c) {
+    limits.lane_threads[c].fifo_priority = priority[c];
+    limits.lane_threads[c].cpus = rt.cpus;
+  }
+  return limits;
+}
+
+std::string format_ms(Nanos value) { return format_duration(value); }
+}  // namespace
+
 BindResult Gateway::start(const Config& config) {
   identity_.name = config.gateway.name;
-  router_ = std::make_unique<Router>(identity_, kMaxSegments);
+  router_ = std::make_unique<Router>(identity_, kMaxSegments, router_limits(config.gateway));
+  const ThreadPolicy receive{"rx", config.gateway.realtime.receive_priority, 0, config.gateway.realtime.cpus};
+  for (std::size_t i = 0; i < kMaxSegments; ++i) router_->inbox(i).set_receive_thread_policy(receive);
   config_ = config;
   kb_ = knowledge_base_for(config);
   BindResult result;
@@ -64,7 +84,6 @@ BindResult Gateway::start(const Config& config) {
   }
   if (auto error = configure_adapters()) log_.log(LogLevel::error, *error);
   apply_routes();
-  router_thread_ = std::thread([this] { router_->run(); });
   result.applied = true;
   return result;
 }
@@ -99,20 +118,39 @@ void Gateway::apply_routes() {
 }
 
 BindResult Gateway::bind(const std::vector<ChannelSpec>& channels) {
-  BindResult result;
-  KnowledgeBase trial = *kb_;
-  bool rejected = false;
-  for (const auto& channel : channels) {
-    BindOutcome outcome = trial.bind(channel);
-    rejected = rejected || !outcome.bound();
-    result.channels.push_back(std::move(outcome.report));
+  BindPlan plan = bind_plan_input(channels);
+  plan_bind(plan);
+  return commit_bind(std::move(plan));
+}
+
+BindPlan Gateway::bind_plan_input(std::vector<ChannelSpec> channels) const {
+  return BindPlan{generation_, std::move(channels), std::make_shared<KnowledgeBase>(*kb_), {}, false};
+}
+
+void Gateway::plan_bind(BindPlan& plan) {
+  plan.admitted = true;
+  for (const auto& channel : plan.channels) {
+    BindOutcome outcome = plan.kb->bind(channel);
+    plan.admitted = plan.admitted && outcome.bound();
+    plan.reports.push_back(std::move(outcome.report));
   }
-  if (rejected) {
+}
+
+BindResult Gateway::commit_bind(BindPlan plan) {
+  BindResult result;
+  result.channels = std::move(plan.reports);
+  const auto& channels = plan.channels;
+  if (plan.generation != generation_) {
+    result.error = "the bindings changed while admission ran; nothing changed, try again";
+    return result;
+  }
+  if (!plan.admitted) {
     result.error = "rejected by admission; nothing changed";
     return result;
   }
+  ++generation_;
   KnowledgeBase previous = *kb_;
-  *kb_ = std::move(trial);
+  *kb_ = std::move(*plan.kb);
   if (auto error = configure_adapters()) {
     *kb_ = std::move(previous);
     configure_adapters();
@@ -127,16 +165,28 @@ BindResult Gateway::bind(const std::vector<ChannelSpec>& channels) {
 
 bool Gateway::unbind(const std::string& name) {
   if (!kb_->unbind(name)) return false;
+  ++generation_;
   apply_routes();
   if (auto error = configure_adapters()) log_.log(LogLevel::error, *error);
   log_.log(LogLevel::notice, "unbound channel " + name);
   return true;
 }
 
-BindResult Gateway::reload(const Config& config) {
+BindResult Gateway::reload(const Config& config) { return commit_reload(plan_reload(config)); }
+
+ReloadPlan Gateway::plan_reload(Config config) {
+  std::shared_ptr<KnowledgeBase> kb = knowledge_base_for(config);
+  ReloadPlan plan{std::move(config), std::move(kb), {}};
+  for (const auto& channel : plan.config.channels) plan.reports.push_back(plan.kb->bind(channel).report);
+  return plan;
+}
+
+BindResult Gateway::commit_reload(ReloadPlan plan) {
+  const Config& config = plan.config;
   BindResult result;
-  auto next_kb = knowledge_base_for(config);
-  for (const auto& channel : config.channels) result.channels.push_back(next_kb->bind(channel).report);
+  result.channels = std::move(plan.reports);
+  auto next_kb = std::make_unique<KnowledgeBase>(std::move(*plan.kb));
+  ++generation_;
   // New or changed segments get fresh adapters in free slots; the old ones keep running until
   // the swap below.
   std::map<std::string, SegmentSlot> fresh;
@@ -174,6 +224,9 @@ BindResult Gateway::reload(const Config& config) {
   if (config.gateway.control_socket != config_.gateway.control_socket) {
     log_.log(LogLevel::warning, "gateway.control_socket changes take effect at the next start");
   }
+  if (config.gateway.realtime != config_.gateway.realtime || config.gateway.residence_bound != config_.gateway.residence_bound) {
+    log_.log(LogLevel::warning, "gateway.realtime and gateway.residence_bound changes take effect at the next start");
+  }
   config_ = config;
   identity_.name = config.gateway.name;
   kb_ = std::move(next_kb);
@@ -191,7 +244,6 @@ BindResult Gateway::reload(const Config& config) {
 
 void Gateway::stop() {
   if (router_) router_->stop();
-  if (router_thread_.joinable()) router_thread_.join();
   for (auto& [name, slot] : slots_) {
     if (router_) router_->set_segment(slot.index, "", nullptr);
     slot.adapter->stop();
@@ -205,6 +257,68 @@ void Gateway::refresh_health() {
     kb_->set_health(name, health.state, std::move(health.detail));
   }
 }
+
+std::vector<ChannelStatsSnapshot> Gateway::channel_stats() const {
+  std::vector<ChannelStatsSnapshot> stats = router_->snapshot();
+  for (auto& channel : stats) {
+    const auto track = runtime_.find(channel.name);
+    if (track == runtime_.end()) continue;
+    channel.runtime_state = track->second.state;
+    channel.violations = track->second.violations;
+  }
+  return stats;
+}
+
+void Gateway::refresh_runtime(Nanos now) {
+  std::unordered_map<std::string_view, const ChannelSpec*> bound;
+  for (const auto& spec : kb_->bound_channels()) bound.emplace(spec.name, &spec);
+  std::map<std::string, RuntimeTrack> next;
+  for (const auto& stats : router_->snapshot()) {
+    const auto found = bound.find(stats.name);
+    if (found == bound.end()) continue;
+    const ChannelSpec* spec = found->second;
+    auto previous = runtime_.find(stats.name);
+    RuntimeTrack track = previous != runtime_.end() ? previous->second : RuntimeTrack{};
+    judge(stats, *spec, track, now);
+    next.emplace(stats.name, track);
+  }
+  runtime_ = std::move(next);
+}
+
+// One channel: a new miss of an HRT hop starts (or extends) a violation episode; a clean
+// interval ends it. SRT and NRT channels count misses but keep their state (they were promised
+// no bound).
+void Gateway::judge(const ChannelStatsSnapshot& stats, const ChannelSpec& spec, RuntimeTrack& track, Nanos now) {
+  const std::uint64_t misses = stats.residence_miss + stats.deadline_miss;
+  const bool missed = misses > track.misses;
+  track.misses = misses;
+  if (missed) track.last_miss = now;
+  if (spec.cls != ChannelClass::hrt) return;
+  if (missed && track.state == RuntimeState::bound) {
+    track.state = RuntimeState::violated;
+    ++track.violations;
+    std::string line = "channel " + spec.name + " violated its admitted bounds:";
+    for (const auto& seg : stats.segments) {
+      if (!seg.egress || (seg.egress->residence_miss == 0 && seg.egress->deadline_miss == 0)) continue;
+      line += " hop " + seg.segment + ": residence max " + format_ms(seg.egress->residence_max) + " > bound " +
+              format_ms(config_.gateway.residence_bound) + " (" + std::to_string(seg.egress->residence_miss) +
+              " misses), " + std::to_string(seg.egress->deadline_miss) + " events older than reaction_time " +
+              (spec.reaction_time ? format_ms(*spec.reaction_time) : std::string("-")) + ";";
+    }
+    log_.log(LogLevel::warning, line);
+  } else if (!missed && track.state == RuntimeState::violated && now - track.last_miss >= config_.gateway.clean_interval) {
+    track.state = RuntimeState::bound;
+    log_.log(LogLevel::notice, "channel " + spec.name + " is within its admitted bounds again (no miss for " +
+                                   format_ms(config_.gateway.clean_interval) + ")");
+  }
+}
+
+std::size_t Gateway::violated_channels() const {
+  return static_cast<std::size_t>(std::count_if(runtime_.begin(), runtime_.end(),
+                                                [](const auto& t) { return t.second.state == RuntimeState::violated; }));
+}
+
+std::vector<std::string> Gateway::take_thread_problems() { return router_ ? router_->take_thread_problems() : std::vector<std::string>{}; }
 
 std::optional<std::size_t> Gateway::matched_peers(const std::string& segment, const std::string& channel) const {
   const auto slot = slots_.find(segment);

@@ -83,11 +83,36 @@ struct ChannelSpec {
   friend bool operator==(const ChannelSpec&, const ChannelSpec&) = default;
 };
 
+// Opt-in HTTP endpoint serving the gateway's metrics (docs/metrics.md). Off unless configured.
+struct MetricsSpec {
+  bool enabled = false;
+  std::string host;           // an IPv4 or IPv6 literal (IPv6 without brackets)
+  std::uint16_t port = 0;
+  bool allow_remote = false;  // true: the operator opted in to a non-loopback host
+  friend bool operator==(const MetricsSpec&, const MetricsSpec&) = default;
+};
+
+// gateway.realtime: how the forwarding threads run. Priorities are SCHED_FIFO (1..99, 0 = the
+// normal time-sharing class); without the privilege cosmicd runs on and says what it could not get.
+struct RealtimeSpec {
+  int hrt_priority = 0;      // the HRT egress lanes
+  int srt_priority = 0;      // the SRT egress lanes
+  int nrt_priority = 0;      // the NRT egress lanes (0: time sharing at nice 10)
+  int receive_priority = 0;  // the adapters' receive threads that cosmicd owns (CAN, LCM)
+  std::vector<int> cpus;     // CPU affinity of those threads; empty: any CPU
+  bool lock_memory = false;  // mlockall(MCL_CURRENT | MCL_FUTURE) at start
+  bool requested() const { return hrt_priority || srt_priority || nrt_priority || receive_priority || !cpus.empty() || lock_memory; }
+  friend bool operator==(const RealtimeSpec&, const RealtimeSpec&) = default;
+};
+
 struct GatewaySpec {
   std::string name = "cosmicd";
   std::uint8_t can_node_id = 1;
   Nanos residence_bound{Nanos(1'000'000)};  // worst-case time an event spends inside the gateway
+  Nanos clean_interval{Nanos(10'000'000'000)};  // a violated channel is bound again after this long without a miss
+  RealtimeSpec realtime;
   std::string control_socket = "/run/cosmicd/control.sock";
+  MetricsSpec metrics;
   friend bool operator==(const GatewaySpec&, const GatewaySpec&) = default;
 };
 

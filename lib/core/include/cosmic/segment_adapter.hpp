@@ -2,8 +2,14 @@
 // transport-specific methods: what a transport needs to know about a channel travels in
 // ChannelBinding (the channel's spec plus admission's plan for this hop).
 //
-// Threads: start/configure/stop are called by the control thread, send() by the router thread,
-// health()/statistics() by any thread. Inbound events go to the EventSink from threads the
+// Threads: start/configure/stop are called by the control thread, send() by the egress lane
+// threads of this segment (one per class, so send() may run on up to three threads at once, each
+// for channels of its own class), health()/statistics() by any thread.
+//
+// send() contract: it returns within a bounded, short time (microseconds; a transport that can
+// block, like a reliable DDS writer, is given a small blocking bound) and never waits on another
+// segment or on a lower class's send for longer than one frame or message. What the transport
+// cannot take now is refused with SendStatus::queue_full (the router counts it), not waited for. Inbound events go to the EventSink from threads the
 // adapter owns, between start() and the return of stop().
 #pragma once
 
@@ -16,6 +22,7 @@
 #include "cosmic/event.hpp"
 #include "cosmic/knowledge_base.hpp"
 #include "cosmic/model.hpp"
+#include "cosmic/thread_policy.hpp"
 
 namespace cosmic {
 
@@ -30,14 +37,25 @@ struct ChannelBinding {
 // Why an inbound message could not become an event.
 enum class InboundProblem { decode_error, unknown_channel, own_echo };
 
-// Implemented by the router, one per segment. Called from adapter threads; never blocks long.
+// Implemented by the router, one per segment. Called from adapter threads; never blocks long:
+// the router does its ingress work on the calling thread and hands the event to the egress
+// lanes (one hand-off), so the adapter should call it straight from the thread that read the
+// network.
 class EventSink {
  public:
   virtual void on_event(const InboundEvent& event) = 0;
   virtual void on_problem(ChannelId channel, InboundProblem problem) = 0;
 
+  // How the adapter's receive threads should run (gateway.realtime): an adapter applies it, with
+  // its own thread name, to every receive thread it owns, and logs what it could not get.
+  const ThreadPolicy& receive_thread_policy() const { return receive_policy_; }
+  void set_receive_thread_policy(ThreadPolicy policy) { receive_policy_ = std::move(policy); }
+
  protected:
   ~EventSink() = default;
+
+ private:
+  ThreadPolicy receive_policy_;
 };
 
 struct Status {
@@ -77,6 +95,13 @@ class SegmentAdapter {
   // Remote endpoints discovered for `channel` here, for transports with discovery (DDS);
   // nullopt where the transport cannot know its peers (LCM multicast, CAN broadcast).
   virtual std::optional<std::size_t> matched_peers(ChannelId channel) const = 0;
+  // Remote endpoints of `channel` discovered here but refused because their QoS is incompatible
+  // with ours (counted each time one is refused, never reset while the channel stays bound);
+  // nullopt where the transport has no such negotiation. A non-zero count is a per-channel
+  // mismatch the operator must see: the peer is there and receives or sends nothing.
+  virtual std::optional<std::uint64_t> incompatible_peers(ChannelId /*channel*/) const {
+    return std::nullopt;
+  }
   virtual void stop() = 0;
 };
 

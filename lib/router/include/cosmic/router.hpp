@@ -1,29 +1,33 @@
-// The router: takes events from publisher-side segments, applies validity, loop, duplicate and
-// rate policies, queues them by class (HRT before SRT before NRT, each queue bounded) and hands
-// them to the subscriber-side segments.
+// The router: takes events from publisher-side segments, checks them against the channel's
+// admitted contract (ingress_check), applies duplicate, validity and rate policies, and queues
+// them on the egress lanes of the channel's subscriber segments: one lane per (segment, class),
+// each served by its own thread, so no segment and no lower class delays a higher class
+// elsewhere. Every forwarded event's residence is measured (from the kernel's arrival to the
+// return of send()) and compared with gateway.residence_bound, and its age at egress with the
+// channel's reaction_time (see EgressStats).
 //
-// Threads: inbox(i).on_event() is called from adapter threads; run_once()/run() from the one
-// router thread; apply()/snapshot() from the control thread. The router does not own the
-// adapters: the caller keeps them alive while they are in a route table.
+// Threads: inbox(i).on_event() is called from adapter threads and does the ingress work on that
+// thread (one hand-off to the lane thread after it); apply(), set_segment(), snapshot() and
+// stop() from the control thread. The route table is an immutable snapshot swapped atomically:
+// no lock is held across any I/O. The router does not own the adapters: the caller keeps an
+// adapter alive until set_segment(index, ..., nullptr) has returned (which waits for the send in
+// progress on that segment).
 #pragma once
 
+#include <array>
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <memory>
 #include <mutex>
-#include <optional>
-#include <shared_mutex>
 #include <string>
 #include <vector>
 
 #include "cosmic/event.hpp"
 #include "cosmic/log.hpp"
 #include "cosmic/model.hpp"
-#include "cosmic/router_policy.hpp"
 #include "cosmic/router_stats.hpp"
 #include "cosmic/segment_adapter.hpp"
+#include "cosmic/thread_policy.hpp"
 
 namespace cosmic {
 
@@ -37,15 +41,26 @@ struct Route {
 };
 
 struct RouterLimits {
-  std::size_t hrt_queue = 256;
+  std::size_t hrt_queue = 256;  // events per egress lane of each class
   std::size_t srt_queue = 1024;
   std::size_t nrt_queue = 1024;
-  std::size_t queue_bytes = 16u << 20;  // each class queue is also bounded by bytes (large events)
-  std::uint32_t rate_burst = 3;              // events a channel may bank beyond its rate
+  std::size_t queue_bytes = 16u << 20;  // each lane is also bounded by bytes (large events)
+  std::uint32_t rate_burst = 3;         // events a channel may bank beyond its rate
+  Nanos residence_bound{Nanos(1'000'000)};  // gateway.residence_bound: what each hop is checked against
+  // How the lane threads of each class run (index: ChannelClass). The name is completed with the
+  // segment's name. Without lane threads (false) nothing is sent until run_once() (tests).
+  std::array<ThreadPolicy, 3> lane_threads{ThreadPolicy{"hrt", 0, 0, {}}, ThreadPolicy{"srt", 0, 0, {}},
+                                           ThreadPolicy{"nrt", 0, 10, {}}};
+  bool threaded = true;
 };
 
 using SteadyClock = Nanos (*)();
 Nanos steady_now();
+
+class EgressLane;
+struct ChannelState;
+class PayloadPool;
+struct LaneContext;
 
 class Router {
  public:
@@ -58,7 +73,8 @@ class Router {
 
   // Sink to give the adapter of segment `index`.
   EventSink& inbox(std::size_t index);
-  // Names slot `index` and sets the adapter that sends there (null: slot unused). Control thread.
+  // Names slot `index` and sets the adapter that sends there; starts that segment's lane threads.
+  // Null: stops them (after the send in progress) and drops what they had queued. Control thread.
   void set_segment(std::size_t index, std::string name, SegmentAdapter* adapter);
   std::size_t segment_capacity() const { return segment_names_.size(); }
 
@@ -66,51 +82,49 @@ class Router {
   // duplicate state; queued events of removed or changed channels are dropped silently.
   void apply(std::vector<Route> routes);
 
-  // Router thread: dispatches queued events until none is left or `budget` were handled;
-  // returns how many. run() loops until stop().
+  // Without lane threads: dispatches queued events, HRT lanes first, then SRT, then NRT, until
+  // none is left or `budget` were handled; returns how many.
   std::size_t run_once(std::size_t budget);
-  void run();
+  // Stops every lane (control thread, before the adapters stop).
   void stop();
 
   std::vector<ChannelStatsSnapshot> snapshot() const;
-  // Events the router has dispatched or dropped since start: the watchdog's progress measure.
+  // Events the lanes have handled (sent or dropped) since start: the watchdog's progress measure.
   std::uint64_t progress() const { return progress_.load(std::memory_order_relaxed); }
   // Inbound messages that matched no bound channel, per segment.
   std::uint64_t unrouted(std::size_t segment) const;
   std::size_t queued() const;
+  // What lane threads could not get of their ThreadPolicy since the last call (control thread).
+  std::vector<std::string> take_thread_problems();
 
  private:
-  struct ChannelState;
-  struct Slot;
-  class ClassQueue;
+  struct Table;
   class SegmentInbox;
 
   void receive(std::size_t segment, const InboundEvent& event);
   void problem(std::size_t segment, ChannelId channel, InboundProblem what);
-  void dispatch(Slot& slot);
+  bool admit(ChannelState& channel, SegmentCounters& counters, const InboundEvent& event);
+  void enqueue(const std::shared_ptr<ChannelState>& channel, std::size_t ingress, const InboundEvent& event);
   std::shared_ptr<ChannelState> find(ChannelId id) const;
-  ClassQueue& queue_for(ChannelClass cls);
+  EgressLane& lane(std::size_t segment, ChannelClass cls);
 
   GatewayIdentity self_;
   std::vector<std::string> segment_names_;
   RouterLimits limits_;
   SteadyClock clock_;
   std::vector<std::unique_ptr<SegmentInbox>> inboxes_;
-  std::vector<SegmentAdapter*> adapters_;
   std::unique_ptr<std::atomic<std::uint64_t>[]> unrouted_;
 
-  mutable std::shared_mutex table_mutex_;
-  std::vector<std::shared_ptr<ChannelState>> table_;  // sorted by id
+  std::atomic<std::shared_ptr<const Table>> table_;
+  std::mutex apply_mutex_;  // serialises apply() (control thread) against itself
 
-  std::unique_ptr<ClassQueue> hrt_;
-  std::unique_ptr<ClassQueue> srt_;
-  std::unique_ptr<ClassQueue> nrt_;
-  std::mutex wake_mutex_;
-  std::condition_variable wake_;
-  std::atomic<bool> stopping_{false};
-  std::atomic<bool> sleeping_{false};
   std::atomic<std::uint64_t> progress_{0};
-  std::unique_ptr<Slot> scratch_;
+  std::unique_ptr<PayloadPool> pool_;
+  std::unique_ptr<LaneContext> lane_context_;
+  std::vector<std::unique_ptr<EgressLane>> lanes_;  // segment * 3 + class
+
+  std::mutex problems_mutex_;
+  std::vector<std::string> thread_problems_;
 };
 
 }  // namespace cosmic

@@ -1,10 +1,11 @@
-// Counters of the router, updated lock-free from adapter threads and the router thread and read
-// by the control thread.
+// Counters of the router, updated lock-free from ingress (adapter) threads and the egress lane
+// threads, and read by the control thread.
 #pragma once
 
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,8 +13,15 @@
 
 namespace cosmic {
 
-enum class DropReason : std::size_t { expired, rate, queue_full, duplicate, decode_error, no_route, send_failed };
-inline constexpr std::size_t kDropReasonCount = 7;
+// expired: temp_validity reached; rate: beyond the channel's rate; queue_full: the egress lane or
+// the transport could not take it; duplicate: seen before or a loop copy; decode_error: the
+// bytes were not an event; no_route: not bound for that direction; send_failed: the transport
+// refused it; invalid: a header field out of range (negative or absurd age, foreign subject,
+// our own origin); oversize: larger than the channel's admitted payload.
+enum class DropReason : std::size_t {
+  expired, rate, queue_full, duplicate, decode_error, no_route, send_failed, invalid, oversize
+};
+inline constexpr std::size_t kDropReasonCount = 9;
 const char* to_string(DropReason reason);
 
 struct SegmentCounters {
@@ -31,30 +39,65 @@ class LatencyHistogram {
   Nanos quantile(double q) const;
   Nanos max() const { return Nanos(max_.load(std::memory_order_relaxed)); }
   std::uint64_t count() const;
+  // Per-bucket counts (not cumulative) and each bucket's inclusive upper bound in ns, for
+  // exporters that re-bucket (Prometheus).
+  static constexpr std::size_t kBuckets = 4 * 48;
+  std::uint64_t bucket_count(std::size_t bucket) const { return buckets_[bucket].load(std::memory_order_relaxed); }
+  static std::uint64_t upper_bound_of(std::size_t bucket);
 
  private:
-  static constexpr std::size_t kBuckets = 4 * 48;
   static std::size_t bucket_of(std::uint64_t ns);
-  static std::uint64_t upper_bound_of(std::size_t bucket);
   std::array<std::atomic<std::uint64_t>, kBuckets> buckets_{};
   std::atomic<std::int64_t> max_{0};
 };
 
+// Runtime verification of one egress hop (channel x subscriber segment), written by that
+// segment's lane thread. Residence runs from the kernel's arrival of the event to the return of
+// the transport's send(); age at egress is the age the event arrived with plus that residence.
+struct EgressStats {
+  LatencyHistogram residence;
+  std::atomic<std::uint64_t> residence_miss{0};  // residence > gateway.residence_bound
+  std::atomic<std::uint64_t> deadline_miss{0};   // age at egress > the channel's reaction_time
+};
+
 // Plain copies for reporting.
+struct HopRuntimeSnapshot {
+  std::uint64_t events = 0;  // residences recorded
+  Nanos residence_p50{0};
+  Nanos residence_p99{0};
+  Nanos residence_p999{0};
+  Nanos residence_max{0};
+  std::uint64_t residence_miss = 0;
+  std::uint64_t deadline_miss = 0;
+  std::vector<std::uint64_t> residence_buckets;  // LatencyHistogram buckets, trimmed after the last non-empty one
+};
+
 struct SegmentCountersSnapshot {
   std::string segment;
   std::uint64_t rx = 0;
   std::uint64_t tx = 0;
   std::array<std::uint64_t, kDropReasonCount> dropped{};
+  std::optional<HopRuntimeSnapshot> egress;  // set on the channel's subscriber segments
 };
+
+// Runtime state of a channel, judged against what admission promised (Gateway, control thread):
+// bound: no miss within the clean interval; violated: an HRT hop missed its residence bound or
+// its reaction time (SRT channels count misses but stay bound: they were promised no bound).
+enum class RuntimeState { bound, violated };
+const char* to_string(RuntimeState state);
 
 struct ChannelStatsSnapshot {
   std::string name;
   std::vector<SegmentCountersSnapshot> segments;
-  Nanos residence_p50{0};
+  Nanos residence_p50{0};  // over every egress hop of the channel
   Nanos residence_p99{0};
+  Nanos residence_p999{0};
   Nanos residence_max{0};
-  std::uint64_t forwarded = 0;  // events dispatched to at least one subscriber segment
+  std::uint64_t residence_miss = 0;  // sums over the egress hops
+  std::uint64_t deadline_miss = 0;
+  std::uint64_t forwarded = 0;  // events accepted and queued for at least one subscriber segment
+  RuntimeState runtime_state = RuntimeState::bound;  // filled in by the Gateway
+  std::uint64_t violations = 0;                      // episodes since the channel was bound (Gateway)
 };
 
 }  // namespace cosmic

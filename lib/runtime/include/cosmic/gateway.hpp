@@ -1,8 +1,13 @@
 // The running gateway: the knowledge base, one adapter per segment, the router and its thread,
 // and the binding operations (start, bind, unbind, reload) that keep the three consistent.
 //
-// Threads: every public method is called by the one control thread; the router runs on its own
-// thread started by start(); adapters run their own receive threads.
+// Threads: every public method is called by the one control thread; the router's egress lanes
+// run their own threads (started per segment); adapters run their own receive threads.
+//
+// Runtime verification: refresh_runtime() compares what the lanes measured with what admission
+// promised. An HRT channel whose hop missed gateway.residence_bound or its reaction_time becomes
+// `violated` (logged once per episode at warning, with the numbers) and returns to `bound` after
+// gateway.clean_interval without a miss.
 #pragma once
 
 #include <functional>
@@ -39,6 +44,23 @@ struct SegmentInfo {
   std::uint64_t unrouted = 0;
 };
 
+// Admission of a bind, split so a long one can run off the control thread: the plan is pure
+// (any thread, on its own copy of the knowledge base), the commit runs on the control thread.
+struct BindPlan {
+  std::uint64_t generation = 0;           // Gateway::generation() the copy was taken at
+  std::vector<ChannelSpec> channels;
+  std::shared_ptr<KnowledgeBase> kb;      // the copy; holds `channels` once planned and admitted
+  std::vector<ChannelReport> reports;     // verdict of each channel, once planned
+  bool admitted = false;                  // every channel bound in `kb`
+};
+
+// The same for a reload: a fresh knowledge base built from the new configuration.
+struct ReloadPlan {
+  Config config;
+  std::shared_ptr<KnowledgeBase> kb;
+  std::vector<ChannelReport> reports;
+};
+
 class Gateway {
  public:
   static constexpr std::size_t kMaxSegments = 64;
@@ -59,17 +81,36 @@ class Gateway {
   // Validated configuration in, running one swapped: unchanged segments and channels keep
   // flowing. On failure the running configuration stays untouched.
   BindResult reload(const Config& config);
+
+  // bind() in steps. Control thread: the plan's input (a copy of the knowledge base).
+  BindPlan bind_plan_input(std::vector<ChannelSpec> channels) const;
+  // Any thread, no I/O: admission of plan.channels on plan.kb.
+  static void plan_bind(BindPlan& plan);
+  // Control thread: applies an admitted plan. Refused (nothing changes) when the bindings
+  // changed since the plan's copy was taken.
+  BindResult commit_bind(BindPlan plan);
+  // reload() in steps: the plan on any thread (no I/O), the commit on the control thread.
+  static ReloadPlan plan_reload(Config config);
+  BindResult commit_reload(ReloadPlan plan);
+  // Changes with every applied bind, unbind and reload.
+  std::uint64_t generation() const { return generation_; }
   void stop();
 
   // Reads adapter health into the knowledge base (call periodically).
   void refresh_health();
+  // Updates the runtime state of every channel from the lanes' miss counters (call periodically).
+  void refresh_runtime(Nanos now);
+  std::size_t violated_channels() const;
+  // What the forwarding threads could not get of gateway.realtime since the last call.
+  std::vector<std::string> take_thread_problems();
 
   const GatewayIdentity& identity() const { return identity_; }
   const Config& config() const { return config_; }
   const KnowledgeBase& knowledge_base() const { return *kb_; }
   AdmissionReport admission() const { return kb_->report(); }
   std::vector<SegmentInfo> segments() const;
-  std::vector<ChannelStatsSnapshot> channel_stats() const { return router_->snapshot(); }
+  // The router's counters plus each channel's runtime state.
+  std::vector<ChannelStatsSnapshot> channel_stats() const;
   const Router& router() const { return *router_; }
   bool all_segments_up() const;
   // Discovered remote endpoints of a bound channel on a segment (see SegmentAdapter).
@@ -82,7 +123,15 @@ class Gateway {
     std::unique_ptr<SegmentAdapter> adapter;
   };
 
+  struct RuntimeTrack {
+    RuntimeState state = RuntimeState::bound;
+    std::uint64_t misses = 0;  // residence + deadline misses seen at the last refresh
+    Nanos last_miss{0};
+    std::uint64_t violations = 0;
+  };
+
   std::optional<std::string> configure_adapters();
+  void judge(const ChannelStatsSnapshot& stats, const ChannelSpec& spec, RuntimeTrack& track, Nanos now);
   void apply_routes();
   ChannelId id_for(const ChannelSpec& spec);
   // Lowest slot index used neither by a running segment nor by one in `also_taken`.
@@ -95,10 +144,11 @@ class Gateway {
   Config config_;
   std::unique_ptr<KnowledgeBase> kb_;
   std::unique_ptr<Router> router_;
-  std::thread router_thread_;
+  std::map<std::string, RuntimeTrack> runtime_;  // by channel name
   std::map<std::string, SegmentSlot> slots_;  // by segment name
   std::map<std::string, std::pair<ChannelSpec, ChannelId>> channel_ids_;
   ChannelId next_channel_id_ = 1;
+  std::uint64_t generation_ = 0;
 };
 
 }  // namespace cosmic

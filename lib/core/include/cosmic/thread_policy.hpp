@@ -1,0 +1,21 @@
+// How a gateway thread runs: its name (as shown by ps/top/gdb), its scheduling class and priority,
+// and the CPUs it may run on. Applied by the thread itself when it starts.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace cosmic {
+
+struct ThreadPolicy {
+  std::string name;        // at most 15 characters are kept (the kernel's limit)
+  int fifo_priority = 0;   // 1..99: SCHED_FIFO at that priority; 0: the normal time-sharing class
+  int nice = 0;            // for the time-sharing class (positive values need no privilege)
+  std::vector<int> cpus;   // empty: any CPU
+};
+
+// Applies `policy` to the calling thread. Returns what could not be applied (e.g. "SCHED_FIFO 80:
+// Operation not permitted"); the thread runs on with what it got.
+std::vector<std::string> apply_thread_policy(const ThreadPolicy& policy);
+
+}  // namespace cosmic

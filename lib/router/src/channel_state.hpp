@@ -1,0 +1,36 @@
+// The router's state of one bound channel: its (immutable) route, its ingress policies and its
+// counters. Shared by the route table snapshots and the events queued for it (shared_ptr), so a
+// channel removed by apply() stays valid until the last queued event of it is handled.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "cosmic/router.hpp"
+#include "cosmic/router_policy.hpp"
+#include "cosmic/router_stats.hpp"
+
+namespace cosmic {
+
+struct ChannelState {
+  ChannelState(Route r, std::size_t segment_count, std::uint32_t burst)
+      : route(std::move(r)),
+        bucket(route.spec.period.value_or(Nanos(0)), burst),
+        counters(segment_count),
+        egress(route.subscribers.size()) {}
+
+  const Route route;
+  std::mutex policy_mutex;  // guards bucket and dedup (ingress threads of several segments)
+  TokenBucket bucket;
+  DuplicateFilter dedup;
+  std::vector<SegmentCounters> counters;  // indexed by segment slot
+  std::vector<EgressStats> egress;        // parallel to route.subscribers
+  LatencyHistogram residence;             // over every egress hop
+  std::atomic<std::uint32_t> next_sequence{0};
+  std::atomic<std::uint64_t> forwarded{0};
+  std::atomic<bool> removed{false};
+};
+
+}  // namespace cosmic

@@ -1,0 +1,163 @@
+#include "egress_lane.hpp"
+
+#include <algorithm>
+#include <limits>
+
+namespace cosmic {
+
+EgressLane::EgressLane(LaneContext& context, std::size_t segment, std::size_t depth, std::size_t byte_budget)
+    : context_(context), segment_(segment), depth_(std::max<std::size_t>(1, depth)), byte_budget_(byte_budget) {}
+
+EgressLane::~EgressLane() { deactivate(); }
+
+bool EgressLane::push(LaneItem&& item) noexcept {
+  const std::size_t size = item.payload->bytes().size();
+  {
+    std::lock_guard lock(mutex_);
+    if (!active_ || count_ == ring_.size() || bytes_ + size > byte_budget_) return false;
+    item.generation = generation_;
+    ring_[(head_ + count_) % ring_.size()] = std::move(item);
+    bytes_ += size;
+    ++count_;
+  }
+  ticket_.fetch_add(1, std::memory_order_release);
+  ticket_.notify_one();
+  return true;
+}
+
+bool EgressLane::pop(LaneItem& out) noexcept {
+  std::lock_guard lock(mutex_);
+  if (count_ == 0) return false;
+  out = std::move(ring_[head_]);
+  bytes_ -= out.payload->bytes().size();
+  head_ = (head_ + 1) % ring_.size();
+  --count_;
+  return true;
+}
+
+std::size_t EgressLane::size() const {
+  std::lock_guard lock(mutex_);
+  return count_;
+}
+
+void EgressLane::activate(SegmentAdapter* adapter, const ThreadPolicy& policy, bool threaded) {
+  deactivate();
+  {
+    std::lock_guard lock(mutex_);
+    if (ring_.empty()) ring_.resize(depth_);
+    active_ = true;
+    current_generation_.store(generation_, std::memory_order_release);
+  }
+  adapter_.store(adapter, std::memory_order_release);
+  if (!threaded) return;
+  running_.store(true, std::memory_order_release);
+  thread_ = std::thread([this, policy] { worker(policy); });
+}
+
+void EgressLane::deactivate() {
+  if (thread_.joinable()) {
+    running_.store(false, std::memory_order_release);
+    ticket_.fetch_add(1, std::memory_order_release);
+    ticket_.notify_all();
+    thread_.join();
+  }
+  std::vector<LaneItem> dropped;
+  {
+    std::lock_guard lock(mutex_);
+    active_ = false;
+    ++generation_;  // an event pushed while this runs is discarded when next seen
+    while (count_ > 0) {
+      dropped.push_back(std::move(ring_[head_]));
+      head_ = (head_ + 1) % ring_.size();
+      --count_;
+    }
+    bytes_ = 0;
+  }
+  adapter_.store(nullptr, std::memory_order_release);
+  for (auto& item : dropped) discard(item);
+}
+
+std::size_t EgressLane::run_once(std::size_t budget) {
+  std::size_t handled = 0;
+  LaneItem item;
+  while (handled < budget && pop(item)) {
+    forward(item);
+    ++handled;
+  }
+  return handled;
+}
+
+void EgressLane::worker(ThreadPolicy policy) {
+  if (auto problems = apply_thread_policy(policy); !problems.empty() && context_.report_thread_problems) {
+    for (auto& p : problems) p = "thread " + policy.name + ": " + p;
+    context_.report_thread_problems(problems);
+  }
+  LaneItem item;
+  while (running_.load(std::memory_order_acquire)) {
+    const std::uint32_t ticket = ticket_.load(std::memory_order_acquire);
+    if (pop(item)) {
+      forward(item);
+      continue;
+    }
+    ticket_.wait(ticket, std::memory_order_acquire);
+  }
+}
+
+void EgressLane::discard(LaneItem& item) noexcept {
+  context_.pool.release(item.payload);
+  item.payload = nullptr;
+  item.channel.reset();
+}
+
+namespace {
+// a + b without signed overflow (both are validated ages and residences, but a stuck clock or a
+// hostile envelope must never make the arithmetic undefined).
+std::int64_t saturating_add(std::int64_t a, std::int64_t b) {
+  if (b > 0 && a > std::numeric_limits<std::int64_t>::max() - b) return std::numeric_limits<std::int64_t>::max();
+  if (b < 0 && a < std::numeric_limits<std::int64_t>::min() - b) return std::numeric_limits<std::int64_t>::min();
+  return a + b;
+}
+}  // namespace
+
+void EgressLane::forward(LaneItem& item) noexcept {
+  context_.progress.fetch_add(1, std::memory_order_relaxed);
+  ChannelState& channel = *item.channel;
+  SegmentAdapter* adapter = adapter_.load(std::memory_order_acquire);
+  if (channel.removed.load(std::memory_order_relaxed) ||
+      item.generation != current_generation_.load(std::memory_order_acquire)) {
+    discard(item);
+    return;
+  }
+  const ChannelSpec& spec = channel.route.spec;
+  SegmentCounters& counters = channel.counters[segment_];
+  EgressStats& hop = channel.egress[item.hop];
+  const Nanos waited = context_.clock() - item.received;
+  const Nanos age(saturating_add(item.header.age_ns, waited.count()));
+  if (spec.temp_validity && age >= *spec.temp_validity) {
+    counters.drop(DropReason::expired);
+    if (spec.reaction_time && age > *spec.reaction_time) hop.deadline_miss.fetch_add(1, std::memory_order_relaxed);
+    discard(item);
+    return;
+  }
+  OutboundEvent out{channel.route.id, item.header, item.payload->bytes()};
+  out.header.age_ns = age.count();
+  // Counted before the send, taken back if it fails: whoever sees the event on the wire sees the
+  // counter already moved.
+  counters.tx.fetch_add(1, std::memory_order_relaxed);
+  const SendStatus status = adapter != nullptr ? adapter->send(out) : SendStatus::failed;
+  if (status != SendStatus::sent) {
+    counters.tx.fetch_sub(1, std::memory_order_relaxed);
+    counters.drop(status == SendStatus::queue_full ? DropReason::queue_full : DropReason::send_failed);
+    discard(item);
+    return;
+  }
+  const Nanos residence = context_.clock() - item.received;
+  hop.residence.record(residence);
+  channel.residence.record(residence);
+  if (residence > context_.residence_bound) hop.residence_miss.fetch_add(1, std::memory_order_relaxed);
+  if (spec.reaction_time && Nanos(saturating_add(item.header.age_ns, residence.count())) > *spec.reaction_time)
+    hop.deadline_miss.fetch_add(1, std::memory_order_relaxed);
+  discard(item);
+}
+
+}  // namespace cosmic

@@ -1,0 +1,87 @@
+// One egress lane: the events of one class waiting for one subscriber segment, and the thread
+// that hands them to that segment's adapter. Each (segment, class) has its own lane and thread,
+// so a slow or blocking transport delays only its own lanes, and a lower class never holds up a
+// higher one: the higher class's thread runs at a higher priority (gateway.realtime), and it
+// never waits for a lower class's queue.
+//
+// Threads: push() from ingress (adapter) threads; the lane thread pops and sends; activate(),
+// deactivate() and size() from the control thread; run_once() instead of the lane thread when
+// the router runs without threads (tests).
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "channel_state.hpp"
+#include "cosmic/segment_adapter.hpp"
+#include "cosmic/thread_policy.hpp"
+#include "payload_pool.hpp"
+
+namespace cosmic {
+
+struct LaneItem {
+  std::shared_ptr<ChannelState> channel;
+  PayloadBuffer* payload = nullptr;
+  EventHeader header;  // as it leaves (origin, sequence, hop count set), age as it arrived
+  Nanos received{0};   // kernel arrival, steady clock
+  std::uint32_t hop = 0;  // index of this lane's segment in the channel's route.subscribers
+  std::uint64_t generation = 0;
+};
+
+// What every lane of one router shares.
+struct LaneContext {
+  SteadyClock clock;
+  Nanos residence_bound;
+  PayloadPool& pool;
+  std::atomic<std::uint64_t>& progress;  // events handled (sent or dropped): the watchdog's measure
+  std::function<void(const std::vector<std::string>&)> report_thread_problems;
+};
+
+class EgressLane {
+ public:
+  EgressLane(LaneContext& context, std::size_t segment, std::size_t depth, std::size_t byte_budget);
+  ~EgressLane();
+  EgressLane(const EgressLane&) = delete;
+  EgressLane& operator=(const EgressLane&) = delete;
+
+  // False when the lane is full (by count or bytes) or not active: the caller counts queue_full.
+  bool push(LaneItem&& item) noexcept;
+  // Starts sending to `adapter`; with `threaded`, on a new thread run under `policy`.
+  void activate(SegmentAdapter* adapter, const ThreadPolicy& policy, bool threaded);
+  // Stops sending: joins the thread (after its send in progress) and drops what is queued.
+  void deactivate();
+  // Without a thread: handles up to `budget` queued events now; returns how many.
+  std::size_t run_once(std::size_t budget);
+  std::size_t size() const;
+
+ private:
+  bool pop(LaneItem& out) noexcept;
+  void forward(LaneItem& item) noexcept;
+  void discard(LaneItem& item) noexcept;
+  void worker(ThreadPolicy policy);
+
+  LaneContext& context_;
+  const std::size_t segment_;
+  const std::size_t depth_;
+  const std::size_t byte_budget_;
+
+  mutable std::mutex mutex_;  // the ring; held for moves only, never across send()
+  std::vector<LaneItem> ring_;  // allocated at the first activation
+  std::size_t head_ = 0;
+  std::size_t count_ = 0;
+  std::size_t bytes_ = 0;
+  bool active_ = false;
+  std::uint64_t generation_ = 0;
+
+  std::atomic<SegmentAdapter*> adapter_{nullptr};
+  std::atomic<std::uint64_t> current_generation_{0};
+  std::atomic<std::uint32_t> ticket_{0};  // bumped by every push and by deactivate (futex wait)
+  std::atomic<bool> running_{false};
+  std::thread thread_;
+};
+
+}  // namespace cosmic

@@ -1,0 +1,55 @@
+// Copy-once payloads: an ingress thread copies an event's bytes once into a pooled buffer, and
+// every egress lane the event is queued on holds a reference to that one copy. Buffers return to
+// the pool when the last lane is done; their capacity is reused, so steady-state forwarding
+// allocates nothing.
+//
+// Threads: acquire() on ingress threads, release() on lane threads (and the control thread when
+// a lane is drained). The free list has its own mutex, held for a pointer swap only.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <span>
+#include <vector>
+
+namespace cosmic {
+
+class PayloadBuffer {
+ public:
+  std::span<const std::uint8_t> bytes() const { return bytes_; }
+
+ private:
+  friend class PayloadPool;
+  std::vector<std::uint8_t> bytes_;
+  std::atomic<std::uint32_t> references_{0};
+  PayloadBuffer* next_free_ = nullptr;
+};
+
+class PayloadPool {
+ public:
+  // At most `max_buffers` buffers exist at once; a released buffer larger than `retained_bytes`
+  // gives its memory back (one burst of big NRT events must not pin it).
+  PayloadPool(std::size_t max_buffers, std::size_t retained_bytes);
+  PayloadPool(const PayloadPool&) = delete;
+  PayloadPool& operator=(const PayloadPool&) = delete;
+
+  // A buffer holding a copy of `payload`, referenced `references` times; nullptr when the pool is
+  // exhausted (every buffer is queued somewhere) or memory is short.
+  PayloadBuffer* acquire(std::span<const std::uint8_t> payload, std::uint32_t references) noexcept;
+  // Drops one reference; the last one returns the buffer to the pool.
+  void release(PayloadBuffer* buffer) noexcept;
+
+ private:
+  PayloadBuffer* pop_free() noexcept;
+  void push_free(PayloadBuffer* buffer) noexcept;
+
+  const std::size_t max_buffers_;
+  const std::size_t retained_bytes_;
+  std::mutex mutex_;
+  PayloadBuffer* free_ = nullptr;
+  std::vector<std::unique_ptr<PayloadBuffer>> all_;  // ownership; grows up to max_buffers_
+};
+
+}  // namespace cosmic
