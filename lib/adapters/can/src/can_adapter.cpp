@@ -25,6 +25,7 @@
 
 #include "can_binding.hpp"
 #include "cosmic/arrival_clock.hpp"
+#include "cosmic/thread_policy.hpp"
 #include "cosmic/can_fragment.hpp"
 #include "cosmic/can_timing.hpp"
 #include "cosmic/can_wire.hpp"
@@ -199,7 +200,13 @@ Status CanAdapter::start(EventSink& sink) {
   started_ = true;
   check_link();  // opens the socket now when the interface is there: health is right at once
   try {
-    thread_ = std::thread([this] { run(); });
+    ThreadPolicy policy = sink.receive_thread_policy();
+    policy.name = "rx:" + segment_.name;
+    thread_ = std::thread([this, policy] {
+      for (const auto& problem : apply_thread_policy(policy))
+        log_.log(LogLevel::warning, "segment " + segment_.name + ": receive thread: " + problem);
+      run();
+    });
   } catch (const std::exception& e) {
     close_socket();
     ::close(ctl_fd_);

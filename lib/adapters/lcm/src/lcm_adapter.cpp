@@ -17,6 +17,8 @@
 #include "cosmic/lcm_adapter.hpp"
 
 #include "cosmic/adapter_counters.hpp"
+#include "cosmic/arrival_clock.hpp"
+#include "cosmic/thread_policy.hpp"
 
 #include <lcm/lcm.h>
 
@@ -190,7 +192,9 @@ class LcmAdapter final : public SegmentAdapter {
     }
     running_.store(true, std::memory_order_release);
     try {
-      thread_ = std::thread([this, lcm] { receive_loop(lcm); });
+      ThreadPolicy policy = sink.receive_thread_policy();
+      policy.name = "rx:" + segment_.name;
+      thread_ = std::thread([this, lcm, policy] { receive_loop(lcm, policy); });
     } catch (const std::exception& e) {
       running_.store(false);
       {
@@ -399,7 +403,9 @@ class LcmAdapter final : public SegmentAdapter {
     return errors;
   }
 
-  void receive_loop(lcm_t* lcm) {
+  void receive_loop(lcm_t* lcm, const ThreadPolicy& policy) {
+    for (const auto& problem : apply_thread_policy(policy))
+      log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": receive thread: " + problem);
     bool failing = false;
     while (running_.load(std::memory_order_acquire)) {
       const int rc = lcm_handle_timeout(lcm, kHandleTimeoutMs);
@@ -429,7 +435,9 @@ class LcmAdapter final : public SegmentAdapter {
 
   // Receive thread only.
   void handle_message(const lcm_recv_buf_t& rbuf, const char* channel_name) {
-    const auto received_at = Clock::now().time_since_epoch();
+    // liblcm's reader thread stamps each datagram with the kernel's arrival time (SO_TIMESTAMP,
+    // microseconds, realtime clock): residence starts there, not when this thread got to it.
+    const Nanos received_at = steady_arrival_now(rbuf.recv_utime * 1000);
     std::shared_lock table(table_mutex_);
     const auto it = by_name_.find(std::string_view(channel_name));
     if (it == by_name_.end() || !it->second->rx || sink_ == nullptr) return;  // no longer bound
@@ -439,7 +447,7 @@ class LcmAdapter final : public SegmentAdapter {
                                               rbuf.data_size);
     InboundEvent event;
     event.channel = channel.id;
-    event.received_at = std::chrono::duration_cast<Nanos>(received_at);
+    event.received_at = received_at;
 
     if (channel.encoding == LcmEncoding::raw) {
       if (echo_.consume(channel.id, bytes, now_ns())) {
