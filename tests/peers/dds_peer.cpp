@@ -4,15 +4,16 @@
 //   cosmic-dds-peer pub --domain D --topic NAME --count N --size B [--rate HZ]
 //                       [--reliable|--best-effort] [--subject S] [--origin O]
 //                       [--wait-subscribers K] [--match-timeout S] [--hop-count H] [--age-ns A]
-//                       [--start-on-stdin]
+//                       [--start-on-stdin] [--first-sequence F]
 //   cosmic-dds-peer sub --domain D --topic NAME --count N [--timeout S]
-//                       [--reliable|--best-effort] [--quiet]
+//                       [--reliable|--best-effort] [--transient-local] [--quiet]
 //
 // --topic is the DDS topic name verbatim; --channel NAME is a shorthand for the gateway's
 // scheme, --topic cosmic/NAME.
 //
 // pub waits until K (default 1) subscribers matched (discovery, never a fixed sleep; exit 2 after
-// --match-timeout seconds), then writes N envelopes, sequence 1..N, payload byte i of event q =
+// --match-timeout seconds), then writes N envelopes, envelope sequence F..F+N-1 (F = 1 unless
+// --first-sequence; the RTPS sample sequence numbers are always 1..N), payload byte i of event q =
 // (q + i) mod 256, created_ns = CLOCK_MONOTONIC now (comparable between processes of one host),
 // paced at --rate events/s (0: as fast as possible). Reliable (the default) uses KEEP_ALL, so
 // nothing is dropped by the writer, and waits for all acknowledgements before exiting.
@@ -26,7 +27,8 @@
 //    "received_ns":R,"size":B,"payload":"hex"}
 // (received_ns: CLOCK_MONOTONIC at reception) and exits 0 once N arrived (N = 0: runs until the
 // timeout and exits 0), 1 on timeout (default 30 s). The default reader is best-effort, which
-// matches every writer; --reliable requests RELIABLE.
+// matches every writer; --reliable requests RELIABLE, --transient-local TRANSIENT_LOCAL
+// durability (default VOLATILE).
 //
 // Diagnostics go to stderr as JSON lines, so tests can wait on them:
 //   {"event":"matched","count":K}                  matched remote endpoints changed
@@ -227,6 +229,8 @@ struct Options {
   double timeout = 30;
   bool quiet = false;
   bool start_on_stdin = false;
+  bool transient_local = false;
+  std::uint32_t first_sequence = 1;
 };
 
 struct Entities {
@@ -327,7 +331,7 @@ int run_pub(const Options& o) {
     for (std::uint64_t i = 0; i < o.size; ++i) {
       env.payload()[i] = static_cast<std::uint8_t>((q + i) & 0xff);
     }
-    env.sequence(static_cast<std::uint32_t>(q));
+    env.sequence(static_cast<std::uint32_t>(o.first_sequence + q - 1));
     env.created_ns(monotonic_ns());
     // A reliable KEEP_ALL writer blocks while its history is full, but may still answer
     // OUT_OF_RESOURCES/TIMEOUT (acknowledged samples not yet released): retry for up to 10 s.
@@ -367,7 +371,8 @@ int run_sub(const Options& o) {
   fdds::DataReaderQos qos = fdds::DATAREADER_QOS_DEFAULT;
   qos.reliability().kind =
       o.reliable ? fdds::RELIABLE_RELIABILITY_QOS : fdds::BEST_EFFORT_RELIABILITY_QOS;
-  qos.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
+  qos.durability().kind =
+      o.transient_local ? fdds::TRANSIENT_LOCAL_DURABILITY_QOS : fdds::VOLATILE_DURABILITY_QOS;
   qos.history().kind = fdds::KEEP_ALL_HISTORY_QOS;
   qos.resource_limits().max_samples = 100000;
   qos.resource_limits().allocated_samples = 100;
@@ -463,10 +468,12 @@ int main(int argc, char** argv) {
   pub->add_option("--match-timeout", o.match_timeout, "seconds to wait for them (exit 2)");
   pub->add_flag("--start-on-stdin", o.start_on_stdin,
                 "after matching, wait for a line on stdin (or EOF) before publishing");
+  pub->add_option("--first-sequence", o.first_sequence, "envelope sequence of the first event");
   CLI::App* sub = app.add_subcommand("sub", "receive N envelopes, one JSON line each");
   common(sub);
   sub->add_option("--timeout", o.timeout, "seconds before giving up (exit 1)");
   sub->add_flag("--quiet", o.quiet, "count only, print nothing per envelope");
+  sub->add_flag("--transient-local", o.transient_local, "request TRANSIENT_LOCAL durability");
   CLI11_PARSE(app, argc, argv);
 
   if (!o.channel.empty()) {

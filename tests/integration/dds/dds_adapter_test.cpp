@@ -144,7 +144,7 @@ TEST(DdsAdapter, SendsEnvelopesToNativeSubscriber) {
   ASSERT_TRUE(f.adapter->configure(std::span(&b, 1)).ok);
 
   constexpr int kCount = 50;
-  Child sub(peer({"sub", "--domain", "41", "--topic", "cosmic/robot.pose", "--count",
+  Child sub(peer({"sub", "--domain", "41", "--topic", "cosmic/robot_pose", "--count",
                   std::to_string(kCount), "--reliable", "--timeout", "30"}));
   // Discovery done in both directions: our writer sees the reader, the reader sees our writer.
   ASSERT_TRUE(f.matched(7, HopRole::subscriber)) << sub.describe();
@@ -292,7 +292,9 @@ TEST(DdsAdapter, NeverReceivesItsOwnPublications) {
 
 // ---- QoS on the wire --------------------------------------------------------------------------
 
-TEST(DdsAdapter, ChannelQosIsVisibleToNativeParticipants) {
+// What a channel's writer offers is what a default reader of any vendor accepts: reliable,
+// non-volatile, no deadline (not even from `period`), latency budget 0; lifespan = validity.
+TEST(DdsAdapter, WritersOfferWhatDefaultReadersAccept) {
   Fixture f(dds_segment(44));
   ASSERT_TRUE(f.adapter->start(f.sink).ok);
   ChannelBinding b = binding(9, "imu", HopRole::subscriber, 3);
@@ -310,40 +312,151 @@ TEST(DdsAdapter, ChannelQosIsVisibleToNativeParticipants) {
   }
   EXPECT_EQ(announced["topic"], "cosmic/imu");
   EXPECT_EQ(announced["reliability"], "reliable");
-  EXPECT_EQ(announced["durability"], "volatile");
-  EXPECT_EQ(announced["deadline_ns"], 10'000'000);
+  EXPECT_EQ(announced["durability"], "non_volatile");
+  EXPECT_TRUE(announced["deadline_ns"].is_null()) << announced;
   EXPECT_EQ(announced["lifespan_ns"], 50'000'000);
-  EXPECT_EQ(announced["latency_budget_ns"], 5'000'000);
+  EXPECT_EQ(announced["latency_budget_ns"], 0);
+  ASSERT_TRUE(f.matched(9, HopRole::subscriber)) << sub.describe();
+  EXPECT_EQ(f.adapter->incompatible_peers(9), 0u);
 }
 
-TEST(DdsAdapter, BestEffortSegmentRefusesReliableReaders) {
+// Even on a best-effort segment the writer is reliable, so both kinds of reader match.
+TEST(DdsAdapter, WritersServeReliableAndBestEffortReaders) {
   Fixture f(dds_segment(45, Reliability::best_effort));
   ASSERT_TRUE(f.adapter->start(f.sink).ok);
   const ChannelBinding b = binding(2, "status", HopRole::subscriber);
   ASSERT_TRUE(f.adapter->configure(std::span(&b, 1)).ok);
 
-  Child reliable(peer({"sub", "--domain", "45", "--channel", "status", "--count", "0",
+  Child reliable(peer({"sub", "--domain", "45", "--channel", "status", "--count", "1",
                        "--reliable", "--timeout", "30"}));
-  ASSERT_TRUE(reliable.wait_err(diag_event("incompatible_qos"), kWait)) << reliable.describe();
-  const auto err = reliable.err_lines();
-  const json j = parse(*std::find_if(err.begin(), err.end(), diag_event("incompatible_qos")));
-  EXPECT_EQ(j["policy"], "reliability");
-  EXPECT_EQ(f.adapter->matched_endpoints(2, HopRole::subscriber), 0u);
-
-  // A best-effort reader matches, and reads the announced best-effort QoS.
   Child best(peer({"sub", "--domain", "45", "--channel", "status", "--count", "1",
                    "--timeout", "30"}));
-  ASSERT_TRUE(f.matched(2, HopRole::subscriber)) << best.describe();
+  ASSERT_TRUE(f.matched(2, HopRole::subscriber, 2)) << reliable.describe() << best.describe();
+  ASSERT_TRUE(reliable.wait_err(matched_at_least(1), kWait)) << reliable.describe();
   ASSERT_TRUE(best.wait_err(matched_at_least(1), kWait)) << best.describe();
-  ASSERT_TRUE(best.wait_err(diag_event("publication"), kWait));
-  for (const auto& line : best.err_lines()) {
-    if (diag_event("publication")(line)) {
-      EXPECT_EQ(parse(line)["reliability"], "best_effort");
-    }
-  }
   std::vector<std::uint8_t> storage;
   ASSERT_EQ(f.adapter->send(outbound(2, 1, storage)), SendStatus::sent);
+  EXPECT_EQ(reliable.wait_exit(kWait), 0) << reliable.describe();
   EXPECT_EQ(best.wait_exit(kWait), 0) << best.describe();
+  EXPECT_EQ(f.adapter->incompatible_peers(2), 0u);
+}
+
+// A transient-local reader (e.g. a late-joining ROS 2 tool) is served by our writer.
+TEST(DdsAdapter, TransientLocalReadersMatch) {
+  Fixture f(dds_segment(60));
+  ASSERT_TRUE(f.adapter->start(f.sink).ok);
+  const ChannelBinding b = binding(5, "map", HopRole::subscriber);
+  ASSERT_TRUE(f.adapter->configure(std::span(&b, 1)).ok);
+  Child sub(peer({"sub", "--domain", "60", "--channel", "map", "--count", "1", "--reliable",
+                  "--transient-local", "--timeout", "30"}));
+  ASSERT_TRUE(f.matched(5, HopRole::subscriber)) << sub.describe();
+  ASSERT_TRUE(sub.wait_err(matched_at_least(1), kWait)) << sub.describe();
+  std::vector<std::uint8_t> storage;
+  ASSERT_EQ(f.adapter->send(outbound(5, 1, storage)), SendStatus::sent);
+  EXPECT_EQ(sub.wait_exit(kWait), 0) << sub.describe();
+  EXPECT_EQ(f.adapter->incompatible_peers(5), 0u);
+}
+
+// On a reliable segment a best-effort writer cannot match our reliable reader (DDS rule): the
+// refusal is a per-channel count, not only a log line.
+TEST(DdsAdapter, IncompatibleRemoteWriterIsCountedPerChannel) {
+  Fixture f(dds_segment(61));
+  ASSERT_TRUE(f.adapter->start(f.sink).ok);
+  const ChannelBinding bindings[] = {binding(6, "wheel", HopRole::publisher),
+                                     binding(8, "other", HopRole::publisher)};
+  ASSERT_TRUE(f.adapter->configure(bindings).ok);
+  EXPECT_EQ(f.adapter->incompatible_peers(6), 0u);
+  Child pub(peer({"pub", "--domain", "61", "--channel", "wheel", "--count", "1", "--size", "8",
+                  "--best-effort", "--match-timeout", "30"}));
+  ASSERT_TRUE(test::eventually([&] { return f.adapter->incompatible_peers(6) >= 1u; }, kWait))
+      << pub.describe();
+  EXPECT_EQ(f.adapter->matched_endpoints(6, HopRole::publisher), 0u);
+  EXPECT_EQ(f.adapter->incompatible_peers(8), 0u);
+  EXPECT_EQ(f.adapter->incompatible_peers(99), 0u);  // not bound: nothing refused
+}
+
+// A best-effort segment's reader accepts a best-effort writer.
+TEST(DdsAdapter, BestEffortSegmentAcceptsBestEffortWriters) {
+  Fixture f(dds_segment(62, Reliability::best_effort));
+  ASSERT_TRUE(f.adapter->start(f.sink).ok);
+  const ChannelBinding b = binding(6, "wheel", HopRole::publisher);
+  ASSERT_TRUE(f.adapter->configure(std::span(&b, 1)).ok);
+  auto pub = start_pub({"pub", "--domain", "62", "--channel", "wheel", "--count", "3", "--size",
+                        "8", "--best-effort"},
+                       f.reader_matched(6));
+  ASSERT_TRUE(f.sink.wait_count(6, 1, kWait)) << pub->describe();
+  EXPECT_EQ(f.adapter->incompatible_peers(6), 0u);
+}
+
+// ---- topic names ------------------------------------------------------------------------------
+
+TEST(DdsAdapter, ChannelNamesBecomeValidTopicNames) {
+  EXPECT_EQ(dds_topic_name("robot.arm-left_2"), "cosmic/robot_arm_left_2");
+  EXPECT_EQ(dds_topic_name("Imu0"), "cosmic/Imu0");
+}
+
+TEST(DdsAdapter, ChannelsMappingToOneTopicAreRefused) {
+  Fixture f(dds_segment(63));
+  ASSERT_TRUE(f.adapter->start(f.sink).ok);
+  const ChannelBinding running = binding(1, "keep", HopRole::subscriber);
+  ASSERT_TRUE(f.adapter->configure(std::span(&running, 1)).ok);
+  const ChannelBinding clash[] = {binding(1, "keep", HopRole::subscriber),
+                                  binding(2, "arm-left", HopRole::subscriber),
+                                  binding(3, "arm.left", HopRole::publisher)};
+  const Status st = f.adapter->configure(clash);
+  ASSERT_FALSE(st.ok);
+  EXPECT_NE(st.error.find("'arm-left'"), std::string::npos) << st.error;
+  EXPECT_NE(st.error.find("'arm.left'"), std::string::npos) << st.error;
+  EXPECT_NE(st.error.find("cosmic/arm_left"), std::string::npos) << st.error;
+  // The running channel is untouched; one channel in both roles is no collision.
+  Child sub(peer({"sub", "--domain", "63", "--channel", "keep", "--count", "1", "--timeout",
+                  "30"}));
+  ASSERT_TRUE(f.matched(1, HopRole::subscriber)) << sub.describe();
+  const ChannelBinding both[] = {binding(1, "keep", HopRole::subscriber),
+                                 binding(1, "keep", HopRole::publisher)};
+  EXPECT_TRUE(f.adapter->configure(both).ok);
+}
+
+// ---- native sequence numbers and arrival time ---------------------------------------------------
+
+// A native publisher (origin 0) gets its writer's sample sequence number, whatever its envelope
+// says; a gateway's envelope (origin != 0) keeps its own. received_at lies between the first
+// write and the callback, on the steady clock.
+TEST(DdsAdapter, NativePublisherSequenceIsItsSampleSequence) {
+  Fixture f(dds_segment(64));
+  ASSERT_TRUE(f.adapter->start(f.sink).ok);
+  const ChannelBinding bindings[] = {binding(3, "native", HopRole::publisher),
+                                     binding(4, "relayed", HopRole::publisher)};
+  ASSERT_TRUE(f.adapter->configure(bindings).ok);
+  constexpr int kCount = 20;
+  const auto steady = [] {
+    return std::chrono::duration_cast<Nanos>(std::chrono::steady_clock::now().time_since_epoch());
+  };
+  const Nanos before = steady();
+  auto native = start_pub({"pub", "--domain", "64", "--channel", "native", "--count",
+                           std::to_string(kCount), "--size", "8", "--origin", "0",
+                           "--first-sequence", "1000"},
+                          f.reader_matched(3));
+  auto relayed = start_pub({"pub", "--domain", "64", "--channel", "relayed", "--count",
+                            std::to_string(kCount), "--size", "8", "--origin", "77",
+                            "--first-sequence", "1000"},
+                           f.reader_matched(4));
+  ASSERT_TRUE(f.sink.wait_count(3, kCount, kWait)) << native->describe();
+  ASSERT_TRUE(f.sink.wait_count(4, kCount, kWait)) << relayed->describe();
+  const Nanos after = steady();
+  std::uint32_t native_q = 0;
+  std::uint32_t relayed_q = 999;
+  for (const auto& e : f.sink.events()) {
+    EXPECT_GE(e.received_at, before);
+    EXPECT_LE(e.received_at, after);
+    if (e.channel == 3) {
+      EXPECT_EQ(e.header.origin, 0u);
+      EXPECT_EQ(e.header.sequence, ++native_q);
+    } else {
+      EXPECT_EQ(e.header.sequence, ++relayed_q);
+    }
+  }
+  EXPECT_EQ(native_q, static_cast<std::uint32_t>(kCount));
 }
 
 // ---- runtime reconfiguration ------------------------------------------------------------------
@@ -456,20 +569,20 @@ TEST(DdsAdapter, ChangedChannelQosReplacesTheEndpoint) {
   Fixture f(dds_segment(52));
   ASSERT_TRUE(f.adapter->start(f.sink).ok);
   ChannelBinding b = binding(4, "odometry", HopRole::subscriber);
-  b.spec.period = Nanos(20'000'000);
+  b.spec.temp_validity = Nanos(20'000'000);
   ASSERT_TRUE(f.adapter->configure(std::span(&b, 1)).ok);
   Child sub(peer({"sub", "--domain", "52", "--channel", "odometry", "--count", "1", "--reliable",
                   "--timeout", "30"}));
-  auto announced_deadline = [&](std::int64_t ns) {
+  auto announced_lifespan = [&](std::int64_t ns) {
     return [ns](const std::string& line) {
       const json j = parse(line);
-      return diag_event("publication")(line) && j["deadline_ns"] == ns;
+      return diag_event("publication")(line) && j["lifespan_ns"] == ns;
     };
   };
-  ASSERT_TRUE(sub.wait_err(announced_deadline(20'000'000), kWait)) << sub.describe();
-  b.spec.period = Nanos(40'000'000);
+  ASSERT_TRUE(sub.wait_err(announced_lifespan(20'000'000), kWait)) << sub.describe();
+  b.spec.temp_validity = Nanos(40'000'000);
   ASSERT_TRUE(f.adapter->configure(std::span(&b, 1)).ok);
-  ASSERT_TRUE(sub.wait_err(announced_deadline(40'000'000), kWait)) << sub.describe();
+  ASSERT_TRUE(sub.wait_err(announced_lifespan(40'000'000), kWait)) << sub.describe();
   // The new writer carries the channel. The reader saw the old writer match, the new one match
   // and the old one leave (in some order): three changes, ending with exactly one writer.
   ASSERT_TRUE(f.matched(4, HopRole::subscriber)) << sub.describe();

@@ -21,6 +21,7 @@
 #include <exception>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <shared_mutex>
 #include <unordered_map>
@@ -48,8 +49,27 @@ namespace cosmic {
 
 std::string dds_topic_name(std::string_view channel_name) {
   std::string name = "cosmic/";
-  name.append(channel_name);
+  for (const char c : channel_name) {
+    // Channel names allow [A-Za-z0-9_.-]; a DDS topic name only letters, digits, '_' and the
+    // '/' separator (Cyclone DDS refuses the rest).
+    const bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                      c == '_';
+    name.push_back(keep ? c : '_');
+  }
   return name;
+}
+
+std::optional<std::string> dds_topic_collision(std::span<const ChannelBinding> bindings) {
+  std::map<std::string, std::string_view> owner;  // topic -> channel name
+  for (const ChannelBinding& b : bindings) {
+    const auto [it, inserted] = owner.emplace(dds_topic_name(b.spec.name), b.spec.name);
+    if (!inserted && it->second != b.spec.name) {
+      return "channels '" + std::string(it->second) + "' and '" + b.spec.name +
+             "' both map to DDS topic " + it->first +
+             " ('-' and '.' become '_'); rename one of them";
+    }
+  }
+  return std::nullopt;
 }
 
 namespace {
@@ -143,6 +163,7 @@ struct WriterEntry : dds::DataWriterListener {
                                    const dds::OfferedIncompatibleQosStatus& status) override;
 
   DdsAdapter& owner;
+  std::atomic<std::uint64_t> incompatible{0};  // remote readers refused for their QoS
   ChannelId id;
   ChannelSpec spec;
   EndpointShape shape;
@@ -161,6 +182,7 @@ struct ReaderEntry : dds::DataReaderListener {
   void on_sample_lost(dds::DataReader*, const dds::SampleLostStatus& status) override;
 
   DdsAdapter& owner;
+  std::atomic<std::uint64_t> incompatible{0};  // remote writers refused for their QoS
   ChannelId id;
   ChannelSpec spec;
   EndpointShape shape;
@@ -194,6 +216,7 @@ class DdsAdapter final : public DdsSegmentAdapter {
     // A channel is either written or read on one segment: the other count is 0.
     return matched_endpoints(channel, HopRole::subscriber) + matched_endpoints(channel, HopRole::publisher);
   }
+  std::optional<std::uint64_t> incompatible_peers(ChannelId channel) const override;
 
   // Reader callbacks (Fast DDS threads, reader mutex held).
   void deliver(ReaderEntry& entry, const dds::SampleInfo& info);
@@ -254,12 +277,16 @@ class DdsAdapter final : public DdsSegmentAdapter {
 
 void WriterEntry::on_offered_incompatible_qos(dds::DataWriter*,
                                               const dds::OfferedIncompatibleQosStatus& status) {
+  incompatible.fetch_add(static_cast<std::uint64_t>(status.total_count_change),
+                         std::memory_order_relaxed);
   owner.warn("a reader of " + shape.topic + " requests incompatible QoS (" +
              policy_name(status.last_policy_id) + "); not matched");
 }
 
 void ReaderEntry::on_requested_incompatible_qos(
     dds::DataReader*, const dds::RequestedIncompatibleQosStatus& status) {
+  incompatible.fetch_add(static_cast<std::uint64_t>(status.total_count_change),
+                         std::memory_order_relaxed);
   owner.warn("a writer of " + shape.topic + " offers incompatible QoS (" +
              policy_name(status.last_policy_id) + "); not matched");
 }
@@ -297,6 +324,24 @@ void ReaderEntry::on_data_available(dds::DataReader* dr) {
   }
 }
 
+// The RTPS sequence number of the sample in its writer, truncated to the envelope's 32 bits.
+std::uint32_t native_sequence(const dds::SampleInfo& info) {
+  return static_cast<std::uint32_t>(info.sample_identity.sequence_number().to64long());
+}
+
+// Fast DDS stamps a sample with the realtime clock when its receive thread got it; the router
+// measures residence on the steady clock. Moved over by the current offset between the two and
+// never later than now, so residence counts from arrival rather than from this callback.
+Nanos arrival_on_steady_clock(const eprosima::fastrtps::rtps::Time_t& reception) {
+  const Nanos steady_now = std::chrono::duration_cast<Nanos>(
+      std::chrono::steady_clock::now().time_since_epoch());
+  const Nanos realtime_now = std::chrono::duration_cast<Nanos>(
+      std::chrono::system_clock::now().time_since_epoch());
+  const Nanos arrived(reception.to_ns());
+  const Nanos waited = realtime_now - arrived;
+  return waited > Nanos(0) ? steady_now - waited : steady_now;
+}
+
 void DdsAdapter::deliver(ReaderEntry& entry, const dds::SampleInfo& info) {
   counters_.received.fetch_add(1, std::memory_order_relaxed);
   const cosmic::Envelope& env = entry.sample;
@@ -312,13 +357,14 @@ void DdsAdapter::deliver(ReaderEntry& entry, const dds::SampleInfo& info) {
   event.channel = entry.id;
   event.header.subject = env.subject();
   event.header.origin = env.origin();
-  event.header.sequence = env.sequence();
+  // A native publisher (origin 0) has no envelope sequence of ours: its writer's own sample
+  // sequence number takes its place, so a loss on the hop from it stays visible downstream.
+  event.header.sequence = env.origin() == 0 ? native_sequence(info) : env.sequence();
   event.header.hop_count = env.hop_count();
   event.header.created_ns = env.created_ns();
   event.header.age_ns = env.age_ns();
   event.payload = std::span<const std::uint8_t>(env.payload().data(), env.payload().size());
-  event.received_at =
-      std::chrono::duration_cast<Nanos>(std::chrono::steady_clock::now().time_since_epoch());
+  event.received_at = arrival_on_steady_clock(info.reception_timestamp);
   sink_->on_event(event);
 }
 
@@ -492,6 +538,11 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
     }
   }
 
+  if (const auto collision = dds_topic_collision(bindings)) {
+    log_.log(LogLevel::error, prefix() + *collision);
+    return Status::failure(*collision);
+  }
+
   // 1. Create what is new or changed, before touching anything that runs: a failure leaves the
   //    running configuration as it was.
   std::vector<std::unique_ptr<WriterEntry>> new_writers;
@@ -636,6 +687,21 @@ std::size_t DdsAdapter::matched_endpoints(ChannelId channel, HopRole role) const
   } catch (...) {
     return 0;
   }
+}
+
+std::optional<std::uint64_t> DdsAdapter::incompatible_peers(ChannelId channel) const {
+  std::uint64_t total = 0;
+  {
+    std::shared_lock lock(writers_mutex_);
+    if (auto it = writers_.find(channel); it != writers_.end()) {
+      total += it->second->incompatible.load(std::memory_order_relaxed);
+    }
+  }
+  std::shared_lock lock(readers_mutex_);
+  if (auto it = readers_.find(channel); it != readers_.end()) {
+    total += it->second->incompatible.load(std::memory_order_relaxed);
+  }
+  return total;
 }
 
 void DdsAdapter::teardown() {

@@ -85,27 +85,29 @@ EndpointShape shape_of(const ChannelSpec& channel) {
   EndpointShape shape;
   shape.topic = dds_topic_name(channel.name);
   shape.depth = history_depth(channel.omission_degree);
-  shape.period = channel.period;
   shape.validity = channel.temp_validity;
   shape.reaction_time = channel.reaction_time;
   return shape;
 }
 
-dds::DataWriterQos writer_qos(const SegmentSpec& segment, const ChannelSpec& channel) {
+dds::DataWriterQos writer_qos(const SegmentSpec& /*segment*/, const ChannelSpec& channel) {
   dds::DataWriterQos qos = dds::DATAWRITER_QOS_DEFAULT;
-  qos.reliability().kind = reliability_of(segment);
+  // Offered QoS is chosen so that any requested QoS a default reader can have is satisfied:
+  // RELIABLE serves reliable and best-effort readers, TRANSIENT_LOCAL serves volatile and
+  // transient-local readers, and neither deadline nor latency_budget is offered (a reader's
+  // default deadline is infinite, its default latency budget 0; an offered budget above the
+  // reader's refuses the match).
+  qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
   qos.reliability().max_blocking_time = to_duration(Nanos(kMaxBlockingNs));
-  qos.durability().kind = dds::VOLATILE_DURABILITY_QOS;
+  qos.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
   qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
   qos.history().depth = history_depth(channel.omission_degree);
-  if (channel.period && channel.period->count() > 0) {
-    qos.deadline().period = to_duration(*channel.period);
-  }
+  qos.latency_budget().duration = eprosima::fastrtps::Duration_t(0, 0);
+  qos.deadline().period = eprosima::fastrtps::c_TimeInfinite;
+  // Lifespan does not take part in matching: a sample older than the channel's validity is
+  // neither delivered nor repaired nor handed to a late-joining transient-local reader.
   if (channel.temp_validity && channel.temp_validity->count() > 0) {
     qos.lifespan().duration = to_duration(*channel.temp_validity);
-  }
-  if (channel.reaction_time) {
-    qos.latency_budget().duration = to_duration(*channel.reaction_time);
   }
   // Heartbeats announce what a reliable writer has, so a reader can ask for what it lost; the
   // last event of a burst is only repaired at the next one. Fast DDS's default period (3 s) is
@@ -116,7 +118,7 @@ dds::DataWriterQos writer_qos(const SegmentSpec& segment, const ChannelSpec& cha
                            Nanos(kMaxHeartbeatNs));
   }
   qos.reliable_writer_qos().times.heartbeatPeriod = to_duration(heartbeat);
-  // Synchronous publication: write() hands the sample to the transport on the router thread,
+  // Synchronous publication: write() hands the sample to the transport on the calling thread,
   // which keeps the added latency minimal for small events.
   qos.publish_mode().kind = dds::SYNCHRONOUS_PUBLISH_MODE;
   qos.endpoint().history_memory_policy = rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
@@ -127,6 +129,10 @@ constexpr std::int32_t kReaderBufferDepth = 256;
 
 dds::DataReaderQos reader_qos(const SegmentSpec& segment, const ChannelSpec& channel) {
   dds::DataReaderQos qos = dds::DATAREADER_QOS_DEFAULT;
+  // Requested QoS is the least a default writer offers: the segment's reliability (a
+  // best-effort segment also accepts best-effort writers; on a reliable segment they are a
+  // reported mismatch, the DDS rule has no way to both accept them and demand repair), VOLATILE
+  // durability, no deadline, and a latency budget no writer's default (0) exceeds.
   qos.reliability().kind = reliability_of(segment);
   qos.durability().kind = dds::VOLATILE_DURABILITY_QOS;
   qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
@@ -134,11 +140,14 @@ dds::DataReaderQos reader_qos(const SegmentSpec& segment, const ChannelSpec& cha
   // take(): deeper than the channel's own depth so a burst does not fill it. A full reliable
   // reader rejects samples and stalls a KEEP_ALL writer until it gives up (seen under overload).
   qos.history().depth = std::max<std::int32_t>(history_depth(channel.omission_degree), kReaderBufferDepth);
+  // A requested budget accepts every writer offering at most that much: the channel's reaction
+  // time is the most it can allow, and it only widens what matches.
   if (channel.reaction_time) {
     qos.latency_budget().duration = to_duration(*channel.reaction_time);
   }
-  // No deadline (a requested deadline refuses every writer not offering one) and no lifespan
-  // (needs synchronised clocks): validity is the router's business, from the envelope's age.
+  qos.deadline().period = eprosima::fastrtps::c_TimeInfinite;
+  // No lifespan here (it is a writer policy): validity is the router's business, from the
+  // envelope's age.
   qos.endpoint().history_memory_policy = rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
   return qos;
 }

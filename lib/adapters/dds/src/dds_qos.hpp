@@ -17,10 +17,12 @@ namespace cosmic::dds_detail {
 // Largest history depth of a channel endpoint.
 inline constexpr std::int32_t kMaxHistoryDepth = 32;
 
-// Longest time DataWriter::write() may block the router thread (reliable writers only; with
-// KEEP_LAST it only waits for the writer's own mutex, never for acknowledgements). On timeout
-// send() answers queue_full instead of stalling every other channel behind this one.
-inline constexpr std::int64_t kMaxBlockingNs = 2'000'000;
+// Longest time DataWriter::write() may block the calling egress lane (every writer is reliable;
+// with KEEP_LAST it only waits for the writer's own mutex and history, never for
+// acknowledgements). On timeout send() answers queue_full instead of stalling every other
+// channel of its class behind this one. 100 us is a fraction of the shortest latency bound a
+// segment is configured with, and far above an uncontended write (a few microseconds).
+inline constexpr std::int64_t kMaxBlockingNs = 100'000;
 
 // Heartbeat period of reliable writers: reaction_time / 2 within these bounds.
 inline constexpr std::int64_t kMinHeartbeatNs = 5'000'000;
@@ -38,13 +40,15 @@ std::int32_t history_depth(std::uint32_t omission_degree);
 struct EndpointShape {
   std::string topic;
   std::int32_t depth = 1;
-  std::optional<Nanos> period;
   std::optional<Nanos> validity;
   std::optional<Nanos> reaction_time;
   bool operator==(const EndpointShape&) const = default;
 };
 EndpointShape shape_of(const ChannelSpec& channel);
 
+// Writers offer the most (RELIABLE, TRANSIENT_LOCAL) and promise nothing a default reader does
+// not request (no deadline, latency_budget 0); readers request the least (the segment's
+// reliability, VOLATILE, no deadline). docs/dds-mapping.md lists every policy and why.
 eprosima::fastdds::dds::DataWriterQos writer_qos(const SegmentSpec& segment,
                                                  const ChannelSpec& channel);
 eprosima::fastdds::dds::DataReaderQos reader_qos(const SegmentSpec& segment,
