@@ -89,7 +89,7 @@ void Router::set_segment(std::size_t index, std::string name, SegmentAdapter* ad
 
 void Router::apply(std::vector<Route> routes) {
   std::lock_guard serial(apply_mutex_);
-  const std::shared_ptr<const Table> current = table_.load();
+  const std::shared_ptr<const Table> current = load_table();
   auto next = std::make_shared<Table>();
   next->channels.reserve(routes.size());
   for (auto& route : routes) {
@@ -110,11 +110,20 @@ void Router::apply(std::vector<Route> routes) {
     if (kept == next->channels.end() || *kept != old) old->removed.store(true);
   }
   // Readers holding the old snapshot keep it alive until they let go (their last event of it).
-  table_.store(std::move(next));
+  std::shared_ptr<const Table> retired;
+  {
+    std::lock_guard lock(table_mutex_);
+    retired = std::exchange(table_, std::move(next));
+  }
+}
+
+std::shared_ptr<const Router::Table> Router::load_table() const {
+  std::lock_guard lock(table_mutex_);
+  return table_;
 }
 
 std::shared_ptr<ChannelState> Router::find(ChannelId id) const {
-  const std::shared_ptr<const Table> table = table_.load();
+  const std::shared_ptr<const Table> table = load_table();
   const auto it = std::lower_bound(table->channels.begin(), table->channels.end(), id,
                                    [](const auto& s, ChannelId v) { return s->route.id < v; });
   if (it == table->channels.end() || (*it)->route.id != id) return nullptr;
@@ -260,7 +269,7 @@ SegmentCountersSnapshot counters_snapshot(const std::string& name, const Segment
 }  // namespace
 
 std::vector<ChannelStatsSnapshot> Router::snapshot() const {
-  const std::shared_ptr<const Table> table = table_.load();
+  const std::shared_ptr<const Table> table = load_table();
   std::vector<ChannelStatsSnapshot> out;
   out.reserve(table->channels.size());
   for (const auto& state : table->channels) {

@@ -115,7 +115,14 @@ class Router {
   std::vector<std::unique_ptr<SegmentInbox>> inboxes_;
   std::unique_ptr<std::atomic<std::uint64_t>[]> unrouted_;
 
-  std::atomic<std::shared_ptr<const Table>> table_;
+  // The current route table. Readers copy the pointer under table_mutex_ (a pointer copy, never
+  // any I/O) and then work on an immutable table that stays alive while they hold it; apply()
+  // builds the next table outside the lock and swaps it in. (libstdc++ 12's
+  // std::atomic<std::shared_ptr> would do the same with a spin bit that ThreadSanitizer cannot
+  // see through.)
+  std::shared_ptr<const Table> load_table() const;
+  mutable std::mutex table_mutex_;
+  std::shared_ptr<const Table> table_;
   std::mutex apply_mutex_;  // serialises apply() (control thread) against itself
 
   std::atomic<std::uint64_t> progress_{0};
