@@ -143,12 +143,16 @@ void Router::receive(std::size_t segment, const InboundEvent& event) {
     return;
   }
   counters.rx.fetch_add(1, std::memory_order_relaxed);
-  if (const IngressFault fault = ingress_check(event, channel->route.spec, self_); fault != IngressFault::none) {
+  // Subject 0 means "not given" (a publisher that only knows the topic): the event is the
+  // channel's. Any other subject must be the channel's own.
+  InboundEvent checked = event;
+  if (checked.header.subject == 0) checked.header.subject = channel->route.spec.subject;
+  if (const IngressFault fault = ingress_check(checked, channel->route.spec, self_); fault != IngressFault::none) {
     counters.drop(drop_reason(fault));
     return;
   }
-  if (!admit(*channel, counters, event)) return;
-  enqueue(channel, segment, event);
+  if (!admit(*channel, counters, checked)) return;
+  enqueue(channel, segment, checked);
 }
 
 // Duplicate, validity and rate policies; counts what it refuses.
