@@ -78,6 +78,12 @@ const std::vector<BadConfig> kBadConfigs = {
   // names: dangling and duplicate
   {"dangling_segment.yaml", {{11, 19, "channels[0].subscribers[0]", "unknown segment 'vis' (one of the segments: lan, viz)"}}},
   {"duplicate_segment_name.yaml", {{6, 11, "segments[2].name", "duplicate segment name 'lan' (a name not used by another segment (first at line 2))"}}},
+  // overlapping segments: one network attached twice would loop every message
+  {"overlapping_lcm_port.yaml", {{7, 10, "segments[1].url", "segment 'viz2' attaches the same network as segment 'viz' (line 2): UDP port 7667"}}},
+  {"overlapping_lcm_default_url.yaml", {{5, 5, "segments[1].url", "as segment 'viz' (line 2): UDP port 7667"}}},
+  {"overlapping_dds_domain.yaml", {{7, 13, "segments[1].domain", "as segment 'lan' (line 2): DDS domain 3"}}},
+  {"overlapping_can_interface.yaml", {{4, 41, "segments[2].interface", "as segment 'body' (line 2): CAN interface can0"},
+                                      {5, 41, "segments[3].interface", "as segment 'body' (line 2): CAN interface can0"}}},
   {"duplicate_channel_name.yaml", {{12, 11, "channels[1].name", "duplicate channel name 'c1'"}}},
   {"duplicate_subject.yaml", {{13, 14, "channels[1].subject", "subject already used by channel 'c1'"}}},  // 0x10 == 16
   {"duplicate_etag.yaml", {{18, 11, "channels[1].etag", "etag already used by channel 'c1'"}}},
