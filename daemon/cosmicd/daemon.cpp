@@ -79,15 +79,22 @@ class Daemon {
       return kExitConfigError;
     }
     if (!start(loaded.config)) return kExitStartFailure;
-    cosmic::ControlProtocol protocol(
-        gateway_, [this] { return cosmic::load_config_file(options_.config); }, make_access_policy(options_.groups), log_,
-        [this](const std::string& command, const nlohmann::json& request) { remember(command, request); });
+    const cosmic::AccessPolicy policy = make_access_policy(options_.groups);
     cosmic::ControlServerOptions server_options;
     server_options.path = options_.socket.empty() ? loaded.config.gateway.control_socket : options_.socket;
+    server_options.privileged = policy.may_modify;  // admins keep reserved control slots
     if (const ::group* g = ::getgrnam(options_.groups.read_group.c_str())) server_options.socket_group = g->gr_gid;
-    cosmic::ControlServer server(server_options, [&](std::string_view line, const cosmic::PeerCredentials& peer) {
-      return protocol.handle(line, peer);
+    cosmic::ControlServer server(server_options, [this](std::string_view line, const cosmic::PeerCredentials& peer,
+                                                        cosmic::ControlServer::Responder later) {
+      return protocol_->handle(line, peer, std::move(later));
     });
+    // Admission of bind and reload runs on the server's worker thread, so status answers and
+    // watchdog keep-alives continue meanwhile.
+    cosmic::ControlProtocol protocol(
+        gateway_, [this] { return cosmic::load_config_file(options_.config); }, policy, log_,
+        [this](const std::string& command, const nlohmann::json& request) { return remember(command, request); },
+        server.offload());
+    protocol_ = &protocol;
     server.watch(signal_fd, [&] { on_signals(signal_fd); });
     if (const auto opened = server.open(); !opened.ok) {
       log_.log(cosmic::LogLevel::error, "control socket: " + opened.error);
@@ -97,7 +104,8 @@ class Daemon {
     log_.log(cosmic::LogLevel::notice, "cosmicd " + loaded.config.gateway.name + " running; control socket " + server_options.path);
     loop(server);
     notifier_.stopping();
-    server.close_all();
+    server.close_all();  // joins the admission worker before `protocol` goes
+    protocol_ = nullptr;
     gateway_.stop();
     log_.log(cosmic::LogLevel::notice, "cosmicd stopped");
     return kExitOk;
@@ -145,17 +153,26 @@ class Daemon {
                                          ", receive " + std::to_string(realtime.receive_priority));
   }
 
+  // An entry that cannot be bound now (a segment down at boot, a changed configuration) stays
+  // in the state file for the next start; only an entry that lies about its name is dropped.
   void restore_runtime_bindings() {
     std::vector<RuntimeBinding> kept;
     for (const auto& binding : state_.bound) {
       const auto parsed = cosmic::parse_channels(binding.yaml, state_file_, gateway_.config());
+      if (const std::string wrong = check_binding_entry(binding, parsed.channels); parsed.ok() && !wrong.empty()) {
+        log_.log(cosmic::LogLevel::error, state_file_ + ": " + wrong + "; entry dropped");
+        continue;
+      }
+      kept.push_back(binding);
       const auto result = parsed.ok() ? gateway_.bind(parsed.channels) : cosmic::BindResult{};
       if (result.applied) {
         log_.log(cosmic::LogLevel::notice, "restored runtime binding of channel " + binding.name);
-        kept.push_back(binding);
-      } else {
-        log_.log(cosmic::LogLevel::warning, "runtime binding of channel " + binding.name + " could not be restored; dropped");
+        continue;
       }
+      std::string why = parsed.ok() ? result.error : std::to_string(parsed.errors.size()) + " error(s) in its definition";
+      if (!parsed.ok()) why += ": " + parsed.errors.front().to_string();
+      log_.log(cosmic::LogLevel::warning, "runtime binding of channel " + binding.name + " could not be restored (" + why +
+                                              "); kept in the state file for the next start");
     }
     if (kept.size() != state_.bound.size()) {
       state_.bound = std::move(kept);
@@ -163,7 +180,8 @@ class Daemon {
     }
   }
 
-  void remember(const std::string& command, const nlohmann::json& request) {
+  // Returns why the new state could not be saved, or an empty string.
+  std::string remember(const std::string& command, const nlohmann::json& request) {
     if (command == "reload") {
       state_ = {};  // the file is the truth again
       file_config_ = gateway_.config();
@@ -184,13 +202,13 @@ class Daemon {
         state_.unbound.push_back(name);
       }
     }
-    persist();
+    return persist();
   }
 
-  void persist() {
-    if (const std::string error = save_binding_state(state_file_, state_); !error.empty()) {
-      log_.log(cosmic::LogLevel::error, "cannot save runtime bindings: " + error);
-    }
+  std::string persist() {
+    const std::string error = save_binding_state(state_file_, state_);
+    if (!error.empty()) log_.log(cosmic::LogLevel::error, "cannot save runtime bindings: " + error);
+    return error;
   }
 
   void on_signals(int signal_fd) {
@@ -205,26 +223,30 @@ class Daemon {
     }
   }
 
+  // SIGHUP takes the control socket's path (root asking): the same validation, the same
+  // off-thread admission, and `busy` while another admission runs.
   void reload() {
     notifier_.reloading();
     log_.log(cosmic::LogLevel::notice, "SIGHUP: reloading " + options_.config);
-    const auto loaded = cosmic::load_config_file(options_.config);
-    if (!loaded.ok()) {
-      for (const auto& error : loaded.errors) log_.log(cosmic::LogLevel::error, error.to_string());
-      log_.log(cosmic::LogLevel::error, "reload refused; the running configuration is unchanged");
-    } else {
-      const auto result = gateway_.reload(loaded.config);
-      if (!result.applied) {
-        log_.log(cosmic::LogLevel::error, "reload failed: " + result.error);
-        notifier_.reloaded(gateway_);
-        return;
-      }
-      log_verdicts(log_, result.channels);
-      file_config_ = loaded.config;
-      state_ = {};
-      persist();
+    const cosmic::PeerCredentials self{static_cast<int>(::getpid()), 0, 0};
+    auto finished = [this](const std::string& line) {
+      log_reload_answer(nlohmann::json::parse(line, nullptr, false));
+      notifier_.reloaded(gateway_);
+    };
+    if (auto now = protocol_->handle(R"({"command":"reload"})", self, finished)) finished(*now);
+  }
+
+  void log_reload_answer(const nlohmann::json& answer) {
+    if (answer.is_discarded()) return;
+    for (const auto& c : answer.value("channels", nlohmann::json::array())) {
+      std::string line = "channel " + c.value("name", "") + " (" + c.value("class", "") + "): " + c.value("verdict", "");
+      for (const auto& reason : c.value("reasons", nlohmann::json::array())) line += "; " + reason.get<std::string>();
+      log_.log(c.value("verdict", "") == "bound" ? cosmic::LogLevel::info : cosmic::LogLevel::warning, line);
     }
-    notifier_.reloaded(gateway_);
+    if (answer.value("ok", false)) return;
+    for (const auto& error : answer.value("errors", nlohmann::json::array())) log_.log(cosmic::LogLevel::error, error.value("text", ""));
+    const auto& error = answer["error"];
+    log_.log(cosmic::LogLevel::error, "reload " + error.value("code", "failed") + ": " + error.value("message", ""));
   }
 
   void loop(cosmic::ControlServer& server) {
@@ -249,6 +271,7 @@ class Daemon {
   BindingState state_;
   cosmic::Config file_config_;  // the configuration file as last loaded
   bool running_ = true;
+  cosmic::ControlProtocol* protocol_ = nullptr;  // while run() serves the control socket
 };
 
 }  // namespace

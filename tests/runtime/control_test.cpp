@@ -96,9 +96,10 @@ class ControlTest : public ::testing::Test {
     options.max_request_bytes = 4096;
     options.max_clients = max_clients;
     options.max_pending_output = 8192;
-    server = std::make_unique<ControlServer>(options, [this](std::string_view line, const PeerCredentials& peer) {
-      return protocol->handle(line, peer);
-    });
+    server = std::make_unique<ControlServer>(
+        options, [this](std::string_view line, const PeerCredentials& peer, ControlServer::Responder later) {
+          return protocol->handle(line, peer, std::move(later));
+        });
     const Status opened = server->open();
     ASSERT_TRUE(opened.ok) << opened.error;
     server_thread = std::thread([this] {

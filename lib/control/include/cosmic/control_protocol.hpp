@@ -1,11 +1,13 @@
 // The control protocol of cosmicd (docs/control-protocol.md): one JSON object per line in each
 // direction over a Unix stream socket. This part turns a request line into a response line; it
-// does no I/O of its own. Called by the control thread only.
+// does no I/O of its own. Called by the control thread only; the admission of a bind or reload
+// may run on a worker thread (see Offload), and its answer then comes back on the control thread.
 #pragma once
 
 #include <chrono>
 #include <nlohmann/json.hpp>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -27,29 +29,55 @@ struct AccessPolicy {
   std::function<bool(const PeerCredentials&)> may_modify = [](const PeerCredentials&) { return true; };
 };
 
-// Told about every mutating command that changed the gateway (e.g. to persist it).
-using ChangeObserver = std::function<void(const std::string& command, const nlohmann::json& request)>;
+// Told about every mutating command that changed the gateway (e.g. to persist it). Returns why
+// the change could not be saved, or an empty string; the client then gets `not_persisted`.
+using ChangeObserver = std::function<std::string(const std::string& command, const nlohmann::json& request)>;
+
+// Runs `work` away from the control thread, then `done` on the control thread. `work` touches
+// only what it was given (a copy of the knowledge base, a configuration being loaded).
+using Offload = std::function<void(std::function<void()> work, std::function<void()> done)>;
+
+// Delivers a deferred answer line; called once, on the control thread.
+using Reply = std::function<void(std::string line)>;
+
+// Bounds of a request the parser accepts (no recursion over attacker-chosen nesting).
+inline constexpr int kMaxRequestNesting = 16;
+// Characters of a client-chosen text (command, channel name) quoted in a log line.
+inline constexpr std::size_t kMaxLoggedText = 64;
 
 class ControlProtocol {
  public:
-  // `reload_source` re-reads the daemon's configuration file.
+  // `reload_source` re-reads the daemon's configuration file (on the worker thread when
+  // `offload` is given). Without `offload`, admission runs inline on the calling thread.
   ControlProtocol(Gateway& gateway, std::function<ConfigResult()> reload_source, AccessPolicy policy, Logger& log,
-                  ChangeObserver on_change = {});
+                  ChangeObserver on_change = {}, Offload offload = {});
 
+  // The answer line now, or nullopt when a bind or reload runs off the control thread: `later`
+  // then gets the answer. While one runs, every bind, unbind and reload is answered `busy`.
+  std::optional<std::string> handle(std::string_view request_line, const PeerCredentials& peer, Reply later);
+  // The same for callers without an Offload (every answer is immediate).
   std::string handle(std::string_view request_line, const PeerCredentials& peer);
+  bool admission_running() const { return !running_.empty(); }
 
   static bool is_mutating(std::string_view command);
 
  private:
   using Json = nlohmann::json;
-  Json dispatch(const Json& request, const PeerCredentials& peer);
+  // Holds the answer, or nothing when it will come through `later`.
+  using Answer = std::optional<Json>;
+  Answer dispatch(const Json& request, const PeerCredentials& peer, const Reply& later);
+  Answer mutate(const std::string& command, const Json& request, const PeerCredentials& peer, const Reply& later);
+  Json finish(const std::string& command, const Json& request, Json answer);
+  // Runs `work` through offload_ (or inline) and answers with `done`'s result.
+  Answer run_admission(std::string what, std::function<void()> work, std::function<Json()> done, const Reply& later);
+  std::string next_log_tag(const char* kind, const PeerCredentials& peer);
   Json status() const;
   Json segments() const;
   Json channels() const;
   Json channel(const Json& request) const;
-  Json bind(const Json& request);
+  Answer bind(const Json& request, const Reply& later);
   Json unbind(const Json& request);
-  Json reload();
+  Answer reload(const Reply& later);
   Json channel_entry(const ChannelReport& verdict, const ChannelStatsSnapshot* stats) const;
 
   Gateway& gateway_;
@@ -57,7 +85,10 @@ class ControlProtocol {
   AccessPolicy policy_;
   Logger& log_;
   ChangeObserver on_change_;
+  Offload offload_;
   std::chrono::steady_clock::time_point started_;
+  std::string running_;  // what admission runs off the control thread, for `busy` answers
+  std::uint64_t log_sequence_ = 0;  // numbers audit and denial lines: no two are alike, none folded
 };
 
 }  // namespace cosmic
