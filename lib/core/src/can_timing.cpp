@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 namespace cosmic {
 namespace {
@@ -25,37 +26,46 @@ std::int64_t error_overhead(std::int64_t interval, const CanBusTiming& timing, s
   return windows * timing.errors.max_per_window * (timing.error_frame_time.count() + largest_hep_frame);
 }
 
-struct StreamContext {
-  const CanStream& self;
-  std::vector<const CanStream*> higher;  // hp(m)
-  std::int64_t blocking = 0;             // B: longest lower-priority frame
-  std::int64_t largest_hep_frame = 0;
+// Streams of one bus sorted by threshold T - J: a higher-priority stream k is released once in
+// an interval x (w + J_k + offset <= T_k) exactly when x + offset <= T_k - J_k, so only the
+// streams at the front of this list, below the threshold, need their ceiling computed.
+struct Release {
+  std::int64_t threshold;  // T - J
+  std::size_t position;    // place in priority order
+  std::int64_t transmission;
+  std::int64_t period;
+  std::int64_t jitter;
 };
 
-StreamContext context_of(std::span<const CanStream> streams, std::size_t index) {
-  StreamContext ctx{streams[index], {}, 0, streams[index].transmission.count()};
-  for (std::size_t k = 0; k < streams.size(); ++k) {
-    if (k == index) continue;
-    const CanStream& other = streams[k];
-    if (other.can_id < ctx.self.can_id) {
-      ctx.higher.push_back(&other);
-      ctx.largest_hep_frame = std::max(ctx.largest_hep_frame, other.transmission.count());
-    } else {
-      ctx.blocking = std::max(ctx.blocking, other.transmission.count());
-    }
+// What the recurrences of one stream need: itself, and its higher-priority streams as the
+// positions before `first_of_level` in priority order.
+struct StreamContext {
+  const CanStream& self;
+  std::size_t first_of_level = 0;
+  std::int64_t blocking = 0;           // B: longest frame of equal or lower priority
+  std::int64_t largest_hep_frame = 0;  // longest frame of higher or equal priority
+  std::int64_t higher_frames = 0;      // sum of C over hp(m): each released at least once
+  const std::vector<Release>* releases = nullptr;
+};
+
+// sum over hp(m) of ceil((x + J_k + offset) / T_k) * C_k, x + J_k + offset > 0.
+std::int64_t interference(const StreamContext& ctx, std::int64_t x, std::int64_t offset) {
+  std::int64_t sum = ctx.higher_frames;
+  for (const Release& k : *ctx.releases) {
+    if (k.threshold >= x + offset) break;
+    if (k.position >= ctx.first_of_level) continue;
+    sum += (ceil_div(x + k.jitter + offset, k.period) - 1) * k.transmission;
   }
-  return ctx;
+  return sum;
 }
 
 // Length of the priority level-m busy period; nullopt when it does not end within the horizon.
 std::optional<std::int64_t> busy_period(const StreamContext& ctx, const CanBusTiming& timing) {
   std::int64_t t = ctx.self.transmission.count();
   while (true) {
-    std::int64_t next = ctx.blocking + error_overhead(t, timing, ctx.largest_hep_frame) +
-                        ceil_div(t + ctx.self.jitter.count(), ctx.self.period.count()) * ctx.self.transmission.count();
-    for (const CanStream* k : ctx.higher) {
-      next += ceil_div(t + k->jitter.count(), k->period.count()) * k->transmission.count();
-    }
+    const std::int64_t next = ctx.blocking + error_overhead(t, timing, ctx.largest_hep_frame) +
+                              ceil_div(t + ctx.self.jitter.count(), ctx.self.period.count()) * ctx.self.transmission.count() +
+                              interference(ctx, t, 0);
     if (next == t) return t;
     if (next > kHorizonNs) return std::nullopt;
     t = next;
@@ -67,33 +77,15 @@ std::optional<std::int64_t> queuing_delay(const StreamContext& ctx, const CanBus
   const std::int64_t own = ctx.self.transmission.count();
   std::int64_t w = ctx.blocking + q * own;
   while (true) {
-    std::int64_t next = ctx.blocking + q * own + error_overhead(w + own, timing, ctx.largest_hep_frame);
-    for (const CanStream* k : ctx.higher) {
-      next += ceil_div(w + k->jitter.count() + timing.bit_time.count(), k->period.count()) * k->transmission.count();
-    }
+    const std::int64_t next = ctx.blocking + q * own + error_overhead(w + own, timing, ctx.largest_hep_frame) +
+                              interference(ctx, w, timing.bit_time.count());
     if (next == w) return w;
     if (next > kHorizonNs) return std::nullopt;
     w = next;
   }
 }
 
-// Load of the streams at priority m or higher plus the worst error rate: at 1 or above the busy
-// period never ends, which the recurrences would only find out at the horizon.
-double level_load(const StreamContext& ctx, const CanBusTiming& timing) {
-  double load = static_cast<double>(ctx.self.transmission.count()) / static_cast<double>(ctx.self.period.count());
-  for (const CanStream* k : ctx.higher) {
-    load += static_cast<double>(k->transmission.count()) / static_cast<double>(k->period.count());
-  }
-  if (timing.errors.max_per_window > 0 && timing.errors.window.count() > 0) {
-    load += static_cast<double>(timing.errors.max_per_window) *
-            static_cast<double>(timing.error_frame_time.count() + ctx.largest_hep_frame) /
-            static_cast<double>(timing.errors.window.count());
-  }
-  return load;
-}
-
 std::optional<Nanos> response_time(const StreamContext& ctx, const CanBusTiming& timing) {
-  if (level_load(ctx, timing) >= 1.0) return std::nullopt;
   const auto t = busy_period(ctx, timing);
   if (!t) return std::nullopt;
   const std::int64_t period = ctx.self.period.count();
@@ -106,6 +98,30 @@ std::optional<Nanos> response_time(const StreamContext& ctx, const CanBusTiming&
   }
   return Nanos(worst);
 }
+
+double share(const CanStream& s) {
+  return static_cast<double>(s.transmission.count()) / static_cast<double>(s.period.count());
+}
+
+double fault_share(const CanBusTiming& timing, std::int64_t largest_hep_frame) {
+  if (timing.errors.max_per_window == 0 || timing.errors.window.count() <= 0) return 0.0;
+  return static_cast<double>(timing.errors.max_per_window) *
+         static_cast<double>(timing.error_frame_time.count() + largest_hep_frame) /
+         static_cast<double>(timing.errors.window.count());
+}
+
+// Load of level m summed in input order (own stream first, then hp(m) as given): the rounding
+// of the published analysis, used only when the prefix sum is within rounding of 100 %.
+double level_load_in_input_order(std::span<const CanStream> streams, std::size_t index, const CanBusTiming& timing,
+                                 std::int64_t largest_hep_frame) {
+  double load = share(streams[index]);
+  for (std::size_t k = 0; k < streams.size(); ++k) {
+    if (k != index && streams[k].can_id < streams[index].can_id) load += share(streams[k]);
+  }
+  return load + fault_share(timing, largest_hep_frame);
+}
+
+constexpr double kRoundingMargin = 1e-9;
 
 }  // namespace
 
@@ -163,12 +179,79 @@ CanBusTiming bus_timing(const CanSegmentProperties& bus) {
 }
 
 std::vector<std::optional<Nanos>> response_times(std::span<const CanStream> streams, const CanBusTiming& timing) {
-  std::vector<std::optional<Nanos>> out;
-  out.reserve(streams.size());
-  for (std::size_t i = 0; i < streams.size(); ++i) {
-    out.push_back(response_time(context_of(streams, i), timing));
+  return CanBusAnalysis(streams, timing).results();
+}
+
+bool CanBusAnalysis::Entry::same_stream(const Entry& other) const {
+  return transmission == other.transmission && period == other.period && jitter == other.jitter && tied == other.tied;
+}
+
+CanBusAnalysis::CanBusAnalysis(std::span<const CanStream> streams, const CanBusTiming& timing,
+                               const CanBusAnalysis* previous)
+    : timing_(timing), results_(streams.size()) {
+  const std::size_t n = streams.size();
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return streams[a].can_id < streams[b].can_id; });
+  entries_.resize(n);
+  std::vector<Release> releases(n);
+  for (std::size_t p = 0; p < n; ++p) {
+    const CanStream& s = streams[order[p]];
+    entries_[p].transmission = s.transmission.count();
+    entries_[p].period = s.period.count();
+    entries_[p].jitter = s.jitter.count();
+    entries_[p].tied = p > 0 && streams[order[p - 1]].can_id == s.can_id;
+    releases[p] = Release{s.period.count() - s.jitter.count(), p, s.transmission.count(), s.period.count(), s.jitter.count()};
   }
-  return out;
+  std::sort(releases.begin(), releases.end(),
+            [](const Release& a, const Release& b) { return a.threshold < b.threshold; });
+  // Longest frame from position p to the end: the blocking of the level before p.
+  std::vector<std::int64_t> longest_from(n + 1, 0);
+  for (std::size_t p = n; p-- > 0;) longest_from[p] = std::max(longest_from[p + 1], entries_[p].transmission);
+
+  const bool reusable = previous && previous->timing_ == timing;
+  std::size_t same_prefix = 0;
+  if (reusable) {
+    const auto& old = previous->entries_;
+    while (same_prefix < n && same_prefix < old.size() && entries_[same_prefix].same_stream(old[same_prefix])) ++same_prefix;
+  }
+  std::size_t first_of_level = 0;
+  std::int64_t higher_frames = 0;
+  std::int64_t longest_higher = 0;
+  double higher_load = 0.0;
+  for (std::size_t p = 0; p < n;) {
+    std::size_t end = p + 1;
+    while (end < n && entries_[end].tied) ++end;
+    first_of_level = p;
+    for (std::size_t m = p; m < end; ++m) {
+      Entry& e = entries_[m];
+      const std::size_t input = order[m];
+      std::int64_t blocking = longest_from[end];
+      for (std::size_t o = p; o < end; ++o) {
+        if (o != m) blocking = std::max(blocking, entries_[o].transmission);
+      }
+      e.blocking = blocking;
+      if (reusable && m < same_prefix && previous->entries_[m].blocking == blocking && !previous->entries_[m].near_full) {
+        e.result = previous->entries_[m].result;
+      } else {
+        StreamContext ctx{streams[input], first_of_level, blocking, std::max(longest_higher, e.transmission),
+                          higher_frames, &releases};
+        double load = higher_load + share(streams[input]) + fault_share(timing, ctx.largest_hep_frame);
+        e.near_full = std::abs(load - 1.0) < kRoundingMargin;
+        if (e.near_full) load = level_load_in_input_order(streams, input, timing, ctx.largest_hep_frame);
+        e.result = load >= 1.0 ? std::nullopt : response_time(ctx, timing);
+        ++analysed_;
+      }
+      results_[input] = e.result;
+    }
+    for (std::size_t m = p; m < end; ++m) {
+      higher_frames += entries_[m].transmission;
+      longest_higher = std::max(longest_higher, entries_[m].transmission);
+      higher_load += share(streams[order[m]]);
+    }
+    p = end;
+  }
 }
 
 double utilization(std::span<const CanStream> streams) {

@@ -58,6 +58,7 @@ struct CanBusTiming {
   Nanos bit_time{0};           // tau_bit
   Nanos error_frame_time{0};   // kErrorFrameBits nominal bits
   CanFaultHypothesis errors;
+  friend bool operator==(const CanBusTiming&, const CanBusTiming&) = default;
 };
 
 CanBusTiming bus_timing(const CanSegmentProperties& bus);
@@ -65,6 +66,47 @@ CanBusTiming bus_timing(const CanSegmentProperties& bus);
 // Worst-case response time R = J + w + C of every stream (same order as the input), or nullopt
 // when the busy period does not end (the streams of higher or equal priority overload the bus).
 std::vector<std::optional<Nanos>> response_times(std::span<const CanStream> streams, const CanBusTiming& timing);
+
+// response_times() kept for the next analysis of the same bus, so that the next one re-examines
+// only what changed. A stream's result depends on its own C, T, J, on the ordered list of
+// higher-priority streams, on its blocking and on the bus timing; when all of these equal what
+// `previous` saw at the same place in priority order, the result is reused without iteration.
+// A newcomer therefore re-examines the streams of equal or lower priority, plus higher ones whose
+// blocking its frame lengthens. Overload of a priority level (utilization >= 100 %, faults
+// included) is found from prefix sums before any fixed-point iteration, and each iteration
+// visits only the higher-priority streams released more than once in the interval (the others
+// are a prefix sum), so a long bus of rarely-interfering streams costs about O(n log n).
+//
+// Plain value, cheap to copy (a few vectors of numbers, O(streams)). Pure: no I/O, no state
+// shared between instances.
+class CanBusAnalysis {
+ public:
+  CanBusAnalysis() = default;
+  CanBusAnalysis(std::span<const CanStream> streams, const CanBusTiming& timing, const CanBusAnalysis* previous = nullptr);
+
+  // Same order as the input streams.
+  const std::vector<std::optional<Nanos>>& results() const { return results_; }
+  // How many streams went through the fixed-point iteration (the others were reused).
+  std::size_t analysed() const { return analysed_; }
+
+ private:
+  // One stream at its place in priority order (lowest can_id first) and what decided its result.
+  struct Entry {
+    std::int64_t transmission = 0;
+    std::int64_t period = 0;
+    std::int64_t jitter = 0;
+    bool tied = false;       // same can_id as the entry before it (same channel on both sides)
+    bool near_full = false;  // level load within rounding of 100 %: never reused
+    std::int64_t blocking = 0;
+    std::optional<Nanos> result;
+    bool same_stream(const Entry& other) const;
+  };
+
+  CanBusTiming timing_;
+  std::vector<Entry> entries_;
+  std::vector<std::optional<Nanos>> results_;
+  std::size_t analysed_ = 0;
+};
 
 // Sum of C/T over the streams.
 double utilization(std::span<const CanStream> streams);
