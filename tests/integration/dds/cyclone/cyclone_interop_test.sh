@@ -1,0 +1,94 @@
+#!/usr/bin/env bash
+# Eclipse Cyclone DDS peers with DEFAULT reader and writer QoS against cosmicd, inside a fresh
+# network namespace (run through scripts/netns-run):
+#   cyclone_interop_test.sh COSMICD COSMICCTL COSMIC_CYCLONE_PEER
+# One gateway between two DDS domains. For an HRT, an SRT and an NRT channel (names with '-'
+# and '.', so the topic-name mapping is exercised), a Cyclone writer publishes into cosmicd on
+# one domain and a Cyclone reader receives from cosmicd on the other: both directions of every
+# class. Each event must arrive once, bytes unchanged, in order, and no endpoint may be refused
+# for incompatible QoS.
+set -uo pipefail
+[ "${COSMIC_IN_NETNS:-}" = 1 ] || { echo "run me through scripts/netns-run" >&2; exit 2; }
+COSMICD=$1 COSMICCTL=$2 CYCLONE_PEER=$3
+WORK=$(mktemp -d /tmp/cosmic-cyclone.XXXXXX)
+# shellcheck source=../../daemon/lib.sh
+source "$(dirname "$0")/../../daemon/lib.sh"
+trap 'cleanup; rm -rf "$WORK"' EXIT
+
+# The namespace's only interface is a multicast-capable loopback; Cyclone DDS does not use
+# multicast on loopback unless told so (Fast DDS does).
+export CYCLONEDDS_URI='<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface name="lo" multicast="true"/></Interfaces></General></Domain></CycloneDDS>'
+
+cat >"$WORK/gw.yaml" <<YAML
+gateway: {name: gw-cyclone}
+segments:
+  - {name: left, type: dds, domain: 31, latency_bound: 1ms, realtime: true}
+  - {name: right, type: dds, domain: 32, latency_bound: 1ms, realtime: true}
+channels:
+  - {name: brake-pressure, subject: 0x201, class: hrt, period: 5ms, reaction_time: 20ms, omission_degree: 0, temp_validity: 500ms, payload: 8B, publishers: [left], subscribers: [right]}
+  - {name: arm.pose, subject: 0x202, class: srt, period: 5ms, reaction_time: 50ms, omission_degree: 1, payload: 48B, publishers: [right], subscribers: [left]}
+  - {name: map-tiles.v2, subject: 0x203, class: nrt, payload: 3000B, omission_degree: 3, publishers: [left], subscribers: [right]}
+YAML
+
+domain_of() { [ "$1" = left ] && echo 31 || echo 32; }
+
+# check_output FILE COUNT SIZE: COUNT envelopes, payloads of event q = (q*7+i)&0xff in order,
+# sequences strictly increasing, origin stamped by the gateway (non-zero).
+check_output() {
+  python3 - "$@" <<'PY'
+import json, sys
+path, count, size = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+lines = [json.loads(l) for l in open(path)]
+assert len(lines) == count, f"{len(lines)} envelopes, expected {count}"
+for q, e in enumerate(lines, start=1):
+    expected = bytes(((q * 7 + i) & 0xff) for i in range(size)).hex()
+    assert e["payload"] == expected, f"event {q}: payload {e['payload'][:32]}... changed or out of order"
+    assert e["origin"] != 0, f"event {q}: origin not stamped by the gateway"
+seqs = [e["sequence"] for e in lines]
+assert all(a < b for a, b in zip(seqs, seqs[1:])), f"sequences not increasing: {seqs[:10]}..."
+PY
+}
+
+# One channel, both directions: Cyclone writer -> cosmicd (segment FROM) -> Cyclone reader (TO).
+run_channel() {
+  local channel=$1 topic=$2 from=$3 to=$4 size=$5 count=$6
+  scenario "$channel: Cyclone writer (domain $(domain_of "$from")) -> cosmicd -> Cyclone reader (domain $(domain_of "$to"))"
+  "$CYCLONE_PEER" sub --domain "$(domain_of "$to")" --topic "$topic" --count "$count" --timeout 60 \
+    >"$WORK/$channel.out" 2>"$WORK/$channel.sub.err" &
+  local sub=$!
+  PIDS+=("$sub")
+  wait_until 30 "$channel: cosmicd's writer matched the Cyclone reader" field_at_least gw "$channel" "$to" matched 1 || return
+  wait_until 30 "$channel: Cyclone reader matched cosmicd's writer" stderr_has "$WORK/$channel.sub.err" MATCHED || return
+
+  mkfifo "$WORK/$channel.go"
+  "$CYCLONE_PEER" pub --domain "$(domain_of "$from")" --topic "$topic" --count "$count" --size "$size" \
+    --period-ms 10 --timeout 60 <"$WORK/$channel.go" 2>"$WORK/$channel.pub.err" &
+  local pub=$!
+  PIDS+=("$pub")
+  exec {go}>"$WORK/$channel.go"
+  wait_until 30 "$channel: Cyclone writer matched cosmicd's reader" stderr_has "$WORK/$channel.pub.err" MATCHED || { exec {go}>&-; return; }
+  wait_until 30 "$channel: cosmicd's reader matched the Cyclone writer" field_at_least gw "$channel" "$from" matched 1 || { exec {go}>&-; return; }
+  echo go >&"$go"
+  exec {go}>&-
+
+  wait "$pub" || fail "$channel: Cyclone publisher failed: $(cat "$WORK/$channel.pub.err")"
+  wait "$sub" || { fail "$channel: Cyclone subscriber: $(cat "$WORK/$channel.sub.err")"; return; }
+  check_output "$WORK/$channel.out" "$count" "$size" || fail "$channel: wrong envelopes"
+  expect_field gw "$channel" "$from" rx "$count"
+  expect_field gw "$channel" "$to" tx "$count"
+  passed
+}
+
+start_daemon gw "$WORK/gw.yaml" || exit 1
+# Every channel admitted (an HRT rejection would leave it unbound and the test meaningless).
+[ "$(channel_count gw)" -eq 3 ] || fail "expected 3 bound channels, got $(channel_count gw)"
+
+run_channel brake-pressure cosmic/brake_pressure left right 8 40
+run_channel arm.pose cosmic/arm_pose right left 48 40
+run_channel map-tiles.v2 cosmic/map_tiles_v2 left right 3000 20
+
+if grep -q "incompatible QoS" "$WORK/gw.log"; then
+  fail "cosmicd refused a Cyclone endpoint: $(grep "incompatible QoS" "$WORK/gw.log" | head -3)"
+fi
+[ "$FAILED" = 0 ] || { log "--- cosmicd log"; tail -40 "$WORK/gw.log" >&2; exit 1; }
+log "all Cyclone DDS interoperability scenarios passed"
