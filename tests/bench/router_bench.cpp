@@ -9,9 +9,14 @@
 //                                 increasing sequences (duplicate filter path), 0: native source.
 //   BM_MemoryAdapterInject/B      the same through MemoryAdapter::inject() (its lock, channel
 //                                 lookup by name and payload copy included).
-//   BM_Threaded                   a producer thread (the adapter's) feeding router.run() on its
-//                                 own thread (the daemon's router thread): cross-thread hand-off
-//                                 and wake-ups included; real time until the last event is sent.
+//   BM_Threaded                   a producer thread (the adapter's) feeding the NRT egress lane
+//                                 thread: cross-thread hand-off and wake-ups included; real time
+//                                 until the last event is sent.
+//   BM_HrtResidence/flood         HRT events at 1 kHz through their own lane, idle (flood=0) or
+//                                 while a second thread floods an NRT channel to the same
+//                                 segment as fast as it can (flood=1); counters: HRT residence
+//                                 p50/p99/p99.9/max in microseconds (from the router's own
+//                                 histogram) and the NRT events dropped as queue_full.
 // items_per_second is events per second; ns/event = 1e9 / items_per_second.
 #include <benchmark/benchmark.h>
 
@@ -53,8 +58,14 @@ class CountingAdapter final : public SegmentAdapter {
 
 constexpr ChannelId kChannel = 1;
 
+RouterLimits limits_for(bool threaded) {
+  RouterLimits limits;
+  limits.threaded = threaded;
+  return limits;
+}
+
 struct Bench {
-  Bench() : router(GatewayIdentity{0xAAAA, "bench"}, 2) {
+  explicit Bench(bool threaded = false) : router(GatewayIdentity{0xAAAA, "bench"}, 2, limits_for(threaded)) {
     ChannelSpec spec;
     spec.name = "bench";
     spec.subject = 0x100;
@@ -115,8 +126,7 @@ void BM_MemoryAdapterInject(benchmark::State& state) {
 BENCHMARK(BM_MemoryAdapterInject)->Arg(1)->Arg(64)->ArgName("batch");
 
 void BM_Threaded(benchmark::State& state) {
-  Bench b;
-  std::thread router_thread([&] { b.router.run(); });
+  Bench b(true);
   constexpr std::size_t kPerIteration = 10000;
   std::uint64_t total = 0;
   EventHeader header{};
@@ -133,10 +143,59 @@ void BM_Threaded(benchmark::State& state) {
     state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   b.router.stop();
-  router_thread.join();
   state.SetItemsProcessed(static_cast<std::int64_t>(total));
 }
 BENCHMARK(BM_Threaded)->UseManualTime()->Unit(benchmark::kMillisecond);
+
+void BM_HrtResidence(benchmark::State& state) {
+  Bench b(true);
+  ChannelSpec hrt;
+  hrt.name = "brake";
+  hrt.subject = 0x200;
+  hrt.cls = ChannelClass::hrt;
+  hrt.payload = 8;
+  ChannelSpec nrt;
+  nrt.name = "bulk";
+  nrt.subject = 0x100;
+  nrt.cls = ChannelClass::nrt;
+  nrt.payload = 64;
+  b.router.apply({Route{1, nrt, {0}, {1}}, Route{2, hrt, {0}, {1}}});
+  const bool flood = state.range(0) != 0;
+  std::atomic<bool> flooding{flood};
+  std::thread flooder([&] {
+    EventHeader header{};
+    header.subject = 0x100;
+    while (flooding.load(std::memory_order_relaxed))
+      b.router.inbox(0).on_event(InboundEvent{1, header, b.payload, steady_now()});
+  });
+  EventHeader header{};
+  header.subject = 0x200;
+  const std::uint8_t payload[8] = {};
+  for (auto _ : state) {
+    for (int i = 0; i < 200; ++i) {
+      b.router.inbox(0).on_event(InboundEvent{2, header, payload, steady_now()});
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  }
+  flooding = false;
+  flooder.join();
+  b.router.stop();
+  for (const auto& channel : b.router.snapshot()) {
+    if (channel.name == "brake") {
+      const auto& hop = *channel.segments.back().egress;
+      state.counters["hrt_p50_us"] = static_cast<double>(hop.residence_p50.count()) / 1e3;
+      state.counters["hrt_p99_us"] = static_cast<double>(hop.residence_p99.count()) / 1e3;
+      state.counters["hrt_p999_us"] = static_cast<double>(hop.residence_p999.count()) / 1e3;
+      state.counters["hrt_max_us"] = static_cast<double>(hop.residence_max.count()) / 1e3;
+      state.counters["hrt_events"] = static_cast<double>(hop.events);
+    } else {
+      state.counters["nrt_queue_full"] =
+          static_cast<double>(channel.segments.back().dropped[static_cast<std::size_t>(DropReason::queue_full)]);
+      state.counters["nrt_sent"] = static_cast<double>(channel.segments.back().tx);
+    }
+  }
+}
+BENCHMARK(BM_HrtResidence)->Arg(0)->Arg(1)->ArgName("flood")->Iterations(5)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
