@@ -1,5 +1,7 @@
 // Persistence of runtime bindings: round trip, atomic replacement, corrupted files.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -68,6 +70,55 @@ channels:
   ASSERT_TRUE(back.ok()) << back.errors[0].to_string();
   ASSERT_EQ(back.channels.size(), 1u);
   EXPECT_EQ(back.channels[0], config.config.channels[0]);
+}
+
+TEST_F(BindingStoreTest, SymlinksPlantedForTheTemporaryFileAreNeverFollowed) {
+  std::filesystem::create_directories(dir);
+  const std::string victim = (dir / "victim").string();
+  std::ofstream(victim) << "untouched\n";
+  std::filesystem::create_symlink(victim, path + ".tmp");  // the name the old code wrote through
+  cosmicd::BindingState state;
+  state.bound.push_back({"extra", "{name: extra}"});
+  ASSERT_EQ(cosmicd::save_binding_state(path, state), "");
+  std::ifstream in(victim);
+  std::string content;
+  std::getline(in, content);
+  EXPECT_EQ(content, "untouched");
+  EXPECT_TRUE(std::filesystem::is_symlink(path + ".tmp"));
+  EXPECT_EQ(cosmicd::load_binding_state(path).state.bound.size(), 1u);
+}
+
+TEST_F(BindingStoreTest, AFifoADeviceAndAHugeFileAreRefusedWithoutBlocking) {
+  std::filesystem::create_directories(dir);
+  ASSERT_EQ(::mkfifo(path.c_str(), 0600), 0);
+  const auto fifo = cosmicd::load_binding_state(path);  // without O_NONBLOCK this waits for a writer forever
+  EXPECT_NE(fifo.error.find("not a regular file"), std::string::npos) << fifo.error;
+  std::filesystem::remove(path);
+  const auto device = cosmicd::load_binding_state("/dev/zero");
+  EXPECT_NE(device.error.find("not a regular file"), std::string::npos) << device.error;
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT, 0600);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::ftruncate(fd, static_cast<off_t>(cosmicd::kMaxStateFileBytes + 1)), 0);  // sparse: costs no disk
+  ::close(fd);
+  const auto huge = cosmicd::load_binding_state(path);
+  EXPECT_NE(huge.error.find("above the limit"), std::string::npos) << huge.error;
+}
+
+TEST_F(BindingStoreTest, AFailedSaveSaysWhy) {
+  std::filesystem::create_directories(dir);
+  std::ofstream((dir / "file").string()) << "x";
+  EXPECT_NE(cosmicd::save_binding_state((dir / "file" / "bindings.json").string(), {}), "");
+}
+
+TEST(BindingEntryTest, AnEntryMustDefineExactlyTheChannelItIsNamedAfter) {
+  const auto config = cosmic::parse_config("segments: [{name: a, type: dds}, {name: b, type: lcm}]\nchannels: []\n", "t.yaml");
+  const auto parse = [&](const char* yaml) { return cosmic::parse_channels(yaml, "state", config.config).channels; };
+  const char* other = "{name: other, subject: 7, class: nrt, publishers: [a], subscribers: [b]}";
+  EXPECT_EQ(cosmicd::check_binding_entry({"other", other}, parse(other)), "");
+  EXPECT_NE(cosmicd::check_binding_entry({"speed", other}, parse(other)), "");
+  const char* two = "[{name: speed, subject: 7, class: nrt, publishers: [a], subscribers: [b]},"
+                    " {name: other, subject: 8, class: nrt, publishers: [a], subscribers: [b]}]";
+  EXPECT_NE(cosmicd::check_binding_entry({"speed", two}, parse(two)), "");
 }
 
 }  // namespace

@@ -5,8 +5,13 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <poll.h>
+#include <sys/resource.h>
+
 #include <atomic>
+#include <condition_variable>
 #include <cstring>
+#include <fstream>
 #include <filesystem>
 #include <thread>
 
@@ -51,6 +56,7 @@ class Client {
   }
   ~Client() { ::close(fd_); }
   bool connected() const { return connected_; }
+  int fd() const { return fd_; }
   void send_raw(const std::string& data) { ASSERT_EQ(::send(fd_, data.data(), data.size(), MSG_NOSIGNAL), static_cast<ssize_t>(data.size())); }
   std::string read_line() {
     std::string line;
@@ -82,6 +88,8 @@ class ControlTest : public ::testing::Test {
     gateway.start(parse_config(kConfig, "test.yaml").config);
   }
   ~ControlTest() override {
+    open_gate();
+    if (admission_thread.joinable()) admission_thread.join();
     running = false;
     if (server_thread.joinable()) server_thread.join();
     server.reset();
@@ -89,22 +97,62 @@ class ControlTest : public ::testing::Test {
     std::filesystem::remove_all(dir);
   }
 
+  enum class Admission { inline_run, server_worker, gated };
+  struct Setup {
+    AccessPolicy policy;
+    std::function<void(ControlServerOptions&)> tune = [](ControlServerOptions&) {};
+    Admission admission = Admission::inline_run;
+    ChangeObserver on_change;
+  };
+
   void serve(AccessPolicy policy = {}, std::size_t max_clients = 32) {
-    protocol = std::make_unique<ControlProtocol>(gateway, [] { return parse_config("nonsense: [", "reload.yaml"); }, policy, log);
+    Setup setup;
+    setup.policy = std::move(policy);
+    setup.tune = [max_clients](ControlServerOptions& o) { o.max_clients = max_clients; };
+    serve_with(setup);
+  }
+
+  void serve_with(const Setup& setup) {
     ControlServerOptions options;
     options.path = socket_path;
     options.max_request_bytes = 4096;
-    options.max_clients = max_clients;
     options.max_pending_output = 8192;
+    options.privileged = [](const PeerCredentials&) { return true; };
+    setup.tune(options);
     server = std::make_unique<ControlServer>(
         options, [this](std::string_view line, const PeerCredentials& peer, ControlServer::Responder later) {
           return protocol->handle(line, peer, std::move(later));
         });
+    Offload offload;
+    if (setup.admission == Admission::server_worker) offload = server->offload();
+    if (setup.admission == Admission::gated) offload = gated_offload();
+    protocol = std::make_unique<ControlProtocol>(gateway, [] { return parse_config("nonsense: [", "reload.yaml"); },
+                                                 setup.policy, log, setup.on_change, offload);
     const Status opened = server->open();
     ASSERT_TRUE(opened.ok) << opened.error;
     server_thread = std::thread([this] {
       while (running) server->run_for(std::chrono::milliseconds(20));
     });
+  }
+
+  // Admission work waits for open_gate(): an admission as long as the test wants.
+  Offload gated_offload() {
+    return [this](std::function<void()> work, std::function<void()> done) {
+      if (admission_thread.joinable()) admission_thread.join();  // the previous one has posted its answer
+      admission_thread = std::thread([this, work, done] {
+        {
+          std::unique_lock lock(gate_mutex);
+          gate_changed.wait(lock, [this] { return gate_open; });
+        }
+        work();
+        server->post(done);
+      });
+    };
+  }
+  void open_gate() {
+    std::lock_guard lock(gate_mutex);
+    gate_open = true;
+    gate_changed.notify_all();
   }
 
   std::filesystem::path dir;
@@ -115,6 +163,10 @@ class ControlTest : public ::testing::Test {
   std::unique_ptr<ControlServer> server;
   std::atomic<bool> running{true};
   std::thread server_thread;
+  std::mutex gate_mutex;
+  std::condition_variable gate_changed;
+  bool gate_open = false;
+  std::thread admission_thread;
 };
 
 TEST_F(ControlTest, SocketAndDirectoryPermissions) {
@@ -226,6 +278,215 @@ TEST_F(ControlTest, ManyClientsAtOnceAndALimit) {
   for (auto& c : clients) EXPECT_EQ(c->call({{"command", "status"}})["ok"], true);
   Client extra(socket_path);
   EXPECT_EQ(Json::parse(extra.read_line(), nullptr, false)["error"]["code"], "busy");
+}
+
+// `count` LCM-to-DDS channels in one bind file: an admission with real work in it.
+std::string many_channels(int count, int first_subject) {
+  std::string yaml = "channels:\n";
+  for (int i = 0; i < count; ++i) {
+    yaml += "  - {name: bulk" + std::to_string(first_subject + i) + ", subject: " + std::to_string(first_subject + i) +
+            ", class: nrt, publishers: [viz], subscribers: [lan]}\n";
+  }
+  return yaml;
+}
+
+TEST_F(ControlTest, StatusIsAnsweredWhileALongAdmissionRunsAndASecondBindIsBusy) {
+  Setup setup;
+  setup.admission = Admission::gated;
+  serve_with(setup);
+  Client binder(socket_path);
+  binder.send_raw(Json{{"command", "bind"}, {"yaml", many_channels(40, 1000)}}.dump() + "\n");
+  Client other(socket_path);
+  // The control thread answers while the admission waits on the gate.
+  EXPECT_EQ(other.call({{"command", "status"}})["ok"], true);
+  const Json second = other.call({{"command", "bind"}, {"yaml", many_channels(1, 5000)}});
+  EXPECT_EQ(second["error"]["code"], "busy");
+  EXPECT_NE(second["error"]["message"].get<std::string>().find("bind of bulk1000"), std::string::npos);
+  EXPECT_EQ(other.call({{"command", "unbind"}, {"name", "speed"}})["error"]["code"], "busy");
+  EXPECT_EQ(other.call({{"command", "reload"}})["error"]["code"], "busy");
+  open_gate();
+  const Json first = Json::parse(binder.read_line(), nullptr, false);
+  EXPECT_EQ(first["ok"], true) << first.dump();
+  EXPECT_EQ(first["channels"].size(), 40u);
+  EXPECT_EQ(other.call({{"command", "channels"}})["channels"].size(), 41u);
+  // Once it is done, binding works again.
+  EXPECT_EQ(other.call({{"command", "bind"}, {"yaml", many_channels(1, 5000)}})["ok"], true);
+}
+
+TEST_F(ControlTest, AdmissionOnTheServersWorkerAnswersInOrder) {
+  Setup setup;
+  setup.admission = Admission::server_worker;
+  setup.tune = [](ControlServerOptions& o) { o.max_request_bytes = 64 * 1024; };
+  serve_with(setup);
+  Client client(socket_path);
+  // Pipelined: the status after the bind waits for the bind's deferred answer.
+  client.send_raw(Json{{"command", "bind"}, {"yaml", many_channels(200, 1000)}}.dump() + "\n" + R"({"command":"status"})" + "\n");
+  const Json bound = Json::parse(client.read_line(), nullptr, false);
+  EXPECT_EQ(bound["ok"], true) << bound.dump();
+  EXPECT_EQ(bound["channels"].size(), 200u);  // the bind's answer comes first
+  EXPECT_TRUE(Json::parse(client.read_line(), nullptr, false).contains("gateway"));
+  EXPECT_EQ(client.call({{"command", "channels"}})["channels"].size(), 201u);
+  EXPECT_EQ(client.call({{"command", "reload"}})["error"]["code"], "config_error");  // its load ran on the worker too
+}
+
+TEST_F(ControlTest, PlanCommittedAfterTheBindingsChangedIsRefused) {
+  BindPlan plan = gateway.bind_plan_input(parse_channels(many_channels(1, 7000), "t", gateway.config()).channels);
+  Gateway::plan_bind(plan);
+  ASSERT_TRUE(gateway.unbind("speed"));
+  const BindResult result = gateway.commit_bind(std::move(plan));
+  EXPECT_FALSE(result.applied);
+  EXPECT_EQ(gateway.knowledge_base().find_bound("bulk7000"), nullptr);
+}
+
+TEST_F(ControlTest, UnprivilegedPeersGetAShareAndAdminsKeepReservedSlots) {
+  std::atomic<bool> admin{false};
+  Setup setup;
+  setup.tune = [&admin](ControlServerOptions& o) {
+    o.max_clients = 5;
+    o.privileged_reserve = 2;
+    o.max_clients_per_uid = 2;
+    o.privileged = [&admin](const PeerCredentials&) { return admin.load(); };
+  };
+  serve_with(setup);
+  std::vector<std::unique_ptr<Client>> readers;
+  for (int i = 0; i < 2; ++i) {
+    readers.push_back(std::make_unique<Client>(socket_path));
+    ASSERT_EQ(readers.back()->call({{"command", "status"}})["ok"], true);
+  }
+  Client third(socket_path);
+  const Json per_uid = Json::parse(third.read_line(), nullptr, false);
+  EXPECT_EQ(per_uid["error"]["code"], "busy");
+  EXPECT_NE(per_uid["error"]["message"].get<std::string>().find("limit per user"), std::string::npos);
+  admin = true;  // admins are not limited per uid and may use the reserve
+  std::vector<std::unique_ptr<Client>> admins;
+  for (int i = 0; i < 3; ++i) {
+    admins.push_back(std::make_unique<Client>(socket_path));
+    ASSERT_EQ(admins.back()->call({{"command", "status"}})["ok"], true) << i;
+  }
+  Client sixth(socket_path);
+  EXPECT_EQ(Json::parse(sixth.read_line(), nullptr, false)["error"]["code"], "busy");
+  admins.clear();
+  admin = false;  // 2 readers of 5 slots: one more reader would eat into the reserve of 2
+  readers.pop_back();
+  readers.push_back(std::make_unique<Client>(socket_path));
+  ASSERT_EQ(readers.back()->call({{"command", "status"}})["ok"], true);
+  Client into_reserve(socket_path);
+  const Json reserved = Json::parse(into_reserve.read_line(), nullptr, false);
+  EXPECT_EQ(reserved["error"]["code"], "busy");
+}
+
+TEST_F(ControlTest, IncompleteRequestTimesOutEvenWhenBytesKeepTrickling) {
+  Setup setup;
+  setup.tune = [](ControlServerOptions& o) {
+    o.request_timeout = std::chrono::milliseconds(300);
+    o.idle_timeout = std::chrono::seconds(60);
+  };
+  serve_with(setup);
+  Client client(socket_path);
+  client.send_raw(R"({"command":)");
+  // One more byte whenever 20 ms pass without an answer: an idle timer would never fire.
+  pollfd ready{client.fd(), POLLIN, 0};
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (::poll(&ready, 1, 20) == 0 && std::chrono::steady_clock::now() < give_up) client.send_raw(" ");
+  const Json answer = Json::parse(client.read_line(), nullptr, false);
+  EXPECT_EQ(answer["error"]["code"], "timeout") << answer.dump();
+}
+
+TEST_F(ControlTest, ARegularFileAtTheSocketPathIsRefusedAndKept) {
+  std::filesystem::create_directories(dir / "run");
+  std::ofstream(socket_path) << "precious\n";
+  ControlServerOptions options;
+  options.path = socket_path;
+  ControlServer server_at_file(options, [](std::string_view, const PeerCredentials&, ControlServer::Responder) {
+    return std::optional<std::string>("{}\n");
+  });
+  const Status opened = server_at_file.open();
+  EXPECT_FALSE(opened.ok);
+  EXPECT_NE(opened.error.find("not a socket"), std::string::npos) << opened.error;
+  server_at_file.close_all();
+  std::ifstream kept(socket_path);
+  std::string content;
+  std::getline(kept, content);
+  EXPECT_EQ(content, "precious");
+}
+
+TEST_F(ControlTest, AcceptAtTheDescriptorLimitRefusesInsteadOfSpinning) {
+  serve();
+  const int client = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  ASSERT_GE(client, 0);
+  rlimit saved{};
+  ::getrlimit(RLIMIT_NOFILE, &saved);
+  const int probe = ::dup(0);
+  rlimit low = saved;
+  low.rlim_cur = static_cast<rlim_t>(probe + 8);
+  ::close(probe);
+  ASSERT_EQ(::setrlimit(RLIMIT_NOFILE, &low), 0);
+  std::vector<int> filler;
+  for (int fd; (fd = ::dup(0)) >= 0;) filler.push_back(fd);
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  std::strcpy(address.sun_path, socket_path.c_str());
+  const bool connected = ::connect(client, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0;
+  pollfd ready{client, POLLIN, 0};
+  const bool answered = connected && ::poll(&ready, 1, 5000) == 1;
+  char buffer[512] = {};
+  const ssize_t n = answered ? ::read(client, buffer, sizeof buffer - 1) : -1;
+  for (const int fd : filler) ::close(fd);
+  ::setrlimit(RLIMIT_NOFILE, &saved);
+  ::close(client);
+  ASSERT_TRUE(connected);
+  ASSERT_TRUE(answered) << "the pending connection was never taken off the backlog";
+  ASSERT_GT(n, 0);
+  const Json answer = Json::parse(std::string(buffer, static_cast<std::size_t>(n)), nullptr, false);
+  EXPECT_EQ(answer["error"]["code"], "busy");
+  EXPECT_NE(answer["error"]["message"].get<std::string>().find("file descriptors"), std::string::npos);
+  Client later(socket_path);  // and serving goes on once descriptors are back
+  EXPECT_EQ(later.call({{"command", "status"}})["ok"], true);
+}
+
+TEST_F(ControlTest, DeepNestingIsRefusedBeforeParsingAndLogLinesStayBounded) {
+  AccessPolicy policy;
+  policy.may_modify = [](const PeerCredentials&) { return false; };
+  serve(policy);
+  Client client(socket_path);
+  const Json deep = client.call(Json::parse(R"({"command":"status","x":)" + std::string(20, '[') + std::string(20, ']') + "}"));
+  EXPECT_EQ(deep["error"]["code"], "bad_request");
+  client.send_raw(std::string(3000, '[') + "\n");
+  EXPECT_EQ(Json::parse(client.read_line(), nullptr, false)["error"]["code"], "bad_request");
+  const std::string long_command(3000, 'u');
+  client.call({{"command", "unbind"}, {"name", Json::array({Json::array({Json::array({1})})})}});
+  client.call({{"command", long_command}});
+  std::lock_guard lock(log.mutex);
+  for (const auto& line : log.lines) EXPECT_LT(line.size(), 300u) << line.substr(0, 80);
+}
+
+TEST_F(ControlTest, DeniedRequestsAreLoggedWithThePidAndNeverAlike) {
+  AccessPolicy policy;
+  policy.may_modify = [](const PeerCredentials&) { return false; };
+  serve(policy);
+  Client client(socket_path);
+  for (int i = 0; i < 2; ++i) client.call({{"command", "unbind"}, {"name", "speed"}});
+  std::vector<std::string> denied;
+  {
+    std::lock_guard lock(log.mutex);
+    for (const auto& line : log.lines) {
+      if (line.find("denied") != std::string::npos) denied.push_back(line);
+    }
+  }
+  ASSERT_EQ(denied.size(), 2u);
+  EXPECT_NE(denied[0], denied[1]);  // a logger folding repeated lines cannot hide the second
+  for (const auto& line : denied) EXPECT_NE(line.find("pid " + std::to_string(::getpid())), std::string::npos) << line;
+}
+
+TEST_F(ControlTest, AChangeThatCannotBeSavedIsNotOk) {
+  Setup setup;
+  setup.on_change = [](const std::string&, const Json&) { return std::string("No space left on device"); };
+  serve_with(setup);
+  Client client(socket_path);
+  const Json answer = client.call({{"command", "unbind"}, {"name", "speed"}});
+  EXPECT_EQ(answer["ok"], false);
+  EXPECT_EQ(answer["error"]["code"], "not_persisted");
+  EXPECT_NE(answer["error"]["message"].get<std::string>().find("No space left"), std::string::npos);
 }
 
 }  // namespace
