@@ -1,6 +1,7 @@
 #include "cosmic/admission.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <tuple>
@@ -21,13 +22,7 @@ constexpr std::uint64_t kMaxIpEventBytes = 1 << 20;
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
-struct HopRef {
-  std::size_t channel;
-  std::size_t hop;
-};
-
 double seconds_or_infinity(const std::optional<Nanos>& value) { return value ? to_seconds(*value) : kInfinity; }
-
 
 Nanos deadline_key(const ChannelSpec& channel) {
   if (channel.reaction_time) return *channel.reaction_time;
@@ -45,172 +40,80 @@ bool segment_realtime(const SegmentSpec& segment) {
   return segment.type == SegmentType::can || segment.realtime;
 }
 
-class Evaluator {
- public:
-  Evaluator(const GatewaySpec& gateway, std::span<const SegmentSpec> segments, std::span<const ChannelSpec> channels,
-            const EtagMap& etags)
-      : gateway_(gateway), segments_(segments), channels_(channels), etags_(etags) {}
+const SegmentSpec& segment_named(std::span<const SegmentSpec> segments, const std::string& name) {
+  return *std::find_if(segments.begin(), segments.end(), [&](const auto& s) { return s.name == name; });
+}
 
-  Evaluation run() {
-    create_hops();
-    for (std::size_t s = 0; s < segments_.size(); ++s) {
-      if (segments_[s].type == SegmentType::can) plan_can_segment(s);
+std::size_t segment_index(std::span<const SegmentSpec> segments, const std::string& name) {
+  return static_cast<std::size_t>(&segment_named(segments, name) - segments.data());
+}
+
+Nanos stream_period(const ChannelSpec& channel, const CanHopPlan& plan) {
+  const Nanos period = channel.period.value_or(kUnratedPeriod);
+  return std::max(Nanos(1), period / plan.frames_per_event);
+}
+
+// Frame layout of a channel on a CAN bus: what does not depend on the other channels.
+CanHopPlan frame_plan(const CanSegmentProperties& bus, const ChannelSpec& channel) {
+  CanHopPlan plan;
+  const std::uint32_t capacity = max_frame_payload(bus);
+  const bool fits = channel.payload <= capacity;
+  plan.frames_per_event = fits ? 1 : fragments_needed(channel.payload, capacity);
+  const auto data_bytes = static_cast<std::uint32_t>(fits ? channel.payload : capacity);
+  plan.frame_bytes = bus.fd ? fd_padded_length(data_bytes) : data_bytes;
+  plan.transmission = frame_time(bus, plan.frame_bytes, CanIdFormat::extended29);
+  return plan;
+}
+
+double hop_load(const SegmentSpec& segment, const ChannelSpec& channel) {
+  if (!channel.period) return 0.0;
+  const double period_s = to_seconds(*channel.period);
+  if (segment.type == SegmentType::can) {
+    const CanHopPlan plan = frame_plan(segment.can, channel);
+    return to_seconds(plan.transmission) * plan.frames_per_event / period_s;
+  }
+  const double bits = static_cast<double>(channel.payload + kIpOverheadBytes) * 8.0;
+  return bits / period_s / static_cast<double>(segment.bandwidth.bits_per_second);
+}
+
+// The verdict of one channel from its hops' latencies and plans and the segment loads.
+class Judge {
+ public:
+  Judge(const GatewaySpec& gateway, std::span<const SegmentSpec> segments, const std::vector<double>& loads)
+      : gateway_(gateway), segments_(segments), loads_(loads) {}
+
+  void judge(const ChannelSpec& channel, ChannelReport& report) const {
+    auto worsen = [&](Verdict v, std::string reason) {
+      report.verdict = std::max(report.verdict, v);
+      report.reasons.push_back(std::move(reason));
+    };
+    for (HopReport& h : report.hops) {
+      const SegmentSpec& segment = segment_named(segments_, h.segment);
+      add_hop_checks(channel, segment, h);
+      for (const Check& check : h.checks) {
+        if (!check.ok) worsen(consequence(check.check, channel.cls), failure_text(check, h, segment));
+      }
     }
-    iterate_latencies();
-    compute_loads();
-    for (std::size_t c = 0; c < channels_.size(); ++c) judge_channel(c);
-    return Evaluation{std::move(reports_), std::move(loads_)};
+    EndToEnd& e2e = report.end_to_end;
+    e2e.latency = end_to_end_latency(report);
+    e2e.reaction_time = channel.reaction_time;
+    e2e.temp_validity = channel.temp_validity;
+    const double latency = seconds_or_infinity(e2e.latency);
+    if (channel.cls != ChannelClass::nrt && channel.reaction_time && latency > to_seconds(*channel.reaction_time)) {
+      e2e.latency_ok = false;
+      worsen(consequence("latency", channel.cls), "end-to-end latency " + format_seconds(latency) +
+                                                      " > reaction_time " + format_duration(*channel.reaction_time));
+    }
+    if (channel.temp_validity && latency >= to_seconds(*channel.temp_validity)) {
+      e2e.validity_ok = false;
+      worsen(consequence("validity", channel.cls), "end-to-end latency " + format_seconds(latency) +
+                                                       " >= temp_validity " + format_duration(*channel.temp_validity) +
+                                                       ": events would arrive stale");
+    }
   }
 
  private:
-  const SegmentSpec& segment_named(const std::string& name) const {
-    return *std::find_if(segments_.begin(), segments_.end(), [&](const auto& s) { return s.name == name; });
-  }
-
-  std::size_t segment_index(const std::string& name) const {
-    return static_cast<std::size_t>(
-        std::find_if(segments_.begin(), segments_.end(), [&](const auto& s) { return s.name == name; }) -
-        segments_.begin());
-  }
-
-  HopReport& hop(const HopRef& ref) { return reports_[ref.channel].hops[ref.hop]; }
-
-  void create_hops() {
-    hops_by_segment_.assign(segments_.size(), {});
-    for (std::size_t c = 0; c < channels_.size(); ++c) {
-      const ChannelSpec& channel = channels_[c];
-      ChannelReport report;
-      report.name = channel.name;
-      report.cls = channel.cls;
-      auto add = [&](const std::string& segment, HopRole role) {
-        hops_by_segment_[segment_index(segment)].push_back(HopRef{c, report.hops.size()});
-        report.hops.push_back(HopReport{segment, role, std::nullopt, std::nullopt, {}});
-      };
-      for (const auto& p : channel.publishers) add(p, HopRole::publisher);
-      for (const auto& s : channel.subscribers) add(s, HopRole::subscriber);
-      reports_.push_back(std::move(report));
-    }
-  }
-
-  // Priorities (band, then deadline-monotonic), identifiers and frame times of one CAN bus.
-  void plan_can_segment(std::size_t s) {
-    const CanSegmentProperties& bus = segments_[s].can;
-    std::vector<HopRef> ordered = hops_by_segment_[s];
-    std::sort(ordered.begin(), ordered.end(), [&](const HopRef& a, const HopRef& b) {
-      const ChannelSpec& ca = channels_[a.channel];
-      const ChannelSpec& cb = channels_[b.channel];
-      return std::tuple(static_cast<int>(ca.cls), deadline_key(ca), ca.subject) <
-             std::tuple(static_cast<int>(cb.cls), deadline_key(cb), cb.subject);
-    });
-    const std::uint32_t capacity = max_frame_payload(bus);
-    for (std::size_t i = 0; i < ordered.size(); ++i) {
-      const ChannelSpec& channel = channels_[ordered[i].channel];
-      std::size_t rank = 0;
-      std::size_t count = 0;
-      for (std::size_t j = 0; j < ordered.size(); ++j) {
-        if (channels_[ordered[j].channel].cls != channel.cls) continue;
-        if (j < i) ++rank;
-        ++count;
-      }
-      CanHopPlan plan;
-      plan.priority = band_priority(channel.cls, rank, count);
-      const auto etag = etags_.find(channel.name);
-      plan.etag = etag == etags_.end() ? 0 : etag->second;
-      plan.can_id = encode_can_id(CanIdentifier{plan.priority, gateway_.can_node_id, plan.etag});
-      const bool fits = channel.payload <= capacity;
-      plan.frames_per_event = fits ? 1 : fragments_needed(channel.payload, capacity);
-      const auto data_bytes = static_cast<std::uint32_t>(fits ? channel.payload : capacity);
-      plan.frame_bytes = bus.fd ? fd_padded_length(data_bytes) : data_bytes;
-      plan.transmission = frame_time(bus, plan.frame_bytes, CanIdFormat::extended29);
-      hop(ordered[i]).can = plan;
-    }
-  }
-
-  Nanos stream_period(const ChannelSpec& channel, const CanHopPlan& plan) const {
-    const Nanos period = channel.period.value_or(kUnratedPeriod);
-    return std::max(Nanos(1), period / plan.frames_per_event);
-  }
-
-  void analyse_can_segment(std::size_t s) {
-    std::vector<CanStream> streams;
-    for (const HopRef& ref : hops_by_segment_[s]) {
-      const CanHopPlan& plan = *hop(ref).can;
-      streams.push_back(CanStream{plan.can_id, plan.transmission, stream_period(channels_[ref.channel], plan), plan.jitter});
-    }
-    const auto results = response_times(streams, bus_timing(segments_[s].can));
-    for (std::size_t i = 0; i < results.size(); ++i) {
-      HopReport& h = hop(hops_by_segment_[s][i]);
-      h.can->response_time = results[i];
-      h.latency = results[i];
-    }
-  }
-
-  // Worst latency of the channel's publisher hops.
-  std::optional<Nanos> publisher_latency(std::size_t c) const {
-    Nanos worst{0};
-    for (const HopReport& h : reports_[c].hops) {
-      if (h.role != HopRole::publisher) continue;
-      if (!h.latency) return std::nullopt;
-      worst = std::max(worst, *h.latency);
-    }
-    return worst;
-  }
-
-  // Subscriber-side CAN streams are released by the gateway up to (upstream latency + residence)
-  // after the event occurred: that is their jitter. Upstream CAN latencies depend on jitters in
-  // turn, so iterate to the fixed point (holistic analysis).
-  void iterate_latencies() {
-    for (std::size_t s = 0; s < segments_.size(); ++s) {
-      if (segments_[s].type == SegmentType::can) continue;
-      for (const HopRef& ref : hops_by_segment_[s]) hop(ref).latency = segments_[s].latency_bound;
-    }
-    for (int iteration = 0; iteration < kMaxJitterIterations; ++iteration) {
-      for (std::size_t s = 0; s < segments_.size(); ++s) {
-        if (segments_[s].type == SegmentType::can) analyse_can_segment(s);
-      }
-      if (!update_jitters()) return;
-    }
-    // No fixed point: the jitters keep growing, so the subscriber-side CAN hops are unbounded.
-    for (auto& report : reports_) {
-      for (auto& h : report.hops) {
-        if (h.can && h.role == HopRole::subscriber) h.latency = h.can->response_time = std::nullopt;
-      }
-    }
-  }
-
-  bool update_jitters() {
-    bool changed = false;
-    for (std::size_t c = 0; c < reports_.size(); ++c) {
-      const auto upstream = publisher_latency(c);
-      const Nanos jitter = upstream ? std::min(kUnboundedJitter, *upstream + gateway_.residence_bound) : kUnboundedJitter;
-      for (HopReport& h : reports_[c].hops) {
-        if (!h.can || h.role != HopRole::subscriber || h.can->jitter == jitter) continue;
-        h.can->jitter = jitter;
-        changed = true;
-      }
-    }
-    return changed;
-  }
-
-  double hop_load(const SegmentSpec& segment, const ChannelSpec& channel, const HopReport& h) const {
-    if (!channel.period) return 0.0;
-    const double period_s = to_seconds(*channel.period);
-    if (segment.type == SegmentType::can) {
-      return to_seconds(h.can->transmission) * h.can->frames_per_event / period_s;
-    }
-    const double bits = static_cast<double>(channel.payload + kIpOverheadBytes) * 8.0;
-    return bits / period_s / static_cast<double>(segment.bandwidth.bits_per_second);
-  }
-
-  void compute_loads() {
-    for (std::size_t s = 0; s < segments_.size(); ++s) {
-      double load = 0.0;
-      for (const HopRef& ref : hops_by_segment_[s]) load += hop_load(segments_[s], channels_[ref.channel], hop(ref));
-      loads_.push_back(SegmentLoad{segments_[s].name, segments_[s].type, load, segments_[s].max_utilization});
-    }
-  }
-
-  void add_frame_fit(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) {
+  static void add_frame_fit(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) {
     double limit = 0;
     if (segment.type == SegmentType::can) {
       const std::uint32_t capacity = max_frame_payload(segment.can);
@@ -225,14 +128,12 @@ class Evaluator {
     h.checks.push_back(Check{"frame_fit", value, limit, "B", "<=", value <= limit});
   }
 
-  void add_hop_checks(std::size_t c, HopReport& h) {
-    const ChannelSpec& channel = channels_[c];
-    const SegmentSpec& segment = segment_named(h.segment);
+  void add_hop_checks(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) const {
     add_frame_fit(channel, segment, h);
     if (channel.period) {
-      const SegmentLoad& load = loads_[segment_index(h.segment)];
-      h.checks.push_back(Check{"utilization", load.utilization, load.max_utilization, "ratio", "<=",
-                               load.utilization <= load.max_utilization + 1e-12});
+      const double load = loads_[static_cast<std::size_t>(&segment - segments_.data())];
+      h.checks.push_back(Check{"utilization", load, segment.max_utilization, "ratio", "<=",
+                               load <= segment.max_utilization + 1e-12});
     }
     if (channel.cls != ChannelClass::nrt && channel.reaction_time) {
       const double value = seconds_or_infinity(h.latency);
@@ -249,10 +150,10 @@ class Evaluator {
     }
   }
 
-  std::optional<Nanos> end_to_end_latency(std::size_t c) const {
+  std::optional<Nanos> end_to_end_latency(const ChannelReport& report) const {
     Nanos worst_publisher{0};
     Nanos worst_subscriber{0};
-    for (const HopReport& h : reports_[c].hops) {
+    for (const HopReport& h : report.hops) {
       if (!h.latency) return std::nullopt;
       Nanos& worst = h.role == HopRole::publisher ? worst_publisher : worst_subscriber;
       // A subscriber-side CAN response time already contains its release jitter (upstream
@@ -292,44 +193,9 @@ class Evaluator {
     return Verdict::degraded;
   }
 
-  void judge_channel(std::size_t c) {
-    const ChannelSpec& channel = channels_[c];
-    ChannelReport& report = reports_[c];
-    auto worsen = [&](Verdict v, std::string reason) {
-      report.verdict = std::max(report.verdict, v);
-      report.reasons.push_back(std::move(reason));
-    };
-    for (HopReport& h : report.hops) {
-      add_hop_checks(c, h);
-      for (const Check& check : h.checks) {
-        if (!check.ok) worsen(consequence(check.check, channel.cls), failure_text(check, h, segment_named(h.segment)));
-      }
-    }
-    EndToEnd& e2e = report.end_to_end;
-    e2e.latency = end_to_end_latency(c);
-    e2e.reaction_time = channel.reaction_time;
-    e2e.temp_validity = channel.temp_validity;
-    const double latency = seconds_or_infinity(e2e.latency);
-    if (channel.cls != ChannelClass::nrt && channel.reaction_time && latency > to_seconds(*channel.reaction_time)) {
-      e2e.latency_ok = false;
-      worsen(consequence("latency", channel.cls), "end-to-end latency " + format_seconds(latency) +
-                                                      " > reaction_time " + format_duration(*channel.reaction_time));
-    }
-    if (channel.temp_validity && latency >= to_seconds(*channel.temp_validity)) {
-      e2e.validity_ok = false;
-      worsen(consequence("validity", channel.cls), "end-to-end latency " + format_seconds(latency) +
-                                                       " >= temp_validity " + format_duration(*channel.temp_validity) +
-                                                       ": events would arrive stale");
-    }
-  }
-
   const GatewaySpec& gateway_;
   std::span<const SegmentSpec> segments_;
-  std::span<const ChannelSpec> channels_;
-  const EtagMap& etags_;
-  std::vector<std::vector<HopRef>> hops_by_segment_;
-  std::vector<ChannelReport> reports_;
-  std::vector<SegmentLoad> loads_;
+  const std::vector<double>& loads_;
 };
 
 }  // namespace
@@ -356,7 +222,322 @@ const ChannelReport* AdmissionReport::find(const std::string& name) const {
 
 Evaluation evaluate(const GatewaySpec& gateway, std::span<const SegmentSpec> segments,
                     std::span<const ChannelSpec> channels, const EtagMap& etags) {
-  return Evaluator(gateway, segments, channels, etags).run();
+  const AdmissionSet set =
+      AdmissionSet::whole(gateway, std::vector<SegmentSpec>(segments.begin(), segments.end()), channels, etags);
+  return Evaluation{set.reports(), set.loads()};
+}
+
+AdmissionSet::AdmissionSet(GatewaySpec gateway, std::vector<SegmentSpec> segments)
+    : gateway_(std::move(gateway)), segment_specs_(std::move(segments)), segments_(segment_specs_.size()) {}
+
+AdmissionSet AdmissionSet::whole(GatewaySpec gateway, std::vector<SegmentSpec> segments,
+                                 std::span<const ChannelSpec> channels, const EtagMap& etags) {
+  AdmissionSet set(std::move(gateway), std::move(segments));
+  for (const ChannelSpec& channel : channels) {
+    const auto etag = etags.find(channel.name);
+    ChannelData data = set.place(channel, etag == etags.end() ? 0 : etag->second);
+    for (const HopPlace& p : data.places) set.segments_[p.segment].load += hop_load(set.segment_specs_[p.segment], channel);
+    set.append(channel, std::move(data));
+  }
+  set.apply(set.analyse_can(nullptr, true));
+  return set;
+}
+
+AdmissionSet::ChannelData AdmissionSet::place(const ChannelSpec& channel, std::uint16_t etag) const {
+  ChannelData data{etag, {}};
+  auto add = [&](const std::string& name, HopRole role) {
+    const std::size_t s = segment_index(segment_specs_, name);
+    const auto earlier = std::count_if(data.places.begin(), data.places.end(), [&](const auto& p) { return p.segment == s; });
+    data.places.push_back(HopPlace{s, segments_[s].hops.size() + static_cast<std::size_t>(earlier), role});
+  };
+  for (const auto& p : channel.publishers) add(p, HopRole::publisher);
+  for (const auto& s : channel.subscribers) add(s, HopRole::subscriber);
+  return data;
+}
+
+void AdmissionSet::append(ChannelSpec spec, ChannelData data) {
+  const std::size_t index = specs_.size();
+  for (std::size_t h = 0; h < data.places.size(); ++h) segments_[data.places[h].segment].hops.push_back(HopRef{index, h});
+  index_[spec.name] = index;
+  specs_.push_back(std::move(spec));
+  data_.push_back(std::move(data));
+}
+
+AdmissionSet::Member AdmissionSet::member(std::size_t segment, std::size_t position, const Trial* newcomer) const {
+  const auto& hops = segments_[segment].hops;
+  if (position < hops.size()) {
+    const HopRef& ref = hops[position];
+    return Member{&specs_[ref.channel], &data_[ref.channel], data_[ref.channel].places[ref.hop].role};
+  }
+  for (const HopPlace& p : newcomer->data.places) {
+    if (p.segment == segment && p.position == position) return Member{&newcomer->spec, &newcomer->data, p.role};
+  }
+  return Member{nullptr, nullptr, HopRole::publisher};  // unreachable: positions come from place()
+}
+
+// Priorities (band, then deadline-monotonic), identifiers and frame times of one CAN bus, in the
+// order of its hop list (the newcomer's hops last).
+std::vector<CanHopPlan> AdmissionSet::plan_bus(std::size_t segment, const Trial* newcomer) const {
+  std::vector<Member> members;
+  for (std::size_t pos = 0; pos < segments_[segment].hops.size(); ++pos) members.push_back(member(segment, pos, nullptr));
+  if (newcomer) {
+    for (const HopPlace& p : newcomer->data.places) {
+      if (p.segment == segment) members.push_back(Member{&newcomer->spec, &newcomer->data, p.role});
+    }
+  }
+  std::vector<std::size_t> ordered(members.size());
+  for (std::size_t i = 0; i < ordered.size(); ++i) ordered[i] = i;
+  std::sort(ordered.begin(), ordered.end(), [&](std::size_t a, std::size_t b) {
+    const ChannelSpec& ca = *members[a].spec;
+    const ChannelSpec& cb = *members[b].spec;
+    return std::tuple(static_cast<int>(ca.cls), deadline_key(ca), ca.subject) <
+           std::tuple(static_cast<int>(cb.cls), deadline_key(cb), cb.subject);
+  });
+  std::array<std::size_t, 3> count{};
+  for (const Member& m : members) ++count[static_cast<std::size_t>(m.spec->cls)];
+  const CanSegmentProperties& bus = segment_specs_[segment].can;
+  std::vector<CanHopPlan> plans(members.size());
+  std::size_t first_of_class = 0;
+  for (std::size_t i = 0; i < ordered.size(); ++i) {
+    const Member& m = members[ordered[i]];
+    if (i > 0 && members[ordered[i - 1]].spec->cls != m.spec->cls) first_of_class = i;
+    CanHopPlan plan = frame_plan(bus, *m.spec);
+    plan.priority = band_priority(m.spec->cls, i - first_of_class, count[static_cast<std::size_t>(m.spec->cls)]);
+    plan.etag = m.data->etag;
+    plan.can_id = encode_can_id(CanIdentifier{plan.priority, gateway_.can_node_id, plan.etag});
+    plans[ordered[i]] = plan;
+  }
+  return plans;
+}
+
+// Subscriber-side CAN streams are released by the gateway up to (upstream latency + residence)
+// after the event occurred: that is their jitter. True when a jitter changed.
+bool AdmissionSet::update_jitters(CanSide& side, const Trial* newcomer) const {
+  bool changed = false;
+  for (std::size_t s = 0; s < side.plans.size(); ++s) {
+    for (std::size_t pos = 0; pos < side.plans[s].size(); ++pos) {
+      const Member m = member(s, pos, newcomer);
+      if (m.role != HopRole::subscriber) continue;
+      std::optional<Nanos> upstream = Nanos(0);
+      for (const HopPlace& p : m.data->places) {
+        if (p.role != HopRole::publisher) continue;
+        const std::optional<Nanos> latency = segment_specs_[p.segment].type == SegmentType::can
+                                                 ? side.plans[p.segment][p.position].response_time
+                                                 : std::optional<Nanos>(segment_specs_[p.segment].latency_bound);
+        upstream = upstream && latency ? std::optional<Nanos>(std::max(*upstream, *latency)) : std::nullopt;
+      }
+      const Nanos jitter = upstream ? std::min(kUnboundedJitter, *upstream + gateway_.residence_bound) : kUnboundedJitter;
+      CanHopPlan& plan = side.plans[s][pos];
+      if (plan.jitter == jitter) continue;
+      plan.jitter = jitter;
+      changed = true;
+    }
+  }
+  return changed;
+}
+
+// Response times of every CAN bus with the holistic jitter iteration (from zero jitter to the
+// fixed point, as a whole-set analysis does). Each bus run reuses the committed run of the same
+// iteration for the streams whose higher-priority prefix did not change.
+AdmissionSet::CanSide AdmissionSet::analyse_can(const Trial* newcomer, bool replan) const {
+  CanSide side;
+  side.plans.resize(segments_.size());
+  side.runs.resize(segments_.size());
+  for (std::size_t s = 0; s < segments_.size(); ++s) {
+    if (segment_specs_[s].type != SegmentType::can) continue;
+    side.plans[s] = replan ? plan_bus(s, newcomer) : segments_[s].plans;
+    for (CanHopPlan& plan : side.plans[s]) plan.jitter = Nanos(0);
+    side.runs[s].reserve(kMaxJitterIterations);
+  }
+  for (int iteration = 0; iteration < kMaxJitterIterations; ++iteration) {
+    const auto it = static_cast<std::size_t>(iteration);
+    for (std::size_t s = 0; s < segments_.size(); ++s) {
+      if (side.plans[s].empty()) continue;
+      std::vector<CanStream> streams;
+      streams.reserve(side.plans[s].size());
+      for (std::size_t pos = 0; pos < side.plans[s].size(); ++pos) {
+        const CanHopPlan& plan = side.plans[s][pos];
+        streams.push_back(CanStream{plan.can_id, plan.transmission, stream_period(*member(s, pos, newcomer).spec, plan), plan.jitter});
+      }
+      const auto& committed = segments_[s].runs;
+      const CanBusAnalysis* memo = it < committed.size() ? &committed[it]
+                                   : it > 0             ? &side.runs[s][it - 1]
+                                   : committed.empty()  ? nullptr
+                                                        : &committed.back();
+      side.runs[s].emplace_back(streams, bus_timing(segment_specs_[s].can), memo);
+      const auto& results = side.runs[s].back().results();
+      for (std::size_t pos = 0; pos < results.size(); ++pos) side.plans[s][pos].response_time = results[pos];
+    }
+    if (!update_jitters(side, newcomer)) return side;
+  }
+  side.diverged = true;  // the jitters keep growing: the subscriber-side CAN hops are unbounded
+  return side;
+}
+
+void AdmissionSet::apply(CanSide side) {
+  for (std::size_t s = 0; s < segments_.size(); ++s) {
+    if (segment_specs_[s].type != SegmentType::can) continue;
+    segments_[s].plans = std::move(side.plans[s]);
+    segments_[s].runs = std::move(side.runs[s]);
+    segments_[s].pinned = false;
+  }
+  diverged_ = side.diverged;
+}
+
+ChannelReport AdmissionSet::report_of(const ChannelSpec& spec, const ChannelData& data, const Trial* change) const {
+  const CanSide* can = change && change->can ? &*change->can : nullptr;
+  const bool diverged = can ? can->diverged : diverged_;
+  ChannelReport report;
+  report.name = spec.name;
+  report.cls = spec.cls;
+  for (const HopPlace& p : data.places) {
+    const SegmentSpec& segment = segment_specs_[p.segment];
+    HopReport h{segment.name, p.role, std::nullopt, std::nullopt, {}};
+    if (segment.type == SegmentType::can) {
+      CanHopPlan plan = can ? can->plans[p.segment][p.position] : segments_[p.segment].plans[p.position];
+      if (diverged && p.role == HopRole::subscriber) plan.response_time = std::nullopt;
+      h.latency = plan.response_time;
+      h.can = plan;
+    } else {
+      h.latency = segment.latency_bound;
+    }
+    report.hops.push_back(std::move(h));
+  }
+  std::vector<double> loads(segments_.size());
+  for (std::size_t s = 0; s < segments_.size(); ++s) loads[s] = segments_[s].load;
+  if (change) {
+    for (const auto& [s, load] : change->loads) loads[s] = load;
+  }
+  Judge(gateway_, segment_specs_, loads).judge(spec, report);
+  return report;
+}
+
+AdmissionSet::Trial AdmissionSet::trial(const ChannelSpec& channel, std::uint16_t etag) const {
+  Trial t;
+  t.spec = channel;
+  t.data = place(channel, etag);
+  bool touches_can = false;
+  for (const HopPlace& p : t.data.places) {
+    touches_can = touches_can || segment_specs_[p.segment].type == SegmentType::can;
+    auto load = std::find_if(t.loads.begin(), t.loads.end(), [&](const auto& l) { return l.first == p.segment; });
+    if (load == t.loads.end()) load = t.loads.insert(t.loads.end(), {p.segment, segments_[p.segment].load});
+    load->second += hop_load(segment_specs_[p.segment], channel);
+  }
+  const bool pinned = std::any_of(segments_.begin(), segments_.end(), [](const auto& s) { return s.pinned; });
+  if (touches_can || pinned) t.can = analyse_can(&t, true);
+  t.report = report_of(t.spec, t.data, &t);
+  for (const std::size_t c : affected_by(t)) {
+    if (specs_[c].cls != ChannelClass::hrt) continue;
+    ChannelReport existing = report_of(specs_[c], data_[c], &t);
+    if (existing.verdict == Verdict::rejected) t.broken_hrt.push_back(std::move(existing));
+  }
+  return t;
+}
+
+// Bound channels whose report the trial can change: those on a segment it pushes over its
+// utilization limit and those with a CAN hop whose plan or bound it changes. Bind order.
+std::vector<std::size_t> AdmissionSet::affected_by(const Trial& t) const {
+  std::vector<bool> marked(specs_.size(), false);
+  for (const auto& [s, load] : t.loads) {
+    if (load <= segment_specs_[s].max_utilization + 1e-12) continue;
+    for (const HopRef& ref : segments_[s].hops) marked[ref.channel] = true;
+  }
+  if (t.can) {
+    for (std::size_t s = 0; s < segments_.size(); ++s) {
+      for (std::size_t pos = 0; pos < segments_[s].plans.size(); ++pos) {
+        const CanHopPlan& before = segments_[s].plans[pos];
+        const CanHopPlan& after = t.can->plans[s][pos];
+        const HopRef& ref = segments_[s].hops[pos];
+        const bool bound_changed = t.can->diverged != diverged_ && data_[ref.channel].places[ref.hop].role == HopRole::subscriber;
+        if (bound_changed || before.can_id != after.can_id || before.jitter != after.jitter ||
+            before.response_time != after.response_time) {
+          marked[ref.channel] = true;
+        }
+      }
+    }
+  }
+  std::vector<std::size_t> out;
+  for (std::size_t c = 0; c < marked.size(); ++c) {
+    if (marked[c]) out.push_back(c);
+  }
+  return out;
+}
+
+void AdmissionSet::commit(Trial t) {
+  for (const auto& [s, load] : t.loads) segments_[s].load = load;
+  if (t.can) apply(std::move(*t.can));
+  append(std::move(t.spec), std::move(t.data));
+}
+
+bool AdmissionSet::remove(const std::string& name) {
+  const auto found = index_.find(name);
+  if (found == index_.end()) return false;
+  const std::size_t gone = found->second;
+  std::vector<std::size_t> touched;
+  for (const HopPlace& p : data_[gone].places) {
+    if (std::find(touched.begin(), touched.end(), p.segment) == touched.end()) touched.push_back(p.segment);
+  }
+  for (const std::size_t s : touched) {
+    Segment& seg = segments_[s];
+    std::vector<HopRef> hops;
+    std::vector<CanHopPlan> plans;
+    for (std::size_t pos = 0; pos < seg.hops.size(); ++pos) {
+      if (seg.hops[pos].channel == gone) continue;
+      hops.push_back(seg.hops[pos]);
+      if (!seg.plans.empty()) plans.push_back(seg.plans[pos]);
+    }
+    seg.hops = std::move(hops);
+    seg.plans = std::move(plans);
+    seg.pinned = segment_specs_[s].type == SegmentType::can;
+  }
+  specs_.erase(specs_.begin() + static_cast<std::ptrdiff_t>(gone));
+  data_.erase(data_.begin() + static_cast<std::ptrdiff_t>(gone));
+  index_.erase(found);
+  for (auto& [n, i] : index_) {
+    if (i > gone) --i;
+  }
+  for (Segment& seg : segments_) {
+    for (HopRef& ref : seg.hops) {
+      if (ref.channel > gone) --ref.channel;
+    }
+  }
+  for (const std::size_t s : touched) {
+    segments_[s].load = 0.0;
+    for (std::size_t pos = 0; pos < segments_[s].hops.size(); ++pos) {
+      const HopRef& ref = segments_[s].hops[pos];
+      data_[ref.channel].places[ref.hop].position = pos;
+      segments_[s].load += hop_load(segment_specs_[s], specs_[ref.channel]);
+    }
+  }
+  const bool can = std::any_of(touched.begin(), touched.end(), [&](std::size_t s) { return segment_specs_[s].type == SegmentType::can; });
+  if (can) {
+    std::vector<bool> pinned;
+    for (const Segment& seg : segments_) pinned.push_back(seg.pinned);
+    apply(analyse_can(nullptr, false));
+    for (std::size_t s = 0; s < segments_.size(); ++s) segments_[s].pinned = pinned[s];
+  }
+  return true;
+}
+
+const ChannelSpec* AdmissionSet::find(const std::string& name) const {
+  const auto it = index_.find(name);
+  return it == index_.end() ? nullptr : &specs_[it->second];
+}
+
+std::vector<ChannelReport> AdmissionSet::reports() const {
+  std::vector<ChannelReport> out;
+  out.reserve(specs_.size());
+  for (std::size_t c = 0; c < specs_.size(); ++c) out.push_back(report_of(specs_[c], data_[c], nullptr));
+  return out;
+}
+
+std::vector<SegmentLoad> AdmissionSet::loads() const {
+  std::vector<SegmentLoad> out;
+  for (std::size_t s = 0; s < segments_.size(); ++s) {
+    const SegmentSpec& spec = segment_specs_[s];
+    out.push_back(SegmentLoad{spec.name, spec.type, segments_[s].load, spec.max_utilization});
+  }
+  return out;
 }
 
 }  // namespace cosmic

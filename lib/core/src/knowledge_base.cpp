@@ -16,16 +16,11 @@ const char* to_string(SegmentHealth value) {
 }
 
 KnowledgeBase::KnowledgeBase(GatewaySpec gateway, std::vector<SegmentSpec> segments, std::set<std::uint16_t> reserved_etags)
-    : gateway_(std::move(gateway)), reserved_etags_(std::move(reserved_etags)) {
+    : set_(std::move(gateway), segments), reserved_etags_(std::move(reserved_etags)) {
   for (auto& spec : segments) segments_.push_back(SegmentState{std::move(spec), SegmentHealth::up, {}});
-  current_ = evaluate(gateway_, segment_specs(), bound_, etags_);
-}
-
-std::vector<SegmentSpec> KnowledgeBase::segment_specs() const {
-  std::vector<SegmentSpec> specs;
-  specs.reserve(segments_.size());
-  for (const auto& state : segments_) specs.push_back(state.spec);
-  return specs;
+  for (const std::uint16_t etag : reserved_etags_) {
+    if (etag <= kMaxEtag) etag_taken_.set(etag);
+  }
 }
 
 bool KnowledgeBase::touches_can(const ChannelSpec& channel) const {
@@ -37,11 +32,10 @@ bool KnowledgeBase::touches_can(const ChannelSpec& channel) const {
          std::any_of(channel.subscribers.begin(), channel.subscribers.end(), is_can);
 }
 
-std::optional<std::uint16_t> KnowledgeBase::allocate_etag(const EtagMap& in_use) const {
+// The highest etag neither reserved nor bound.
+std::optional<std::uint16_t> KnowledgeBase::allocate_etag() const {
   for (std::uint16_t etag = kMaxEtag; etag > kHighestReservedEtag; --etag) {
-    if (reserved_etags_.count(etag)) continue;
-    const bool taken = std::any_of(in_use.begin(), in_use.end(), [&](const auto& e) { return e.second == etag; });
-    if (!taken) return etag;
+    if (!etag_taken_.test(etag)) return etag;
   }
   return std::nullopt;
 }
@@ -55,70 +49,74 @@ ChannelReport rejection(const ChannelSpec& channel, std::string reason) {
   report.reasons.push_back(std::move(reason));
   return report;
 }
+
+std::optional<std::string> static_etag_owner(const EtagMap& etags, std::uint16_t etag) {
+  for (const auto& [name, e] : etags) {
+    if (e == etag) return name;
+  }
+  return std::nullopt;
+}
 }  // namespace
 
-KnowledgeBase::Trial KnowledgeBase::trial(const ChannelSpec& channel) const {
-  Trial t;
-  t.etags = etags_;
-  t.channels = bound_;
+KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel) const {
+  Attempt a;
   if (find_bound(channel.name)) {
-    t.report = rejection(channel, "channel " + channel.name + " is already bound");
-    return t;
+    a.report = rejection(channel, "channel " + channel.name + " is already bound");
+    return a;
   }
-  for (const auto& other : bound_) {
-    if (other.subject == channel.subject) {
-      t.report = rejection(channel, "subject already carried by bound channel " + other.name);
-      return t;
-    }
+  if (const auto other = subjects_.find(channel.subject); other != subjects_.end()) {
+    a.report = rejection(channel, "subject already carried by bound channel " + other->second);
+    return a;
   }
   if (touches_can(channel)) {
     if (channel.etag) {
-      for (const auto& [name, etag] : etags_) {
-        if (etag == *channel.etag) {
-          t.report = rejection(channel, "etag " + std::to_string(etag) + " is already used by channel " + name);
-          return t;
-        }
+      if (const auto owner = static_etag_owner(etags_, *channel.etag)) {
+        a.report = rejection(channel, "etag " + std::to_string(*channel.etag) + " is already used by channel " + *owner);
+        return a;
       }
-      t.etags[channel.name] = *channel.etag;
-    } else if (const auto etag = allocate_etag(etags_)) {
-      t.etags[channel.name] = *etag;
+      a.etag = *channel.etag;
+    } else if (const auto etag = allocate_etag()) {
+      a.etag = *etag;
     } else {
-      t.report = rejection(channel, "no free etag left (101..16383 all in use)");
-      return t;
+      a.report = rejection(channel, "no free etag left (101..16383 all in use)");
+      return a;
     }
   }
-  t.channels.push_back(channel);
-  t.evaluation = evaluate(gateway_, segment_specs(), t.channels, t.etags);
-  t.report = t.evaluation.channels.back();
-  for (std::size_t i = 0; i + 1 < t.channels.size(); ++i) {
-    const ChannelReport& existing = t.evaluation.channels[i];
-    if (existing.cls != ChannelClass::hrt || existing.verdict != Verdict::rejected) continue;
-    t.report.verdict = Verdict::rejected;
+  a.trial = set_.trial(channel, a.etag.value_or(0));
+  a.report = a.trial->report;
+  for (const ChannelReport& existing : a.trial->broken_hrt) {
+    a.report.verdict = Verdict::rejected;
     for (const auto& reason : existing.reasons) {
-      t.report.reasons.push_back("would break hrt channel " + existing.name + ": " + reason);
+      a.report.reasons.push_back("would break hrt channel " + existing.name + ": " + reason);
     }
   }
-  return t;
+  return a;
 }
 
 BindOutcome KnowledgeBase::bind(const ChannelSpec& channel) {
-  Trial t = trial(channel);
-  if (t.report.verdict != Verdict::rejected) {
-    bound_ = std::move(t.channels);
-    etags_ = std::move(t.etags);
-    current_ = std::move(t.evaluation);
+  Attempt a = attempt(channel);
+  if (a.report.verdict != Verdict::rejected) {
+    if (a.etag) {
+      etags_[channel.name] = *a.etag;
+      etag_taken_.set(*a.etag);
+    }
+    subjects_[channel.subject] = channel.name;
+    set_.commit(std::move(*a.trial));
   }
-  return BindOutcome{std::move(t.report)};
+  return BindOutcome{std::move(a.report)};
 }
 
-ChannelReport KnowledgeBase::probe(const ChannelSpec& channel) const { return trial(channel).report; }
+ChannelReport KnowledgeBase::probe(const ChannelSpec& channel) const { return attempt(channel).report; }
 
 bool KnowledgeBase::unbind(const std::string& name) {
-  const auto it = std::find_if(bound_.begin(), bound_.end(), [&](const auto& c) { return c.name == name; });
-  if (it == bound_.end()) return false;
-  bound_.erase(it);
-  etags_.erase(name);
-  current_ = evaluate(gateway_, segment_specs(), bound_, etags_);
+  const ChannelSpec* spec = set_.find(name);
+  if (!spec) return false;
+  subjects_.erase(spec->subject);
+  if (const auto etag = etags_.find(name); etag != etags_.end()) {
+    if (!reserved_etags_.count(etag->second)) etag_taken_.reset(etag->second);
+    etags_.erase(etag);
+  }
+  set_.remove(name);
   return true;
 }
 
@@ -132,8 +130,8 @@ void KnowledgeBase::set_health(const std::string& segment, SegmentHealth health,
 
 AdmissionReport KnowledgeBase::report() const {
   AdmissionReport out;
-  out.segments = current_.segments;
-  out.channels = current_.channels;
+  out.segments = set_.loads();
+  out.channels = set_.reports();
   for (auto& channel : out.channels) {
     for (const auto& hop : channel.hops) {
       const auto state = std::find_if(segments_.begin(), segments_.end(), [&](const auto& s) { return s.spec.name == hop.segment; });
@@ -146,10 +144,7 @@ AdmissionReport KnowledgeBase::report() const {
   return out;
 }
 
-const ChannelSpec* KnowledgeBase::find_bound(const std::string& name) const {
-  const auto it = std::find_if(bound_.begin(), bound_.end(), [&](const auto& c) { return c.name == name; });
-  return it == bound_.end() ? nullptr : &*it;
-}
+const ChannelSpec* KnowledgeBase::find_bound(const std::string& name) const { return set_.find(name); }
 
 std::optional<std::uint16_t> KnowledgeBase::etag_of(const std::string& channel) const {
   const auto it = etags_.find(channel);

@@ -3,17 +3,21 @@
 // evaluate() analyses one set of channels as if all of them were bound together: CAN priorities
 // (class band, deadline-monotonic inside it), frame times, worst-case response times with a
 // holistic jitter iteration across gateway hops, bandwidth, latency budget, validity, omission
-// and real-time capability. The incremental policy (a newcomer never breaks an admitted HRT
-// channel) lives in KnowledgeBase, which calls evaluate() for each tentative set.
+// and real-time capability. AdmissionSet keeps that analysis between binds and gives, for a
+// newcomer, exactly what evaluate() would give for the whole set while re-examining only what the
+// newcomer can change. The policy (a newcomer never breaks an admitted HRT channel) lives in
+// KnowledgeBase.
 #pragma once
 
 #include <cstdint>
 #include <map>
+#include <unordered_map>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "cosmic/can_timing.hpp"
 #include "cosmic/model.hpp"
 
 namespace cosmic {
@@ -102,5 +106,109 @@ struct Evaluation {
 // segments (the configuration layer guarantees it).
 Evaluation evaluate(const GatewaySpec& gateway, std::span<const SegmentSpec> segments,
                     std::span<const ChannelSpec> channels, const EtagMap& etags);
+
+// A bound set with its analysis kept between binds.
+//
+// trial() analyses a newcomer on top of the set and answers exactly what evaluate() answers for
+// the whole set plus the newcomer, at the cost of what the newcomer can change:
+// - a channel on IP segments only: its own hops and the load of its segments, O(hops);
+// - a channel on a CAN bus: that bus's priorities (O(n log n)), the response times of the streams
+//   of equal or lower priority (higher ones only if its frame lengthens their blocking, and the
+//   whole band when more channels than priority levels re-spread it), and, through the holistic
+//   jitter iteration, the CAN hops downstream of the changed ones. IP-only channels are not
+//   visited.
+// remove() keeps every remaining CAN hop's priority and identifier (see remove()).
+//
+// Copy: O(channels + hops): the specs (strings), each hop's place, each CAN hop's plan and the
+// last analysis of each CAN bus; no shared state, so a copy can be analysed on another thread.
+// Not thread-safe: one owner at a time.
+class AdmissionSet {
+ public:
+  AdmissionSet(GatewaySpec gateway, std::vector<SegmentSpec> segments);
+  // The set of `channels` bound together (etags by channel name, 0 when absent), analysed as a
+  // whole: what evaluate() reports.
+  static AdmissionSet whole(GatewaySpec gateway, std::vector<SegmentSpec> segments,
+                            std::span<const ChannelSpec> channels, const EtagMap& etags);
+
+ private:
+  struct HopPlace {
+    std::size_t segment;
+    std::size_t position;  // index in that segment's hop list
+    HopRole role;
+  };
+  struct ChannelData {
+    std::uint16_t etag = 0;
+    std::vector<HopPlace> places;  // publishers then subscribers, as in the spec
+  };
+  struct HopRef {
+    std::size_t channel;
+    std::size_t hop;
+  };
+  struct Segment {
+    std::vector<HopRef> hops;  // bind order
+    double load = 0.0;
+    std::vector<CanHopPlan> plans;     // CAN: one per hop, same order
+    std::vector<CanBusAnalysis> runs;  // CAN: one per jitter iteration of the last analysis
+    bool pinned = false;  // CAN: priorities kept over a removal, not those a fresh plan gives
+  };
+  struct CanSide {
+    std::vector<std::vector<CanHopPlan>> plans;  // by segment
+    std::vector<std::vector<CanBusAnalysis>> runs;
+    bool diverged = false;  // no jitter fixed point: subscriber-side CAN hops unbounded
+  };
+
+ public:
+  // A newcomer analysed on top of the set; commit() binds it as analysed.
+  struct Trial {
+    ChannelReport report;                  // the newcomer in the new set
+    std::vector<ChannelReport> broken_hrt;  // bound HRT channels the newcomer would reject, bind order
+   private:
+    friend class AdmissionSet;
+    ChannelSpec spec;
+    ChannelData data;
+    std::vector<std::pair<std::size_t, double>> loads;  // touched segments
+    std::optional<CanSide> can;                          // nullopt: the CAN side is unchanged
+  };
+  Trial trial(const ChannelSpec& channel, std::uint16_t etag) const;
+  void commit(Trial trial);
+
+  // Removes a bound channel. Every remaining CAN hop keeps its priority and identifier: with
+  // more channels than priority levels in a band, re-spreading the band could put a channel
+  // level with one that wins arbitration over it and break an admitted HRT guarantee. With
+  // priorities kept, every remaining response time, load and latency can only shrink. The next
+  // bind re-plans the bus (and re-checks every admitted HRT channel). False when not bound.
+  bool remove(const std::string& name);
+
+  const std::vector<ChannelSpec>& channels() const { return specs_; }
+  const ChannelSpec* find(const std::string& name) const;
+  std::vector<ChannelReport> reports() const;  // bind order
+  std::vector<SegmentLoad> loads() const;      // segment order
+  const std::vector<SegmentSpec>& segment_specs() const { return segment_specs_; }
+  const GatewaySpec& gateway() const { return gateway_; }
+
+ private:
+  ChannelData place(const ChannelSpec& channel, std::uint16_t etag) const;
+  void append(ChannelSpec spec, ChannelData data);
+  std::vector<CanHopPlan> plan_bus(std::size_t segment, const Trial* newcomer) const;
+  CanSide analyse_can(const Trial* newcomer, bool replan) const;
+  ChannelReport report_of(const ChannelSpec& spec, const ChannelData& data, const Trial* change) const;
+  std::vector<std::size_t> affected_by(const Trial& t) const;
+  struct Member {
+    const ChannelSpec* spec;
+    const ChannelData* data;
+    HopRole role;
+  };
+  Member member(std::size_t segment, std::size_t position, const Trial* newcomer) const;
+  bool update_jitters(CanSide& side, const Trial* newcomer) const;
+  void apply(CanSide side);
+
+  GatewaySpec gateway_;
+  std::vector<SegmentSpec> segment_specs_;
+  std::vector<Segment> segments_;
+  std::vector<ChannelSpec> specs_;  // bind order
+  std::vector<ChannelData> data_;   // same order
+  std::unordered_map<std::string, std::size_t> index_;
+  bool diverged_ = false;
+};
 
 }  // namespace cosmic

@@ -3,16 +3,27 @@
 // if the whole set stays acceptable; a newcomer never breaks an admitted HRT channel, and a
 // rejected channel changes nothing.
 //
-// Not thread-safe: one owner (the daemon's control thread, or cosmicctl check) calls it.
+// Binding costs what the newcomer can change (see AdmissionSet): an IP-only channel O(hops + log n),
+// a CAN channel the re-analysis of its bus from its priority down. Unbinding keeps every remaining
+// CAN channel's priority (see AdmissionSet::remove) and costs O(bound channels).
+//
+// Not thread-safe: one owner (the daemon's control thread, or cosmicctl check) calls it. A copy is
+// independent of the original (plain values, no sharing) and costs O(bound channels + hops): the
+// specs with their strings, per-hop places and CAN plans, the last run of each CAN bus, and the
+// etag and subject indexes. Measured in tests/bench/admission_bench.cpp (README "Admission at
+// scale"): a few milliseconds for 11,000 channels.
 #pragma once
 
 #include <cstdint>
 #include <optional>
+#include <bitset>
 #include <set>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "cosmic/admission.hpp"
+#include "cosmic/can_wire.hpp"
 #include "cosmic/model.hpp"
 
 namespace cosmic {
@@ -49,30 +60,28 @@ class KnowledgeBase {
   // Verdicts of the bound set (live health applied) and the load of every segment.
   AdmissionReport report() const;
 
-  const GatewaySpec& gateway() const { return gateway_; }
+  const GatewaySpec& gateway() const { return set_.gateway(); }
   const std::vector<SegmentState>& segments() const { return segments_; }
-  const std::vector<ChannelSpec>& bound_channels() const { return bound_; }
+  const std::vector<ChannelSpec>& bound_channels() const { return set_.channels(); }
   const ChannelSpec* find_bound(const std::string& name) const;
   std::optional<std::uint16_t> etag_of(const std::string& channel) const;
 
  private:
-  struct Trial {
-    Evaluation evaluation;
-    ChannelReport report;  // the newcomer's report, including "would break" reasons
-    EtagMap etags;
-    std::vector<ChannelSpec> channels;
+  struct Attempt {
+    std::optional<AdmissionSet::Trial> trial;  // nullopt: refused before any analysis
+    ChannelReport report;                      // the newcomer's report, including "would break" reasons
+    std::optional<std::uint16_t> etag;         // CAN channels: the etag it would take
   };
-  Trial trial(const ChannelSpec& channel) const;
-  std::optional<std::uint16_t> allocate_etag(const EtagMap& in_use) const;
-  std::vector<SegmentSpec> segment_specs() const;
+  Attempt attempt(const ChannelSpec& channel) const;
+  std::optional<std::uint16_t> allocate_etag() const;
   bool touches_can(const ChannelSpec& channel) const;
 
-  GatewaySpec gateway_;
   std::vector<SegmentState> segments_;
+  AdmissionSet set_;
   std::set<std::uint16_t> reserved_etags_;
-  std::vector<ChannelSpec> bound_;
-  EtagMap etags_;
-  Evaluation current_;
+  EtagMap etags_;                                         // bound CAN channels
+  std::bitset<kMaxEtag + 1> etag_taken_;                  // reserved or bound: never handed out
+  std::unordered_map<std::uint64_t, std::string> subjects_;  // subject -> bound channel
 };
 
 // Binds every channel of `config` in order and reports the final set; each rejected channel is
