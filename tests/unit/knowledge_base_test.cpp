@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
+
 #include "cosmic/can_wire.hpp"
 #include "cosmic/report.hpp"
 #include "test_support.hpp"
@@ -121,6 +123,49 @@ TEST(KnowledgeBase, UnbindFreesEtagAndLoad) {
   // The logger that would have broken brake now fits.
   EXPECT_TRUE(kb.bind(logger()).bound());
   EXPECT_EQ(kb.etag_of("logger"), 16381);
+}
+
+// Twenty HRT channels share the 16 HRT priority levels of a 125 kbit/s bus (frame C = 1.28 ms,
+// periods 1 s, so R = (frames ahead + 2) * C with one blocking frame). Levels are spread as
+// rank * 16 / count; channels on one level are ordered by etag, and etags go downward in bind
+// order. Bound in the order below, x (rank 6) shares its level with r5 and wins (bound later):
+// 5 frames ahead, R = 8.96 ms, e2e 9.16 ms <= 11 ms. Unbinding the last channel (r19) would
+// re-spread 19 channels so that x shares a level with y, bound after it, which then wins: 7 frames
+// ahead, R = 11.52 ms, e2e 11.72 ms > 11 ms. Unbinding must keep every priority instead.
+TEST(KnowledgeBase, UnbindKeepsPrioritiesOfBoundChannels) {
+  KnowledgeBase kb = slow_bus_kb();
+  auto hrt = [](const std::string& name, std::uint64_t subject, Nanos reaction) {
+    return channel(name, subject, ChannelClass::hrt, {"can"}, {"lan"}, 8, Nanos(1s), reaction);
+  };
+  std::vector<ChannelSpec> order;
+  for (std::uint64_t r = 1; r <= 4; ++r) order.push_back(hrt("r" + std::to_string(r), r + 1, Nanos(9500us)));
+  order.push_back(hrt("r5", 6, Nanos(11ms)));
+  order.push_back(hrt("x", 7, Nanos(11ms)));
+  order.push_back(hrt("y", 8, Nanos(30ms)));
+  for (std::uint64_t r = 8; r <= 19; ++r) order.push_back(hrt("r" + std::to_string(r), r + 1, Nanos(30ms)));
+  order.push_back(hrt("r0", 1, Nanos(9500us)));
+  for (const auto& c : order) ASSERT_TRUE(kb.bind(c).bound()) << c.name << ": " << reasons_text(kb.probe(c));
+  std::map<std::string, std::uint32_t> ids;
+  for (const auto& r : kb.report().channels) ids[r.name] = find_hop(r, "can")->can->can_id;
+  EXPECT_EQ(find_hop(*kb.report().find("x"), "can")->can->response_time, Nanos(8960us));
+
+  ASSERT_TRUE(kb.unbind("r19"));
+  const AdmissionReport after = kb.report();
+  for (const auto& r : after.channels) {
+    EXPECT_EQ(find_hop(r, "can")->can->can_id, ids[r.name]) << r.name;
+    EXPECT_NE(r.verdict, Verdict::rejected) << r.name << ": " << reasons_text(r);
+  }
+  EXPECT_EQ(find_hop(*after.find("x"), "can")->can->response_time, Nanos(8960us));
+
+  // A bind elsewhere leaves the bus as it is; the next bind onto the bus plans it afresh, and the
+  // fresh plan would break x, so that bind is refused and nothing changes.
+  ASSERT_TRUE(kb.bind(channel("ip", 100, ChannelClass::nrt, {"lan"}, {"lan"}, 8, Nanos(1s))).bound());
+  EXPECT_EQ(find_hop(*kb.report().find("x"), "can")->can->can_id, ids["x"]);
+  const BindOutcome late = kb.bind(small("late", 101));
+  EXPECT_FALSE(late.bound());
+  EXPECT_TRUE(has_reason(late.report, "would break hrt channel x: R = 11.5 ms > reaction_time 11 ms on can"))
+      << reasons_text(late.report);
+  EXPECT_EQ(find_hop(*kb.report().find("x"), "can")->can->can_id, ids["x"]);
 }
 
 TEST(KnowledgeBase, StaticEtags) {

@@ -337,15 +337,19 @@ bool AdmissionSet::update_jitters(CanSide& side, const Trial* newcomer) const {
 }
 
 // Response times of every CAN bus with the holistic jitter iteration (from zero jitter to the
-// fixed point, as a whole-set analysis does). Each bus run reuses the committed run of the same
+// fixed point, as a whole-set analysis does). Buses the newcomer joins (all with replan_all) get
+// fresh priorities; the others keep theirs, which are fresh unless a removal pinned them. Each bus run reuses the committed run of the same
 // iteration for the streams whose higher-priority prefix did not change.
-AdmissionSet::CanSide AdmissionSet::analyse_can(const Trial* newcomer, bool replan) const {
+AdmissionSet::CanSide AdmissionSet::analyse_can(const Trial* newcomer, bool replan_all) const {
   CanSide side;
+  side.replanned.assign(segments_.size(), false);
   side.plans.resize(segments_.size());
   side.runs.resize(segments_.size());
   for (std::size_t s = 0; s < segments_.size(); ++s) {
     if (segment_specs_[s].type != SegmentType::can) continue;
-    side.plans[s] = replan ? plan_bus(s, newcomer) : segments_[s].plans;
+    side.replanned[s] = replan_all || (newcomer && std::any_of(newcomer->data.places.begin(), newcomer->data.places.end(),
+                                                                [&](const HopPlace& p) { return p.segment == s; }));
+    side.plans[s] = side.replanned[s] ? plan_bus(s, newcomer) : segments_[s].plans;
     for (CanHopPlan& plan : side.plans[s]) plan.jitter = Nanos(0);
     side.runs[s].reserve(kMaxJitterIterations);
   }
@@ -379,7 +383,7 @@ void AdmissionSet::apply(CanSide side) {
     if (segment_specs_[s].type != SegmentType::can) continue;
     segments_[s].plans = std::move(side.plans[s]);
     segments_[s].runs = std::move(side.runs[s]);
-    segments_[s].pinned = false;
+    if (side.replanned[s]) segments_[s].pinned = false;
   }
   diverged_ = side.diverged;
 }
@@ -423,8 +427,7 @@ AdmissionSet::Trial AdmissionSet::trial(const ChannelSpec& channel, std::uint16_
     if (load == t.loads.end()) load = t.loads.insert(t.loads.end(), {p.segment, segments_[p.segment].load});
     load->second += hop_load(segment_specs_[p.segment], channel);
   }
-  const bool pinned = std::any_of(segments_.begin(), segments_.end(), [](const auto& s) { return s.pinned; });
-  if (touches_can || pinned) t.can = analyse_can(&t, true);
+  if (touches_can) t.can = analyse_can(&t, false);
   t.report = report_of(t.spec, t.data, &t);
   for (const std::size_t c : affected_by(t)) {
     if (specs_[c].cls != ChannelClass::hrt) continue;
@@ -510,12 +513,7 @@ bool AdmissionSet::remove(const std::string& name) {
     }
   }
   const bool can = std::any_of(touched.begin(), touched.end(), [&](std::size_t s) { return segment_specs_[s].type == SegmentType::can; });
-  if (can) {
-    std::vector<bool> pinned;
-    for (const Segment& seg : segments_) pinned.push_back(seg.pinned);
-    apply(analyse_can(nullptr, false));
-    for (std::size_t s = 0; s < segments_.size(); ++s) segments_[s].pinned = pinned[s];
-  }
+  if (can) apply(analyse_can(nullptr, false));
   return true;
 }
 

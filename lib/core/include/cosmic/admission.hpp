@@ -117,7 +117,8 @@ Evaluation evaluate(const GatewaySpec& gateway, std::span<const SegmentSpec> seg
 //   whole band when more channels than priority levels re-spread it), and, through the holistic
 //   jitter iteration, the CAN hops downstream of the changed ones. IP-only channels are not
 //   visited.
-// remove() keeps every remaining CAN hop's priority and identifier (see remove()).
+// remove() keeps every remaining CAN hop's priority and identifier (see remove()); while no
+// removal happened, every result equals evaluate()'s.
 //
 // Copy: O(channels + hops): the specs (strings), each hop's place, each CAN hop's plan and the
 // last analysis of each CAN bus; no shared state, so a copy can be analysed on another thread.
@@ -152,6 +153,7 @@ class AdmissionSet {
     bool pinned = false;  // CAN: priorities kept over a removal, not those a fresh plan gives
   };
   struct CanSide {
+    std::vector<bool> replanned;                 // by segment: priorities planned afresh
     std::vector<std::vector<CanHopPlan>> plans;  // by segment
     std::vector<std::vector<CanBusAnalysis>> runs;
     bool diverged = false;  // no jitter fixed point: subscriber-side CAN hops unbounded
@@ -176,7 +178,9 @@ class AdmissionSet {
   // more channels than priority levels in a band, re-spreading the band could put a channel
   // level with one that wins arbitration over it and break an admitted HRT guarantee. With
   // priorities kept, every remaining response time, load and latency can only shrink. The next
-  // bind re-plans the bus (and re-checks every admitted HRT channel). False when not bound.
+  // bind onto that bus plans it afresh and re-checks every admitted HRT channel (so it may be
+  // refused as "would break"); binds elsewhere leave it as it is. Until then the set differs from
+  // what evaluate() gives for the same channels, by design. False when not bound.
   bool remove(const std::string& name);
 
   const std::vector<ChannelSpec>& channels() const { return specs_; }
@@ -190,7 +194,7 @@ class AdmissionSet {
   ChannelData place(const ChannelSpec& channel, std::uint16_t etag) const;
   void append(ChannelSpec spec, ChannelData data);
   std::vector<CanHopPlan> plan_bus(std::size_t segment, const Trial* newcomer) const;
-  CanSide analyse_can(const Trial* newcomer, bool replan) const;
+  CanSide analyse_can(const Trial* newcomer, bool replan_all) const;
   ChannelReport report_of(const ChannelSpec& spec, const ChannelData& data, const Trial* change) const;
   std::vector<std::size_t> affected_by(const Trial& t) const;
   struct Member {
