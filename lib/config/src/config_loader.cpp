@@ -237,7 +237,7 @@ class ConfigParser {
       if (auto v = reader_.name(node["name"], key(path, "name"))) s.name = *v;
     }
     if (!type) {
-      reader_.check_map(node, path, {"name", "type", "interface", "bitrate", "fd", "data_bitrate", "errors", "max_utilization",
+      reader_.check_map(node, path, {"name", "type", "interface", "profile", "bitrate", "fd", "data_bitrate", "errors", "max_utilization",
                                      "domain", "latency_bound", "bandwidth", "reliability", "realtime", "max_message_size",
                                      "interfaces", "discovery_server", "url"});
       return std::nullopt;
@@ -256,7 +256,7 @@ class ConfigParser {
   }
 
   void parse_can(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
-    reader_.check_map(node, path, {"name", "type", "interface", "bitrate", "fd", "data_bitrate", "errors", "max_utilization"});
+    reader_.check_map(node, path, {"name", "type", "interface", "profile", "bitrate", "fd", "data_bitrate", "errors", "max_utilization"});
     CanSegmentProperties& can = s.can;
     if (require(node, path, "interface", "a network interface such as can0")) {
       if (auto v = reader_.string(node["interface"], key(path, "interface"))) {
@@ -268,6 +268,13 @@ class ConfigParser {
       }
     }
     if (has(node, "fd")) can.fd = reader_.boolean(node["fd"], key(path, "fd")).value_or(false);
+    if (has(node, "profile")) {
+      const std::string p = key(path, "profile");
+      if (auto v = reader_.choice(node["profile"], p, {"cosmic", "famouso"})) can.profile = static_cast<CanProfile>(*v);
+      if (can.profile == CanProfile::famouso && can.fd) {
+        reader_.error_at(node["profile"], p, "profile famouso is classic CAN only", "fd: false, or profile: cosmic");
+      }
+    }
     if (require(node, path, "bitrate", "the nominal bit rate, e.g. 500kbit/s")) {
       if (auto v = reader_.bitrate(node["bitrate"], key(path, "bitrate"))) {
         if (v->bits_per_second > kClassicCanMaxBitrate) {

@@ -37,6 +37,10 @@ std::uint32_t supply_etag_id(std::uint8_t gateway_node) {
   return encode_can_id(CanIdentifier{kPriority, gateway_node, kEtagSupplyEtag});
 }
 
+std::uint32_t supply_etag_new_bp_id() {
+  return encode_famouso_id(FamousoIdentifier{kFamousoProtocolPriority, false, kFamousoBrokerNode, kEtagSupplyEtagNewBp});
+}
+
 std::optional<SupplyEtag> decode_supply_etag(std::span<const std::uint8_t> data) {
   if (data.size() != kFrameBytes || data[1] > 1) return std::nullopt;
   SupplyEtag s;

@@ -32,6 +32,11 @@ std::array<std::array<std::uint8_t, kFrameBytes>, 2> supply_etag_data(std::uint8
 // Identifier of the answer frames sent by the gateway with TxNode `gateway_node`.
 std::uint32_t supply_etag_id(std::uint8_t gateway_node);
 
+// FAMOUSO profile: the same two frames on etag 4 (SUPPLY_ETAG_NEW_BP), sent the way FAMOUSO's
+// broker sends them (TxNode 0x7F, priority 0x7D in the 7-bit layout). FAMOUSO's client ignores
+// byte 0 and takes the etag from frame 1 once both subject halves matched its request.
+std::uint32_t supply_etag_new_bp_id();
+
 struct SupplyEtag {
   std::uint8_t requester = 0;
   std::uint8_t part = 0;  // 0: subject bytes 0-3, 1: bytes 4-7

@@ -39,6 +39,41 @@ PriorityBand band_of(ChannelClass cls);
 // one level each while the band has room, otherwise ranks are spread evenly over the band.
 std::uint8_t band_priority(ChannelClass cls, std::size_t rank, std::size_t count);
 
+// --- FAMOUSO profile (docs/can-wire-format.md, "FAMOUSO profile"): FAMOUSO's little-endian PC
+// layout, priority (7 bits, 28..22) | fragment flag (21) | TxNode (20..14) | etag (13..0).
+// TxNode and etag sit where they sit in our layout, so decode_can_id() reads them for both.
+struct FamousoIdentifier {
+  std::uint8_t priority = 0;  // 7 bits
+  bool fragment = false;      // the frame carries an AFP fragment
+  std::uint8_t tx_node = 0;   // 7 bits
+  std::uint16_t etag = 0;     // 14 bits
+  friend bool operator==(const FamousoIdentifier&, const FamousoIdentifier&) = default;
+};
+std::uint32_t encode_famouso_id(const FamousoIdentifier& id);
+FamousoIdentifier decode_famouso_id(std::uint32_t can_id);
+
+// Class bands in 7 bits. HRT keeps all 16 levels of our band; SRT gets 0x10-0x77 (104 levels);
+// NRT 0x78-0x7F holds FAMOUSO's own level (its nodes send everything with prio(0xFD) = 0x7D).
+inline constexpr PriorityBand kFamousoHrtBand{0x00, 0x0F};
+inline constexpr PriorityBand kFamousoSrtBand{0x10, 0x77};
+inline constexpr PriorityBand kFamousoNrtBand{0x78, 0x7F};
+inline constexpr std::uint8_t kFamousoProtocolPriority = 0x7D;  // FAMOUSO's prio(0xFD) in 7 bits
+inline constexpr std::uint8_t kFamousoBrokerNode = 0x7F;        // TxNode of FAMOUSO's brokers
+
+// Admission's 8-bit priority (band_priority) in 7 bits: order-preserving, the class stays in its
+// band, and distinct levels stay distinct while a band has room (HRT 16, SRT 104, NRT 8 channels).
+std::uint8_t famouso_priority(std::uint8_t priority);
+// Admission's identifier (our layout) as the gateway sends it on a FAMOUSO segment.
+std::uint32_t famouso_id_of(std::uint32_t cosmic_can_id, bool fragment);
+
+inline constexpr std::uint16_t kEtagCcpSsi = 0;           // CCP: broker -> node
+inline constexpr std::uint16_t kEtagCcpRsi = 1;           // CCP: node -> broker
+inline constexpr std::uint16_t kEtagSupplyEtagNewBp = 4;  // FAMOUSO's binding answers
+// Where a FAMOUSO segment's "SUBSCRIBE" subject lives: a protocol etag (5..100), so it never takes
+// an etag admission hands out.
+inline constexpr std::uint16_t kEtagFamousoSubscribe = 5;
+inline constexpr std::uint64_t kFamousoSubscribeSubject = 0x5355425343524942ull;  // "SUBSCRIB"
+
 // NRT events larger than one frame travel as fragments, each starting with a 2-byte header.
 inline constexpr std::uint32_t kFragmentHeaderBytes = 2;
 inline constexpr std::uint32_t kMaxFragments = 2048;

@@ -30,8 +30,13 @@ struct CanFaultHypothesis {
   friend bool operator==(const CanFaultHypothesis&, const CanFaultHypothesis&) = default;
 };
 
+// Wire profile of a CAN segment (docs/can-wire-format.md): this project's layout, or FAMOUSO's
+// (7-bit priority, fragment flag, CCP node ids, etag-4 binding answers, AFP fragments).
+enum class CanProfile { cosmic, famouso };
+
 struct CanSegmentProperties {
   std::string interface;
+  CanProfile profile = CanProfile::cosmic;
   BitRate bitrate{500'000};
   bool fd = false;
   BitRate data_bitrate{0};  // FD data phase; equals bitrate when not FD or not given
