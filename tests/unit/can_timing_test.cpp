@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <optional>
+#include <vector>
 
 #include "cosmic/can_wire.hpp"
 
@@ -262,6 +264,50 @@ TEST(ResponseTime, JitterOfOwnAndHigherStreams) {
   EXPECT_EQ(response_times(hp, timing_with_bit(Nanos(1us)))[1], Nanos(3ms));
   const std::array<CanStream, 2> no_jitter{{{1, Nanos(1ms), Nanos(5ms), Nanos(0)}, {2, Nanos(1ms), Nanos(100ms), Nanos(0)}}};
   EXPECT_EQ(response_times(no_jitter, timing_with_bit(Nanos(1us)))[1], Nanos(2ms));
+}
+
+// ---------------------------------------------------------------- incremental analysis
+
+// Fifty 100 us frames with identifiers 10, 20, ..., 500, every 100 ms, plus one newcomer.
+std::vector<CanStream> fifty_and(std::optional<CanStream> newcomer) {
+  std::vector<CanStream> streams;
+  for (std::uint32_t id = 10; id <= 500; id += 10) streams.push_back(CanStream{id, Nanos(100us), Nanos(100ms), Nanos(0)});
+  if (newcomer) streams.push_back(*newcomer);
+  return streams;
+}
+
+TEST(IncrementalResponseTime, NewcomerReexaminesOnlyEqualOrLowerPriority) {
+  const CanBusTiming timing = timing_with_bit(Nanos(2us), {1, Nanos(100ms)});
+  const auto before_streams = fifty_and(std::nullopt);
+  const CanBusAnalysis before(before_streams, timing);
+  EXPECT_EQ(before.analysed(), 50u);
+  struct Case {
+    std::uint32_t id;
+    Nanos transmission;
+    std::size_t analysed;
+  };
+  // Lowest priority: itself, and the previous lowest whose blocking it becomes. Middle: itself
+  // and the 25 below it. Highest: everyone. A longer frame below all others: it blocks them all.
+  for (const Case c : {Case{1000, Nanos(100us), 2}, Case{255, Nanos(100us), 26}, Case{5, Nanos(100us), 51},
+                       Case{1000, Nanos(200us), 51}}) {
+    const auto streams = fifty_and(CanStream{c.id, c.transmission, Nanos(50ms), Nanos(0)});
+    const CanBusAnalysis incremental(streams, timing, &before);
+    EXPECT_EQ(incremental.analysed(), c.analysed) << c.id;
+    EXPECT_EQ(incremental.results(), response_times(streams, timing)) << c.id;
+  }
+  // Another bus timing: nothing is reused.
+  EXPECT_EQ(CanBusAnalysis(before_streams, timing_with_bit(Nanos(1us)), &before).analysed(), 50u);
+}
+
+TEST(IncrementalResponseTime, ChangedJitterReexaminesFromThatStreamDown) {
+  const CanBusTiming timing = timing_with_bit(Nanos(2us));
+  const auto streams = fifty_and(std::nullopt);
+  const CanBusAnalysis before(streams, timing);
+  auto jittered = streams;
+  jittered[39].jitter = Nanos(3ms);  // id 400: itself and the ten below
+  const CanBusAnalysis after(jittered, timing, &before);
+  EXPECT_EQ(after.analysed(), 11u);
+  EXPECT_EQ(after.results(), response_times(jittered, timing));
 }
 
 // ---------------------------------------------------------------- identifiers (DESIGN.md §5)

@@ -72,10 +72,15 @@ std::optional<std::int64_t> busy_period(const StreamContext& ctx, const CanBusTi
   }
 }
 
-// Queuing delay w_m(q) of instance q.
-std::optional<std::int64_t> queuing_delay(const StreamContext& ctx, const CanBusTiming& timing, std::int64_t q) {
+// Queuing delay w_m(q) of instance q. `floor` is a value at or below w_m(q) from which the
+// recurrence still climbs (w_m(q-1) + C_m: the recurrence of q is that of q-1 plus C_m, and both
+// are monotonic), so starting there skips iterations without changing the fixed point reached.
+std::optional<std::int64_t> queuing_delay(const StreamContext& ctx, const CanBusTiming& timing, std::int64_t q,
+                                          std::int64_t floor) {
   const std::int64_t own = ctx.self.transmission.count();
-  std::int64_t w = ctx.blocking + q * own;
+  const std::int64_t start = ctx.blocking + q * own;
+  std::int64_t w = std::max(start, floor);
+  if (w != start && w > kHorizonNs) return std::nullopt;  // the plain iteration would pass the horizon
   while (true) {
     const std::int64_t next = ctx.blocking + q * own + error_overhead(w + own, timing, ctx.largest_hep_frame) +
                               interference(ctx, w, timing.bit_time.count());
@@ -91,9 +96,11 @@ std::optional<Nanos> response_time(const StreamContext& ctx, const CanBusTiming&
   const std::int64_t period = ctx.self.period.count();
   const std::int64_t instances = std::max<std::int64_t>(1, ceil_div(*t + ctx.self.jitter.count(), period));
   std::int64_t worst = 0;
+  std::int64_t floor = 0;
   for (std::int64_t q = 0; q < instances; ++q) {
-    const auto w = queuing_delay(ctx, timing, q);
+    const auto w = queuing_delay(ctx, timing, q, floor);
     if (!w) return std::nullopt;
+    floor = *w + ctx.self.transmission.count();
     worst = std::max(worst, ctx.self.jitter.count() + *w - q * period + ctx.self.transmission.count());
   }
   return Nanos(worst);
