@@ -234,7 +234,8 @@ struct CcpNode {
 };
 
 TEST(FamousoCcp, AssignsTxNodesToNodesThatStartTogether) {
-  famouso::CcpBroker broker(1);
+  famouso::CcpBroker broker;
+  broker.reserve(1);
   std::vector<CcpNode> nodes{CcpNode({'S', 'c', 'h', 'u', 'l', 'z', 'e', 0}), CcpNode({'S', 'c', 'h', 'u', 'l', 'z', 'e', 1}),
                              CcpNode({'N', 'o', 'd', 'e', '-', 'B', 0, 0})};
   // The bus: every node with a pending request sends; arbitration lets the lowest identifier
@@ -266,7 +267,7 @@ TEST(FamousoCcp, AssignsTxNodesToNodesThatStartTogether) {
 }
 
 TEST(FamousoCcp, RestartedNodeGetsItsTxNodeAgainAndStuckRoundsExpire) {
-  famouso::CcpBroker broker(1, Nanos(100));
+  famouso::CcpBroker broker(Nanos(100));
   CcpNode node({1, 2, 3, 4, 5, 6, 7, 8});
   auto run = [&](CcpNode& n) {
     for (int i = 0; i < 20 && !n.tx_node; ++i) {

@@ -76,6 +76,7 @@ class ProtocolQueue {
     queue_.pop_front();
     next_ = now + gap_;
   }
+  void wait(Nanos now) { next_ = now + gap_; }  // the kernel refused it for now: keep it
   std::optional<Nanos> deadline() const { return queue_.empty() ? std::nullopt : std::optional<Nanos>(next_); }
   void clear() { queue_.clear(); }
 

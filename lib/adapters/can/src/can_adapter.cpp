@@ -16,6 +16,7 @@
 #include <atomic>
 #include <cerrno>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <mutex>
 #include <string>
@@ -23,12 +24,15 @@
 #include <unordered_map>
 #include <vector>
 
+#include "binding_guard.hpp"
 #include "can_binding.hpp"
 #include "cosmic/arrival_clock.hpp"
 #include "cosmic/thread_policy.hpp"
 #include "cosmic/can_fragment.hpp"
 #include "cosmic/can_timing.hpp"
 #include "cosmic/can_wire.hpp"
+#include "famouso_afp.hpp"
+#include "famouso_ccp.hpp"
 #include "frame_backlog.hpp"
 
 namespace cosmic {
@@ -48,12 +52,34 @@ constexpr int kFramesPerWakeup = 256;
 constexpr std::size_t kReadBatch = 32;  // frames per recvmmsg
 constexpr std::size_t kFdPaddingSlack = 15;  // 48 -> 64 is the largest step between FD lengths
 constexpr can_err_mask_t kErrorMask = CAN_ERR_CRTL | CAN_ERR_BUSOFF | CAN_ERR_RESTARTED;
+constexpr std::size_t kMaxPendingRequests = 64;     // FAMOUSO: unanswered GET_ETAGs kept for a later bind
+constexpr std::size_t kMaxAnnouncedSubscriptions = 256;  // FAMOUSO: subscriptions logged once each
+constexpr canid_t kEtagFilterMask = 0x3FFF | CAN_EFF_FLAG;
 
 Nanos steady_now() { return std::chrono::duration_cast<Nanos>(std::chrono::steady_clock::now().time_since_epoch()); }
 
 std::string errno_text(int err) { return std::strerror(err); }
 
 std::uint32_t source_key(const CanIdentifier& id) { return (static_cast<std::uint32_t>(id.tx_node) << 14) | id.etag; }
+
+// Binding answers leave one at a time, two frame times apart (an extended 8-byte frame is at
+// most 160 bits with stuffing), so at most one is in the kernel's FIFO ahead of a real-time frame.
+Nanos answer_gap(const CanSegmentProperties& can) {
+  const double bits = 2 * 160.0;
+  const double rate = static_cast<double>(std::max<std::uint64_t>(can.bitrate.bits_per_second, 10'000));
+  return std::max(Nanos(200'000), Nanos(static_cast<std::int64_t>(bits * 1e9 / rate)));
+}
+
+// Etags the socket receives whatever is bound: the binding protocol, and on a FAMOUSO segment
+// the configuration protocol and the SUBSCRIBE announcements.
+std::vector<can_filter> protocol_filters(bool famouso) {
+  std::vector<can_filter> f{can_filter{kEtagGetEtag | CAN_EFF_FLAG, kEtagFilterMask}};
+  if (famouso) {
+    f.push_back(can_filter{kEtagCcpRsi | CAN_EFF_FLAG, kEtagFilterMask});
+    f.push_back(can_filter{kEtagFamousoSubscribe | CAN_EFF_FLAG, kEtagFilterMask});
+  }
+  return f;
+}
 
 class CanAdapter final : public SegmentAdapter {
  public:
@@ -62,8 +88,13 @@ class CanAdapter final : public SegmentAdapter {
         log_(log),
         capacity_(max_frame_payload(segment.can)),
         brs_(segment.can.fd && segment.can.data_bitrate > segment.can.bitrate),
+        famouso_(segment.can.profile == CanProfile::famouso),
         reassembler_(ReassemblyLimits{kMaxPartialEvents, kReassemblyTimeout, segment.can.fd ? kFdPaddingSlack : 0}),
-        table_(std::make_shared<const Table>()) {}
+        afp_(famouso::AfpLimits{kMaxPartialEvents, kReassemblyTimeout}),
+        ccp_(segment.can.profile == CanProfile::famouso ? std::optional<famouso::CcpBroker>(std::in_place)
+                                                        : std::nullopt),
+        table_(std::make_shared<const Table>()),
+        answers_(answer_gap(segment.can)) {}
 
   ~CanAdapter() override { stop(); }
 
@@ -84,7 +115,8 @@ class CanAdapter final : public SegmentAdapter {
   };
   struct TxChannel {
     ChannelId id = kNoChannel;
-    std::uint32_t can_id = 0;  // 29 bits
+    std::uint32_t can_id = 0;  // 29 bits, in the segment's profile
+    std::uint32_t afp_id = 0;  // FAMOUSO: the identifier with the fragment flag
     std::uint16_t etag = 0;
     std::size_t payload = 0;
     bool fragmented = false;
@@ -113,7 +145,11 @@ class CanAdapter final : public SegmentAdapter {
   void handle_datagram(canfd_frame& frame, msghdr& msg, std::size_t bytes);
   void handle_frame(const canfd_frame& frame, bool fd_frame, Nanos now);
   void handle_error_frame(const canfd_frame& frame);
-  void handle_get_etag(const canfd_frame& frame, std::size_t len);
+  void handle_get_etag(const canfd_frame& frame, std::size_t len, Nanos now);
+  void reassembly_losses(ChannelId channel, std::optional<std::uint32_t> displaced, bool lost);
+  void handle_famouso_protocol(const CanIdentifier& id, const canfd_frame& frame, std::size_t len, Nanos now);
+  void handle_afp(const RxChannel& channel, const CanIdentifier& id, std::span<const std::uint8_t> data, Nanos now);
+  void handle_protocol_timeouts(Nanos now);
   void deliver(const RxChannel& channel, std::span<const std::uint8_t> payload, Nanos now);
   void problem(ChannelId channel, InboundProblem what);
   void drain_backlog();
@@ -126,6 +162,10 @@ class CanAdapter final : public SegmentAdapter {
 
   // --- send side (io_mutex_ held)
   WriteResult submit(const canfd_frame& frame, bool fd);
+  void queue_answer(std::uint32_t can_id, std::span<const std::uint8_t> data);
+  void queue_supply_etag(std::uint8_t requester, std::uint16_t etag, std::uint64_t subject, const Table& table);
+  void drain_answers();
+  SendStatus send_afp(const TxChannel& channel, std::span<const std::uint8_t> payload, std::unique_lock<std::mutex>& lock);
   void wake();
   void drop_backlog(const char* why);
 
@@ -133,6 +173,7 @@ class CanAdapter final : public SegmentAdapter {
   Logger& log_;
   const std::uint32_t capacity_;  // data bytes of one frame on this bus
   const bool brs_;
+  const bool famouso_;  // FAMOUSO profile: its identifier layout, CCP, etag-4 answers, AFP
 
   EventSink* sink_ = nullptr;
   std::thread thread_;
@@ -143,6 +184,9 @@ class CanAdapter final : public SegmentAdapter {
 
   // Receive-thread state.
   Reassembler reassembler_;
+  famouso::AfpReassembler afp_;
+  std::optional<famouso::CcpBroker> ccp_;  // FAMOUSO segments only
+  std::vector<std::pair<std::uint8_t, std::uint64_t>> announced_;  // FAMOUSO subscriptions seen (node, subject)
   std::shared_ptr<const Table> rx_table_;
   std::uint64_t rx_generation_ = ~0ull;
   int bound_ifindex_ = 0;
@@ -155,6 +199,10 @@ class CanAdapter final : public SegmentAdapter {
   std::shared_ptr<const Table> table_;
   std::atomic<std::uint64_t> generation_{0};
   FrameBacklog backlog_;
+  ProtocolQueue answers_;  // binding and CCP answers: after the backlog, paced
+  BindingRateLimit request_limit_;
+  std::vector<can_binding::GetEtagRequest> pending_requests_;  // FAMOUSO: unknown subjects, answered on bind
+  std::uint64_t refused_requests_ = 0;
   std::unordered_map<std::uint16_t, std::uint8_t> tx_sequence_;
   bool wait_pollout_ = false;      // backlog waits for POLLOUT (EAGAIN)
   std::optional<Nanos> retry_at_;  // backlog waits for the qdisc (ENOBUFS)
@@ -283,21 +331,25 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
         continue;
       }
     } else {
-      table->tx[b.id] = TxChannel{b.id, b.can->can_id & CAN_EFF_MASK, etag, payload, fragmented};
+      const std::uint32_t planned = b.can->can_id & CAN_EFF_MASK;
+      const std::uint32_t can_id = famouso_ ? famouso_id_of(planned, false) : planned;
+      table->tx[b.id] = TxChannel{b.id, can_id, famouso_id_of(planned, true), etag, payload, fragmented};
       if (fragmented) {
-        table->backlog_frames = std::max<std::size_t>(table->backlog_frames, 2 * fragment_count(payload, capacity_));
+        const std::size_t frames = famouso_ ? famouso::afp_fragment_count(payload) : fragment_count(payload, capacity_);
+        table->backlog_frames = std::max<std::size_t>(table->backlog_frames, 2 * frames);
       }
     }
     table->etag_of[b.spec.subject] = etag;
     if (!table->tx_node) table->tx_node = id.tx_node;
   }
-  // Kernel filters: the 14 etag bits of every etag bound as publisher, plus GET_ETAG; extended
-  // frames only. Everything else stays in the kernel.
-  constexpr canid_t kEtagMask = 0x3FFF | CAN_EFF_FLAG;
-  if (table->rx.size() + 1 <= CAN_RAW_FILTER_MAX) {
-    table->filters.push_back(can_filter{kEtagGetEtag | CAN_EFF_FLAG, kEtagMask});
-    for (const auto& [etag, channel] : table->rx) table->filters.push_back(can_filter{etag | CAN_EFF_FLAG, kEtagMask});
+  if (famouso_) table->etag_of[kFamousoSubscribeSubject] = kEtagFamousoSubscribe;  // FAMOUSO nodes bind it at start
+  // Kernel filters: the 14 etag bits of every etag bound as publisher, plus the protocols' etags;
+  // extended frames only. Everything else stays in the kernel.
+  table->filters = protocol_filters(famouso_);
+  if (table->rx.size() + table->filters.size() <= CAN_RAW_FILTER_MAX) {
+    for (const auto& [etag, channel] : table->rx) table->filters.push_back(can_filter{etag | CAN_EFF_FLAG, kEtagFilterMask});
   } else {
+    table->filters.clear();
     table->filters.push_back(can_filter{CAN_EFF_FLAG, CAN_EFF_FLAG});  // too many: filter in user space
   }
 
@@ -312,8 +364,16 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
         std::any_of(table->tx.begin(), table->tx.end(), [&](const auto& t) { return t.second.etag == it->first; });
     it = bound ? std::next(it) : tx_sequence_.erase(it);
   }
+  // FAMOUSO nodes ask once and wait: requests for subjects bound only now are answered now.
+  std::erase_if(pending_requests_, [&](const can_binding::GetEtagRequest& r) {
+    const auto found = table->etag_of.find(r.subject);
+    if (found == table->etag_of.end()) return false;
+    queue_supply_etag(r.requester, found->second, r.subject, *table);
+    return true;
+  });
   table_ = std::move(table);
   generation_.fetch_add(1, std::memory_order_release);
+  if (!answers_.empty()) wake();
   if (!errors.empty()) {
     log_.log(LogLevel::error, "segment " + segment_.name + ": " + errors);
     return Status::failure(errors);
@@ -373,7 +433,10 @@ void CanAdapter::set_link(Link link, std::string detail) {
     std::lock_guard lock(io_mutex_);
     drop_backlog("interface not up");
   }
-  if (came_up || went_down) reassembler_.clear();
+  if (came_up || went_down) {
+    reassembler_.clear();
+    afp_.clear();
+  }
   if (came_up) {
     std::lock_guard lock(io_mutex_);
     send_error_logged_ = false;
@@ -448,7 +511,7 @@ bool CanAdapter::open_socket(int ifindex) {
       generation = generation_.load();
       filters = table_->filters;
     }
-    if (filters.empty()) filters.push_back(can_filter{kEtagGetEtag | CAN_EFF_FLAG, 0x3FFF | CAN_EFF_FLAG});
+    if (filters.empty()) filters = protocol_filters(famouso_);
     if (::setsockopt(s, SOL_CAN_RAW, CAN_RAW_FILTER, filters.data(),
                      static_cast<socklen_t>(filters.size() * sizeof(can_filter))) != 0) {
       return fail("CAN_RAW_FILTER");
@@ -537,16 +600,17 @@ void CanAdapter::run() {
       next_link_check_ = now + (link_up_ ? kLinkCheckWhileUp : kLinkCheckWhileDown);
     }
     refresh_rx_table();
-    reassembler_.expire(now, [this](std::uint32_t source) {
-      const auto it = rx_table_->rx.find(static_cast<std::uint16_t>(source & 0x3FFF));
-      problem(it == rx_table_->rx.end() ? kNoChannel : it->second.id, InboundProblem::decode_error);
-    });
+    reassembler_.expire(now, [this](std::uint32_t source) { reassembly_losses(kNoChannel, source, false); });
+    handle_protocol_timeouts(now);
 
     pollfd fds[2] = {{wake_fd_, POLLIN, 0}, {-1, 0, 0}};
     Nanos deadline = next_link_check_;
     if (const auto d = reassembler_.next_deadline()) deadline = std::min(deadline, *d + Nanos(1));
+    if (const auto d = afp_.next_deadline()) deadline = std::min(deadline, *d + Nanos(1));
+    if (const auto d = ccp_ ? ccp_->deadline() : std::nullopt) deadline = std::min(deadline, *d);
     {
       std::lock_guard lock(io_mutex_);
+      if (const auto d = answers_.deadline(); d && backlog_.empty()) deadline = std::min(deadline, *d);
       if (sock_ >= 0) {
         fds[1].fd = sock_;
         fds[1].events = POLLIN;
@@ -568,6 +632,7 @@ void CanAdapter::run() {
     }
     if (fds[1].fd >= 0 && (fds[1].revents & (POLLIN | POLLERR | POLLHUP))) read_frames();
     drain_backlog();
+    drain_answers();
   }
 }
 
@@ -667,8 +732,12 @@ void CanAdapter::handle_frame(const canfd_frame& frame, bool fd_frame, Nanos now
     if (frame.can_id & CAN_RTR_FLAG) {
       problem(kNoChannel, InboundProblem::decode_error);
     } else {
-      handle_get_etag(frame, len);
+      handle_get_etag(frame, len, now);
     }
+    return;
+  }
+  if (famouso_ && (id.etag == kEtagCcpRsi || id.etag == kEtagFamousoSubscribe)) {
+    handle_famouso_protocol(id, frame, len, now);
     return;
   }
   const auto it = table.rx.find(id.etag);
@@ -682,7 +751,11 @@ void CanAdapter::handle_frame(const canfd_frame& frame, bool fd_frame, Nanos now
     return;
   }
   const std::span<const std::uint8_t> data(frame.data, len);
-  if (!channel.fragmented) {
+  if (famouso_ && decode_famouso_id(frame.can_id & CAN_EFF_MASK).fragment) {
+    handle_afp(channel, id, data, now);
+    return;
+  }
+  if (!channel.fragmented || famouso_) {  // FAMOUSO: events of up to 8 bytes are plain frames
     // A device may send shorter events; on CAN FD the frame may carry padding up to the next
     // FD length, which is cut off at the channel's payload.
     const std::size_t allowed =
@@ -695,12 +768,61 @@ void CanAdapter::handle_frame(const canfd_frame& frame, bool fd_frame, Nanos now
     return;
   }
   const FragmentResult r = reassembler_.accept(source_key(id), data, channel.payload, now);
-  if (r.displaced) {
-    const auto other = table.rx.find(static_cast<std::uint16_t>(*r.displaced & 0x3FFF));
-    problem(other == table.rx.end() ? kNoChannel : other->second.id, InboundProblem::decode_error);
-  }
-  if (r.dropped_event || r.outcome == FragmentOutcome::rejected) problem(channel.id, InboundProblem::decode_error);
+  reassembly_losses(channel.id, r.displaced, r.dropped_event || r.outcome == FragmentOutcome::rejected);
   if (r.outcome == FragmentOutcome::complete) deliver(channel, r.event, now);
+}
+
+void CanAdapter::handle_afp(const RxChannel& channel, const CanIdentifier& id, std::span<const std::uint8_t> data,
+                            Nanos now) {
+  const famouso::AfpResult r = afp_.accept(source_key(id), data, channel.payload, now);
+  reassembly_losses(channel.id, r.displaced, r.dropped_event || r.outcome == famouso::AfpOutcome::rejected);
+  if (r.outcome == famouso::AfpOutcome::complete) deliver(channel, r.event, now);
+}
+
+// Every event lost in reassembly is counted on its channel; `displaced` is a source (TxNode and
+// etag) whose partial event was given up: for a newcomer, or idle too long.
+void CanAdapter::reassembly_losses(ChannelId channel, std::optional<std::uint32_t> displaced, bool lost) {
+  if (displaced) {
+    const auto other = rx_table_->rx.find(static_cast<std::uint16_t>(*displaced & 0x3FFF));
+    problem(other == rx_table_->rx.end() ? kNoChannel : other->second.id, InboundProblem::decode_error);
+  }
+  if (lost) problem(channel, InboundProblem::decode_error);
+}
+
+// FAMOUSO segments: CCP requests (node ids) and SUBSCRIBE announcements.
+void CanAdapter::handle_famouso_protocol(const CanIdentifier& id, const canfd_frame& frame, std::size_t len, Nanos now) {
+  const Table& table = *rx_table_;
+  if (id.etag == kEtagCcpRsi) {
+    if (table.tx_node) ccp_->reserve(*table.tx_node);
+    const auto answer = ccp_->on_request(frame.can_id & CAN_EFF_MASK, now);
+    if (answer) {
+      std::lock_guard lock(io_mutex_);
+      queue_answer(answer->can_id, answer->data);
+    } else if (ccp_->exhausted()) {
+      problem(kNoChannel, InboundProblem::decode_error);
+      log_.log(LogLevel::warning, "segment " + segment_.name + ": CCP: every TxNode is taken, a node stays unconfigured");
+    }
+    return;
+  }
+  // A FAMOUSO node announces each subject it subscribes on the SUBSCRIBE subject's etag. The
+  // gateway forwards what is bound, so the announcement is only worth a line in the log.
+  if (len != can_binding::kFrameBytes) {
+    problem(kNoChannel, InboundProblem::decode_error);
+    return;
+  }
+  std::uint64_t subject = 0;
+  for (std::size_t i = 0; i < len; ++i) subject = (subject << 8) | frame.data[i];
+  const std::pair<std::uint8_t, std::uint64_t> key{id.tx_node, subject};
+  if (announced_.size() >= kMaxAnnouncedSubscriptions ||
+      std::find(announced_.begin(), announced_.end(), key) != announced_.end()) {
+    return;
+  }
+  announced_.push_back(key);
+  const bool bound = table.etag_of.count(subject) != 0;
+  char text[64];
+  std::snprintf(text, sizeof text, "0x%016llx", static_cast<unsigned long long>(subject));
+  log_.log(LogLevel::notice, "segment " + segment_.name + ": FAMOUSO node " + std::to_string(id.tx_node) +
+                                 " subscribes subject " + text + (bound ? "" : " (no channel bound for it)"));
 }
 
 void CanAdapter::deliver(const RxChannel& channel, std::span<const std::uint8_t> payload, Nanos now) {
@@ -732,7 +854,7 @@ void CanAdapter::handle_error_frame(const canfd_frame& frame) {
   }
 }
 
-void CanAdapter::handle_get_etag(const canfd_frame& frame, std::size_t len) {
+void CanAdapter::handle_get_etag(const canfd_frame& frame, std::size_t len, Nanos now) {
   const auto request =
       can_binding::decode_get_etag(frame.can_id & CAN_EFF_MASK, std::span<const std::uint8_t>(frame.data, len));
   if (!request) {
@@ -740,20 +862,81 @@ void CanAdapter::handle_get_etag(const canfd_frame& frame, std::size_t len) {
     return;
   }
   const Table& table = *rx_table_;
-  const auto it = table.etag_of.find(request->subject);
-  if (it == table.etag_of.end() || !table.tx_node) return;  // unknown subject: no answer
-  const auto answers = can_binding::supply_etag_data(request->requester, it->second, request->subject);
   std::lock_guard lock(io_mutex_);
-  if (!backlog_.empty() && !backlog_.room_for(answers.size())) {
-    send_errors_ += answers.size();
+  if (!request_limit_.admit(request->requester, now)) {
+    ++receive_errors_;
+    if (refused_requests_++ % 1000 == 0) {
+      log_.log(LogLevel::warning, "segment " + segment_.name + ": GET_ETAG from TxNode " +
+                                      std::to_string(request->requester) + " over the rate limit, not answered (" +
+                                      std::to_string(refused_requests_) + " refused so far)");
+    }
     return;
   }
-  for (const auto& data : answers) {
-    canfd_frame out{};
-    out.can_id = can_binding::supply_etag_id(*table.tx_node) | CAN_EFF_FLAG;
-    out.len = static_cast<std::uint8_t>(data.size());
-    std::memcpy(out.data, data.data(), data.size());
-    if (submit(out, false) == WriteResult::failed) break;
+  const auto it = table.etag_of.find(request->subject);
+  if (it != table.etag_of.end()) {
+    queue_supply_etag(request->requester, it->second, request->subject, table);
+    return;
+  }
+  // Unknown subject: no answer. FAMOUSO's client asks only once and waits, so its request is
+  // kept (bounded) and answered when a channel with that subject is bound.
+  const bool known = std::any_of(pending_requests_.begin(), pending_requests_.end(), [&](const auto& p) {
+    return p.requester == request->requester && p.subject == request->subject;
+  });
+  if (famouso_ && !known && pending_requests_.size() < kMaxPendingRequests) pending_requests_.push_back(*request);
+}
+
+void CanAdapter::queue_supply_etag(std::uint8_t requester, std::uint16_t etag, std::uint64_t subject, const Table& table) {
+  if (!famouso_ && !table.tx_node) return;  // no channel bound yet: the gateway has no TxNode here
+  const std::uint32_t id = famouso_ ? can_binding::supply_etag_new_bp_id() : can_binding::supply_etag_id(*table.tx_node);
+  const auto frames = can_binding::supply_etag_data(requester, etag, subject);
+  if (!answers_.room_for(frames.size())) {
+    send_errors_ += frames.size();
+    return;
+  }
+  for (const auto& data : frames) queue_answer(id, data);
+}
+
+void CanAdapter::queue_answer(std::uint32_t can_id, std::span<const std::uint8_t> data) {
+  if (!answers_.room_for(1)) {
+    ++send_errors_;
+    return;
+  }
+  can_frame out{};
+  out.can_id = can_id | CAN_EFF_FLAG;
+  out.len = static_cast<std::uint8_t>(std::min<std::size_t>(data.size(), CAN_MAX_DLEN));
+  std::memcpy(out.data, data.data(), out.len);
+  answers_.push(out);
+  wake();
+}
+
+// One answer per call, only when no real-time frame waits in the backlog.
+void CanAdapter::drain_answers() {
+  std::lock_guard lock(io_mutex_);
+  if (sock_ < 0 || !backlog_.empty()) return;
+  const Nanos now = steady_now();
+  const can_frame* answer = answers_.due(now);
+  if (!answer) return;
+  const ssize_t n = ::write(sock_, answer, CAN_MTU);
+  if (n == static_cast<ssize_t>(CAN_MTU)) {
+    ++sent_;
+    answers_.sent(now);
+    return;
+  }
+  const int err = n < 0 ? errno : EIO;
+  if (err == EAGAIN || err == EWOULDBLOCK || err == ENOBUFS) {
+    answers_.wait(now);  // the kernel's queue is full: try again one gap later
+    return;
+  }
+  ++send_errors_;
+  answers_.sent(now);  // dropped
+}
+
+void CanAdapter::handle_protocol_timeouts(Nanos now) {
+  afp_.expire(now, [this](std::uint32_t source) { reassembly_losses(kNoChannel, source, false); });
+  if (!ccp_) return;
+  if (const auto reset = ccp_->expire(now)) {
+    std::lock_guard lock(io_mutex_);
+    queue_answer(reset->can_id, reset->data);
   }
 }
 
@@ -860,7 +1043,8 @@ SendStatus CanAdapter::send(const OutboundEvent& event) {
       std::memset(frame.data + len, 0, sizeof frame.data - len);
       frame.len = static_cast<std::uint8_t>(wire);
     };
-    if (!channel.fragmented) {
+    if (famouso_ && event.payload.size() > famouso::kAfpMtu) return send_afp(channel, event.payload, lock);
+    if (!channel.fragmented || famouso_) {  // FAMOUSO: events of up to 8 bytes are plain frames
       std::memcpy(frame.data, event.payload.data(), event.payload.size());
       finish(event.payload.size());
       switch (submit(frame, fd)) {
@@ -900,6 +1084,29 @@ SendStatus CanAdapter::send(const OutboundEvent& event) {
     ++send_errors_;
     return SendStatus::failed;
   }
+}
+
+// FAMOUSO: an event of more than 8 bytes as AFP fragments with the identifier's fragment flag.
+SendStatus CanAdapter::send_afp(const TxChannel& channel, std::span<const std::uint8_t> payload,
+                                std::unique_lock<std::mutex>& lock) {
+  if (!backlog_.empty() && !backlog_.room_for(famouso::afp_fragment_count(payload.size()))) {
+    ++send_errors_;
+    return SendStatus::queue_full;
+  }
+  famouso::AfpFragmenter fragments(payload);
+  canfd_frame frame{};
+  frame.can_id = channel.afp_id | CAN_EFF_FLAG;
+  while (!fragments.done()) {
+    frame.len = static_cast<std::uint8_t>(fragments.next(std::span<std::uint8_t>(frame.data, famouso::kAfpMtu)));
+    const WriteResult r = submit(frame, false);
+    if (r == WriteResult::failed || r == WriteResult::full) return SendStatus::failed;
+    if (!fragments.done()) {  // as in send(): a higher class waits for at most one frame
+      lock.unlock();
+      lock.lock();
+      if (sock_ < 0) return SendStatus::failed;
+    }
+  }
+  return SendStatus::sent;
 }
 
 }  // namespace

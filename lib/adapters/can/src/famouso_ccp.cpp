@@ -29,8 +29,9 @@ std::uint32_t encode_ccp_request(std::uint8_t stage, std::uint8_t nibble) {
          (static_cast<std::uint32_t>(nibble & 0xF) << kNibbleShift) | kEtagCcpRsi;
 }
 
-CcpBroker::CcpBroker(std::uint8_t gateway_node, Nanos round_timeout)
-    : gateway_node_(gateway_node & 0x7F), round_timeout_(round_timeout) {}
+CcpBroker::CcpBroker(Nanos round_timeout) : round_timeout_(round_timeout) {}
+
+void CcpBroker::reserve(std::uint8_t tx_node) { reserved_[tx_node & 0x7F] = true; }
 
 std::optional<CcpFrame> CcpBroker::on_request(std::uint32_t can_id, Nanos now) {
   const auto request = decode_ccp_request(can_id);
@@ -69,10 +70,10 @@ std::optional<Nanos> CcpBroker::deadline() const {
 // TxNode below 0x7F that is not the gateway's (FAMOUSO's broker hands them out the same way).
 std::uint8_t CcpBroker::assign(std::uint64_t uid) {
   for (std::uint8_t n = 0; n < kFamousoBrokerNode; ++n) {
-    if (nodes_[n] == uid && uid != 0) return n;
+    if (nodes_[n] == uid && uid != 0 && !reserved_[n]) return n;
   }
   for (int n = kFamousoBrokerNode - 1; n >= 0; --n) {
-    if (n == gateway_node_ || nodes_[n] != 0) continue;
+    if (reserved_[n] || nodes_[n] != 0) continue;
     nodes_[n] = uid == 0 ? ~0ull : uid;  // UID 0 is not used by FAMOUSO nodes; keep the slot taken anyway
     exhausted_ = false;
     return static_cast<std::uint8_t>(n);

@@ -33,8 +33,10 @@ std::uint32_t encode_ccp_request(std::uint8_t stage, std::uint8_t nibble);  // w
 
 class CcpBroker {
  public:
-  // `reserved` TxNodes are never given out (the gateway's own, FAMOUSO's broker 0x7F always).
-  explicit CcpBroker(std::uint8_t gateway_node, Nanos round_timeout = Nanos(500'000'000));
+  explicit CcpBroker(Nanos round_timeout = Nanos(500'000'000));
+
+  // A TxNode never given out: the gateway's own (0x7F, FAMOUSO's broker, never is either).
+  void reserve(std::uint8_t tx_node);
 
   // A CCP_RSI frame: the answer to send, or nullopt for a frame of another round (the node
   // lost arbitration and waits) or when every TxNode is taken (counted by the caller).
@@ -51,12 +53,12 @@ class CcpBroker {
   std::uint8_t assign(std::uint64_t uid);
   CcpFrame answer(std::uint8_t tx_node) const;
 
-  std::uint8_t gateway_node_;
   Nanos round_timeout_;
   std::uint8_t stage_ = kCcpFirstStage;
   std::array<std::uint8_t, 8> uid_{};
   Nanos last_round_{0};
   std::array<std::uint64_t, 128> nodes_{};  // TxNode -> UID, 0 = free
+  std::array<bool, 128> reserved_{};
   bool exhausted_ = false;
 };
 
