@@ -440,10 +440,10 @@ AdmissionSet::Trial AdmissionSet::trial(const ChannelSpec& channel, std::uint16_
 // Bound channels whose report the trial can change: those on a segment it pushes over its
 // utilization limit and those with a CAN hop whose plan or bound it changes. Bind order.
 std::vector<std::size_t> AdmissionSet::affected_by(const Trial& t) const {
-  std::vector<bool> marked(specs_.size(), false);
+  std::vector<std::size_t> out;
   for (const auto& [s, load] : t.loads) {
     if (load <= segment_specs_[s].max_utilization + 1e-12) continue;
-    for (const HopRef& ref : segments_[s].hops) marked[ref.channel] = true;
+    for (const HopRef& ref : segments_[s].hops) out.push_back(ref.channel);
   }
   if (t.can) {
     for (std::size_t s = 0; s < segments_.size(); ++s) {
@@ -454,15 +454,13 @@ std::vector<std::size_t> AdmissionSet::affected_by(const Trial& t) const {
         const bool bound_changed = t.can->diverged != diverged_ && data_[ref.channel].places[ref.hop].role == HopRole::subscriber;
         if (bound_changed || before.can_id != after.can_id || before.jitter != after.jitter ||
             before.response_time != after.response_time) {
-          marked[ref.channel] = true;
+          out.push_back(ref.channel);
         }
       }
     }
   }
-  std::vector<std::size_t> out;
-  for (std::size_t c = 0; c < marked.size(); ++c) {
-    if (marked[c]) out.push_back(c);
-  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
 }
 
