@@ -14,9 +14,10 @@
 //                              validate the file, admit_all, render the text report.
 //                              COSMIC_ADMISSION_YAML=PATH also leaves the file there, to time the
 //                              real `cosmicctl check PATH`.
-//   BM_OverloadedCanToCan/n    admit_all of n SRT/HRT channels from one 125 kbit/s CAN bus to
-//                              another, 8 B every 10 ms (12.8 % each: the bus overloads after 5),
-//                              the shape issue 11 measured at 0.02 / 0.85 / 18 s for 25 / 50 / 100.
+//   BM_OverloadedCanToCan/n    admit_all of n SRT channels from one 125 kbit/s CAN bus to
+//                              another, 8 B every 10 ms (12.8 % each: the bus overloads after 5;
+//                              SRT is degraded, not refused, so all stay bound and analysed), the
+//                              shape issue 11 measured at 0.02 / 0.85 / 18 s for 25 / 50 / 100.
 //   BM_LcmChannels/n           admit_all of n DDS -> LCM channels (issue 11: 0.45 / 1.8 / 7.1 s for
 //                              1k / 2k / 4k before).
 #include <benchmark/benchmark.h>
@@ -111,8 +112,7 @@ Config overloaded_can_to_can(std::size_t n) {
   Config config = base_config();
   config.segments = {can_bus("can-a", "vcan0", 125'000), can_bus("can-b", "vcan1", 125'000)};
   for (std::size_t i = 0; i < n; ++i) {
-    const ChannelClass cls = i % 4 == 0 ? ChannelClass::hrt : ChannelClass::srt;
-    config.channels.push_back(channel("c" + std::to_string(i), 0x300000 + i, cls, "can-a", "can-b", 8, 10,
+    config.channels.push_back(channel("c" + std::to_string(i), 0x300000 + i, ChannelClass::srt, "can-a", "can-b", 8, 10,
                                       20 + static_cast<std::int64_t>(i % 30)));
   }
   return config;
@@ -134,8 +134,7 @@ void report_verdicts(benchmark::State& state, const cosmic::AdmissionReport& rep
   state.counters["rejected"] = static_cast<double>(rejected);
 }
 
-void BM_AdmitBigSet(benchmark::State& state) {
-  const Config config = big_config();
+void admit_repeatedly(benchmark::State& state, const Config& config) {
   cosmic::AdmissionReport report;
   for (auto _ : state) {
     report = cosmic::admit_all(config);
@@ -143,6 +142,8 @@ void BM_AdmitBigSet(benchmark::State& state) {
   }
   report_verdicts(state, report);
 }
+
+void BM_AdmitBigSet(benchmark::State& state) { admit_repeatedly(state, big_config()); }
 BENCHMARK(BM_AdmitBigSet)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 cosmic::KnowledgeBase big_knowledge_base() {
@@ -227,19 +228,11 @@ void BM_CheckFile(benchmark::State& state) {
 BENCHMARK(BM_CheckFile)->Unit(benchmark::kMillisecond)->Iterations(2);
 
 void BM_OverloadedCanToCan(benchmark::State& state) {
-  const Config config = overloaded_can_to_can(static_cast<std::size_t>(state.range(0)));
-  cosmic::AdmissionReport report;
-  for (auto _ : state) report = cosmic::admit_all(config);
-  report_verdicts(state, report);
+  admit_repeatedly(state, overloaded_can_to_can(static_cast<std::size_t>(state.range(0))));
 }
 BENCHMARK(BM_OverloadedCanToCan)->Arg(25)->Arg(50)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 
-void BM_LcmChannels(benchmark::State& state) {
-  const Config config = lcm_channels(static_cast<std::size_t>(state.range(0)));
-  cosmic::AdmissionReport report;
-  for (auto _ : state) report = cosmic::admit_all(config);
-  report_verdicts(state, report);
-}
+void BM_LcmChannels(benchmark::State& state) { admit_repeatedly(state, lcm_channels(static_cast<std::size_t>(state.range(0)))); }
 BENCHMARK(BM_LcmChannels)->Arg(1000)->Arg(2000)->Arg(4000)->Arg(10000)->Unit(benchmark::kMillisecond);
 
 }  // namespace
