@@ -121,10 +121,23 @@ struct GatewaySpec {
   friend bool operator==(const GatewaySpec&, const GatewaySpec&) = default;
 };
 
+// A component of the application (the paper's Event-Channel Diagram, Fig. 6): it lives on one
+// segment and publishes (P) and/or subscribes (S) channels by name. cosmicd does not run
+// components; tools read them (cosmicctl diagram, cosmicctl gen) and a channel without
+// publishers/subscribers takes its P/S segments from them (docs/components.md).
+struct ComponentSpec {
+  std::string name;
+  std::string segment;
+  std::vector<std::string> publishes;   // channel names
+  std::vector<std::string> subscribes;  // channel names
+  friend bool operator==(const ComponentSpec&, const ComponentSpec&) = default;
+};
+
 struct Config {
   GatewaySpec gateway;
   std::vector<SegmentSpec> segments;
   std::vector<ChannelSpec> channels;
+  std::vector<ComponentSpec> components;  // optional application model, may be empty
 
   const SegmentSpec* find_segment(const std::string& name) const;
   const ChannelSpec* find_channel(const std::string& name) const;

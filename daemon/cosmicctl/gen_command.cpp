@@ -1,0 +1,88 @@
+// `cosmicctl gen FILE --component NAME --output DIR`: a buildable C++ skeleton of one component
+// on libcosmic-client (gen_skeleton.hpp lists the files). The user's file NAME_logic.cpp is
+// written only when it does not exist yet; the rest is regenerated every time.
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+#include "commands.hpp"
+#include "cosmic/config_loader.hpp"
+#include "gen_skeleton.hpp"
+
+#ifndef COSMIC_CLIENT_CONFIG_DIR
+#define COSMIC_CLIENT_CONFIG_DIR ""
+#endif
+
+namespace cosmicctl {
+namespace {
+
+struct GenOptions {
+  std::string file;
+  std::string component;
+  std::string output;
+};
+
+bool write_file(const std::filesystem::path& path, const std::string& content) {
+  std::ofstream out(path, std::ios::trunc);
+  out << content;
+  out.close();
+  if (!out) std::cerr << "cosmicctl: cannot write " << path.string() << "\n";
+  return static_cast<bool>(out);
+}
+
+std::string component_names(const cosmic::Config& config) {
+  std::string out;
+  for (const auto& c : config.components) out += (out.empty() ? "" : ", ") + c.name;
+  return out.empty() ? "(the file has no components: section)" : out;
+}
+
+int run_gen(const GenOptions& o) {
+  const auto loaded = cosmic::load_config_file(o.file);
+  if (!loaded.ok()) {
+    for (const auto& error : loaded.errors) std::cerr << error.to_string() << "\n";
+    return kExitConfigError;
+  }
+  const cosmic::ComponentSpec* component = nullptr;
+  for (const auto& c : loaded.config.components) {
+    if (c.name == o.component) component = &c;
+  }
+  if (!component) {
+    std::cerr << "cosmicctl: no component '" << o.component << "' in " << o.file << " (one of: " << component_names(loaded.config) << ")\n";
+    return kExitUsage;
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(o.output, ec);
+  if (ec) {
+    std::cerr << "cosmicctl: cannot create " << o.output << ": " << ec.message() << "\n";
+    return kExitUnavailable;
+  }
+  const Skeleton skeleton = generate_skeleton(loaded.config, *component, o.file, COSMIC_CLIENT_CONFIG_DIR);
+  for (const auto& [name, content] : skeleton.files) {
+    const auto path = std::filesystem::path(o.output) / name;
+    if (name == skeleton.logic_file && std::filesystem::exists(path)) {
+      std::cerr << "kept " << path.string() << " (yours)\n";
+      continue;
+    }
+    if (!write_file(path, content)) return kExitUnavailable;
+    std::cerr << "wrote " << path.string() << "\n";
+  }
+  std::cerr << "build: cmake -S " << o.output << " -B " << o.output << "/build && cmake --build " << o.output << "/build\n";
+  return kExitOk;
+}
+
+}  // namespace
+
+CommandRunner add_gen_command(CLI::App& app, const GlobalOptions&) {
+  auto* command = app.add_subcommand("gen", "Generate the C++ skeleton of one component (libcosmic-client)");
+  auto o = std::make_shared<GenOptions>();
+  command->add_option("FILE", o->file, "Configuration file (YAML) with a components: section")->required();
+  command->add_option("--component", o->component, "Name of the component")->required();
+  command->add_option("--output", o->output, "Directory of the generated project")->required();
+  return [command, o]() -> int {
+    if (!command->parsed()) return -1;
+    return run_gen(*o);
+  };
+}
+
+}  // namespace cosmicctl

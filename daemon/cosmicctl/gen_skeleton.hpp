@@ -1,0 +1,33 @@
+// Code generation from the Event-Channel Diagram (Kaiser et al., Fig. 8): the C++ skeleton of one
+// component on libcosmic-client. Pure text building; gen_command.cpp writes the files.
+//
+// Files (NAME = the component, Class = NAME in CamelCase):
+//   CMakeLists.txt     the project; finds libcosmic-client (cosmic_client-config.cmake)
+//   channels.hpp       the channel configuration from the model (cosmic_channel_desc per channel)
+//   NAME.hpp, NAME.cpp the component class: announces its channels, one handler per subscribed
+//                      channel (refresh_CHANNEL), one periodic handler per published channel with
+//                      a period (CHANNEL_period), run loop; handlers never run at the same time
+//   NAME_logic.cpp     the handlers' bodies and the component's State: the user's file
+//   main.cpp           options (--segment, --check SOCKET), signals, run
+#pragma once
+
+#include <map>
+#include <string>
+
+#include "cosmic/model.hpp"
+
+namespace cosmicctl {
+
+struct Skeleton {
+  std::map<std::string, std::string> files;  // file name -> content
+  std::string logic_file;                    // the one file the user edits
+};
+
+// `client_config_dir`: where cosmic_client-config.cmake lives (a hint; -Dcosmic_client_DIR wins).
+Skeleton generate_skeleton(const cosmic::Config& config, const cosmic::ComponentSpec& component, const std::string& model_file,
+                           const std::string& client_config_dir);
+
+// How a component on `segment` opens it with cosmic_open() (CAN: TxNode `can_node`).
+std::string client_segment(const cosmic::SegmentSpec& segment, unsigned can_node);
+
+}  // namespace cosmicctl

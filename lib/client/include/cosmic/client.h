@@ -1,0 +1,97 @@
+/* libcosmic-client: join COSMIC event channels from a component (Kaiser et al., Fig. 9) without
+ * hand-crafting CAN identifiers or DDS/LCM envelopes. A component names its channel (name and
+ * subject, with the channel's class and QoS from the model) and the segment it lives on; the
+ * library speaks the gateway's own formats there (docs/components.md):
+ *   DDS  topic cosmic/<name>, type cosmic::Envelope, QoS derived from the channel as cosmicd does;
+ *   LCM  channel <name>, type cosmic.envelope;
+ *   CAN  29-bit identifiers of docs/can-wire-format.md; the etag is bound with GET_ETAG at
+ *        cosmic_announce(), fragments for NRT events larger than one frame.
+ * No addresses anywhere, and no admission: cosmic_check_channel() asks a running cosmicd.
+ *
+ * Ownership: cosmic_open() returns a client the caller frees with cosmic_close(), which also frees
+ * every channel announced on it. Threads: every function may be called from any thread; each
+ * client has its own receive thread(s), on which cosmic_subscribe() callbacks run (keep them
+ * short: they delay the next event). The library never prints; cosmic_last_error() says why a
+ * call failed. */
+#ifndef COSMIC_CLIENT_H
+#define COSMIC_CLIENT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct cosmic_client cosmic_client;
+typedef struct cosmic_channel cosmic_channel;
+
+typedef enum { COSMIC_HRT = 0, COSMIC_SRT = 1, COSMIC_NRT = 2 } cosmic_class;
+
+/* Roles of this component on a channel (bit mask). */
+enum { COSMIC_PUBLISH = 1, COSMIC_SUBSCRIBE = 2 };
+
+/* Results: 0 or a negative code. */
+enum {
+  COSMIC_OK = 0,
+  COSMIC_E_INVALID = -1,     /* a bad argument (see cosmic_last_error) */
+  COSMIC_E_TRANSPORT = -2,   /* the network refused (interface down, participant failed) */
+  COSMIC_E_AGAIN = -3,       /* cosmic_get_event: no event waiting; publish: try again */
+  COSMIC_E_TOO_LARGE = -4,   /* event larger than the channel's payload or the caller's buffer */
+  COSMIC_E_UNBOUND = -5,     /* CAN: no gateway answered GET_ETAG for the subject */
+  COSMIC_E_UNAVAILABLE = -6  /* cosmic_check_channel: the gateway cannot be reached */
+};
+
+/* A channel as the model (the YAML) describes it. Durations in nanoseconds, 0 = not given. */
+typedef struct {
+  const char* name;          /* the channel's name: DDS topic cosmic/<name>, LCM channel <name> */
+  uint64_t subject;          /* 64-bit subject UID */
+  cosmic_class cls;
+  int64_t period_ns;
+  int64_t reaction_time_ns;
+  int64_t temp_validity_ns;
+  uint32_t omission_degree;
+  uint32_t payload;          /* largest event in bytes */
+  int roles;                 /* COSMIC_PUBLISH | COSMIC_SUBSCRIBE */
+} cosmic_channel_desc;
+
+typedef struct {
+  uint64_t subject;
+  uint32_t sequence;  /* per publisher; 0 where the source has none (CAN) */
+  int64_t age_ns;     /* time spent in transit before the last gateway forwarded it */
+  uint32_t size;      /* bytes of the event */
+} cosmic_event_info;
+
+typedef void (*cosmic_event_fn)(const cosmic_event_info* info, const uint8_t* data, void* user);
+
+/* Attaches to one segment:
+ *   "dds:DOMAIN" or "dds:DOMAIN?reliability=best_effort"
+ *   "lcm:udpm://GROUP:PORT?ttl=N" (or "lcm:memq://")
+ *   "can:IFACE?node=N"  (N = this component's 7-bit TxNode, unique on the bus)
+ * NULL on failure, with the reason in `error` (may be NULL). */
+cosmic_client* cosmic_open(const char* segment, char* error, size_t error_size);
+void cosmic_close(cosmic_client* client);
+const char* cosmic_last_error(const cosmic_client* client);
+
+/* Sets up the channel for the roles in desc->roles (creates the DDS writer/reader, binds the CAN
+ * etag: up to timeout_ms waiting for the gateway's SUPPLY_ETAG). NULL on failure. */
+cosmic_channel* cosmic_announce(cosmic_client* client, const cosmic_channel_desc* desc, int timeout_ms);
+/* One event of `size` bytes (at most desc->payload). */
+int cosmic_publish(cosmic_channel* channel, const void* data, size_t size);
+/* Events of the channel go to `fn` on the receive thread; fn NULL: they are queued for
+ * cosmic_get_event() instead (the default; the newest 64 are kept). */
+int cosmic_subscribe(cosmic_channel* channel, cosmic_event_fn fn, void* user);
+/* Takes the oldest queued event without waiting: COSMIC_OK, COSMIC_E_AGAIN when none waits,
+ * COSMIC_E_TOO_LARGE when `capacity` is too small (the event stays queued; info->size says how
+ * much is needed). For periodic tools (Simulink) that poll once per step. */
+int cosmic_get_event(cosmic_channel* channel, cosmic_event_info* info, void* buffer, size_t capacity);
+
+/* Asks the cosmicd at `control_socket` (docs/control-protocol.md) for the channel's verdict
+ * ("bound", "degraded", "violated"); "not_found" when the gateway does not carry it. */
+int cosmic_check_channel(const char* control_socket, const char* name, char* verdict, size_t verdict_size);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

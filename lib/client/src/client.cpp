@@ -1,0 +1,220 @@
+// The C API of libcosmic-client over one Transport per client.
+#include "cosmic/client.h"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "control_query.hpp"
+#include "cosmic/can_wire.hpp"
+#include "transport.hpp"
+
+using cosmic::client_detail::Delivery;
+using cosmic::client_detail::Transport;
+
+namespace {
+
+constexpr std::size_t kQueuedEvents = 64;
+
+void copy_text(const std::string& text, char* out, std::size_t size) {
+  if (!out || size == 0) return;
+  std::snprintf(out, size, "%s", text.c_str());
+}
+
+struct QueuedEvent {
+  cosmic_event_info info{};
+  std::vector<std::uint8_t> data;
+};
+
+}  // namespace
+
+struct cosmic_channel {
+  cosmic_client* client = nullptr;
+  std::size_t index = 0;
+  cosmic::ChannelSpec spec;
+  int roles = 0;
+  std::mutex mutex;  // guards everything below (receive thread vs. caller)
+  cosmic_event_fn callback = nullptr;
+  void* user = nullptr;
+  std::deque<QueuedEvent> queue;
+  std::uint32_t sequence = 0;
+};
+
+struct cosmic_client final : Delivery {
+  std::mutex mutex;  // guards channels and error
+  std::vector<std::unique_ptr<cosmic_channel>> channels;
+  std::string error;
+  std::unique_ptr<Transport> transport;  // last member: stopped before the channels go
+
+  ~cosmic_client() { transport.reset(); }
+
+  void deliver(std::size_t index, const cosmic::EventHeader& header, std::span<const std::uint8_t> payload) override {
+    cosmic_channel* channel = nullptr;
+    {
+      std::lock_guard lock(mutex);
+      if (index < channels.size()) channel = channels[index].get();
+    }
+    if (!channel) return;
+    const cosmic_event_info info{header.subject, header.sequence, header.age_ns, static_cast<std::uint32_t>(payload.size())};
+    std::lock_guard lock(channel->mutex);
+    if (channel->callback) {
+      channel->callback(&info, payload.data(), channel->user);
+      return;
+    }
+    if (channel->queue.size() == kQueuedEvents) channel->queue.pop_front();  // the newest matter most
+    channel->queue.push_back(QueuedEvent{info, {payload.begin(), payload.end()}});
+  }
+
+  int fail(int code, std::string why) {
+    std::lock_guard lock(mutex);
+    error = std::move(why);
+    return code;
+  }
+};
+
+namespace {
+
+// "dds:0?reliability=best_effort", "lcm:udpm://...", "can:vcan0?node=5".
+std::unique_ptr<Transport> transport_for(const std::string& segment, std::string& error) {
+  const auto colon = segment.find(':');
+  const std::string kind = segment.substr(0, colon);
+  const std::string rest = colon == std::string::npos ? "" : segment.substr(colon + 1);
+  const auto query = rest.find('?');
+  const std::string target = rest.substr(0, query);
+  const std::string options = query == std::string::npos ? "" : rest.substr(query + 1);
+  cosmic::SegmentSpec spec;
+  spec.name = kind;
+  if (kind == "dds" && !target.empty() && target.find_first_not_of("0123456789") == std::string::npos && target.size() < 4) {
+    spec.type = cosmic::SegmentType::dds;
+    spec.dds.domain = static_cast<std::uint32_t>(std::stoul(target));
+    if (options == "reliability=best_effort") spec.reliability = cosmic::Reliability::best_effort;
+    else if (!options.empty() && options != "reliability=reliable") error = "unknown DDS option '" + options + "'";
+    return error.empty() ? cosmic::client_detail::make_ip_transport(spec) : nullptr;
+  }
+  if (kind == "lcm" && (rest.rfind("udpm://", 0) == 0 || rest.rfind("memq://", 0) == 0)) {
+    spec.type = cosmic::SegmentType::lcm;
+    spec.reliability = cosmic::Reliability::best_effort;
+    spec.lcm.url = rest;
+    return cosmic::client_detail::make_ip_transport(spec);
+  }
+  if (kind == "can" && !target.empty() && options.rfind("node=", 0) == 0) {
+    const unsigned long node = std::strtoul(options.c_str() + 5, nullptr, 0);
+    if (node <= cosmic::kMaxTxNode) return cosmic::client_detail::make_can_transport(target, static_cast<std::uint8_t>(node));
+  }
+  error = "segment '" + segment + "' is none of dds:DOMAIN[?reliability=best_effort], lcm:udpm://GROUP:PORT?ttl=N, can:IFACE?node=0..127";
+  return nullptr;
+}
+
+cosmic::ChannelSpec spec_of(const cosmic_channel_desc& d) {
+  cosmic::ChannelSpec s;
+  s.name = d.name;
+  s.subject = d.subject;
+  s.cls = static_cast<cosmic::ChannelClass>(d.cls);
+  if (d.period_ns > 0) s.period = cosmic::Nanos(d.period_ns);
+  if (d.reaction_time_ns > 0) s.reaction_time = cosmic::Nanos(d.reaction_time_ns);
+  if (d.temp_validity_ns > 0) s.temp_validity = cosmic::Nanos(d.temp_validity_ns);
+  s.omission_degree = d.omission_degree;
+  s.payload = d.payload;
+  return s;
+}
+
+std::int64_t wall_clock_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+}  // namespace
+
+extern "C" {
+
+cosmic_client* cosmic_open(const char* segment, char* error, size_t error_size) {
+  std::string why;
+  auto client = std::make_unique<cosmic_client>();
+  client->transport = transport_for(segment ? segment : "", why);
+  if (client->transport && client->transport->start(*client, why) == COSMIC_OK) return client.release();
+  copy_text(why, error, error_size);
+  return nullptr;
+}
+
+void cosmic_close(cosmic_client* client) { delete client; }
+
+const char* cosmic_last_error(const cosmic_client* client) { return client ? client->error.c_str() : "no client"; }
+
+cosmic_channel* cosmic_announce(cosmic_client* client, const cosmic_channel_desc* desc, int timeout_ms) {
+  if (!client) return nullptr;
+  if (!desc || !desc->name || !*desc->name || desc->subject == 0 || desc->cls < COSMIC_HRT || desc->cls > COSMIC_NRT ||
+      !(desc->roles & (COSMIC_PUBLISH | COSMIC_SUBSCRIBE))) {
+    client->fail(COSMIC_E_INVALID, "a channel needs a name, a subject other than 0, a class and roles");
+    return nullptr;
+  }
+  auto channel = std::make_unique<cosmic_channel>();
+  channel->client = client;
+  channel->spec = spec_of(*desc);
+  channel->roles = desc->roles;
+  cosmic_channel* handle = channel.get();
+  {
+    std::lock_guard lock(client->mutex);
+    handle->index = client->channels.size();
+    client->channels.push_back(std::move(channel));
+  }
+  std::string why;
+  if (client->transport->announce(handle->index, handle->spec, handle->roles, timeout_ms, why) != COSMIC_OK) {
+    client->fail(COSMIC_E_TRANSPORT, why);
+    handle->roles = 0;  // stays in the table (indices are stable) but carries nothing
+    return nullptr;
+  }
+  return handle;
+}
+
+int cosmic_publish(cosmic_channel* channel, const void* data, size_t size) {
+  if (!channel || (size && !data) || !(channel->roles & COSMIC_PUBLISH)) return COSMIC_E_INVALID;
+  if (size > channel->spec.payload) {
+    return channel->client->fail(COSMIC_E_TOO_LARGE, "event of " + std::to_string(size) + " B on channel '" + channel->spec.name +
+                                                         "' whose payload is " + std::to_string(channel->spec.payload) + " B");
+  }
+  cosmic::EventHeader header;
+  header.subject = channel->spec.subject;
+  {
+    std::lock_guard lock(channel->mutex);
+    header.sequence = ++channel->sequence;
+  }
+  header.created_ns = wall_clock_ns();
+  std::string why;
+  const int rc = channel->client->transport->send(channel->index, header, {static_cast<const std::uint8_t*>(data), size}, why);
+  return rc == COSMIC_OK || rc == COSMIC_E_AGAIN ? rc : channel->client->fail(rc, why);
+}
+
+int cosmic_subscribe(cosmic_channel* channel, cosmic_event_fn fn, void* user) {
+  if (!channel || !(channel->roles & COSMIC_SUBSCRIBE)) return COSMIC_E_INVALID;
+  std::lock_guard lock(channel->mutex);
+  channel->callback = fn;
+  channel->user = user;
+  return COSMIC_OK;
+}
+
+int cosmic_get_event(cosmic_channel* channel, cosmic_event_info* info, void* buffer, size_t capacity) {
+  if (!channel || !info || (capacity && !buffer)) return COSMIC_E_INVALID;
+  std::lock_guard lock(channel->mutex);
+  if (channel->queue.empty()) return COSMIC_E_AGAIN;
+  const QueuedEvent& e = channel->queue.front();
+  *info = e.info;
+  if (e.data.size() > capacity) return COSMIC_E_TOO_LARGE;
+  if (!e.data.empty()) std::memcpy(buffer, e.data.data(), e.data.size());
+  channel->queue.pop_front();
+  return COSMIC_OK;
+}
+
+int cosmic_check_channel(const char* control_socket, const char* name, char* verdict, size_t verdict_size) {
+  if (!control_socket || !name) return COSMIC_E_INVALID;
+  std::string answer;
+  const int rc = cosmic::client_detail::query_verdict(control_socket, name, answer);
+  copy_text(answer, verdict, verdict_size);
+  return rc;
+}
+
+}  // extern "C"

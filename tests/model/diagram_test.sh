@@ -1,0 +1,42 @@
+#!/bin/bash
+# The Event-Channel Diagram of config/robot.yaml, offline: DOT text, SVG from Graphviz, and the
+# SVG drawn by a real browser (headless Chromium) into a PNG that must show the diagram's colours.
+# Usage: diagram_test.sh COSMICCTL ROBOT_YAML
+set -u
+COSMICCTL=$1
+ROBOT=$2
+HERE=$(cd "$(dirname "$0")" && pwd)
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+status=0
+fail() { echo "FAIL: $*" >&2; status=1; }
+
+"$COSMICCTL" diagram --format dot "$ROBOT" >"$WORK/robot.dot" || fail "diagram --format dot exited $?"
+grep -q '^digraph event_channels' "$WORK/robot.dot" || fail "DOT has no digraph"
+for channel in distance acceleration odometry obstacle speed command actual_speed diagnostics; do
+  grep -q "channel_$channel \[" "$WORK/robot.dot" || fail "DOT lacks channel $channel"
+done
+grep -q 'component_speed_controller -> channel_speed \[label="P"' "$WORK/robot.dot" || fail "no P tag speed_controller -> speed"
+grep -q 'channel_actual_speed -> component_speed_controller \[label="S"' "$WORK/robot.dot" || fail "no S tag actual_speed -> speed_controller"
+grep -q 'subject 0x0000000100000042' "$WORK/robot.dot" || fail "distance's subject missing"
+grep -q 'reaction_time 5 ms' "$WORK/robot.dot" || fail "distance's QoS list missing"
+
+"$COSMICCTL" diagram "$ROBOT" >"$WORK/robot.svg" || fail "diagram (svg) exited $?"
+grep -q '<svg' "$WORK/robot.svg" || fail "no SVG on stdout"
+grep -q '#a5d6a7' "$WORK/robot.svg" || fail "SVG has no 'bound' colour"
+
+# A configuration error is reported with its location, nothing on stdout.
+printf 'segments: []\nchannels: []\ncomponents: [{name: x, segment: nowhere, publishes: [a]}]\n' >"$WORK/bad.yaml"
+"$COSMICCTL" diagram "$WORK/bad.yaml" >"$WORK/bad.out" 2>"$WORK/bad.err"
+[ $? -eq 2 ] || fail "bad file: exit code is not 2"
+grep -q "bad.yaml:3:.*components\[0\].segment: unknown segment 'nowhere'" "$WORK/bad.err" || fail "bad file: no located error: $(cat "$WORK/bad.err")"
+[ -s "$WORK/bad.out" ] && fail "bad file: something on stdout"
+
+# A real browser draws it.
+timeout 120 chromium --headless --no-sandbox --disable-gpu --disable-background-networking --disable-component-update \
+  --disable-sync --no-first-run --user-data-dir="$WORK/chromium" --window-size=1800,1600 \
+  --screenshot="$WORK/robot.png" "file://$WORK/robot.svg" >"$WORK/chromium.log" 2>&1
+[ -s "$WORK/robot.png" ] || fail "chromium made no screenshot: $(tail -5 "$WORK/chromium.log")"
+# bound (green), the channel header (slate), the segment clusters (light blue), components (cream)
+python3 "$HERE/png_colours.py" "$WORK/robot.png" a5d6a7 37474f e3f2fd fff8e1 || fail "the screenshot lacks the diagram's colours"
+exit $status
