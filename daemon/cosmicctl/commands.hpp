@@ -1,6 +1,7 @@
 // cosmicctl subcommands. Each registers itself on the CLI11 app and runs when selected.
 // Exit codes: 0 success, 1 a channel was rejected or the daemon refused, 2 configuration
-// errors, 64 usage errors, 69 daemon unreachable, 77 permission denied.
+// errors, 64 usage errors, 69 daemon unreachable, 75 the daemon is busy (try again), 77 permission
+// denied.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -15,6 +16,7 @@ inline constexpr int kExitRejected = 1;
 inline constexpr int kExitConfigError = 2;
 inline constexpr int kExitUsage = 64;
 inline constexpr int kExitUnavailable = 69;
+inline constexpr int kExitTempFail = 75;
 inline constexpr int kExitNoPermission = 77;
 
 using CommandRunner = std::function<int()>;
@@ -28,5 +30,6 @@ CommandRunner add_check_command(CLI::App& app, const GlobalOptions& options);
 std::vector<CommandRunner> add_daemon_commands(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_diagram_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_gen_command(CLI::App& app, const GlobalOptions& options);
+CommandRunner add_top_command(CLI::App& app, const GlobalOptions& options);
 
 }  // namespace cosmicctl

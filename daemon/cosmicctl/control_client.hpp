@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 
 namespace cosmicctl {
 
@@ -13,6 +14,11 @@ struct ClientResult {
   bool permission_denied = false;  // the socket refused us (file permissions)
 };
 
+// The daemon's answer is returned even when it closed the connection before reading the whole
+// request (too_large, busy): that answer says more than "Broken pipe".
 ClientResult request(const std::string& socket_path, const nlohmann::json& request, int timeout_ms = 30'000);
+
+// Offset of the first byte that is not well-formed UTF-8 (JSON carries UTF-8 only), if any.
+std::optional<std::size_t> first_invalid_utf8(std::string_view text);
 
 }  // namespace cosmicctl

@@ -39,7 +39,15 @@ int exit_code_for_failure(const Json& response) {
   if (code == "permission_denied") return kExitNoPermission;
   if (code == "config_error") return kExitConfigError;
   if (code == "bad_request" || code == "unknown_command") return kExitUsage;
+  if (code == "busy" || code == "timeout") return kExitTempFail;
   return kExitRejected;
+}
+
+// JSON carries UTF-8 only: other bytes get a clear message instead of an encoder exception.
+bool is_utf8(const std::string& what, const std::string& text) {
+  const auto bad = first_invalid_utf8(text);
+  if (bad) std::cerr << "cosmicctl: " << what << " is not valid UTF-8 (byte " << *bad << ")\n";
+  return !bad;
 }
 
 void print_verdicts(const Json& channels) {
@@ -197,6 +205,7 @@ std::vector<CommandRunner> add_daemon_commands(CLI::App& app, const GlobalOption
   auto channel_name = std::make_shared<std::string>();
   channel->add_option("NAME", *channel_name, "Channel name")->required();
   runners.push_back(add_request_command(app, options, channel, [channel_name](Json& req) {
+    if (!is_utf8("channel name", *channel_name)) return kExitUsage;
     req = {{"command", "channel"}, {"name", *channel_name}};
     return kExitOk;
   }, print_channel));
@@ -205,6 +214,7 @@ std::vector<CommandRunner> add_daemon_commands(CLI::App& app, const GlobalOption
   auto unbind_name = std::make_shared<std::string>();
   unbind->add_option("NAME", *unbind_name, "Channel name")->required();
   runners.push_back(add_request_command(app, options, unbind, [unbind_name](Json& req) {
+    if (!is_utf8("channel name", *unbind_name)) return kExitUsage;
     req = {{"command", "unbind"}, {"name", *unbind_name}};
     return kExitOk;
   }, [](const Json& r) { std::cout << "unbound " << text(r["unbound"]) << "\n"; }));
@@ -220,6 +230,8 @@ std::vector<CommandRunner> add_daemon_commands(CLI::App& app, const GlobalOption
     }
     std::stringstream content;
     content << in.rdbuf();
+    if (!is_utf8("file name " + *bind_file, *bind_file)) return kExitUsage;
+    if (!is_utf8(*bind_file, content.str())) return kExitConfigError;
     req = {{"command", "bind"}, {"yaml", content.str()}, {"file", *bind_file}};
     return kExitOk;
   }, [](const Json& r) { print_verdicts(r["channels"]); }));

@@ -70,6 +70,13 @@ const std::vector<BadConfig> kBadConfigs = {
   {"bad_lcm_url.yaml", {{6, 10, "segments[1].url", "unsupported LCM URL 'http://239.255.76.67:7667'"}}},
   {"bad_discovery_server.yaml", {{4, 23, "segments[0].discovery_server", "'127.0.0.1' is not IP:PORT"}}},
   {"relative_control_socket.yaml", {{2, 19, "gateway.control_socket", "'run/cosmicd.sock' is not an absolute path"}}},
+  // quantities past what their type holds: a located, precise message (never an overflow)
+  {"tiny_max_rate.yaml", {{10, 15, "channels[0].max_rate", "'0.00000000001Hz' is out of range (from 0.000000001Hz"}}},
+  {"subject_above_64_bits.yaml", {{8, 14, "channels[0].subject", "'18446744073709551616' is out of range (above 2^64 - 1)"}}},
+  {"subject_5000_digits.yaml", {{8, 14, "channels[0].subject", "'111111111111111111111111...' (5000 characters) is out of range (above 2^64 - 1)"}}},
+  {"period_5000_digits.yaml", {{10, 13, "channels[0].period", "(5002 characters) has 5000 digits (at most 30,"}}},
+  // transport limits (cosmic/transport_limits.hpp), the same the adapters apply
+  {"lcm_name_too_long.yaml", {{7, 11, "channels[0].name", "segment 'viz' cannot carry this channel: LCM channel names have at most 63 characters"}}},
   // bad units
   {"bad_duration_unit.yaml", {{10, 13, "channels[0].period", "unknown unit 'msec' in '10 msec' (a duration such as 250us, 10ms, 1.5s)"}}},
   {"missing_unit.yaml", {{11, 20, "channels[0].reaction_time", "'5' has no unit"}}},
@@ -102,6 +109,7 @@ const std::vector<BadConfig> kBadConfigs = {
   // documents
   {"yaml_syntax_error.yaml", {{7, 10, "", "YAML syntax error: end of sequence flow not found"}}},
   {"empty.yaml", {{1, 1, "", "the document is empty"}}},
+  {"alias_bomb.yaml", {{7, 8, "", "aliases expand the document beyond 2000000 nodes"}}},
   {"missing_segments.yaml", {{1, 1, "segments", "missing required key 'segments'"},
                              {7, 18, "channels[0].publishers[0]", "unknown segment 'lan'"},
                              {8, 19, "channels[0].subscribers[0]", "unknown segment 'viz'"}}},

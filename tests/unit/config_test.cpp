@@ -366,5 +366,73 @@ TEST(BindDocument, ErrorsWithLocation) {
   EXPECT_NE(r.errors[0].message.find("empty"), std::string::npos);
 }
 
+// A running configuration with IP segments only: lan and lan2 (DDS), viz (LCM).
+Config ip_segments() {
+  return parse_ok("segments: [{name: lan, type: dds}, {name: lan2, type: dds, domain: 1}, {name: viz, type: lcm}]\nchannels: []\n");
+}
+
+TEST(BoundedYaml, AliasAmplificationInABindRequestIsRefusedWithItsLocation) {
+  std::string yaml = "a: &a [{name: c, subject: 1, class: nrt, publishers: [lan], subscribers: [viz]}]\n";
+  std::string previous = "a";
+  for (const char* level : {"b", "c", "d", "e", "f", "g", "h"}) {
+    yaml += std::string(level) + ": &" + level + " [";
+    for (int i = 0; i < 10; ++i) yaml += (i ? ", *" : "*") + previous;
+    yaml += "]\n";
+    previous = level;
+  }
+  yaml += "channels: *h\n";
+  ASSERT_LT(yaml.size(), 1000u);
+  const auto r = parse_channels(yaml, "bind.yaml", ip_segments());
+  ASSERT_EQ(r.errors.size(), 1u) << describe(r.errors);
+  EXPECT_NE(r.errors[0].message.find("aliases expand the document beyond"), std::string::npos);
+  EXPECT_GT(r.errors[0].line, 1);
+  EXPECT_TRUE(r.channels.empty());
+}
+
+TEST(BoundedYaml, ErrorsBeyondTheLimitAreCountedInOneLine) {
+  std::string yaml = "segments: [{name: lan, type: dds}, {name: viz, type: lcm}]\nchannels:\n";
+  for (int i = 0; i < 250; ++i) yaml += "  - {name: c" + std::to_string(i) + ", subject: 0, class: nrt, publishers: [lan], subscribers: [viz]}\n";
+  const auto r = parse_config(yaml, "many.yaml");
+  ASSERT_EQ(r.errors.size(), 101u);
+  EXPECT_EQ(r.errors[99].path, "channels[99].subject");
+  EXPECT_EQ(r.errors[100].message, "150 more error(s) not shown");
+}
+
+TEST(BoundedYaml, ALargeFileWithinTheLimitsStillLoads) {
+  std::string yaml = "segments: [{name: lan, type: dds}, {name: viz, type: lcm}]\nchannels:\n";
+  const std::string comment = "  # " + std::string(200, '-') + "\n";  // bytes without nodes: parsing stays quick
+  for (int i = 1; i <= 4000; ++i) {  // above 1 MiB: the node count runs too
+    yaml += comment + "  - {name: channel_number_" + std::to_string(i) + ", subject: " + std::to_string(i) +
+            ", class: nrt, publishers: [lan], subscribers: [viz]}\n";
+  }
+  ASSERT_GT(yaml.size(), 1u << 20);
+  const auto r = parse_config(yaml, "large.yaml");
+  EXPECT_TRUE(r.ok()) << describe(r.errors);
+  EXPECT_EQ(r.config.channels.size(), 4000u);
+  EXPECT_FALSE(parse_config(std::string(9u << 20, '#'), "huge.yaml").ok());
+}
+
+TEST(Quantities, MaxRateBecomesAPeriodWithoutOverflow) {
+  const auto slowest = parse_channels("{name: c, subject: 1, class: nrt, max_rate: 0.000000001Hz, publishers: [lan], subscribers: [viz]}",
+                                      "bind.yaml", ip_segments());
+  ASSERT_TRUE(slowest.ok()) << describe(slowest.errors);
+  ASSERT_TRUE(slowest.channels[0].period);
+  EXPECT_GT(*slowest.channels[0].period, Nanos(999'999'999'000'000'000));  // 1e9 s, give or take rounding
+  EXPECT_LE(*slowest.channels[0].period, Nanos(1'000'000'000'000'000'000));
+  EXPECT_EQ(period_of_rate(1e9), Nanos(1));
+  EXPECT_EQ(period_of_rate(3.0), Nanos(333'333'333));
+}
+
+TEST(Quantities, ALongLcmNameIsRefusedOnlyWhereLcmCarriesIt) {
+  const std::string name(64, 'n');
+  const auto over_dds = parse_channels("{name: " + name + ", subject: 1, class: nrt, publishers: [lan], subscribers: [lan2]}",
+                                       "bind.yaml", ip_segments());
+  const auto over_lcm = parse_channels("{name: " + name + ", subject: 1, class: nrt, publishers: [lan], subscribers: [viz]}",
+                                       "bind.yaml", ip_segments());
+  EXPECT_FALSE(over_lcm.ok());
+  EXPECT_NE(describe(over_lcm.errors).find("at most 63 characters"), std::string::npos) << describe(over_lcm.errors);
+  EXPECT_TRUE(over_dds.ok()) << describe(over_dds.errors);
+}
+
 }  // namespace
 }  // namespace cosmic

@@ -1,4 +1,5 @@
 #include "cosmic/config_loader.hpp"
+#include "cosmic/transport_limits.hpp"
 
 #include <arpa/inet.h>
 #include <yaml-cpp/yaml.h>
@@ -10,7 +11,6 @@
 #include <sstream>
 
 #include "cosmic/admission.hpp"
-#include "components_loader.hpp"
 #include "realtime_loader.hpp"
 #include "segment_overlap.hpp"
 #include "yaml_reader.hpp"
@@ -84,12 +84,10 @@ class ConfigParser {
       result.errors = reader_.take_errors();
       return result;
     }
-    if (reader_.check_map(*root, "", {"gateway", "segments", "channels", "components"})) {
+    if (reader_.check_map(*root, "", {"gateway", "segments", "channels"})) {
       if (has(*root, "gateway")) parse_gateway((*root)["gateway"]);
       if (require(*root, "", "segments", "a list of segments (type can, dds or lcm)")) parse_segments((*root)["segments"]);
-      derive_bindings_ = config_detail::has_components(*root);
       if (require(*root, "", "channels", "a list of channels")) parse_channel_list((*root)["channels"], "channels");
-      config_detail::load_components(reader_, *root, config_);
     }
     result.config = std::move(config_);
     result.errors = reader_.take_errors();
@@ -122,17 +120,7 @@ class ConfigParser {
 
  private:
   std::optional<YAML::Node> load(std::string_view text) {
-    try {
-      YAML::Node root = YAML::Load(std::string(text));
-      if (!root || root.IsNull()) {
-        reader_.error(YAML::Mark(), "", "the document is empty", "a map with gateway, segments and channels");
-        return std::nullopt;
-      }
-      return root;
-    } catch (const YAML::ParserException& e) {
-      reader_.error(e.mark, "", "YAML syntax error: " + e.msg, "well-formed YAML");
-      return std::nullopt;
-    }
+    return reader_.load(text, "a map with gateway, segments and channels");
   }
 
   bool require(const YAML::Node& map, const std::string& path, const char* name, const char* valid) {
@@ -441,6 +429,7 @@ class ConfigParser {
       c.lcm_encoding = static_cast<LcmEncoding>(reader_.choice(node["encoding"], key(path, "encoding"), {"envelope", "raw"}).value_or(0));
     }
     parse_bindings(node, path, c);
+    check_transport_limits(node, path, c);
     if (reader_.error_count() != errors_before) return std::nullopt;
     return c;
   }
@@ -454,7 +443,7 @@ class ConfigParser {
     } else if (has(node, "max_rate")) {
       if (auto hz = reader_.frequency(node["max_rate"], key(path, "max_rate"))) {
         // Minimum inter-arrival time, rounded down: a conservative (higher) load.
-        c.period = Nanos(std::max<std::int64_t>(1, static_cast<std::int64_t>(1e9 / *hz)));
+        c.period = period_of_rate(*hz);
       }
     } else if (realtime && !node["period"] && !node["max_rate"]) {  // a key without value: check_map said so
       reader_.error_at(node, key(path, "period"), "an hrt or srt channel needs period or max_rate",
@@ -473,7 +462,6 @@ class ConfigParser {
     std::set<std::string> publishers;
     for (const char* role : {"publishers", "subscribers"}) {
       const std::string p = key(path, role);
-      if (derive_bindings_ && !node[role]) continue;  // taken from the components (components_loader)
       if (!require(node, path, role, "a non-empty list of segment names")) continue;
       auto names = reader_.string_list(node[role], p);
       if (!names) continue;
@@ -505,6 +493,23 @@ class ConfigParser {
     }
   }
 
+  // The same limits the adapters apply (cosmic/transport_limits.hpp): refused here, with a
+  // location, rather than bound and silent at run time.
+  void check_transport_limits(const YAML::Node& node, const std::string& path, const ChannelSpec& c) {
+    std::set<std::string> reported;
+    for (const auto* names : {&c.publishers, &c.subscribers}) {
+      for (const auto& name : *names) {
+        const SegmentSpec* segment = config_.find_segment(name);
+        if (!segment) continue;
+        const auto problem = transport_name_problem(segment->type, c.name);
+        if (problem && reported.insert(*problem).second) {
+          reader_.error_at(node["name"], key(path, "name"), "segment '" + name + "' cannot carry this channel: " + *problem,
+                           "a shorter name");
+        }
+      }
+    }
+  }
+
   std::string segment_list() const {
     std::string out;
     for (const auto& name : segment_names_) out += (out.empty() ? "" : ", ") + name;
@@ -515,7 +520,6 @@ class ConfigParser {
 
   YamlReader reader_;
   Config config_;
-  bool derive_bindings_ = false;  // the document has components: P/S lists may be left out
   std::set<std::string> segment_names_;
   std::map<std::string, int> channel_names_;
   std::map<std::uint64_t, std::string> subjects_;
@@ -537,15 +541,13 @@ ConfigResult parse_config(std::string_view text, const std::string& file_name) {
 }
 
 ConfigResult load_config_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) {
+  std::string text;
+  if (const std::string error = config_detail::read_yaml_file(path, text); !error.empty()) {
     ConfigResult result;
-    result.errors.push_back(ConfigError{path, 0, 0, "", "cannot read the file", "a readable YAML file"});
+    result.errors.push_back(ConfigError{path, 0, 0, "", error, "a readable YAML file"});
     return result;
   }
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return parse_config(buffer.str(), path);
+  return parse_config(text, path);
 }
 
 ChannelsResult parse_channels(std::string_view text, const std::string& file_name, const Config& running) {

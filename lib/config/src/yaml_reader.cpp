@@ -1,8 +1,15 @@
 #include "yaml_reader.hpp"
 
+#include "cosmic/transport_limits.hpp"
+
+#include <yaml-cpp/eventhandler.h>
+
 #include <algorithm>
 #include <charconv>
+#include <fstream>
+#include <map>
 #include <set>
+#include <sstream>
 
 namespace cosmic::config_detail {
 
@@ -15,7 +22,143 @@ std::string join(std::initializer_list<const char*> words) {
   return out;
 }
 
+std::string read_yaml_file(const std::string& path, std::string& text) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "cannot read the file";
+  text.resize(kMaxYamlBytes + 1);
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxYamlBytes) return "the file is larger than " + std::to_string(kMaxYamlBytes >> 20) + " MiB";
+  if (in.bad()) return "cannot read the file";
+  return {};
+}
+
+namespace {
+
+// Counts the nodes of a YAML stream as if every alias were expanded, without building it:
+// each anchored node's expanded size is remembered and an alias adds it. Stops counting at the
+// limit and keeps where the limit was crossed.
+class ExpansionCounter final : public YAML::EventHandler {
+ public:
+  explicit ExpansionCounter(std::uint64_t limit) : limit_(limit) {}
+  bool exceeded() const { return exceeded_; }
+  const YAML::Mark& where() const { return where_; }
+  bool by_alias() const { return by_alias_; }
+
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) override { leaf(mark, anchor); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, const std::string&) override {
+    leaf(mark, anchor);
+  }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t anchor) override {
+    const auto size = sizes_.find(anchor);
+    add(size == sizes_.end() ? 1 : size->second, mark, true);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+    open(mark, anchor);
+  }
+  void OnSequenceEnd() override { close(); }
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+    open(mark, anchor);
+  }
+  void OnMapEnd() override { close(); }
+
+ private:
+  struct Frame {
+    std::uint64_t size = 1;
+    YAML::anchor_t anchor = 0;
+  };
+  void leaf(const YAML::Mark& mark, YAML::anchor_t anchor) {
+    if (anchor) sizes_[anchor] = 1;
+    add(1, mark, false);
+  }
+  void open(const YAML::Mark& mark, YAML::anchor_t anchor) {
+    count(1, mark, false);  // the collection itself; its children arrive as events
+    stack_.push_back({1, anchor});
+  }
+  void close() {
+    const Frame done = stack_.back();
+    stack_.pop_back();
+    if (done.anchor) sizes_[done.anchor] = done.size;
+    if (!stack_.empty()) stack_.back().size = saturated(stack_.back().size + done.size);
+  }
+  // A leaf (1) or an alias (the size of what it repeats) inside the innermost collection.
+  void add(std::uint64_t nodes, const YAML::Mark& mark, bool alias) {
+    if (!stack_.empty()) stack_.back().size = saturated(stack_.back().size + nodes);
+    count(nodes, mark, alias);
+  }
+  void count(std::uint64_t nodes, const YAML::Mark& mark, bool alias) {
+    total_ = saturated(total_ + nodes);
+    if (total_ > limit_ && !exceeded_) {
+      exceeded_ = true;
+      where_ = mark;
+      by_alias_ = alias;
+    }
+  }
+  std::uint64_t saturated(std::uint64_t value) const { return std::min(value, limit_ + 1); }
+
+  std::uint64_t limit_;
+  std::uint64_t total_ = 0;
+  std::vector<Frame> stack_;
+  std::map<YAML::anchor_t, std::uint64_t> sizes_;
+  bool exceeded_ = false;
+  bool by_alias_ = false;
+  YAML::Mark where_ = YAML::Mark::null_mark();
+};
+
+// Cheap first: a text without '*' has no alias, and a small one cannot hold many nodes.
+bool worth_counting(std::string_view text) { return text.find('*') != std::string_view::npos || text.size() > (1u << 20); }
+
+}  // namespace
+
+std::optional<YAML::Node> YamlReader::load(std::string_view text, const char* expected) {
+  if (text.size() > kMaxYamlBytes) {
+    error(YAML::Mark(), "", "the document is larger than " + std::to_string(kMaxYamlBytes >> 20) + " MiB",
+          "a smaller file (split it)");
+    return std::nullopt;
+  }
+  try {
+    if (worth_counting(text)) {
+      std::istringstream stream{std::string(text)};
+      YAML::Parser parser(stream);
+      ExpansionCounter counter(kMaxYamlNodes);
+      while (!counter.exceeded() && parser.HandleNextDocument(counter)) {
+      }
+      if (counter.exceeded()) {
+        error(counter.where(), "",
+              counter.by_alias() ? "aliases expand the document beyond " + std::to_string(kMaxYamlNodes) + " nodes"
+                                 : "the document has more than " + std::to_string(kMaxYamlNodes) + " nodes",
+              "fewer nodes; an alias (*name) counts every node it repeats");
+        return std::nullopt;
+      }
+    }
+    YAML::Node root = YAML::Load(std::string(text));
+    if (!root || root.IsNull()) {
+      error(YAML::Mark(), "", "the document is empty", expected);
+      return std::nullopt;
+    }
+    return root;
+  } catch (const YAML::ParserException& e) {
+    error(e.mark, "", "YAML syntax error: " + e.msg, "well-formed YAML");
+    return std::nullopt;
+  }
+}
+
+std::vector<ConfigError> YamlReader::take_errors() {
+  if (suppressed_ > 0) {
+    errors_.push_back(ConfigError{file_, 0, 0, "", std::to_string(suppressed_) + " more error(s) not shown",
+                                  "fix the errors above and check again"});
+    suppressed_ = 0;
+  }
+  return std::move(errors_);
+}
+
 void YamlReader::error(const YAML::Mark& mark, const std::string& path, std::string message, std::string valid) {
+  if (errors_.size() >= kMaxReportedErrors) {
+    ++suppressed_;
+    return;
+  }
   const int line = mark.is_null() ? 0 : mark.line + 1;
   const int column = mark.is_null() ? 0 : mark.column + 1;
   errors_.push_back(ConfigError{file_, line, column, path, std::move(message), std::move(valid)});
@@ -76,12 +219,13 @@ std::optional<std::string> YamlReader::string(const YAML::Node& node, const std:
 std::optional<std::string> YamlReader::name(const YAML::Node& node, const std::string& path) {
   auto value = string(node, path);
   if (!value) return std::nullopt;
-  const bool ok = value->size() <= 64 && std::all_of(value->begin(), value->end(), [](char c) {
+  const bool ok = value->size() <= kMaxNameLength && std::all_of(value->begin(), value->end(), [](char c) {
                     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
                            c == '-' || c == '.';
                   });
   if (!ok) {
-    error_at(node, path, "invalid name '" + *value + "'", "1 to 64 characters from A-Z a-z 0-9 _ - .");
+    error_at(node, path, "invalid name " + quote_value(*value),
+             "1 to " + std::to_string(kMaxNameLength) + " characters from A-Z a-z 0-9 _ - .");
     return std::nullopt;
   }
   return value;
@@ -109,12 +253,17 @@ std::optional<std::uint64_t> YamlReader::unsigned_int(const YAML::Node& node, co
   }
   std::uint64_t parsed = 0;
   const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), parsed, base);
-  if (digits.empty() || ec != std::errc() || end != digits.data() + digits.size()) {
-    error_at(node, path, "'" + *value + "' is not a whole number", range + " (decimal or 0x hex)");
+  const bool all_digits = !digits.empty() && end == digits.data() + digits.size();
+  if (ec == std::errc::result_out_of_range && all_digits) {  // 2^64 and above, 5,000 digits
+    error_at(node, path, quote_value(*value) + " is out of range (above 2^64 - 1)", range);
+    return std::nullopt;
+  }
+  if (ec != std::errc() || !all_digits) {
+    error_at(node, path, quote_value(*value) + " is not a whole number", range + " (decimal or 0x hex)");
     return std::nullopt;
   }
   if (parsed < min || parsed > max) {
-    error_at(node, path, "'" + *value + "' is out of range", range);
+    error_at(node, path, quote_value(*value) + " is out of range", range);
     return std::nullopt;
   }
   return parsed;

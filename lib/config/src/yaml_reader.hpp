@@ -16,14 +16,30 @@
 
 namespace cosmic::config_detail {
 
+// Bounds on what one YAML text may cost, so a small hostile file (alias amplification, a
+// device, a huge file) cannot stall the control loop or `cosmicctl check`.
+inline constexpr std::size_t kMaxYamlBytes = 8u << 20;
+// Nodes after every alias is expanded (a 10,000-channel file has about 300,000).
+inline constexpr std::uint64_t kMaxYamlNodes = 2'000'000;
+// Errors reported per file; the rest are counted in one closing line.
+inline constexpr std::size_t kMaxReportedErrors = 100;
+
+// Reads at most kMaxYamlBytes of `path` into `text`; empty string or why not.
+std::string read_yaml_file(const std::string& path, std::string& text);
+
 class YamlReader {
  public:
   explicit YamlReader(std::string file) : file_(std::move(file)) {}
 
   void error(const YAML::Mark& mark, const std::string& path, std::string message, std::string valid = {});
   void error_at(const YAML::Node& node, const std::string& path, std::string message, std::string valid = {});
-  std::vector<ConfigError> take_errors() { return std::move(errors_); }
-  std::size_t error_count() const { return errors_.size(); }
+  std::vector<ConfigError> take_errors();
+  // Every error found, also those beyond kMaxReportedErrors.
+  std::size_t error_count() const { return errors_.size() + suppressed_; }
+
+  // Parses `text` within the bounds above; nullopt after recording why not. `expected` says
+  // what a non-empty document holds.
+  std::optional<YAML::Node> load(std::string_view text, const char* expected);
 
   // True when `node` is a map; reports unknown and duplicate keys against `allowed`.
   bool check_map(const YAML::Node& node, const std::string& path, std::initializer_list<const char*> allowed);
@@ -49,6 +65,7 @@ class YamlReader {
   std::optional<std::string> scalar(const YAML::Node& node, const std::string& path, const char* expected);
   std::string file_;
   std::vector<ConfigError> errors_;
+  std::size_t suppressed_ = 0;
 };
 
 std::string join(std::initializer_list<const char*> words);

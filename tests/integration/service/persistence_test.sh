@@ -145,7 +145,7 @@ corrupt no_version '{"bound": [], "unbound": []}' "unsupported state version (ex
 corrupt malformed '{"version": 1, "bound": "plot", "unbound": []}' "malformed state file"
 corrupt wrong_type '{"version": 1, "bound": [{"name": 7, "yaml": "x"}], "unbound": []}' "malformed state file"
 
-note "a recorded binding that no longer fits the configuration: dropped with a warning"
+note "a recorded binding that cannot be bound now (its segment is gone or failed at boot): kept for the next start"
 cat >"$STATE" <<'EOF'
 {"version": 1,
  "bound": [{"name": "ghost", "yaml": "{name: ghost, subject: 0x99, class: nrt, period: 1s, payload: 8B, publishers: [gone], subscribers: [lan]}"},
@@ -153,22 +153,45 @@ cat >"$STATE" <<'EOF'
  "unbound": ["no_such_channel"]}
 EOF
 start_daemon "${ARGS[@]}" || finish
-log_contains "runtime binding of channel ghost could not be restored; dropped"
+log_contains "runtime binding of channel ghost could not be restored ("
+log_contains "kept in the state file for the next start"
 log_contains "restored runtime binding of channel plot"
 expect_channels "stale binding" "plot speed status"
-state_check "after dropping ghost" '[b["name"] for b in d["bound"]] == ["plot"]'
+ctl unbind_after_ghost 0 unbind speed  # a later change rewrites the file: ghost stays in it
+state_check "ghost kept" '[b["name"] for b in d["bound"]] == ["ghost", "plot"]'
 stop_daemon
 
-note "a state file cosmicd cannot write: the change is still made, the error is logged"
-rm -rf "$WORK/state"
-install -d -m 0755 "$WORK/state"
-install -d -m 0555 "$WORK/state/bindings.json.tmp"  # a directory where the temporary file goes
+note "an entry whose name differs from the channel it defines: refused, never bound"
+cat >"$STATE" <<'EOF'
+{"version": 1,
+ "bound": [{"name": "alias", "yaml": "{name: plot, subject: 0x000000090000a010, class: nrt, period: 200ms, omission_degree: 5, payload: 16B, publishers: [viz], subscribers: [lan]}"}],
+ "unbound": []}
+EOF
 start_daemon "${ARGS[@]}" || finish
-ctl bind_unwritable 0 bind "$WORK/plot.yaml"
-log_contains "cannot save runtime bindings: open $STATE.tmp"
+log_contains "entry 'alias' defines channel(s) plot instead of exactly the channel it is named after; entry dropped"
+expect_channels "misnamed entry" "speed status"
+ctl unbind_after_alias 0 unbind speed
+state_check "misnamed entry dropped" 'd["bound"] == []'
+stop_daemon
+
+note "a state file that is a FIFO: refused at once, cosmicd starts from its configuration"
+rm -f "$STATE"
+mkfifo "$STATE"
+start_daemon "${ARGS[@]}" || finish
+log_contains "not a regular file; refusing to read it"
+expect_channels "FIFO state" "speed status"
+stop_daemon
+rm -f "$STATE"
+
+note "a state file cosmicd cannot write: the change is made, the answer says it was not saved"
+rm -rf "$WORK/state"
+echo "not a directory" >"$WORK/state"  # the state directory cannot be created
+start_daemon "${ARGS[@]}" || finish
+ctl bind_unwritable 1 bind "$WORK/plot.yaml"
+contains bind_unwritable err "will not survive a restart"
+log_contains "cannot save runtime bindings: create a temporary file beside $STATE"
 expect_channels "unwritable state" "plot speed status"
 stop_daemon
-[ -e "$STATE" ] && fail "a state file appeared although its temporary could not be written"
-rm -rf "$WORK/state/bindings.json.tmp"
+rm -f "$WORK/state"
 
 finish

@@ -33,8 +33,14 @@ Parsed<BitRate> parse_bitrate(std::string_view text);
 Parsed<std::uint64_t> parse_size(std::string_view text);
 // "70%" -> 0.70. Range 0..100 %.
 Parsed<double> parse_percent(std::string_view text);
-// "100Hz", "2.5kHz". Events per second, > 0.
+// "100Hz", "2.5kHz". Events per second, from 1e-9 (one per 1e9 s, the longest duration) to 1e9.
+// Numbers have at most 30 digits; every refusal quotes the text cut to a readable length.
 Parsed<double> parse_frequency(std::string_view text);
+// Minimum inter-arrival time of `hz` events per second, rounded down (a conservative, higher
+// load); `hz` is clamped to parse_frequency's range, so the result is 1 ns to 1e9 s.
+Nanos period_of_rate(double hz);
+// A value quoted in an error message: 'text', cut after 24 characters with its full length.
+std::string quote_value(std::string_view text);
 
 // Human-readable forms used in reports: "3.2 ms", "500 kbit/s".
 std::string format_duration(Nanos value);
