@@ -15,7 +15,11 @@ HERE=$(cd "$(dirname "$0")" && pwd)
 WORK=$(mktemp -d /tmp/cosmic-proof.XXXXXX)
 PIDS=()
 trap 'for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null; done; wait 2>/dev/null; rm -rf "$WORK"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
+fail() {
+  echo "FAIL: $*" >&2
+  [ -s "$WORK/cosmicd.log" ] && tail -n 20 "$WORK/cosmicd.log" | sed 's/^/cosmicd: /' >&2
+  exit 1
+}
 wait_until() {  # wait_until SECONDS WHAT CMD...: polls CMD until it succeeds
   local deadline=$((SECONDS + $1)) what=$2
   shift 2
@@ -41,8 +45,8 @@ PY
 cp "$HERE/speed_controller_logic.cpp" "$WORK/sc/speed_controller_logic.cpp"
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-cmake -S "$WORK/sc" -B "$WORK/sc/build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "${launcher[@]}" >"$WORK/build.log" 2>&1 &&
-  nice cmake --build "$WORK/sc/build" >>"$WORK/build.log" 2>&1 || fail "the generated project does not build: $(tail -30 "$WORK/build.log")"
+CCACHE_BASEDIR="$WORK" cmake -S "$WORK/sc" -B "$WORK/sc/build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "${launcher[@]}" >"$WORK/build.log" 2>&1 &&
+  CCACHE_BASEDIR="$WORK" nice cmake --build "$WORK/sc/build" >>"$WORK/build.log" 2>&1 || fail "the generated project does not build: $(tail -30 "$WORK/build.log")"
 
 # 3. cosmicd, the generated component (asking cosmicd for its channels first), the probe.
 "$COSMICD" --config "$WORK/robot-ip.yaml" --socket "$WORK/control.sock" --state-file "$WORK/state" 2>"$WORK/cosmicd.log" &
