@@ -2,7 +2,7 @@
 // sensors and the drive on the body segment (LCM here, or CAN in the VM), the operator's command
 // and the obstacle detector on the LAN, all through libcosmic-client.
 //
-//   cosmic-speed-probe --body SEGMENT --lan SEGMENT --count N
+//   cosmic-speed-probe --body SEGMENT --lan SEGMENT --count N [--ready-s S]
 //
 // It sets the nominal speed, then N times: actual speed = nominal (the controller falls silent),
 // then at T0 actual speed = 0; T1 is the arrival of the controller's next `speed` event at the
@@ -104,7 +104,7 @@ int main(int argc, char** argv) {
     speed.on_event([&](const cosmic_event_info&, std::span<const std::uint8_t> e) { drive.push(e); });
 
     // Ready when the whole chain carries: repeat command and sensor until the drive hears.
-    const auto ready_by = Clock::now() + std::chrono::seconds(30);
+    const auto ready_by = Clock::now() + std::chrono::seconds(std::stoi(arg(argc, argv, "--ready-s", "30")));
     bool ready = false;
     while (!ready && Clock::now() < ready_by) {
       command.publish_value(kNominal);
@@ -112,7 +112,7 @@ int main(int argc, char** argv) {
       ready = drive.wait_for(kNominal, Clock::time_point{}, Clock::now() + std::chrono::milliseconds(100)).has_value();
     }
     if (!ready) {
-      std::cerr << "speed-probe: no speed event reached the drive within 30 s\n";
+      std::cerr << "speed-probe: no speed event reached the drive in time\n";
       return 1;
     }
     std::vector<double> samples;

@@ -4,9 +4,12 @@
 # as its own CMake project and run against cosmicd:
 #   sensors (body segment) -> cosmicd -> speed_controller on DDS -> cosmicd -> drive (body segment)
 # with the end-to-end reaction measured (cosmic-speed-probe) next to what admission promised.
-# Here the body segment is LCM in a private network namespace (the DDS/LCM-only version of the
-# proof: the CAN kernel modules exist only in scripts/can-vm); every channel keeps robot.yaml's
-# definition.
+# Environment:
+#   PROOF_BODY=lcm (default)  the body bus is an LCM group (DDS/LCM-only proof; any host)
+#   PROOF_BODY=can            the body bus is robot.yaml's CAN bus on vcan0 (inside scripts/can-vm)
+#   PROOF_CONTROLLER_DIR=DIR  where the controller is generated and built (default: a temp dir)
+#   PROOF_PREBUILT=1          use the controller already built in PROOF_CONTROLLER_DIR
+# Every channel keeps robot.yaml's definition.
 #   speed_proof.sh COSMICD COSMICCTL SPEED_PROBE ROBOT_YAML [COUNT]
 set -u
 [ "${COSMIC_IN_NETNS:-}" = 1 ] || { echo "run me through scripts/netns-run" >&2; exit 2; }
@@ -29,34 +32,51 @@ wait_until() {  # wait_until SECONDS WHAT CMD...: polls CMD until it succeeds
   done
 }
 
-# 1. robot.yaml with the body bus as an LCM group (real-time declared, as the CAN bus would be).
-python3 - "$ROBOT" "$WORK/robot-ip.yaml" "$WORK/control.sock" <<'PY'
+BODY=${PROOF_BODY:-lcm}
+SC=${PROOF_CONTROLLER_DIR:-$WORK/sc}
+body_segment="lcm:udpm://239.255.76.68:7668?ttl=0"
+WAIT_S=30
+if [ "$BODY" = can ]; then
+  body_segment="can:vcan0?node=9"  # the probe's own TxNode; etags by GET_ETAG
+  WAIT_S=180                        # the VM emulates its CPU: everything starts slower
+  ip link add vcan0 type vcan 2>/dev/null || true
+  ip link set vcan0 up
+fi
+
+# 1. robot.yaml with its own control socket; for lcm the body bus becomes an LCM group
+#    (real-time declared, as the CAN bus would be).
+python3 - "$ROBOT" "$WORK/robot-run.yaml" "$WORK/control.sock" "$BODY" <<'PY'
 import re, sys
 text = open(sys.argv[1]).read()
-text = re.sub(r"  - name: body-can\n    type: can\n(    .*\n)+?(?=  - name:)",
-              "  - name: body-can\n    type: lcm\n    url: udpm://239.255.76.68:7668?ttl=0\n    latency_bound: 1ms\n    realtime: true\n", text)
+if sys.argv[4] == "lcm":
+  text = re.sub(r"  - name: body-can\n    type: can\n(    .*\n)+?(?=  - name:)",
+                "  - name: body-can\n    type: lcm\n    url: udpm://239.255.76.68:7668?ttl=0\n    latency_bound: 1ms\n    realtime: true\n", text)
 text = re.sub(r"control_socket: .*", "control_socket: " + sys.argv[3], text)
 open(sys.argv[2], "w").write(text)
 PY
-"$COSMICCTL" --json check "$WORK/robot-ip.yaml" >"$WORK/check.json"
+"$COSMICCTL" --json check "$WORK/robot-run.yaml" >"$WORK/check.json"
 
 # 2. Generate, fill in Fig. 8, build as its own CMake project.
-"$COSMICCTL" gen "$ROBOT" --component speed_controller --output "$WORK/sc" 2>"$WORK/gen.log" || fail "gen: $(cat "$WORK/gen.log")"
-cp "$HERE/speed_controller_logic.cpp" "$WORK/sc/speed_controller_logic.cpp"
-launcher=()
-command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-CCACHE_BASEDIR="$WORK" cmake -S "$WORK/sc" -B "$WORK/sc/build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "${launcher[@]}" >"$WORK/build.log" 2>&1 &&
-  CCACHE_BASEDIR="$WORK" nice cmake --build "$WORK/sc/build" >>"$WORK/build.log" 2>&1 || fail "the generated project does not build: $(tail -30 "$WORK/build.log")"
+if [ "${PROOF_PREBUILT:-0}" = 1 ]; then
+  [ -x "$SC/build/speed_controller" ] || fail "no controller built in $SC (run the lcm proof first)"
+else
+  "$COSMICCTL" gen "$ROBOT" --component speed_controller --output "$SC" 2>"$WORK/gen.log" || fail "gen: $(cat "$WORK/gen.log")"
+  cp "$HERE/speed_controller_logic.cpp" "$SC/speed_controller_logic.cpp"
+  launcher=()
+  command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  CCACHE_BASEDIR="$SC" cmake -S "$SC" -B "$SC/build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "${launcher[@]}" >"$WORK/build.log" 2>&1 &&
+    CCACHE_BASEDIR="$SC" nice cmake --build "$SC/build" >>"$WORK/build.log" 2>&1 || fail "the generated project does not build: $(tail -30 "$WORK/build.log")"
+fi
 
 # 3. cosmicd, the generated component (asking cosmicd for its channels first), the probe.
-"$COSMICD" --config "$WORK/robot-ip.yaml" --socket "$WORK/control.sock" --state-file "$WORK/state" 2>"$WORK/cosmicd.log" &
+"$COSMICD" --config "$WORK/robot-run.yaml" --socket "$WORK/control.sock" --state-file "$WORK/state" 2>"$WORK/cosmicd.log" &
 PIDS+=($!)
-wait_until 30 "cosmicd" "$COSMICCTL" --socket "$WORK/control.sock" status
-"$WORK/sc/build/speed_controller" --check "$WORK/control.sock" >"$WORK/sc.out" 2>&1 &
+wait_until "$WAIT_S" "cosmicd" "$COSMICCTL" --socket "$WORK/control.sock" status
+"$SC/build/speed_controller" --check "$WORK/control.sock" >"$WORK/sc.out" 2>&1 &
 PIDS+=($!)
-wait_until 30 "speed_controller ready" grep -q "speed_controller: ready on dds:0" "$WORK/sc.out"
+wait_until "$WAIT_S" "speed_controller ready" grep -q "speed_controller: ready on dds:0" "$WORK/sc.out"
 echo "speed_controller asked cosmicd:"; grep -v ready "$WORK/sc.out" | sed 's/^/  /'
-"$PROBE" --body "lcm:udpm://239.255.76.68:7668?ttl=0" --lan dds:0 --count "$COUNT" >"$WORK/probe.out" 2>&1
+"$PROBE" --body "$body_segment" --lan dds:0 --count "$COUNT" --ready-s "$WAIT_S" >"$WORK/probe.out" 2>&1
 probe_status=$?
 cat "$WORK/probe.out" | grep -v '^sample' | sed 's/^/probe: /'
 [ $probe_status -eq 0 ] || fail "the chain did not carry every step (probe exit $probe_status)"
