@@ -1,0 +1,39 @@
+#!/bin/bash
+# cosmicctl gen without building: the files of a skeleton, what they hold from the model, the
+# user's logic file kept on regeneration, and clear refusals.
+# Usage: gen_cli_test.sh COSMICCTL ROBOT_YAML
+set -u
+COSMICCTL=$1 ROBOT=$2
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+status=0
+fail() { echo "FAIL: $*" >&2; status=1; }
+
+"$COSMICCTL" gen "$ROBOT" --component speed_controller --output "$WORK/sc" 2>"$WORK/gen.err" || fail "gen exited $?"
+for f in CMakeLists.txt channels.hpp speed_controller.hpp speed_controller.cpp speed_controller_logic.cpp main.cpp; do
+  [ -s "$WORK/sc/$f" ] || fail "no $f"
+done
+grep -q 'kSegment = "dds:0"' "$WORK/sc/channels.hpp" || fail "segment of lan is not dds:0"
+grep -q 'speed{"speed", 0x0000000100000051ull, COSMIC_SRT, 10000000, 8000000, 40000000, 1, 4, COSMIC_PUBLISH}' "$WORK/sc/channels.hpp" ||
+  fail "speed's configuration differs from the model"
+grep -q 'actual_speed{"actual_speed", 0x0000000100000070ull, COSMIC_NRT, 20000000, 0, 0, 5, 4, COSMIC_SUBSCRIBE}' "$WORK/sc/channels.hpp" ||
+  fail "actual_speed's configuration differs from the model"
+for h in refresh_actual_speed refresh_command refresh_obstacle speed_period; do
+  grep -q "void $h(" "$WORK/sc/speed_controller.hpp" || fail "no handler $h"
+done
+grep -q "refresh_speed\|actual_speed_period" "$WORK/sc/speed_controller.hpp" && fail "a handler for a channel in the wrong direction"
+
+# The logic file is the user's: a second run keeps it.
+echo "// mine" >>"$WORK/sc/speed_controller_logic.cpp"
+"$COSMICCTL" gen "$ROBOT" --component speed_controller --output "$WORK/sc" 2>"$WORK/gen2.err" || fail "second gen exited $?"
+grep -q "// mine" "$WORK/sc/speed_controller_logic.cpp" || fail "the user's logic file was overwritten"
+grep -q "kept .*speed_controller_logic.cpp" "$WORK/gen2.err" || fail "gen did not say it kept the logic file"
+
+# A CAN component opens its bus with a TxNode of its own.
+"$COSMICCTL" gen "$ROBOT" --component drives --output "$WORK/drives" 2>/dev/null || fail "gen drives exited $?"
+grep -q 'kSegment = "can:vcan0?node=' "$WORK/drives/channels.hpp" || fail "drives does not open vcan0"
+
+"$COSMICCTL" gen "$ROBOT" --component nobody --output "$WORK/x" 2>"$WORK/unknown.err"
+[ $? -eq 64 ] || fail "unknown component: exit code is not 64"
+grep -q "no component 'nobody'.*speed_controller" "$WORK/unknown.err" || fail "unknown component: $(cat "$WORK/unknown.err")"
+exit $status
