@@ -13,15 +13,7 @@ DOMAIN=75
 LCM_PORT=7775
 # shellcheck source=lib.sh
 . "$(dirname "$0")/lib.sh"
-in_netns_or_skip
-
-WORK=$(mktemp -d /tmp/cosmic-svc-hostile.XXXXXX)
-cleanup() {
-  kill_daemon
-  [ -n "${KEEP_WORK:-}" ] || rm -rf "$WORK"
-}
-trap cleanup EXIT
-trap 'exit 130' INT TERM
+service_test_setup hostile
 
 SOCKET=$WORK/run/control.sock
 write_config "$WORK/cosmicd.yaml" "$SOCKET"

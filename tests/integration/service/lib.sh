@@ -25,6 +25,15 @@ finish() {
   exit 0
 }
 
+# service_test_setup NAME: checks the environment, makes the scratch directory $WORK (kept with
+# KEEP_WORK=1) and kills a daemon left running on exit.
+service_test_setup() {
+  in_netns_or_skip
+  WORK=$(mktemp -d "/tmp/cosmic-svc-$1.XXXXXX")
+  trap 'kill_daemon; [ -n "${KEEP_WORK:-}" ] || rm -rf "$WORK"' EXIT
+  trap 'exit 130' INT TERM
+}
+
 in_netns_or_skip() {
   if [ "$(id -u)" -ne 0 ]; then
     echo "SKIP: needs root (network namespace, users, groups)"
