@@ -275,6 +275,8 @@ void CanAdapter::stop() {
   {
     std::lock_guard lock(io_mutex_);
     backlog_.clear();
+    answers_.clear();
+    pending_requests_.clear();
     backlog_size_ = 0;
     wait_pollout_ = false;
     retry_at_.reset();
