@@ -17,6 +17,7 @@
 #include "cosmic/config_loader.hpp"
 #include "cosmic/control_server.hpp"
 #include "daemon_logger.hpp"
+#include "metrics_server.hpp"
 #include "service_notifier.hpp"
 
 namespace cosmicd {
@@ -249,6 +250,13 @@ class Daemon {
     log_.log(cosmic::LogLevel::error, "reload " + error.value("code", "failed") + ": " + error.value("message", ""));
   }
 
+  // Follows gateway.metrics (a reload may move or close the endpoint) and hands the endpoint's
+  // threads a fresh snapshot: they never call the gateway themselves.
+  void publish_metrics() {
+    metrics_.follow(gateway_.config().gateway.metrics);
+    if (metrics_.serving()) metrics_.publish(take_metrics_snapshot(gateway_, started_));
+  }
+
   void loop(cosmic::ControlServer& server) {
     auto last_health = std::chrono::steady_clock::now() - std::chrono::seconds(1);
     while (running_) {
@@ -258,6 +266,7 @@ class Daemon {
         gateway_.refresh_runtime(std::chrono::duration_cast<cosmic::Nanos>(std::chrono::steady_clock::now().time_since_epoch()));
         for (const auto& problem : gateway_.take_thread_problems()) log_.log(cosmic::LogLevel::warning, "realtime: " + problem);
         notifier_.tick(gateway_);
+        publish_metrics();
         last_health = std::chrono::steady_clock::now();
       }
     }
@@ -272,6 +281,8 @@ class Daemon {
   cosmic::Config file_config_;  // the configuration file as last loaded
   bool running_ = true;
   cosmic::ControlProtocol* protocol_ = nullptr;  // while run() serves the control socket
+  std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
+  MetricsServer metrics_{log_};  // last: its threads stop before anything they were given goes
 };
 
 }  // namespace

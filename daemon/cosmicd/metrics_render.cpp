@@ -215,15 +215,14 @@ void render_residence(Exposition& out, const std::vector<HopView>& hops) {
   out.family("cosmic_channel_residence_seconds", MetricType::histogram,
              "Time from the event's arrival at the gateway to the end of its send on this subscriber segment.");
   for (const auto& [h, e] : egress) out.histogram(hop_labels(*h), residence_bucket_bounds(), rebucket_residence(e->residence_buckets));
-  out.family("cosmic_channel_residence_quantile_seconds", MetricType::gauge,
-             "Residence quantiles since the channel was bound (upper bound of the router's fine-grained bucket).");
-  for (const auto& [h, e] : egress) {
-    const std::pair<const char*, cosmic::Nanos> quantiles[] = {{"0.5", e->residence_p50}, {"0.99", e->residence_p99}, {"0.999", e->residence_p999}};
-    for (const auto& [q, value] : quantiles) {
-      Labels labels = hop_labels(*h);
-      labels.emplace_back("quantile", q);
-      out.sample(labels, seconds(value));
-    }
+  // Gauges of their own: a "quantile" label belongs to summaries, which these are not.
+  const std::pair<const char*, cosmic::Nanos cosmic::HopRuntimeSnapshot::*> quantiles[] = {
+      {"cosmic_channel_residence_p50_seconds", &cosmic::HopRuntimeSnapshot::residence_p50},
+      {"cosmic_channel_residence_p99_seconds", &cosmic::HopRuntimeSnapshot::residence_p99},
+      {"cosmic_channel_residence_p999_seconds", &cosmic::HopRuntimeSnapshot::residence_p999}};
+  for (const auto& [name, field] : quantiles) {
+    out.family(name, MetricType::gauge, "Residence quantile since the channel was bound (upper end of the router's fine bucket).");
+    for (const auto& [h, e] : egress) out.sample(hop_labels(*h), seconds(e->*field));
   }
   out.family("cosmic_channel_residence_max_seconds", MetricType::gauge, "Longest residence since the channel was bound.");
   for (const auto& [h, e] : egress) out.sample(hop_labels(*h), seconds(e->residence_max));

@@ -174,8 +174,9 @@ TEST(MetricsRender, ResidenceHistogramIsRebucketedCumulatively) {
 TEST(MetricsRender, ResidenceQuantilesAndMisses) {
   const std::string m = text();
   const std::string out = "channel=\"distance\",class=\"hrt\",segment=\"lan\",role=\"subscriber\"";
-  EXPECT_LINE(m, "cosmic_channel_residence_quantile_seconds{" + out + ",quantile=\"0.5\"} " + format_number(3071e-9));
-  EXPECT_LINE(m, "cosmic_channel_residence_quantile_seconds{" + out + ",quantile=\"0.999\"} 0.002");
+  EXPECT_LINE(m, "cosmic_channel_residence_p50_seconds{" + out + "} " + format_number(3071e-9));
+  EXPECT_LINE(m, "cosmic_channel_residence_p99_seconds{" + out + "} 0.002");
+  EXPECT_LINE(m, "cosmic_channel_residence_p999_seconds{" + out + "} 0.002");
   EXPECT_LINE(m, "cosmic_channel_residence_max_seconds{" + out + "} 0.002");
   EXPECT_LINE(m, "cosmic_channel_residence_misses_total{" + out + "} 1");
   EXPECT_LINE(m, "cosmic_channel_deadline_misses_total{" + out + "} 2");
@@ -220,8 +221,8 @@ std::map<std::string, std::string> families(const std::string& document, Exposit
   std::string current_type;
   std::istringstream lines(document);
   std::string line;
-  const std::regex type_line("# TYPE ([a-z_]+) (counter|gauge|histogram)");
-  const std::regex sample_line("([a-z_]+)(\\{.*\\})? [-+0-9.eInfNa]+");
+  const std::regex type_line("# TYPE ([a-z0-9_]+) (counter|gauge|histogram)");
+  const std::regex sample_line("([a-z0-9_]+)(\\{.*\\})? [-+0-9.eInfNa]+");
   while (std::getline(lines, line)) {
     std::smatch match;
     if (std::regex_match(line, match, type_line)) {
