@@ -136,7 +136,10 @@ int run_top(const GlobalOptions& global, const TopOptions& options) {
   Fetched first = fetch(global.socket);
   if (!first.sample) {  // nothing to show: fail like every other command
     std::cerr << "cosmicctl: " << first.failure.error << "\n";
-    if (first.failure.response) return kExitRejected;
+    if (first.failure.response) {
+      const bool denied = first.failure.response->value("error", Json::object()).value("code", "") == "permission_denied";
+      return denied ? kExitNoPermission : kExitRejected;
+    }
     return first.failure.permission_denied ? kExitNoPermission : kExitUnavailable;
   }
   install_stop_handlers();
