@@ -77,11 +77,15 @@ class DotWriter {
   DotWriter(const cosmic::Config& config, const DiagramStatus& status) : config_(config), status_(status) {}
 
   std::string write(const std::string& title) {
-    out_ << "digraph event_channels {\n  rankdir=LR; nodesep=0.25; ranksep=1.2; fontname=\"Helvetica\";\n"
+    out_ << "digraph event_channels {\n  rankdir=LR; newrank=true; nodesep=0.25; ranksep=1.2; fontname=\"Helvetica\";\n"
          << "  label=<" << escape(title) << ">; labelloc=t;\n"
          << "  node [fontname=\"Helvetica\", fontsize=10]; edge [fontname=\"Helvetica\", fontsize=10, penwidth=1.4];\n";
     for (const auto& s : config_.segments) write_segment(s);
     for (const auto& c : config_.channels) write_channel(c);
+    // Fig. 6: every channel in one middle column, publishers before it, subscribers after it.
+    out_ << "  { rank=same;";
+    for (const auto& c : config_.channels) out_ << " " << id("channel_", c.name) << ";";
+    out_ << " }\n";
     write_legend();
     out_ << "}\n";
     return out_.str();
