@@ -344,7 +344,7 @@ def scenario_etags(s):
                           capture_output=True, text=True, check=True).stdout
     for name in CHANNELS:
         row = next((line.split() for line in text.splitlines() if line.split()[:1] == [name]), None)
-        check(row is not None and str(ETAG[name]) in row[:4],
+        check(row is not None and str(ETAG[name]) in row[:5],  # NAME CLASS VERDICT RUNTIME ETAG
               "cosmicctl channels (text) shows etag %d for %s: %r" % (ETAG[name], name, row))
     expect_eq("planned identifier of command", hexid(gw.can_hop("command")["can_id"]),
               hexid(canlog.can_id(PRIO_COMMAND, GW_NODE, ETAG["command"])))
