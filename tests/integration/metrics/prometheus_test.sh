@@ -112,6 +112,11 @@ test_reload() {
   ctl gw reload >/dev/null || fail "reload to port 9878"
   wait_until 10 "endpoint on 9878" scrape http://127.0.0.1:9878/metrics || return
   wait_until 10 "9877 closed" bash -c '! curl -sf --max-time 2 -o /dev/null http://127.0.0.1:9877/metrics'
+  # Prometheus holds 9090: the endpoint stays where it was.
+  write_config "$WORK/gw.yaml" "  metrics: {listen: 127.0.0.1:9090}"
+  ctl gw reload >/dev/null || fail "reload to a taken port"
+  wait_until 10 "move refused and logged" stderr_has "$WORK/gw.log" "metrics endpoint stays on http://127.0.0.1:9878/metrics" || return
+  scrape http://127.0.0.1:9878/metrics || fail "endpoint lost after a refused move"
   write_config "$WORK/gw.yaml" ""
   ctl gw reload >/dev/null || fail "reload without metrics"
   wait_until 10 "endpoint closed" bash -c '! curl -sf --max-time 2 -o /dev/null http://127.0.0.1:9878/metrics'
