@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "cosmic/admission.hpp"
+#include "components_loader.hpp"
 #include "realtime_loader.hpp"
 #include "segment_overlap.hpp"
 #include "yaml_reader.hpp"
@@ -84,10 +85,12 @@ class ConfigParser {
       result.errors = reader_.take_errors();
       return result;
     }
-    if (reader_.check_map(*root, "", {"gateway", "segments", "channels"})) {
+    if (reader_.check_map(*root, "", {"gateway", "segments", "channels", "components"})) {
       if (has(*root, "gateway")) parse_gateway((*root)["gateway"]);
       if (require(*root, "", "segments", "a list of segments (type can, dds or lcm)")) parse_segments((*root)["segments"]);
+      derive_bindings_ = config_detail::has_components(*root);
       if (require(*root, "", "channels", "a list of channels")) parse_channel_list((*root)["channels"], "channels");
+      config_detail::load_components(reader_, *root, config_);
     }
     result.config = std::move(config_);
     result.errors = reader_.take_errors();
@@ -462,6 +465,7 @@ class ConfigParser {
     std::set<std::string> publishers;
     for (const char* role : {"publishers", "subscribers"}) {
       const std::string p = key(path, role);
+      if (derive_bindings_ && !node[role]) continue;  // taken from the components (components_loader)
       if (!require(node, path, role, "a non-empty list of segment names")) continue;
       auto names = reader_.string_list(node[role], p);
       if (!names) continue;
@@ -520,6 +524,7 @@ class ConfigParser {
 
   YamlReader reader_;
   Config config_;
+  bool derive_bindings_ = false;  // the document has components: P/S lists may be left out
   std::set<std::string> segment_names_;
   std::map<std::string, int> channel_names_;
   std::map<std::uint64_t, std::string> subjects_;
