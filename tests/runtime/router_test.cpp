@@ -186,6 +186,28 @@ TEST_F(RouterTest, QueuesAreBoundedAndOverflowIsCounted) {
   EXPECT_EQ(counters("bulk", "out").dropped[static_cast<std::size_t>(DropReason::queue_full)], 6u);
 }
 
+TEST_F(RouterTest, RawChannelsDropTheSamePayloadSeenAgainWithinTheLoopWindow) {
+  ChannelSpec raw = channel("pose", ChannelClass::nrt);
+  raw.lcm_encoding = LcmEncoding::raw;
+  bind({raw});
+  const Nanos t0 = steady_now();
+  deliver(1, EventHeader{}, t0, {1, 2, 3});
+  deliver(1, EventHeader{}, t0 + Nanos(1'000'000), {1, 2, 3});  // came back around a loop
+  deliver(1, EventHeader{}, t0 + Nanos(2'000'000), {4, 5, 6});
+  router.run_once(10);
+  EXPECT_EQ(out.sent().size(), 2u);
+  EXPECT_EQ(dropped("pose", DropReason::duplicate), 1u);
+}
+
+TEST_F(RouterTest, EnvelopeChannelsForwardRepeatedPayloads) {
+  bind({channel("speed", ChannelClass::nrt)});
+  const Nanos t0 = steady_now();
+  deliver(1, EventHeader{}, t0, {1, 2, 3});
+  deliver(1, EventHeader{}, t0 + Nanos(1'000'000), {1, 2, 3});  // a sensor reporting the same value
+  router.run_once(10);
+  EXPECT_EQ(out.sent().size(), 2u);
+}
+
 TEST_F(RouterTest, EventsOnASubscriberOnlySegmentHaveNoRoute) {
   bind({channel("a", ChannelClass::srt)});
   router.inbox(1).on_event(InboundEvent{1, EventHeader{}, {}, steady_now()});

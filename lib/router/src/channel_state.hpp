@@ -22,9 +22,10 @@ struct ChannelState {
         egress(route.subscribers.size()) {}
 
   const Route route;
-  std::mutex policy_mutex;  // guards bucket and dedup (ingress threads of several segments)
+  std::mutex policy_mutex;  // guards bucket, dedup and loop_guard (ingress threads of several segments)
   TokenBucket bucket;
   DuplicateFilter dedup;
+  RawLoopGuard loop_guard;  // raw LCM channels: their events carry no origin to cut loops by
   std::vector<SegmentCounters> counters;  // indexed by segment slot
   std::vector<EgressStats> egress;        // parallel to route.subscribers
   LatencyHistogram residence;             // over every egress hop

@@ -152,7 +152,7 @@ void Router::receive(std::size_t segment, const InboundEvent& event) {
     return;
   }
   if (!admit(*channel, counters, checked)) return;
-  enqueue(channel, segment, checked);
+  enqueue(channel, checked);
 }
 
 // Duplicate, validity and rate policies; counts what it refuses.
@@ -160,7 +160,9 @@ bool Router::admit(ChannelState& channel, SegmentCounters& counters, const Inbou
   const EventHeader& header = event.header;
   const ChannelSpec& spec = channel.route.spec;
   std::lock_guard lock(channel.policy_mutex);
-  if (header.origin != 0 && channel.dedup.seen(header.origin, header.sequence)) {
+  const bool loop_copy = header.origin == 0 && spec.lcm_encoding == LcmEncoding::raw &&
+                         channel.loop_guard.loop_copy(event.payload, event.received_at);
+  if (loop_copy || (header.origin != 0 && channel.dedup.seen(header.origin, header.sequence))) {
     counters.drop(DropReason::duplicate);
     return false;
   }
@@ -176,8 +178,7 @@ bool Router::admit(ChannelState& channel, SegmentCounters& counters, const Inbou
 }
 
 // Copies the payload once and queues the event on the lane of each subscriber segment.
-void Router::enqueue(const std::shared_ptr<ChannelState>& channel, std::size_t ingress, const InboundEvent& event) {
-  (void)ingress;
+void Router::enqueue(const std::shared_ptr<ChannelState>& channel, const InboundEvent& event) {
   const Route& route = channel->route;
   if (route.subscribers.empty()) return;
   EventHeader header = event.header;

@@ -49,8 +49,6 @@ RouterLimits router_limits(const GatewaySpec& gateway) {
   }
   return limits;
 }
-
-std::string format_ms(Nanos value) { return format_duration(value); }
 }  // namespace
 
 BindResult Gateway::start(const Config& config) {
@@ -300,16 +298,16 @@ void Gateway::judge(const ChannelStatsSnapshot& stats, const ChannelSpec& spec, 
     std::string line = "channel " + spec.name + " violated its admitted bounds:";
     for (const auto& seg : stats.segments) {
       if (!seg.egress || (seg.egress->residence_miss == 0 && seg.egress->deadline_miss == 0)) continue;
-      line += " hop " + seg.segment + ": residence max " + format_ms(seg.egress->residence_max) + " > bound " +
-              format_ms(config_.gateway.residence_bound) + " (" + std::to_string(seg.egress->residence_miss) +
+      line += " hop " + seg.segment + ": residence max " + format_duration(seg.egress->residence_max) + " > bound " +
+              format_duration(config_.gateway.residence_bound) + " (" + std::to_string(seg.egress->residence_miss) +
               " misses), " + std::to_string(seg.egress->deadline_miss) + " events older than reaction_time " +
-              (spec.reaction_time ? format_ms(*spec.reaction_time) : std::string("-")) + ";";
+              (spec.reaction_time ? format_duration(*spec.reaction_time) : std::string("-")) + ";";
     }
     log_.log(LogLevel::warning, line);
   } else if (!missed && track.state == RuntimeState::violated && now - track.last_miss >= config_.gateway.clean_interval) {
     track.state = RuntimeState::bound;
     log_.log(LogLevel::notice, "channel " + spec.name + " is within its admitted bounds again (no miss for " +
-                                   format_ms(config_.gateway.clean_interval) + ")");
+                                   format_duration(config_.gateway.clean_interval) + ")");
   }
 }
 

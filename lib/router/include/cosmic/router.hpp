@@ -104,7 +104,7 @@ class Router {
   void receive(std::size_t segment, const InboundEvent& event);
   void problem(std::size_t segment, ChannelId channel, InboundProblem what);
   bool admit(ChannelState& channel, SegmentCounters& counters, const InboundEvent& event);
-  void enqueue(const std::shared_ptr<ChannelState>& channel, std::size_t ingress, const InboundEvent& event);
+  void enqueue(const std::shared_ptr<ChannelState>& channel, const InboundEvent& event);
   std::shared_ptr<ChannelState> find(ChannelId id) const;
   EgressLane& lane(std::size_t segment, ChannelClass cls);
 
