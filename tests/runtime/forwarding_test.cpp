@@ -234,6 +234,32 @@ TEST(ForwardingTest, AnHrtChannelThatMissesIsViolatedLoggedOnceAndBoundAgainAfte
   gateway.stop();
 }
 
+TEST(ForwardingTest, AReloadedResidenceBoundIsWhatTheLanesCheck) {
+  RecordingLogger log;
+  std::map<std::string, MemoryAdapter*> adapters;
+  Gateway gateway(
+      [&](const SegmentSpec& spec, const GatewayIdentity&, Logger&) -> std::unique_ptr<SegmentAdapter> {
+        auto adapter = std::make_unique<MemoryAdapter>(spec.name);
+        adapters[spec.name] = adapter.get();
+        return adapter;
+      },
+      log, 0x43);
+  ASSERT_TRUE(gateway.start(parse_config(kHrtConfig, "hrt.yaml").config).applied);
+  std::string relaxed = kHrtConfig;
+  relaxed.replace(relaxed.find("residence_bound: 1ns"), 20, "residence_bound: 40ms");  // 1 + 40 + 1 ms <= reaction_time 50 ms
+  const auto reloaded = parse_config(relaxed, "hrt.yaml");
+  ASSERT_TRUE(reloaded.ok());
+  ASSERT_TRUE(gateway.reload(reloaded.config).applied);
+  ASSERT_TRUE(adapters["lan"]->inject("distance", {1, 2, 3, 4}));
+  ASSERT_EQ(adapters["rt"]->wait_sent(1, 5s), 1u);
+  for (auto deadline = steady_now() + Nanos(5'000'000'000); gateway.channel_stats().at(0).segments.back().egress->events == 0;) {
+    ASSERT_LT(steady_now(), deadline);
+    std::this_thread::yield();
+  }
+  EXPECT_EQ(gateway.channel_stats().at(0).residence_miss, 0u);  // 1 ns would have been missed
+  gateway.stop();
+}
+
 // Producers on several threads, the lane threads, and the control thread replacing the route
 // table all at once (run under ThreadSanitizer by scripts/test). Every event is either sent or
 // counted; nothing crashes or races.

@@ -154,7 +154,7 @@ void EgressLane::forward(LaneItem& item) noexcept {
   const Nanos residence = context_.clock() - item.received;
   hop.residence.record(residence);
   channel.residence.record(residence);
-  if (residence > context_.residence_bound) hop.residence_miss.fetch_add(1, std::memory_order_relaxed);
+  if (residence.count() > context_.residence_bound_ns.load(std::memory_order_relaxed)) hop.residence_miss.fetch_add(1, std::memory_order_relaxed);
   if (spec.reaction_time && Nanos(saturating_add(item.header.age_ns, residence.count())) > *spec.reaction_time)
     hop.deadline_miss.fetch_add(1, std::memory_order_relaxed);
   discard(item);

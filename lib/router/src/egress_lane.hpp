@@ -35,7 +35,7 @@ struct LaneItem {
 // What every lane of one router shares.
 struct LaneContext {
   SteadyClock clock;
-  Nanos residence_bound;
+  std::atomic<std::int64_t> residence_bound_ns;  // gateway.residence_bound; a reload may change it
   PayloadPool& pool;
   std::atomic<std::uint64_t>& progress;  // events handled (sent or dropped): the watchdog's measure
   std::function<void(const std::vector<std::string>&)> report_thread_problems;

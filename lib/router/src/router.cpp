@@ -52,8 +52,8 @@ Router::Router(GatewayIdentity self, std::size_t segment_capacity, RouterLimits 
       table_(std::make_shared<const Table>()),
       pool_(std::make_unique<PayloadPool>(4 * (limits_.hrt_queue + limits_.srt_queue + limits_.nrt_queue),
                                           kRetainedPayloadBytes)) {
-  lane_context_ = std::make_unique<LaneContext>(LaneContext{
-      clock_, limits_.residence_bound, *pool_, progress_, [this](const std::vector<std::string>& problems) {
+  lane_context_.reset(new LaneContext{
+      clock_, limits_.residence_bound.count(), *pool_, progress_, [this](const std::vector<std::string>& problems) {
         std::lock_guard lock(problems_mutex_);
         thread_problems_.insert(thread_problems_.end(), problems.begin(), problems.end());
       }});
@@ -237,6 +237,10 @@ std::size_t Router::queued() const {
   std::size_t total = 0;
   for (const auto& l : lanes_) total += l->size();
   return total;
+}
+
+void Router::set_residence_bound(Nanos bound) {
+  lane_context_->residence_bound_ns.store(bound.count(), std::memory_order_relaxed);
 }
 
 std::vector<std::string> Router::take_thread_problems() {

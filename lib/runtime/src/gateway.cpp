@@ -222,9 +222,11 @@ BindResult Gateway::commit_reload(ReloadPlan plan) {
   if (config.gateway.control_socket != config_.gateway.control_socket) {
     log_.log(LogLevel::warning, "gateway.control_socket changes take effect at the next start");
   }
-  if (config.gateway.realtime != config_.gateway.realtime || config.gateway.residence_bound != config_.gateway.residence_bound) {
-    log_.log(LogLevel::warning, "gateway.realtime and gateway.residence_bound changes take effect at the next start");
+  if (config.gateway.realtime != config_.gateway.realtime) {
+    log_.log(LogLevel::warning, "gateway.realtime changes take effect at the next start");
   }
+  // Admission of the new configuration used its residence_bound: the lanes check that one.
+  router_->set_residence_bound(config.gateway.residence_bound);
   config_ = config;
   identity_.name = config.gateway.name;
   kb_ = std::move(next_kb);

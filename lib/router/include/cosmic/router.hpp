@@ -94,6 +94,8 @@ class Router {
   // Inbound messages that matched no bound channel, per segment.
   std::uint64_t unrouted(std::size_t segment) const;
   std::size_t queued() const;
+  // The bound each hop's residence is checked against from now on (reload; control thread).
+  void set_residence_bound(Nanos bound);
   // What lane threads could not get of their ThreadPolicy since the last call (control thread).
   std::vector<std::string> take_thread_problems();
 
