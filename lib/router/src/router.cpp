@@ -277,6 +277,21 @@ SegmentCountersSnapshot counters_snapshot(const std::string& name, const Segment
 }
 }  // namespace
 
+std::vector<ChannelMisses> Router::misses() const {
+  const std::shared_ptr<const Table> table = load_table();
+  std::vector<ChannelMisses> out;
+  out.reserve(table->channels.size());
+  for (const auto& state : table->channels) {
+    ChannelMisses m{state->route.spec.name};
+    for (const auto& hop : state->egress) {
+      m.residence_miss += hop.residence_miss.load(std::memory_order_relaxed);
+      m.deadline_miss += hop.deadline_miss.load(std::memory_order_relaxed);
+    }
+    out.push_back(std::move(m));
+  }
+  return out;
+}
+
 std::vector<ChannelStatsSnapshot> Router::snapshot() const {
   const std::shared_ptr<const Table> table = load_table();
   std::vector<ChannelStatsSnapshot> out;

@@ -273,14 +273,13 @@ void Gateway::refresh_runtime(Nanos now) {
   std::unordered_map<std::string_view, const ChannelSpec*> bound;
   for (const auto& spec : kb_->bound_channels()) bound.emplace(spec.name, &spec);
   std::map<std::string, RuntimeTrack> next;
-  for (const auto& stats : router_->snapshot()) {
-    const auto found = bound.find(stats.name);
+  for (const auto& counted : router_->misses()) {
+    const auto found = bound.find(counted.name);
     if (found == bound.end()) continue;
-    const ChannelSpec* spec = found->second;
-    auto previous = runtime_.find(stats.name);
+    auto previous = runtime_.find(counted.name);
     RuntimeTrack track = previous != runtime_.end() ? previous->second : RuntimeTrack{};
-    judge(stats, *spec, track, now);
-    next.emplace(stats.name, track);
+    judge(counted, *found->second, track, now);
+    next.emplace(counted.name, track);
   }
   runtime_ = std::move(next);
 }
@@ -288,8 +287,8 @@ void Gateway::refresh_runtime(Nanos now) {
 // One channel: a new miss of an HRT hop starts (or extends) a violation episode; a clean
 // interval ends it. SRT and NRT channels count misses but keep their state (they were promised
 // no bound).
-void Gateway::judge(const ChannelStatsSnapshot& stats, const ChannelSpec& spec, RuntimeTrack& track, Nanos now) {
-  const std::uint64_t misses = stats.residence_miss + stats.deadline_miss;
+void Gateway::judge(const ChannelMisses& counted, const ChannelSpec& spec, RuntimeTrack& track, Nanos now) {
+  const std::uint64_t misses = counted.residence_miss + counted.deadline_miss;
   const bool missed = misses > track.misses;
   track.misses = misses;
   if (missed) track.last_miss = now;
@@ -297,7 +296,19 @@ void Gateway::judge(const ChannelStatsSnapshot& stats, const ChannelSpec& spec, 
   if (missed && track.state == RuntimeState::bound) {
     track.state = RuntimeState::violated;
     ++track.violations;
-    std::string line = "channel " + spec.name + " violated its admitted bounds:";
+    log_.log(LogLevel::warning, violation_line(spec));
+  } else if (!missed && track.state == RuntimeState::violated && now - track.last_miss >= config_.gateway.clean_interval) {
+    track.state = RuntimeState::bound;
+    log_.log(LogLevel::notice, "channel " + spec.name + " is within its admitted bounds again (no miss for " +
+                                   format_duration(config_.gateway.clean_interval) + ")");
+  }
+}
+
+// The numbers behind a violation, hop by hop (once per episode: a full snapshot is fine here).
+std::string Gateway::violation_line(const ChannelSpec& spec) const {
+  std::string line = "channel " + spec.name + " violated its admitted bounds:";
+  for (const auto& stats : router_->snapshot()) {
+    if (stats.name != spec.name) continue;
     for (const auto& seg : stats.segments) {
       if (!seg.egress || (seg.egress->residence_miss == 0 && seg.egress->deadline_miss == 0)) continue;
       line += " hop " + seg.segment + ": residence max " + format_duration(seg.egress->residence_max) + " > bound " +
@@ -305,12 +316,8 @@ void Gateway::judge(const ChannelStatsSnapshot& stats, const ChannelSpec& spec, 
               " misses), " + std::to_string(seg.egress->deadline_miss) + " events older than reaction_time " +
               (spec.reaction_time ? format_duration(*spec.reaction_time) : std::string("-")) + ";";
     }
-    log_.log(LogLevel::warning, line);
-  } else if (!missed && track.state == RuntimeState::violated && now - track.last_miss >= config_.gateway.clean_interval) {
-    track.state = RuntimeState::bound;
-    log_.log(LogLevel::notice, "channel " + spec.name + " is within its admitted bounds again (no miss for " +
-                                   format_duration(config_.gateway.clean_interval) + ")");
   }
+  return line;
 }
 
 std::size_t Gateway::violated_channels() const {

@@ -89,6 +89,7 @@ class Router {
   void stop();
 
   std::vector<ChannelStatsSnapshot> snapshot() const;
+  std::vector<ChannelMisses> misses() const;
   // Events the lanes have handled (sent or dropped) since start: the watchdog's progress measure.
   std::uint64_t progress() const { return progress_.load(std::memory_order_relaxed); }
   // Inbound messages that matched no bound channel, per segment.

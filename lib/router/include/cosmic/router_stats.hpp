@@ -86,6 +86,14 @@ struct SegmentCountersSnapshot {
 enum class RuntimeState { bound, violated };
 const char* to_string(RuntimeState state);
 
+// The miss counters of one channel summed over its egress hops: what the run-time check reads
+// every tick (cheap, unlike a full snapshot with its histograms).
+struct ChannelMisses {
+  std::string name;
+  std::uint64_t residence_miss = 0;
+  std::uint64_t deadline_miss = 0;
+};
+
 struct ChannelStatsSnapshot {
   std::string name;
   std::vector<SegmentCountersSnapshot> segments;

@@ -131,7 +131,8 @@ class Gateway {
   };
 
   std::optional<std::string> configure_adapters();
-  void judge(const ChannelStatsSnapshot& stats, const ChannelSpec& spec, RuntimeTrack& track, Nanos now);
+  void judge(const ChannelMisses& counted, const ChannelSpec& spec, RuntimeTrack& track, Nanos now);
+  std::string violation_line(const ChannelSpec& spec) const;
   void apply_routes();
   ChannelId id_for(const ChannelSpec& spec);
   // Lowest slot index used neither by a running segment nor by one in `also_taken`.
