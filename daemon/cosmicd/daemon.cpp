@@ -247,7 +247,8 @@ class Daemon {
     if (answer.value("ok", false)) return;
     for (const auto& error : answer.value("errors", nlohmann::json::array())) log_.log(cosmic::LogLevel::error, error.value("text", ""));
     const auto& error = answer["error"];
-    log_.log(cosmic::LogLevel::error, "reload " + error.value("code", "failed") + ": " + error.value("message", ""));
+    log_.log(cosmic::LogLevel::error, "reload refused (" + error.value("code", "failed") + "): " + error.value("message", "") +
+                                          "; the running configuration is unchanged");
   }
 
   // Follows gateway.metrics (a reload may move or close the endpoint) and hands the endpoint's

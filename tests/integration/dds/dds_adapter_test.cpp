@@ -381,8 +381,10 @@ TEST(DdsAdapter, BestEffortSegmentAcceptsBestEffortWriters) {
   ASSERT_TRUE(f.adapter->start(f.sink).ok);
   const ChannelBinding b = binding(6, "wheel", HopRole::publisher);
   ASSERT_TRUE(f.adapter->configure(std::span(&b, 1)).ok);
-  auto pub = start_pub({"pub", "--domain", "62", "--channel", "wheel", "--count", "3", "--size",
-                        "8", "--best-effort"},
+  // Best effort may lose samples (a loaded host, a shared-memory segment being recycled), so a
+  // steady stream is offered and one delivered sample proves the match.
+  auto pub = start_pub({"pub", "--domain", "62", "--channel", "wheel", "--count", "200", "--rate", "100",
+                        "--size", "8", "--best-effort"},
                        f.reader_matched(6));
   ASSERT_TRUE(f.sink.wait_count(6, 1, kWait)) << pub->describe();
   EXPECT_EQ(f.adapter->incompatible_peers(6), 0u);

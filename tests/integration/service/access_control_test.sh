@@ -74,7 +74,7 @@ ctl_raw carried_status_json 77 setpriv --reuid "$OTHER" --regid "$(id -g "$OTHER
 json_check "$WORK/carried_status_json.out" '
   d["ok"] is False
   d["error"]["code"] == "permission_denied"'
-log_contains "denied status to uid $OTHER_UID"
+log_matches "denied #[0-9]+: uid $OTHER_UID pid [0-9]+ may not run status"
 
 note "a member of the read group: reads, may not change anything"
 ctl reader_status 0 as "$READER" status
@@ -96,10 +96,10 @@ ctl reader_reload 77 as "$READER" reload
 contains reader_reload err "may not change the gateway (reload)"
 expect_channels "after the reader's refused bind/unbind/reload" "speed status"
 [ -e "$STATE" ] && fail "a refused bind wrote the state file $STATE"
-log_contains "denied bind to uid $READER_UID"
-log_contains "denied unbind to uid $READER_UID"
-log_contains "denied reload to uid $READER_UID"
-log_lacks "audit: uid $READER_UID "
+log_matches "denied #[0-9]+: uid $READER_UID pid [0-9]+ may not run bind"
+log_matches "denied #[0-9]+: uid $READER_UID pid [0-9]+ may not run unbind"
+log_matches "denied #[0-9]+: uid $READER_UID pid [0-9]+ may not run reload"
+! grep -qE "audit #[0-9]+: uid $READER_UID " "$DAEMON_LOG" || fail "a refused reader was audited as if it ran a command"
 
 note "a member of the admin group: binds"
 ctl admin_bind 0 as "$ADMIN" bind "$WORK/plot.yaml"
@@ -107,8 +107,8 @@ contains admin_bind out "plot"
 contains admin_bind out "bound"
 expect_channels "after the admin's bind" "plot speed status"
 ctl reader_sees_plot 0 as "$READER" channel plot
-log_contains "audit: uid $ADMIN_UID pid "
-grep -qE "audit: uid $ADMIN_UID pid [0-9]+ runs bind" "$DAEMON_LOG" || fail "no audit line for the admin's bind"
+log_matches "audit #[0-9]+: uid $ADMIN_UID pid "
+grep -qE "audit #[0-9]+: uid $ADMIN_UID pid [0-9]+ runs bind" "$DAEMON_LOG" || fail "no audit line for the admin's bind"
 [ -s "$STATE" ] || fail "the admin's bind did not write $STATE"
 
 note "restart with the same state file: the binding is still there"
@@ -124,13 +124,13 @@ got=$(mode_owner "$SOCKET")
 note "unbind and reload by the admin: audited"
 ctl admin_unbind 0 as "$ADMIN" unbind plot
 contains admin_unbind out "unbound plot"
-grep -qE "audit: uid $ADMIN_UID pid [0-9]+ runs unbind \"plot\"" "$DAEMON_LOG" || fail "no audit line for the admin's unbind"
+grep -qE "audit #[0-9]+: uid $ADMIN_UID pid [0-9]+ runs unbind plot" "$DAEMON_LOG" || fail "no audit line for the admin's unbind"
 ctl admin_reload 0 as "$ADMIN" reload
 contains admin_reload out "reloaded"
-grep -qE "audit: uid $ADMIN_UID pid [0-9]+ runs reload" "$DAEMON_LOG" || fail "no audit line for the admin's reload"
+grep -qE "audit #[0-9]+: uid $ADMIN_UID pid [0-9]+ runs reload" "$DAEMON_LOG" || fail "no audit line for the admin's reload"
 expect_channels "after unbind and reload" "speed status"
 ctl root_status 0 status
-n=$(grep -c "audit: " "$FIRST_LOG" "$DAEMON_LOG" | awk -F: '{s += $2} END {print s}')
+n=$(grep -cE "audit #[0-9]+: " "$FIRST_LOG" "$DAEMON_LOG" | awk -F: '{s += $2} END {print s}')
 [ "$n" -eq 3 ] || fail "expected 3 audit lines (bind, unbind, reload), found $n"
 
 stop_daemon

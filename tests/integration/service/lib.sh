@@ -167,6 +167,14 @@ log_contains() {  # log_contains TEXT [LOG]: the daemon's stderr has a line with
   fi
 }
 
+log_matches() {  # log_matches REGEX [LOG]: the daemon's stderr has a line matching REGEX (grep -E)
+  local log=${2:-$DAEMON_LOG}
+  if ! grep -qE -- "$1" "$log"; then
+    fail "cosmicd log $(basename "$log") has no line matching '$1'"
+    sed 's/^/    /' "$log" >&2
+  fi
+}
+
 log_lacks() {  # log_lacks TEXT [LOG]
   local log=${2:-$DAEMON_LOG}
   if grep -qF -- "$1" "$log"; then

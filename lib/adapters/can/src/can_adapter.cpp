@@ -18,6 +18,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <deque>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -52,6 +53,7 @@ constexpr int kFramesPerWakeup = 256;
 constexpr std::size_t kReadBatch = 32;  // frames per recvmmsg
 constexpr std::size_t kFdPaddingSlack = 15;  // 48 -> 64 is the largest step between FD lengths
 constexpr can_err_mask_t kErrorMask = CAN_ERR_CRTL | CAN_ERR_BUSOFF | CAN_ERR_RESTARTED;
+constexpr Nanos kDeferredRequestRetry = std::chrono::milliseconds(20);  // well below one token (100 ms)
 constexpr std::size_t kMaxPendingRequests = 64;     // FAMOUSO: unanswered GET_ETAGs kept for a later bind
 constexpr std::size_t kMaxAnnouncedSubscriptions = 256;  // FAMOUSO: subscriptions logged once each
 constexpr canid_t kEtagFilterMask = 0x3FFF | CAN_EFF_FLAG;
@@ -146,6 +148,9 @@ class CanAdapter final : public SegmentAdapter {
   void handle_frame(const canfd_frame& frame, bool fd_frame, Nanos now);
   void handle_error_frame(const canfd_frame& frame);
   void handle_get_etag(const canfd_frame& frame, std::size_t len, Nanos now);
+  void answer_request(const can_binding::GetEtagRequest& request, const Table& table);  // io_mutex_ held
+  void defer_request(const can_binding::GetEtagRequest& request);                      // io_mutex_ held
+  void serve_deferred_requests(Nanos now);
   void reassembly_losses(ChannelId channel, std::optional<std::uint32_t> displaced, bool lost);
   void handle_famouso_protocol(const CanIdentifier& id, const canfd_frame& frame, std::size_t len, Nanos now);
   void handle_afp(const RxChannel& channel, const CanIdentifier& id, std::span<const std::uint8_t> data, Nanos now);
@@ -202,6 +207,10 @@ class CanAdapter final : public SegmentAdapter {
   ProtocolQueue answers_;  // binding and CCP answers: after the backlog, paced
   BindingRateLimit request_limit_;
   std::vector<can_binding::GetEtagRequest> pending_requests_;  // FAMOUSO: unknown subjects, answered on bind
+  // Requests over the rate limit, answered when the node's budget allows: a client that asks
+  // once (FAMOUSO's) must not lose its binding to a burst at start-up. One entry per (node,
+  // subject), bounded, so a flood costs a counter and at most one later answer.
+  std::deque<can_binding::GetEtagRequest> deferred_requests_;
   std::uint64_t refused_requests_ = 0;
   std::unordered_map<std::uint16_t, std::uint8_t> tx_sequence_;
   bool wait_pollout_ = false;      // backlog waits for POLLOUT (EAGAIN)
@@ -277,6 +286,7 @@ void CanAdapter::stop() {
     backlog_.clear();
     answers_.clear();
     pending_requests_.clear();
+    deferred_requests_.clear();
     backlog_size_ = 0;
     wait_pollout_ = false;
     retry_at_.reset();
@@ -604,6 +614,7 @@ void CanAdapter::run() {
     refresh_rx_table();
     reassembler_.expire(now, [this](std::uint32_t source) { reassembly_losses(kNoChannel, source, false); });
     handle_protocol_timeouts(now);
+    serve_deferred_requests(now);
 
     pollfd fds[2] = {{wake_fd_, POLLIN, 0}, {-1, 0, 0}};
     Nanos deadline = next_link_check_;
@@ -613,6 +624,7 @@ void CanAdapter::run() {
     {
       std::lock_guard lock(io_mutex_);
       if (const auto d = answers_.deadline(); d && backlog_.empty()) deadline = std::min(deadline, *d);
+      if (!deferred_requests_.empty()) deadline = std::min(deadline, now + kDeferredRequestRetry);
       if (sock_ >= 0) {
         fds[1].fd = sock_;
         fds[1].events = POLLIN;
@@ -867,24 +879,49 @@ void CanAdapter::handle_get_etag(const canfd_frame& frame, std::size_t len, Nano
   std::lock_guard lock(io_mutex_);
   if (!request_limit_.admit(request->requester, now)) {
     ++receive_errors_;
-    if (refused_requests_++ % 1000 == 0) {
-      log_.log(LogLevel::warning, "segment " + segment_.name + ": GET_ETAG from TxNode " +
-                                      std::to_string(request->requester) + " over the rate limit, not answered (" +
-                                      std::to_string(refused_requests_) + " refused so far)");
-    }
+    defer_request(*request);
     return;
   }
-  const auto it = table.etag_of.find(request->subject);
+  answer_request(*request, table);
+}
+
+void CanAdapter::defer_request(const can_binding::GetEtagRequest& request) {
+  const bool known = std::any_of(deferred_requests_.begin(), deferred_requests_.end(), [&](const auto& d) {
+    return d.requester == request.requester && d.subject == request.subject;
+  });
+  const bool kept = !known && deferred_requests_.size() < kMaxPendingRequests;
+  if (kept) deferred_requests_.push_back(request);
+  if (refused_requests_++ % 1000 == 0) {
+    log_.log(LogLevel::warning, "segment " + segment_.name + ": GET_ETAG from TxNode " +
+                                    std::to_string(request.requester) + " over the rate limit, " +
+                                    (kept ? "answered later" : known ? "already waiting" : "deferred queue full, dropped") +
+                                    " (" + std::to_string(refused_requests_) + " over the limit so far)");
+  }
+}
+
+void CanAdapter::serve_deferred_requests(Nanos now) {
+  std::lock_guard lock(io_mutex_);
+  if (deferred_requests_.empty()) return;
+  const Table& table = *rx_table_;
+  std::erase_if(deferred_requests_, [&](const can_binding::GetEtagRequest& r) {
+    if (!request_limit_.admit(r.requester, now)) return false;
+    answer_request(r, table);
+    return true;
+  });
+}
+
+void CanAdapter::answer_request(const can_binding::GetEtagRequest& request, const Table& table) {
+  const auto it = table.etag_of.find(request.subject);
   if (it != table.etag_of.end()) {
-    queue_supply_etag(request->requester, it->second, request->subject, table);
+    queue_supply_etag(request.requester, it->second, request.subject, table);
     return;
   }
   // Unknown subject: no answer. FAMOUSO's client asks only once and waits, so its request is
   // kept (bounded) and answered when a channel with that subject is bound.
   const bool known = std::any_of(pending_requests_.begin(), pending_requests_.end(), [&](const auto& p) {
-    return p.requester == request->requester && p.subject == request->subject;
+    return p.requester == request.requester && p.subject == request.subject;
   });
-  if (famouso_ && !known && pending_requests_.size() < kMaxPendingRequests) pending_requests_.push_back(*request);
+  if (famouso_ && !known && pending_requests_.size() < kMaxPendingRequests) pending_requests_.push_back(request);
 }
 
 void CanAdapter::queue_supply_etag(std::uint8_t requester, std::uint16_t etag, std::uint64_t subject, const Table& table) {
