@@ -21,13 +21,16 @@
 #include "cosmic/thread_policy.hpp"
 
 #include <lcm/lcm.h>
+#include <poll.h>
+#include <sys/eventfd.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
 #include <climits>
-#include <condition_variable>
+#include <cerrno>
 #include <cstring>
 #include <exception>
 #include <mutex>
@@ -46,7 +49,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr int kHandleTimeoutMs = 100;          // bounds how long stop() waits for the thread
+constexpr int kRetryAfterFailureMs = 100;      // pause before retrying a failing liblcm
 constexpr int kSubscriptionQueueCapacity = 4096;  // LCM's default (30) drops bursts
 constexpr std::size_t kMaxChannelNameLength = 63;  // LCM_MAX_CHANNEL_NAME_LENGTH
 
@@ -185,6 +188,14 @@ class LcmAdapter final : public SegmentAdapter {
       log_.log(LogLevel::error, "LCM segment " + segment_.name + ": " + why);
       return Status::failure(why);
     }
+    stop_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+    if (stop_fd_ < 0) {
+      const std::string why = std::string("eventfd for the receive loop: ") + std::strerror(errno);
+      lcm_destroy(lcm);
+      set_health(SegmentHealth::down, why);
+      log_.log(LogLevel::error, "LCM segment " + segment_.name + ": " + why);
+      return Status::failure(why);
+    }
     {
       std::unique_lock table(table_mutex_);
       lcm_ = lcm;
@@ -194,9 +205,10 @@ class LcmAdapter final : public SegmentAdapter {
     try {
       ThreadPolicy policy = sink.receive_thread_policy();
       policy.name = "rx:" + segment_.name;
-      thread_ = std::thread([this, lcm, policy] { receive_loop(lcm, policy); });
+      thread_ = std::thread([this, lcm, stop_fd = stop_fd_, policy] { receive_loop(lcm, stop_fd, policy); });
     } catch (const std::exception& e) {
       running_.store(false);
+      ::close(std::exchange(stop_fd_, -1));
       {
         std::unique_lock table(table_mutex_);
         lcm_ = nullptr;
@@ -340,12 +352,11 @@ class LcmAdapter final : public SegmentAdapter {
   void stop() override {
     std::lock_guard control(control_mutex_);
     if (!thread_.joinable()) return;
-    {
-      std::lock_guard lock(wake_mutex_);
-      running_.store(false, std::memory_order_release);
-    }
-    wake_.notify_all();
+    running_.store(false, std::memory_order_release);
+    const std::uint64_t one = 1;
+    [[maybe_unused]] const ssize_t n = ::write(stop_fd_, &one, sizeof one);
     thread_.join();
+    ::close(std::exchange(stop_fd_, -1));
     lcm_t* lcm = nullptr;
     {
       std::unique_lock table(table_mutex_);  // waits for sends in flight
@@ -403,30 +414,43 @@ class LcmAdapter final : public SegmentAdapter {
     return errors;
   }
 
-  void receive_loop(lcm_t* lcm, const ThreadPolicy& policy) {
+  // The gateway's own loop over liblcm's descriptor (lcm_get_fileno) and our stop eventfd:
+  // an event is dispatched as soon as liblcm has it, and stop() ends the wait at once instead of
+  // after a polling timeout. liblcm's udpm provider keeps its reader thread (it owns the socket and
+  // the fragment reassembly; the descriptor is its notification pipe), so LCM ingress is that
+  // thread, then this one, which runs the ingress checks and queues to the egress lanes.
+  void receive_loop(lcm_t* lcm, int stop_fd, const ThreadPolicy& policy) {
     for (const auto& problem : apply_thread_policy(policy))
       log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": receive thread: " + problem);
+    const int lcm_fd = lcm_get_fileno(lcm);
     bool failing = false;
     while (running_.load(std::memory_order_acquire)) {
-      const int rc = lcm_handle_timeout(lcm, kHandleTimeoutMs);
-      if (rc >= 0) {
-        if (failing) {
-          failing = false;
-          set_health(SegmentHealth::up, "");
-          log_.log(LogLevel::notice, "LCM segment " + segment_.name + " receiving again");
-        }
+      pollfd fds[2] = {{lcm_fd, POLLIN, 0}, {stop_fd, POLLIN, 0}};
+      // A failing liblcm is retried after a pause rather than in a spin; stop_fd still ends it.
+      const int ready = ::poll(fds, 2, failing ? kRetryAfterFailureMs : -1);
+      if (ready < 0 && errno != EINTR) {
+        note_receive_failure(failing, "poll: " + std::string(std::strerror(errno)));
         continue;
       }
-      if (!failing) {
-        failing = true;
-        set_health(SegmentHealth::degraded, "lcm_handle failed on " + segment_.lcm.url);
-        log_.log(LogLevel::error, "LCM segment " + segment_.name + ": lcm_handle failed");
+      if (fds[1].revents != 0) break;
+      if (ready <= 0 || (fds[0].revents & POLLIN) == 0) continue;
+      if (lcm_handle(lcm) < 0) {
+        note_receive_failure(failing, "lcm_handle failed");
+        continue;
       }
-      // Back off instead of spinning on a persistent error; stop() wakes us.
-      std::unique_lock lock(wake_mutex_);
-      wake_.wait_for(lock, std::chrono::milliseconds(kHandleTimeoutMs),
-                     [this] { return !running_.load(std::memory_order_acquire); });
+      if (failing) {
+        failing = false;
+        set_health(SegmentHealth::up, "");
+        log_.log(LogLevel::notice, "LCM segment " + segment_.name + " receiving again");
+      }
     }
+  }
+
+  void note_receive_failure(bool& failing, const std::string& what) {
+    if (failing) return;
+    failing = true;
+    set_health(SegmentHealth::degraded, what + " on " + segment_.lcm.url);
+    log_.log(LogLevel::error, "LCM segment " + segment_.name + ": " + what);
   }
 
   static void on_message(const lcm_recv_buf_t* rbuf, const char* channel, void* self) {
@@ -519,8 +543,7 @@ class LcmAdapter final : public SegmentAdapter {
   bool subscribe_failed_ = false;                              // control thread
   std::thread thread_;
   std::atomic<bool> running_{false};
-  std::mutex wake_mutex_;
-  std::condition_variable wake_;
+  int stop_fd_ = -1;  // eventfd: stop() wakes the receive loop; owned by start()/stop()
 
   mutable std::shared_mutex table_mutex_;
   lcm_t* lcm_ = nullptr;
