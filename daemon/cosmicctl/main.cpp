@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   std::vector<cosmicctl::CommandRunner> commands;
   app.add_option("--socket", options.socket, "Control socket of the daemon")->capture_default_str()->envname("COSMIC_SOCKET");
   commands.push_back(cosmicctl::add_check_command(app, options));
+  commands.push_back(cosmicctl::add_calibrate_command(app, options));
   commands.push_back(cosmicctl::add_diagram_command(app, options));
   commands.push_back(cosmicctl::add_gen_command(app, options));
   commands.push_back(cosmicctl::add_top_command(app, options));

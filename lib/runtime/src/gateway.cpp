@@ -37,7 +37,6 @@ ChannelId Gateway::id_for(const ChannelSpec& spec) {
   return id;
 }
 
-namespace {
 RouterLimits router_limits(const GatewaySpec& gateway) {
   RouterLimits limits;
   limits.residence_bound = gateway.residence_bound;
@@ -49,7 +48,6 @@ RouterLimits router_limits(const GatewaySpec& gateway) {
   }
   return limits;
 }
-}  // namespace
 
 BindResult Gateway::start(const Config& config) {
   identity_.name = config.gateway.name;

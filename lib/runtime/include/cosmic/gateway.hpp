@@ -61,6 +61,10 @@ struct ReloadPlan {
   std::vector<ChannelReport> reports;
 };
 
+// The router limits gateway.residence_bound and gateway.realtime ask for (the lanes' priorities
+// and CPUs); shared by the gateway and `cosmicctl calibrate`.
+RouterLimits router_limits(const GatewaySpec& gateway);
+
 class Gateway {
  public:
   static constexpr std::size_t kMaxSegments = 64;

@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# `cosmicctl calibrate` end to end: it runs the forwarding plane idle and under an NRT flood,
+# reports HRT residence per phase (text and --json), and its verdict follows the configuration's
+# gateway.residence_bound: exit 0 when the bound covers the measured p99.9, 1 with a warning when
+# it is below. The bounds are chosen so the verdict does not depend on the machine's speed: 1 ns
+# is below any residence, 60 s above any (the phases last 0.3 s).
+# Usage: calibrate_cli_test.sh PATH_TO_cosmicctl PROJECT_SOURCE_DIR
+set -u
+
+CTL=${1:?path to cosmicctl}
+SRC=${2:?project source dir}
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+FAILURES=0
+
+fail() {
+  echo "FAIL: $*" >&2
+  FAILURES=$((FAILURES + 1))
+}
+
+run() {  # run NAME EXPECTED_EXIT ARGS...
+  local name=$1 expected=$2
+  shift 2
+  "$CTL" "$@" >"$WORK/$name.out" 2>"$WORK/$name.err"
+  local code=$?
+  if [ "$code" -ne "$expected" ]; then
+    fail "$name: exit $code, expected $expected (cosmicctl $*)"
+    sed 's/^/    /' "$WORK/$name.out" "$WORK/$name.err" >&2
+  fi
+}
+
+contains() {  # contains NAME out|err TEXT
+  if ! grep -qF -- "$3" "$WORK/$1.$2"; then
+    fail "$1: $2 lacks '$3'"
+    sed 's/^/    /' "$WORK/$1.$2" >&2
+  fi
+}
+
+with_bound() {  # with_bound FILE BOUND: the bundled robot with another gateway.residence_bound
+  sed "s/^  residence_bound: .*/  residence_bound: $2/" "$SRC/config/robot.yaml" >"$1"
+  grep -q "residence_bound: $2" "$1" || fail "could not set residence_bound in $1"
+}
+
+with_bound "$WORK/loose.yaml" 60s
+with_bound "$WORK/tight.yaml" 1ns
+
+# 1. A generous bound: covered, exit 0, both phases measured, the flood really ran.
+run loose_json 0 calibrate "$WORK/loose.yaml" --seconds 0.3 --rate 500 --json
+if ! python3 - "$WORK/loose_json.out" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["bound_covers_p999"] is True, d
+assert d["residence_bound_us"] == 60e6, d["residence_bound_us"]
+phases = {p["phase"]: p for p in d["phases"]}
+assert set(phases) == {"idle", "nrt-flood"}, phases
+for p in phases.values():
+    assert p["hrt_events"] > 50, p                      # 0.3 s at 500/s, late wake-ups allowed
+    assert 0 < p["residence_p50_us"] <= p["residence_p99_us"] <= p["residence_p999_us"] <= p["residence_max_us"], p
+    assert p["residence_miss"] == 0, p
+assert phases["idle"]["flood_offered"] == 0, phases["idle"]
+flood = phases["nrt-flood"]
+assert flood["flood_offered"] > 0 and flood["flood_sent"] > 0, flood
+assert flood["flood_sent"] + flood["flood_queue_full"] <= flood["flood_offered"], flood
+assert d["worst_p999_us"] == max(p["residence_p999_us"] for p in phases.values()), d
+PY
+then
+  fail "loose_json: JSON contract"
+  sed 's/^/    /' "$WORK/loose_json.out" >&2
+fi
+
+# 2. A bound below any residence: exit 1, a warning with both numbers, every HRT event a miss.
+run tight_text 1 calibrate "$WORK/tight.yaml" --seconds 0.3 --rate 500
+contains tight_text out "idle"
+contains tight_text out "nrt-flood"
+contains tight_text out "residence_bound 1 ns is BELOW this machine's residence p99.9"
+contains tight_text err "warning: gateway.residence_bound 1 ns is below the residence p99.9 measured here"
+run tight_json 1 calibrate "$WORK/tight.yaml" --seconds 0.3 --rate 500 --json
+python3 -c '
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["bound_covers_p999"] is False
+assert all(p["residence_miss"] == p["hrt_events"] > 0 for p in d["phases"]), d["phases"]
+' "$WORK/tight_json.out" || fail "tight_json: every HRT event should miss a 1 ns bound"
+
+# 3. Bad input: a usage error or a located configuration error, nothing measured.
+run bad_rate 64 calibrate --rate 0
+run bad_seconds 64 calibrate --seconds -1
+run missing_file 64 calibrate "$WORK/nope.yaml"
+printf 'gateway:\n  residence_bound: fast\n' >"$WORK/broken.yaml"
+run broken 2 calibrate "$WORK/broken.yaml"
+contains broken err "broken.yaml:2:"
+contains broken err "gateway.residence_bound"
+
+if [ "$FAILURES" -ne 0 ]; then
+  echo "$FAILURES check(s) failed" >&2
+  exit 1
+fi
+echo "calibrate CLI: all checks passed"
