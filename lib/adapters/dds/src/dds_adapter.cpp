@@ -24,6 +24,8 @@
 #include <optional>
 #include <set>
 #include <shared_mutex>
+#include <string>
+#include <thread>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -43,6 +45,7 @@
 
 #include <cosmic_dds_idl/EnvelopePubSubTypes.h>
 
+#include "cosmic/thread_policy.hpp"
 #include "dds_qos.hpp"
 
 namespace cosmic {
@@ -244,6 +247,7 @@ class DdsAdapter final : public DdsSegmentAdapter {
   void deactivate(ReaderEntry& entry);
   void destroy_reader(std::unique_ptr<ReaderEntry> entry);
   void teardown();
+  dds::DomainParticipant* create_participant_as(const ThreadPolicy& receive, const dds::DomainParticipantQos& qos);
 
   const SegmentSpec segment_;
   const GatewayIdentity self_;
@@ -368,6 +372,29 @@ void DdsAdapter::deliver(ReaderEntry& entry, const dds::SampleInfo& info) {
   sink_->on_event(event);
 }
 
+// Fast DDS 2.9 has no thread settings, but Linux threads inherit the scheduling policy, priority,
+// CPU affinity and name of the thread that creates them, and a participant starts its receive
+// and event threads when it is created. So it is created on a short-lived thread that runs as
+// gateway.realtime says receive threads run (named rx:<segment>, like cosmicd's own receive
+// threads), and Fast DDS's threads of this segment run that way too.
+dds::DomainParticipant* DdsAdapter::create_participant_as(const ThreadPolicy& receive,
+                                                          const dds::DomainParticipantQos& qos) {
+  const auto domain = static_cast<dds::DomainId_t>(segment_.dds.domain);
+  ThreadPolicy policy = receive;
+  policy.name = "rx:" + segment_.name;
+  dds::DomainParticipant* created = nullptr;
+  std::vector<std::string> problems;
+  std::thread creator([&] {
+    problems = apply_thread_policy(policy);
+    created = dds::DomainParticipantFactory::get_instance()->create_participant(domain, qos);
+  });
+  creator.join();
+  for (const auto& problem : problems) {
+    log_.log(LogLevel::warning, prefix() + "Fast DDS receive threads: " + problem);
+  }
+  return created;
+}
+
 Status DdsAdapter::start(EventSink& sink) {
   std::lock_guard control(control_mutex_);
   if (participant_ != nullptr) {
@@ -397,8 +424,7 @@ Status DdsAdapter::start(EventSink& sink) {
     if (Status st = dds_detail::participant_qos(segment_, name, qos); !st.ok) {
       return fail(st.error);
     }
-    participant_ = dds::DomainParticipantFactory::get_instance()->create_participant(
-        static_cast<dds::DomainId_t>(segment_.dds.domain), qos);
+    participant_ = create_participant_as(sink.receive_thread_policy(), qos);
     if (participant_ == nullptr) {
       return fail("cannot create a DDS participant in domain " +
                   std::to_string(segment_.dds.domain));
