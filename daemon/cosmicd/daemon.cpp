@@ -103,7 +103,10 @@ class Daemon {
       return kExitStartFailure;
     }
     log_.log(cosmic::LogLevel::notice, "cosmicd " + loaded.config.gateway.name + " running; control socket " + server_options.path);
+    // /metrics asks for a snapshot only when scraped; it is taken here, on the control thread.
+    metrics_.attach([this, &server] { server.post([this] { metrics_.publish(take_metrics_snapshot(gateway_, started_)); }); });
     loop(server);
+    metrics_.detach();  // before `server` goes: scrapes stop posting to it
     notifier_.stopping();
     server.close_all();  // joins the admission worker before `protocol` goes
     protocol_ = nullptr;
@@ -251,13 +254,6 @@ class Daemon {
                                           "; the running configuration is unchanged");
   }
 
-  // Follows gateway.metrics (a reload may move or close the endpoint) and hands the endpoint's
-  // threads a fresh snapshot: they never call the gateway themselves.
-  void publish_metrics() {
-    metrics_.follow(gateway_.config().gateway.metrics);
-    if (metrics_.serving()) metrics_.publish(take_metrics_snapshot(gateway_, started_));
-  }
-
   void loop(cosmic::ControlServer& server) {
     auto last_health = std::chrono::steady_clock::now() - std::chrono::seconds(1);
     while (running_) {
@@ -267,7 +263,7 @@ class Daemon {
         gateway_.refresh_runtime(std::chrono::duration_cast<cosmic::Nanos>(std::chrono::steady_clock::now().time_since_epoch()));
         for (const auto& problem : gateway_.take_thread_problems()) log_.log(cosmic::LogLevel::warning, "realtime: " + problem);
         notifier_.tick(gateway_);
-        publish_metrics();
+        metrics_.follow(gateway_.config().gateway.metrics);  // a reload may move or close the endpoint
         last_health = std::chrono::steady_clock::now();
       }
     }

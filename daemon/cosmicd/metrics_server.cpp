@@ -67,10 +67,10 @@ std::unique_ptr<MetricsServer::Endpoint> MetricsServer::open(const cosmic::Metri
   http.set_write_timeout(kIoTimeoutSeconds);
   http.set_payload_max_length(4096);
   http.Get("/metrics", [this](const httplib::Request& request, httplib::Response& response) {
-    const auto snapshot = latest();
+    const auto snapshot = relay_.get();
     if (!snapshot) {
       response.status = 503;
-      response.set_content("cosmicd has not taken its first snapshot yet\n", "text/plain");
+      response.set_content("cosmicd did not answer with a snapshot in time\n", "text/plain");
       return;
     }
     const ExpositionFormat format = format_for_accept(request.get_header_value("Accept"));
@@ -120,17 +120,6 @@ void MetricsServer::follow(const cosmic::MetricsSpec& spec) {
   } else {
     log_.log(cosmic::LogLevel::error, "metrics endpoint: " + again + "; no metrics are served");
   }
-}
-
-void MetricsServer::publish(MetricsSnapshot snapshot) {
-  auto shared = std::make_shared<const MetricsSnapshot>(std::move(snapshot));
-  std::lock_guard lock(mutex_);
-  latest_ = std::move(shared);
-}
-
-std::shared_ptr<const MetricsSnapshot> MetricsServer::latest() const {
-  std::lock_guard lock(mutex_);
-  return latest_;
 }
 
 }  // namespace cosmicd

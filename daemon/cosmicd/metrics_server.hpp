@@ -1,17 +1,19 @@
 // The opt-in HTTP endpoint of gateway.metrics (docs/metrics.md), on cpp-httplib.
 //
-// Threads: follow() and publish() are called by the control thread only. HTTP is served by the
-// endpoint's own threads, all named "cosmic-metrics"; they never touch the Gateway, only the
-// last published MetricsSnapshot (shared, immutable), so a scrape costs the forwarding threads
-// nothing and a slow scraper cannot stall the control loop.
+// Threads: follow(), attach(), detach() and publish() are called by the control thread only. HTTP
+// is served by the endpoint's own threads, all named "cosmic-metrics"; they never touch the
+// Gateway. A scrape asks the control thread for a snapshot (SnapshotRelay: only while scrapes
+// happen, at most one per 100 ms) and renders that shared, immutable MetricsSnapshot, so a scrape
+// costs the forwarding threads nothing and a slow scraper cannot stall the control loop.
 #pragma once
 
+#include <functional>
 #include <memory>
-#include <mutex>
 #include <string>
 
 #include "cosmic/log.hpp"
 #include "cosmic/model.hpp"
+#include "metrics_relay.hpp"
 #include "metrics_snapshot.hpp"
 
 namespace cosmicd {
@@ -31,21 +33,25 @@ class MetricsServer {
   bool serving() const { return endpoint_ != nullptr; }
   // The address actually served ("http://127.0.0.1:9877/metrics"); empty when not serving.
   const std::string& url() const { return url_; }
-  // Makes `snapshot` what the next scrapes render.
-  void publish(MetricsSnapshot snapshot);
+  // How a scrape gets a snapshot: `ask` (called on a scrape's thread) must lead to publish() on
+  // the control thread soon, e.g. by posting a task to its loop. Without it scrapes get the last
+  // snapshot published, or 503.
+  void attach(std::function<void()> ask) { relay_.attach(std::move(ask)); }
+  // Call before what `ask` refers to goes away: scrapes stop asking and waiting.
+  void detach() { relay_.detach(); }
+  // The answer to `ask`: what the scrapes waiting (and those of the next 100 ms) render.
+  void publish(MetricsSnapshot snapshot) { relay_.publish(std::move(snapshot)); }
 
  private:
   class Endpoint;
   std::unique_ptr<Endpoint> open(const cosmic::MetricsSpec& spec, std::string& error);
-  std::shared_ptr<const MetricsSnapshot> latest() const;
 
   cosmic::Logger& log_;
   cosmic::MetricsSpec requested_;
   cosmic::MetricsSpec serving_spec_;
   std::string url_;
+  SnapshotRelay<MetricsSnapshot> relay_;  // before endpoint_: its threads use it until they stop
   std::unique_ptr<Endpoint> endpoint_;
-  mutable std::mutex mutex_;  // guards latest_, shared with the HTTP threads
-  std::shared_ptr<const MetricsSnapshot> latest_;
 };
 
 }  // namespace cosmicd
