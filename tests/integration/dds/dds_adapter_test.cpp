@@ -2,8 +2,12 @@
 // programs (cosmic-dds-peer) in separate processes. Run inside a fresh network namespace
 // (ctest does, through scripts/netns-run); every test uses its own DDS domain id.
 #include <gtest/gtest.h>
+#include <sched.h>
+#include <sys/resource.h>
 
 #include <atomic>
+#include <filesystem>
+#include <fstream>
 #include <chrono>
 #include <set>
 #include <string>
@@ -132,6 +136,39 @@ OutboundEvent outbound(ChannelId channel, std::uint32_t q, std::vector<std::uint
   ev.header.age_ns = 1000 * q;
   ev.payload = storage;
   return ev;
+}
+
+// ---- thread policy ----------------------------------------------------------------------------
+
+// Fast DDS's threads of a segment run as gateway.realtime's receive policy says: they inherit it
+// from the thread the adapter creates the participant on (nice and affinity here, which need no
+// privilege; SCHED_FIFO is inherited the same way).
+TEST(DdsAdapter, FastDdsThreadsInheritTheReceivePolicy) {
+  Fixture f(dds_segment(65));
+  errno = 0;
+  const int own_nice = getpriority(PRIO_PROCESS, 0);
+  f.sink.set_receive_thread_policy(ThreadPolicy{"rx", 0, 7, {0}});
+  ASSERT_TRUE(f.adapter->start(f.sink).ok);
+  const std::string name = "rx:" + f.spec.name;
+  std::size_t inherited = 0;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::string comm;
+    std::getline(std::ifstream(task.path() / "comm"), comm);
+    if (comm != name) continue;
+    const pid_t tid = static_cast<pid_t>(std::stol(task.path().filename().string()));
+    cpu_set_t cpus;
+    CPU_ZERO(&cpus);
+    ASSERT_EQ(sched_getaffinity(tid, sizeof cpus, &cpus), 0);
+    EXPECT_EQ(CPU_COUNT(&cpus), 1) << "thread " << tid;
+    EXPECT_TRUE(CPU_ISSET(0, &cpus)) << "thread " << tid;
+    errno = 0;
+    EXPECT_EQ(getpriority(PRIO_PROCESS, static_cast<id_t>(tid)), 7) << "thread " << tid;
+    ++inherited;
+  }
+  EXPECT_GE(inherited, 2u) << "Fast DDS's receive and event threads should carry the name " << name;
+  // The test's own thread is untouched.
+  errno = 0;
+  EXPECT_EQ(getpriority(PRIO_PROCESS, 0), own_nice);
 }
 
 // ---- adapter -> native subscriber -------------------------------------------------------------
