@@ -74,7 +74,7 @@ class Daemon {
 
   int run() {
     const int signal_fd = signal_descriptor();
-    const auto loaded = cosmic::load_config_file(options_.config);
+    const auto loaded = config_loader_.load(options_.config);
     if (!loaded.ok()) {
       for (const auto& error : loaded.errors) log_.log(cosmic::LogLevel::error, error.to_string());
       return kExitConfigError;
@@ -92,7 +92,7 @@ class Daemon {
     // Admission of bind and reload runs on the server's worker thread, so status answers and
     // watchdog keep-alives continue meanwhile.
     cosmic::ControlProtocol protocol(
-        gateway_, [this] { return cosmic::load_config_file(options_.config); }, policy, log_,
+        gateway_, [this] { return config_loader_.load(options_.config); }, policy, log_,
         [this](const std::string& command, const nlohmann::json& request) { return remember(command, request); },
         server.offload());
     protocol_ = &protocol;
@@ -276,6 +276,8 @@ class Daemon {
   ServiceNotifier notifier_;
   BindingState state_;
   cosmic::Config file_config_;  // the configuration file as last loaded
+  // Start and then the admission worker, one reload at a time: an unchanged file is not parsed again.
+  cosmic::ConfigFileLoader config_loader_;
   bool running_ = true;
   cosmic::ControlProtocol* protocol_ = nullptr;  // while run() serves the control socket
   std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();

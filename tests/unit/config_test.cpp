@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <fstream>
 #include <tuple>
 
 #include "cosmic/knowledge_base.hpp"
@@ -432,6 +434,52 @@ TEST(Quantities, ALongLcmNameIsRefusedOnlyWhereLcmCarriesIt) {
   EXPECT_FALSE(over_lcm.ok());
   EXPECT_NE(describe(over_lcm.errors).find("at most 63 characters"), std::string::npos) << describe(over_lcm.errors);
   EXPECT_TRUE(over_dds.ok()) << describe(over_dds.errors);
+}
+
+// cosmicd's reload source: an unchanged file is not parsed again; any change, a broken file or
+// another path is.
+TEST(ConfigFileLoader, OnlyAnUnchangedValidFileSkipsParsing) {
+  const std::string dir = ::testing::TempDir();
+  const std::string path = dir + "/cosmic_loader_test.yaml";
+  const std::string other = dir + "/cosmic_loader_test_other.yaml";
+  const std::string one = "segments: [{name: lan, type: dds}, {name: viz, type: lcm}]\nchannels:\n"
+                          "  - {name: a, subject: 1, class: nrt, publishers: [lan], subscribers: [viz]}\n";
+  auto write = [](const std::string& file, const std::string& text) { std::ofstream(file, std::ios::trunc) << text; };
+  write(path, one);
+  write(other, one);
+  ConfigFileLoader loader;
+  const ConfigResult first = loader.load(path);
+  ASSERT_TRUE(first.ok()) << describe(first.errors);
+  EXPECT_FALSE(loader.last_was_unchanged());
+  const ConfigResult again = loader.load(path);
+  ASSERT_TRUE(again.ok());
+  EXPECT_TRUE(loader.last_was_unchanged());
+  ASSERT_EQ(again.config.channels.size(), 1u);
+  EXPECT_EQ(again.config.channels[0], first.config.channels[0]);
+  EXPECT_EQ(again.config.segments, first.config.segments);
+
+  loader.load(other);  // same bytes, another file: parsed (errors would name that file)
+  EXPECT_FALSE(loader.last_was_unchanged());
+
+  write(path, one + "  - {name: b, subject: 2, class: nrt, publishers: [viz], subscribers: [lan]}\n");
+  const ConfigResult changed = loader.load(path);
+  ASSERT_TRUE(changed.ok()) << describe(changed.errors);
+  EXPECT_FALSE(loader.last_was_unchanged());
+  EXPECT_EQ(changed.config.channels.size(), 2u);
+
+  write(path, one + "  - {name: b, subject: two}\n");
+  const ConfigResult broken = loader.load(path);
+  EXPECT_FALSE(broken.ok());
+  EXPECT_FALSE(loader.last_was_unchanged());
+  write(path, one);
+  EXPECT_TRUE(loader.load(path).ok());
+  EXPECT_FALSE(loader.last_was_unchanged());  // parsed: a failed load forgets the remembered file
+
+  std::remove(other.c_str());
+  std::remove(path.c_str());
+  const ConfigResult gone = loader.load(path);
+  EXPECT_FALSE(gone.ok());
+  EXPECT_FALSE(loader.last_was_unchanged());
 }
 
 }  // namespace

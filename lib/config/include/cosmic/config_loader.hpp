@@ -38,6 +38,23 @@ ConfigResult parse_config(std::string_view text, const std::string& file_name);
 // Reads and parses a file; an unreadable file is one error at 0:0.
 ConfigResult load_config_file(const std::string& path);
 
+// load_config_file() for a file that is read again and again (cosmicd's reloads): a file whose
+// bytes are those of the last valid document it loaded from that path is not parsed again, its
+// Config is returned from memory (parsing is most of the cost of reloading a large, unchanged
+// file). Any change of the bytes, the path or a failed load parses afresh. One caller at a time.
+class ConfigFileLoader {
+ public:
+  ConfigResult load(const std::string& path);
+  // Whether the last load() returned the remembered Config without parsing.
+  bool last_was_unchanged() const { return last_unchanged_; }
+
+ private:
+  std::string path_;
+  std::string text_;  // of the remembered document; empty: nothing remembered
+  Config config_;
+  bool last_unchanged_ = false;
+};
+
 // Parses channel definitions for a runtime bind: a document with a `channels:` list, a list of
 // channel maps, or one channel map, validated against the segments of `running`.
 ChannelsResult parse_channels(std::string_view text, const std::string& file_name, const Config& running);
