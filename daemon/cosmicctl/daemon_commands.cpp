@@ -73,7 +73,7 @@ void print_status(const Json& r) {
   std::cout << text(g["name"]) << " (id " << text(g["id"]) << "), up " << static_cast<long>(g["uptime_s"].get<double>()) << " s\n"
             << "segments: " << r["segments"]["up"] << "/" << r["segments"]["total"] << " up\n"
             << "channels: " << r["channels"]["bound"] << " bound, " << r["channels"]["degraded"] << " degraded, "
-            << r["channels"].value("violated", 0) << " violated at run time\n"
+            << r["channels"].value("failed", 0) << " failed, " << r["channels"].value("violated", 0) << " violated at run time\n"
             << "router:   " << r["router"]["queued"] << " queued, " << r["router"]["progress"] << " events handled\n";
 }
 

@@ -150,7 +150,7 @@ class DotWriter {
   void write_legend() {
     out_ << "  legend [shape=plain, label=<<TABLE BORDER=\"0\" CELLBORDER=\"1\" CELLSPACING=\"0\" CELLPADDING=\"3\">"
          << "<TR><TD>verdict</TD></TR>";
-    for (const char* v : {"bound", "degraded", "rejected", "violated", "not bound"}) {
+    for (const char* v : {"bound", "degraded", "rejected", "failed", "violated", "not bound"}) {
       out_ << "<TR><TD BGCOLOR=\"" << verdict_colour(v) << "\">" << v << "</TD></TR>";
     }
     out_ << "</TABLE>>];\n";
@@ -167,6 +167,7 @@ const char* verdict_colour(const std::string& verdict) {
   if (verdict == "bound") return "#a5d6a7";
   if (verdict == "degraded") return "#ffe082";
   if (verdict == "rejected") return "#ef9a9a";
+  if (verdict == "failed") return "#e57373";  // admitted, refused by its transport
   if (verdict == "violated") return "#ffab91";
   return "#e0e0e0";
 }

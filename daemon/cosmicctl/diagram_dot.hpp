@@ -13,7 +13,7 @@
 namespace cosmicctl {
 
 // What the diagram says about one channel beyond its model: the verdict ("bound", "degraded",
-// "rejected", "violated", or "not bound" for a channel the gateway does not carry) and
+// "rejected", "failed", "violated", or "not bound" for a channel the gateway does not carry) and
 // extra lines (admission's promise offline; live counters and measured residence from cosmicd).
 struct ChannelStatus {
   std::string verdict = "not bound";

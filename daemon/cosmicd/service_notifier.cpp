@@ -23,13 +23,16 @@ std::string ServiceNotifier::summary(const cosmic::Gateway& gateway) {
   }
   std::size_t bound = 0;
   std::size_t degraded = 0;
+  std::size_t failed = 0;
   for (const auto& c : gateway.admission().channels) {
     bound += c.verdict == cosmic::Verdict::bound ? 1 : 0;
     degraded += c.verdict == cosmic::Verdict::degraded ? 1 : 0;
+    failed += c.verdict == cosmic::Verdict::failed ? 1 : 0;
   }
   std::string line = std::to_string(up) + "/" + std::to_string(segments.size()) + " segments up, " + std::to_string(bound) +
                      " channels bound, " + std::to_string(degraded) + " degraded, " +
                      std::to_string(gateway.router().progress()) + " events handled";
+  if (failed > 0) line += ", " + std::to_string(failed) + " FAILED (refused by their transport)";
   if (const std::size_t violated = gateway.violated_channels(); violated > 0)
     line += ", " + std::to_string(violated) + " VIOLATED (measured beyond admitted bounds)";
   if (!down.empty()) line += " (" + down + ")";

@@ -12,6 +12,7 @@
 #include <condition_variable>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <filesystem>
 #include <thread>
 
@@ -81,7 +82,11 @@ class ControlTest : public ::testing::Test {
  protected:
   ControlTest()
       : dir(std::filesystem::temp_directory_path() / ("cosmic-control-" + std::to_string(::getpid()))),
-        gateway([](const SegmentSpec& spec, const GatewayIdentity&, Logger&) { return std::make_unique<MemoryAdapter>(spec.name); },
+        gateway([this](const SegmentSpec& spec, const GatewayIdentity&, Logger&) {
+                  auto adapter = std::make_unique<MemoryAdapter>(spec.name);
+                  adapters[spec.name] = adapter.get();
+                  return adapter;
+                },
                 log, 0x42) {
     std::filesystem::remove_all(dir);
     socket_path = (dir / "run" / "control.sock").string();
@@ -158,6 +163,7 @@ class ControlTest : public ::testing::Test {
   std::filesystem::path dir;
   std::string socket_path;
   QuietLogger log;
+  std::map<std::string, MemoryAdapter*> adapters;
   Gateway gateway;
   std::unique_ptr<ControlProtocol> protocol;
   std::unique_ptr<ControlServer> server;
@@ -202,6 +208,48 @@ TEST_F(ControlTest, StatusSegmentsAndChannels) {
   const Json one = client.call({{"command", "channel"}, {"name", "speed"}});
   EXPECT_EQ(one["channel"]["admission"]["verdict"], "bound");
   EXPECT_EQ(client.call({{"command", "channel"}, {"name", "nope"}})["error"]["code"], "not_found");
+}
+
+// Issue 9, item 10: what a segment's transport refuses is `failed` with its reason in every
+// answer that shows the channel, never `bound`.
+TEST_F(ControlTest, AChannelASegmentRefusesIsFailedWithItsReason) {
+  serve();
+  Client client(socket_path);
+  ASSERT_TRUE(client.connected());
+  adapters.at("viz")->refuse_channel("speed", "LCM channel names have at most 63 characters");
+  // Any change reconfigures every segment: this bind's own channel is carried, speed is not.
+  const Json bound = client.call({{"command", "bind"},
+                                  {"yaml", "{name: plot, subject: 7, class: nrt, omission_degree: 1, publishers: [lan], subscribers: [viz]}"}});
+  EXPECT_EQ(bound["ok"], true) << bound.dump();
+  const Json channels = client.call({{"command", "channels"}});
+  ASSERT_EQ(channels["channels"].size(), 2u);
+  for (const auto& c : channels["channels"]) {
+    EXPECT_EQ(c["verdict"], c["name"] == "speed" ? "failed" : "bound") << c.dump();
+  }
+  const Json one = client.call({{"command", "channel"}, {"name", "speed"}});
+  ASSERT_EQ(one["ok"], true);
+  EXPECT_EQ(one["channel"]["verdict"], "failed");
+  EXPECT_EQ(one["channel"]["admission"]["verdict"], "failed");
+  bool has_reason = false;
+  for (const auto& reason : one["channel"]["reasons"]) {
+    has_reason |= reason.get<std::string>() == "segment viz does not carry it: LCM channel names have at most 63 characters";
+  }
+  EXPECT_TRUE(has_reason) << one.dump();
+  const Json status = client.call({{"command", "status"}});
+  EXPECT_EQ(status["channels"]["bound"], 1);
+  EXPECT_EQ(status["channels"]["failed"], 1);
+  // A bind whose own channel is refused is refused as a whole, with the transport's reason.
+  adapters.at("lan")->refuse_channel("more", "cannot create topic cosmic/more");
+  const Json refused = client.call({{"command", "bind"},
+                                    {"yaml", "{name: more, subject: 8, class: nrt, publishers: [lan], subscribers: [viz]}"}});
+  EXPECT_EQ(refused["ok"], false);
+  EXPECT_EQ(refused["error"]["code"], "bind_failed");
+  EXPECT_NE(refused["error"]["message"].get<std::string>().find("segment lan does not carry channel more: cannot create topic cosmic/more"),
+            std::string::npos)
+      << refused.dump();
+  ASSERT_EQ(refused["channels"].size(), 1u);
+  EXPECT_EQ(refused["channels"][0]["verdict"], "failed");
+  EXPECT_EQ(client.call({{"command", "channel"}, {"name", "more"}})["error"]["code"], "not_found");
 }
 
 TEST_F(ControlTest, BadRequestsGetClearErrorsAndTheConnectionSurvives) {

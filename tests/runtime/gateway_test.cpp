@@ -13,8 +13,18 @@ namespace {
 
 class NullLogger final : public Logger {
  public:
-  void log(LogLevel, std::string_view message) override { lines.emplace_back(message); }
+  void log(LogLevel level, std::string_view message) override {
+    lines.emplace_back(message);
+    levels.push_back(level);
+  }
+  // Lines containing `text` logged at `level`.
+  std::size_t count(std::string_view text, LogLevel level) const {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < lines.size(); ++i) n += levels[i] == level && lines[i].find(text) != std::string::npos;
+    return n;
+  }
   std::vector<std::string> lines;
+  std::vector<LogLevel> levels;
 };
 
 constexpr const char* kConfig = R"(
@@ -32,6 +42,8 @@ class GatewayTest : public ::testing::Test {
   GatewayTest()
       : gateway([this](const SegmentSpec& spec, const GatewayIdentity&, Logger&) -> std::unique_ptr<SegmentAdapter> {
           auto adapter = std::make_unique<MemoryAdapter>(spec.name);
+          for (const auto& [channel, reason] : refuse_at_creation[spec.name]) adapter->refuse_channel(channel, reason);
+          adapter->fail_configure(fail_at_creation[spec.name]);
           adapters[spec.name] = adapter.get();
           return adapter;
         }, log, 0x1234) {}
@@ -54,8 +66,35 @@ class GatewayTest : public ::testing::Test {
     EXPECT_EQ(adapters[to]->wait_sent(before + 1, std::chrono::seconds(5)), before + 1);
   }
 
+  const ChannelReport* verdict_of(const std::string& channel) {
+    report_ = gateway.admission();
+    return report_.find(channel);
+  }
+
+  // The channel shows admission's own verdict (bound or degraded), nothing refused.
+  void expect_carried(const std::string& channel) {
+    const ChannelReport* shown = verdict_of(channel);
+    const AdmissionReport admitted = gateway.knowledge_base().report();
+    ASSERT_NE(shown, nullptr) << channel;
+    ASSERT_NE(admitted.find(channel), nullptr) << channel;
+    EXPECT_NE(shown->verdict, Verdict::failed) << channel;
+    EXPECT_EQ(shown->verdict, admitted.find(channel)->verdict) << channel;
+    EXPECT_FALSE(has_reason(*shown, "does not carry")) << channel;
+  }
+
+  static bool has_reason(const ChannelReport& report, const std::string& text) {
+    for (const auto& reason : report.reasons) {
+      if (reason.find(text) != std::string::npos) return true;
+    }
+    return false;
+  }
+
   NullLogger log;
   std::map<std::string, MemoryAdapter*> adapters;
+  // Set before start(): what each segment's adapter refuses from its creation on.
+  std::map<std::string, std::map<std::string, std::string>> refuse_at_creation;  // segment -> channel -> reason
+  std::map<std::string, std::string> fail_at_creation;                           // segment -> reason
+  AdmissionReport report_;
   Gateway gateway;
 };
 
@@ -173,6 +212,129 @@ TEST_F(GatewayTest, SegmentHealthDegradesItsChannels) {
   ASSERT_NE(report.find("speed"), nullptr);
   EXPECT_EQ(report.find("speed")->verdict, Verdict::degraded);
   EXPECT_FALSE(gateway.all_segments_up());
+}
+
+// Issue 9, item 10: a channel a segment's transport refuses (configure) is `failed` with the
+// transport's reason, never `bound` and silent.
+TEST_F(GatewayTest, AChannelItsSegmentRefusesAtStartIsFailedWithTheReason) {
+  refuse_at_creation["viz"]["speed"] = "LCM channel names have at most 63 characters";
+  const auto result = gateway.start(parse(kConfig));
+  ASSERT_TRUE(result.applied);
+  ASSERT_EQ(result.channels.size(), 2u);
+  EXPECT_EQ(result.channels[0].name, "speed");
+  EXPECT_EQ(result.channels[0].verdict, Verdict::failed);
+  EXPECT_TRUE(has_reason(result.channels[0], "segment viz does not carry it: LCM channel names have at most 63 characters"));
+  EXPECT_EQ(result.channels[1].name, "log");
+  EXPECT_NE(result.channels[1].verdict, Verdict::failed);
+  // What cosmicctl channels shows (admission()) says the same, and the log has one error line.
+  const ChannelReport* speed = verdict_of("speed");
+  ASSERT_NE(speed, nullptr);
+  EXPECT_EQ(speed->verdict, Verdict::failed);
+  EXPECT_TRUE(has_reason(*speed, "segment viz does not carry it"));
+  expect_carried("log");
+  EXPECT_EQ(log.count("channel speed: segment viz does not carry it: LCM channel names have at most 63 characters", LogLevel::error), 1u);
+  // Admitted all the same: its reservation is held, so a later configuration can carry it.
+  EXPECT_NE(gateway.knowledge_base().find_bound("speed"), nullptr);
+  // The other channel flows; speed's other segment still has it.
+  expect_flow("log", "viz", "lan");
+  EXPECT_EQ(adapters["lan"]->bindings().size(), 2u);
+  EXPECT_EQ(adapters["viz"]->bindings().size(), 1u);
+}
+
+TEST_F(GatewayTest, ARefusalIsLoggedOnceAndItsEndIsLoggedAndShown) {
+  refuse_at_creation["viz"]["speed"] = "no room";
+  gateway.start(parse(kConfig));
+  // Other changes reconfigure every segment: the refusal stays visible, logged once.
+  ASSERT_TRUE(gateway.bind(channels("{name: extra, subject: 12, class: nrt, publishers: [lan], subscribers: [viz]}")).applied);
+  EXPECT_TRUE(gateway.unbind("extra"));
+  EXPECT_EQ(verdict_of("speed")->verdict, Verdict::failed);
+  EXPECT_EQ(log.count("channel speed: segment viz does not carry it: no room", LogLevel::error), 1u);
+  // A new reason is a new line.
+  adapters["viz"]->refuse_channel("speed", "still no room");
+  ASSERT_TRUE(gateway.bind(channels("{name: extra, subject: 12, class: nrt, publishers: [lan], subscribers: [viz]}")).applied);
+  EXPECT_EQ(log.count("channel speed: segment viz does not carry it: still no room", LogLevel::error), 1u);
+  // The transport takes it at the next configuration: bound again, said once, and it flows.
+  adapters["viz"]->refuse_channel("speed", "");
+  EXPECT_TRUE(gateway.unbind("extra"));
+  expect_carried("speed");
+  EXPECT_EQ(verdict_of("speed")->verdict, Verdict::bound);
+  EXPECT_EQ(log.count("channel speed: segment viz carries it now", LogLevel::notice), 1u);
+  expect_flow("speed", "lan", "viz");
+}
+
+TEST_F(GatewayTest, ASegmentFailingAsAWholeFailsEveryChannelItDoesNotCarry) {
+  fail_at_creation["lan"] = "DDS segment lan is not started";
+  const auto result = gateway.start(parse(kConfig));
+  ASSERT_TRUE(result.applied);
+  for (const auto& channel : result.channels) {
+    EXPECT_EQ(channel.verdict, Verdict::failed) << channel.name;
+    EXPECT_TRUE(has_reason(channel, "segment lan does not carry it: DDS segment lan is not started")) << channel.name;
+  }
+  EXPECT_EQ(log.count("segment lan does not carry it: DDS segment lan is not started", LogLevel::error), 2u);
+  // Once it takes its channels, everything is bound; a later whole failure concerns only what it
+  // did not carry yet: the new channel of a bind, which is then refused.
+  adapters["lan"]->fail_configure("");
+  ASSERT_TRUE(gateway.bind(channels("{name: extra, subject: 12, class: nrt, publishers: [lan], subscribers: [viz]}")).applied);
+  expect_carried("speed");
+  expect_carried("log");
+  adapters["lan"]->fail_configure("cannot create a DataReader on cosmic/more");
+  const auto bind = gateway.bind(channels("{name: more, subject: 13, class: nrt, publishers: [lan], subscribers: [viz]}"));
+  EXPECT_FALSE(bind.applied);
+  ASSERT_EQ(bind.channels.size(), 1u);
+  EXPECT_EQ(bind.channels[0].verdict, Verdict::failed);
+  EXPECT_NE(bind.error.find("segment lan does not carry channel more: cannot create a DataReader on cosmic/more"), std::string::npos)
+      << bind.error;
+  EXPECT_EQ(gateway.knowledge_base().find_bound("more"), nullptr);
+  for (const char* name : {"speed", "log", "extra"}) expect_carried(name);
+  expect_flow("speed", "lan", "viz");
+}
+
+TEST_F(GatewayTest, ABindWhoseChannelASegmentRefusesChangesNothing) {
+  gateway.start(parse(kConfig));
+  adapters["viz"]->refuse_channel("extra", "LCM channel names have at most 63 characters");
+  const auto result = gateway.bind(channels(R"(
+channels:
+  - {name: fine, subject: 11, class: nrt, publishers: [lan], subscribers: [viz]}
+  - {name: extra, subject: 12, class: nrt, publishers: [lan], subscribers: [viz]}
+)"));
+  EXPECT_FALSE(result.applied);
+  ASSERT_EQ(result.channels.size(), 2u);
+  EXPECT_NE(result.channels[0].verdict, Verdict::failed);
+  EXPECT_EQ(result.channels[1].verdict, Verdict::failed);
+  EXPECT_TRUE(has_reason(result.channels[1], "segment viz does not carry it: LCM channel names have at most 63 characters"));
+  EXPECT_NE(result.error.find("segment viz does not carry channel extra"), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find("nothing changed"), std::string::npos) << result.error;
+  EXPECT_EQ(gateway.knowledge_base().find_bound("fine"), nullptr);
+  EXPECT_EQ(gateway.knowledge_base().find_bound("extra"), nullptr);
+  EXPECT_EQ(adapters["lan"]->bindings().size(), 2u);
+  EXPECT_EQ(gateway.admission().channels.size(), 2u);
+  for (const char* name : {"speed", "log"}) expect_carried(name);
+}
+
+TEST_F(GatewayTest, ARefusalOfABoundChannelDoesNotBlockOtherBinds) {
+  refuse_at_creation["viz"]["speed"] = "no room";
+  gateway.start(parse(kConfig));
+  const auto result = gateway.bind(channels("{name: extra, subject: 12, class: nrt, publishers: [lan], subscribers: [viz]}"));
+  EXPECT_TRUE(result.applied) << result.error;
+  EXPECT_NE(result.channels.at(0).verdict, Verdict::failed);
+  expect_flow("extra", "lan", "viz");
+  EXPECT_EQ(verdict_of("speed")->verdict, Verdict::failed);
+}
+
+TEST_F(GatewayTest, ReloadShowsWhatASegmentRefuses) {
+  gateway.start(parse(kConfig));
+  adapters["viz"]->refuse_channel("extra", "no room");
+  std::string next = kConfig;
+  next += "  - {name: extra, subject: 3, class: nrt, publishers: [lan], subscribers: [viz]}\n";
+  const auto result = gateway.reload(parse(next));
+  ASSERT_TRUE(result.applied);
+  ASSERT_EQ(result.channels.size(), 3u);
+  EXPECT_EQ(result.channels[2].name, "extra");
+  EXPECT_EQ(result.channels[2].verdict, Verdict::failed);
+  EXPECT_TRUE(has_reason(result.channels[2], "segment viz does not carry it: no room"));
+  EXPECT_EQ(verdict_of("extra")->verdict, Verdict::failed);
+  EXPECT_EQ(log.count("channel extra: segment viz does not carry it: no room", LogLevel::error), 1u);
+  expect_flow("speed", "lan", "viz");
 }
 
 }  // namespace

@@ -205,6 +205,7 @@ const char* to_string(Verdict value) {
     case Verdict::bound: return "bound";
     case Verdict::degraded: return "degraded";
     case Verdict::rejected: return "rejected";
+    case Verdict::failed: return "failed";
   }
   return "?";
 }

@@ -58,7 +58,7 @@ BindResult Gateway::start(const Config& config) {
   kb_ = knowledge_base_for(config);
   BindResult result;
   for (const auto& spec : config.segments) {
-    SegmentSlot slot{free_slot(), spec, factory_(spec, identity_, log_)};
+    SegmentSlot slot{free_slot(), spec, factory_(spec, identity_, log_), {}};
     if (!slot.adapter || slot.index >= kMaxSegments) {
       result.error = "cannot create the adapter of segment " + spec.name;
       stop();
@@ -78,15 +78,16 @@ BindResult Gateway::start(const Config& config) {
     }
     result.channels.push_back(std::move(outcome.report));
   }
-  if (auto error = configure_adapters()) log_.log(LogLevel::error, *error);
+  configure_adapters();
+  for (auto& report : result.channels) mark_refused(report);
   apply_routes();
   result.applied = true;
   return result;
 }
 
-std::optional<std::string> Gateway::configure_adapters() {
+Gateway::Refusals Gateway::configure_adapters() {
   const AdmissionReport report = kb_->report();
-  std::optional<std::string> first_error;
+  Refusals refusals;
   for (auto& [name, slot] : slots_) {
     std::vector<ChannelBinding> bindings;
     for (const auto& channel : kb_->bound_channels()) {
@@ -97,9 +98,75 @@ std::optional<std::string> Gateway::configure_adapters() {
       }
     }
     const Status status = slot.adapter->configure(bindings);
-    if (!status.ok && !first_error) first_error = "segment " + name + ": " + status.error;
+    std::set<std::pair<ChannelId, HopRole>> given;
+    for (const auto& b : bindings) given.emplace(b.id, b.role);
+    if (status.ok) {
+      slot.carried = std::move(given);
+      continue;
+    }
+    // Which channels the failure concerns: those the adapter names, else every binding it was
+    // not already known to carry (an adapter that fails as a whole keeps at most what it had).
+    std::map<ChannelId, std::string> why;
+    for (const auto& refusal : status.refused) why.emplace(refusal.channel, refusal.reason);
+    std::set<std::pair<ChannelId, HopRole>> carried;
+    for (const auto& b : bindings) {
+      const bool was_carried = slot.carried.count({b.id, b.role}) > 0;
+      if (status.refused.empty() && !was_carried) why.emplace(b.id, status.error);
+      if (!why.count(b.id) && (was_carried || !status.refused.empty())) carried.emplace(b.id, b.role);
+    }
+    slot.carried = std::move(carried);
+    bool named = false;
+    for (const auto& b : bindings) {
+      const auto reason = why.find(b.id);
+      if (reason == why.end()) continue;
+      refusals[b.spec.name].emplace(name, reason->second);
+      named = true;
+    }
+    if (!named) {
+      // Nothing bound here is affected (the adapter still carries every binding it was given).
+      log_.log(LogLevel::error, "segment " + name + ": configuring its channels failed: " + status.error +
+                                    " (every channel bound there is still carried)");
+    }
   }
-  return first_error;
+  // One line per channel and segment when a refusal starts or its reason changes, one when it ends.
+  for (const auto& [channel, segments] : refusals) {
+    const auto before = refused_.find(channel);
+    for (const auto& [segment, reason] : segments) {
+      if (before != refused_.end()) {
+        const auto same = before->second.find(segment);
+        if (same != before->second.end() && same->second == reason) continue;
+      }
+      log_.log(LogLevel::error, "channel " + channel + ": segment " + segment + " does not carry it: " + reason +
+                                    " (verdict failed)");
+    }
+  }
+  for (const auto& [channel, segments] : refused_) {
+    if (!kb_->find_bound(channel)) continue;
+    const auto now = refusals.find(channel);
+    for (const auto& [segment, reason] : segments) {
+      if (now != refusals.end() && now->second.count(segment)) continue;
+      if (slots_.count(segment)) log_.log(LogLevel::notice, "channel " + channel + ": segment " + segment + " carries it now");
+    }
+  }
+  refused_ = refusals;
+  return refusals;
+}
+
+void Gateway::mark_refused(ChannelReport& report) const {
+  const auto refused = refused_.find(report.name);
+  if (refused == refused_.end()) return;
+  report.verdict = Verdict::failed;
+  for (const auto& [segment, reason] : refused->second) {
+    report.reasons.push_back("segment " + segment + " does not carry it: " + reason);
+  }
+}
+
+AdmissionReport Gateway::admission() const {
+  AdmissionReport report = kb_->report();
+  if (!refused_.empty()) {
+    for (auto& channel : report.channels) mark_refused(channel);
+  }
+  return report;
 }
 
 void Gateway::apply_routes() {
@@ -147,10 +214,22 @@ BindResult Gateway::commit_bind(BindPlan plan) {
   ++generation_;
   KnowledgeBase previous = *kb_;
   *kb_ = std::move(*plan.kb);
-  if (auto error = configure_adapters()) {
+  // A segment refusing one of the new channels undoes the whole bind; refusals of channels
+  // bound before are theirs to show and do not block it.
+  const Refusals refusals = configure_adapters();
+  std::string refused;
+  for (auto& report : result.channels) {
+    const auto found = refusals.find(report.name);
+    if (found == refusals.end()) continue;
+    mark_refused(report);
+    for (const auto& [segment, reason] : found->second) {
+      refused += (refused.empty() ? "" : "; ") + ("segment " + segment + " does not carry channel " + report.name + ": " + reason);
+    }
+  }
+  if (!refused.empty()) {
     *kb_ = std::move(previous);
     configure_adapters();
-    result.error = *error + "; nothing changed";
+    result.error = refused + "; nothing changed";
     return result;
   }
   apply_routes();
@@ -163,7 +242,7 @@ bool Gateway::unbind(const std::string& name) {
   if (!kb_->unbind(name)) return false;
   ++generation_;
   apply_routes();
-  if (auto error = configure_adapters()) log_.log(LogLevel::error, *error);
+  configure_adapters();
   log_.log(LogLevel::notice, "unbound channel " + name);
   return true;
 }
@@ -192,7 +271,7 @@ BindResult Gateway::commit_reload(ReloadPlan plan) {
     std::set<std::size_t> taken;
     for (const auto& [n, s] : fresh) taken.insert(s.index);
     const std::size_t index = free_slot(taken);
-    SegmentSlot slot{index, spec, index < kMaxSegments ? factory_(spec, identity_, log_) : nullptr};
+    SegmentSlot slot{index, spec, index < kMaxSegments ? factory_(spec, identity_, log_) : nullptr, {}};
     if (!slot.adapter) {
       for (auto& [n, s] : fresh) {
         s.adapter->stop();
@@ -229,7 +308,8 @@ BindResult Gateway::commit_reload(ReloadPlan plan) {
   identity_.name = config.gateway.name;
   kb_ = std::move(next_kb);
   // As in bind(): adapters carry the new channels before the router sends to them.
-  if (auto error = configure_adapters()) log_.log(LogLevel::error, *error);
+  configure_adapters();
+  for (auto& report : result.channels) mark_refused(report);
   apply_routes();
   for (auto& slot : retired) {
     router_->set_segment(slot.index, "", nullptr);

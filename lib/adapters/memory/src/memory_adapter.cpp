@@ -14,8 +14,34 @@ Status MemoryAdapter::start(EventSink& sink) {
 
 Status MemoryAdapter::configure(std::span<const ChannelBinding> bindings) {
   std::lock_guard lock(mutex_);
-  bindings_.assign(bindings.begin(), bindings.end());
-  return Status::success();
+  if (!fail_configure_.empty()) return Status::failure(fail_configure_);
+  Status status;
+  bindings_.clear();
+  for (const auto& b : bindings) {
+    const auto refused = refuse_.find(b.spec.name);
+    if (refused == refuse_.end()) {
+      bindings_.push_back(b);
+      continue;
+    }
+    status.ok = false;
+    status.error += (status.error.empty() ? "" : "; ") + ("channel " + b.spec.name + ": " + refused->second);
+    status.refused.push_back(ChannelRefusal{b.id, refused->second});
+  }
+  return status;
+}
+
+void MemoryAdapter::refuse_channel(const std::string& name, std::string reason) {
+  std::lock_guard lock(mutex_);
+  if (reason.empty()) {
+    refuse_.erase(name);
+  } else {
+    refuse_[name] = std::move(reason);
+  }
+}
+
+void MemoryAdapter::fail_configure(std::string reason) {
+  std::lock_guard lock(mutex_);
+  fail_configure_ = std::move(reason);
 }
 
 const ChannelBinding* MemoryAdapter::find(const std::string& name) const {

@@ -22,7 +22,10 @@
 
 namespace cosmic {
 
-enum class Verdict { bound, degraded, rejected };
+// Admission answers bound, degraded or rejected. `failed` is never admission's answer: the
+// gateway gives it to an admitted channel that a segment's transport refused to carry
+// (SegmentAdapter::configure), with the transport's reason; its reservations stay held.
+enum class Verdict { bound, degraded, rejected, failed };
 enum class HopRole { publisher, subscriber };
 
 const char* to_string(Verdict value);

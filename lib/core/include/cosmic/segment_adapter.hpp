@@ -17,6 +17,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "cosmic/admission.hpp"
 #include "cosmic/event.hpp"
@@ -58,11 +59,21 @@ class EventSink {
   ThreadPolicy receive_policy_;
 };
 
+// A channel a segment does not carry after configure(), and the transport's reason.
+struct ChannelRefusal {
+  ChannelId channel = kNoChannel;
+  std::string reason;
+};
+
 struct Status {
   bool ok = true;
   std::string error;
+  // configure() only: when not empty, exactly the channels the failure concerns (the segment
+  // carries every other binding it was given). Empty with !ok: the adapter cannot say which, and
+  // the gateway holds every binding the segment did not already carry as refused.
+  std::vector<ChannelRefusal> refused;
   static Status success() { return {}; }
-  static Status failure(std::string why) { return {false, std::move(why)}; }
+  static Status failure(std::string why) { return {false, std::move(why), {}}; }
 };
 
 enum class SendStatus { sent, queue_full, failed };
@@ -87,6 +98,8 @@ class SegmentAdapter {
   // Opens the transport; inbound events flow to `sink` (which must outlive stop()).
   virtual Status start(EventSink& sink) = 0;
   // Makes the segment carry exactly `bindings`. Channels present before and after keep flowing.
+  // A failure names the channels it concerns in Status::refused where the adapter can tell; the
+  // gateway shows each of them as `failed` with the reason (never bound and silent).
   virtual Status configure(std::span<const ChannelBinding> bindings) = 0;
   // Transmits one event of a channel bound here as subscriber. Never throws.
   virtual SendStatus send(const OutboundEvent& event) = 0;

@@ -8,6 +8,13 @@
 // promised. An HRT channel whose hop missed gateway.residence_bound or its reaction_time becomes
 // `violated` (logged once per episode at warning, with the numbers) and returns to `bound` after
 // gateway.clean_interval without a miss.
+//
+// Transport refusals: when a segment's adapter does not take a channel (configure() fails, at
+// start, bind, unbind or reload), the channel's verdict is `failed` with the adapter's reason in
+// admission(), in the BindResult and in one error log line naming the channel and the segment
+// (repeated only when the reason changes). A bind whose own channels are refused changes
+// nothing; at start and reload the channel stays admitted (its reservations held, so the next
+// configuration, e.g. a reload, tries again) and the rest runs.
 #pragma once
 
 #include <functional>
@@ -111,7 +118,8 @@ class Gateway {
   const GatewayIdentity& identity() const { return identity_; }
   const Config& config() const { return config_; }
   const KnowledgeBase& knowledge_base() const { return *kb_; }
-  AdmissionReport admission() const { return kb_->report(); }
+  // Verdicts of the bound channels: admission's, or `failed` where a segment refused the channel.
+  AdmissionReport admission() const;
   std::vector<SegmentInfo> segments() const;
   // The router's counters plus each channel's runtime state.
   std::vector<ChannelStatsSnapshot> channel_stats() const;
@@ -125,7 +133,12 @@ class Gateway {
     std::size_t index = 0;
     SegmentSpec spec;
     std::unique_ptr<SegmentAdapter> adapter;
+    // Bindings (channel id, role) the adapter is known to carry: all it was given at its last
+    // successful configure(), less what it refused since.
+    std::set<std::pair<ChannelId, HopRole>> carried;
   };
+  // Channel name -> segment name -> the transport's reason for not carrying it.
+  using Refusals = std::map<std::string, std::map<std::string, std::string>>;
 
   struct RuntimeTrack {
     RuntimeState state = RuntimeState::bound;
@@ -134,7 +147,10 @@ class Gateway {
     std::uint64_t violations = 0;
   };
 
-  std::optional<std::string> configure_adapters();
+  // Configures every adapter with the bound set; returns (and keeps in refused_) what they refused.
+  Refusals configure_adapters();
+  // Makes `report` say `failed`, with the reasons, when a segment refused its channel.
+  void mark_refused(ChannelReport& report) const;
   void judge(const ChannelMisses& counted, const ChannelSpec& spec, RuntimeTrack& track, Nanos now);
   std::string violation_line(const ChannelSpec& spec) const;
   void apply_routes();
@@ -150,6 +166,7 @@ class Gateway {
   std::unique_ptr<KnowledgeBase> kb_;
   std::unique_ptr<Router> router_;
   std::map<std::string, RuntimeTrack> runtime_;  // by channel name
+  Refusals refused_;                             // after the last configure_adapters()
   std::map<std::string, SegmentSlot> slots_;  // by segment name
   std::map<std::string, std::pair<ChannelSpec, ChannelId>> channel_ids_;
   ChannelId next_channel_id_ = 1;

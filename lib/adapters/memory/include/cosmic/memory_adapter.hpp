@@ -4,6 +4,7 @@
 #pragma once
 
 #include <condition_variable>
+#include <map>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -44,6 +45,12 @@ class MemoryAdapter final : public SegmentAdapter {
   // While held, send() blocks (a stuck network driver): the router stalls.
   void hold_sends(bool hold);
   std::vector<ChannelBinding> bindings() const;
+  // Makes configure() refuse channel `name` with `reason` (named in Status::refused, as a
+  // transport that cannot carry that channel) and take the other bindings; "" accepts it again.
+  void refuse_channel(const std::string& name, std::string reason);
+  // Makes configure() fail as a whole with `reason`, naming no channel and keeping the bindings it
+  // had (as a transport that rolls back); "" lets configure() succeed again.
+  void fail_configure(std::string reason);
 
  private:
   const ChannelBinding* find(const std::string& name) const;
@@ -55,6 +62,8 @@ class MemoryAdapter final : public SegmentAdapter {
   std::vector<RecordedEvent> sent_;
   HealthReport health_;
   AdapterStatistics stats_;
+  std::map<std::string, std::string> refuse_;  // channel name -> reason
+  std::string fail_configure_;
   bool congested_ = false;
   bool held_ = false;
   mutable std::condition_variable released_;
