@@ -31,6 +31,8 @@
 
 #include "cosmic/envelope.hpp"
 #include "cosmic/lcm_adapter.hpp"
+#include "cosmic/lcm_wire.hpp"
+#include "cosmic/transport_limits.hpp"
 
 namespace cosmic {
 namespace {
@@ -731,6 +733,96 @@ TEST_F(LcmAdapterTest, MalformedEnvelopesCountDecodeErrors) {
   ASSERT_TRUE(sink_.wait_events(8, 3));
   EXPECT_TRUE(sink_.events(8)[2].payload.empty());
   adapter->stop();
+}
+
+// Issue 9, item 10: the LCM name limit comes from cosmic/transport_limits.hpp (what the
+// configuration checks), and a refused name is reported for its channel (Status::refused) while
+// the segment carries the rest.
+TEST_F(LcmAdapterTest, ANameBeyondTheTransportLimitIsRefusedForItsChannelAlone) {
+  auto adapter = make(7710);
+  const std::string longest(kLcmMaxChannelName, 'a');
+  const std::string too_long(kLcmMaxChannelName + 1, 'b');
+  const std::vector<ChannelBinding> bindings{binding(1, longest, HopRole::subscriber),
+                                             binding(2, too_long, HopRole::subscriber),
+                                             binding(3, "FINE", HopRole::subscriber)};
+  const Status status = adapter->configure(bindings);
+  EXPECT_FALSE(status.ok);
+  ASSERT_EQ(status.refused.size(), 1u) << status.error;
+  EXPECT_EQ(status.refused[0].channel, 2u);
+  EXPECT_EQ(status.refused[0].reason, *transport_name_problem(SegmentType::lcm, too_long));
+  EXPECT_NE(status.error.find("at most 63 characters"), std::string::npos) << status.error;
+  ASSERT_TRUE(adapter->start(sink_).ok);
+  EXPECT_EQ(adapter->send(outbound(1, Bytes{1})), SendStatus::sent);
+  EXPECT_EQ(adapter->send(outbound(3, Bytes{1})), SendStatus::sent);
+  EXPECT_EQ(adapter->send(outbound(2, Bytes{1})), SendStatus::failed);
+  // Without the long name, nothing is refused.
+  EXPECT_TRUE(adapter->configure(std::vector<ChannelBinding>{bindings[0], bindings[2]}).ok);
+  adapter->stop();
+}
+
+// The envelope decoder the adapter runs (cosmic/lcm_wire.hpp) against what lcm-gen encodes.
+Bytes encoded(const ::cosmic::envelope& e) {
+  Bytes out(static_cast<std::size_t>(e.getEncodedSize()));
+  EXPECT_EQ(e.encode(out.data(), 0, static_cast<int>(out.size())), static_cast<int>(out.size()));
+  return out;
+}
+
+TEST(LcmWire, TheFingerprintIsLcmGens) {
+  EXPECT_EQ(::cosmic::envelope::getHash(), static_cast<std::int64_t>(kLcmEnvelopeHash));
+  ::cosmic::envelope e{};
+  EXPECT_EQ(encoded(e).size(), kLcmEnvelopeHeaderSize);
+}
+
+TEST(LcmWire, DecodesWhatLcmGenEncodesWithoutCopying) {
+  ::cosmic::envelope e{};
+  e.subject = -1;  // subject 0xFFFFFFFFFFFFFFFF
+  e.origin = INT64_MIN;
+  e.sequence = -1;
+  e.hop_count = -1;
+  e.created_ns = 1'700'000'000'000'000'000;
+  e.age_ns = -5;  // the router's ingress check refuses it; the decoder only reports it
+  e.payload = {9, 8, 7};
+  e.payload_size = 3;
+  const Bytes bytes = encoded(e);
+  const auto decoded = decode_lcm_envelope(bytes, 3);
+  ASSERT_TRUE(decoded.has_value());
+  EXPECT_EQ(decoded->header.subject, 0xFFFFFFFFFFFFFFFFull);
+  EXPECT_EQ(decoded->header.origin, 0x8000000000000000ull);
+  EXPECT_EQ(decoded->header.sequence, 0xFFFFFFFFu);
+  EXPECT_EQ(decoded->header.hop_count, 255u);
+  EXPECT_EQ(decoded->header.created_ns, 1'700'000'000'000'000'000);
+  EXPECT_EQ(decoded->header.age_ns, -5);
+  ASSERT_EQ(decoded->payload.size(), 3u);
+  EXPECT_EQ(decoded->payload.data(), bytes.data() + kLcmEnvelopeHeaderSize);
+  EXPECT_EQ(Bytes(decoded->payload.begin(), decoded->payload.end()), e.payload);
+
+  ::cosmic::envelope empty{};
+  const Bytes no_payload = encoded(empty);
+  ASSERT_TRUE(decode_lcm_envelope(no_payload, 0).has_value());
+  EXPECT_TRUE(decode_lcm_envelope(no_payload, 0)->payload.empty());
+}
+
+TEST(LcmWire, RefusesAnythingButExactlyOneEnvelopeWithinTheLimit) {
+  ::cosmic::envelope e{};
+  e.payload = Bytes(10, 0x5a);
+  e.payload_size = 10;
+  const Bytes valid = encoded(e);
+  ASSERT_TRUE(decode_lcm_envelope(valid, 10).has_value());
+  EXPECT_FALSE(decode_lcm_envelope(valid, 9).has_value());  // above max_message_size
+  auto with_payload_size = [&](std::uint32_t v) {
+    Bytes b = valid;
+    for (int i = 0; i < 4; ++i) b[kLcmEnvelopePayloadSizeOffset + i] = static_cast<std::uint8_t>(v >> (24 - 8 * i));
+    return b;
+  };
+  Bytes wrong_hash = valid;
+  wrong_hash[7] ^= 1;
+  Bytes trailing = valid;
+  trailing.push_back(0);
+  for (const Bytes& bad : {Bytes{}, Bytes(valid.begin(), valid.begin() + 48), Bytes(valid.begin(), valid.end() - 1), trailing,
+                           wrong_hash, with_payload_size(static_cast<std::uint32_t>(-5)), with_payload_size(11),
+                           with_payload_size(9), with_payload_size(0x7fffffff), with_payload_size(0xffffffff)}) {
+    EXPECT_FALSE(decode_lcm_envelope(bad, UINT64_MAX).has_value()) << bad.size();
+  }
 }
 
 }  // namespace

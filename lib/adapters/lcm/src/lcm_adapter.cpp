@@ -18,7 +18,9 @@
 
 #include "cosmic/adapter_counters.hpp"
 #include "cosmic/arrival_clock.hpp"
+#include "cosmic/lcm_wire.hpp"
 #include "cosmic/thread_policy.hpp"
+#include "cosmic/transport_limits.hpp"
 
 #include <lcm/lcm.h>
 #include <poll.h>
@@ -51,21 +53,11 @@ using Clock = std::chrono::steady_clock;
 
 constexpr int kRetryAfterFailureMs = 100;      // pause before retrying a failing liblcm
 constexpr int kSubscriptionQueueCapacity = 4096;  // LCM's default (30) drops bursts
-constexpr std::size_t kMaxChannelNameLength = 63;  // LCM_MAX_CHANNEL_NAME_LENGTH
-
-// Fixed layout of an encoded cosmic::envelope: 8-byte type hash, subject, origin, sequence,
-// hop_count, created_ns, age_ns, payload_size, then payload_size bytes. Big-endian.
-constexpr std::size_t kEnvelopeHeaderSize = 8 + 8 + 8 + 4 + 1 + 8 + 8 + 4;
-constexpr std::size_t kPayloadSizeOffset = kEnvelopeHeaderSize - 4;
+// Channel name limits: cosmic/transport_limits.hpp (the configuration refuses the same names).
+// The envelope layout and decoder: cosmic/lcm_wire.hpp.
 
 std::int64_t now_ns() {
   return std::chrono::duration_cast<Nanos>(Clock::now().time_since_epoch()).count();
-}
-
-std::int32_t read_be32(const std::uint8_t* p) {
-  const std::uint32_t v = (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) |
-                          (std::uint32_t{p[2]} << 8) | std::uint32_t{p[3]};
-  return static_cast<std::int32_t>(v);
 }
 
 // lcm_subscribe() takes a regular expression (implicitly anchored); channel names are literal.
@@ -230,10 +222,15 @@ class LcmAdapter final : public SegmentAdapter {
   Status configure(std::span<const ChannelBinding> bindings) override {
     std::lock_guard control(control_mutex_);
     std::string errors;
-    auto add_error = [&errors](const std::string& e) {
+    std::size_t error_count = 0;
+    auto add_error = [&errors, &error_count](const std::string& e) {
       if (!errors.empty()) errors += "; ";
       errors += e;
+      ++error_count;
     };
+    // Channels refused for a name LCM cannot carry; they name the failure's channels only when
+    // nothing else failed (Status::refused).
+    std::vector<ChannelRefusal> refused;
 
     // The table the segment must carry.
     std::unordered_map<ChannelId, Channel> wanted;
@@ -244,8 +241,9 @@ class LcmAdapter final : public SegmentAdapter {
         add_error("channel '" + name + "' has no id or name");
         continue;
       }
-      if (name.size() > kMaxChannelNameLength) {
-        add_error("LCM channel name '" + name + "' is longer than 63 characters");
+      if (const auto problem = transport_name_problem(SegmentType::lcm, name)) {
+        add_error("channel " + name + ": " + *problem);
+        refused.push_back(ChannelRefusal{b.id, *problem});
         continue;
       }
       auto [nit, fresh_name] = names.emplace(name, b.id);
@@ -295,7 +293,9 @@ class LcmAdapter final : public SegmentAdapter {
     }
     if (!errors.empty()) {
       log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + errors);
-      return Status::failure(errors);
+      Status status = Status::failure(errors);
+      if (error_count == refused.size()) status.refused = std::move(refused);
+      return status;
     }
     return Status::success();
   }
@@ -316,7 +316,7 @@ class LcmAdapter final : public SegmentAdapter {
       rc = lcm_publish(lcm_, channel.name.c_str(), event.payload.data(),
                        static_cast<unsigned>(event.payload.size()));
     } else {
-      if (event.payload.size() > static_cast<std::size_t>(INT32_MAX) - kEnvelopeHeaderSize)
+      if (event.payload.size() > static_cast<std::size_t>(INT32_MAX) - kLcmEnvelopeHeaderSize)
         return send_failed(channel, "payload too large");
       std::lock_guard encode(encode_mutex_);
       envelope& e = tx_envelope_;
@@ -485,38 +485,20 @@ class LcmAdapter final : public SegmentAdapter {
       return;
     }
 
-    if (!decode_envelope(bytes)) {
+    // Decoded in place (cosmic/lcm_wire.hpp): the payload stays in LCM's buffer, no copy.
+    const auto decoded = decode_lcm_envelope(bytes, segment_.max_message_size);
+    if (!decoded) {
       counters_.receive_errors.fetch_add(1, std::memory_order_relaxed);
       sink_->on_problem(channel.id, InboundProblem::decode_error);
       return;
     }
-    const envelope& e = rx_envelope_;
-    if (static_cast<std::uint64_t>(e.origin) == self_.id) {
+    if (decoded->header.origin == self_.id) {
       sink_->on_problem(channel.id, InboundProblem::own_echo);
       return;
     }
-    event.header.subject = static_cast<std::uint64_t>(e.subject);
-    event.header.origin = static_cast<std::uint64_t>(e.origin);
-    event.header.sequence = static_cast<std::uint32_t>(e.sequence);
-    event.header.hop_count = static_cast<std::uint8_t>(e.hop_count);
-    event.header.created_ns = e.created_ns;
-    event.header.age_ns = e.age_ns;
-    // payload_size, not payload.size(): the generated decode leaves the vector untouched for 0.
-    event.payload = std::span<const std::uint8_t>(e.payload.data(),
-                                                  static_cast<std::size_t>(e.payload_size));
+    event.header = decoded->header;
+    event.payload = decoded->payload;
     sink_->on_event(event);
-  }
-
-  // Validates the layout before the generated decoder sees it (it would resize its vector to a
-  // negative or huge payload_size), then decodes into the reused rx_envelope_.
-  bool decode_envelope(std::span<const std::uint8_t> bytes) {
-    if (bytes.size() < kEnvelopeHeaderSize || bytes.size() > INT_MAX) return false;
-    const std::int32_t payload_size = read_be32(bytes.data() + kPayloadSizeOffset);
-    if (payload_size < 0 || static_cast<std::uint64_t>(payload_size) > segment_.max_message_size ||
-        bytes.size() != kEnvelopeHeaderSize + static_cast<std::size_t>(payload_size))
-      return false;
-    const int size = static_cast<int>(bytes.size());
-    return rx_envelope_.decode(bytes.data(), 0, size) == size;
   }
 
   SendStatus send_failed(const Channel& channel, const char* why) {
@@ -555,7 +537,6 @@ class LcmAdapter final : public SegmentAdapter {
   envelope tx_envelope_{};
   std::vector<std::uint8_t> encode_buffer_ = std::vector<std::uint8_t>(4096);
 
-  envelope rx_envelope_{};  // receive thread
   EchoFilter echo_;
 
   mutable std::mutex health_mutex_;
