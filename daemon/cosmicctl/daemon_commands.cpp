@@ -117,6 +117,9 @@ void print_channels(const Json& r) {
       first = false;
     }
     for (const auto& reason : c["reasons"]) std::cout << "    - " << text(reason) << "\n";
+    if (c.contains("mismatches")) {
+      for (const auto& mismatch : c["mismatches"]) std::cout << "    ! QoS mismatch: " << text(mismatch) << "\n";
+    }
   }
 }
 
@@ -148,9 +151,9 @@ void print_channel(const Json& r) {
   for (const auto& hop : c["admission"]["hops"]) {
     std::cout << "  " << text(hop["role"]) << " " << text(hop["segment"]);
     if (hop.contains("can")) {
-      char id[16];
-      std::snprintf(id, sizeof id, "0x%08X", hop["can"]["can_id"].get<unsigned>());
-      std::cout << "  can_id " << id << " priority " << hop["can"]["priority"] << " etag " << hop["can"]["etag"];
+      const Json& can = hop["can"];
+      const auto layout = can.value("layout", "cosmic") == "famouso" ? cosmic::CanProfile::famouso : cosmic::CanProfile::cosmic;
+      std::cout << "  can_id " << cosmic::can_identifier_text(can["can_id"].get<std::uint32_t>(), layout);
     }
     std::cout << "\n";
     for (const auto& check : hop["checks"]) {

@@ -210,6 +210,77 @@ TEST_F(ControlTest, StatusSegmentsAndChannels) {
   EXPECT_EQ(client.call({{"command", "channel"}, {"name", "nope"}})["error"]["code"], "not_found");
 }
 
+// An in-memory segment whose transport negotiates QoS (as DDS does) and has a rate-limited
+// binding protocol (as CAN has): what it counts is what the control answers show.
+class NegotiatingAdapter final : public SegmentAdapter {
+ public:
+  NegotiatingAdapter(const std::string& name, const std::atomic<std::uint64_t>& incompatible)
+      : inner_(name), incompatible_(incompatible) {}
+  Status start(EventSink& sink) override { return inner_.start(sink); }
+  Status configure(std::span<const ChannelBinding> bindings) override { return inner_.configure(bindings); }
+  SendStatus send(const OutboundEvent& event) override { return inner_.send(event); }
+  HealthReport health() const override { return inner_.health(); }
+  AdapterStatistics statistics() const override {
+    AdapterStatistics s = inner_.statistics();
+    s.binding_requests_over_limit = incompatible_.load() * 10;
+    return s;
+  }
+  std::optional<std::size_t> matched_peers(ChannelId) const override { return 0; }
+  std::optional<std::uint64_t> incompatible_peers(ChannelId) const override { return incompatible_.load(); }
+  void stop() override { inner_.stop(); }
+
+ private:
+  MemoryAdapter inner_;
+  const std::atomic<std::uint64_t>& incompatible_;
+};
+
+// Remote endpoints refused for their QoS are a per-hop count and a per-channel mismatch line;
+// a transport without negotiation (LCM, CAN) answers null.
+TEST(ControlAnswers, IncompatiblePeersAndBindingRequestsOverTheLimit) {
+  QuietLogger log;
+  std::atomic<std::uint64_t> incompatible{0};
+  Gateway gateway(
+      [&](const SegmentSpec& spec, const GatewayIdentity&, Logger&) -> std::unique_ptr<SegmentAdapter> {
+        if (spec.name == "lan") return std::make_unique<NegotiatingAdapter>(spec.name, incompatible);
+        return std::make_unique<MemoryAdapter>(spec.name);
+      },
+      log, 0x42);
+  ASSERT_TRUE(gateway.start(parse_config(kConfig, "test.yaml").config).applied);
+  ControlProtocol protocol(gateway, [] { return parse_config("nonsense: [", "reload.yaml"); }, AccessPolicy{}, log);
+  auto call = [&](const Json& request) { return Json::parse(protocol.handle(request.dump(), PeerCredentials{})); };
+  auto hop = [](const Json& channel, const std::string& segment) {
+    for (const auto& s : channel["segments"]) {
+      if (s["segment"] == segment) return s;
+    }
+    return Json();
+  };
+
+  Json speed = call({{"command", "channels"}})["channels"][0];
+  EXPECT_EQ(hop(speed, "lan")["incompatible"], 0);
+  EXPECT_TRUE(hop(speed, "viz")["incompatible"].is_null());
+  EXPECT_EQ(speed["mismatches"], Json::array());
+
+  incompatible = 2;  // two remote writers of `speed` refused on lan (the gateway reads there)
+  for (const Json& answer : {call({{"command", "channels"}})["channels"][0], call({{"command", "channel"}, {"name", "speed"}})["channel"]}) {
+    EXPECT_EQ(hop(answer, "lan")["incompatible"], 2) << answer;
+    EXPECT_EQ(hop(answer, "lan")["matched"], 0) << answer;
+    ASSERT_EQ(answer["mismatches"].size(), 1u) << answer;
+    EXPECT_EQ(answer["mismatches"][0],
+              "2 remote writers on lan refused for incompatible QoS (not matched; the log names the policy)");
+  }
+
+  const Json segments = call({{"command", "segments"}})["segments"];
+  for (const auto& s : segments) {
+    const Json& over = s["adapter"]["binding_requests_over_limit"];
+    if (s["name"] == "lan") {
+      EXPECT_EQ(over, 20);
+    } else {
+      EXPECT_TRUE(over.is_null()) << s;  // no binding protocol
+    }
+  }
+  gateway.stop();
+}
+
 // Issue 9, item 10: what a segment's transport refuses is `failed` with its reason in every
 // answer that shows the channel, never `bound`.
 TEST_F(ControlTest, AChannelASegmentRefusesIsFailedWithItsReason) {

@@ -439,5 +439,96 @@ TEST(Verdicts, HopsInDeclarationOrder) {
   EXPECT_EQ(std::string(to_string(HopRole::subscriber)), "subscriber");
 }
 
+// ---------------------------------------------------------------- FAMOUSO profile
+
+SegmentSpec famouso_segment(const std::string& name, std::uint64_t bitrate = 500'000) {
+  SegmentSpec s = can_segment(name, bitrate);
+  s.can.profile = CanProfile::famouso;
+  return s;
+}
+
+// docs/can-wire-format.md section 8: priority (7 bits) | fragment | TxNode | etag, the identifier
+// each hop's frames carry on the wire.
+TEST(FamousoProfile, IdentifiersInFamousosLayout) {
+  ChannelSpec sensor = channel("sensor", 1, ChannelClass::nrt, {"bus"}, {"lan"}, 4, Nanos(5ms));
+  ChannelSpec command = channel("command", 2, ChannelClass::srt, {"lan"}, {"bus"}, 6, Nanos(10ms), Nanos(50ms));
+  ChannelSpec bulk = channel("bulk", 3, ChannelClass::nrt, {"lan"}, {"bus"}, 100, Nanos(100ms));
+  const auto e = run({famouso_segment("bus"), dds_segment("lan")}, {sensor, command, bulk},
+                     {{"sensor", 16383}, {"command", 300}, {"bulk", 202}}, gateway(500us, 9));
+  // The gateway sends `command`, the only SRT channel: plan 0x10, 0x10 in 7 bits, TxNode 9:
+  // (0x10 << 22) | (9 << 14) | 300 = 0x0402412C (the document's example).
+  const CanHopPlan& cmd = *find_hop(e.channels[1], "bus")->can;
+  EXPECT_EQ(cmd.profile, CanProfile::famouso);
+  EXPECT_EQ(cmd.priority, 0x10);
+  EXPECT_EQ(cmd.can_id, 0x0402412Cu);
+  EXPECT_EQ(decode_famouso_id(cmd.can_id), (FamousoIdentifier{0x10, false, 9, 300}));
+  // `bulk` (100 B) travels as AFP fragments: the fragment flag is in its identifier. It is the
+  // only NRT channel the gateway sends (the FAMOUSO node's `sensor` takes no level even though
+  // its period is shorter): plan 0xF0, 0x78 in 7 bits.
+  const CanHopPlan& frag = *find_hop(e.channels[2], "bus")->can;
+  EXPECT_GT(frag.frames_per_event, 1u);
+  EXPECT_EQ(frag.priority, 0x78);
+  EXPECT_EQ(frag.can_id, (0x78u << 22) | (1u << 21) | (9u << 14) | 202u);
+  // A FAMOUSO node publishes `sensor` at its fixed 0x7D, with a TxNode from the CCP broker: the
+  // analysis takes the last one it assigns (0x7E).
+  const CanHopPlan& up = *find_hop(e.channels[0], "bus")->can;
+  EXPECT_EQ(up.priority, kFamousoProtocolPriority);
+  EXPECT_EQ(decode_famouso_id(up.can_id), (FamousoIdentifier{0x7D, false, 0x7E, 16383}));
+  // The default profile keeps its own layout on the same set.
+  const auto plain = run({can_segment("bus"), dds_segment("lan")}, {sensor, command, bulk},
+                         {{"sensor", 16383}, {"command", 300}, {"bulk", 202}}, gateway(500us, 9));
+  const CanHopPlan& plain_cmd = *find_hop(plain.channels[1], "bus")->can;
+  EXPECT_EQ(plain_cmd.profile, CanProfile::cosmic);
+  EXPECT_EQ(plain_cmd.can_id, encode_can_id(CanIdentifier{0x10, 9, 300}));
+}
+
+// Beyond 8 NRT channels the last 7-bit level is shared and the bus orders its frames by TxNode
+// and etag: the analysis must see that order, not the 8-bit plan's.
+TEST(FamousoProfile, SharedLevelsAreAnalysedInWireOrder) {
+  std::vector<ChannelSpec> channels;
+  EtagMap etags;
+  for (int i = 0; i < 10; ++i) {
+    const std::string name = "n" + std::to_string(i);
+    channels.push_back(channel(name, 100 + i, ChannelClass::nrt, {"lan"}, {"bus"}, 8, Nanos(10ms) + Nanos(i * 1'000'000)));
+    etags[name] = static_cast<std::uint16_t>(1000 - 10 * i);  // the later the deadline, the lower the etag
+  }
+  const auto e = run({famouso_segment("bus"), dds_segment("lan")}, channels, etags, gateway(500us, 9));
+  auto plan = [&](int i) { return *find_hop(e.channels[static_cast<std::size_t>(i)], "bus")->can; };
+  for (int i = 0; i < 7; ++i) EXPECT_EQ(plan(i).priority, 0x78 + i) << i;
+  for (int i = 7; i < 10; ++i) EXPECT_EQ(plan(i).priority, 0x7F) << i;
+  // On 0x7F the lowest etag wins: n9 before n8 before n7.
+  EXPECT_LT(plan(9).can_id, plan(8).can_id);
+  EXPECT_LT(plan(8).can_id, plan(7).can_id);
+  ASSERT_TRUE(plan(9).response_time && plan(7).response_time);
+  // 500 kbit/s, 8 B: 320 us a frame; each is released up to lan's 1 ms + residence 0.5 ms late
+  // (jitter 1.5 ms). n7 waits for n0..n6, n8 and n9 (9 frames), then sends: 1.5 + 3.2 ms; n9 for
+  // one frame of n7 or n8 already on the bus and n0..n6, then sends: 1.5 + 2.88 ms.
+  EXPECT_EQ(*plan(7).response_time, Nanos(4'700'000));
+  EXPECT_EQ(*plan(9).response_time, Nanos(4'380'000));
+}
+
+// An HRT channel a FAMOUSO node publishes travels at 0x7D: every frame the gateway sends on an
+// HRT or SRT channel wins over it, and admission counts that.
+TEST(FamousoProfile, ChannelsNodesPublishAreAnalysedAtTheirPriority) {
+  // 125 kbit/s, 8 B frames of 1.28 ms. Default profile: `brake` (HRT) has the highest priority,
+  // R = blocking by one SRT frame 1.28 + 1.28 = 2.56 ms, end to end 2.56 + 0.5 + 0.1 = 3.16 ms
+  // <= 4 ms. FAMOUSO: it goes at 0x7D behind the three SRT frames the gateway sends:
+  // R = 3 * 1.28 + 1.28 = 5.12 ms > 4 ms, rejected.
+  const std::vector<ChannelSpec> channels{
+      channel("brake", 1, ChannelClass::hrt, {"bus"}, {"lan"}, 8, Nanos(10ms), Nanos(4ms)),
+      channel("steer", 2, ChannelClass::srt, {"lan"}, {"bus"}, 8, Nanos(10ms), Nanos(20ms)),
+      channel("turn", 3, ChannelClass::srt, {"lan"}, {"bus"}, 8, Nanos(10ms), Nanos(20ms)),
+      channel("lift", 4, ChannelClass::srt, {"lan"}, {"bus"}, 8, Nanos(10ms), Nanos(20ms))};
+  const auto plain = run({can_segment("bus", 125'000), dds_segment("lan", 100us)}, channels);
+  EXPECT_EQ(find_hop(plain.channels[0], "bus")->can->response_time, Nanos(2'560'000));
+  EXPECT_EQ(plain.channels[0].verdict, Verdict::bound) << reasons_text(plain.channels[0]);
+  const auto e = run({famouso_segment("bus", 125'000), dds_segment("lan", 100us)}, channels);
+  const ChannelReport& brake = e.channels[0];
+  EXPECT_EQ(find_hop(brake, "bus")->can->priority, kFamousoProtocolPriority);
+  EXPECT_EQ(find_hop(brake, "bus")->can->response_time, Nanos(5'120'000));
+  EXPECT_EQ(brake.verdict, Verdict::rejected);
+  EXPECT_TRUE(has_reason(brake, "R = 5.12 ms > reaction_time 4 ms on bus")) << reasons_text(brake);
+}
+
 }  // namespace
 }  // namespace cosmic

@@ -49,6 +49,8 @@ class RandomSets {
     if (chance(4)) {
       s.can.fd = true;
       s.can.data_bitrate = BitRate{2'000'000};
+    } else if (chance(3)) {
+      s.can.profile = CanProfile::famouso;  // classic CAN only; its own identifiers and priorities
     }
     if (chance(3)) s.can.errors = CanFaultHypothesis{static_cast<std::uint32_t>(1 + below(2)), Nanos(pick({10'000'000, 100'000'000}))};
     return s;

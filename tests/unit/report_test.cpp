@@ -109,6 +109,9 @@ TEST(JsonReport, Values) {
   EXPECT_EQ(hop["can"]["priority"], 0);
   EXPECT_EQ(hop["can"]["etag"], 16383);
   EXPECT_EQ(hop["can"]["can_id"], (0u << 21) | (1u << 14) | 16383u);  // 29-bit identifier
+  EXPECT_EQ(hop["can"]["layout"], "cosmic");
+  EXPECT_EQ(hop["can"]["tx_node"], 1);
+  EXPECT_FALSE(hop["can"].contains("fragment"));  // a FAMOUSO field
   EXPECT_EQ(hop["can"]["frame_bytes"], 8);
   EXPECT_DOUBLE_EQ(hop["can"]["transmission_time_s"].get<double>(), 0.00128);
   EXPECT_DOUBLE_EQ(hop["can"]["response_time_s"].get<double>(), 0.00256);
@@ -189,11 +192,43 @@ TEST(TextReport, ChannelDetail) {
   const std::string text = render_channel_text(*report.find("steer"));
   EXPECT_NE(text.find("steer (srt): degraded"), std::string::npos) << text;
   // priority 0x10, node 1, etag 16382: 0x10 << 21 | 1 << 14 | 16382 = 0x02007FFE.
-  EXPECT_NE(text.find("id 0x02007FFE prio 16 etag 16382"), std::string::npos) << text;
+  EXPECT_NE(text.find("id 0x02007FFE (priority 0x10, TxNode 1, etag 16382)"), std::string::npos) << text;
   EXPECT_NE(text.find("FAIL response_time"), std::string::npos) << text;
   EXPECT_NE(text.find("2.56 ms <= 2 ms"), std::string::npos) << text;
   EXPECT_NE(text.find("ok   frame_fit"), std::string::npos) << text;
   EXPECT_NE(text.find("end-to-end 2.76 ms, reaction_time 2 ms  FAIL"), std::string::npos) << text;
+}
+
+// A FAMOUSO segment's hops in FAMOUSO's layout (docs/can-wire-format.md section 8): JSON and text.
+TEST(JsonReport, FamousoHopsInFamousosLayout) {
+  Config config;
+  config.gateway = gateway(100us, 9);
+  config.segments = {can_segment("bus"), dds_segment("lan", 100us)};
+  config.segments[0].can.profile = CanProfile::famouso;
+  ChannelSpec command = channel("command", 2, ChannelClass::srt, {"lan"}, {"bus"}, 6, Nanos(10ms), Nanos(50ms));
+  command.etag = 300;
+  ChannelSpec bulk = channel("bulk", 3, ChannelClass::nrt, {"lan"}, {"bus"}, 100, Nanos(100ms));
+  bulk.etag = 202;
+  config.channels = {command, bulk};
+  const AdmissionReport report = admit_all(config);
+  const json j = to_json(report);
+  const json& cmd = channel_named(j, "command")["hops"][1]["can"];
+  EXPECT_EQ(cmd["layout"], "famouso");
+  EXPECT_EQ(cmd["priority"], 0x10);  // 7 bits
+  EXPECT_EQ(cmd["fragment"], false);
+  EXPECT_EQ(cmd["tx_node"], 9);
+  EXPECT_EQ(cmd["etag"], 300);
+  EXPECT_EQ(cmd["can_id"], 0x0402412Cu);  // (0x10 << 22) | (9 << 14) | 300
+  const json& frag = channel_named(j, "bulk")["hops"][1]["can"];
+  EXPECT_EQ(frag["priority"], 0x78);
+  EXPECT_EQ(frag["fragment"], true);
+  EXPECT_EQ(frag["can_id"], (0x78u << 22) | (1u << 21) | (9u << 14) | 202u);
+  const std::string text = render_channel_text(*report.find("command"));
+  EXPECT_NE(text.find("id 0x0402412C (FAMOUSO layout: priority 0x10, fragment 0, TxNode 9, etag 300)"), std::string::npos)
+      << text;
+  EXPECT_EQ(can_identifier_text(0x1E2140C9u, CanProfile::famouso),
+            "0x1E2140C9 (FAMOUSO layout: priority 0x78, fragment 1, TxNode 5, etag 201)");
+  EXPECT_EQ(can_identifier_text(0x1E2140C9u, CanProfile::cosmic), "0x1E2140C9 (priority 0xF1, TxNode 5, etag 201)");
 }
 
 }  // namespace

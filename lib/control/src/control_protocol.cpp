@@ -231,7 +231,10 @@ Json ControlProtocol::segments() const {
                  {"receive_errors", s.adapter.receive_errors},
                  {"send_errors", s.adapter.send_errors},
                  {"overflow_drops", s.adapter.overflow_drops},
-                 {"backlog", s.adapter.backlog}}}};
+                 {"backlog", s.adapter.backlog},
+                 {"binding_requests_over_limit", s.adapter.binding_requests_over_limit
+                                                     ? Json(*s.adapter.binding_requests_over_limit)
+                                                     : Json(nullptr)}}}};
     if (s.spec.type == SegmentType::can) {
       entry["interface"] = s.spec.can.interface;
       entry["bitrate"] = s.spec.can.bitrate.bits_per_second;
@@ -246,6 +249,14 @@ Json ControlProtocol::segments() const {
 }
 
 namespace {
+// A hop whose transport refused remote endpoints for their QoS: they are there and exchange
+// nothing with the gateway. On a publisher hop the gateway reads, so the refused are writers.
+std::string incompatible_text(const HopReport& hop, std::uint64_t count) {
+  const char* peer = hop.role == HopRole::publisher ? "writer" : "reader";
+  return std::to_string(count) + " remote " + peer + (count == 1 ? "" : "s") + " on " + hop.segment +
+         " refused for incompatible QoS (not matched; the log names the policy)";
+}
+
 // Predicted (admission) next to measured (the lane) for one egress hop.
 Json hop_runtime(const HopReport& hop, const HopRuntimeSnapshot& measured) {
   return Json{{"predicted_latency_s", hop.latency ? Json(to_seconds(*hop.latency)) : Json(nullptr)},
@@ -269,10 +280,14 @@ Json ControlProtocol::channel_entry(const ChannelReport& verdict, const ChannelS
     entry["subject"] = subject;
   }
   if (const auto etag = gateway_.knowledge_base().etag_of(verdict.name)) entry["etag"] = *etag;
+  entry["mismatches"] = Json::array();
   for (const auto& hop : verdict.hops) {
     Json seg{{"segment", hop.segment}, {"role", to_string(hop.role)}, {"rx", 0}, {"tx", 0}, {"dropped", Json::object()}};
     const auto matched = gateway_.matched_peers(hop.segment, verdict.name);
     seg["matched"] = matched ? Json(*matched) : Json(nullptr);
+    const auto incompatible = gateway_.incompatible_peers(hop.segment, verdict.name);
+    seg["incompatible"] = incompatible ? Json(*incompatible) : Json(nullptr);
+    if (incompatible && *incompatible > 0) entry["mismatches"].push_back(incompatible_text(hop, *incompatible));
     for (std::size_t r = 0; r < kDropReasonCount; ++r) seg["dropped"][to_string(static_cast<DropReason>(r))] = 0;
     if (stats) {
       for (const auto& counters : stats->segments) {

@@ -277,7 +277,10 @@ AdmissionSet::Member AdmissionSet::member(std::size_t segment, std::size_t posit
 }
 
 // Priorities (band, then deadline-monotonic), identifiers and frame times of one CAN bus, in the
-// order of its hop list (the newcomer's hops last).
+// order of its hop list (the newcomer's hops last). Each identifier is the one on the wire in the
+// bus's profile (CanHopPlan): on a FAMOUSO bus the gateway's frames carry the planned priority in
+// 7 bits (famouso_priority) and the fragment flag, while the nodes publish at their own fixed
+// priority, so only subscriber hops take a level of the bands there.
 std::vector<CanHopPlan> AdmissionSet::plan_bus(std::size_t segment, const Trial* newcomer) const {
   std::vector<Member> members;
   for (std::size_t pos = 0; pos < segments_[segment].hops.size(); ++pos) members.push_back(member(segment, pos, nullptr));
@@ -286,8 +289,23 @@ std::vector<CanHopPlan> AdmissionSet::plan_bus(std::size_t segment, const Trial*
       if (p.segment == segment) members.push_back(Member{&newcomer->spec, &newcomer->data, p.role});
     }
   }
-  std::vector<std::size_t> ordered(members.size());
-  for (std::size_t i = 0; i < ordered.size(); ++i) ordered[i] = i;
+  const CanSegmentProperties& bus = segment_specs_[segment].can;
+  const bool famouso = bus.profile == CanProfile::famouso;
+  std::vector<CanHopPlan> plans(members.size());
+  std::vector<std::size_t> ordered;
+  for (std::size_t i = 0; i < members.size(); ++i) {
+    CanHopPlan& plan = plans[i];
+    plan = frame_plan(bus, *members[i].spec);
+    plan.profile = bus.profile;
+    plan.etag = members[i].data->etag;
+    if (famouso && members[i].role == HopRole::publisher) {
+      plan.priority = kFamousoProtocolPriority;
+      plan.can_id = encode_famouso_id(
+          FamousoIdentifier{plan.priority, plan.frames_per_event > 1, kFamousoLastAssignedNode, plan.etag});
+    } else {
+      ordered.push_back(i);
+    }
+  }
   std::sort(ordered.begin(), ordered.end(), [&](std::size_t a, std::size_t b) {
     const ChannelSpec& ca = *members[a].spec;
     const ChannelSpec& cb = *members[b].spec;
@@ -295,18 +313,20 @@ std::vector<CanHopPlan> AdmissionSet::plan_bus(std::size_t segment, const Trial*
            std::tuple(static_cast<int>(cb.cls), deadline_key(cb), cb.subject);
   });
   std::array<std::size_t, 3> count{};
-  for (const Member& m : members) ++count[static_cast<std::size_t>(m.spec->cls)];
-  const CanSegmentProperties& bus = segment_specs_[segment].can;
-  std::vector<CanHopPlan> plans(members.size());
+  for (const std::size_t i : ordered) ++count[static_cast<std::size_t>(members[i].spec->cls)];
   std::size_t first_of_class = 0;
-  for (std::size_t i = 0; i < ordered.size(); ++i) {
-    const Member& m = members[ordered[i]];
-    if (i > 0 && members[ordered[i - 1]].spec->cls != m.spec->cls) first_of_class = i;
-    CanHopPlan plan = frame_plan(bus, *m.spec);
-    plan.priority = band_priority(m.spec->cls, i - first_of_class, count[static_cast<std::size_t>(m.spec->cls)]);
-    plan.etag = m.data->etag;
-    plan.can_id = encode_can_id(CanIdentifier{plan.priority, gateway_.can_node_id, plan.etag});
-    plans[ordered[i]] = plan;
+  for (std::size_t k = 0; k < ordered.size(); ++k) {
+    const ChannelSpec& spec = *members[ordered[k]].spec;
+    if (k > 0 && members[ordered[k - 1]].spec->cls != spec.cls) first_of_class = k;
+    CanHopPlan& plan = plans[ordered[k]];
+    const std::uint8_t planned = band_priority(spec.cls, k - first_of_class, count[static_cast<std::size_t>(spec.cls)]);
+    if (famouso) {
+      plan.priority = famouso_priority(planned);
+      plan.can_id = encode_famouso_id(FamousoIdentifier{plan.priority, plan.frames_per_event > 1, gateway_.can_node_id, plan.etag});
+    } else {
+      plan.priority = planned;
+      plan.can_id = encode_can_id(CanIdentifier{plan.priority, gateway_.can_node_id, plan.etag});
+    }
   }
   return plans;
 }

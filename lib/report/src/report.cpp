@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include "cosmic/can_wire.hpp"
+
 namespace cosmic {
 namespace {
 
@@ -26,14 +28,18 @@ nlohmann::json to_json(const HopReport& hop) {
   nlohmann::json out{{"segment", hop.segment}, {"role", to_string(hop.role)}, {"latency_s", seconds_or_null(hop.latency)}};
   if (hop.can) {
     const CanHopPlan& can = *hop.can;
-    out["can"] = {{"priority", can.priority},
+    const CanIdentifier fields = decode_can_id(can.can_id);  // TxNode and etag: same bits in both layouts
+    out["can"] = {{"layout", can.profile == CanProfile::famouso ? "famouso" : "cosmic"},
+                  {"priority", can.priority},
                   {"can_id", can.can_id},
+                  {"tx_node", fields.tx_node},
                   {"etag", can.etag},
                   {"frame_bytes", can.frame_bytes},
                   {"frames_per_event", can.frames_per_event},
                   {"transmission_time_s", to_seconds(can.transmission)},
                   {"jitter_s", to_seconds(can.jitter)},
                   {"response_time_s", seconds_or_null(can.response_time)}};
+    if (can.profile == CanProfile::famouso) out["can"]["fragment"] = decode_famouso_id(can.can_id).fragment;
   }
   out["checks"] = nlohmann::json::array();
   for (const auto& check : hop.checks) out["checks"].push_back(to_json(check));
@@ -57,6 +63,21 @@ std::string limit_text(const Check& check) {
 }
 
 }  // namespace
+
+std::string can_identifier_text(std::uint32_t can_id, CanProfile profile) {
+  char text[96];
+  if (profile == CanProfile::famouso) {
+    const FamousoIdentifier id = decode_famouso_id(can_id);
+    std::snprintf(text, sizeof text, "0x%08X (FAMOUSO layout: priority 0x%02X, fragment %d, TxNode %u, etag %u)", can_id,
+                  static_cast<unsigned>(id.priority), id.fragment ? 1 : 0, static_cast<unsigned>(id.tx_node),
+                  static_cast<unsigned>(id.etag));
+  } else {
+    const CanIdentifier id = decode_can_id(can_id);
+    std::snprintf(text, sizeof text, "0x%08X (priority 0x%02X, TxNode %u, etag %u)", can_id,
+                  static_cast<unsigned>(id.priority), static_cast<unsigned>(id.tx_node), static_cast<unsigned>(id.etag));
+  }
+  return text;
+}
 
 std::string pad_column(const std::string& text, std::size_t width) {
   return text.size() >= width ? text + " " : text + std::string(width - text.size(), ' ');
@@ -134,9 +155,7 @@ std::string render_channel_text(const ChannelReport& channel) {
   for (const auto& hop : channel.hops) {
     out << "  " << to_string(hop.role) << " " << hop.segment;
     if (hop.can) {
-      char id[16];
-      std::snprintf(id, sizeof id, "0x%08X", hop.can->can_id);
-      out << "  id " << id << " prio " << static_cast<int>(hop.can->priority) << " etag " << hop.can->etag << " C "
+      out << "  id " << can_identifier_text(hop.can->can_id, hop.can->profile) << " C "
           << format_duration(hop.can->transmission) << " x" << hop.can->frames_per_event;
     }
     out << "\n";

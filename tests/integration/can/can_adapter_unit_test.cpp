@@ -132,6 +132,30 @@ TEST(CanAdapterWithoutBus, RejectsBindingsItCannotCarry) {
   EXPECT_NE(status.error.find("no CAN plan"), std::string::npos);
 }
 
+// Admission plans each hop in its segment's identifier layout; a plan for the other layout would
+// put the wrong priority (or the fragment flag) on the wire, so it is refused.
+TEST(CanAdapterWithoutBus, RefusesAPlanInAnotherLayout) {
+  NullLogger log;
+  SegmentSpec famouso = can_segment("nosuchcan7");
+  famouso.can.profile = CanProfile::famouso;
+  auto adapter = make_can_adapter(famouso, GatewayIdentity{1, "gw"}, log);
+  ChannelBinding binding;
+  binding.id = 5;
+  binding.spec.name = "c";
+  binding.spec.subject = 0x42;
+  binding.spec.payload = 4;
+  binding.role = HopRole::subscriber;
+  binding.can = CanHopPlan{};
+  binding.can->etag = 200;
+  binding.can->can_id = encode_can_id(CanIdentifier{0x11, 1, 200});  // cosmic layout: bit 21 set
+  const Status status = adapter->configure(std::span(&binding, 1));
+  EXPECT_FALSE(status.ok);
+  EXPECT_NE(status.error.find("another identifier layout"), std::string::npos) << status.error;
+  binding.can->profile = CanProfile::famouso;
+  binding.can->can_id = encode_famouso_id(FamousoIdentifier{0x11, false, 1, 200});
+  EXPECT_TRUE(adapter->configure(std::span(&binding, 1)).ok);
+}
+
 TEST(CanAdapterWithoutBus, ANonCanInterfaceIsReported) {
   NullLogger log;
   NullSink sink;

@@ -203,6 +203,50 @@ YAML
   passed
 }
 
+# A remote DDS writer whose QoS cosmicd must refuse (best effort on a reliable segment) is a
+# visible per-channel mismatch: counted in the control answer, named by cosmicctl.
+test_incompatible_peer_is_a_visible_mismatch() {
+  scenario "a DDS writer refused for its QoS shows in cosmicctl channels and channel"
+  cat >"$WORK/wheel.yaml" <<YAML
+channels:
+  - {name: wheel, subject: 0x1c0, class: nrt, payload: 8B, omission_degree: 3, publishers: [lan], subscribers: [lcm-a]}
+YAML
+  ctl a bind "$WORK/wheel.yaml" >/dev/null || { fail "bind of wheel failed"; return; }
+  expect_field a wheel lan incompatible 0
+  "$DDS_PEER" pub --domain 21 --channel wheel --count 1 --size 8 --best-effort --match-timeout 60 \
+    >/dev/null 2>"$WORK/wheel.pub.err" &
+  local pub=$!
+  PIDS+=("$pub")
+  wait_until 30 "gw-a counts the best-effort writer of wheel as incompatible" field_at_least a wheel lan incompatible 1 || return
+  expect_field a wheel lan matched 0
+  ctl a channels >"$WORK/wheel.channels" || fail "cosmicctl channels failed"
+  grep -Eq '! QoS mismatch: [0-9]+ remote writers? on lan refused for incompatible QoS' "$WORK/wheel.channels" ||
+    fail "cosmicctl channels shows no QoS mismatch: $(cat "$WORK/wheel.channels")"
+  ctl a channel wheel >"$WORK/wheel.channel" || fail "cosmicctl channel failed"
+  grep -Eq '! QoS mismatch: [0-9]+ remote writers? on lan refused for incompatible QoS' "$WORK/wheel.channel" ||
+    fail "cosmicctl channel wheel shows no QoS mismatch: $(cat "$WORK/wheel.channel")"
+  ctl a --json channel wheel | python3 -c '
+import json, sys
+c = json.load(sys.stdin)["channel"]
+lan = next(s for s in c["segments"] if s["segment"] == "lan")
+lcm = next(s for s in c["segments"] if s["segment"] == "lcm-a")
+assert lan["incompatible"] >= 1, lan
+assert lcm["incompatible"] is None, lcm
+assert len(c["mismatches"]) == 1 and "on lan refused for incompatible QoS" in c["mismatches"][0], c["mismatches"]
+' || fail "cosmicctl --json channel wheel: no incompatible count or mismatch"
+  # A channel nobody refused shows none.
+  ctl a --json channel steady | python3 -c '
+import json, sys
+c = json.load(sys.stdin)["channel"]
+assert c["mismatches"] == [], c["mismatches"]
+assert all(s["incompatible"] in (0, None) for s in c["segments"]), c["segments"]
+' || fail "a channel without refused peers shows a mismatch"
+  kill "$pub" 2>/dev/null
+  wait "$pub" 2>/dev/null
+  ctl a unbind wheel >/dev/null || fail "unbind of wheel failed"
+  passed
+}
+
 write_gateway_a ""
 write_gateway_b
 start_daemon a "$WORK/a.yaml" || exit 1
@@ -211,7 +255,7 @@ start_daemon b "$WORK/b.yaml" || exit 1
 scenarios=("$@")
 [ ${#scenarios[@]} -gt 0 ] || scenarios=(raw_lcm_across_dds cross_connected_gateways expired_events_are_dropped
   rate_limit_holds bind_unbind_while_traffic_flows hrt_bind_over_lcm_is_rejected
-  reload_of_broken_file_keeps_running_configuration)
+  incompatible_peer_is_a_visible_mismatch reload_of_broken_file_keeps_running_configuration)
 for s in "${scenarios[@]}"; do
   "test_$s"
 done

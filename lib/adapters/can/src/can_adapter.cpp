@@ -211,7 +211,7 @@ class CanAdapter final : public SegmentAdapter {
   // once (FAMOUSO's) must not lose its binding to a burst at start-up. One entry per (node,
   // subject), bounded, so a flood costs a counter and at most one later answer.
   std::deque<can_binding::GetEtagRequest> deferred_requests_;
-  std::uint64_t refused_requests_ = 0;
+  std::atomic<std::uint64_t> refused_requests_{0};  // over the rate limit (deferred or dropped)
   std::unordered_map<std::uint16_t, std::uint8_t> tx_sequence_;
   bool wait_pollout_ = false;      // backlog waits for POLLOUT (EAGAIN)
   std::optional<Nanos> retry_at_;  // backlog waits for the qdisc (ENOBUFS)
@@ -323,6 +323,10 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
       refuse(b, "no CAN plan");
       continue;
     }
+    if (b.can->profile != segment_.can.profile) {
+      refuse(b, "the plan is for another identifier layout than the segment's profile");
+      continue;
+    }
     const std::uint16_t etag = b.can->etag;
     if (etag <= kHighestReservedEtag || etag > kMaxEtag) {
       refuse(b, "etag " + std::to_string(etag) + " is reserved or out of range");
@@ -343,16 +347,21 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
         continue;
       }
     } else {
+      // Admission's identifier, in the segment's layout. FAMOUSO: a single frame goes without
+      // the fragment flag, AFP fragments with it (admission planned the flag of the channel's
+      // largest events).
       const std::uint32_t planned = b.can->can_id & CAN_EFF_MASK;
-      const std::uint32_t can_id = famouso_ ? famouso_id_of(planned, false) : planned;
-      table->tx[b.id] = TxChannel{b.id, can_id, famouso_id_of(planned, true), etag, payload, fragmented};
+      const std::uint32_t can_id = famouso_ ? planned & ~kFamousoFragmentFlag : planned;
+      table->tx[b.id] = TxChannel{b.id, can_id, planned | kFamousoFragmentFlag, etag, payload, fragmented};
       if (fragmented) {
         const std::size_t frames = famouso_ ? famouso::afp_fragment_count(payload) : fragment_count(payload, capacity_);
         table->backlog_frames = std::max<std::size_t>(table->backlog_frames, 2 * frames);
       }
+      if (!table->tx_node) table->tx_node = id.tx_node;
     }
     table->etag_of[b.spec.subject] = etag;
-    if (!table->tx_node) table->tx_node = id.tx_node;
+    // FAMOUSO: a publisher hop's plan carries the nodes' TxNode, not the gateway's.
+    if (!famouso_ && !table->tx_node) table->tx_node = id.tx_node;
   }
   if (famouso_) table->etag_of[kFamousoSubscribeSubject] = kEtagFamousoSubscribe;  // FAMOUSO nodes bind it at start
   // Kernel filters: the 14 etag bits of every etag bound as publisher, plus the protocols' etags;
@@ -474,6 +483,7 @@ AdapterStatistics CanAdapter::statistics() const {
   s.send_errors = send_errors_.load();
   s.overflow_drops = overflow_closed_.load() + overflow_socket_.load() + overflow_controller_.load();
   s.backlog = backlog_size_.load();
+  s.binding_requests_over_limit = refused_requests_.load();
   return s;
 }
 
@@ -891,11 +901,12 @@ void CanAdapter::defer_request(const can_binding::GetEtagRequest& request) {
   });
   const bool kept = !known && deferred_requests_.size() < kMaxPendingRequests;
   if (kept) deferred_requests_.push_back(request);
-  if (refused_requests_++ % 1000 == 0) {
+  const std::uint64_t over = refused_requests_.fetch_add(1) + 1;
+  if (over % 1000 == 1) {
     log_.log(LogLevel::warning, "segment " + segment_.name + ": GET_ETAG from TxNode " +
                                     std::to_string(request.requester) + " over the rate limit, " +
                                     (kept ? "answered later" : known ? "already waiting" : "deferred queue full, dropped") +
-                                    " (" + std::to_string(refused_requests_) + " over the limit so far)");
+                                    " (" + std::to_string(over) + " over the limit so far)");
   }
 }
 

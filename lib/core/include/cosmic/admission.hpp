@@ -42,9 +42,17 @@ struct Check {
   bool ok = true;
 };
 
+// A CAN hop as it is on the wire, in the segment's profile (docs/can-wire-format.md):
+// - cosmic: can_id = priority (8 bits) | TxNode | etag; the gateway's TxNode on both roles.
+// - famouso: can_id = priority (7 bits) | fragment flag | TxNode | etag. Subscriber hops (the
+//   gateway sends): the planned priority in 7 bits, the gateway's TxNode, the fragment flag when
+//   the channel's events need AFP fragments. Publisher hops (FAMOUSO nodes send): their fixed
+//   priority 0x7D and the last TxNode the CCP broker assigns (0x7E).
+// The response-time analysis orders the streams by can_id, so it sees the arbitration the bus does.
 struct CanHopPlan {
-  std::uint8_t priority = 0;
-  std::uint32_t can_id = 0;  // 29-bit identifier as the gateway sends it
+  CanProfile profile = CanProfile::cosmic;
+  std::uint8_t priority = 0;  // the identifier's priority field (7 bits in the FAMOUSO profile)
+  std::uint32_t can_id = 0;   // 29-bit identifier of the hop's frames
   std::uint16_t etag = 0;
   std::uint32_t frame_bytes = 0;        // data bytes of one frame (FD: padded length)
   std::uint32_t frames_per_event = 1;   // > 1 for fragmented NRT events

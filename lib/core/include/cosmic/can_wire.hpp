@@ -59,11 +59,17 @@ inline constexpr PriorityBand kFamousoSrtBand{0x10, 0x77};
 inline constexpr PriorityBand kFamousoNrtBand{0x78, 0x7F};
 inline constexpr std::uint8_t kFamousoProtocolPriority = 0x7D;  // FAMOUSO's prio(0xFD) in 7 bits
 inline constexpr std::uint8_t kFamousoBrokerNode = 0x7F;        // TxNode of FAMOUSO's brokers
+inline constexpr std::uint32_t kFamousoFragmentFlag = 1u << 21;
+// FAMOUSO nodes send their events with kFamousoProtocolPriority, whatever the channel's class,
+// and a TxNode from the CCP broker (0x7E downwards): admission analyses a channel a FAMOUSO node
+// publishes at that priority, as the last TxNode of that level (the latest its frames can win).
+inline constexpr std::uint8_t kFamousoLastAssignedNode = 0x7E;
 
 // Admission's 8-bit priority (band_priority) in 7 bits: order-preserving, the class stays in its
 // band, and distinct levels stay distinct while a band has room (HRT 16, SRT 104, NRT 8 channels).
 std::uint8_t famouso_priority(std::uint8_t priority);
-// Admission's identifier (our layout) as the gateway sends it on a FAMOUSO segment.
+// An identifier in our layout (section 1) carried over to FAMOUSO's: priority through
+// famouso_priority(), TxNode and etag unchanged.
 std::uint32_t famouso_id_of(std::uint32_t cosmic_can_id, bool fragment);
 
 inline constexpr std::uint16_t kEtagCcpSsi = 0;           // CCP: broker -> node

@@ -90,6 +90,9 @@ struct AdapterStatistics {
   std::uint64_t send_errors = 0;
   std::uint64_t overflow_drops = 0;  // lost before we could read them (e.g. SO_RXQ_OVFL)
   std::uint64_t backlog = 0;         // frames waiting in the adapter's own send queue
+  // Requests of the transport's binding protocol over its rate limit (CAN: GET_ETAG, answered
+  // later or not at all; also counted in receive_errors); nullopt where there is no such protocol.
+  std::optional<std::uint64_t> binding_requests_over_limit;
 };
 
 class SegmentAdapter {

@@ -127,6 +127,8 @@ class Gateway {
   bool all_segments_up() const;
   // Discovered remote endpoints of a bound channel on a segment (see SegmentAdapter).
   std::optional<std::size_t> matched_peers(const std::string& segment, const std::string& channel) const;
+  // Remote endpoints of a bound channel refused on a segment for incompatible QoS (see SegmentAdapter).
+  std::optional<std::uint64_t> incompatible_peers(const std::string& segment, const std::string& channel) const;
 
  private:
   struct SegmentSlot {

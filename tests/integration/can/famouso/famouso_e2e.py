@@ -12,11 +12,15 @@ cosmic-dds-peer. One cosmicd (gateway.yaml here) for all scenarios, in one VM bo
                  fragment flag, TxNode 9), payload
   down_afp       a 300-byte LCM event -> the node: 45 AFP fragments with the fragment flag,
                  2-byte headers first, reassembled by the node
+  (up_*, down_*: the identifier `cosmicctl channel` reports, in FAMOUSO's layout, is the one on
+                 the wire: the node's 0x7D for what it publishes, the gateway's frames' for the rest)
   rate_limit     a flood of GET_ETAGs from one node: a few answered, the rest refused and counted
+                 (receive errors and the adapter's binding_requests_over_limit)
 Expected identifiers and bytes come from FAMOUSO's rules (famouso_node.py) and
 docs/can-wire-format.md, never from cosmicd's output. Every wait has a deadline; no fixed sleeps.
 """
 import os
+import subprocess
 import sys
 import threading
 import time
@@ -94,6 +98,22 @@ def scenario_bind(s):
     check(100 < result["etag"] <= 16383, "a channel etag (%d)" % result["etag"])
 
 
+def expect_admission_id(gw, channel, ident):
+    """cosmicctl channel CHANNEL shows IDENT, in FAMOUSO's layout, as the channel's identifier on
+    the bus (JSON: layout, can_id and its fields; text: the fields spelled out)."""
+    can = gw.can_hop(channel)
+    parts = fn.split_id(ident)
+    expect_eq(channel + ": layout", can["layout"], "famouso")
+    expect_eq(channel + ": admission's identifier", "%08X" % can["can_id"], "%08X" % ident)
+    expect_eq(channel + ": admission's priority (7 bits)", can["priority"], parts["prio"])
+    expect_eq(channel + ": fragment flag", can["fragment"], parts["fragment"])
+    expect_eq(channel + ": TxNode", can["tx_node"], parts["node"])
+    r = subprocess.run([gw.cosmicctl, "--socket", gw.sock, "channel", channel], capture_output=True, text=True)
+    text = "can_id 0x%08X (FAMOUSO layout: priority 0x%02X, fragment %d, TxNode %d, etag %d)" % (
+        ident, parts["prio"], int(parts["fragment"]), parts["node"], parts["etag"])
+    check(text in r.stdout, "cosmicctl channel %s shows %r: %s" % (channel, text, r.stdout))
+
+
 def scenario_up_single(s):
     gw = s.t.gw
     lcm = s.lcm_sub("lcm", "sensor")
@@ -102,6 +122,10 @@ def scenario_up_single(s):
     s.received("LCM subscriber", lcm, "deadbeef", "sensor")
     s.received("DDS subscriber", dds, "deadbeef", "sensor")
     check(gw.hop("sensor", "bus")["rx"] >= 1, "received on bus")
+    # The node publishes at its own prio(0xFD) (docs/can-wire-format.md section 8): admission
+    # analyses `sensor` (100 B: its largest events are AFP fragments, flag set) at that priority,
+    # as the last TxNode the broker assigns.
+    expect_admission_id(gw, "sensor", fn.famouso_id(fn.PRIO, True, 0x7E, ETAG["sensor"]))
 
 
 def scenario_up_afp(s):
@@ -125,6 +149,7 @@ def scenario_down_single(s):
     ident, data, _ = node.receive_event(ETAG["command"], timeout=40)
     expect_eq("DDS event on the node", data, canlog.payload("dds", 6, 1))
     expect_eq("DDS publisher exit status", pub.wait(30), 0)
+    expect_admission_id(s.t.gw, "command", ident)
     s.notes.append("identifier %08X (7-bit priority 0x10, TxNode 9, etag 300)" % expected_id)
 
 
@@ -138,25 +163,36 @@ def scenario_down_afp(s):
     expect_eq("AFP fragments", len(headers), 45)
     expect_eq("header lengths", headers, [2] * 13 + [1] * 32)
     expect_eq("reassembled event", data, canlog.payload("lcm", 300, 1))
+    expect_admission_id(s.t.gw, "bulk_down", ident)
 
 
 def scenario_rate_limit(s):
     gw = s.t.gw
     node = NODES["b"]
-    errors0 = gw.segments()["bus"]["adapter"]["receive_errors"]
+    adapter0 = gw.segments()["bus"]["adapter"]
+    errors0, over0 = adapter0["receive_errors"], adapter0["binding_requests_over_limit"]
+    check(isinstance(over0, int), "binding_requests_over_limit in the adapter counters (%r)" % over0)
     for _ in range(50):
         node.send(fn.famouso_id(fn.PRIO, False, node.node, fn.GET_ETAG), subject_bytes("sensor"))
-    wait_until("50 requests counted", 20,
-               lambda: gw.segments()["bus"]["adapter"]["receive_errors"] - errors0 >= 40, interval=0.2)
-    refused = gw.segments(cli=True)["bus"]["adapter"]["receive_errors"] - errors0
+
+    def counted():
+        a = gw.segments()["bus"]["adapter"]
+        return a["receive_errors"] - errors0 >= 40 and a["binding_requests_over_limit"] - over0 >= 40
+    wait_until("the requests over the limit counted", 20, counted, interval=0.2)
+    adapter = gw.segments(cli=True)["bus"]["adapter"]  # as cosmicctl segments --json shows it
+    refused = adapter["receive_errors"] - errors0
+    over = adapter["binding_requests_over_limit"] - over0
     check(40 <= refused <= 50, "refused requests counted (%d)" % refused)
+    # Each request over the limit is also a receive error; nothing else counts as one.
+    check(40 <= over <= refused, "binding_requests_over_limit (cosmicctl segments --json) %d of %d receive errors"
+          % (over, refused))
     # Each admitted request is two answer frames; at most the node's burst (4) plus what it earned.
     deadline = time.monotonic() + 3
     while node.recv(deadline) is not None:
         pass
     answers = sum(1 for i, d in node.log if i & 0x3FFF == fn.SUPPLY_ETAG_NEW_BP and d[4:8] == subject_bytes("sensor")[:4])
     check(answers <= 10, "answered at most the node's burst (%d)" % answers)
-    s.notes.append("%d refused, %d answered" % (refused, answers))
+    s.notes.append("%d refused (binding_requests_over_limit %d), %d answered" % (refused, over, answers))
 
 
 SCENARIOS = [scenario_ccp, scenario_bind, scenario_up_single, scenario_up_afp, scenario_down_single,
