@@ -25,6 +25,7 @@ nlohmann::json to_json(const cosmic::CalibrationResult& result) {
   for (const auto& p : result.phases) {
     phases.push_back({{"phase", p.name},
                       {"hrt_events", p.hrt_events},
+                      {"hrt_sent", p.hrt_sent},
                       {"residence_p50_us", micros(p.p50)},
                       {"residence_p99_us", micros(p.p99)},
                       {"residence_p999_us", micros(p.p999)},

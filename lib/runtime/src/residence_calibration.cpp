@@ -116,6 +116,7 @@ CalibrationPhase run_phase(const GatewaySpec& gateway, const CalibrationOptions&
       phase.p999 = hop.egress->residence_p999;
       phase.max = hop.egress->residence_max;
       phase.residence_miss = hop.egress->residence_miss;
+      phase.hrt_sent = hop.egress->events;
     } else if (stats.name == "flood") {
       phase.flood_sent = hop.tx;
       phase.flood_queue_full = hop.dropped[static_cast<std::size_t>(DropReason::queue_full)];

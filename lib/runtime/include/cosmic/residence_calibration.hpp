@@ -30,7 +30,8 @@ struct CalibrationOptions {
 
 struct CalibrationPhase {
   std::string name;  // "idle" or "nrt-flood"
-  std::uint64_t hrt_events = 0;
+  std::uint64_t hrt_events = 0;           // HRT events offered
+  std::uint64_t hrt_sent = 0;             // HRT events the lane sent (the histogram's events)
   Nanos p50{0}, p99{0}, p999{0}, max{0};  // HRT residence
   std::uint64_t residence_miss = 0;       // HRT events above the configured residence_bound
   std::uint64_t flood_offered = 0;        // NRT events the flood thread offered
