@@ -9,10 +9,18 @@
 #   PROOF_BODY=can            the body bus is robot.yaml's CAN bus on vcan0 (inside scripts/can-vm)
 #   PROOF_CONTROLLER_DIR=DIR  where the controller is generated and built (default: a temp dir)
 #   PROOF_PREBUILT=1          use the controller already built in PROOF_CONTROLLER_DIR
+#   PROOF_BUILD_ONLY=1        only generate and build the controller into PROOF_CONTROLLER_DIR
+#                             (no network namespace needed; scripts/demo builds it on the host
+#                             before running the proof inside scripts/can-vm)
 # Every channel keeps robot.yaml's definition.
 #   speed_proof.sh COSMICD COSMICCTL SPEED_PROBE ROBOT_YAML [COUNT]
 set -u
-[ "${COSMIC_IN_NETNS:-}" = 1 ] || { echo "run me through scripts/netns-run" >&2; exit 2; }
+BUILD_ONLY=${PROOF_BUILD_ONLY:-0}
+if [ "$BUILD_ONLY" = 1 ]; then
+  [ -n "${PROOF_CONTROLLER_DIR:-}" ] || { echo "PROOF_BUILD_ONLY=1 needs PROOF_CONTROLLER_DIR" >&2; exit 2; }
+else
+  [ "${COSMIC_IN_NETNS:-}" = 1 ] || { echo "run me through scripts/netns-run" >&2; exit 2; }
+fi
 COSMICD=$1 COSMICCTL=$2 PROBE=$3 ROBOT=$4 COUNT=${5:-20}
 HERE=$(cd "$(dirname "$0")" && pwd)
 WORK=$(mktemp -d /tmp/cosmic-proof.XXXXXX)
@@ -36,7 +44,7 @@ BODY=${PROOF_BODY:-lcm}
 SC=${PROOF_CONTROLLER_DIR:-$WORK/sc}
 body_segment="lcm:udpm://239.255.76.68:7668?ttl=0"
 WAIT_S=30
-if [ "$BODY" = can ]; then
+if [ "$BODY" = can ] && [ "$BUILD_ONLY" != 1 ]; then
   body_segment="can:vcan0?node=9"  # the probe's own TxNode; etags by GET_ETAG
   WAIT_S=180                        # the VM emulates its CPU: everything starts slower
   ip link add vcan0 type vcan 2>/dev/null || true
@@ -66,6 +74,10 @@ else
   command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
   CCACHE_BASEDIR="$SC" cmake -S "$SC" -B "$SC/build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "${launcher[@]}" >"$WORK/build.log" 2>&1 &&
     CCACHE_BASEDIR="$SC" nice cmake --build "$SC/build" >>"$WORK/build.log" 2>&1 || fail "the generated project does not build: $(tail -30 "$WORK/build.log")"
+fi
+if [ "$BUILD_ONLY" = 1 ]; then
+  echo "speed_controller generated from $ROBOT and built: $SC/build/speed_controller"
+  exit 0
 fi
 
 # 3. cosmicd, the generated component (asking cosmicd for its channels first), the probe.
