@@ -1,0 +1,107 @@
+#!/usr/bin/env bash
+# A channel a segment's transport refuses is a visible verdict, never `bound` and silent (issue 9,
+# item 10), end to end over real Fast DDS and LCM: two channel names that map to one DDS topic
+# ('-' and '.' become '_') make the DDS adapter refuse its configuration at start.
+#   - both channels are `failed` with the adapter's reason in `cosmicctl channels`, `channel`
+#     (text and --json), `status`, the start-up verdict lines and one error line each;
+#   - a channel on other segments only is untouched;
+#   - a bind onto the refusing segment is refused with the reason and changes nothing;
+#   - once one of the two is unbound, the segment takes the other: its verdict is admission's
+#     again, the log says so, and an event flows DDS -> cosmicd -> LCM.
+#   refused_channel_test.sh COSMICD COSMICCTL COSMIC_LCM_PEER COSMIC_DDS_PEER
+set -uo pipefail
+[ "${COSMIC_IN_NETNS:-}" = 1 ] || { echo "run me through scripts/netns-run" >&2; exit 2; }
+COSMICD=$1 COSMICCTL=$2 LCM_PEER=$3 DDS_PEER=$4
+WORK=$(mktemp -d /tmp/cosmic-refused.XXXXXX)
+# shellcheck source=lib.sh
+source "$(dirname "$0")/lib.sh"
+trap 'cleanup; [ -n "${KEEP_WORK:-}" ] || rm -rf "$WORK"' EXIT
+
+LCM_VIZ="udpm://239.255.76.67:7831?ttl=0"
+LCM_LOG="udpm://239.255.76.67:7832?ttl=0"
+TOPIC_CLASH="channels 'cam-pose' and 'cam.pose' both map to DDS topic cosmic/cam_pose ('-' and '.' become '_'); rename one of them"
+
+cat >"$WORK/g.yaml" <<YAML
+gateway: {name: gw-refused}
+segments:
+  - {name: lan, type: dds, domain: 23, latency_bound: 2ms}
+  - {name: viz, type: lcm, url: "$LCM_VIZ", latency_bound: 2ms}
+  - {name: logbook, type: lcm, url: "$LCM_LOG", latency_bound: 2ms}
+channels:
+  - {name: cam-pose, subject: 0x300, class: nrt, payload: 16B, omission_degree: 3, publishers: [lan], subscribers: [viz]}
+  - {name: cam.pose, subject: 0x301, class: nrt, payload: 16B, omission_degree: 3, publishers: [lan], subscribers: [viz]}
+  - {name: notes, subject: 0x302, class: nrt, payload: 16B, omission_degree: 3, publishers: [viz], subscribers: [logbook]}
+YAML
+
+# verdicts: "name=verdict ..." sorted, from `cosmicctl --json channels`.
+verdicts() {
+  ctl g --json channels | python3 -c '
+import json, sys
+print(" ".join(sorted(c["name"] + "=" + c["verdict"] for c in json.load(sys.stdin)["channels"])))'
+}
+
+start_daemon g "$WORK/g.yaml" || exit 1
+
+scenario "a channel the DDS adapter refuses at start is failed, with its reason, everywhere"
+got=$(verdicts)
+[ "$got" = "cam-pose=failed cam.pose=failed notes=bound" ] || fail "verdicts after start: '$got'"
+ctl g --json channel cam-pose | python3 -c '
+import json, sys
+c = json.load(sys.stdin)["channel"]
+assert c["verdict"] == "failed", c["verdict"]
+assert c["admission"]["verdict"] == "failed", c["admission"]["verdict"]
+want = "segment lan does not carry it: " + sys.argv[1]
+assert want in c["reasons"], c["reasons"]' "$TOPIC_CLASH" || fail "cosmicctl --json channel cam-pose: no failed verdict with the adapter's reason"
+ctl g channels >"$WORK/channels.txt" || fail "cosmicctl channels failed"
+grep -Eq '^cam-pose +nrt +failed ' "$WORK/channels.txt" || fail "cosmicctl channels: cam-pose not shown failed: $(cat "$WORK/channels.txt")"
+grep -qF -- "- segment lan does not carry it: $TOPIC_CLASH" "$WORK/channels.txt" ||
+  fail "cosmicctl channels: no reason line: $(cat "$WORK/channels.txt")"
+ctl g channel cam.pose >"$WORK/channel.txt" || fail "cosmicctl channel failed"
+grep -Eq '^cam\.pose +nrt +failed ' "$WORK/channel.txt" || fail "cosmicctl channel cam.pose: not failed: $(cat "$WORK/channel.txt")"
+ctl g status >"$WORK/status.txt" || fail "cosmicctl status failed"
+grep -qF "1 bound, 0 degraded, 2 failed" "$WORK/status.txt" || fail "cosmicctl status: $(cat "$WORK/status.txt")"
+for c in cam-pose cam.pose; do
+  [ "$(grep -cF " error channel $c: segment lan does not carry it: $TOPIC_CLASH (verdict failed)" "$WORK/g.log")" -eq 1 ] ||
+    fail "log: not exactly one error line for $c: $(grep -F "channel $c" "$WORK/g.log")"
+  grep -qF " warning channel $c (nrt): failed; segment lan does not carry it: $TOPIC_CLASH" "$WORK/g.log" ||
+    fail "log: no start-up verdict line 'failed' for $c"
+done
+passed
+
+scenario "a bind onto the refusing segment is refused with the reason and changes nothing"
+cat >"$WORK/extra.yaml" <<YAML
+- {name: extra, subject: 0x303, class: nrt, payload: 8B, omission_degree: 3, publishers: [lan], subscribers: [viz]}
+YAML
+ctl g bind "$WORK/extra.yaml" >"$WORK/bind.out" 2>&1
+code=$?
+[ "$code" -eq 1 ] || fail "bind onto the refusing segment exited $code, expected 1"
+grep -qF "segment lan does not carry channel extra: $TOPIC_CLASH; nothing changed" "$WORK/bind.out" ||
+  fail "bind: no reason: $(cat "$WORK/bind.out")"
+got=$(verdicts)
+[ "$got" = "cam-pose=failed cam.pose=failed notes=bound" ] || fail "verdicts after the refused bind: '$got'"
+passed
+
+scenario "once the clash is gone the segment carries the channel and it flows"
+ctl g unbind cam.pose >/dev/null || fail "unbind cam.pose failed"
+got=$(verdicts)
+[ "$got" = "cam-pose=bound notes=bound" ] || fail "verdicts after the unbind: '$got'"
+grep -qF " channel cam-pose: segment lan carries it now" "$WORK/g.log" || fail "log: no 'carries it now' line"
+"$LCM_PEER" sub --url "$LCM_VIZ" --channel cam-pose --count 1 --timeout 30 >"$WORK/sub.out" 2>"$WORK/sub.err" &
+sub=$!
+PIDS+=("$sub")
+wait_until 10 "LCM subscriber ready" stderr_has "$WORK/sub.err" READY || exit 1
+mkfifo "$WORK/start"
+"$DDS_PEER" pub --domain 23 --topic cosmic/cam_pose --subject 768 --count 1 --size 16 --start-on-stdin \
+  <"$WORK/start" 2>"$WORK/pub.err" &
+pub=$!
+PIDS+=("$pub")
+exec 7>"$WORK/start"
+wait_until 20 "cosmicd's reader of cam-pose matched" field_at_least g cam-pose lan matched 1
+echo go >&7
+exec 7>&-
+wait "$pub" || fail "DDS publisher failed: $(tail -2 "$WORK/pub.err")"
+wait "$sub" || fail "the event did not reach LCM: $(cat "$WORK/sub.err")"
+passed
+
+[ "$FAILED" = 0 ] || exit 1
+log "all scenarios passed"
