@@ -40,7 +40,7 @@ speed_file "$WORK/speed40.yaml" 40ms
 
 # speed_load: the utilization admission reserved for `speed` on lan (depends on its period).
 speed_load() {
-  "$COSMICCTL" --socket "$SOCKET" --json channel speed | python3 -c '
+  "$COSMICCTL" --socket "$SOCKET" --json channel speed | "$PYTHON" -S -c '
 import json, sys
 c = json.load(sys.stdin)["channel"]
 print(next(k["value"] for h in c["admission"]["hops"] if h["segment"] == "lan" for k in h["checks"] if k["check"] == "utilization"))'
