@@ -20,6 +20,7 @@
 //                              shape issue 11 measured at 0.02 / 0.85 / 18 s for 25 / 50 / 100.
 //   BM_LcmChannels/n           admit_all of n DDS -> LCM channels (issue 11: 0.45 / 1.8 / 7.1 s for
 //                              1k / 2k / 4k before).
+// A reload of that set by a running cosmicd is timed by tests/bench/reload_bench.sh.
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
@@ -237,4 +238,17 @@ BENCHMARK(BM_LcmChannels)->Arg(1000)->Arg(2000)->Arg(4000)->Arg(10000)->Unit(ben
 
 }  // namespace
 
-BENCHMARK_MAIN();
+// `cosmic_admission_bench --write-config PATH` only writes the big set (BM_AdmitBigSet's) as YAML,
+// for tests/bench/reload_bench.sh to run cosmicd on.
+int main(int argc, char** argv) {
+  if (argc == 3 && std::string(argv[1]) == "--write-config") {
+    std::ofstream out(argv[2]);
+    out << to_yaml(big_config());
+    return out.good() ? 0 : 1;
+  }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -365,9 +365,10 @@ Json ControlProtocol::unbind(const Json& request) {
 ControlProtocol::Answer ControlProtocol::reload(const Reply& later) {
   auto loaded = std::make_shared<ConfigResult>();
   auto plan = std::make_shared<ReloadPlan>();
-  auto work = [this, loaded, plan] {
+  // Channels unchanged since the running bindings were admitted are not admitted again.
+  auto work = [this, loaded, plan, base = gateway_.reload_base()] {
     *loaded = reload_source_();
-    if (loaded->ok()) *plan = Gateway::plan_reload(loaded->config);
+    if (loaded->ok()) *plan = Gateway::plan_reload(loaded->config, base);
   };
   auto done = [this, loaded, plan] {
     if (!loaded->ok()) {

@@ -12,12 +12,29 @@ Gateway::Gateway(AdapterFactory factory, Logger& log, std::uint64_t gateway_id)
 
 Gateway::~Gateway() { stop(); }
 
-std::unique_ptr<KnowledgeBase> Gateway::knowledge_base_for(const Config& config) {
+namespace {
+
+std::set<std::uint16_t> reserved_etags(const Config& config) {
   std::set<std::uint16_t> reserved;
   for (const auto& channel : config.channels) {
     if (channel.etag) reserved.insert(*channel.etag);
   }
-  return std::make_unique<KnowledgeBase>(config.gateway, config.segments, reserved);
+  return reserved;
+}
+
+// Whether admitting `config` from scratch passes through the state admitting `base` left: the
+// same knowledge base to start from, and `base`'s channels bound first, in the same order.
+bool extends(const Config& config, const Config& base) {
+  return config.gateway == base.gateway && config.segments == base.segments &&
+         config.channels.size() >= base.channels.size() &&
+         std::equal(base.channels.begin(), base.channels.end(), config.channels.begin()) &&
+         reserved_etags(config) == reserved_etags(base);
+}
+
+}  // namespace
+
+std::unique_ptr<KnowledgeBase> Gateway::knowledge_base_for(const Config& config) {
+  return std::make_unique<KnowledgeBase>(config.gateway, config.segments, reserved_etags(config));
 }
 
 std::size_t Gateway::free_slot(const std::set<std::size_t>& also_taken) const {
@@ -78,6 +95,8 @@ BindResult Gateway::start(const Config& config) {
     }
     result.channels.push_back(std::move(outcome.report));
   }
+  base_ = std::make_shared<const ReloadBase>(ReloadBase{config, *kb_, result.channels});
+  base_generation_ = generation_;
   configure_adapters();
   for (auto& report : result.channels) mark_refused(report);
   apply_routes();
@@ -87,13 +106,16 @@ BindResult Gateway::start(const Config& config) {
 
 Gateway::Refusals Gateway::configure_adapters() {
   const AdmissionReport report = kb_->report();
+  std::unordered_map<std::string_view, const ChannelReport*> verdicts;
+  verdicts.reserve(report.channels.size());
+  for (const auto& verdict : report.channels) verdicts.emplace(verdict.name, &verdict);
   Refusals refusals;
   for (auto& [name, slot] : slots_) {
     std::vector<ChannelBinding> bindings;
     for (const auto& channel : kb_->bound_channels()) {
-      const ChannelReport* verdict = report.find(channel.name);
-      if (!verdict) continue;
-      for (const auto& hop : verdict->hops) {
+      const auto found = verdicts.find(channel.name);
+      if (found == verdicts.end()) continue;
+      for (const auto& hop : found->second->hops) {
         if (hop.segment == name) bindings.push_back(ChannelBinding{id_for(channel), channel, hop.role, hop.can});
       }
     }
@@ -249,11 +271,27 @@ bool Gateway::unbind(const std::string& name) {
 
 BindResult Gateway::reload(const Config& config) { return commit_reload(plan_reload(config)); }
 
-ReloadPlan Gateway::plan_reload(Config config) {
-  std::shared_ptr<KnowledgeBase> kb = knowledge_base_for(config);
-  ReloadPlan plan{std::move(config), std::move(kb), {}};
-  for (const auto& channel : plan.config.channels) plan.reports.push_back(plan.kb->bind(channel).report);
+ReloadPlan Gateway::plan_reload(Config config, std::shared_ptr<const ReloadBase> base) {
+  ReloadPlan plan;
+  const bool from_base = base && extends(config, base->config);
+  if (from_base) {
+    plan.kb = std::make_shared<KnowledgeBase>(base->kb);
+    plan.reports = base->reports;
+    plan.reused = base->config.channels.size();
+  } else {
+    plan.kb = knowledge_base_for(config);
+  }
+  plan.config = std::move(config);
+  for (std::size_t c = plan.reused; c < plan.config.channels.size(); ++c) {
+    plan.reports.push_back(plan.kb->bind(plan.config.channels[c]).report);
+  }
+  const bool unchanged = from_base && plan.reused == plan.config.channels.size();
+  plan.admitted = unchanged ? std::move(base) : std::make_shared<const ReloadBase>(ReloadBase{plan.config, *plan.kb, plan.reports});
   return plan;
+}
+
+std::shared_ptr<const ReloadBase> Gateway::reload_base() const {
+  return generation_ == base_generation_ ? base_ : nullptr;
 }
 
 BindResult Gateway::commit_reload(ReloadPlan plan) {
@@ -315,7 +353,11 @@ BindResult Gateway::commit_reload(ReloadPlan plan) {
     router_->set_segment(slot.index, "", nullptr);
     slot.adapter->stop();
   }
-  log_.log(LogLevel::notice, "configuration reloaded");
+  base_ = std::move(plan.admitted);
+  base_generation_ = generation_;
+  log_.log(LogLevel::notice, "configuration reloaded" + (plan.reused > 0 ? " (" + std::to_string(plan.reused) +
+                                                                                " unchanged channels kept their admission)"
+                                                                          : std::string()));
   result.applied = true;
   return result;
 }

@@ -61,11 +61,23 @@ struct BindPlan {
   bool admitted = false;                  // every channel bound in `kb`
 };
 
-// The same for a reload: a fresh knowledge base built from the new configuration.
+// What the running bindings were admitted from (at start or by the last reload): the
+// configuration, its knowledge base right after admission (no live health, no refusals) and the
+// verdicts given then. A reload of the same or an extended configuration starts from it.
+// Immutable once made.
+struct ReloadBase {
+  Config config;
+  KnowledgeBase kb;
+  std::vector<ChannelReport> reports;
+};
+
+// The same for a reload: the knowledge base of the new configuration.
 struct ReloadPlan {
   Config config;
   std::shared_ptr<KnowledgeBase> kb;
   std::vector<ChannelReport> reports;
+  std::size_t reused = 0;  // channels taken over from the ReloadBase, not admitted again
+  std::shared_ptr<const ReloadBase> admitted;  // this plan's admission, for the next reload
 };
 
 // The router limits gateway.residence_bound and gateway.realtime ask for (the lanes' priorities
@@ -101,8 +113,16 @@ class Gateway {
   // changed since the plan's copy was taken.
   BindResult commit_bind(BindPlan plan);
   // reload() in steps: the plan on any thread (no I/O), the commit on the control thread.
-  static ReloadPlan plan_reload(Config config);
+  // With `base` (reload_base(), taken on the control thread) a configuration with the base's
+  // gateway, segments and reserved etags whose channels begin with the base's, in order, starts
+  // from the base's admission and admits only the channels after them: an unchanged file is not
+  // admitted again. The plan is the one admission from scratch gives (binding is incremental and
+  // deterministic); any other configuration is admitted from scratch.
+  static ReloadPlan plan_reload(Config config, std::shared_ptr<const ReloadBase> base = nullptr);
   BindResult commit_reload(ReloadPlan plan);
+  // Control thread: what the running bindings were admitted from; null once a bind or unbind
+  // changed them since start or the last reload.
+  std::shared_ptr<const ReloadBase> reload_base() const;
   // Changes with every applied bind, unbind and reload.
   std::uint64_t generation() const { return generation_; }
   void stop();
@@ -173,6 +193,8 @@ class Gateway {
   std::map<std::string, std::pair<ChannelSpec, ChannelId>> channel_ids_;
   ChannelId next_channel_id_ = 1;
   std::uint64_t generation_ = 0;
+  std::shared_ptr<const ReloadBase> base_;  // valid while generation_ == base_generation_
+  std::uint64_t base_generation_ = 0;
 };
 
 }  // namespace cosmic
