@@ -108,12 +108,14 @@ TopLine header(const TopSample& current, const Rates& rates) {
   const Json& router = s["router"];
   const std::uint64_t progress = count_at(router, "progress");
   const std::uint64_t violated = count_at(s["channels"], "violated");
+  const std::uint64_t failed = count_at(s["channels"], "failed");
   std::string line = "cosmicd " + text(g["name"]) + " (id " + text(g["id"]) + "), up " +
                      std::to_string(static_cast<long>(g.value("uptime_s", 0.0))) + " s   segments " + text(s["segments"]["up"]) +
                      "/" + text(s["segments"]["total"]) + " up   channels " + text(s["channels"]["bound"]) + " bound, " +
-                     text(s["channels"]["degraded"]) + " degraded, " + std::to_string(violated) + " violated   router " +
+                     text(s["channels"]["degraded"]) + " degraded, " + std::to_string(failed) + " failed, " +
+                     std::to_string(violated) + " violated   router " +
                      text(router["queued"]) + " queued, " + rate_text(rates.of(progress, rates.previous_progress())) + " ev/s";
-  return {line, violated > 0 || count_at(s["segments"], "up") < count_at(s["segments"], "total")};
+  return {line, violated > 0 || failed > 0 || count_at(s["segments"], "up") < count_at(s["segments"], "total")};
 }
 
 void segment_rows(std::vector<TopLine>& out, const TopSample& current, const Rates& rates) {
@@ -153,7 +155,8 @@ void channel_rows(std::vector<TopLine>& out, const TopSample& current, const Rat
                  pad_column("MISS res/dl", 12) + pad_column("STATE", 9) + "DROPS"});
   for (const auto& c : member(current.channels, "channels")) {
     const std::string name = c.value("name", "");
-    const std::string state = c.value("runtime_state", "bound");
+    // A channel its transport refused shows that (verdict `failed`) rather than its runtime state.
+    const std::string state = c.value("verdict", "") == "failed" ? "failed" : c.value("runtime_state", "bound");
     bool first = true;
     for (const auto& hop : member(c, "segments")) {
       const Json* old = rates.previous_hop(name, hop.value("segment", ""));
