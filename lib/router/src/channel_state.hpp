@@ -8,6 +8,7 @@
 #include <mutex>
 #include <vector>
 
+#include "cosmic/pi_mutex.hpp"
 #include "cosmic/router.hpp"
 #include "cosmic/router_policy.hpp"
 #include "cosmic/router_stats.hpp"
@@ -22,7 +23,7 @@ struct ChannelState {
         egress(route.subscribers.size()) {}
 
   const Route route;
-  std::mutex policy_mutex;  // guards bucket, dedup and loop_guard (ingress threads of several segments)
+  PiMutex policy_mutex;  // guards bucket, dedup and loop_guard (ingress threads of several segments)
   TokenBucket bucket;
   DuplicateFilter dedup;
   RawLoopGuard loop_guard;  // raw LCM channels: their events carry no origin to cut loops by

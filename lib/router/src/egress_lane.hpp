@@ -69,7 +69,7 @@ class EgressLane {
   const std::size_t depth_;
   const std::size_t byte_budget_;
 
-  mutable std::mutex mutex_;  // the ring; held for moves only, never across send()
+  mutable PiMutex mutex_;  // the ring; held for moves only, never across send()
   std::vector<LaneItem> ring_;  // allocated at the first activation
   std::size_t head_ = 0;
   std::size_t count_ = 0;

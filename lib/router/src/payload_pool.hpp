@@ -14,6 +14,8 @@
 #include <span>
 #include <vector>
 
+#include "cosmic/pi_mutex.hpp"
+
 namespace cosmic {
 
 class PayloadBuffer {
@@ -47,7 +49,7 @@ class PayloadPool {
 
   const std::size_t max_buffers_;
   const std::size_t retained_bytes_;
-  std::mutex mutex_;
+  PiMutex mutex_;
   PayloadBuffer* free_ = nullptr;
   std::vector<std::unique_ptr<PayloadBuffer>> all_;  // ownership; grows up to max_buffers_
 };

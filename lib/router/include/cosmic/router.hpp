@@ -25,6 +25,7 @@
 #include "cosmic/event.hpp"
 #include "cosmic/log.hpp"
 #include "cosmic/model.hpp"
+#include "cosmic/pi_mutex.hpp"
 #include "cosmic/router_stats.hpp"
 #include "cosmic/segment_adapter.hpp"
 #include "cosmic/thread_policy.hpp"
@@ -124,7 +125,7 @@ class Router {
   // std::atomic<std::shared_ptr> would do the same with a spin bit that ThreadSanitizer cannot
   // see through.)
   std::shared_ptr<const Table> load_table() const;
-  mutable std::mutex table_mutex_;
+  mutable PiMutex table_mutex_;
   std::shared_ptr<const Table> table_;
   std::mutex apply_mutex_;  // serialises apply() (control thread) against itself
 
