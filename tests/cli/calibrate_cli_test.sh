@@ -7,34 +7,7 @@
 # Usage: calibrate_cli_test.sh PATH_TO_cosmicctl PROJECT_SOURCE_DIR
 set -u
 
-CTL=${1:?path to cosmicctl}
-SRC=${2:?project source dir}
-WORK=$(mktemp -d)
-trap 'rm -rf "$WORK"' EXIT
-FAILURES=0
-
-fail() {
-  echo "FAIL: $*" >&2
-  FAILURES=$((FAILURES + 1))
-}
-
-run() {  # run NAME EXPECTED_EXIT ARGS...
-  local name=$1 expected=$2
-  shift 2
-  "$CTL" "$@" >"$WORK/$name.out" 2>"$WORK/$name.err"
-  local code=$?
-  if [ "$code" -ne "$expected" ]; then
-    fail "$name: exit $code, expected $expected (cosmicctl $*)"
-    sed 's/^/    /' "$WORK/$name.out" "$WORK/$name.err" >&2
-  fi
-}
-
-contains() {  # contains NAME out|err TEXT
-  if ! grep -qF -- "$3" "$WORK/$1.$2"; then
-    fail "$1: $2 lacks '$3'"
-    sed 's/^/    /' "$WORK/$1.$2" >&2
-  fi
-}
+. "$(dirname "${BASH_SOURCE[0]}")/cli_lib.sh"
 
 with_bound() {  # with_bound FILE BOUND: the bundled robot with another gateway.residence_bound
   sed "s/^  residence_bound: .*/  residence_bound: $2/" "$SRC/config/robot.yaml" >"$1"
@@ -92,8 +65,4 @@ run broken 2 calibrate "$WORK/broken.yaml"
 contains broken err "broken.yaml:2:"
 contains broken err "gateway.residence_bound"
 
-if [ "$FAILURES" -ne 0 ]; then
-  echo "$FAILURES check(s) failed" >&2
-  exit 1
-fi
-echo "calibrate CLI: all checks passed"
+finish "cosmicctl calibrate"
