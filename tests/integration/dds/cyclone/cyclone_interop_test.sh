@@ -72,7 +72,12 @@ run_channel() {
   exec {go}>&-
 
   wait "$pub" || fail "$channel: Cyclone publisher failed: $(cat "$WORK/$channel.pub.err")"
-  wait "$sub" || { fail "$channel: Cyclone subscriber: $(cat "$WORK/$channel.sub.err")"; return; }
+  if ! wait "$sub"; then
+    fail "$channel: Cyclone subscriber: $(cat "$WORK/$channel.sub.err")"
+    log "--- where the events went (cosmicd's counters of $channel)"
+    ctl gw channel "$channel" >&2
+    return
+  fi
   check_output "$WORK/$channel.out" "$count" "$size" || fail "$channel: wrong envelopes"
   expect_field gw "$channel" "$from" rx "$count"
   expect_field gw "$channel" "$to" tx "$count"
