@@ -5,7 +5,7 @@
 # One gateway between two DDS domains. For an HRT, an SRT and an NRT channel (names with '-'
 # and '.', so the topic-name mapping is exercised), a Cyclone writer publishes into cosmicd on
 # one domain and a Cyclone reader receives from cosmicd on the other: both directions of every
-# class. Each event must arrive once, bytes unchanged, in order, and no endpoint may be refused
+# class. cosmicd must take and forward every event (its counters, exactly); the Cyclone reader, BEST_EFFORT by default, gets each at most once, unchanged and in order (at most 10% lost on the wire); and no endpoint may be refused
 # for incompatible QoS.
 set -uo pipefail
 [ "${COSMIC_IN_NETNS:-}" = 1 ] || { echo "run me through scripts/netns-run" >&2; exit 2; }
@@ -32,20 +32,32 @@ YAML
 
 domain_of() { [ "$1" = left ] && echo 31 || echo 32; }
 
-# check_output FILE COUNT SIZE: COUNT envelopes, payloads of event q = (q*7+i)&0xff in order,
-# sequences strictly increasing, origin stamped by the gateway (non-zero).
+# check_output FILE COUNT SIZE: the envelopes the Cyclone reader got, each event's payload
+# (q*7+i)&0xff unchanged, events in order without duplicates, origin stamped by the gateway
+# (non-zero), sequences strictly increasing. A reader with DEFAULT QoS is BEST_EFFORT (the DDS
+# default), so the wire may lose a sample the gateway sent (no repair): at most 10% may be
+# missing, and whether cosmicd forwarded every event is checked exactly on its counters.
 check_output() {
   python3 - "$@" <<'PY'
 import json, sys
 path, count, size = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
 lines = [json.loads(l) for l in open(path)]
-assert len(lines) == count, f"{len(lines)} envelopes, expected {count}"
-for q, e in enumerate(lines, start=1):
-    expected = bytes(((q * 7 + i) & 0xff) for i in range(size)).hex()
-    assert e["payload"] == expected, f"event {q}: payload {e['payload'][:32]}... changed or out of order"
+missing = count - len(lines)
+assert 0 <= missing <= count // 10, f"{len(lines)} envelopes, expected {count} (at most {count // 10} lost)"
+qs = []
+for e in lines:
+    payload = bytes.fromhex(e["payload"])
+    assert len(payload) == size, f"payload of {len(payload)} bytes, expected {size}"
+    q = (payload[0] * 183) % 256  # 183 = 7^-1 mod 256: the event number from its first byte
+    expected = bytes(((q * 7 + i) & 0xff) for i in range(size))
+    assert payload == expected, f"event {q}: payload {e['payload'][:32]}... changed"
     assert e["origin"] != 0, f"event {q}: origin not stamped by the gateway"
+    qs.append(q)
+assert all(a < b for a, b in zip(qs, qs[1:])), f"events out of order or duplicated: {qs}"
 seqs = [e["sequence"] for e in lines]
 assert all(a < b for a, b in zip(seqs, seqs[1:])), f"sequences not increasing: {seqs[:10]}..."
+if missing:
+    print(f"note: the best-effort reader missed {missing} of {count} on the wire", file=sys.stderr)
 PY
 }
 
@@ -53,7 +65,7 @@ PY
 run_channel() {
   local channel=$1 topic=$2 from=$3 to=$4 size=$5 count=$6
   scenario "$channel: Cyclone writer (domain $(domain_of "$from")) -> cosmicd -> Cyclone reader (domain $(domain_of "$to"))"
-  "$CYCLONE_PEER" sub --domain "$(domain_of "$to")" --topic "$topic" --count "$count" --timeout 60 \
+  "$CYCLONE_PEER" sub --domain "$(domain_of "$to")" --topic "$topic" --count "$count" --timeout 20 \
     >"$WORK/$channel.out" 2>"$WORK/$channel.sub.err" &
   local sub=$!
   PIDS+=("$sub")
@@ -72,13 +84,16 @@ run_channel() {
   exec {go}>&-
 
   wait "$pub" || fail "$channel: Cyclone publisher failed: $(cat "$WORK/$channel.pub.err")"
-  if ! wait "$sub"; then
-    fail "$channel: Cyclone subscriber: $(cat "$WORK/$channel.sub.err")"
+  # The subscriber ends after COUNT envelopes or, when the best-effort wire lost some, after its
+  # timeout; check_output judges what it got.
+  wait "$sub"
+  local sub_rc=$?
+  if ! check_output "$WORK/$channel.out" "$count" "$size"; then
+    fail "$channel: wrong envelopes (subscriber exit $sub_rc: $(cat "$WORK/$channel.sub.err"))"
     log "--- where the events went (cosmicd's counters of $channel)"
     ctl gw channel "$channel" >&2
     return
   fi
-  check_output "$WORK/$channel.out" "$count" "$size" || fail "$channel: wrong envelopes"
   expect_field gw "$channel" "$from" rx "$count"
   expect_field gw "$channel" "$to" tx "$count"
   passed
