@@ -122,9 +122,10 @@ void render_segment_counters(Exposition& out, const MetricsSnapshot& s) {
 }
 
 void render_channel_state(Exposition& out, const MetricsSnapshot& s) {
-  out.family("cosmic_channel_verdict", MetricType::gauge, "1 for the channel's admission verdict (bound, degraded, rejected), 0 for the others.");
+  out.family("cosmic_channel_verdict", MetricType::gauge, "1 for the channel's verdict (bound, degraded, rejected; failed: admitted but refused by a transport), 0 for the others.");
   for (const auto& c : s.channels) {
-    for (const auto verdict : {cosmic::Verdict::bound, cosmic::Verdict::degraded, cosmic::Verdict::rejected}) {
+    for (const auto verdict : {cosmic::Verdict::bound, cosmic::Verdict::degraded, cosmic::Verdict::rejected,
+                               cosmic::Verdict::failed}) {
       Labels labels = channel_labels(c);
       labels.emplace_back("verdict", cosmic::to_string(verdict));
       out.sample(labels, c.verdict == verdict ? 1.0 : 0.0);

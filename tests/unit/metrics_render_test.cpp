@@ -191,6 +191,16 @@ TEST(MetricsRender, VerdictAndRuntimeStateAreStateSets) {
   EXPECT_LINE(m, "cosmic_channel_violations_total{channel=\"distance\",class=\"hrt\"} 1");
 }
 
+// A channel a transport refused (issue 9) is admitted but not carried: its own state of the set.
+TEST(MetricsRender, AChannelATransportRefusedIsFailed) {
+  MetricsSnapshot s = robot();
+  s.channels[1].verdict = cosmic::Verdict::failed;
+  const std::string m = render_metrics(s, ExpositionFormat::prometheus_text);
+  EXPECT_LINE(m, "cosmic_channel_verdict{channel=\"plot\",class=\"nrt\",verdict=\"failed\"} 1");
+  EXPECT_LINE(m, "cosmic_channel_verdict{channel=\"plot\",class=\"nrt\",verdict=\"degraded\"} 0");
+  EXPECT_LINE(m, "cosmic_channel_verdict{channel=\"distance\",class=\"hrt\",verdict=\"failed\"} 0");
+}
+
 TEST(MetricsRender, AdmissionNumbersAndSlack) {
   const std::string m = text();
   EXPECT_LINE(m, "cosmic_channel_end_to_end_bound_seconds{channel=\"distance\",class=\"hrt\"} 0.004");
