@@ -33,10 +33,10 @@
 // Diagnostics go to stderr as JSON lines, so tests can wait on them:
 //   {"event":"matched","count":K}                  matched remote endpoints changed
 //   {"event":"incompatible_qos","policy":"reliability"}
-//   {"event":"publication"|"subscription","topic":T,"reliability":"reliable"|"best_effort",
+//   {"event":"publication"|"subscription","topic":T,"participant":P,"reliability":"reliable"|"best_effort",
 //    "durability":..,"deadline_ns":..,"lifespan_ns":..,"latency_budget_ns":..}
 //      a remote writer (sub mode) or reader (pub mode) of the topic was discovered, with the QoS
-//      it announced (durations null when infinite)
+//      it announced (durations null when infinite) and its participant's GUID prefix P (hex)
 //   {"event":"done",...}
 // Fast DDS's own log goes to stderr too.
 #include <signal.h>
@@ -130,10 +130,23 @@ const char* policy_name(fdds::QosPolicyId_t id) {
   }
 }
 
+// The GUID prefix of an endpoint's participant, as hex: which participant a remote endpoint lives in.
+std::string prefix_hex(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) {
+  static const char* digits = "0123456789abcdef";
+  std::string out;
+  for (const auto octet : prefix.value) {
+    out.push_back(digits[octet >> 4]);
+    out.push_back(digits[octet & 0xf]);
+  }
+  return out;
+}
+
 template <typename Qos>
-json qos_json(const char* kind, const std::string& topic, const Qos& qos) {
+json qos_json(const char* kind, const std::string& topic, const Qos& qos,
+              const eprosima::fastrtps::rtps::GuidPrefix_t& participant) {
   return json{{"event", kind},
               {"topic", topic},
+              {"participant", prefix_hex(participant)},
               {"reliability", qos.m_reliability.kind == fdds::RELIABLE_RELIABILITY_QOS
                                   ? "reliable"
                                   : "best_effort"},
@@ -156,7 +169,7 @@ class Listener : public fdds::DomainParticipantListener {
     if (info.info.guid().guidPrefix == participant->guid().guidPrefix) return;  // our own
     if (info.status == eprosima::fastrtps::rtps::WriterDiscoveryInfo::DISCOVERED_WRITER &&
         info.info.topicName().to_string() == topic_) {
-      diag(qos_json("publication", topic_, info.info.m_qos));
+      diag(qos_json("publication", topic_, info.info.m_qos, info.info.guid().guidPrefix));
     }
   }
   void on_subscriber_discovery(fdds::DomainParticipant* participant,
@@ -164,7 +177,7 @@ class Listener : public fdds::DomainParticipantListener {
     if (info.info.guid().guidPrefix == participant->guid().guidPrefix) return;  // our own
     if (info.status == eprosima::fastrtps::rtps::ReaderDiscoveryInfo::DISCOVERED_READER &&
         info.info.topicName().to_string() == topic_) {
-      diag(qos_json("subscription", topic_, info.info.m_qos));
+      diag(qos_json("subscription", topic_, info.info.m_qos, info.info.guid().guidPrefix));
     }
   }
   void on_publication_matched(fdds::DataWriter*,

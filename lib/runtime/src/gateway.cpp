@@ -70,7 +70,14 @@ BindResult Gateway::start(const Config& config) {
   identity_.name = config.gateway.name;
   router_ = std::make_unique<Router>(identity_, kMaxSegments, router_limits(config.gateway));
   const ThreadPolicy receive{"rx", config.gateway.realtime.receive_priority, 0, config.gateway.realtime.cpus};
-  for (std::size_t i = 0; i < kMaxSegments; ++i) router_->inbox(i).set_receive_thread_policy(receive);
+  const RouterLimits limits = router_limits(config.gateway);
+  for (std::size_t i = 0; i < kMaxSegments; ++i) {
+    EventSink& inbox = router_->inbox(i);
+    inbox.set_receive_thread_policy(receive);
+    for (const ChannelClass cls : {ChannelClass::hrt, ChannelClass::srt, ChannelClass::nrt}) {
+      inbox.set_class_thread_policy(cls, limits.lane_threads[static_cast<std::size_t>(cls)]);
+    }
+  }
   config_ = config;
   kb_ = knowledge_base_for(config);
   BindResult result;

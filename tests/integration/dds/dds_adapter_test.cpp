@@ -171,6 +171,83 @@ TEST(DdsAdapter, FastDdsThreadsInheritTheReceivePolicy) {
   EXPECT_EQ(getpriority(PRIO_PROCESS, 0), own_nice);
 }
 
+// Each class of channel has a participant of its own, so an NRT write never holds the send lock,
+// shared-memory segment or threads an HRT write needs; its Fast DDS threads run as that class's
+// lane does (here: nice and affinity, which need no privilege; SCHED_FIFO is inherited the same
+// way). A channel moved to another class moves to that class's participant.
+TEST(DdsAdapter, EachClassHasAParticipantOfItsOwn) {
+  Fixture f(dds_segment(66));
+  f.sink.set_class_thread_policy(ChannelClass::hrt, ThreadPolicy{"ignored", 0, 6, {0}});
+  ASSERT_TRUE(f.adapter->start(f.sink).ok);
+  ChannelBinding hrt = binding(1, "ctl.hrt", HopRole::subscriber);
+  hrt.spec.cls = ChannelClass::hrt;
+  ChannelBinding nrt = binding(2, "log.nrt", HopRole::subscriber);
+  nrt.spec.cls = ChannelClass::nrt;
+  ChannelBinding srt = binding(3, "cam.srt", HopRole::subscriber);
+  srt.spec.cls = ChannelClass::srt;
+  const ChannelBinding all[] = {hrt, nrt, srt};
+  ASSERT_TRUE(f.adapter->configure(all).ok);
+
+  // The participant each writer lives in, as a native subscriber discovers it.
+  auto writer_participant = [&](const std::string& topic) {
+    Child sub(peer({"sub", "--domain", "66", "--topic", topic, "--count", "1", "--reliable", "--timeout", "30"}));
+    std::string participant;
+    EXPECT_TRUE(sub.wait_err(
+        [&](const std::string& line) {
+          const json j = parse(line);
+          if (!j.is_object() || j.value("event", "") != "publication") return false;
+          participant = j.value("participant", "");
+          return true;
+        },
+        kWait))
+        << sub.describe();
+    return participant;
+  };
+  const std::string hrt_home = writer_participant("cosmic/ctl_hrt");
+  const std::string nrt_home = writer_participant("cosmic/log_nrt");
+  const std::string srt_home = writer_participant("cosmic/cam_srt");
+  ASSERT_FALSE(hrt_home.empty());
+  ASSERT_FALSE(nrt_home.empty());
+  ASSERT_FALSE(srt_home.empty());
+  EXPECT_NE(hrt_home, nrt_home);
+  EXPECT_NE(hrt_home, srt_home);
+  EXPECT_NE(srt_home, nrt_home);
+
+  // The HRT participant's Fast DDS threads run as the HRT lane does.
+  const std::string name = "rx-hrt:" + f.spec.name;
+  std::size_t inherited = 0;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::string comm;
+    std::getline(std::ifstream(task.path() / "comm"), comm);
+    if (comm != name) continue;
+    const pid_t tid = static_cast<pid_t>(std::stol(task.path().filename().string()));
+    cpu_set_t cpus;
+    CPU_ZERO(&cpus);
+    ASSERT_EQ(sched_getaffinity(tid, sizeof cpus, &cpus), 0);
+    EXPECT_EQ(CPU_COUNT(&cpus), 1) << "thread " << tid;
+    errno = 0;
+    EXPECT_EQ(getpriority(PRIO_PROCESS, static_cast<id_t>(tid)), 6) << "thread " << tid;
+    ++inherited;
+  }
+  EXPECT_GE(inherited, 2u) << "the HRT participant's threads should carry the name " << name;
+
+  // Events still flow on every class; the NRT channel moved to HRT lands in the HRT participant.
+  nrt.spec.cls = ChannelClass::hrt;
+  const ChannelBinding moved[] = {hrt, nrt, srt};
+  ASSERT_TRUE(f.adapter->configure(moved).ok);
+  EXPECT_EQ(writer_participant("cosmic/log_nrt"), hrt_home);
+  Child sub(peer({"sub", "--domain", "66", "--topic", "cosmic/log_nrt", "--count", "3", "--reliable",
+                  "--timeout", "30"}));
+  ASSERT_TRUE(f.matched(2, HopRole::subscriber)) << sub.describe();
+  ASSERT_TRUE(sub.wait_err(matched_at_least(1), kWait)) << sub.describe();
+  std::vector<std::uint8_t> storage;
+  for (std::uint32_t q = 1; q <= 3; ++q) {
+    ASSERT_EQ(f.adapter->send(outbound(2, q, storage)), SendStatus::sent);
+  }
+  ASSERT_EQ(sub.wait_exit(kWait), 0) << sub.describe();
+  EXPECT_EQ(sub.out_lines().size(), 3u);
+}
+
 // ---- adapter -> native subscriber -------------------------------------------------------------
 
 TEST(DdsAdapter, SendsEnvelopesToNativeSubscriber) {

@@ -1,5 +1,14 @@
 // The DDS segment adapter on Fast DDS 2.9. The mapping is documented in cosmic/dds_adapter.hpp.
 //
+// Participants: one per class of channel in use on the segment. The NRT participant is created
+// by start() and also carries discovery of the segment's health; the HRT and SRT ones when the
+// first channel of their class is configured. Readers and writers of a channel live in its
+// class's participant, so a lower class never shares Fast DDS's per-participant send lock,
+// shared-memory segment, event thread or receive threads with a higher one (a flood of NRT writes
+// would otherwise hold the send lock an HRT write needs, on a thread that runs below every
+// real-time thread: a priority inversion the router's own locks cannot fix). Each participant's
+// Fast DDS threads run as its class's lane does (see create_participant_as).
+//
 // Threads and locks:
 // - control_mutex_ serialises start/configure/stop (control thread).
 // - writers_mutex_ (shared_mutex) guards the channel -> writer table: send() (router thread)
@@ -16,6 +25,7 @@
 
 #include "cosmic/adapter_counters.hpp"
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <exception>
@@ -102,6 +112,10 @@ const char* policy_name(dds::QosPolicyId_t id) {
 // Fast DDS logs through a process-wide singleton that prints to stdout by default. The first
 // adapter replaces that with one consumer forwarding to the Loggers of the running adapters
 // (each distinct Logger once): the library never prints.
+// Lock order: Fast DDS's log thread holds its own configuration mutex while it calls Consume(),
+// which takes mutex_; so mutex_ is never held while calling into dds::Log (Clear/Register/
+// SetVerbosity take that configuration mutex: holding mutex_ there could deadlock against a
+// message being consumed, as ThreadSanitizer's lock-order check showed).
 class LogRouter {
  public:
   static LogRouter& instance() {
@@ -109,14 +123,15 @@ class LogRouter {
     return *router;
   }
   void attach(Logger& log) {
-    std::lock_guard lock(mutex_);
-    if (!installed_) {
-      installed_ = true;
+    {
+      std::lock_guard lock(mutex_);
+      ++loggers_[&log];
+    }
+    std::call_once(installed_, [] {
       dds::Log::ClearConsumers();
       dds::Log::RegisterConsumer(std::make_unique<Consumer>());
       dds::Log::SetVerbosity(dds::Log::Warning);
-    }
-    ++loggers_[&log];
+    });
   }
   void detach(Logger& log) {
     std::lock_guard lock(mutex_);
@@ -150,14 +165,28 @@ class LogRouter {
       log->log(level, text);
     }
   }
-  std::mutex mutex_;
-  bool installed_ = false;
+  std::once_flag installed_;  // the consumer is installed once per process
+  std::mutex mutex_;          // guards loggers_; never held while calling into dds::Log
   std::map<Logger*, int> loggers_;
 };
 
 // ---- the adapter -------------------------------------------------------------------------------
 
 class DdsAdapter;
+
+struct TopicRef {
+  dds::Topic* topic = nullptr;
+  int users = 0;
+};
+
+// The DDS entities serving one class of channels on the segment (control thread only).
+struct ClassParticipant {
+  dds::DomainParticipant* participant = nullptr;
+  dds::Publisher* publisher = nullptr;
+  dds::Subscriber* subscriber = nullptr;
+  rtps::GuidPrefix_t prefix;
+  std::map<std::string, TopicRef> topics;
+};
 
 struct WriterEntry : dds::DataWriterListener {
   WriterEntry(DdsAdapter& owner, ChannelId id, const ChannelSpec& spec)
@@ -170,6 +199,7 @@ struct WriterEntry : dds::DataWriterListener {
   ChannelId id;
   ChannelSpec spec;
   EndpointShape shape;
+  ClassParticipant* home = nullptr;  // the participant of the channel's class
   dds::Topic* topic = nullptr;
   dds::DataWriter* writer = nullptr;
   std::mutex sample_mutex;
@@ -189,6 +219,10 @@ struct ReaderEntry : dds::DataReaderListener {
   ChannelId id;
   ChannelSpec spec;
   EndpointShape shape;
+  ClassParticipant* home = nullptr;  // the participant of the channel's class
+  // GUID prefix of `home`: a sample whose writer has it is this gateway's own publication (a
+  // channel's reader and writer on one segment share the class, hence the participant).
+  rtps::GuidPrefix_t own_prefix;
   dds::Topic* topic = nullptr;
   dds::DataReader* reader = nullptr;
   std::mutex mutex;     // serialises callbacks; guards `active` and `sample`
@@ -239,15 +273,20 @@ class DdsAdapter final : public DdsSegmentAdapter {
     health_.state = state;
     health_.detail = std::move(detail);
   }
-  dds::Topic* acquire_topic(const std::string& name);
-  void release_topic(dds::Topic* topic);
+  ClassParticipant& home_of(ChannelClass cls) { return classes_.at(static_cast<std::size_t>(cls)); }
+  bool started() const { return classes_[static_cast<std::size_t>(ChannelClass::nrt)].participant != nullptr; }
+  Status open_participant(ChannelClass cls, const ThreadPolicy& threads, const std::string& thread_name);
+  Status ensure_class_participant(ChannelClass cls);
+  void close_participant(ClassParticipant& home);
+  dds::Topic* acquire_topic(ClassParticipant& home, const std::string& name);
+  void release_topic(ClassParticipant& home, dds::Topic* topic);
   std::unique_ptr<WriterEntry> create_writer(const ChannelBinding& binding, std::string& error);
   std::unique_ptr<ReaderEntry> create_reader(const ChannelBinding& binding, std::string& error);
   void destroy_writer(std::unique_ptr<WriterEntry> entry);
   void deactivate(ReaderEntry& entry);
   void destroy_reader(std::unique_ptr<ReaderEntry> entry);
   void teardown();
-  dds::DomainParticipant* create_participant_as(const ThreadPolicy& receive, const dds::DomainParticipantQos& qos);
+  dds::DomainParticipant* create_participant_as(const ThreadPolicy& threads, const dds::DomainParticipantQos& qos);
 
   const SegmentSpec segment_;
   const GatewayIdentity self_;
@@ -255,16 +294,8 @@ class DdsAdapter final : public DdsSegmentAdapter {
 
   std::mutex control_mutex_;
   EventSink* sink_ = nullptr;
-  dds::DomainParticipant* participant_ = nullptr;
-  dds::Publisher* publisher_ = nullptr;
-  dds::Subscriber* subscriber_ = nullptr;
-  rtps::GuidPrefix_t own_prefix_;
+  std::array<ClassParticipant, 3> classes_;  // indexed by ChannelClass; entries point into it
   bool log_attached_ = false;
-  struct TopicRef {
-    dds::Topic* topic = nullptr;
-    int users = 0;
-  };
-  std::map<std::string, TopicRef> topics_;
 
   mutable std::shared_mutex writers_mutex_;
   std::unordered_map<ChannelId, std::unique_ptr<WriterEntry>> writers_;
@@ -349,7 +380,7 @@ Nanos arrival_on_steady_clock(const eprosima::fastrtps::rtps::Time_t& reception)
 void DdsAdapter::deliver(ReaderEntry& entry, const dds::SampleInfo& info) {
   counters_.received.fetch_add(1, std::memory_order_relaxed);
   const cosmic::Envelope& env = entry.sample;
-  if (info.sample_identity.writer_guid().guidPrefix == own_prefix_ || env.origin() == self_.id) {
+  if (info.sample_identity.writer_guid().guidPrefix == entry.own_prefix || env.origin() == self_.id) {
     sink_->on_problem(entry.id, InboundProblem::own_echo);
     return;
   }
@@ -375,29 +406,93 @@ void DdsAdapter::deliver(ReaderEntry& entry, const dds::SampleInfo& info) {
 // Fast DDS 2.9 has no thread settings, but Linux threads inherit the scheduling policy, priority,
 // CPU affinity and name of the thread that creates them, and a participant starts its receive
 // and event threads when it is created. So it is created on a short-lived thread that runs as
-// gateway.realtime says receive threads run (named rx:<segment>, like cosmicd's own receive
-// threads), and Fast DDS's threads of this segment run that way too.
-dds::DomainParticipant* DdsAdapter::create_participant_as(const ThreadPolicy& receive,
+// `threads` says (named by the caller), and Fast DDS's threads of that participant run that way
+// too: the NRT participant's as gateway.realtime's receive threads (rx:<segment>), an HRT or SRT
+// participant's as that class's lanes (rx-hrt:<segment>, rx-srt:<segment>).
+dds::DomainParticipant* DdsAdapter::create_participant_as(const ThreadPolicy& threads,
                                                           const dds::DomainParticipantQos& qos) {
   const auto domain = static_cast<dds::DomainId_t>(segment_.dds.domain);
-  ThreadPolicy policy = receive;
-  policy.name = "rx:" + segment_.name;
   dds::DomainParticipant* created = nullptr;
   std::vector<std::string> problems;
   std::thread creator([&] {
-    problems = apply_thread_policy(policy);
+    problems = apply_thread_policy(threads);
     created = dds::DomainParticipantFactory::get_instance()->create_participant(domain, qos);
   });
   creator.join();
   for (const auto& problem : problems) {
-    log_.log(LogLevel::warning, prefix() + "Fast DDS receive threads: " + problem);
+    log_.log(LogLevel::warning, prefix() + "Fast DDS threads " + threads.name + ": " + problem);
   }
   return created;
 }
 
+// Creates the participant of `cls` with its publisher and subscriber; on failure nothing of it
+// remains. Control thread, control_mutex_ held.
+Status DdsAdapter::open_participant(ChannelClass cls, const ThreadPolicy& threads,
+                                    const std::string& thread_name) {
+  static const char* const kClassName[3] = {"hrt", "srt", "nrt"};
+  ClassParticipant& home = home_of(cls);
+  const std::string gateway = self_.name.empty() ? std::string("cosmicd") : self_.name;
+  std::string name = gateway + "/" + segment_.name;
+  if (cls != ChannelClass::nrt) name += std::string("/") + kClassName[static_cast<std::size_t>(cls)];
+  dds::DomainParticipantQos qos;
+  if (Status st = dds_detail::participant_qos(segment_, name, qos); !st.ok) {
+    return st;
+  }
+  ThreadPolicy policy = threads;
+  policy.name = thread_name;
+  home.participant = create_participant_as(policy, qos);
+  if (home.participant == nullptr) {
+    return Status::failure("cannot create a DDS participant (" + std::string(kClassName[static_cast<std::size_t>(cls)]) +
+                           ") in domain " + std::to_string(segment_.dds.domain));
+  }
+  dds::TypeSupport type(new cosmic::EnvelopePubSubType());
+  if (type.register_type(home.participant) != ReturnCode_t::RETCODE_OK) {
+    close_participant(home);
+    return Status::failure("cannot register type cosmic::Envelope");
+  }
+  home.publisher = home.participant->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+  home.subscriber = home.participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+  if (home.publisher == nullptr || home.subscriber == nullptr) {
+    close_participant(home);
+    return Status::failure("cannot create the DDS publisher/subscriber");
+  }
+  home.prefix = home.participant->guid().guidPrefix;
+  return Status::success();
+}
+
+// The HRT or SRT participant is created with the first channel of its class and kept until
+// stop(): creating one costs discovery time, and a class that had channels is likely to again.
+Status DdsAdapter::ensure_class_participant(ChannelClass cls) {
+  if (home_of(cls).participant != nullptr) {
+    return Status::success();
+  }
+  const std::string thread_name = (cls == ChannelClass::hrt ? "rx-hrt:" : "rx-srt:") + segment_.name;
+  Status st = open_participant(cls, sink_->class_thread_policy(cls), thread_name);
+  if (st.ok) {
+    log_.log(LogLevel::info, prefix() + "participant for " + (cls == ChannelClass::hrt ? "HRT" : "SRT") +
+                                 " channels up in domain " + std::to_string(segment_.dds.domain));
+  }
+  return st;
+}
+
+// Deletes what is left of a participant whose endpoints are gone (control thread).
+void DdsAdapter::close_participant(ClassParticipant& home) {
+  if (home.participant == nullptr) {
+    return;
+  }
+  if (home.publisher != nullptr) home.participant->delete_publisher(home.publisher);
+  if (home.subscriber != nullptr) home.participant->delete_subscriber(home.subscriber);
+  for (auto& [name, ref] : home.topics) home.participant->delete_topic(ref.topic);
+  if (dds::DomainParticipantFactory::get_instance()->delete_participant(home.participant) !=
+      ReturnCode_t::RETCODE_OK) {
+    warn("cannot delete the DDS participant");
+  }
+  home = ClassParticipant{};
+}
+
 Status DdsAdapter::start(EventSink& sink) {
   std::lock_guard control(control_mutex_);
-  if (participant_ != nullptr) {
+  if (started()) {
     return Status::failure("DDS segment " + segment_.name + " already started");
   }
   auto fail = [&](std::string why) {
@@ -418,27 +513,10 @@ Status DdsAdapter::start(EventSink& sink) {
     log_attached_ = true;
   }
   try {
-    dds::DomainParticipantQos qos;
-    const std::string name =
-        (self_.name.empty() ? std::string("cosmicd") : self_.name) + "/" + segment_.name;
-    if (Status st = dds_detail::participant_qos(segment_, name, qos); !st.ok) {
+    if (Status st = open_participant(ChannelClass::nrt, sink.receive_thread_policy(), "rx:" + segment_.name);
+        !st.ok) {
       return fail(st.error);
     }
-    participant_ = create_participant_as(sink.receive_thread_policy(), qos);
-    if (participant_ == nullptr) {
-      return fail("cannot create a DDS participant in domain " +
-                  std::to_string(segment_.dds.domain));
-    }
-    dds::TypeSupport type(new cosmic::EnvelopePubSubType());
-    if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK) {
-      return fail("cannot register type cosmic::Envelope");
-    }
-    publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
-    subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
-    if (publisher_ == nullptr || subscriber_ == nullptr) {
-      return fail("cannot create the DDS publisher/subscriber");
-    }
-    own_prefix_ = participant_->guid().guidPrefix;
   } catch (const std::exception& e) {
     return fail(std::string("Fast DDS: ") + e.what());
   } catch (...) {
@@ -451,25 +529,25 @@ Status DdsAdapter::start(EventSink& sink) {
   return Status::success();
 }
 
-dds::Topic* DdsAdapter::acquire_topic(const std::string& name) {
-  auto it = topics_.find(name);
-  if (it != topics_.end()) {
+dds::Topic* DdsAdapter::acquire_topic(ClassParticipant& home, const std::string& name) {
+  auto it = home.topics.find(name);
+  if (it != home.topics.end()) {
     ++it->second.users;
     return it->second.topic;
   }
-  dds::Topic* topic = participant_->create_topic(name, kTypeName, dds::TOPIC_QOS_DEFAULT);
+  dds::Topic* topic = home.participant->create_topic(name, kTypeName, dds::TOPIC_QOS_DEFAULT);
   if (topic != nullptr) {
-    topics_[name] = TopicRef{topic, 1};
+    home.topics[name] = TopicRef{topic, 1};
   }
   return topic;
 }
 
-void DdsAdapter::release_topic(dds::Topic* topic) {
-  for (auto it = topics_.begin(); it != topics_.end(); ++it) {
+void DdsAdapter::release_topic(ClassParticipant& home, dds::Topic* topic) {
+  for (auto it = home.topics.begin(); it != home.topics.end(); ++it) {
     if (it->second.topic == topic) {
       if (--it->second.users == 0) {
-        participant_->delete_topic(topic);
-        topics_.erase(it);
+        home.participant->delete_topic(topic);
+        home.topics.erase(it);
       }
       return;
     }
@@ -479,16 +557,17 @@ void DdsAdapter::release_topic(dds::Topic* topic) {
 std::unique_ptr<WriterEntry> DdsAdapter::create_writer(const ChannelBinding& binding,
                                                        std::string& error) {
   auto entry = std::make_unique<WriterEntry>(*this, binding.id, binding.spec);
-  entry->topic = acquire_topic(entry->shape.topic);
+  entry->home = &home_of(binding.spec.cls);
+  entry->topic = acquire_topic(*entry->home, entry->shape.topic);
   if (entry->topic == nullptr) {
     error = "cannot create topic " + entry->shape.topic;
     return nullptr;
   }
-  entry->writer = publisher_->create_datawriter(entry->topic,
+  entry->writer = entry->home->publisher->create_datawriter(entry->topic,
                                                 dds_detail::writer_qos(segment_, binding.spec),
                                                 entry.get(), dds::StatusMask::offered_incompatible_qos());
   if (entry->writer == nullptr) {
-    release_topic(entry->topic);
+    release_topic(*entry->home, entry->topic);
     error = "cannot create a DataWriter on " + entry->shape.topic;
     return nullptr;
   }
@@ -499,7 +578,9 @@ std::unique_ptr<WriterEntry> DdsAdapter::create_writer(const ChannelBinding& bin
 std::unique_ptr<ReaderEntry> DdsAdapter::create_reader(const ChannelBinding& binding,
                                                        std::string& error) {
   auto entry = std::make_unique<ReaderEntry>(*this, binding.id, binding.spec);
-  entry->topic = acquire_topic(entry->shape.topic);
+  entry->home = &home_of(binding.spec.cls);
+  entry->own_prefix = entry->home->prefix;
+  entry->topic = acquire_topic(*entry->home, entry->shape.topic);
   if (entry->topic == nullptr) {
     error = "cannot create topic " + entry->shape.topic;
     return nullptr;
@@ -509,10 +590,10 @@ std::unique_ptr<ReaderEntry> DdsAdapter::create_reader(const ChannelBinding& bin
   const dds::StatusMask mask = dds::StatusMask::data_available() <<
                                dds::StatusMask::requested_incompatible_qos() <<
                                dds::StatusMask::sample_lost();
-  entry->reader = subscriber_->create_datareader(
+  entry->reader = entry->home->subscriber->create_datareader(
       entry->topic, dds_detail::reader_qos(segment_, binding.spec), entry.get(), mask);
   if (entry->reader == nullptr) {
-    release_topic(entry->topic);
+    release_topic(*entry->home, entry->topic);
     error = "cannot create a DataReader on " + entry->shape.topic;
     return nullptr;
   }
@@ -520,10 +601,11 @@ std::unique_ptr<ReaderEntry> DdsAdapter::create_reader(const ChannelBinding& bin
 }
 
 void DdsAdapter::destroy_writer(std::unique_ptr<WriterEntry> entry) {
-  if (entry->writer != nullptr && publisher_->delete_datawriter(entry->writer) != ReturnCode_t::RETCODE_OK) {
+  if (entry->writer != nullptr &&
+      entry->home->publisher->delete_datawriter(entry->writer) != ReturnCode_t::RETCODE_OK) {
     warn("cannot delete the DataWriter of " + entry->shape.topic);
   }
-  release_topic(entry->topic);
+  release_topic(*entry->home, entry->topic);
 }
 
 void DdsAdapter::deactivate(ReaderEntry& entry) {
@@ -534,18 +616,18 @@ void DdsAdapter::deactivate(ReaderEntry& entry) {
 void DdsAdapter::destroy_reader(std::unique_ptr<ReaderEntry> entry) {
   deactivate(*entry);
   if (entry->reader != nullptr &&
-      subscriber_->delete_datareader(entry->reader) != ReturnCode_t::RETCODE_OK) {
+      entry->home->subscriber->delete_datareader(entry->reader) != ReturnCode_t::RETCODE_OK) {
     warn("cannot delete the DataReader of " + entry->shape.topic);
   }
   entry->reader = nullptr;
-  release_topic(entry->topic);
+  release_topic(*entry->home, entry->topic);
   entry->sample.payload() = {};  // release the buffer; the listener object itself stays
   retired_readers_.push_back(std::move(entry));
 }
 
 Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
   std::lock_guard control(control_mutex_);
-  if (participant_ == nullptr) {
+  if (!started()) {
     return Status::failure("DDS segment " + segment_.name + " is not started");
   }
   // Validate and index the wanted endpoints.
@@ -588,8 +670,13 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
   try {
     for (const auto& [id, b] : want_writers) {
       auto it = writers_.find(id);  // only this (control) thread changes writers_
-      if (it != writers_.end() && it->second->shape == dds_detail::shape_of(b->spec)) {
+      if (it != writers_.end() && it->second->shape == dds_detail::shape_of(b->spec) &&
+          it->second->home == &home_of(b->spec.cls)) {
         continue;
+      }
+      if (Status st = ensure_class_participant(b->spec.cls); !st.ok) {
+        error = st.error;
+        return rollback();
       }
       auto entry = create_writer(*b, error);
       if (!entry) return rollback();
@@ -598,12 +685,16 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
     for (const auto& [id, b] : want_readers) {
       auto it = readers_.find(id);
       if (it != readers_.end()) {
-        if (it->second->shape == dds_detail::shape_of(b->spec)) {
+        if (it->second->shape == dds_detail::shape_of(b->spec) && it->second->home == &home_of(b->spec.cls)) {
           continue;
         }
         // Changed QoS: stop the old reader first so that an event is never delivered twice.
         deactivate(*it->second);
         replaced_readers.push_back(it->second.get());
+      }
+      if (Status st = ensure_class_participant(b->spec.cls); !st.ok) {
+        error = st.error;
+        return rollback();
       }
       auto entry = create_reader(*b, error);
       if (!entry) return rollback();
@@ -747,25 +838,14 @@ void DdsAdapter::teardown() {
     readers.swap(readers_);
   }
   try {
-    if (participant_ != nullptr) {
-      for (auto& [id, w] : writers) destroy_writer(std::move(w));
-      for (auto& [id, r] : readers) destroy_reader(std::move(r));
-      if (publisher_ != nullptr) participant_->delete_publisher(publisher_);
-      if (subscriber_ != nullptr) participant_->delete_subscriber(subscriber_);
-      for (auto& [name, ref] : topics_) participant_->delete_topic(ref.topic);
-      if (dds::DomainParticipantFactory::get_instance()->delete_participant(participant_) !=
-          ReturnCode_t::RETCODE_OK) {
-        warn("cannot delete the DDS participant");
-      }
-    }
+    for (auto& [id, w] : writers) destroy_writer(std::move(w));
+    for (auto& [id, r] : readers) destroy_reader(std::move(r));
+    for (ClassParticipant& home : classes_) close_participant(home);
   } catch (...) {
     warn("Fast DDS threw while stopping");
   }
-  topics_.clear();
+  classes_ = {};
   retired_readers_.clear();
-  publisher_ = nullptr;
-  subscriber_ = nullptr;
-  participant_ = nullptr;
   sink_ = nullptr;
   if (log_attached_) {
     LogRouter::instance().detach(log_);
@@ -775,7 +855,7 @@ void DdsAdapter::teardown() {
 
 void DdsAdapter::stop() {
   std::lock_guard control(control_mutex_);
-  if (participant_ == nullptr) {
+  if (!started()) {
     return;
   }
   teardown();

@@ -13,6 +13,7 @@
 // adapter owns, between start() and the return of stop().
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -52,11 +53,22 @@ class EventSink {
   const ThreadPolicy& receive_thread_policy() const { return receive_policy_; }
   void set_receive_thread_policy(ThreadPolicy policy) { receive_policy_ = std::move(policy); }
 
+  // How the egress lane of `cls` runs (priority, CPUs; the name is the adapter's to choose). An
+  // adapter whose transport runs threads of its own on behalf of one class only (a DDS
+  // participant per class) runs them this way, so they rank with that class and not below it.
+  const ThreadPolicy& class_thread_policy(ChannelClass cls) const {
+    return class_policies_.at(static_cast<std::size_t>(cls));
+  }
+  void set_class_thread_policy(ChannelClass cls, ThreadPolicy policy) {
+    class_policies_.at(static_cast<std::size_t>(cls)) = std::move(policy);
+  }
+
  protected:
   ~EventSink() = default;
 
  private:
   ThreadPolicy receive_policy_;
+  std::array<ThreadPolicy, 3> class_policies_;  // indexed by ChannelClass
 };
 
 // A channel a segment does not carry after configure(), and the transport's reason.
