@@ -10,6 +10,26 @@ ServiceNotifier::ServiceNotifier(std::chrono::milliseconds ready_grace)
   if (sd_watchdog_enabled(0, &usec) > 0) watchdog_interval_ = std::chrono::microseconds(usec / 2);
 }
 
+const ServiceNotifier::VerdictCounts& ServiceNotifier::verdict_counts(const cosmic::Gateway& gateway,
+                                                                      const std::string& health_key) {
+  const auto now = std::chrono::steady_clock::now();
+  if (counts_valid_ && counts_generation_ == gateway.generation() && counts_health_ == health_key &&
+      now - counts_at_ < kVerdictRecount) {
+    return counts_;
+  }
+  counts_ = {};
+  for (const auto& c : gateway.admission().channels) {
+    counts_.bound += c.verdict == cosmic::Verdict::bound ? 1 : 0;
+    counts_.degraded += c.verdict == cosmic::Verdict::degraded ? 1 : 0;
+    counts_.failed += c.verdict == cosmic::Verdict::failed ? 1 : 0;
+  }
+  counts_generation_ = gateway.generation();
+  counts_health_ = health_key;
+  counts_at_ = now;
+  counts_valid_ = true;
+  return counts_;
+}
+
 std::string ServiceNotifier::summary(const cosmic::Gateway& gateway) {
   std::size_t up = 0;
   std::string down;
@@ -21,18 +41,11 @@ std::string ServiceNotifier::summary(const cosmic::Gateway& gateway) {
       down += (down.empty() ? "" : ", ") + s.spec.name + " " + cosmic::to_string(s.health.state);
     }
   }
-  std::size_t bound = 0;
-  std::size_t degraded = 0;
-  std::size_t failed = 0;
-  for (const auto& c : gateway.admission().channels) {
-    bound += c.verdict == cosmic::Verdict::bound ? 1 : 0;
-    degraded += c.verdict == cosmic::Verdict::degraded ? 1 : 0;
-    failed += c.verdict == cosmic::Verdict::failed ? 1 : 0;
-  }
-  std::string line = std::to_string(up) + "/" + std::to_string(segments.size()) + " segments up, " + std::to_string(bound) +
-                     " channels bound, " + std::to_string(degraded) + " degraded, " +
-                     std::to_string(gateway.router().progress()) + " events handled";
-  if (failed > 0) line += ", " + std::to_string(failed) + " FAILED (refused by their transport)";
+  const VerdictCounts& counts = verdict_counts(gateway, down);
+  std::string line = std::to_string(up) + "/" + std::to_string(segments.size()) + " segments up, " +
+                     std::to_string(counts.bound) + " channels bound, " + std::to_string(counts.degraded) +
+                     " degraded, " + std::to_string(gateway.router().progress()) + " events handled";
+  if (counts.failed > 0) line += ", " + std::to_string(counts.failed) + " FAILED (refused by their transport)";
   if (const std::size_t violated = gateway.violated_channels(); violated > 0)
     line += ", " + std::to_string(violated) + " VIOLATED (measured beyond admitted bounds)";
   if (!down.empty()) line += " (" + down + ")";

@@ -21,10 +21,26 @@ class ServiceNotifier {
   void reloaded(const cosmic::Gateway& gateway);
   void stopping();
 
-  static std::string summary(const cosmic::Gateway& gateway);
+  // The STATUS line. Counting verdicts builds every channel's report (milliseconds at ten
+  // thousand channels), so the counts are reused until the bindings or a segment's health change,
+  // or for at most kVerdictRecount.
+  std::string summary(const cosmic::Gateway& gateway);
 
  private:
+  struct VerdictCounts {
+    std::size_t bound = 0;
+    std::size_t degraded = 0;
+    std::size_t failed = 0;
+  };
+  static constexpr std::chrono::seconds kVerdictRecount{5};
+  const VerdictCounts& verdict_counts(const cosmic::Gateway& gateway, const std::string& health_key);
   bool router_alive(const cosmic::Gateway& gateway);
+
+  VerdictCounts counts_;
+  std::uint64_t counts_generation_ = 0;
+  std::string counts_health_;
+  std::chrono::steady_clock::time_point counts_at_{};
+  bool counts_valid_ = false;
 
   std::chrono::steady_clock::time_point started_;
   std::chrono::milliseconds ready_grace_;

@@ -66,6 +66,25 @@ nlohmann::json whole_set_json(const RandomSet& set, const KnowledgeBase& kb) {
   return to_json(AdmissionReport{whole.segments, whole.channels});
 }
 
+// The per-segment load and hop count that cosmicctl segments and the STATUS line read every
+// tick (without building reports) are what the full report says.
+void expect_cheap_counts_match_the_report(const KnowledgeBase& kb, int set) {
+  const AdmissionReport report = kb.report();
+  const std::vector<SegmentLoad> loads = kb.loads();
+  const std::vector<std::size_t> hops = kb.hop_counts();
+  ASSERT_EQ(loads.size(), report.segments.size()) << "set " << set;
+  ASSERT_EQ(hops.size(), loads.size()) << "set " << set;
+  for (std::size_t s = 0; s < loads.size(); ++s) {
+    EXPECT_EQ(loads[s].name, report.segments[s].name) << "set " << set;
+    EXPECT_EQ(loads[s].utilization, report.segments[s].utilization) << "set " << set;
+    std::size_t in_report = 0;
+    for (const auto& channel : report.channels) {
+      for (const auto& hop : channel.hops) in_report += hop.segment == loads[s].name ? 1 : 0;
+    }
+    EXPECT_EQ(hops[s], in_report) << "set " << set << " segment " << loads[s].name;
+  }
+}
+
 // Four blocks of 50 sets, each its own test (seconds each, even under ASan).
 class IncrementalBinds : public ::testing::TestWithParam<int> {};
 
@@ -87,6 +106,7 @@ TEST_P(IncrementalBinds, EveryBindEqualsTheWholeSetAnalysis) {
           << "set " << n << " bind " << channel.name;
     }
     ASSERT_EQ(to_json(kb.report()), whole_set_json(set, kb)) << "set " << n;
+    expect_cheap_counts_match_the_report(kb, n);
   }
   // The generator exercises both outcomes in quantity.
   EXPECT_GT(bound, 150);

@@ -548,6 +548,14 @@ std::vector<ChannelReport> AdmissionSet::reports() const {
   return out;
 }
 
+std::vector<std::size_t> AdmissionSet::hop_counts() const {
+  std::vector<std::size_t> out(segment_specs_.size(), 0);
+  for (const ChannelData& channel : data_) {
+    for (const HopPlace& p : channel.places) ++out.at(p.segment);
+  }
+  return out;
+}
+
 std::vector<SegmentLoad> AdmissionSet::loads() const {
   std::vector<SegmentLoad> out;
   for (std::size_t s = 0; s < segments_.size(); ++s) {

@@ -280,14 +280,14 @@ SegmentCountersSnapshot counters_snapshot(const std::string& name, const Segment
 std::vector<ChannelMisses> Router::misses() const {
   const std::shared_ptr<const Table> table = load_table();
   std::vector<ChannelMisses> out;
-  out.reserve(table->channels.size());
   for (const auto& state : table->channels) {
-    ChannelMisses m{state->route.spec.name};
+    std::uint64_t residence = 0;
+    std::uint64_t deadline = 0;
     for (const auto& hop : state->egress) {
-      m.residence_miss += hop.residence_miss.load(std::memory_order_relaxed);
-      m.deadline_miss += hop.deadline_miss.load(std::memory_order_relaxed);
+      residence += hop.residence_miss.load(std::memory_order_relaxed);
+      deadline += hop.deadline_miss.load(std::memory_order_relaxed);
     }
-    out.push_back(std::move(m));
+    if (residence + deadline > 0) out.push_back(ChannelMisses{state->route.spec.name, residence, deadline});
   }
   return out;
 }

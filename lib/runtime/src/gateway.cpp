@@ -397,16 +397,21 @@ std::vector<ChannelStatsSnapshot> Gateway::channel_stats() const {
 }
 
 void Gateway::refresh_runtime(Nanos now) {
-  std::unordered_map<std::string_view, const ChannelSpec*> bound;
-  for (const auto& spec : kb_->bound_channels()) bound.emplace(spec.name, &spec);
   std::map<std::string, RuntimeTrack> next;
-  for (const auto& counted : router_->misses()) {
-    const auto found = bound.find(counted.name);
-    if (found == bound.end()) continue;
-    auto previous = runtime_.find(counted.name);
+  auto judge_bound = [&](const ChannelMisses& counted) {
+    const ChannelSpec* spec = kb_->find_bound(counted.name);
+    if (spec == nullptr) return;  // unbound since: its track ends
+    const auto previous = runtime_.find(counted.name);
     RuntimeTrack track = previous != runtime_.end() ? previous->second : RuntimeTrack{};
-    judge(counted, *found->second, track, now);
+    judge(counted, *spec, track, now);
     next.emplace(counted.name, track);
+  };
+  // Only channels that ever missed are tracked (every other one is `bound` at run time).
+  for (const auto& counted : router_->misses()) judge_bound(counted);
+  // A tracked channel the router reports no miss for any more (its route was applied afresh) is
+  // judged with zero counts: a violation still ends only after a clean interval.
+  for (const auto& [name, track] : runtime_) {
+    if (next.count(name) == 0) judge_bound(ChannelMisses{name, 0, 0});
   }
   runtime_ = std::move(next);
 }
@@ -474,19 +479,18 @@ bool Gateway::all_segments_up() const {
 }
 
 std::vector<SegmentInfo> Gateway::segments() const {
-  const AdmissionReport report = kb_->report();
+  const std::vector<SegmentLoad> loads = kb_->loads();
+  const std::vector<std::size_t> hops = kb_->hop_counts();
   std::vector<SegmentInfo> out;
   for (const auto& spec : config_.segments) {
     const auto slot = slots_.find(spec.name);
     if (slot == slots_.end()) continue;
     SegmentInfo info{spec, slot->second.adapter->health(), slot->second.adapter->statistics(), 0, 0,
                      router_->unrouted(slot->second.index)};
-    for (const auto& load : report.segments) {
-      if (load.name == spec.name) info.utilization = load.utilization;
-    }
-    for (const auto& channel : report.channels) {
-      info.channels += static_cast<std::size_t>(std::count_if(channel.hops.begin(), channel.hops.end(),
-                                                              [&](const auto& h) { return h.segment == spec.name; }));
+    for (std::size_t s = 0; s < loads.size() && s < hops.size(); ++s) {
+      if (loads[s].name != spec.name) continue;
+      info.utilization = loads[s].utilization;
+      info.channels = hops[s];
     }
     out.push_back(std::move(info));
   }

@@ -198,6 +198,8 @@ class AdmissionSet {
   const ChannelSpec* find(const std::string& name) const;
   std::vector<ChannelReport> reports() const;  // bind order
   std::vector<SegmentLoad> loads() const;      // segment order
+  // How many hops of bound channels each segment carries, in segment order (no reports built).
+  std::vector<std::size_t> hop_counts() const;
   const std::vector<SegmentSpec>& segment_specs() const { return segment_specs_; }
   const GatewaySpec& gateway() const { return gateway_; }
 

@@ -59,6 +59,10 @@ class KnowledgeBase {
 
   // Verdicts of the bound set (live health applied) and the load of every segment.
   AdmissionReport report() const;
+  // The load of every segment and how many hops of bound channels it carries (same order),
+  // without building the channels' reports: cheap enough to call every control-loop tick.
+  std::vector<SegmentLoad> loads() const { return set_.loads(); }
+  std::vector<std::size_t> hop_counts() const { return set_.hop_counts(); }
 
   const GatewaySpec& gateway() const { return set_.gateway(); }
   const std::vector<SegmentState>& segments() const { return segments_; }

@@ -90,6 +90,8 @@ class Router {
   void stop();
 
   std::vector<ChannelStatsSnapshot> snapshot() const;
+  // Miss counters of the channels that missed at least once since their route was applied
+  // (channels without a miss are left out: at ten thousand channels this runs every 250 ms).
   std::vector<ChannelMisses> misses() const;
   // Events the lanes have handled (sent or dropped) since start: the watchdog's progress measure.
   std::uint64_t progress() const { return progress_.load(std::memory_order_relaxed); }
