@@ -140,6 +140,27 @@ OutboundEvent outbound(ChannelId channel, std::uint32_t q, std::vector<std::uint
 
 // ---- thread policy ----------------------------------------------------------------------------
 
+// How many of this process's threads are named `name`; each must be pinned to CPU 0 alone and
+// run at `nice` (a failed expectation names the thread).
+std::size_t threads_running_on_cpu0_at_nice(const std::string& name, int nice) {
+  std::size_t found = 0;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::string comm;
+    std::getline(std::ifstream(task.path() / "comm"), comm);
+    if (comm != name) continue;
+    const pid_t tid = static_cast<pid_t>(std::stol(task.path().filename().string()));
+    cpu_set_t cpus;
+    CPU_ZERO(&cpus);
+    EXPECT_EQ(sched_getaffinity(tid, sizeof cpus, &cpus), 0) << "thread " << tid;
+    EXPECT_EQ(CPU_COUNT(&cpus), 1) << "thread " << tid;
+    EXPECT_TRUE(CPU_ISSET(0, &cpus)) << "thread " << tid;
+    errno = 0;
+    EXPECT_EQ(getpriority(PRIO_PROCESS, static_cast<id_t>(tid)), nice) << "thread " << tid;
+    ++found;
+  }
+  return found;
+}
+
 // Fast DDS's threads of a segment run as gateway.realtime's receive policy says: they inherit it
 // from the thread the adapter creates the participant on (nice and affinity here, which need no
 // privilege; SCHED_FIFO is inherited the same way).
@@ -150,22 +171,8 @@ TEST(DdsAdapter, FastDdsThreadsInheritTheReceivePolicy) {
   f.sink.set_receive_thread_policy(ThreadPolicy{"rx", 0, 7, {0}});
   ASSERT_TRUE(f.adapter->start(f.sink).ok);
   const std::string name = "rx:" + f.spec.name;
-  std::size_t inherited = 0;
-  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
-    std::string comm;
-    std::getline(std::ifstream(task.path() / "comm"), comm);
-    if (comm != name) continue;
-    const pid_t tid = static_cast<pid_t>(std::stol(task.path().filename().string()));
-    cpu_set_t cpus;
-    CPU_ZERO(&cpus);
-    ASSERT_EQ(sched_getaffinity(tid, sizeof cpus, &cpus), 0);
-    EXPECT_EQ(CPU_COUNT(&cpus), 1) << "thread " << tid;
-    EXPECT_TRUE(CPU_ISSET(0, &cpus)) << "thread " << tid;
-    errno = 0;
-    EXPECT_EQ(getpriority(PRIO_PROCESS, static_cast<id_t>(tid)), 7) << "thread " << tid;
-    ++inherited;
-  }
-  EXPECT_GE(inherited, 2u) << "Fast DDS's receive and event threads should carry the name " << name;
+  EXPECT_GE(threads_running_on_cpu0_at_nice(name, 7), 2u)
+      << "Fast DDS's receive and event threads should carry the name " << name;
   // The test's own thread is untouched.
   errno = 0;
   EXPECT_EQ(getpriority(PRIO_PROCESS, 0), own_nice);
@@ -215,21 +222,8 @@ TEST(DdsAdapter, EachClassHasAParticipantOfItsOwn) {
 
   // The HRT participant's Fast DDS threads run as the HRT lane does.
   const std::string name = "rx-hrt:" + f.spec.name;
-  std::size_t inherited = 0;
-  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
-    std::string comm;
-    std::getline(std::ifstream(task.path() / "comm"), comm);
-    if (comm != name) continue;
-    const pid_t tid = static_cast<pid_t>(std::stol(task.path().filename().string()));
-    cpu_set_t cpus;
-    CPU_ZERO(&cpus);
-    ASSERT_EQ(sched_getaffinity(tid, sizeof cpus, &cpus), 0);
-    EXPECT_EQ(CPU_COUNT(&cpus), 1) << "thread " << tid;
-    errno = 0;
-    EXPECT_EQ(getpriority(PRIO_PROCESS, static_cast<id_t>(tid)), 6) << "thread " << tid;
-    ++inherited;
-  }
-  EXPECT_GE(inherited, 2u) << "the HRT participant's threads should carry the name " << name;
+  EXPECT_GE(threads_running_on_cpu0_at_nice(name, 6), 2u)
+      << "the HRT participant's threads should carry the name " << name;
 
   // Events still flow on every class; the NRT channel moved to HRT lands in the HRT participant.
   nrt.spec.cls = ChannelClass::hrt;
