@@ -20,8 +20,7 @@ bool EgressLane::push(LaneItem&& item) noexcept {
     bytes_ += size;
     ++count_;
   }
-  ticket_.fetch_add(1, std::memory_order_release);
-  ticket_.notify_one();
+  wake_.notify_one();
   return true;
 }
 
@@ -57,8 +56,7 @@ void EgressLane::activate(SegmentAdapter* adapter, const ThreadPolicy& policy, b
 void EgressLane::deactivate() {
   if (thread_.joinable()) {
     running_.store(false, std::memory_order_release);
-    ticket_.fetch_add(1, std::memory_order_release);
-    ticket_.notify_all();
+    wake_.notify_all();
     thread_.join();
   }
   std::vector<LaneItem> dropped;
@@ -94,12 +92,12 @@ void EgressLane::worker(ThreadPolicy policy) {
   }
   LaneItem item;
   while (running_.load(std::memory_order_acquire)) {
-    const std::uint32_t ticket = ticket_.load(std::memory_order_acquire);
+    const std::uint32_t seen = wake_.current();
     if (pop(item)) {
       forward(item);
       continue;
     }
-    ticket_.wait(ticket, std::memory_order_acquire);
+    wake_.wait(seen);
   }
 }
 

@@ -20,6 +20,7 @@
 #include "cosmic/segment_adapter.hpp"
 #include "cosmic/thread_policy.hpp"
 #include "payload_pool.hpp"
+#include "wake_signal.hpp"
 
 namespace cosmic {
 
@@ -79,7 +80,7 @@ class EgressLane {
 
   std::atomic<SegmentAdapter*> adapter_{nullptr};
   std::atomic<std::uint64_t> current_generation_{0};
-  std::atomic<std::uint32_t> ticket_{0};  // bumped by every push and by deactivate (futex wait)
+  WakeSignal wake_;  // notified by every push and by deactivate
   std::atomic<bool> running_{false};
   std::thread thread_;
 };
