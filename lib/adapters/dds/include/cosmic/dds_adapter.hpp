@@ -1,8 +1,10 @@
 // The DDS segment adapter (eProsima Fast DDS 2.9), behind cosmic::SegmentAdapter.
 //
 // Mapping (DESIGN.md section 6; docs/dds-mapping.md has every policy and the reasons):
-// - One DomainParticipant per segment (domain id = segment.dds.domain), one Publisher and one
-//   Subscriber. One topic per channel, named by dds_topic_name() ("cosmic/<channel name>" with
+// - One DomainParticipant per class of channel in use on the segment (domain id =
+//   segment.dds.domain; the NRT one from start(), HRT and SRT with their first channel), each
+//   with one Publisher and one Subscriber, so no lower class shares Fast DDS's per-participant
+//   send lock or threads with a higher one. One topic per channel, named by dds_topic_name() ("cosmic/<channel name>" with
 //   '-' and '.' mapped to '_'; two channels mapping to one topic are refused by configure()),
 //   of type "cosmic::Envelope" (lib/adapters/dds/idl/Envelope.idl, @final, plain CDR). A
 //   channel bound with role subscriber (the gateway sends there) gets a DataWriter; with role
