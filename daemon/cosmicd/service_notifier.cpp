@@ -10,19 +10,14 @@ ServiceNotifier::ServiceNotifier(std::chrono::milliseconds ready_grace)
   if (sd_watchdog_enabled(0, &usec) > 0) watchdog_interval_ = std::chrono::microseconds(usec / 2);
 }
 
-const ServiceNotifier::VerdictCounts& ServiceNotifier::verdict_counts(const cosmic::Gateway& gateway,
+const cosmic::Gateway::VerdictCounts& ServiceNotifier::verdict_counts(const cosmic::Gateway& gateway,
                                                                       const std::string& health_key) {
   const auto now = std::chrono::steady_clock::now();
   if (counts_valid_ && counts_generation_ == gateway.generation() && counts_health_ == health_key &&
       now - counts_at_ < kVerdictRecount) {
     return counts_;
   }
-  counts_ = {};
-  for (const auto& c : gateway.admission().channels) {
-    counts_.bound += c.verdict == cosmic::Verdict::bound ? 1 : 0;
-    counts_.degraded += c.verdict == cosmic::Verdict::degraded ? 1 : 0;
-    counts_.failed += c.verdict == cosmic::Verdict::failed ? 1 : 0;
-  }
+  counts_ = gateway.verdict_counts();
   counts_generation_ = gateway.generation();
   counts_health_ = health_key;
   counts_at_ = now;
@@ -41,7 +36,7 @@ std::string ServiceNotifier::summary(const cosmic::Gateway& gateway) {
       down += (down.empty() ? "" : ", ") + s.spec.name + " " + cosmic::to_string(s.health.state);
     }
   }
-  const VerdictCounts& counts = verdict_counts(gateway, down);
+  const cosmic::Gateway::VerdictCounts& counts = verdict_counts(gateway, down);
   std::string line = std::to_string(up) + "/" + std::to_string(segments.size()) + " segments up, " +
                      std::to_string(counts.bound) + " channels bound, " + std::to_string(counts.degraded) +
                      " degraded, " + std::to_string(gateway.router().progress()) + " events handled";

@@ -27,16 +27,11 @@ class ServiceNotifier {
   std::string summary(const cosmic::Gateway& gateway);
 
  private:
-  struct VerdictCounts {
-    std::size_t bound = 0;
-    std::size_t degraded = 0;
-    std::size_t failed = 0;
-  };
   static constexpr std::chrono::seconds kVerdictRecount{5};
-  const VerdictCounts& verdict_counts(const cosmic::Gateway& gateway, const std::string& health_key);
+  const cosmic::Gateway::VerdictCounts& verdict_counts(const cosmic::Gateway& gateway, const std::string& health_key);
   bool router_alive(const cosmic::Gateway& gateway);
 
-  VerdictCounts counts_;
+  cosmic::Gateway::VerdictCounts counts_;
   std::uint64_t counts_generation_ = 0;
   std::string counts_health_;
   std::chrono::steady_clock::time_point counts_at_{};

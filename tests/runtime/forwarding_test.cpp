@@ -234,6 +234,42 @@ TEST(ForwardingTest, AnHrtChannelThatMissesIsViolatedLoggedOnceAndBoundAgainAfte
   gateway.stop();
 }
 
+// A route applied afresh (the channel changed on reload) starts with zero counters; its violation
+// still ends only after a clean interval, not at the next judgement.
+TEST(ForwardingTest, AViolatedChannelStaysViolatedWhenItsRouteIsAppliedAfresh) {
+  RecordingLogger log;
+  std::map<std::string, MemoryAdapter*> adapters;
+  Gateway gateway(
+      [&](const SegmentSpec& spec, const GatewayIdentity&, Logger&) -> std::unique_ptr<SegmentAdapter> {
+        auto adapter = std::make_unique<MemoryAdapter>(spec.name);
+        adapters[spec.name] = adapter.get();
+        return adapter;
+      },
+      log, 0x44);
+  ASSERT_TRUE(gateway.start(parse_config(kHrtConfig, "hrt.yaml").config).applied);
+  ASSERT_TRUE(adapters["lan"]->inject("distance", {1, 2, 3, 4}));
+  ASSERT_EQ(adapters["rt"]->wait_sent(1, 5s), 1u);
+  for (auto deadline = steady_now() + Nanos(5'000'000'000); gateway.channel_stats().at(0).residence_miss == 0;) {
+    ASSERT_LT(steady_now(), deadline);
+    std::this_thread::yield();
+  }
+  const Nanos t0 = steady_now();
+  gateway.refresh_runtime(t0);
+  ASSERT_EQ(gateway.channel_stats().at(0).runtime_state, RuntimeState::violated);
+
+  std::string changed = kHrtConfig;
+  changed.replace(changed.find("temp_validity: 1s"), 17, "temp_validity: 2s");
+  ASSERT_TRUE(gateway.reload(parse_config(changed, "hrt.yaml").config).applied);
+  ASSERT_EQ(gateway.channel_stats().at(0).residence_miss, 0u);  // a fresh route: fresh counters
+  gateway.refresh_runtime(t0 + Nanos(10'000'000));
+  EXPECT_EQ(gateway.channel_stats().at(0).runtime_state, RuntimeState::violated);
+  EXPECT_EQ(gateway.violated_channels(), 1u);
+  gateway.refresh_runtime(t0 + Nanos(60'000'000));
+  EXPECT_EQ(gateway.channel_stats().at(0).runtime_state, RuntimeState::bound);
+  EXPECT_EQ(log.count("violated its admitted bounds"), 1u);
+  gateway.stop();
+}
+
 TEST(ForwardingTest, AReloadedResidenceBoundIsWhatTheLanesCheck) {
   RecordingLogger log;
   std::map<std::string, MemoryAdapter*> adapters;

@@ -192,15 +192,7 @@ ControlProtocol::Answer ControlProtocol::run_admission(std::string what, std::fu
 }
 
 Json ControlProtocol::status() const {
-  const AdmissionReport report = gateway_.admission();
-  std::size_t bound = 0;
-  std::size_t degraded = 0;
-  std::size_t failed = 0;
-  for (const auto& c : report.channels) {
-    if (c.verdict == Verdict::bound) ++bound;
-    if (c.verdict == Verdict::degraded) ++degraded;
-    if (c.verdict == Verdict::failed) ++failed;
-  }
+  const Gateway::VerdictCounts counts = gateway_.verdict_counts();
   std::size_t up = 0;
   const auto segments = gateway_.segments();
   for (const auto& s : segments) up += s.health.state == SegmentHealth::up ? 1 : 0;
@@ -210,7 +202,8 @@ Json ControlProtocol::status() const {
   return Json{{"ok", true},
               {"gateway", {{"name", gateway_.identity().name}, {"id", id}, {"uptime_s", uptime}}},
               {"segments", {{"total", segments.size()}, {"up", up}}},
-              {"channels", {{"bound", bound}, {"degraded", degraded}, {"failed", failed}, {"violated", gateway_.violated_channels()}}},
+              {"channels",
+               {{"bound", counts.bound}, {"degraded", counts.degraded}, {"failed", counts.failed}, {"violated", gateway_.violated_channels()}}},
               {"router", {{"queued", gateway_.router().queued()}, {"progress", gateway_.router().progress()}}}};
 }
 

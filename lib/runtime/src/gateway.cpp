@@ -68,9 +68,9 @@ RouterLimits router_limits(const GatewaySpec& gateway) {
 
 BindResult Gateway::start(const Config& config) {
   identity_.name = config.gateway.name;
-  router_ = std::make_unique<Router>(identity_, kMaxSegments, router_limits(config.gateway));
-  const ThreadPolicy receive{"rx", config.gateway.realtime.receive_priority, 0, config.gateway.realtime.cpus};
   const RouterLimits limits = router_limits(config.gateway);
+  router_ = std::make_unique<Router>(identity_, kMaxSegments, limits);
+  const ThreadPolicy receive{"rx", config.gateway.realtime.receive_priority, 0, config.gateway.realtime.cpus};
   for (std::size_t i = 0; i < kMaxSegments; ++i) {
     EventSink& inbox = router_->inbox(i);
     inbox.set_receive_thread_policy(receive);
@@ -196,6 +196,16 @@ AdmissionReport Gateway::admission() const {
     for (auto& channel : report.channels) mark_refused(channel);
   }
   return report;
+}
+
+Gateway::VerdictCounts Gateway::verdict_counts() const {
+  VerdictCounts counts;
+  for (const auto& c : admission().channels) {
+    counts.bound += c.verdict == Verdict::bound ? 1 : 0;
+    counts.degraded += c.verdict == Verdict::degraded ? 1 : 0;
+    counts.failed += c.verdict == Verdict::failed ? 1 : 0;
+  }
+  return counts;
 }
 
 void Gateway::apply_routes() {

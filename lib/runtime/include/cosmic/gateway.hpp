@@ -140,6 +140,14 @@ class Gateway {
   const KnowledgeBase& knowledge_base() const { return *kb_; }
   // Verdicts of the bound channels: admission's, or `failed` where a segment refused the channel.
   AdmissionReport admission() const;
+  // How many bound channels admission() shows bound, degraded and failed (it builds every report:
+  // milliseconds at ten thousand channels).
+  struct VerdictCounts {
+    std::size_t bound = 0;
+    std::size_t degraded = 0;
+    std::size_t failed = 0;
+  };
+  VerdictCounts verdict_counts() const;
   std::vector<SegmentInfo> segments() const;
   // The router's counters plus each channel's runtime state.
   std::vector<ChannelStatsSnapshot> channel_stats() const;
