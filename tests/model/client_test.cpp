@@ -2,12 +2,15 @@
 // namespace), polling with cosmic_get_event, the refusals of bad input, and the control query.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstring>
+#include <functional>
 #include <string>
 #include <thread>
 
 #include "cosmic/client.h"
+#include "cosmic/client.hpp"
 
 namespace {
 
@@ -85,6 +88,172 @@ TEST(Client, AnnounceRefusesIncompleteChannels) {
   EXPECT_EQ(cosmic_announce(c.handle, &no_subject, 0), nullptr);
   EXPECT_NE(std::string(cosmic_last_error(c.handle)).find("subject"), std::string::npos);
   EXPECT_EQ(cosmic_announce(c.handle, &static_cast<const cosmic_channel_desc&>(with_roles(kSpeed, 0)), 0), nullptr);
+}
+
+// Publishes on `out` from its own thread until destroyed: the receive side is kept busy.
+class Flood {
+ public:
+  explicit Flood(cosmic_channel* out)
+      : thread_([this, out] {
+          std::int32_t value = 0;
+          while (!stop_) {
+            cosmic_publish(out, &value, sizeof value);
+            ++value;
+            std::this_thread::sleep_for(std::chrono::microseconds(200));
+          }
+        }) {}
+  ~Flood() {
+    stop_ = true;
+    thread_.join();
+  }
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+bool wait_for(const std::function<bool()>& done, std::chrono::milliseconds limit = std::chrono::seconds(20)) {
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return true;
+}
+
+// Work a callback does while the test may stop it: long enough to be caught in the middle.
+void busy_for(std::chrono::microseconds d) {
+  const auto until = std::chrono::steady_clock::now() + d;
+  while (std::chrono::steady_clock::now() < until) {
+  }
+}
+
+// What a callback sees of the test: counts calls, and calls that end after the test said "stopped".
+struct Watch {
+  std::atomic<int> calls{0};
+  std::atomic<int> late{0};
+  std::atomic<bool> stopped{false};
+  void on_event() {
+    ++calls;
+    busy_for(std::chrono::microseconds(300));
+    if (stopped) ++late;  // still running after unsubscribe returned: its state could be gone
+  }
+};
+
+int queued_events(cosmic_channel* in) {
+  int n = 0;
+  cosmic_event_info info{};
+  std::uint8_t buffer[4];
+  while (cosmic_get_event(in, &info, buffer, sizeof buffer) == COSMIC_OK) ++n;
+  return n;
+}
+
+// Issue 18: a component must be able to stop its callbacks before the state they use goes.
+TEST(Client, UnsubscribeWaitsForARunningCallbackAndStopsIt) {
+  Client pub("dds:0"), sub("dds:0");
+  ASSERT_NE(pub.handle, nullptr) << pub.error;
+  ASSERT_NE(sub.handle, nullptr) << sub.error;
+  cosmic_channel* out = cosmic_announce(pub.handle, &kSpeed, 1000);
+  const auto in_desc = with_roles(kSpeed, COSMIC_SUBSCRIBE);
+  cosmic_channel* in = cosmic_announce(sub.handle, &in_desc, 1000);
+  ASSERT_NE(out, nullptr);
+  ASSERT_NE(in, nullptr);
+  Watch watch;
+  ASSERT_EQ(cosmic_subscribe(in, [](const cosmic_event_info*, const std::uint8_t*, void* w) { static_cast<Watch*>(w)->on_event(); }, &watch),
+            COSMIC_OK);
+  Flood flood(out);
+  ASSERT_TRUE(wait_for([&] { return watch.calls >= 50; })) << "events did not reach the callback";
+  ASSERT_EQ(cosmic_unsubscribe(in), COSMIC_OK);
+  watch.stopped = true;
+  const int calls_at_stop = watch.calls;
+  // Events keep arriving, now into the queue, and the callback is never called again.
+  int queued = 0;
+  ASSERT_TRUE(wait_for([&] { return (queued += queued_events(in)) >= 20; })) << "events stopped arriving";
+  EXPECT_EQ(watch.late, 0) << "a callback was still running when cosmic_unsubscribe returned";
+  EXPECT_EQ(watch.calls, calls_at_stop);
+  EXPECT_EQ(cosmic_unsubscribe(nullptr), COSMIC_E_INVALID);
+}
+
+TEST(Client, ACallbackMayUnsubscribeItself) {
+  Client pub("dds:0"), sub("dds:0");
+  ASSERT_NE(pub.handle, nullptr) << pub.error;
+  ASSERT_NE(sub.handle, nullptr) << sub.error;
+  cosmic_channel* out = cosmic_announce(pub.handle, &kSpeed, 1000);
+  const auto in_desc = with_roles(kSpeed, COSMIC_SUBSCRIBE);
+  cosmic_channel* in = cosmic_announce(sub.handle, &in_desc, 1000);
+  ASSERT_NE(out, nullptr);
+  ASSERT_NE(in, nullptr);
+  struct Self {
+    cosmic_channel* channel;
+    std::atomic<int> calls{0};
+  } self{in};
+  ASSERT_EQ(cosmic_subscribe(in,
+                             [](const cosmic_event_info*, const std::uint8_t*, void* user) {
+                               auto* s = static_cast<Self*>(user);
+                               if (++s->calls == 3) cosmic_unsubscribe(s->channel);  // would deadlock on its own lock
+                             },
+                             &self),
+            COSMIC_OK);
+  Flood flood(out);
+  int queued = 0;
+  ASSERT_TRUE(wait_for([&] { return (queued += queued_events(in)) >= 10; })) << "events did not reach the queue after the stop";
+  EXPECT_EQ(self.calls, 3);
+}
+
+// The C++ wrapper: a Subscription declared after the state its handler uses stops the handler
+// before that state goes, even though the Client (declared first) is still receiving.
+TEST(Client, ASubscriptionStopsItsHandlerBeforeTheStateItUsesGoes) {
+  std::atomic<bool> state_gone{false};
+  std::atomic<int> late{0};
+  std::atomic<int> calls{0};
+  struct State {
+    std::atomic<bool>& gone;
+    std::atomic<int>& calls;
+    // Gives a handler that wrongly still runs the time to be called again (the flood sends every
+    // 200 us): with the subscription gone first, no call comes and this waits its 200 ms out.
+    ~State() {
+      gone = true;
+      const int before = calls;
+      wait_for([&] { return calls > before + 1; }, std::chrono::milliseconds(200));
+    }
+  };
+  cosmic::client::Client pub("dds:0");
+  auto& out = pub.announce(kSpeed, 1000);
+  Flood flood(out.handle());
+  {
+    cosmic::client::Client sub("dds:0");
+    auto& in = sub.announce(with_roles(kSpeed, COSMIC_SUBSCRIBE), 1000);
+    State state{state_gone, calls};
+    auto subscription = in.on_event([&](const cosmic_event_info&, std::span<const std::uint8_t>) {
+      ++calls;
+      busy_for(std::chrono::microseconds(300));
+      if (state.gone) ++late;
+    });
+    EXPECT_TRUE(subscription.active());
+    ASSERT_TRUE(wait_for([&] { return calls >= 50; })) << "events did not reach the handler";
+  }  // subscription, then state, then sub go: the handler never sees the state gone
+  EXPECT_TRUE(state_gone);
+  EXPECT_EQ(late, 0);
+}
+
+TEST(Client, ANewHandlerReplacesTheOldAndTheOldSubscriptionNoLongerStopsIt) {
+  cosmic::client::Client pub("dds:0"), sub("dds:0");
+  auto& out = pub.announce(kSpeed, 1000);
+  auto& in = sub.announce(with_roles(kSpeed, COSMIC_SUBSCRIBE), 1000);
+  std::atomic<int> first{0}, second{0};
+  auto old = in.on_event([&](const cosmic_event_info&, std::span<const std::uint8_t>) { ++first; });
+  Flood flood(out.handle());
+  ASSERT_TRUE(wait_for([&] { return first > 0; }));
+  auto now = in.on_event([&](const cosmic_event_info&, std::span<const std::uint8_t>) { ++second; });
+  const int first_at_switch = first;
+  EXPECT_FALSE(old.active());
+  old.cancel();  // replaced already: must not stop the new handler
+  ASSERT_TRUE(wait_for([&] { return second >= 10; })) << "the new handler stopped";
+  EXPECT_EQ(first, first_at_switch);
+  EXPECT_THROW((void)out.on_event([](const cosmic_event_info&, std::span<const std::uint8_t>) {}), std::invalid_argument);
+  sub.close();  // stops every handler: the subscription outlives its client harmlessly
+  EXPECT_FALSE(now.active());
+  EXPECT_THROW(sub.announce(kSpeed, 0), std::runtime_error);
 }
 
 TEST(Client, CheckChannelWithoutAGateway) {

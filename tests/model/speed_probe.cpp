@@ -93,6 +93,9 @@ double percentile(std::vector<double> v, double p) {
 int main(int argc, char** argv) {
   const int count = std::stoi(arg(argc, argv, "--count", "20"));
   try {
+    // The drive is declared before the clients and its subscription after it: the handler stops
+    // first, then the drive goes, then the clients (a handler outliving the drive was issue 18).
+    Drive drive;
     // The channels as config/robot.yaml defines them.
     cosmic::client::Client body(arg(argc, argv, "--body", "lcm:udpm://239.255.76.68:7668?ttl=0"));
     cosmic::client::Client lan(arg(argc, argv, "--lan", "dds:0"));
@@ -100,8 +103,7 @@ int main(int argc, char** argv) {
     auto& speed = body.announce(desc("speed", 0x0000000100000051ull, COSMIC_SRT, 10, 8, 40, 1, 4, COSMIC_SUBSCRIBE));
     auto& command = lan.announce(desc("command", 0x0000000100000060ull, COSMIC_SRT, 50, 20, 200, 1, 4, COSMIC_PUBLISH));
     auto& obstacle = lan.announce(desc("obstacle", 0x0000000100000050ull, COSMIC_HRT, 10, 4, 30, 0, 1, COSMIC_PUBLISH));
-    Drive drive;
-    speed.on_event([&](const cosmic_event_info&, std::span<const std::uint8_t> e) { drive.push(e); });
+    const auto on_speed = speed.on_event([&](const cosmic_event_info&, std::span<const std::uint8_t> e) { drive.push(e); });
 
     // Ready when the whole chain carries: repeat command and sensor until the drive hears.
     const auto ready_by = Clock::now() + std::chrono::seconds(std::stoi(arg(argc, argv, "--ready-s", "30")));

@@ -210,6 +210,25 @@ TEST_F(ControlTest, StatusSegmentsAndChannels) {
   EXPECT_EQ(client.call({{"command", "channel"}, {"name", "nope"}})["error"]["code"], "not_found");
 }
 
+// A channel of the configuration that admission rejected is not "not found": the answer says
+// rejected and why (what libcosmic-client's cosmic_check_channel shows a component).
+TEST_F(ControlTest, AChannelRejectedAtLoadIsAnsweredRejectedWithTheReasons) {
+  const std::string config = std::string(kConfig) +
+      "  - {name: hard, subject: 2, class: hrt, period: 10ms, reaction_time: 20ms, omission_degree: 1, publishers: [lan], subscribers: [viz]}\n";
+  const BindResult reloaded = gateway.reload(parse_config(config, "test.yaml").config);
+  ASSERT_TRUE(reloaded.applied) << reloaded.error;
+  serve();
+  Client client(socket_path);
+  const Json answer = client.call({{"command", "channel"}, {"name", "hard"}});
+  EXPECT_EQ(answer["ok"], false);
+  ASSERT_EQ(answer["error"]["code"], "rejected") << answer.dump();
+  ASSERT_FALSE(answer["error"]["reasons"].empty());
+  EXPECT_NE(answer["error"]["reasons"][0].get<std::string>().find("declares no real-time guarantee"), std::string::npos);
+  EXPECT_EQ(answer["error"]["admission"]["verdict"], "rejected");
+  EXPECT_EQ(client.call({{"command", "channel"}, {"name", "nope"}})["error"]["code"], "not_found");
+  EXPECT_EQ(client.call({{"command", "channel"}, {"name", "speed"}})["ok"], true);
+}
+
 // An in-memory segment whose transport negotiates QoS (as DDS does) and has a rate-limited
 // binding protocol (as CAN has): what it counts is what the control answers show.
 class NegotiatingAdapter final : public SegmentAdapter {

@@ -1,6 +1,7 @@
 // The C API of libcosmic-client over one Transport per client.
 #include "cosmic/client.h"
 
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -9,6 +10,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "control_query.hpp"
@@ -39,7 +41,10 @@ struct cosmic_channel {
   std::size_t index = 0;
   cosmic::ChannelSpec spec;
   int roles = 0;
-  std::mutex mutex;  // guards everything below (receive thread vs. caller)
+  std::mutex mutex;  // guards everything below (receive thread vs. caller); held while the callback runs
+  // The thread running this channel's callback right now (none: default id). Only that thread
+  // writes it, so it can tell from it that it is inside the callback and already holds `mutex`.
+  std::atomic<std::thread::id> delivering{};
   cosmic_event_fn callback = nullptr;
   void* user = nullptr;
   std::deque<QueuedEvent> queue;
@@ -64,7 +69,9 @@ struct cosmic_client final : Delivery {
     const cosmic_event_info info{header.subject, header.sequence, header.age_ns, static_cast<std::uint32_t>(payload.size())};
     std::lock_guard lock(channel->mutex);
     if (channel->callback) {
+      channel->delivering.store(std::this_thread::get_id(), std::memory_order_relaxed);
       channel->callback(&info, payload.data(), channel->user);
+      channel->delivering.store(std::thread::id{}, std::memory_order_relaxed);
       return;
     }
     if (channel->queue.size() == kQueuedEvents) channel->queue.pop_front();  // the newest matter most
@@ -191,11 +198,21 @@ int cosmic_publish(cosmic_channel* channel, const void* data, size_t size) {
 
 int cosmic_subscribe(cosmic_channel* channel, cosmic_event_fn fn, void* user) {
   if (!channel || !(channel->roles & COSMIC_SUBSCRIBE)) return COSMIC_E_INVALID;
+  if (channel->delivering.load(std::memory_order_relaxed) == std::this_thread::get_id()) {
+    // Called from this channel's own callback: this thread holds the lock in deliver() already.
+    channel->callback = fn;
+    channel->user = user;
+    return COSMIC_OK;
+  }
+  // Taking the lock waits for a callback running on the receive thread: once it is held, the old
+  // callback has returned and the next event sees the new one.
   std::lock_guard lock(channel->mutex);
   channel->callback = fn;
   channel->user = user;
   return COSMIC_OK;
 }
+
+int cosmic_unsubscribe(cosmic_channel* channel) { return cosmic_subscribe(channel, nullptr, nullptr); }
 
 int cosmic_get_event(cosmic_channel* channel, cosmic_event_info* info, void* buffer, size_t capacity) {
   if (!channel || !info || (capacity && !buffer)) return COSMIC_E_INVALID;

@@ -59,9 +59,22 @@ int query_verdict(const std::string& socket_path, const std::string& name, std::
     out = answer["channel"].value("verdict", "bound");
     return COSMIC_OK;
   }
-  const std::string code = answer.value("error", nlohmann::json::object()).value("code", "");
-  out = code == "not_found" ? "not_found" : "refused: " + code;
-  return code == "not_found" ? COSMIC_OK : COSMIC_E_UNAVAILABLE;
+  const auto error = answer.value("error", nlohmann::json::object());
+  const std::string code = error.value("code", "");
+  if (code == "not_found") {
+    out = "not_found";
+    return COSMIC_OK;
+  }
+  if (code == "rejected") {  // a channel of the gateway's configuration that admission rejected
+    std::string reasons;
+    for (const auto& r : error.value("reasons", nlohmann::json::array())) {
+      if (r.is_string()) reasons += (reasons.empty() ? "" : "; ") + r.get<std::string>();
+    }
+    out = "rejected (" + reasons + ")";
+    return COSMIC_OK;
+  }
+  out = "refused: " + code;
+  return COSMIC_E_UNAVAILABLE;
 }
 
 }  // namespace cosmic::client_detail

@@ -317,12 +317,24 @@ Json ControlProtocol::channels() const {
   return Json{{"ok", true}, {"channels", list}};
 }
 
+// Why `name` is not bound: admission rejected it when the configuration was loaded, or no such channel.
+Json ControlProtocol::unbound_channel(const std::string& name) const {
+  const ChannelReport* rejected = gateway_.rejected_at_load(name);
+  if (!rejected) return failure("not_found", "no bound channel named '" + name + "'");
+  std::string reasons;
+  for (const auto& r : rejected->reasons) reasons += (reasons.empty() ? "" : "; ") + r;
+  Json out = failure("rejected", "channel '" + name + "' of the configuration is not bound: admission rejected it (" + reasons + ")");
+  out["error"]["reasons"] = rejected->reasons;
+  out["error"]["admission"] = to_json(*rejected);
+  return out;
+}
+
 Json ControlProtocol::channel(const Json& request) const {
   if (!request.contains("name") || !request["name"].is_string()) return failure("bad_request", "\"name\" (string) is required");
   const std::string name = request["name"].get<std::string>();
   const AdmissionReport report = gateway_.admission();
   const ChannelReport* verdict = report.find(name);
-  if (!verdict) return failure("not_found", "no bound channel named '" + name + "'");
+  if (!verdict) return unbound_channel(name);
   const auto stats = gateway_.channel_stats();
   Json entry = channel_entry(*verdict, find_stats(stats, name));
   entry["admission"] = to_json(*verdict);

@@ -382,7 +382,7 @@ AdmissionSet::CanSide AdmissionSet::analyse_can(const Trial* newcomer, bool repl
       streams.reserve(side.plans[s].size());
       for (std::size_t pos = 0; pos < side.plans[s].size(); ++pos) {
         const CanHopPlan& plan = side.plans[s][pos];
-        streams.push_back(CanStream{plan.can_id, plan.transmission, stream_period(*member(s, pos, newcomer).spec, plan), plan.jitter});
+        streams.push_back(CanStream{arbitration_key(plan.can_id, CanIdFormat::extended29), plan.transmission, stream_period(*member(s, pos, newcomer).spec, plan), plan.jitter});
       }
       const auto& committed = segments_[s].runs;
       const CanBusAnalysis* memo = it < committed.size() ? &committed[it]

@@ -307,6 +307,13 @@ ReloadPlan Gateway::plan_reload(Config config, std::shared_ptr<const ReloadBase>
   return plan;
 }
 
+const ChannelReport* Gateway::rejected_at_load(const std::string& name) const {
+  if (!base_ || kb_->find_bound(name)) return nullptr;
+  const auto& reports = base_->reports;
+  const auto found = std::find_if(reports.begin(), reports.end(), [&](const ChannelReport& r) { return r.name == name; });
+  return found != reports.end() && found->verdict == Verdict::rejected ? &*found : nullptr;
+}
+
 std::shared_ptr<const ReloadBase> Gateway::reload_base() const {
   return generation_ == base_generation_ ? base_ : nullptr;
 }

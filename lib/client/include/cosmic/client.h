@@ -12,7 +12,18 @@
  * every channel announced on it. Threads: every function may be called from any thread; each
  * client has its own receive thread(s), on which cosmic_subscribe() callbacks run (keep them
  * short: they delay the next event). The library never prints; cosmic_last_error() says why a
- * call failed. */
+ * call failed.
+ *
+ * When callbacks run: a callback installed with cosmic_subscribe() is called on the receive
+ * thread from the moment cosmic_subscribe() returns until one of these returns:
+ *   cosmic_unsubscribe(channel) or cosmic_subscribe(channel, another, ...) on its channel, or
+ *   cosmic_close(client).
+ * Each of them waits for a call in progress to finish; after it returns the old callback is not
+ * running and is never called again. So whatever a callback touches (its `user` data) may be freed
+ * only after one of them returned: stop the callbacks first, then free the state they use. From
+ * inside a callback, cosmic_unsubscribe()/cosmic_subscribe() of that same channel are allowed
+ * (they take effect when the callback returns); cosmic_close() is not (it would wait for itself),
+ * nor is changing another channel's callback (two receive threads could wait for each other). */
 #ifndef COSMIC_CLIENT_H
 #define COSMIC_CLIENT_H
 
@@ -70,6 +81,8 @@ typedef void (*cosmic_event_fn)(const cosmic_event_info* info, const uint8_t* da
  *   "can:IFACE?node=N"  (N = this component's 7-bit TxNode, unique on the bus)
  * NULL on failure, with the reason in `error` (may be NULL). */
 cosmic_client* cosmic_open(const char* segment, char* error, size_t error_size);
+/* Stops the client's receive threads (waiting for a callback in progress), then frees the client and
+ * its channels. When it returns no callback of this client runs. Never from inside a callback. */
 void cosmic_close(cosmic_client* client);
 const char* cosmic_last_error(const cosmic_client* client);
 
@@ -79,15 +92,21 @@ cosmic_channel* cosmic_announce(cosmic_client* client, const cosmic_channel_desc
 /* One event of `size` bytes (at most desc->payload). */
 int cosmic_publish(cosmic_channel* channel, const void* data, size_t size);
 /* Events of the channel go to `fn` on the receive thread; fn NULL: they are queued for
- * cosmic_get_event() instead (the default; the newest 64 are kept). */
+ * cosmic_get_event() instead (the default; the newest 64 are kept). Replaces the previous
+ * callback: when it returns, the previous one is not running and is never called again. */
 int cosmic_subscribe(cosmic_channel* channel, cosmic_event_fn fn, void* user);
+/* Stops the channel's callback: when it returns, the callback is not running (unless this is called
+ * from inside it: then it is not called again after it returns) and is never called again; later
+ * events are queued for cosmic_get_event(). The same as cosmic_subscribe(channel, NULL, NULL). */
+int cosmic_unsubscribe(cosmic_channel* channel);
 /* Takes the oldest queued event without waiting: COSMIC_OK, COSMIC_E_AGAIN when none waits,
  * COSMIC_E_TOO_LARGE when `capacity` is too small (the event stays queued; info->size says how
  * much is needed). For periodic tools (Simulink) that poll once per step. */
 int cosmic_get_event(cosmic_channel* channel, cosmic_event_info* info, void* buffer, size_t capacity);
 
 /* Asks the cosmicd at `control_socket` (docs/control-protocol.md) for the channel's verdict
- * ("bound", "degraded", "violated"); "not_found" when the gateway does not carry it. */
+ * ("bound", "degraded", "violated", "failed"); "rejected (REASONS)" for a channel of the gateway's
+ * configuration that admission rejected; "not_found" when the gateway does not know it. */
 int cosmic_check_channel(const char* control_socket, const char* name, char* verdict, size_t verdict_size);
 
 #ifdef __cplusplus

@@ -10,6 +10,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cosmic/client.h"
@@ -23,10 +24,51 @@ struct Event {
 
 using Handler = std::function<void(const cosmic_event_info&, std::span<const std::uint8_t>)>;
 
-// One announced channel; owned by its Client (valid while the Client lives).
-class Channel {
+class Channel;
+
+// A handler installed by Channel::on_event(). Destroying the Subscription (or cancel()) stops the
+// handler: when that returns, the handler is not running and is never called again. Declare it
+// after the state its handler uses, so that it goes first:
+//     Drive drive;                                              // the handler's state
+//     auto on_speed = speed.on_event([&](auto&, auto e) { drive.push(e); });  // stops before drive goes
+// Move-only; an empty one (default, moved from, cancelled, or replaced by a newer on_event() of its
+// channel) does nothing. It may outlive its Client (closing the client stopped every handler), but
+// must not be destroyed while another thread destroys or closes that Client.
+class [[nodiscard]] Subscription {
+ public:
+  Subscription() = default;
+  Subscription(Subscription&& other) noexcept { *this = std::move(other); }
+  Subscription& operator=(Subscription&& other) noexcept {
+    if (this != &other) {
+      cancel();
+      channel_ = std::move(other.channel_);
+      generation_ = other.generation_;
+      other.channel_.reset();
+    }
+    return *this;
+  }
+  Subscription(const Subscription&) = delete;
+  Subscription& operator=(const Subscription&) = delete;
+  ~Subscription() { cancel(); }
+  inline void cancel();
+  // Whether this subscription's handler is still the channel's.
+  inline bool active() const;
+
+ private:
+  friend class Channel;
+  Subscription(std::weak_ptr<Channel> channel, std::uint64_t generation) : channel_(std::move(channel)), generation_(generation) {}
+  std::weak_ptr<Channel> channel_;
+  std::uint64_t generation_ = 0;
+};
+
+// One announced channel; owned by its Client (valid while the Client lives and is not closed).
+// publish() and poll() from any thread; on_event(), stop_events() and the Subscriptions of one
+// channel from one thread at a time (the handler's thread counts as one).
+class Channel : public std::enable_shared_from_this<Channel> {
  public:
   explicit Channel(cosmic_channel* handle) : handle_(handle) {}
+  Channel(const Channel&) = delete;
+  Channel& operator=(const Channel&) = delete;
 
   int publish(std::span<const std::uint8_t> data) { return cosmic_publish(handle_, data.data(), data.size()); }
   // Any trivially copyable value, as its bytes.
@@ -34,12 +76,24 @@ class Channel {
   int publish_value(const T& value) {
     return cosmic_publish(handle_, &value, sizeof value);
   }
-  // Events go to `handler` on the client's receive thread.
-  int on_event(Handler handler) {
-    auto next = std::make_unique<Handler>(std::move(handler));
-    const int rc = cosmic_subscribe(handle_, &Channel::trampoline, next.get());
-    if (rc == COSMIC_OK) handler_.swap(next);  // the old one is no longer called once subscribe returned
-    return rc;
+  // Events go to `handler` on the client's receive thread until the returned Subscription is
+  // destroyed or cancelled, another on_event() or stop_events() of this channel returns, or the
+  // Client is closed. Replaces the previous handler (which is not running once this returns).
+  // Throws std::invalid_argument when the channel was not announced with COSMIC_SUBSCRIBE.
+  // Allowed from inside this channel's own handler (the running handler is kept alive until it returns).
+  Subscription on_event(Handler handler) {
+    auto next = std::make_unique<Installed>(Installed{this, std::move(handler)});
+    if (cosmic_subscribe(handle_, &Channel::trampoline, next.get()) != COSMIC_OK) {
+      throw std::invalid_argument("on_event: the channel was not announced with COSMIC_SUBSCRIBE");
+    }
+    release(std::exchange(installed_, std::move(next)));
+    return Subscription(weak_from_this(), ++generation_);
+  }
+  // Stops the handler (see cosmic_unsubscribe): later events are queued for poll().
+  void stop_events() {
+    cosmic_unsubscribe(handle_);
+    release(std::move(installed_));
+    ++generation_;
   }
   // The oldest queued event, if any (polling mode: no handler installed).
   std::optional<Event> poll(std::size_t capacity = 65536) {
@@ -52,12 +106,46 @@ class Channel {
   cosmic_channel* handle() const { return handle_; }
 
  private:
+  friend class Subscription;
+  struct Installed {
+    Channel* channel;
+    Handler handler;
+  };
+  // The channel whose handler this thread is running, if any.
+  static const Channel*& running() {
+    thread_local const Channel* channel = nullptr;
+    return channel;
+  }
   static void trampoline(const cosmic_event_info* info, const std::uint8_t* data, void* user) {
-    (*static_cast<Handler*>(user))(*info, {data, info->size});
+    auto* installed = static_cast<Installed*>(user);
+    const Channel* outer = std::exchange(running(), installed->channel);
+    installed->handler(*info, {data, info->size});
+    running() = outer;
+  }
+  // A handler that is no longer installed: freed now, or kept until the next release outside a
+  // handler when it may be the one running on this thread.
+  void release(std::unique_ptr<Installed> old) {
+    if (running() == this) {
+      if (old) retired_.push_back(std::move(old));
+      return;
+    }
+    retired_.clear();
   }
   cosmic_channel* handle_;
-  std::unique_ptr<Handler> handler_;
+  std::unique_ptr<Installed> installed_;
+  std::vector<std::unique_ptr<Installed>> retired_;
+  std::uint64_t generation_ = 0;  // counts installs and stops; a Subscription stops only its own
 };
+
+void Subscription::cancel() {
+  if (auto channel = channel_.lock(); channel && channel->generation_ == generation_) channel->stop_events();
+  channel_.reset();
+}
+
+bool Subscription::active() const {
+  const auto channel = channel_.lock();
+  return channel && channel->generation_ == generation_;
+}
 
 class Client {
  public:
@@ -66,20 +154,29 @@ class Client {
     client_ = cosmic_open(segment.c_str(), error, sizeof error);
     if (!client_) throw std::runtime_error(std::string("cosmic_open(") + segment + "): " + error);
   }
-  ~Client() { cosmic_close(client_); }  // stops the receive threads before the handlers go
+  ~Client() { close(); }
   Client(const Client&) = delete;
   Client& operator=(const Client&) = delete;
 
   Channel& announce(const cosmic_channel_desc& desc, int timeout_ms = 5000) {
+    if (!client_) throw std::runtime_error(std::string("cosmic_announce(") + desc.name + "): the client is closed");
     cosmic_channel* handle = cosmic_announce(client_, &desc, timeout_ms);
     if (!handle) throw std::runtime_error(std::string("cosmic_announce(") + desc.name + "): " + cosmic_last_error(client_));
-    channels_.push_back(std::make_unique<Channel>(handle));
+    channels_.push_back(std::make_shared<Channel>(handle));
     return *channels_.back();
+  }
+  // Stops the receive threads (waiting for a handler in progress), then frees the channels: no
+  // handler runs once it returns, and every Channel& of this client is gone. The destructor does it;
+  // call it earlier to stop the handlers before state they use goes. Never from inside a handler.
+  void close() {
+    if (!client_) return;
+    cosmic_close(std::exchange(client_, nullptr));
+    channels_.clear();
   }
 
  private:
   cosmic_client* client_ = nullptr;
-  std::vector<std::unique_ptr<Channel>> channels_;
+  std::vector<std::shared_ptr<Channel>> channels_;
 };
 
 // The verdict cosmicd gives `name`, or the reason it could not be asked.

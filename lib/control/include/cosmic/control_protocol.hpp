@@ -75,6 +75,7 @@ class ControlProtocol {
   Json segments() const;
   Json channels() const;
   Json channel(const Json& request) const;
+  Json unbound_channel(const std::string& name) const;
   Answer bind(const Json& request, const Reply& later);
   Json unbind(const Json& request);
   Answer reload(const Reply& later);

@@ -46,9 +46,19 @@ Nanos frame_time(const CanSegmentProperties& bus, std::uint32_t payload, CanIdFo
 // Largest payload of one frame on this bus.
 std::uint32_t max_frame_payload(const CanSegmentProperties& bus);
 
+// Where a frame stands in arbitration, comparable across identifier formats: lower wins.
+// The 11 base bits go on the wire first; on equal base bits a standard frame (RTR/IDE dominant)
+// beats an extended one (SRR/IDE recessive); two extended frames then compare their 18 low bits.
+// Key = base(11) << 19 | extended << 18 | low(18), so standard id S gets S << 19 and extended id
+// E gets (E >> 18) << 19 | 1 << 18 | (E & 0x3FFFF): ordering keys orders the frames as the bus does.
+constexpr std::uint32_t arbitration_key(std::uint32_t id, CanIdFormat format) {
+  if (format == CanIdFormat::standard11) return (id & 0x7FFu) << 19;
+  return ((id >> 18) & 0x7FFu) << 19 | 1u << 18 | (id & 0x3FFFFu);
+}
+
 // One periodic/sporadic message stream on a bus.
 struct CanStream {
-  std::uint32_t can_id = 0;  // lower value wins arbitration
+  std::uint32_t can_id = 0;  // arbitration_key() of the stream's identifier: lower value wins
   Nanos transmission{0};     // C
   Nanos period{0};           // T, minimum inter-arrival time (> 0)
   Nanos jitter{0};           // J, queuing jitter

@@ -123,6 +123,9 @@ class Gateway {
   // Control thread: what the running bindings were admitted from; null once a bind or unbind
   // changed them since start or the last reload.
   std::shared_ptr<const ReloadBase> reload_base() const;
+  // Control thread: admission's report of a channel of the loaded configuration (start or the last
+  // reload) that admission rejected then and that is not bound now; null otherwise.
+  const ChannelReport* rejected_at_load(const std::string& name) const;
   // Changes with every applied bind, unbind and reload.
   std::uint64_t generation() const { return generation_; }
   void stop();
