@@ -20,11 +20,15 @@
 //                              shape issue 11 measured at 0.02 / 0.85 / 18 s for 25 / 50 / 100.
 //   BM_LcmChannels/n           admit_all of n DDS -> LCM channels (issue 11: 0.45 / 1.8 / 7.1 s for
 //                              1k / 2k / 4k before).
+//   BM_ParseDbc/n              parse_dbc of an n-message DBC (issue 19).
+//   BM_AdmitWithDbcBackground  the 1,000 CAN channels of BM_AdmitBigSet on a bus whose background is
+//                              a 500-message DBC: load the YAML and the DBC, admit_all (issue 19).
 // A reload of that set by a running cosmicd is timed by tests/bench/reload_bench.sh.
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -32,6 +36,7 @@
 #include <unistd.h>
 
 #include "cosmic/config_loader.hpp"
+#include "cosmic/dbc.hpp"
 #include "cosmic/knowledge_base.hpp"
 #include "cosmic/report.hpp"
 
@@ -235,6 +240,68 @@ BENCHMARK(BM_OverloadedCanToCan)->Arg(25)->Arg(50)->Arg(100)->Arg(1000)->Unit(be
 
 void BM_LcmChannels(benchmark::State& state) { admit_repeatedly(state, lcm_channels(static_cast<std::size_t>(state.range(0)))); }
 BENCHMARK(BM_LcmChannels)->Arg(1000)->Arg(2000)->Arg(4000)->Arg(10000)->Unit(benchmark::kMillisecond);
+
+// A body bus's DBC of n messages (issue 19): identifiers spread over the standard and extended
+// ranges (every fourth extended), 1..8 bytes, cycle times 100 ms .. 10 s (about 17 % of 1 Mbit/s).
+std::string body_dbc(std::size_t n) {
+  constexpr std::int64_t kCycles[] = {100, 200, 500, 1000, 2000, 5000, 10000};
+  std::ostringstream out;
+  out << "VERSION \"\"\n\nNS_ :\n\tBA_DEF_\n\nBS_:\n\nBU_: Ecu\n\n";
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool extended = i % 4 == 3;
+    const std::uint64_t id = extended ? 0x80000000ull | (0x10000000ull + i * 977) : 0x080 + (i * 3) % 0x700;
+    out << "BO_ " << id << " Msg" << i << ": " << 1 + i % 8 << " Ecu\n SG_ S" << i << " : 0|8@1+ (1,0) [0|255] \"\" Ecu\n\n";
+  }
+  out << "BA_DEF_ BO_ \"GenMsgCycleTime\" INT 0 65535;\nBA_DEF_DEF_ \"GenMsgCycleTime\" 0;\n";
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool extended = i % 4 == 3;
+    const std::uint64_t id = extended ? 0x80000000ull | (0x10000000ull + i * 977) : 0x080 + (i * 3) % 0x700;
+    out << "BA_ \"GenMsgCycleTime\" BO_ " << id << " " << kCycles[i % 7] << ";\n";
+  }
+  return out.str();
+}
+
+void BM_ParseDbc(benchmark::State& state) {
+  const std::string text = body_dbc(static_cast<std::size_t>(state.range(0)));
+  std::size_t messages = 0;
+  for (auto _ : state) {
+    const cosmic::DbcFile dbc = cosmic::parse_dbc(text);
+    messages = dbc.messages.size();
+    benchmark::DoNotOptimize(messages);
+  }
+  state.counters["messages"] = static_cast<double>(messages);
+  state.counters["bytes"] = static_cast<double>(text.size());
+}
+BENCHMARK(BM_ParseDbc)->Arg(500)->Arg(5000)->Unit(benchmark::kMillisecond);
+
+// BM_AdmitBigSet's 1,000 CAN channels on a bus that also carries a 500-message DBC's frames, from the
+// YAML and DBC files on disk as `cosmicctl check` reads them.
+void BM_AdmitWithDbcBackground(benchmark::State& state) {
+  const std::string dir = "/tmp/cosmic_admission_bench_dbc_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir + "/body.dbc") << body_dbc(500);
+  std::string yaml = to_yaml(big_config(1000, 0));
+  const std::string bus = "    bitrate: 1000kbit/s\n";
+  yaml.insert(yaml.find(bus) + bus.size(), "    background: {dbc: body.dbc}\n");
+  std::ofstream(dir + "/gw.yaml") << yaml;
+  cosmic::AdmissionReport report;
+  for (auto _ : state) {
+    const auto loaded = cosmic::load_config_file(dir + "/gw.yaml");
+    if (!loaded.ok()) {
+      state.SkipWithError(loaded.errors.front().to_string().c_str());
+      break;
+    }
+    report = cosmic::admit_all(loaded.config);
+  }
+  report_verdicts(state, report);
+  if (!report.segments.empty()) {
+    state.counters["background_frames"] = static_cast<double>(report.segments[0].background_frames);
+    state.counters["background_load"] = report.segments[0].background;
+    state.counters["bus_load"] = report.segments[0].utilization;
+  }
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK(BM_AdmitWithDbcBackground)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace
 

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "cosmic/admission.hpp"
+#include "background_loader.hpp"
 #include "components_loader.hpp"
 #include "realtime_loader.hpp"
 #include "segment_overlap.hpp"
@@ -94,6 +95,7 @@ class ConfigParser {
     }
     result.config = std::move(config_);
     result.errors = reader_.take_errors();
+    result.included_files = std::move(included_);
     return result;
   }
 
@@ -232,7 +234,7 @@ class ConfigParser {
     }
     if (!type) {
       reader_.check_map(node, path, {"name", "type", "interface", "profile", "bitrate", "fd", "data_bitrate", "errors", "max_utilization",
-                                     "domain", "latency_bound", "bandwidth", "reliability", "realtime", "max_message_size",
+                                     "background", "domain", "latency_bound", "bandwidth", "reliability", "realtime", "max_message_size",
                                      "interfaces", "discovery_server", "url"});
       return std::nullopt;
     }
@@ -250,7 +252,8 @@ class ConfigParser {
   }
 
   void parse_can(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
-    reader_.check_map(node, path, {"name", "type", "interface", "profile", "bitrate", "fd", "data_bitrate", "errors", "max_utilization"});
+    reader_.check_map(node, path, {"name", "type", "interface", "profile", "bitrate", "fd", "data_bitrate", "errors", "max_utilization",
+                                   "background"});
     CanSegmentProperties& can = s.can;
     if (require(node, path, "interface", "a network interface such as can0")) {
       if (auto v = reader_.string(node["interface"], key(path, "interface"))) {
@@ -291,6 +294,7 @@ class ConfigParser {
       }
     }
     if (has(node, "errors")) parse_fault_hypothesis(node["errors"], key(path, "errors"), can.errors);
+    if (has(node, "background")) config_detail::parse_background(reader_, node["background"], key(path, "background"), can, included_);
   }
 
   void parse_fault_hypothesis(const YAML::Node& node, const std::string& path, CanFaultHypothesis& errors) {
@@ -529,6 +533,7 @@ class ConfigParser {
   std::map<std::string, int> channel_names_;
   std::map<std::uint64_t, std::string> subjects_;
   std::map<std::uint16_t, std::string> etags_;
+  std::vector<std::string> included_;  // files read besides the YAML (DBC)
 };
 
 }  // namespace
@@ -566,10 +571,10 @@ ConfigResult ConfigFileLoader::load(const std::string& path) {
   }
   if (!text_.empty() && path == path_ && text == text_) {
     last_unchanged_ = true;
-    return ConfigResult{config_, {}};
+    return ConfigResult{config_, {}, {}};
   }
   ConfigResult result = parse_config(text, path);
-  if (result.ok() && !text.empty()) {
+  if (result.ok() && !text.empty() && result.included_files.empty()) {
     path_ = path;
     text_ = std::move(text);
     config_ = result.config;

@@ -167,6 +167,14 @@ void YamlReader::error(const YAML::Mark& mark, const std::string& path, std::str
   errors_.push_back(ConfigError{file_, line, column, path, std::move(message), std::move(valid)});
 }
 
+void YamlReader::error_in(ConfigError located) {
+  if (errors_.size() >= kMaxReportedErrors) {
+    ++suppressed_;
+    return;
+  }
+  errors_.push_back(std::move(located));
+}
+
 void YamlReader::error_at(const YAML::Node& node, const std::string& path, std::string message, std::string valid) {
   error(node.Mark(), path, std::move(message), std::move(valid));
 }

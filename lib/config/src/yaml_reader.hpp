@@ -33,7 +33,11 @@ class YamlReader {
 
   void error(const YAML::Mark& mark, const std::string& path, std::string message, std::string valid = {});
   void error_at(const YAML::Node& node, const std::string& path, std::string message, std::string valid = {});
+  // A problem located in another file the configuration names (a DBC file).
+  void error_in(ConfigError located);
   std::vector<ConfigError> take_errors();
+  // The file whose YAML this reader reads (labels its errors, anchors relative paths in it).
+  const std::string& file() const { return file_; }
   // Every error found, also those beyond kMaxReportedErrors.
   std::size_t error_count() const { return errors_.size() + suppressed_; }
 

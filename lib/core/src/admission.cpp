@@ -8,44 +8,37 @@
 
 #include "cosmic/can_timing.hpp"
 #include "cosmic/can_wire.hpp"
+#include "admission_judge.hpp"
 
 namespace cosmic {
 namespace {
+
+using admission_detail::Judge;
+using admission_detail::segment_named;
 
 // A channel without a declared rate still occupies the bus (blocking), but reserves nothing.
 constexpr Nanos kUnratedPeriod{3'600'000'000'000};
 // Jitter standing in for an unbounded upstream latency: makes the analysis report unbounded.
 constexpr Nanos kUnboundedJitter{100'000'000'000};
 constexpr int kMaxJitterIterations = 32;
-// Largest NRT event the gateway accepts on an IP segment.
-constexpr std::uint64_t kMaxIpEventBytes = 1 << 20;
-
-constexpr double kInfinity = std::numeric_limits<double>::infinity();
-
-double seconds_or_infinity(const std::optional<Nanos>& value) { return value ? to_seconds(*value) : kInfinity; }
-
 Nanos deadline_key(const ChannelSpec& channel) {
   if (channel.reaction_time) return *channel.reaction_time;
   if (channel.period) return *channel.period;
   return kUnratedPeriod;
 }
 
-bool segment_retransmits(const SegmentSpec& segment) {
-  if (segment.type == SegmentType::can) return true;  // CAN retransmits within the fault hypothesis
-  if (segment.type == SegmentType::lcm) return false;
-  return segment.reliability == Reliability::reliable;
-}
-
-bool segment_realtime(const SegmentSpec& segment) {
-  return segment.type == SegmentType::can || segment.realtime;
-}
-
-const SegmentSpec& segment_named(std::span<const SegmentSpec> segments, const std::string& name) {
-  return *std::find_if(segments.begin(), segments.end(), [&](const auto& s) { return s.name == name; });
-}
-
 std::size_t segment_index(std::span<const SegmentSpec> segments, const std::string& name) {
   return static_cast<std::size_t>(&segment_named(segments, name) - segments.data());
+}
+
+// The background frames that delay a CAN hop most, when its response time misses the channel's
+// reaction time (what `cosmicctl check` names for a rejected channel); empty otherwise.
+std::vector<BackgroundDelay> background_delaying(const SegmentSpec& segment, const ChannelSpec& channel, const CanHopPlan& plan) {
+  constexpr std::size_t kNamed = 3;
+  if (segment.can.background.empty() || channel.cls == ChannelClass::nrt || !channel.reaction_time) return {};
+  if (plan.response_time && *plan.response_time <= *channel.reaction_time) return {};
+  const CanStream stream{arbitration_key(plan.can_id, CanIdFormat::extended29), plan.transmission, Nanos(0), plan.jitter};
+  return dominant_background(segment.can, stream, plan.response_time, *channel.reaction_time, kNamed);
 }
 
 Nanos stream_period(const ChannelSpec& channel, const CanHopPlan& plan) {
@@ -65,6 +58,11 @@ CanHopPlan frame_plan(const CanSegmentProperties& bus, const ChannelSpec& channe
   return plan;
 }
 
+// What a segment carries before any channel is bound: a CAN bus's background frames.
+double base_load(const SegmentSpec& segment) {
+  return segment.type == SegmentType::can ? background_utilization(segment.can) : 0.0;
+}
+
 double hop_load(const SegmentSpec& segment, const ChannelSpec& channel) {
   if (!channel.period) return 0.0;
   const double period_s = to_seconds(*channel.period);
@@ -75,128 +73,6 @@ double hop_load(const SegmentSpec& segment, const ChannelSpec& channel) {
   const double bits = static_cast<double>(channel.payload + kIpOverheadBytes) * 8.0;
   return bits / period_s / static_cast<double>(segment.bandwidth.bits_per_second);
 }
-
-// The verdict of one channel from its hops' latencies and plans and the segment loads.
-class Judge {
- public:
-  Judge(const GatewaySpec& gateway, std::span<const SegmentSpec> segments, const std::vector<double>& loads)
-      : gateway_(gateway), segments_(segments), loads_(loads) {}
-
-  void judge(const ChannelSpec& channel, ChannelReport& report) const {
-    auto worsen = [&](Verdict v, std::string reason) {
-      report.verdict = std::max(report.verdict, v);
-      report.reasons.push_back(std::move(reason));
-    };
-    for (HopReport& h : report.hops) {
-      const SegmentSpec& segment = segment_named(segments_, h.segment);
-      add_hop_checks(channel, segment, h);
-      for (const Check& check : h.checks) {
-        if (!check.ok) worsen(consequence(check.check, channel.cls), failure_text(check, h, segment));
-      }
-    }
-    EndToEnd& e2e = report.end_to_end;
-    e2e.latency = end_to_end_latency(report);
-    e2e.reaction_time = channel.reaction_time;
-    e2e.temp_validity = channel.temp_validity;
-    const double latency = seconds_or_infinity(e2e.latency);
-    if (channel.cls != ChannelClass::nrt && channel.reaction_time && latency > to_seconds(*channel.reaction_time)) {
-      e2e.latency_ok = false;
-      worsen(consequence("latency", channel.cls), "end-to-end latency " + format_seconds(latency) +
-                                                      " > reaction_time " + format_duration(*channel.reaction_time));
-    }
-    if (channel.temp_validity && latency >= to_seconds(*channel.temp_validity)) {
-      e2e.validity_ok = false;
-      worsen(consequence("validity", channel.cls), "end-to-end latency " + format_seconds(latency) +
-                                                       " >= temp_validity " + format_duration(*channel.temp_validity) +
-                                                       ": events would arrive stale");
-    }
-  }
-
- private:
-  static void add_frame_fit(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) {
-    double limit = 0;
-    if (segment.type == SegmentType::can) {
-      const std::uint32_t capacity = max_frame_payload(segment.can);
-      limit = channel.cls == ChannelClass::nrt && channel.payload > capacity
-                  ? static_cast<double>(kMaxFragments * (capacity - kFragmentHeaderBytes))
-                  : capacity;
-    } else {
-      limit = channel.cls == ChannelClass::nrt ? static_cast<double>(kMaxIpEventBytes)
-                                               : static_cast<double>(segment.max_message_size - kIpOverheadBytes);
-    }
-    const auto value = static_cast<double>(channel.payload);
-    h.checks.push_back(Check{"frame_fit", value, limit, "B", "<=", value <= limit});
-  }
-
-  void add_hop_checks(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) const {
-    add_frame_fit(channel, segment, h);
-    if (channel.period) {
-      const double load = loads_[static_cast<std::size_t>(&segment - segments_.data())];
-      h.checks.push_back(Check{"utilization", load, segment.max_utilization, "ratio", "<=",
-                               load <= segment.max_utilization + 1e-12});
-    }
-    if (channel.cls != ChannelClass::nrt && channel.reaction_time) {
-      const double value = seconds_or_infinity(h.latency);
-      const double limit = to_seconds(*channel.reaction_time);
-      const char* name = segment.type == SegmentType::can ? "response_time" : "latency";
-      h.checks.push_back(Check{name, value, limit, "s", "<=", value <= limit});
-    }
-    const double min_omission = segment_retransmits(segment) ? 0.0 : 1.0;
-    h.checks.push_back(Check{"omission", static_cast<double>(channel.omission_degree), min_omission, "events", ">=",
-                             channel.omission_degree >= min_omission});
-    if (channel.cls == ChannelClass::hrt) {
-      const double capable = segment_realtime(segment) ? 1.0 : 0.0;
-      h.checks.push_back(Check{"realtime", capable, 1.0, "bool", ">=", capable >= 1.0});
-    }
-  }
-
-  std::optional<Nanos> end_to_end_latency(const ChannelReport& report) const {
-    Nanos worst_publisher{0};
-    Nanos worst_subscriber{0};
-    for (const HopReport& h : report.hops) {
-      if (!h.latency) return std::nullopt;
-      Nanos& worst = h.role == HopRole::publisher ? worst_publisher : worst_subscriber;
-      // A subscriber-side CAN response time already contains its release jitter (upstream
-      // latency + residence): count only what the hop adds after the gateway releases the frame.
-      const Nanos added = h.can && h.role == HopRole::subscriber ? *h.latency - h.can->jitter : *h.latency;
-      worst = std::max(worst, added);
-    }
-    return worst_publisher + gateway_.residence_bound + worst_subscriber;
-  }
-
-  static std::string failure_text(const Check& check, const HopReport& h, const SegmentSpec& segment) {
-    const std::string on = " on " + h.segment;
-    if (check.check == "frame_fit") {
-      return "payload " + std::to_string(static_cast<long long>(check.value)) + " B > " +
-             (segment.type == SegmentType::can ? "frame " : "message ") +
-             std::to_string(static_cast<long long>(check.limit)) + " B" + on;
-    }
-    if (check.check == "utilization") {
-      return "utilization " + format_percent(check.value) + " > max_utilization " + format_percent(check.limit) + on;
-    }
-    if (check.check == "response_time") {
-      return "R = " + format_seconds(check.value) + " > reaction_time " + format_seconds(check.limit) + on;
-    }
-    if (check.check == "latency") {
-      return "latency_bound " + format_seconds(check.value) + " > reaction_time " + format_seconds(check.limit) + on;
-    }
-    if (check.check == "omission") {
-      return "omission_degree " + std::to_string(static_cast<long long>(check.value)) + " < " +
-             std::to_string(static_cast<long long>(check.limit)) + on + ", which does not retransmit";
-    }
-    return "hrt" + on + ", which declares no real-time guarantee (realtime: false)";
-  }
-
-  // How a failing criterion affects the verdict of a channel of this class.
-  static Verdict consequence(const std::string& check, ChannelClass cls) {
-    if (cls == ChannelClass::hrt || check == "frame_fit") return Verdict::rejected;
-    return Verdict::degraded;
-  }
-
-  const GatewaySpec& gateway_;
-  std::span<const SegmentSpec> segments_;
-  const std::vector<double>& loads_;
-};
 
 }  // namespace
 
@@ -229,7 +105,9 @@ Evaluation evaluate(const GatewaySpec& gateway, std::span<const SegmentSpec> seg
 }
 
 AdmissionSet::AdmissionSet(GatewaySpec gateway, std::vector<SegmentSpec> segments)
-    : gateway_(std::move(gateway)), segment_specs_(std::move(segments)), segments_(segment_specs_.size()) {}
+    : gateway_(std::move(gateway)), segment_specs_(std::move(segments)), segments_(segment_specs_.size()) {
+  for (std::size_t s = 0; s < segments_.size(); ++s) segments_[s].load = base_load(segment_specs_[s]);
+}
 
 AdmissionSet AdmissionSet::whole(GatewaySpec gateway, std::vector<SegmentSpec> segments,
                                  std::span<const ChannelSpec> channels, const EtagMap& etags) {
@@ -363,6 +241,7 @@ bool AdmissionSet::update_jitters(CanSide& side, const Trial* newcomer) const {
 // iteration for the streams whose higher-priority prefix did not change.
 AdmissionSet::CanSide AdmissionSet::analyse_can(const Trial* newcomer, bool replan_all) const {
   CanSide side;
+  std::vector<std::vector<CanStream>> background(segments_.size());
   side.replanned.assign(segments_.size(), false);
   side.plans.resize(segments_.size());
   side.runs.resize(segments_.size());
@@ -371,6 +250,7 @@ AdmissionSet::CanSide AdmissionSet::analyse_can(const Trial* newcomer, bool repl
     side.replanned[s] = replan_all || (newcomer && std::any_of(newcomer->data.places.begin(), newcomer->data.places.end(),
                                                                 [&](const HopPlace& p) { return p.segment == s; }));
     side.plans[s] = side.replanned[s] ? plan_bus(s, newcomer) : segments_[s].plans;
+    background[s] = background_streams(segment_specs_[s].can);
     for (CanHopPlan& plan : side.plans[s]) plan.jitter = Nanos(0);
     side.runs[s].reserve(kMaxJitterIterations);
   }
@@ -379,11 +259,14 @@ AdmissionSet::CanSide AdmissionSet::analyse_can(const Trial* newcomer, bool repl
     for (std::size_t s = 0; s < segments_.size(); ++s) {
       if (side.plans[s].empty()) continue;
       std::vector<CanStream> streams;
-      streams.reserve(side.plans[s].size());
+      streams.reserve(side.plans[s].size() + background[s].size());
       for (std::size_t pos = 0; pos < side.plans[s].size(); ++pos) {
         const CanHopPlan& plan = side.plans[s][pos];
-        streams.push_back(CanStream{arbitration_key(plan.can_id, CanIdFormat::extended29), plan.transmission, stream_period(*member(s, pos, newcomer).spec, plan), plan.jitter});
+        streams.push_back(CanStream{arbitration_key(plan.can_id, CanIdFormat::extended29), plan.transmission,
+                                    stream_period(*member(s, pos, newcomer).spec, plan), plan.jitter});
       }
+      // Other devices' frames after ours: the results read below are the first plans.size().
+      streams.insert(streams.end(), background[s].begin(), background[s].end());
       const auto& committed = segments_[s].runs;
       const CanBusAnalysis* memo = it < committed.size() ? &committed[it]
                                    : it > 0             ? &side.runs[s][it - 1]
@@ -391,7 +274,7 @@ AdmissionSet::CanSide AdmissionSet::analyse_can(const Trial* newcomer, bool repl
                                                         : &committed.back();
       side.runs[s].emplace_back(streams, bus_timing(segment_specs_[s].can), memo);
       const auto& results = side.runs[s].back().results();
-      for (std::size_t pos = 0; pos < results.size(); ++pos) side.plans[s][pos].response_time = results[pos];
+      for (std::size_t pos = 0; pos < side.plans[s].size(); ++pos) side.plans[s][pos].response_time = results[pos];
     }
     if (!update_jitters(side, newcomer)) return side;
   }
@@ -417,11 +300,12 @@ ChannelReport AdmissionSet::report_of(const ChannelSpec& spec, const ChannelData
   report.cls = spec.cls;
   for (const HopPlace& p : data.places) {
     const SegmentSpec& segment = segment_specs_[p.segment];
-    HopReport h{segment.name, p.role, std::nullopt, std::nullopt, {}};
+    HopReport h{segment.name, p.role, std::nullopt, std::nullopt, {}, {}};
     if (segment.type == SegmentType::can) {
       CanHopPlan plan = can ? can->plans[p.segment][p.position] : segments_[p.segment].plans[p.position];
       if (diverged && p.role == HopRole::subscriber) plan.response_time = std::nullopt;
       h.latency = plan.response_time;
+      h.background = background_delaying(segment, spec, plan);
       h.can = plan;
     } else {
       h.latency = segment.latency_bound;
@@ -524,7 +408,7 @@ bool AdmissionSet::remove(const std::string& name) {
     }
   }
   for (const std::size_t s : touched) {
-    segments_[s].load = 0.0;
+    segments_[s].load = base_load(segment_specs_[s]);
     for (std::size_t pos = 0; pos < segments_[s].hops.size(); ++pos) {
       const HopRef& ref = segments_[s].hops[pos];
       data_[ref.channel].places[ref.hop].position = pos;
@@ -560,7 +444,9 @@ std::vector<SegmentLoad> AdmissionSet::loads() const {
   std::vector<SegmentLoad> out;
   for (std::size_t s = 0; s < segments_.size(); ++s) {
     const SegmentSpec& spec = segment_specs_[s];
-    out.push_back(SegmentLoad{spec.name, spec.type, segments_[s].load, spec.max_utilization});
+    const double background = base_load(spec);
+    out.push_back(SegmentLoad{spec.name, spec.type, segments_[s].load, spec.max_utilization, background,
+                              spec.type == SegmentType::can ? spec.can.background.size() : 0});
   }
   return out;
 }

@@ -43,6 +43,13 @@ nlohmann::json to_json(const HopReport& hop) {
   }
   out["checks"] = nlohmann::json::array();
   for (const auto& check : hop.checks) out["checks"].push_back(to_json(check));
+  if (!hop.background.empty()) {
+    out["background"] = nlohmann::json::array();
+    for (const auto& d : hop.background) {
+      out["background"].push_back({{"name", d.name}, {"can_id", d.can_id}, {"extended", d.extended},
+                                   {"delay_s", to_seconds(d.delay)}, {"kind", d.blocking ? "blocking" : "interference"}});
+    }
+  }
   return out;
 }
 
@@ -99,10 +106,14 @@ nlohmann::json to_json(const ChannelReport& channel) {
 }
 
 nlohmann::json to_json(const SegmentLoad& segment) {
-  return {{"name", segment.name},
-          {"type", to_string(segment.type)},
-          {"utilization", segment.utilization},
-          {"max_utilization", segment.max_utilization}};
+  nlohmann::json out{{"name", segment.name},
+                     {"type", to_string(segment.type)},
+                     {"utilization", segment.utilization},
+                     {"max_utilization", segment.max_utilization}};
+  if (segment.type == SegmentType::can) {
+    out["background"] = {{"utilization", segment.background}, {"frames", segment.background_frames}};
+  }
+  return out;
 }
 
 nlohmann::json to_json(const AdmissionReport& report) {
@@ -123,10 +134,12 @@ nlohmann::json to_json(const std::vector<ConfigError>& errors) {
 
 std::string render_text(const AdmissionReport& report) {
   std::ostringstream out;
-  out << pad_column("SEGMENT", 16) << pad_column("TYPE", 6) << pad_column("UTILIZATION", 13) << "LIMIT\n";
+  out << pad_column("SEGMENT", 16) << pad_column("TYPE", 6) << pad_column("UTILIZATION", 13) << pad_column("LIMIT", 8) << "BACKGROUND\n";
   for (const auto& s : report.segments) {
-    out << pad_column(s.name, 16) << pad_column(to_string(s.type), 6) << pad_column(format_percent(s.utilization), 13) << format_percent(s.max_utilization)
-        << "\n";
+    const std::string background =
+        s.background_frames ? format_percent(s.background) + " (" + std::to_string(s.background_frames) + " frames)" : "-";
+    out << pad_column(s.name, 16) << pad_column(to_string(s.type), 6) << pad_column(format_percent(s.utilization), 13)
+        << pad_column(format_percent(s.max_utilization), 8) << background << "\n";
   }
   out << "\n" << pad_column("CHANNEL", 20) << pad_column("CLASS", 6) << pad_column("VERDICT", 10) << pad_column("END-TO-END", 12) << "DETAILS\n";
   for (const auto& c : report.channels) {

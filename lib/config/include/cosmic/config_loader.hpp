@@ -24,6 +24,7 @@ struct ConfigError {
 struct ConfigResult {
   Config config;  // meaningful only when errors is empty
   std::vector<ConfigError> errors;
+  std::vector<std::string> included_files;  // other files the document names and that were read (DBC)
   bool ok() const { return errors.empty(); }
 };
 
@@ -33,7 +34,8 @@ struct ChannelsResult {
   bool ok() const { return errors.empty(); }
 };
 
-// Parses a whole gateway configuration. `file_name` only labels the errors.
+// Parses a whole gateway configuration. `file_name` labels the errors and anchors the relative
+// paths the document names (a CAN segment's background dbc: FILE), which are read.
 ConfigResult parse_config(std::string_view text, const std::string& file_name);
 // Reads and parses a file; an unreadable file is one error at 0:0.
 ConfigResult load_config_file(const std::string& path);
@@ -41,7 +43,8 @@ ConfigResult load_config_file(const std::string& path);
 // load_config_file() for a file that is read again and again (cosmicd's reloads): a file whose
 // bytes are those of the last valid document it loaded from that path is not parsed again, its
 // Config is returned from memory (parsing is most of the cost of reloading a large, unchanged
-// file). Any change of the bytes, the path or a failed load parses afresh. One caller at a time.
+// file). Any change of the bytes, the path or a failed load parses afresh, and so does every load
+// of a document that names other files (DBC), which may have changed. One caller at a time.
 class ConfigFileLoader {
  public:
   ConfigResult load(const std::string& path);

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "cosmic/can_background.hpp"
 #include "cosmic/can_timing.hpp"
 #include "cosmic/model.hpp"
 
@@ -67,6 +68,8 @@ struct HopReport {
   std::optional<CanHopPlan> can;
   std::optional<Nanos> latency;  // worst-case latency this hop adds; nullopt: unbounded
   std::vector<Check> checks;
+  // CAN hops whose response time misses the reaction time: the background frames delaying it most.
+  std::vector<BackgroundDelay> background;
 };
 
 struct EndToEnd {
@@ -90,8 +93,10 @@ struct ChannelReport {
 struct SegmentLoad {
   std::string name;
   SegmentType type = SegmentType::dds;
-  double utilization = 0;
+  double utilization = 0;  // everything the bus carries: the bound channels plus the background
   double max_utilization = 0;
+  double background = 0;   // CAN: the other devices' frames (segment key `background`)
+  std::size_t background_frames = 0;
 };
 
 struct AdmissionReport {

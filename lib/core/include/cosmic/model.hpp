@@ -34,6 +34,20 @@ struct CanFaultHypothesis {
 // (7-bit priority, fragment flag, CCP node ids, etag-4 binding answers, AFP fragments).
 enum class CanProfile { cosmic, famouso };
 
+// A frame that other devices send on a CAN bus (an ECU's DBC message, a frame declared in the
+// YAML): it delays the gateway's frames like any frame does (interference when its identifier
+// wins arbitration, blocking when it loses), so the response-time analysis and the bus load count it.
+struct CanBackgroundFrame {
+  std::string name;           // the DBC message's name, or "0x123" / "0x18FF0001x" from the YAML
+  std::uint32_t can_id = 0;   // 11 or 29 bits, without flags
+  bool extended = false;      // 29-bit identifier
+  std::uint32_t length = 0;   // data bytes (FD: one of the FD lengths)
+  Nanos period{0};            // minimum inter-arrival time (> 0)
+  Nanos jitter{0};            // queuing jitter
+  std::string origin;         // where it was declared: "body.dbc:12:1" or "robot.yaml:20:9"
+  friend bool operator==(const CanBackgroundFrame&, const CanBackgroundFrame&) = default;
+};
+
 struct CanSegmentProperties {
   std::string interface;
   CanProfile profile = CanProfile::cosmic;
@@ -41,6 +55,7 @@ struct CanSegmentProperties {
   bool fd = false;
   BitRate data_bitrate{0};  // FD data phase; equals bitrate when not FD or not given
   CanFaultHypothesis errors;
+  std::vector<CanBackgroundFrame> background;  // other devices' frames (segment key `background`)
   friend bool operator==(const CanSegmentProperties&, const CanSegmentProperties&) = default;
 };
 
@@ -59,7 +74,7 @@ struct LcmSegmentProperties {
 struct SegmentSpec {
   std::string name;
   SegmentType type = SegmentType::dds;
-  double max_utilization = 0.7;  // share of the bandwidth the gateway may reserve
+  double max_utilization = 0.7;  // share of the bandwidth the bus may reach (CAN: background included)
   // IP segments: declared network properties. CAN derives them from the bit rate.
   BitRate bandwidth{100'000'000};
   Nanos latency_bound{Nanos(10'000'000)};

@@ -1,0 +1,156 @@
+#include "admission_judge.hpp"
+
+#include <cstdio>
+#include <limits>
+
+#include "cosmic/can_background.hpp"
+#include "cosmic/can_fragment.hpp"
+#include "cosmic/can_timing.hpp"
+
+namespace cosmic::admission_detail {
+namespace {
+
+// Largest NRT event the gateway accepts on an IP segment.
+constexpr std::uint64_t kMaxIpEventBytes = 1 << 20;
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+double seconds_or_infinity(const std::optional<Nanos>& value) { return value ? to_seconds(*value) : kInfinity; }
+
+bool segment_retransmits(const SegmentSpec& segment) {
+  if (segment.type == SegmentType::can) return true;  // CAN retransmits within the fault hypothesis
+  if (segment.type == SegmentType::lcm) return false;
+  return segment.reliability == Reliability::reliable;
+}
+
+bool segment_realtime(const SegmentSpec& segment) {
+  return segment.type == SegmentType::can || segment.realtime;
+}
+
+void add_frame_fit(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) {
+  double limit = 0;
+  if (segment.type == SegmentType::can) {
+    const std::uint32_t capacity = max_frame_payload(segment.can);
+    limit = channel.cls == ChannelClass::nrt && channel.payload > capacity
+                ? static_cast<double>(kMaxFragments * (capacity - kFragmentHeaderBytes))
+                : capacity;
+  } else {
+    limit = channel.cls == ChannelClass::nrt ? static_cast<double>(kMaxIpEventBytes)
+                                             : static_cast<double>(segment.max_message_size - kIpOverheadBytes);
+  }
+  const auto value = static_cast<double>(channel.payload);
+  h.checks.push_back(Check{"frame_fit", value, limit, "B", "<=", value <= limit});
+}
+
+// "; background frames delaying it most: EngineData (0x0C0) 2.1 ms, ..." or nothing.
+std::string background_text(const HopReport& h) {
+  std::string text;
+  for (const BackgroundDelay& d : h.background) {
+    char id[16];
+    std::snprintf(id, sizeof id, d.extended ? "0x%08X" : "0x%03X", d.can_id);
+    text += (text.empty() ? "; background frames delaying it most: " : ", ") + d.name + " (" + id + ") " +
+            format_seconds(to_seconds(d.delay)) + (d.blocking ? " blocking" : "");
+  }
+  return text;
+}
+
+std::string failure_text(const Check& check, const HopReport& h, const SegmentSpec& segment) {
+  const std::string on = " on " + h.segment;
+  if (check.check == "frame_fit") {
+    return "payload " + std::to_string(static_cast<long long>(check.value)) + " B > " +
+           (segment.type == SegmentType::can ? "frame " : "message ") +
+           std::to_string(static_cast<long long>(check.limit)) + " B" + on;
+  }
+  if (check.check == "utilization") {
+    const bool background = segment.type == SegmentType::can && !segment.can.background.empty();
+    return "utilization " + format_percent(check.value) +
+           (background ? " (background " + format_percent(background_utilization(segment.can)) + ")" : std::string()) +
+           " > max_utilization " + format_percent(check.limit) + on;
+  }
+  if (check.check == "response_time") {
+    return "R = " + format_seconds(check.value) + " > reaction_time " + format_seconds(check.limit) + on + background_text(h);
+  }
+  if (check.check == "latency") {
+    return "latency_bound " + format_seconds(check.value) + " > reaction_time " + format_seconds(check.limit) + on;
+  }
+  if (check.check == "omission") {
+    return "omission_degree " + std::to_string(static_cast<long long>(check.value)) + " < " +
+           std::to_string(static_cast<long long>(check.limit)) + on + ", which does not retransmit";
+  }
+  return "hrt" + on + ", which declares no real-time guarantee (realtime: false)";
+}
+
+// How a failing criterion affects the verdict of a channel of this class.
+Verdict consequence(const std::string& check, ChannelClass cls) {
+  if (cls == ChannelClass::hrt || check == "frame_fit") return Verdict::rejected;
+  return Verdict::degraded;
+}
+}  // namespace
+
+void Judge::judge(const ChannelSpec& channel, ChannelReport& report) const {
+  auto worsen = [&](Verdict v, std::string reason) {
+    report.verdict = std::max(report.verdict, v);
+    report.reasons.push_back(std::move(reason));
+  };
+  for (HopReport& h : report.hops) {
+    const SegmentSpec& segment = segment_named(segments_, h.segment);
+    add_hop_checks(channel, segment, h);
+    for (const Check& check : h.checks) {
+      if (!check.ok) worsen(consequence(check.check, channel.cls), failure_text(check, h, segment));
+    }
+  }
+  EndToEnd& e2e = report.end_to_end;
+  e2e.latency = end_to_end_latency(report);
+  e2e.reaction_time = channel.reaction_time;
+  e2e.temp_validity = channel.temp_validity;
+  const double latency = seconds_or_infinity(e2e.latency);
+  if (channel.cls != ChannelClass::nrt && channel.reaction_time && latency > to_seconds(*channel.reaction_time)) {
+    e2e.latency_ok = false;
+    worsen(consequence("latency", channel.cls), "end-to-end latency " + format_seconds(latency) +
+                                                    " > reaction_time " + format_duration(*channel.reaction_time));
+  }
+  if (channel.temp_validity && latency >= to_seconds(*channel.temp_validity)) {
+    e2e.validity_ok = false;
+    worsen(consequence("validity", channel.cls), "end-to-end latency " + format_seconds(latency) +
+                                                     " >= temp_validity " + format_duration(*channel.temp_validity) +
+                                                     ": events would arrive stale");
+  }
+}
+
+void Judge::add_hop_checks(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) const {
+  add_frame_fit(channel, segment, h);
+  if (channel.period) {
+    const double load = loads_[static_cast<std::size_t>(&segment - segments_.data())];
+    h.checks.push_back(Check{"utilization", load, segment.max_utilization, "ratio", "<=",
+                             load <= segment.max_utilization + 1e-12});
+  }
+  if (channel.cls != ChannelClass::nrt && channel.reaction_time) {
+    const double value = seconds_or_infinity(h.latency);
+    const double limit = to_seconds(*channel.reaction_time);
+    const char* name = segment.type == SegmentType::can ? "response_time" : "latency";
+    h.checks.push_back(Check{name, value, limit, "s", "<=", value <= limit});
+  }
+  const double min_omission = segment_retransmits(segment) ? 0.0 : 1.0;
+  h.checks.push_back(Check{"omission", static_cast<double>(channel.omission_degree), min_omission, "events", ">=",
+                           channel.omission_degree >= min_omission});
+  if (channel.cls == ChannelClass::hrt) {
+    const double capable = segment_realtime(segment) ? 1.0 : 0.0;
+    h.checks.push_back(Check{"realtime", capable, 1.0, "bool", ">=", capable >= 1.0});
+  }
+}
+
+std::optional<Nanos> Judge::end_to_end_latency(const ChannelReport& report) const {
+  Nanos worst_publisher{0};
+  Nanos worst_subscriber{0};
+  for (const HopReport& h : report.hops) {
+    if (!h.latency) return std::nullopt;
+    Nanos& worst = h.role == HopRole::publisher ? worst_publisher : worst_subscriber;
+    // A subscriber-side CAN response time already contains its release jitter (upstream
+    // latency + residence): count only what the hop adds after the gateway releases the frame.
+    const Nanos added = h.can && h.role == HopRole::subscriber ? *h.latency - h.can->jitter : *h.latency;
+    worst = std::max(worst, added);
+  }
+  return worst_publisher + gateway_.residence_bound + worst_subscriber;
+}
+
+}  // namespace cosmic::admission_detail

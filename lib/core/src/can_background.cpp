@@ -1,0 +1,57 @@
+#include "cosmic/can_background.hpp"
+
+#include <algorithm>
+
+namespace cosmic {
+namespace {
+
+std::int64_t ceil_div(std::int64_t numerator, std::int64_t denominator) {
+  return numerator <= 0 ? 0 : (numerator + denominator - 1) / denominator;
+}
+
+}  // namespace
+
+CanIdFormat id_format(const CanBackgroundFrame& frame) {
+  return frame.extended ? CanIdFormat::extended29 : CanIdFormat::standard11;
+}
+
+std::vector<CanStream> background_streams(const CanSegmentProperties& bus) {
+  std::vector<CanStream> streams;
+  streams.reserve(bus.background.size());
+  for (const CanBackgroundFrame& f : bus.background) {
+    const CanIdFormat format = id_format(f);
+    streams.push_back(CanStream{arbitration_key(f.can_id, format), frame_time(bus, f.length, format), f.period, f.jitter});
+  }
+  return streams;
+}
+
+double background_utilization(const CanSegmentProperties& bus) { return utilization(background_streams(bus)); }
+
+std::vector<BackgroundDelay> dominant_background(const CanSegmentProperties& bus, const CanStream& stream,
+                                                 std::optional<Nanos> response, Nanos horizon, std::size_t top) {
+  const std::vector<CanStream> streams = background_streams(bus);
+  const std::int64_t tau = bit_time(bus.bitrate).count();
+  const std::int64_t queuing =
+      response ? std::max<std::int64_t>(0, (*response - stream.jitter - stream.transmission).count()) : horizon.count();
+  std::vector<BackgroundDelay> delays;
+  std::optional<std::size_t> longest_lower;
+  for (std::size_t i = 0; i < streams.size(); ++i) {
+    const CanStream& k = streams[i];
+    const CanBackgroundFrame& f = bus.background[i];
+    if (k.can_id < stream.can_id) {
+      const std::int64_t releases = std::max<std::int64_t>(1, ceil_div(queuing + k.jitter.count() + tau, k.period.count()));
+      delays.push_back(BackgroundDelay{f.name, f.can_id, f.extended, Nanos(releases * k.transmission.count()), false});
+    } else if (k.can_id > stream.can_id && (!longest_lower || k.transmission > streams[*longest_lower].transmission)) {
+      longest_lower = i;
+    }
+  }
+  if (longest_lower) {
+    const CanBackgroundFrame& f = bus.background[*longest_lower];
+    delays.push_back(BackgroundDelay{f.name, f.can_id, f.extended, streams[*longest_lower].transmission, true});
+  }
+  std::stable_sort(delays.begin(), delays.end(), [](const auto& a, const auto& b) { return a.delay > b.delay; });
+  if (delays.size() > top) delays.resize(top);
+  return delays;
+}
+
+}  // namespace cosmic

@@ -1,0 +1,604 @@
+// DBC reading in two layers: a lexer that cuts the text into tokens (the only place that knows
+// about characters, strings spanning lines, CRLF and the BOM) and a parser that walks statements.
+// Both stream: at most two tokens are held, so memory does not grow with the number of tokens.
+// Cross-references (duplicate ids and names, BA_ naming an unknown message) are resolved once at
+// the end with sorted indexes, never by rescanning, so the whole pass is O(n log n).
+#include "cosmic/dbc.hpp"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <chrono>
+#include <numeric>
+#include <utility>
+
+namespace cosmic {
+namespace {
+
+constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
+constexpr std::string_view kCycleTimeAttribute = "GenMsgCycleTime";
+constexpr std::uint32_t kExtendedFlag = 0x8000'0000u;
+constexpr std::uint32_t kMaxStandardId = 0x7FFu;
+constexpr std::uint32_t kMaxExtendedId = 0x1FFF'FFFFu;
+// Vector tools park signals that belong to no message in this pseudo-message; it is never sent.
+constexpr std::uint32_t kIndependentSignalsId = 0xC000'0000u;
+constexpr std::array<std::uint32_t, 7> kFdLengths{12, 16, 20, 24, 32, 48, 64};
+constexpr std::uint32_t kMaxLength = 64;
+constexpr std::uint32_t kClassicMaxLength = 8;
+
+// ------------------------------------------------------------------------------------ tokens
+
+enum class TokenKind { identifier, number, string, punct, end };
+
+struct Position {
+  int line = 1;
+  int column = 1;
+};
+
+struct Token {
+  TokenKind kind = TokenKind::end;
+  std::string_view text;  // of a string: what lies between the quotes, escapes as written
+  Position at;
+  Position past;  // just after the token's last character
+  bool first_on_line = false;
+
+  // Keywords and punctuation; a string's content never matches.
+  bool is(std::string_view word) const {
+    return (kind == TokenKind::identifier || kind == TokenKind::punct) && text == word;
+  }
+};
+
+bool is_identifier_start(char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || c == '_'; }
+bool is_digit(char c) { return c >= '0' && c <= '9'; }
+bool is_identifier_char(char c) { return is_identifier_start(c) || is_digit(c); }
+bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v'; }
+
+class Lexer {
+ public:
+  explicit Lexer(std::string_view text) : text_(text) {}
+
+  // The next token; `end` forever once the text is used up or a string never closes.
+  Token next() {
+    const bool crossed_line = skip_blanks();
+    Token token;
+    token.at = here_;
+    token.first_on_line = crossed_line || !started_;
+    started_ = true;
+    if (failure_ || pos_ >= text_.size()) {
+      token.past = here_;
+      return token;
+    }
+    const std::size_t start = pos_;
+    const char c = text_[pos_];
+    if (c == '"') {
+      read_string(token);
+    } else if (is_identifier_start(c)) {
+      while (pos_ < text_.size() && is_identifier_char(text_[pos_])) step();
+      token.kind = TokenKind::identifier;
+    } else if (starts_number()) {
+      read_number();
+      token.kind = TokenKind::number;
+    } else {
+      step();
+      token.kind = TokenKind::punct;
+    }
+    if (token.kind != TokenKind::string && token.kind != TokenKind::end) token.text = text_.substr(start, pos_ - start);
+    token.past = here_;
+    return token;
+  }
+
+  const std::optional<DbcError>& failure() const { return failure_; }
+
+ private:
+  void step() {
+    if (text_[pos_] == '\n') {
+      ++here_.line;
+      here_.column = 1;
+    } else {
+      ++here_.column;
+    }
+    ++pos_;
+  }
+
+  // True when a line break was crossed.
+  bool skip_blanks() {
+    bool crossed_line = false;
+    while (pos_ < text_.size() && is_blank(text_[pos_])) {
+      crossed_line = crossed_line || text_[pos_] == '\n';
+      step();
+    }
+    return crossed_line;
+  }
+
+  char at(std::size_t offset) const { return pos_ + offset < text_.size() ? text_[pos_ + offset] : '\0'; }
+
+  bool starts_number() const {
+    std::size_t offset = (at(0) == '-' || at(0) == '+') ? 1 : 0;
+    if (at(offset) == '.') ++offset;
+    return is_digit(at(offset));
+  }
+
+  // A sign, then digits, letters, '_' and '.', so that "0x1F" or "12abc" stay one (bad) number
+  // instead of becoming a number and a name; a sign inside only right after an exponent's 'e'.
+  void read_number() {
+    if (at(0) == '-' || at(0) == '+') step();
+    while (pos_ < text_.size()) {
+      const char c = text_[pos_];
+      if (!is_identifier_char(c) && c != '.' && !is_exponent_sign()) break;
+      step();
+    }
+  }
+
+  // The number so far has at least one character here: signs only start numbers.
+  bool is_exponent_sign() const {
+    if (at(0) != '-' && at(0) != '+') return false;
+    const char before = text_[pos_ - 1];
+    return (before == 'e' || before == 'E') && is_digit(at(1));
+  }
+
+  // "...", may span lines; \" and \\ do not end it.
+  void read_string(Token& token) {
+    step();
+    const std::size_t content = pos_;
+    while (pos_ < text_.size() && text_[pos_] != '"') {
+      if (text_[pos_] == '\\' && pos_ + 1 < text_.size()) step();
+      step();
+    }
+    if (pos_ >= text_.size()) {
+      failure_ = DbcError{token.at.line, token.at.column, "unterminated string: no closing '\"' before the end of the text"};
+      return;
+    }
+    token.kind = TokenKind::string;
+    token.text = text_.substr(content, pos_ - content);
+    step();
+  }
+
+  std::string_view text_;
+  std::size_t pos_ = 0;
+  Position here_;
+  bool started_ = false;
+  std::optional<DbcError> failure_;
+};
+
+// ------------------------------------------------------------------------------------ errors
+
+// Keeps the first kDbcMaxReportedErrors, counts the rest, so a file of garbage costs bounded memory.
+class ErrorList {
+ public:
+  void add(Position at, std::string message) {
+    if (kept_.size() < kDbcMaxReportedErrors) {
+      kept_.push_back(DbcError{at.line, at.column, std::move(message)});
+    } else {
+      ++unreported_;
+    }
+  }
+
+  // In text order (cross-reference errors are found after the parse), then the closing line.
+  std::vector<DbcError> finish() && {
+    std::stable_sort(kept_.begin(), kept_.end(), [](const DbcError& a, const DbcError& b) {
+      return a.line != b.line ? a.line < b.line : a.column < b.column;
+    });
+    if (unreported_ > 0) {
+      kept_.push_back(DbcError{0, 0, std::to_string(unreported_) + " more errors not reported (only the first " +
+                                         std::to_string(kDbcMaxReportedErrors) + " are)"});
+    }
+    return std::move(kept_);
+  }
+
+ private:
+  std::vector<DbcError> kept_;
+  std::size_t unreported_ = 0;
+};
+
+std::optional<std::uint32_t> parse_uint32(std::string_view text) {
+  std::uint32_t value = 0;
+  const char* last = text.data() + text.size();
+  const auto [end, error] = std::from_chars(text.data(), last, value);
+  if (error != std::errc{} || end != last) return std::nullopt;
+  return value;
+}
+
+std::string hex(std::uint32_t value) {
+  std::array<char, 8> digits{};
+  const auto result = std::to_chars(digits.data(), digits.data() + digits.size(), value, 16);
+  std::string out = "0x";
+  for (const char* p = digits.data(); p != result.ptr; ++p) out += (*p >= 'a' && *p <= 'f') ? static_cast<char>(*p - 'a' + 'A') : *p;
+  return out;
+}
+
+std::string describe(const Token& token) {
+  return token.kind == TokenKind::string ? "the string " + quote_value(token.text) : quote_value(token.text);
+}
+
+std::string describe_id(std::uint32_t raw_id) {
+  if ((raw_id & kExtendedFlag) != 0) return std::to_string(raw_id) + " (extended " + hex(raw_id & ~kExtendedFlag) + ")";
+  return std::to_string(raw_id) + " (" + hex(raw_id) + ")";
+}
+
+// Why a BO_ id names no CAN frame, or nothing.
+std::optional<std::string> id_problem(std::uint32_t raw_id) {
+  if ((raw_id & kExtendedFlag) != 0) {
+    if ((raw_id & ~kExtendedFlag) <= kMaxExtendedId) return std::nullopt;
+    return "extended message id " + std::to_string(raw_id) + " does not fit 29 bits: " + hex(raw_id & ~kExtendedFlag) +
+           " > 0x1FFFFFFF after removing bit 31";
+  }
+  if (raw_id <= kMaxStandardId) return std::nullopt;
+  return "standard message id " + describe_id(raw_id) +
+         " is above 0x7FF (an extended id has bit 31 set: add 2147483648)";
+}
+
+std::optional<std::string> length_problem(std::uint32_t length) {
+  if (length > kMaxLength) return "message length " + std::to_string(length) + " is out of range (0..64 bytes)";
+  if (length > kClassicMaxLength && std::find(kFdLengths.begin(), kFdLengths.end(), length) == kFdLengths.end()) {
+    return "message length " + std::to_string(length) + " is not a CAN FD length (0..8, 12, 16, 20, 24, 32, 48 or 64)";
+  }
+  return std::nullopt;
+}
+
+bool is_multiplexer_indicator(std::string_view text) {
+  if (text == "M") return true;  // the multiplexor switch
+  if (text.size() < 2 || text.front() != 'm') return false;
+  std::string_view digits = text.substr(1);
+  if (digits.back() == 'M') digits.remove_suffix(1);  // extended multiplexing: also a switch itself
+  return !digits.empty() && std::all_of(digits.begin(), digits.end(), is_digit);
+}
+
+bool is_attribute_object(const Token& token) {
+  return token.is("BU_") || token.is("BO_") || token.is("SG_") || token.is("EV_");
+}
+
+// ------------------------------------------------------------------------------------ parser
+
+struct FoundMessage {
+  DbcMessage message;
+  std::uint32_t raw_id = 0;
+  Position id_at, name_at;
+  std::optional<std::uint32_t> explicit_cycle_ms;
+  bool duplicate = false;
+};
+
+struct CycleTimeValue {
+  std::uint32_t raw_id = 0;
+  std::uint32_t ms = 0;
+  Position id_at;
+};
+
+class Parser {
+ public:
+  explicit Parser(std::string_view text) : lexer_(text) {
+    ahead_[0] = lexer_.next();
+    ahead_[1] = lexer_.next();
+  }
+
+  DbcFile run() && {
+    while (!at_end()) statement(take());
+    if (lexer_.failure()) errors_.add({lexer_.failure()->line, lexer_.failure()->column}, lexer_.failure()->message);
+    mark_duplicate_ids();
+    mark_duplicate_names();
+    apply_cycle_times();
+    DbcFile file;
+    for (FoundMessage& found : found_) {
+      if (!found.duplicate) file.messages.push_back(std::move(found.message));
+    }
+    file.errors = std::move(errors_).finish();
+    return file;
+  }
+
+ private:
+  // ---------------------------------------------------------------- the token stream
+  const Token& peek(std::size_t k = 0) const { return ahead_[k]; }
+  bool at_end() const { return peek().kind == TokenKind::end; }
+
+  Token take() {
+    previous_ = ahead_[0];
+    ahead_[0] = ahead_[1];
+    ahead_[1] = lexer_.next();
+    return previous_;
+  }
+
+  // Statements start with a keyword at the beginning of a line (or right after a ';').
+  static bool starts_statement(const Token& t) { return t.kind == TokenKind::identifier && t.first_on_line; }
+  // Whether `t` still belongs to a statement that ends with ';'.
+  static bool in_statement(const Token& t) { return t.kind != TokenKind::end && !starts_statement(t); }
+  // Whether `t` still belongs to a statement that ends with its line (BO_, SG_, BU_, ...).
+  bool on_same_line(const Token& t) const { return t.kind != TokenKind::end && t.at.line == previous_.past.line; }
+
+  void skip_line() {
+    while (on_same_line(peek())) take();
+  }
+
+  void skip_statement() {
+    while (in_statement(peek())) {
+      if (take().is(";")) return;
+    }
+  }
+
+  // NS_ : and the new symbols' names, one a line, indented by convention, with no terminator: the
+  // list ends at BS_/BU_/BO_ or at an unindented line holding more than one token (a statement).
+  void skip_new_symbols() {
+    while (!at_end()) {
+      const Token& t = peek();
+      const bool statement_line = t.at.column == 1 && peek(1).kind != TokenKind::end && peek(1).at.line == t.past.line;
+      if (t.first_on_line && (t.is("BS_") || t.is("BU_") || t.is("BO_") || statement_line)) return;
+      take();
+    }
+  }
+
+  // ---------------------------------------------------------------- errors
+  void error(Position at, std::string message) { errors_.add(at, std::move(message)); }
+
+  // At the next token when it is on the line, else just after the previous token. Silent at an
+  // end that is an unterminated string: that has its own error, and the rest is unknown.
+  void expected(std::string_view what) {
+    if (at_end() && lexer_.failure()) return;
+    std::string message = "expected " + std::string(what);
+    if (on_same_line(peek())) {
+      error(peek().at, message + ", found " + describe(peek()));
+    } else {
+      error(previous_.past, std::move(message));
+    }
+  }
+
+  void fail_line(std::string_view what) {
+    expected(what);
+    skip_line();
+  }
+
+  void fail_statement(std::string_view what) {
+    expected(what);
+    skip_statement();
+  }
+
+  // ---------------------------------------------------------------- statements
+  void statement(const Token& first) {
+    if (first.is("BO_")) return message(first);
+    if (first.is("SG_")) return signal(first);
+    in_message_ = false;
+    if (first.is(";")) return;
+    if (first.is("NS_")) return skip_new_symbols();
+    if (first.is("VERSION") || first.is("BS_") || first.is("BU_")) return skip_line();
+    if (first.is("BA_DEF_")) return attribute_definition();
+    if (first.is("BA_DEF_DEF_")) return attribute_default();
+    if (first.is("BA_")) return attribute_value();
+    // Everything else (CM_, VAL_, VAL_TABLE_, BO_TX_BU_, EV_, SIG_GROUP_, ..., and what later
+    // versions of the format add) carries nothing the gateway needs.
+    skip_statement();
+  }
+
+  // BO_ <id> <name>: <length> <transmitter>
+  void message(const Token& keyword) {
+    in_message_ = true;
+    if (!on_same_line(peek()) || peek().kind != TokenKind::number) return fail_line("the message id (a decimal number) after BO_");
+    const Token id = take();
+    const auto raw_id = parse_uint32(id.text);
+    if (!raw_id) {
+      error(id.at, "message id " + quote_value(id.text) + " is not a decimal number from 0 to 4294967295");
+      return skip_line();
+    }
+    declared_ids_.push_back(*raw_id);
+    if (!on_same_line(peek()) || peek().kind != TokenKind::identifier) return fail_line("the message name after the id");
+    const Token name = take();
+    if (!on_same_line(peek()) || !peek().is(":")) return fail_line("':' after the message name");
+    take();
+    if (!on_same_line(peek()) || peek().kind != TokenKind::number) return fail_line("the message length in bytes after ':'");
+    const Token length = take();
+    if (!on_same_line(peek()) || peek().kind != TokenKind::identifier) return fail_line("the transmitting node after the length");
+    take();
+    if (on_same_line(peek())) {
+      error(peek().at, "unexpected " + describe(peek()) + " after the transmitting node");
+      skip_line();
+    }
+    if (*raw_id != kIndependentSignalsId) keep_message(MessageLine{keyword.at, id.at, name, length, *raw_id});
+  }
+
+  struct MessageLine {
+    Position keyword_at, id_at;
+    Token name, length;
+    std::uint32_t raw_id = 0;
+  };
+
+  void keep_message(const MessageLine& line) {
+    const auto length = parse_uint32(line.length.text);
+    if (!length) return error(line.length.at, "message length " + quote_value(line.length.text) + " is not a whole number of bytes (0..64)");
+    bool valid = true;
+    if (const auto problem = id_problem(line.raw_id)) {
+      error(line.id_at, *problem);
+      valid = false;
+    }
+    if (const auto problem = length_problem(*length)) {
+      error(line.length.at, *problem);
+      valid = false;
+    }
+    if (!valid) return;
+    if (found_.size() == kDbcMaxMessages) {
+      if (!too_many_reported_) error(line.keyword_at, "more than " + std::to_string(kDbcMaxMessages) + " messages (the limit of one DBC file)");
+      too_many_reported_ = true;
+      return;
+    }
+    FoundMessage found;
+    found.message = DbcMessage{std::string(line.name.text), line.raw_id & ~kExtendedFlag, (line.raw_id & kExtendedFlag) != 0,
+                               *length, std::nullopt, line.keyword_at.line, line.keyword_at.column};
+    found.raw_id = line.raw_id;
+    found.id_at = line.id_at;
+    found.name_at = line.name.at;
+    found_.push_back(std::move(found));
+  }
+
+  // SG_ <name> [M | m<n> | m<n>M] : <start>|<size>@<order><sign> (<factor>,<offset>) [<min>|<max>] "<unit>" <receivers>
+  // Only the head is checked; the layout is not what the gateway needs.
+  void signal(const Token& keyword) {
+    if (!in_message_) {
+      error(keyword.at, "SG_ outside a message: a signal line must follow its BO_ line");
+      return skip_line();
+    }
+    if (!on_same_line(peek()) || peek().kind != TokenKind::identifier) return fail_line("the signal name after SG_");
+    take();
+    if (on_same_line(peek()) && peek().kind == TokenKind::identifier) {
+      if (!is_multiplexer_indicator(peek().text)) {
+        return fail_line("':' or a multiplexer indicator (M, m<n> or m<n>M) after the signal name");
+      }
+      take();
+      if (!on_same_line(peek()) || !peek().is(":")) return fail_line("':' after the multiplexer indicator");
+    } else if (!on_same_line(peek()) || !peek().is(":")) {
+      return fail_line("':' after the signal name");
+    }
+    take();
+    skip_line();
+  }
+
+  // BA_DEF_ [BU_|BO_|SG_|EV_] "<name>" <type> [<min> <max> | <enum values>] ;
+  void attribute_definition() {
+    if (in_statement(peek()) && peek().kind == TokenKind::identifier) {
+      if (!is_attribute_object(peek())) return fail_statement("BU_, BO_, SG_, EV_ or the attribute name as a quoted string after BA_DEF_");
+      take();
+    }
+    if (!in_statement(peek()) || peek().kind != TokenKind::string) return fail_statement("the attribute name as a quoted string");
+    skip_statement();
+  }
+
+  // BA_DEF_DEF_ "<name>" <default value> ;
+  void attribute_default() {
+    if (!in_statement(peek()) || peek().kind != TokenKind::string) {
+      return fail_statement("the attribute name as a quoted string after BA_DEF_DEF_");
+    }
+    if (take().text != kCycleTimeAttribute) return skip_statement();
+    const auto ms = cycle_time_value();
+    if (!ms) return skip_statement();
+    if (expect_semicolon("after the default value")) default_cycle_ms_ = *ms;
+  }
+
+  // BA_ "<name>" [BU_ <node> | BO_ <id> | SG_ <id> <signal> | EV_ <variable>] <value> ;
+  void attribute_value() {
+    if (!in_statement(peek()) || peek().kind != TokenKind::string) return fail_statement("the attribute name as a quoted string after BA_");
+    if (take().text != kCycleTimeAttribute) return skip_statement();
+    if (!in_statement(peek()) || !peek().is("BO_")) return fail_statement("BO_ and a message id after \"GenMsgCycleTime\" (a message attribute)");
+    take();
+    if (!in_statement(peek()) || peek().kind != TokenKind::number) return fail_statement("the message id after BO_");
+    const Token id = take();
+    const auto raw_id = parse_uint32(id.text);
+    if (!raw_id) {
+      error(id.at, "message id " + quote_value(id.text) + " is not a decimal number from 0 to 4294967295");
+      return skip_statement();
+    }
+    const auto ms = cycle_time_value();
+    if (!ms) return skip_statement();
+    if (expect_semicolon("after the attribute value")) cycle_times_.push_back(CycleTimeValue{*raw_id, *ms, id.at});
+  }
+
+  // A GenMsgCycleTime value: whole milliseconds, 0 meaning "not cyclic".
+  std::optional<std::uint32_t> cycle_time_value() {
+    if (!in_statement(peek()) || peek().kind != TokenKind::number) {
+      expected("GenMsgCycleTime in whole milliseconds");
+      return std::nullopt;
+    }
+    const Token value = take();
+    if (value.text.front() == '-') {
+      error(value.at, "GenMsgCycleTime must not be negative, found " + quote_value(value.text));
+      return std::nullopt;
+    }
+    const auto ms = parse_uint32(value.text);
+    if (!ms) error(value.at, "GenMsgCycleTime must be a whole number of milliseconds (0..4294967295), found " + quote_value(value.text));
+    return ms;
+  }
+
+  bool expect_semicolon(std::string_view after) {
+    if (peek().is(";")) {
+      take();
+      return true;
+    }
+    fail_statement("';' " + std::string(after));
+    return false;
+  }
+
+  // ---------------------------------------------------------------- cross-references
+  // Indexes of the messages in `found_` ordered by `key`, file order among equals.
+  template <typename Key>
+  std::vector<std::size_t> order_by(Key key) const {
+    std::vector<std::size_t> order(found_.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(found_[a]) < key(found_[b]); });
+    return order;
+  }
+
+  // Of several messages with one key the first is kept; each other one is an error, `report`ed
+  // with the first.
+  template <typename Key, typename Report>
+  void mark_duplicates(Key key, Report report) {
+    const auto order = order_by(key);
+    std::size_t original = 0;
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      FoundMessage& m = found_[order[i]];
+      if (i == 0 || key(m) != key(found_[order[i - 1]])) {
+        original = order[i];
+        continue;
+      }
+      report(found_[original], m);
+      m.duplicate = true;
+    }
+  }
+
+  void mark_duplicate_ids() {
+    mark_duplicates([](const FoundMessage& m) { return m.raw_id; },
+                    [this](const FoundMessage& first, const FoundMessage& again) {
+                      error(again.id_at, "duplicate message id " + describe_id(again.raw_id) + ": " + again.message.name +
+                                             " repeats the id of " + first.message.name + " declared at line " +
+                                             std::to_string(first.message.line));
+                    });
+  }
+
+  void mark_duplicate_names() {
+    mark_duplicates([](const FoundMessage& m) -> std::string_view { return m.message.name; },
+                    [this](const FoundMessage& first, const FoundMessage& again) {
+                      error(again.name_at, "duplicate message name " + again.message.name + ": already declared at line " +
+                                               std::to_string(first.message.line));
+                    });
+  }
+
+  // Explicit BA_ values (the last one for a message wins), then the default; 0 means none.
+  void apply_cycle_times() {
+    std::vector<std::pair<std::uint32_t, std::size_t>> by_id;  // kept messages: raw id -> index
+    for (std::size_t i = 0; i < found_.size(); ++i) {
+      if (!found_[i].duplicate) by_id.emplace_back(found_[i].raw_id, i);
+    }
+    std::sort(by_id.begin(), by_id.end());
+    std::sort(declared_ids_.begin(), declared_ids_.end());
+    for (const CycleTimeValue& value : cycle_times_) {
+      const auto hit = std::lower_bound(by_id.begin(), by_id.end(), std::pair{value.raw_id, std::size_t{0}});
+      if (hit != by_id.end() && hit->first == value.raw_id) {
+        found_[hit->second].explicit_cycle_ms = value.ms;
+      } else if (!std::binary_search(declared_ids_.begin(), declared_ids_.end(), value.raw_id)) {
+        error(value.id_at, "BA_ \"GenMsgCycleTime\" names message id " + describe_id(value.raw_id) + ", which no BO_ declares");
+      }
+    }
+    for (FoundMessage& found : found_) {
+      const std::optional<std::uint32_t> ms = found.explicit_cycle_ms ? found.explicit_cycle_ms : default_cycle_ms_;
+      if (ms && *ms > 0) found.message.cycle_time = std::chrono::duration_cast<Nanos>(std::chrono::milliseconds(*ms));
+    }
+  }
+
+  Lexer lexer_;
+  std::array<Token, 2> ahead_;
+  Token previous_;
+  ErrorList errors_;
+  bool in_message_ = false;  // SG_ lines may follow
+  bool too_many_reported_ = false;
+  std::vector<FoundMessage> found_;
+  std::vector<std::uint32_t> declared_ids_;  // every BO_ id read, also of messages not kept
+  std::vector<CycleTimeValue> cycle_times_;
+  std::optional<std::uint32_t> default_cycle_ms_;
+};
+
+}  // namespace
+
+DbcFile parse_dbc(std::string_view text) {
+  if (text.size() > kDbcMaxTextBytes) {
+    DbcFile file;
+    file.errors.push_back(DbcError{0, 0, "the DBC text has " + std::to_string(text.size()) + " bytes, more than the limit of " +
+                                             std::to_string(kDbcMaxTextBytes) + " (8 MiB)"});
+    return file;
+  }
+  if (text.starts_with(kUtf8Bom)) text.remove_prefix(kUtf8Bom.size());
+  return Parser(text).run();
+}
+
+}  // namespace cosmic
