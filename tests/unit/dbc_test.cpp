@@ -128,6 +128,7 @@ TEST(DbcParse, CrlfLineEndingsAndBomChangeNothing) {
   const DbcFile file = parse_dbc("\xEF\xBB\xBF" + with_crlf(kRealistic));
   EXPECT_TRUE(file.ok()) << ::testing::PrintToString(errors_of(file));
   EXPECT_EQ(messages_of(file), kRealisticMessages);
+  EXPECT_EQ(messages_of(parse_dbc("\xEF\xBB\xBF BO_ 1 A: 8 X\r\n")), std::vector<std::string>{"A 0x1 std 8 event 1:2"});
   // Errors, too, are located as without the BOM and the carriage returns.
   EXPECT_EQ(errors_of("\xEF\xBB\xBF" + with_crlf("VERSION \"\"\r\nBO_ 1 A 8 X\n")),
             std::vector<std::string>{"2:9: expected ':' after the message name, found '8'"});
@@ -170,15 +171,16 @@ VAL_ 300 S 1 "one" 0 "zero" ;
 }
 
 TEST(DbcParse, NewSymbolsMayStandUnindentedAndTheListEndsAtTheFirstStatement) {
-  const DbcFile file = parse_dbc("NS_ :\nCM_\nBA_\nBO_\nVAL_TABLE_ T 1 \"a\" ;\nBO_ 7 Seven: 8 X\n");
+  // A name alone on its line is a new symbol, even a keyword at column 1; a line of more tokens is a statement.
+  const DbcFile file = parse_dbc("NS_ : NS_DESC_\nCM_\nBA_\n BO_\nBO_TX_BU_\nVAL_TABLE_ T 1 \"a\" ;\nBO_ 7 Seven: 8 X\n");
   EXPECT_TRUE(file.ok()) << ::testing::PrintToString(errors_of(file));
-  EXPECT_EQ(messages_of(file), std::vector<std::string>{"Seven 0x7 std 8 event 6:1"});
+  EXPECT_EQ(messages_of(file), std::vector<std::string>{"Seven 0x7 std 8 event 7:1"});
 }
 
 TEST(DbcParse, StatementsMayShareALine) {
   const DbcFile file = parse_dbc("BA_DEF_DEF_ \"GenMsgCycleTime\" 20; BO_ 8 Eight: 2 X\nBO_ 9 Nine: 3 X\n");
   EXPECT_TRUE(file.ok()) << ::testing::PrintToString(errors_of(file));
-  EXPECT_EQ(messages_of(file), (std::vector<std::string>{"Eight 0x8 std 2 20ms 1:36", "Nine 0x9 std 3 20ms 2:1"}));
+  EXPECT_EQ(messages_of(file), (std::vector<std::string>{"Eight 0x8 std 2 20ms 1:35", "Nine 0x9 std 3 20ms 2:1"}));
 }
 
 TEST(DbcParse, EveryCanFdLengthIsAccepted) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 
 namespace cosmic {
 namespace {
@@ -117,15 +118,50 @@ double fault_share(const CanBusTiming& timing, std::int64_t largest_hep_frame) {
          static_cast<double>(timing.errors.window.count());
 }
 
-// Load of level m summed in input order (own stream first, then hp(m) as given): the rounding
-// of the published analysis, used only when the prefix sum is within rounding of 100 %.
-double level_load_in_input_order(std::span<const CanStream> streams, std::size_t index, const CanBusTiming& timing,
-                                 std::int64_t largest_hep_frame) {
-  double load = share(streams[index]);
-  for (std::size_t k = 0; k < streams.size(); ++k) {
-    if (k != index && streams[k].can_id < streams[index].can_id) load += share(streams[k]);
+// Sum of integer fractions kept exact: p / q with __int128, reduced at every step.
+class ExactShare {
+ public:
+  // False once the sum can no longer be kept exact (its denominator grew past kLimit).
+  bool add(std::int64_t numerator, std::int64_t denominator) {
+    if (!exact_ || numerator == 0) return exact_;
+    const __int128 g = gcd(q_, denominator);
+    const __int128 scale = denominator / g;
+    if (q_ > kLimit / scale) return exact_ = false;
+    p_ = p_ * scale + numerator * (q_ / g);
+    q_ *= scale;
+    const __int128 r = gcd(p_, q_);
+    p_ /= r;
+    q_ /= r;
+    return exact_;
   }
-  return load + fault_share(timing, largest_hep_frame);
+  bool at_least_one() const { return p_ >= q_; }
+
+ private:
+  static __int128 gcd(__int128 a, __int128 b) {
+    while (b != 0) a = std::exchange(b, a % b);
+    return a < 0 ? -a : a;
+  }
+  static constexpr __int128 kLimit = static_cast<__int128>(1) << 80;  // p stays far below 2^127
+  __int128 p_ = 0;
+  __int128 q_ = 1;
+  bool exact_ = true;
+};
+
+// Whether level m's load (own stream, hp(m), fault share) is at least 100 %, decided exactly in
+// integers: used only when the floating-point sum is within rounding of 100 %, where the order of
+// the additions would otherwise decide. A sum too large to keep exact counts as full (unbounded).
+bool level_full_exactly(std::span<const CanStream> streams, std::size_t index, const CanBusTiming& timing,
+                        std::int64_t largest_hep_frame) {
+  ExactShare load;
+  bool exact = load.add(streams[index].transmission.count(), streams[index].period.count());
+  for (std::size_t k = 0; k < streams.size(); ++k) {
+    if (k != index && streams[k].can_id < streams[index].can_id) exact = load.add(streams[k].transmission.count(), streams[k].period.count());
+  }
+  if (timing.errors.max_per_window > 0 && timing.errors.window.count() > 0) {
+    exact = load.add(static_cast<std::int64_t>(timing.errors.max_per_window) * (timing.error_frame_time.count() + largest_hep_frame),
+                     timing.errors.window.count());
+  }
+  return !exact || load.at_least_one();
 }
 
 constexpr double kRoundingMargin = 1e-9;
@@ -246,8 +282,8 @@ CanBusAnalysis::CanBusAnalysis(std::span<const CanStream> streams, const CanBusT
                           higher_frames, &releases};
         double load = higher_load + share(streams[input]) + fault_share(timing, ctx.largest_hep_frame);
         e.near_full = std::abs(load - 1.0) < kRoundingMargin;
-        if (e.near_full) load = level_load_in_input_order(streams, input, timing, ctx.largest_hep_frame);
-        e.result = load >= 1.0 ? std::nullopt : response_time(ctx, timing);
+        const bool full = e.near_full ? level_full_exactly(streams, input, timing, ctx.largest_hep_frame) : load >= 1.0;
+        e.result = full ? std::nullopt : response_time(ctx, timing);
         ++analysed_;
       }
       results_[input] = e.result;
