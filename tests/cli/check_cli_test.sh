@@ -98,4 +98,33 @@ contains missing err "$WORK/no-such-file.yaml:0:0: cannot read the file"
 # 6. Usage errors are not configuration errors.
 run usage 64 check
 
+# 7. Background traffic from a DBC (issue 19): sixteen 8-byte frames 0x010..0x01F every 5 ms
+#    (86.4 % of 500 kbit/s) beat the gateway's SRT frame (base bits 0x080) in arbitration.
+{
+  printf 'VERSION ""\n\nNS_ :\n\nBS_:\n\nBU_: Ecu\n\n'
+  for i in $(seq 16 31); do printf 'BO_ %d F%d: 8 Ecu\n SG_ S : 0|8@1+ (1,0) [0|255] "" Vector__XXX\n\n' "$i" "$((i - 16))"; done
+  printf 'BA_DEF_ BO_ "GenMsgCycleTime" INT 0 65535;\nBA_DEF_DEF_ "GenMsgCycleTime" 5;\n'
+} >"$WORK/busy.dbc"
+cat >"$WORK/busy.yaml" <<'YAML'
+gateway: {name: gw, residence_bound: 500us}
+segments:
+  - {name: body, type: can, interface: vcan0, bitrate: 500kbit/s, max_utilization: 95%, background: {dbc: busy.dbc}}
+  - {name: lan, type: dds, latency_bound: 1ms, realtime: true}
+channels:
+  - {name: speed, subject: 0x51, class: srt, period: 10ms, reaction_time: 4ms, omission_degree: 1, payload: 8B, publishers: [lan], subscribers: [body]}
+YAML
+run busy_text 0 check "$WORK/busy.yaml"
+contains busy_text out "86.4% (16 frames)"
+contains busy_text out "R = 6.14 ms > reaction_time 4 ms on body; background frames delaying it most: F0 (0x010) 270 us, F1 (0x011) 270 us, F2 (0x012) 270 us"
+run busy_json 0 check "$WORK/busy.yaml" --json
+json_check busy_json '
+  d["segments"][0]["background"]["frames"] == 16
+  abs(d["segments"][0]["background"]["utilization"] - 0.864) < 1e-9
+  [b["name"] for b in d["channels"][0]["hops"][1]["background"]] == ["F0", "F1", "F2"]
+  d["channels"][0]["hops"][1]["background"][0]["kind"] == "interference"
+'
+sed -i 's/BA_DEF_DEF_ "GenMsgCycleTime" 5;/BA_DEF_DEF_ "GenMsgCycleTime" 0;/' "$WORK/busy.dbc"
+run busy_no_cycle 2 check "$WORK/busy.yaml"
+contains busy_no_cycle err "$WORK/busy.dbc:9:1: segments[0].background.dbc: message F0 (0x010) has no GenMsgCycleTime"
+
 finish "cosmicctl check"

@@ -148,16 +148,26 @@ int queued_events(cosmic_channel* in) {
   return n;
 }
 
+// A publishing and a subscribing component of kSpeed on one DDS domain.
+class ClientPair : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_NE(pub.handle, nullptr) << pub.error;
+    ASSERT_NE(sub.handle, nullptr) << sub.error;
+    out = cosmic_announce(pub.handle, &kSpeed, 1000);
+    const auto in_desc = with_roles(kSpeed, COSMIC_SUBSCRIBE);
+    in = cosmic_announce(sub.handle, &in_desc, 1000);
+    ASSERT_NE(out, nullptr);
+    ASSERT_NE(in, nullptr);
+  }
+  Client pub{"dds:0"};
+  Client sub{"dds:0"};
+  cosmic_channel* out = nullptr;
+  cosmic_channel* in = nullptr;
+};
+
 // Issue 18: a component must be able to stop its callbacks before the state they use goes.
-TEST(Client, UnsubscribeWaitsForARunningCallbackAndStopsIt) {
-  Client pub("dds:0"), sub("dds:0");
-  ASSERT_NE(pub.handle, nullptr) << pub.error;
-  ASSERT_NE(sub.handle, nullptr) << sub.error;
-  cosmic_channel* out = cosmic_announce(pub.handle, &kSpeed, 1000);
-  const auto in_desc = with_roles(kSpeed, COSMIC_SUBSCRIBE);
-  cosmic_channel* in = cosmic_announce(sub.handle, &in_desc, 1000);
-  ASSERT_NE(out, nullptr);
-  ASSERT_NE(in, nullptr);
+TEST_F(ClientPair, UnsubscribeWaitsForARunningCallbackAndStopsIt) {
   Watch watch;
   ASSERT_EQ(cosmic_subscribe(in, [](const cosmic_event_info*, const std::uint8_t*, void* w) { static_cast<Watch*>(w)->on_event(); }, &watch),
             COSMIC_OK);
@@ -174,15 +184,7 @@ TEST(Client, UnsubscribeWaitsForARunningCallbackAndStopsIt) {
   EXPECT_EQ(cosmic_unsubscribe(nullptr), COSMIC_E_INVALID);
 }
 
-TEST(Client, ACallbackMayUnsubscribeItself) {
-  Client pub("dds:0"), sub("dds:0");
-  ASSERT_NE(pub.handle, nullptr) << pub.error;
-  ASSERT_NE(sub.handle, nullptr) << sub.error;
-  cosmic_channel* out = cosmic_announce(pub.handle, &kSpeed, 1000);
-  const auto in_desc = with_roles(kSpeed, COSMIC_SUBSCRIBE);
-  cosmic_channel* in = cosmic_announce(sub.handle, &in_desc, 1000);
-  ASSERT_NE(out, nullptr);
-  ASSERT_NE(in, nullptr);
+TEST_F(ClientPair, ACallbackMayUnsubscribeItself) {
   struct Self {
     cosmic_channel* channel;
     std::atomic<int> calls{0};

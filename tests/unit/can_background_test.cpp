@@ -122,6 +122,23 @@ TEST(CanBackgroundConfig, YamlFramesAndTheDbcGiveIdenticalNumbers) {
   EXPECT_TRUE(from_yaml.included_files.empty());
 }
 
+// cosmicd's reloads skip parsing an unchanged YAML file, but not one that names a DBC: the DBC
+// may have changed while the YAML did not.
+TEST(CanBackgroundConfig, AReloadReadsTheDbcAgain) {
+  TempDir dir;
+  dir.write("body.dbc", kBodyDbc);
+  const std::string yaml = dir.write("gw.yaml", config_with("    background: {dbc: body.dbc, periods: {DoorEvent: 50ms}}\n"));
+  ConfigFileLoader loader;
+  ASSERT_TRUE(loader.load(yaml).ok());
+  std::string faster = kBodyDbc;
+  faster.replace(faster.find("BO_ 192 10;"), 11, "BO_ 192 5;");
+  dir.write("body.dbc", faster);
+  const ConfigResult again = loader.load(yaml);
+  ASSERT_TRUE(again.ok()) << errors_text(again);
+  EXPECT_FALSE(loader.last_was_unchanged());
+  EXPECT_EQ(again.config.segments[0].can.background[0].period, Nanos(5ms));
+}
+
 TEST(CanBackgroundConfig, ErrorsAreLocatedAndNameTheMessage) {
   TempDir dir;
   dir.write("body.dbc", kBodyDbc);

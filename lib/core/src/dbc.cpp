@@ -1,6 +1,6 @@
 // DBC reading in two layers: a lexer that cuts the text into tokens (the only place that knows
 // about characters, strings spanning lines, CRLF and the BOM) and a parser that walks statements.
-// Both stream: at most two tokens are held, so memory does not grow with the number of tokens.
+// Both stream: the parser looks two tokens ahead and never holds a list of tokens.
 // Cross-references (duplicate ids and names, BA_ naming an unknown message) are resolved once at
 // the end with sorted indexes, never by rescanning, so the whole pass is O(n log n).
 #include "cosmic/dbc.hpp"
@@ -31,8 +31,7 @@ constexpr std::uint32_t kClassicMaxLength = 8;
 enum class TokenKind { identifier, number, string, punct, end };
 
 struct Position {
-  int line = 1;
-  int column = 1;
+  int line = 1, column = 1;
 };
 
 struct Token {
@@ -43,9 +42,7 @@ struct Token {
   bool first_on_line = false;
 
   // Keywords and punctuation; a string's content never matches.
-  bool is(std::string_view word) const {
-    return (kind == TokenKind::identifier || kind == TokenKind::punct) && text == word;
-  }
+  bool is(std::string_view word) const { return kind != TokenKind::string && text == word; }
 };
 
 bool is_identifier_start(char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || c == '_'; }
@@ -91,13 +88,9 @@ class Lexer {
 
  private:
   void step() {
-    if (text_[pos_] == '\n') {
-      ++here_.line;
-      here_.column = 1;
-    } else {
-      ++here_.column;
-    }
-    ++pos_;
+    const bool line_break = text_[pos_++] == '\n';
+    here_.line += line_break ? 1 : 0;
+    here_.column = line_break ? 1 : here_.column + 1;
   }
 
   // True when a line break was crossed.
@@ -166,18 +159,14 @@ class Lexer {
 class ErrorList {
  public:
   void add(Position at, std::string message) {
-    if (kept_.size() < kDbcMaxReportedErrors) {
-      kept_.push_back(DbcError{at.line, at.column, std::move(message)});
-    } else {
-      ++unreported_;
-    }
+    if (kept_.size() < kDbcMaxReportedErrors) kept_.push_back(DbcError{at.line, at.column, std::move(message)});
+    else ++unreported_;
   }
 
   // In text order (cross-reference errors are found after the parse), then the closing line.
   std::vector<DbcError> finish() && {
-    std::stable_sort(kept_.begin(), kept_.end(), [](const DbcError& a, const DbcError& b) {
-      return a.line != b.line ? a.line < b.line : a.column < b.column;
-    });
+    const auto position = [](const DbcError& e) { return std::pair{e.line, e.column}; };
+    std::stable_sort(kept_.begin(), kept_.end(), [&](const auto& a, const auto& b) { return position(a) < position(b); });
     if (unreported_ > 0) {
       kept_.push_back(DbcError{0, 0, std::to_string(unreported_) + " more errors not reported (only the first " +
                                          std::to_string(kDbcMaxReportedErrors) + " are)"});
@@ -201,9 +190,9 @@ std::optional<std::uint32_t> parse_uint32(std::string_view text) {
 std::string hex(std::uint32_t value) {
   std::array<char, 8> digits{};
   const auto result = std::to_chars(digits.data(), digits.data() + digits.size(), value, 16);
-  std::string out = "0x";
-  for (const char* p = digits.data(); p != result.ptr; ++p) out += (*p >= 'a' && *p <= 'f') ? static_cast<char>(*p - 'a' + 'A') : *p;
-  return out;
+  std::string out(digits.data(), result.ptr);
+  for (char& c : out) c = (c >= 'a' && c <= 'f') ? static_cast<char>(c - 'a' + 'A') : c;
+  return "0x" + out;
 }
 
 std::string describe(const Token& token) {
@@ -223,8 +212,7 @@ std::optional<std::string> id_problem(std::uint32_t raw_id) {
            " > 0x1FFFFFFF after removing bit 31";
   }
   if (raw_id <= kMaxStandardId) return std::nullopt;
-  return "standard message id " + describe_id(raw_id) +
-         " is above 0x7FF (an extended id has bit 31 set: add 2147483648)";
+  return "standard message id " + describe_id(raw_id) + " is above 0x7FF (an extended id has bit 31 set: add 2147483648)";
 }
 
 std::optional<std::string> length_problem(std::uint32_t length) {
@@ -235,16 +223,14 @@ std::optional<std::string> length_problem(std::uint32_t length) {
   return std::nullopt;
 }
 
+bool is_attribute_object(const Token& t) { return t.is("BU_") || t.is("BO_") || t.is("SG_") || t.is("EV_"); }
+
 bool is_multiplexer_indicator(std::string_view text) {
   if (text == "M") return true;  // the multiplexor switch
   if (text.size() < 2 || text.front() != 'm') return false;
   std::string_view digits = text.substr(1);
   if (digits.back() == 'M') digits.remove_suffix(1);  // extended multiplexing: also a switch itself
   return !digits.empty() && std::all_of(digits.begin(), digits.end(), is_digit);
-}
-
-bool is_attribute_object(const Token& token) {
-  return token.is("BU_") || token.is("BO_") || token.is("SG_") || token.is("EV_");
 }
 
 // ------------------------------------------------------------------------------------ parser
@@ -258,24 +244,22 @@ struct FoundMessage {
 };
 
 struct CycleTimeValue {
-  std::uint32_t raw_id = 0;
-  std::uint32_t ms = 0;
+  std::uint32_t raw_id = 0, ms = 0;
   Position id_at;
 };
 
 class Parser {
  public:
-  explicit Parser(std::string_view text) : lexer_(text) {
-    ahead_[0] = lexer_.next();
-    ahead_[1] = lexer_.next();
-  }
+  // Braced initializers run in order: the first token, then the second.
+  explicit Parser(std::string_view text) : lexer_(text), ahead_{lexer_.next(), lexer_.next()} {}
 
   DbcFile run() && {
     while (!at_end()) statement(take());
     if (lexer_.failure()) errors_.add({lexer_.failure()->line, lexer_.failure()->column}, lexer_.failure()->message);
     mark_duplicate_ids();
     mark_duplicate_names();
-    apply_cycle_times();
+    assign_explicit_cycle_times();
+    settle_cycle_times();
     DbcFile file;
     for (FoundMessage& found : found_) {
       if (!found.duplicate) file.messages.push_back(std::move(found.message));
@@ -296,16 +280,18 @@ class Parser {
     return previous_;
   }
 
-  // Statements start with a keyword at the beginning of a line (or right after a ';').
+  // A keyword at the beginning of a line starts a statement, and so ends one that lacks its ';'.
   static bool starts_statement(const Token& t) { return t.kind == TokenKind::identifier && t.first_on_line; }
   // Whether `t` still belongs to a statement that ends with ';'.
   static bool in_statement(const Token& t) { return t.kind != TokenKind::end && !starts_statement(t); }
   // Whether `t` still belongs to a statement that ends with its line (BO_, SG_, BU_, ...).
   bool on_same_line(const Token& t) const { return t.kind != TokenKind::end && t.at.line == previous_.past.line; }
+  bool line_goes_on_with(TokenKind kind) const { return on_same_line(peek()) && peek().kind == kind; }
+  bool line_goes_on_with(std::string_view word) const { return on_same_line(peek()) && peek().is(word); }
+  bool statement_goes_on_with(TokenKind kind) const { return in_statement(peek()) && peek().kind == kind; }
+  bool statement_goes_on_with(std::string_view word) const { return in_statement(peek()) && peek().is(word); }
 
-  void skip_line() {
-    while (on_same_line(peek())) take();
-  }
+  void skip_line() { while (on_same_line(peek())) take(); }
 
   void skip_statement() {
     while (in_statement(peek())) {
@@ -313,13 +299,12 @@ class Parser {
     }
   }
 
-  // NS_ : and the new symbols' names, one a line, indented by convention, with no terminator: the
-  // list ends at BS_/BU_/BO_ or at an unindented line holding more than one token (a statement).
+  // NS_ : and the new symbols' names, one a line, with no terminator: the list ends at the first
+  // line holding more than one token, as every statement's line does (BS_:, BU_: ..., BO_ ...).
   void skip_new_symbols() {
     while (!at_end()) {
       const Token& t = peek();
-      const bool statement_line = t.at.column == 1 && peek(1).kind != TokenKind::end && peek(1).at.line == t.past.line;
-      if (t.first_on_line && (t.is("BS_") || t.is("BU_") || t.is("BO_") || statement_line)) return;
+      if (t.first_on_line && peek(1).kind != TokenKind::end && peek(1).at.line == t.past.line) return;
       take();
     }
   }
@@ -365,24 +350,27 @@ class Parser {
     skip_statement();
   }
 
+  struct MessageLine {
+    Position keyword_at, id_at;
+    Token name, length;
+    std::uint32_t raw_id = 0;
+  };
+
   // BO_ <id> <name>: <length> <transmitter>
   void message(const Token& keyword) {
     in_message_ = true;
-    if (!on_same_line(peek()) || peek().kind != TokenKind::number) return fail_line("the message id (a decimal number) after BO_");
+    if (!line_goes_on_with(TokenKind::number)) return fail_line("the message id (a decimal number) after BO_");
     const Token id = take();
-    const auto raw_id = parse_uint32(id.text);
-    if (!raw_id) {
-      error(id.at, "message id " + quote_value(id.text) + " is not a decimal number from 0 to 4294967295");
-      return skip_line();
-    }
+    const auto raw_id = message_id(id);
+    if (!raw_id) return skip_line();
     declared_ids_.push_back(*raw_id);
-    if (!on_same_line(peek()) || peek().kind != TokenKind::identifier) return fail_line("the message name after the id");
+    if (!line_goes_on_with(TokenKind::identifier)) return fail_line("the message name after the id");
     const Token name = take();
-    if (!on_same_line(peek()) || !peek().is(":")) return fail_line("':' after the message name");
+    if (!line_goes_on_with(":")) return fail_line("':' after the message name");
     take();
-    if (!on_same_line(peek()) || peek().kind != TokenKind::number) return fail_line("the message length in bytes after ':'");
+    if (!line_goes_on_with(TokenKind::number)) return fail_line("the message length in bytes after ':'");
     const Token length = take();
-    if (!on_same_line(peek()) || peek().kind != TokenKind::identifier) return fail_line("the transmitting node after the length");
+    if (!line_goes_on_with(TokenKind::identifier)) return fail_line("the transmitting node after the length");
     take();
     if (on_same_line(peek())) {
       error(peek().at, "unexpected " + describe(peek()) + " after the transmitting node");
@@ -391,37 +379,31 @@ class Parser {
     if (*raw_id != kIndependentSignalsId) keep_message(MessageLine{keyword.at, id.at, name, length, *raw_id});
   }
 
-  struct MessageLine {
-    Position keyword_at, id_at;
-    Token name, length;
-    std::uint32_t raw_id = 0;
-  };
-
   void keep_message(const MessageLine& line) {
     const auto length = parse_uint32(line.length.text);
-    if (!length) return error(line.length.at, "message length " + quote_value(line.length.text) + " is not a whole number of bytes (0..64)");
-    bool valid = true;
-    if (const auto problem = id_problem(line.raw_id)) {
-      error(line.id_at, *problem);
-      valid = false;
+    if (!length) {
+      return error(line.length.at, "message length " + quote_value(line.length.text) + " is not a whole number of bytes (0..64)");
     }
-    if (const auto problem = length_problem(*length)) {
-      error(line.length.at, *problem);
-      valid = false;
-    }
-    if (!valid) return;
-    if (found_.size() == kDbcMaxMessages) {
-      if (!too_many_reported_) error(line.keyword_at, "more than " + std::to_string(kDbcMaxMessages) + " messages (the limit of one DBC file)");
-      too_many_reported_ = true;
-      return;
-    }
-    FoundMessage found;
-    found.message = DbcMessage{std::string(line.name.text), line.raw_id & ~kExtendedFlag, (line.raw_id & kExtendedFlag) != 0,
-                               *length, std::nullopt, line.keyword_at.line, line.keyword_at.column};
-    found.raw_id = line.raw_id;
-    found.id_at = line.id_at;
-    found.name_at = line.name.at;
-    found_.push_back(std::move(found));
+    if (!names_a_frame(line, *length) || !below_message_limit(line.keyword_at)) return;
+    const DbcMessage message{std::string(line.name.text), line.raw_id & ~kExtendedFlag, (line.raw_id & kExtendedFlag) != 0,
+                             *length, std::nullopt, line.keyword_at.line, line.keyword_at.column};
+    found_.push_back(FoundMessage{message, line.raw_id, line.id_at, line.name.at, std::nullopt, false});
+  }
+
+  // Reports what is wrong with the id and with the length, both.
+  bool names_a_frame(const MessageLine& line, std::uint32_t length) {
+    const auto wrong_id = id_problem(line.raw_id);
+    const auto wrong_length = length_problem(length);
+    if (wrong_id) error(line.id_at, *wrong_id);
+    if (wrong_length) error(line.length.at, *wrong_length);
+    return !wrong_id && !wrong_length;
+  }
+
+  bool below_message_limit(Position at) {
+    if (found_.size() < kDbcMaxMessages) return true;
+    if (!too_many_reported_) error(at, "more than " + std::to_string(kDbcMaxMessages) + " messages (the limit of one DBC file)");
+    too_many_reported_ = true;
+    return false;
   }
 
   // SG_ <name> [M | m<n> | m<n>M] : <start>|<size>@<order><sign> (<factor>,<offset>) [<min>|<max>] "<unit>" <receivers>
@@ -431,15 +413,15 @@ class Parser {
       error(keyword.at, "SG_ outside a message: a signal line must follow its BO_ line");
       return skip_line();
     }
-    if (!on_same_line(peek()) || peek().kind != TokenKind::identifier) return fail_line("the signal name after SG_");
+    if (!line_goes_on_with(TokenKind::identifier)) return fail_line("the signal name after SG_");
     take();
-    if (on_same_line(peek()) && peek().kind == TokenKind::identifier) {
+    if (line_goes_on_with(TokenKind::identifier)) {
       if (!is_multiplexer_indicator(peek().text)) {
         return fail_line("':' or a multiplexer indicator (M, m<n> or m<n>M) after the signal name");
       }
       take();
-      if (!on_same_line(peek()) || !peek().is(":")) return fail_line("':' after the multiplexer indicator");
-    } else if (!on_same_line(peek()) || !peek().is(":")) {
+      if (!line_goes_on_with(":")) return fail_line("':' after the multiplexer indicator");
+    } else if (!line_goes_on_with(":")) {
       return fail_line("':' after the signal name");
     }
     take();
@@ -448,19 +430,19 @@ class Parser {
 
   // BA_DEF_ [BU_|BO_|SG_|EV_] "<name>" <type> [<min> <max> | <enum values>] ;
   void attribute_definition() {
-    if (in_statement(peek()) && peek().kind == TokenKind::identifier) {
-      if (!is_attribute_object(peek())) return fail_statement("BU_, BO_, SG_, EV_ or the attribute name as a quoted string after BA_DEF_");
+    if (statement_goes_on_with(TokenKind::identifier)) {
+      if (!is_attribute_object(peek())) {
+        return fail_statement("BU_, BO_, SG_, EV_ or the attribute name as a quoted string after BA_DEF_");
+      }
       take();
     }
-    if (!in_statement(peek()) || peek().kind != TokenKind::string) return fail_statement("the attribute name as a quoted string");
+    if (!statement_goes_on_with(TokenKind::string)) return fail_statement("the attribute name as a quoted string");
     skip_statement();
   }
 
   // BA_DEF_DEF_ "<name>" <default value> ;
   void attribute_default() {
-    if (!in_statement(peek()) || peek().kind != TokenKind::string) {
-      return fail_statement("the attribute name as a quoted string after BA_DEF_DEF_");
-    }
+    if (!statement_goes_on_with(TokenKind::string)) return fail_statement("the attribute name as a quoted string after BA_DEF_DEF_");
     if (take().text != kCycleTimeAttribute) return skip_statement();
     const auto ms = cycle_time_value();
     if (!ms) return skip_statement();
@@ -469,25 +451,31 @@ class Parser {
 
   // BA_ "<name>" [BU_ <node> | BO_ <id> | SG_ <id> <signal> | EV_ <variable>] <value> ;
   void attribute_value() {
-    if (!in_statement(peek()) || peek().kind != TokenKind::string) return fail_statement("the attribute name as a quoted string after BA_");
+    if (!statement_goes_on_with(TokenKind::string)) return fail_statement("the attribute name as a quoted string after BA_");
     if (take().text != kCycleTimeAttribute) return skip_statement();
-    if (!in_statement(peek()) || !peek().is("BO_")) return fail_statement("BO_ and a message id after \"GenMsgCycleTime\" (a message attribute)");
-    take();
-    if (!in_statement(peek()) || peek().kind != TokenKind::number) return fail_statement("the message id after BO_");
-    const Token id = take();
-    const auto raw_id = parse_uint32(id.text);
-    if (!raw_id) {
-      error(id.at, "message id " + quote_value(id.text) + " is not a decimal number from 0 to 4294967295");
-      return skip_statement();
+    if (!statement_goes_on_with("BO_")) {
+      return fail_statement("BO_ and a message id after \"GenMsgCycleTime\" (a message attribute)");
     }
+    take();
+    if (!statement_goes_on_with(TokenKind::number)) return fail_statement("the message id after BO_");
+    const Token id = take();
+    const auto raw_id = message_id(id);
+    if (!raw_id) return skip_statement();
     const auto ms = cycle_time_value();
     if (!ms) return skip_statement();
     if (expect_semicolon("after the attribute value")) cycle_times_.push_back(CycleTimeValue{*raw_id, *ms, id.at});
   }
 
+  // The id as BO_ writes it, bit 31 for extended; the range of a CAN id is checked by BO_ alone.
+  std::optional<std::uint32_t> message_id(const Token& id) {
+    const auto raw_id = parse_uint32(id.text);
+    if (!raw_id) error(id.at, "message id " + quote_value(id.text) + " is not a decimal number from 0 to 4294967295");
+    return raw_id;
+  }
+
   // A GenMsgCycleTime value: whole milliseconds, 0 meaning "not cyclic".
   std::optional<std::uint32_t> cycle_time_value() {
-    if (!in_statement(peek()) || peek().kind != TokenKind::number) {
+    if (!statement_goes_on_with(TokenKind::number)) {
       expected("GenMsgCycleTime in whole milliseconds");
       return std::nullopt;
     }
@@ -497,7 +485,9 @@ class Parser {
       return std::nullopt;
     }
     const auto ms = parse_uint32(value.text);
-    if (!ms) error(value.at, "GenMsgCycleTime must be a whole number of milliseconds (0..4294967295), found " + quote_value(value.text));
+    if (!ms) {
+      error(value.at, "GenMsgCycleTime must be a whole number of milliseconds (0..4294967295), found " + quote_value(value.text));
+    }
     return ms;
   }
 
@@ -540,8 +530,8 @@ class Parser {
   void mark_duplicate_ids() {
     mark_duplicates([](const FoundMessage& m) { return m.raw_id; },
                     [this](const FoundMessage& first, const FoundMessage& again) {
-                      error(again.id_at, "duplicate message id " + describe_id(again.raw_id) + ": " + again.message.name +
-                                             " repeats the id of " + first.message.name + " declared at line " +
+                      error(again.id_at, "duplicate message id " + describe_id(again.raw_id) + ": " + quote_value(again.message.name) +
+                                             " repeats the id of " + quote_value(first.message.name) + " declared at line " +
                                              std::to_string(first.message.line));
                     });
   }
@@ -549,13 +539,13 @@ class Parser {
   void mark_duplicate_names() {
     mark_duplicates([](const FoundMessage& m) -> std::string_view { return m.message.name; },
                     [this](const FoundMessage& first, const FoundMessage& again) {
-                      error(again.name_at, "duplicate message name " + again.message.name + ": already declared at line " +
+                      error(again.name_at, "duplicate message name " + quote_value(again.message.name) + ": already declared at line " +
                                                std::to_string(first.message.line));
                     });
   }
 
-  // Explicit BA_ values (the last one for a message wins), then the default; 0 means none.
-  void apply_cycle_times() {
+  // Explicit BA_ values, the last one for a message winning.
+  void assign_explicit_cycle_times() {
     std::vector<std::pair<std::uint32_t, std::size_t>> by_id;  // kept messages: raw id -> index
     for (std::size_t i = 0; i < found_.size(); ++i) {
       if (!found_[i].duplicate) by_id.emplace_back(found_[i].raw_id, i);
@@ -570,6 +560,10 @@ class Parser {
         error(value.id_at, "BA_ \"GenMsgCycleTime\" names message id " + describe_id(value.raw_id) + ", which no BO_ declares");
       }
     }
+  }
+
+  // The explicit value, else the default; 0 means none.
+  void settle_cycle_times() {
     for (FoundMessage& found : found_) {
       const std::optional<std::uint32_t> ms = found.explicit_cycle_ms ? found.explicit_cycle_ms : default_cycle_ms_;
       if (ms && *ms > 0) found.message.cycle_time = std::chrono::duration_cast<Nanos>(std::chrono::milliseconds(*ms));
