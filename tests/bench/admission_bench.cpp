@@ -20,7 +20,7 @@
 //                              shape issue 11 measured at 0.02 / 0.85 / 18 s for 25 / 50 / 100.
 //   BM_LcmChannels/n           admit_all of n DDS -> LCM channels (issue 11: 0.45 / 1.8 / 7.1 s for
 //                              1k / 2k / 4k before).
-//   BM_ParseDbc/n              parse_dbc of an n-message DBC (issue 19).
+//   BM_ParseDbc/n              parse_dbc of an n-message DBC (issue 19; 500 keeps every id unique).
 //   BM_AdmitWithDbcBackground  the 1,000 CAN channels of BM_AdmitBigSet on a bus whose background is
 //                              a 500-message DBC: load the YAML and the DBC, admit_all (issue 19).
 // A reload of that set by a running cosmicd is timed by tests/bench/reload_bench.sh.
@@ -272,7 +272,7 @@ void BM_ParseDbc(benchmark::State& state) {
   state.counters["messages"] = static_cast<double>(messages);
   state.counters["bytes"] = static_cast<double>(text.size());
 }
-BENCHMARK(BM_ParseDbc)->Arg(500)->Arg(5000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ParseDbc)->Arg(500)->Unit(benchmark::kMillisecond);
 
 // BM_AdmitBigSet's 1,000 CAN channels on a bus that also carries a 500-message DBC's frames, from the
 // YAML and DBC files on disk as `cosmicctl check` reads them.
