@@ -240,13 +240,16 @@ TEST(CanBackgroundAdmission, FramesThatWinArbitrationDelayUsAndAreNamed) {
 }
 
 TEST(CanBackgroundAdmission, OnEqualBaseBitsTheStandardFrameWins) {
+  // A jitter of one period releases a winning frame twice in our queuing delay (2 x 270 us), while
+  // a losing one only blocks once (270 us): the two outcomes differ, so the tie rule is what decides.
   // Base bits 0x080 as ours: the standard frame wins the tie (RTR/IDE dominant), so it interferes.
-  const Evaluation tie = speed_on_a_bus_with({CanBackgroundFrame{"Tie", 0x080, false, 8, Nanos(5ms), Nanos(0), "test"}});
-  EXPECT_EQ(find_hop(tie.channels[0], "body")->can->response_time, Nanos(1'500'000 + 270'000 + 320'000));
-  // An extended frame with the same base bits and higher low bits than ours loses: blocking only.
-  const Evaluation ext = speed_on_a_bus_with({CanBackgroundFrame{"Ext", (0x080u << 18) | 0x3FFFF, true, 0, Nanos(5ms), Nanos(0), "test"}});
-  const HopReport* hop = find_hop(ext.channels[0], "body");
-  EXPECT_EQ(hop->can->response_time, Nanos(1'500'000 + frame_time(can_segment("b").can, 0, CanIdFormat::extended29).count() + 320'000));
+  const Evaluation tie = speed_on_a_bus_with({CanBackgroundFrame{"Tie", 0x080, false, 8, Nanos(5ms), Nanos(5ms), "test"}});
+  EXPECT_EQ(find_hop(tie.channels[0], "body")->can->response_time, Nanos(1'500'000 + 2 * 270'000 + 320'000));
+  // An extended frame with the same base bits and higher low bits than ours loses: it blocks once
+  // (0 data bytes, extended: 80 bits = 160 us).
+  const Evaluation ext =
+      speed_on_a_bus_with({CanBackgroundFrame{"Ext", (0x080u << 18) | 0x3FFFF, true, 0, Nanos(5ms), Nanos(5ms), "test"}});
+  EXPECT_EQ(find_hop(ext.channels[0], "body")->can->response_time, Nanos(1'500'000 + 160'000 + 320'000));
 }
 
 TEST(CanBackgroundAdmission, ABusFullOfBackgroundRejectsHrtAndSaysHowFull) {

@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <iterator>
+
 #include <array>
 #include <optional>
 #include <vector>
@@ -97,6 +100,20 @@ TEST(FdFrame, PaddedLengths) {
 //    17), dynamic stuff bits floor((n-1)/4), trailer ACK 1 + ACK del 1 + EOF 7 + IFS 3 = 12.
 //  data rate: ESI 1 + DLC 4 + 8*len, dynamic stuff floor((n-1)/4); stuff count 4 + CRC (17 for
 //    len <= 16, else 21) with one fixed stuff bit per started 4 bits; CRC delimiter 1.
+TEST(FdFrame, FrameLengthsAndDlcCodes) {
+  for (std::uint32_t n = 0; n <= 8; ++n) {
+    EXPECT_TRUE(is_frame_length(n, false)) << n;
+    EXPECT_EQ(dlc_length(n), n);
+  }
+  EXPECT_FALSE(is_frame_length(12, false));  // classic CAN: 8 bytes at most
+  const std::uint32_t fd[] = {12, 16, 20, 24, 32, 48, 64};
+  for (std::uint32_t code = 9; code <= 15; ++code) EXPECT_EQ(dlc_length(code), fd[code - 9]) << code;
+  for (std::uint32_t n = 9; n <= 70; ++n) {
+    const bool expected = std::find(std::begin(fd), std::end(fd), n) != std::end(fd);
+    EXPECT_EQ(is_frame_length(n, true), expected) << n;
+  }
+}
+
 TEST(FdFrame, BitsExtended64) {
   // nominal: 36 + floor(35/4) = 36 + 8 = 44, + 12 = 56.
   // data: 5 + 512 = 517, + floor(516/4) = 129 -> 646; + 4 + 21 = 671; + ceil(25/4) = 7 -> 678; + 1 = 679.

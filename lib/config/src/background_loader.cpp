@@ -4,20 +4,19 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <array>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <map>
 #include <set>
 
+#include "cosmic/can_background.hpp"
 #include "cosmic/can_timing.hpp"
 #include "cosmic/dbc.hpp"
 
 namespace cosmic::config_detail {
 namespace {
 
-constexpr std::size_t kMaxDbcBytes = 8u << 20;
 // Frames of one segment's background, YAML and DBC together: a bus carries far fewer.
 constexpr std::size_t kMaxBackgroundFrames = 20'000;
 
@@ -27,13 +26,7 @@ std::string location(const std::string& file, const YAML::Mark& mark) {
   return file + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1);
 }
 
-std::string hex_id(std::uint32_t id, bool extended) {
-  char text[16];
-  std::snprintf(text, sizeof text, extended ? "0x%08X" : "0x%03X", id);
-  return text;
-}
-
-// Reads a regular file of at most kMaxDbcBytes without ever blocking on a FIFO or a device.
+// Reads a regular file of at most kDbcMaxTextBytes without ever blocking on a FIFO or a device.
 std::string read_regular_file(const std::string& path, std::string& text) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) return std::strerror(errno);
@@ -43,8 +36,8 @@ std::string read_regular_file(const std::string& path, std::string& text) {
     error = std::strerror(errno);
   } else if (!S_ISREG(info.st_mode)) {
     error = "not a regular file";
-  } else if (static_cast<std::uint64_t>(info.st_size) > kMaxDbcBytes) {
-    error = "larger than " + std::to_string(kMaxDbcBytes >> 20) + " MiB";
+  } else if (static_cast<std::uint64_t>(info.st_size) > kDbcMaxTextBytes) {
+    error = "larger than " + std::to_string(kDbcMaxTextBytes >> 20) + " MiB";
   } else {
     text.resize(static_cast<std::size_t>(info.st_size));
     std::size_t done = 0;
@@ -58,18 +51,6 @@ std::string read_regular_file(const std::string& path, std::string& text) {
   }
   ::close(fd);
   return error;
-}
-
-// DLC codes 9..15 of CAN FD and the lengths they stand for.
-constexpr std::array<std::uint32_t, 7> kFdLengths{12, 16, 20, 24, 32, 48, 64};
-
-bool is_frame_length(std::uint32_t length, bool fd) {
-  if (length <= kClassicMaxPayload) return true;
-  if (!fd) return false;
-  for (const std::uint32_t l : kFdLengths) {
-    if (l == length) return true;
-  }
-  return false;
 }
 
 class BackgroundParser {
@@ -120,7 +101,7 @@ class BackgroundParser {
     }
     if (node["jitter"]) ok = assign(reader_.duration(node["jitter"], key(path, "jitter"), true), frame.jitter) && ok;
     if (!ok) return;
-    frame.name = node["name"] ? reader_.string(node["name"], key(path, "name")).value_or("") : hex_id(frame.can_id, frame.extended);
+    frame.name = node["name"] ? reader_.string(node["name"], key(path, "name")).value_or("") : can_id_text(frame.can_id, frame.extended);
     frame.origin = location(reader_.file(), node.Mark());
     if (const std::string conflict = add(std::move(frame)); !conflict.empty()) reader_.error_at(node, path, conflict, "one sender per identifier");
   }
@@ -135,7 +116,7 @@ class BackgroundParser {
     if (node["dlc"]) {
       std::uint64_t dlc = 0;
       if (!assign(reader_.unsigned_int(node["dlc"], key(path, "dlc"), 0, can_.fd ? 15 : 8), dlc)) return false;
-      frame.length = dlc <= 8 ? static_cast<std::uint32_t>(dlc) : kFdLengths[dlc - 9];
+      frame.length = dlc_length(static_cast<std::uint32_t>(dlc));
       return true;
     }
     if (!node["length"]) {
@@ -208,7 +189,7 @@ class BackgroundParser {
       frame.period = *m.cycle_time;
     } else {
       reader_.error_in(ConfigError{file, m.line, m.column, path,
-                                   "message " + m.name + " (" + hex_id(m.can_id, m.extended) +
+                                   "message " + m.name + " (" + can_id_text(m.can_id, m.extended) +
                                        ") has no GenMsgCycleTime: its minimum inter-arrival time is unknown",
                                    "periods: {" + m.name + ": 50ms} or ignore: [" + m.name + "] beside dbc:"});
       return;
@@ -233,7 +214,7 @@ class BackgroundParser {
   std::string add(CanBackgroundFrame frame) {
     const auto id = std::pair(frame.can_id, frame.extended);
     if (const auto earlier = ids_.find(id); earlier != ids_.end()) {
-      return "identifier " + hex_id(frame.can_id, frame.extended) + " (" + frame.name + ") is already declared at " + earlier->second;
+      return "identifier " + can_id_text(frame.can_id, frame.extended) + " (" + frame.name + ") is already declared at " + earlier->second;
     }
     if (can_.background.size() >= kMaxBackgroundFrames) {
       return "more than " + std::to_string(kMaxBackgroundFrames) + " background frames on one segment";

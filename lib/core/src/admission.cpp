@@ -33,12 +33,13 @@ std::size_t segment_index(std::span<const SegmentSpec> segments, const std::stri
 
 // The background frames that delay a CAN hop most, when its response time misses the channel's
 // reaction time (what `cosmicctl check` names for a rejected channel); empty otherwise.
-std::vector<BackgroundDelay> background_delaying(const SegmentSpec& segment, const ChannelSpec& channel, const CanHopPlan& plan) {
+std::vector<BackgroundDelay> background_delaying(const SegmentSpec& segment, std::span<const CanStream> background,
+                                                const ChannelSpec& channel, const CanHopPlan& plan) {
   constexpr std::size_t kNamed = 3;
   if (segment.can.background.empty() || channel.cls == ChannelClass::nrt || !channel.reaction_time) return {};
   if (plan.response_time && *plan.response_time <= *channel.reaction_time) return {};
   const CanStream stream{arbitration_key(plan.can_id, CanIdFormat::extended29), plan.transmission, Nanos(0), plan.jitter};
-  return dominant_background(segment.can, stream, plan.response_time, *channel.reaction_time, kNamed);
+  return dominant_background(segment.can, background, stream, plan.response_time, *channel.reaction_time, kNamed);
 }
 
 Nanos stream_period(const ChannelSpec& channel, const CanHopPlan& plan) {
@@ -56,11 +57,6 @@ CanHopPlan frame_plan(const CanSegmentProperties& bus, const ChannelSpec& channe
   plan.frame_bytes = bus.fd ? fd_padded_length(data_bytes) : data_bytes;
   plan.transmission = frame_time(bus, plan.frame_bytes, CanIdFormat::extended29);
   return plan;
-}
-
-// What a segment carries before any channel is bound: a CAN bus's background frames.
-double base_load(const SegmentSpec& segment) {
-  return segment.type == SegmentType::can ? background_utilization(segment.can) : 0.0;
 }
 
 double hop_load(const SegmentSpec& segment, const ChannelSpec& channel) {
@@ -106,7 +102,13 @@ Evaluation evaluate(const GatewaySpec& gateway, std::span<const SegmentSpec> seg
 
 AdmissionSet::AdmissionSet(GatewaySpec gateway, std::vector<SegmentSpec> segments)
     : gateway_(std::move(gateway)), segment_specs_(std::move(segments)), segments_(segment_specs_.size()) {
-  for (std::size_t s = 0; s < segments_.size(); ++s) segments_[s].load = base_load(segment_specs_[s]);
+  // What a CAN bus carries before any channel is bound: its background frames.
+  for (std::size_t s = 0; s < segments_.size(); ++s) {
+    if (segment_specs_[s].type != SegmentType::can) continue;
+    segments_[s].background = background_streams(segment_specs_[s].can);
+    segments_[s].background_load = utilization(segments_[s].background);
+    segments_[s].load = segments_[s].background_load;
+  }
 }
 
 AdmissionSet AdmissionSet::whole(GatewaySpec gateway, std::vector<SegmentSpec> segments,
@@ -241,7 +243,6 @@ bool AdmissionSet::update_jitters(CanSide& side, const Trial* newcomer) const {
 // iteration for the streams whose higher-priority prefix did not change.
 AdmissionSet::CanSide AdmissionSet::analyse_can(const Trial* newcomer, bool replan_all) const {
   CanSide side;
-  std::vector<std::vector<CanStream>> background(segments_.size());
   side.replanned.assign(segments_.size(), false);
   side.plans.resize(segments_.size());
   side.runs.resize(segments_.size());
@@ -250,7 +251,6 @@ AdmissionSet::CanSide AdmissionSet::analyse_can(const Trial* newcomer, bool repl
     side.replanned[s] = replan_all || (newcomer && std::any_of(newcomer->data.places.begin(), newcomer->data.places.end(),
                                                                 [&](const HopPlace& p) { return p.segment == s; }));
     side.plans[s] = side.replanned[s] ? plan_bus(s, newcomer) : segments_[s].plans;
-    background[s] = background_streams(segment_specs_[s].can);
     for (CanHopPlan& plan : side.plans[s]) plan.jitter = Nanos(0);
     side.runs[s].reserve(kMaxJitterIterations);
   }
@@ -259,14 +259,15 @@ AdmissionSet::CanSide AdmissionSet::analyse_can(const Trial* newcomer, bool repl
     for (std::size_t s = 0; s < segments_.size(); ++s) {
       if (side.plans[s].empty()) continue;
       std::vector<CanStream> streams;
-      streams.reserve(side.plans[s].size() + background[s].size());
+      const std::vector<CanStream>& background = segments_[s].background;
+      streams.reserve(side.plans[s].size() + background.size());
       for (std::size_t pos = 0; pos < side.plans[s].size(); ++pos) {
         const CanHopPlan& plan = side.plans[s][pos];
         streams.push_back(CanStream{arbitration_key(plan.can_id, CanIdFormat::extended29), plan.transmission,
                                     stream_period(*member(s, pos, newcomer).spec, plan), plan.jitter});
       }
       // Other devices' frames after ours: the results read below are the first plans.size().
-      streams.insert(streams.end(), background[s].begin(), background[s].end());
+      streams.insert(streams.end(), background.begin(), background.end());
       const auto& committed = segments_[s].runs;
       const CanBusAnalysis* memo = it < committed.size() ? &committed[it]
                                    : it > 0             ? &side.runs[s][it - 1]
@@ -305,7 +306,7 @@ ChannelReport AdmissionSet::report_of(const ChannelSpec& spec, const ChannelData
       CanHopPlan plan = can ? can->plans[p.segment][p.position] : segments_[p.segment].plans[p.position];
       if (diverged && p.role == HopRole::subscriber) plan.response_time = std::nullopt;
       h.latency = plan.response_time;
-      h.background = background_delaying(segment, spec, plan);
+      h.background = background_delaying(segment, segments_[p.segment].background, spec, plan);
       h.can = plan;
     } else {
       h.latency = segment.latency_bound;
@@ -408,7 +409,7 @@ bool AdmissionSet::remove(const std::string& name) {
     }
   }
   for (const std::size_t s : touched) {
-    segments_[s].load = base_load(segment_specs_[s]);
+    segments_[s].load = segments_[s].background_load;
     for (std::size_t pos = 0; pos < segments_[s].hops.size(); ++pos) {
       const HopRef& ref = segments_[s].hops[pos];
       data_[ref.channel].places[ref.hop].position = pos;
@@ -444,8 +445,7 @@ std::vector<SegmentLoad> AdmissionSet::loads() const {
   std::vector<SegmentLoad> out;
   for (std::size_t s = 0; s < segments_.size(); ++s) {
     const SegmentSpec& spec = segment_specs_[s];
-    const double background = base_load(spec);
-    out.push_back(SegmentLoad{spec.name, spec.type, segments_[s].load, spec.max_utilization, background,
+    out.push_back(SegmentLoad{spec.name, spec.type, segments_[s].load, spec.max_utilization, segments_[s].background_load,
                               spec.type == SegmentType::can ? spec.can.background.size() : 0});
   }
   return out;

@@ -46,9 +46,7 @@ void add_frame_fit(const ChannelSpec& channel, const SegmentSpec& segment, HopRe
 std::string background_text(const HopReport& h) {
   std::string text;
   for (const BackgroundDelay& d : h.background) {
-    char id[16];
-    std::snprintf(id, sizeof id, d.extended ? "0x%08X" : "0x%03X", d.can_id);
-    text += (text.empty() ? "; background frames delaying it most: " : ", ") + d.name + " (" + id + ") " +
+    text += (text.empty() ? "; background frames delaying it most: " : ", ") + d.name + " (" + can_id_text(d.can_id, d.extended) + ") " +
             format_seconds(to_seconds(d.delay)) + (d.blocking ? " blocking" : "");
   }
   return text;

@@ -1,6 +1,7 @@
 #include "cosmic/can_background.hpp"
 
 #include <algorithm>
+#include <cstdio>
 
 namespace cosmic {
 namespace {
@@ -15,6 +16,12 @@ CanIdFormat id_format(const CanBackgroundFrame& frame) {
   return frame.extended ? CanIdFormat::extended29 : CanIdFormat::standard11;
 }
 
+std::string can_id_text(std::uint32_t id, bool extended) {
+  char text[16];
+  std::snprintf(text, sizeof text, extended ? "0x%08X" : "0x%03X", id);
+  return text;
+}
+
 std::vector<CanStream> background_streams(const CanSegmentProperties& bus) {
   std::vector<CanStream> streams;
   streams.reserve(bus.background.size());
@@ -27,9 +34,9 @@ std::vector<CanStream> background_streams(const CanSegmentProperties& bus) {
 
 double background_utilization(const CanSegmentProperties& bus) { return utilization(background_streams(bus)); }
 
-std::vector<BackgroundDelay> dominant_background(const CanSegmentProperties& bus, const CanStream& stream,
-                                                 std::optional<Nanos> response, Nanos horizon, std::size_t top) {
-  const std::vector<CanStream> streams = background_streams(bus);
+std::vector<BackgroundDelay> dominant_background(const CanSegmentProperties& bus, std::span<const CanStream> streams,
+                                                 const CanStream& stream, std::optional<Nanos> response, Nanos horizon,
+                                                 std::size_t top) {
   const std::int64_t tau = bit_time(bus.bitrate).count();
   const std::int64_t queuing =
       response ? std::max<std::int64_t>(0, (*response - stream.jitter - stream.transmission).count()) : horizon.count();

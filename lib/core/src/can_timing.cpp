@@ -174,13 +174,25 @@ std::uint32_t classic_frame_bits(std::uint32_t payload, CanIdFormat format) {
   return body + 13 + (body - 1) / 4;
 }
 
+namespace {
+// The data lengths of CAN FD frames above 8 bytes: DLC codes 9..15.
+constexpr std::array<std::uint32_t, 7> kFdLengths{12, 16, 20, 24, 32, 48, 64};
+}  // namespace
+
 std::uint32_t fd_padded_length(std::uint32_t payload) {
-  if (payload <= 8) return payload;
-  constexpr std::array<std::uint32_t, 7> kSizes{12, 16, 20, 24, 32, 48, 64};
-  for (const std::uint32_t size : kSizes) {
+  if (payload <= kClassicMaxPayload) return payload;
+  for (const std::uint32_t size : kFdLengths) {
     if (payload <= size) return size;
   }
-  return 64;
+  return kFdMaxPayload;
+}
+
+bool is_frame_length(std::uint32_t length, bool fd) {
+  return length <= kClassicMaxPayload || (fd && length <= kFdMaxPayload && fd_padded_length(length) == length);
+}
+
+std::uint32_t dlc_length(std::uint32_t dlc) {
+  return dlc <= kClassicMaxPayload ? dlc : kFdLengths[std::min<std::size_t>(dlc - 9, kFdLengths.size() - 1)];
 }
 
 FdFrameBits fd_frame_bits(std::uint32_t payload, CanIdFormat format) {

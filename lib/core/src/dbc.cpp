@@ -5,6 +5,8 @@
 // the end with sorted indexes, never by rescanning, so the whole pass is O(n log n).
 #include "cosmic/dbc.hpp"
 
+#include "cosmic/can_timing.hpp"
+
 #include <algorithm>
 #include <array>
 #include <charconv>
@@ -22,9 +24,6 @@ constexpr std::uint32_t kMaxStandardId = 0x7FFu;
 constexpr std::uint32_t kMaxExtendedId = 0x1FFF'FFFFu;
 // Vector tools park signals that belong to no message in this pseudo-message; it is never sent.
 constexpr std::uint32_t kIndependentSignalsId = 0xC000'0000u;
-constexpr std::array<std::uint32_t, 7> kFdLengths{12, 16, 20, 24, 32, 48, 64};
-constexpr std::uint32_t kMaxLength = 64;
-constexpr std::uint32_t kClassicMaxLength = 8;
 
 // ------------------------------------------------------------------------------------ tokens
 
@@ -216,8 +215,8 @@ std::optional<std::string> id_problem(std::uint32_t raw_id) {
 }
 
 std::optional<std::string> length_problem(std::uint32_t length) {
-  if (length > kMaxLength) return "message length " + std::to_string(length) + " is out of range (0..64 bytes)";
-  if (length > kClassicMaxLength && std::find(kFdLengths.begin(), kFdLengths.end(), length) == kFdLengths.end()) {
+  if (length > kFdMaxPayload) return "message length " + std::to_string(length) + " is out of range (0..64 bytes)";
+  if (!is_frame_length(length, true)) {
     return "message length " + std::to_string(length) + " is not a CAN FD length (0..8, 12, 16, 20, 24, 32, 48 or 64)";
   }
   return std::nullopt;

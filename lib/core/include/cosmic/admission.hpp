@@ -163,7 +163,9 @@ class AdmissionSet {
   };
   struct Segment {
     std::vector<HopRef> hops;  // bind order
-    double load = 0.0;
+    double load = 0.0;                   // background_load plus the bound channels' hops
+    std::vector<CanStream> background;   // CAN: the background frames as streams, fixed with the spec
+    double background_load = 0.0;
     std::vector<CanHopPlan> plans;     // CAN: one per hop, same order
     std::vector<CanBusAnalysis> runs;  // CAN: one per jitter iteration of the last analysis
     bool pinned = false;  // CAN: priorities kept over a removal, not those a fresh plan gives

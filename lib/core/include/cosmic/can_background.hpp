@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,8 @@
 namespace cosmic {
 
 CanIdFormat id_format(const CanBackgroundFrame& frame);
+// "0x123" (standard) or "0x18EFFF01" (extended): how reports and errors name an identifier.
+std::string can_id_text(std::uint32_t id, bool extended);
 
 // The bus's background frames as analysis streams (can_id = arbitration key), in declaration order.
 std::vector<CanStream> background_streams(const CanSegmentProperties& bus);
@@ -33,7 +36,9 @@ struct BackgroundDelay {
 // The background frames that delay `stream` (a gateway frame on `bus`) most, longest first, at most
 // `top`: each higher-priority frame by its releases in the queuing delay w = R - J - C (or in
 // `horizon` when R is unbounded), and the longest lower-priority frame by its blocking.
-std::vector<BackgroundDelay> dominant_background(const CanSegmentProperties& bus, const CanStream& stream,
-                                                 std::optional<Nanos> response, Nanos horizon, std::size_t top);
+// `streams` is background_streams(bus), computed once by the caller.
+std::vector<BackgroundDelay> dominant_background(const CanSegmentProperties& bus, std::span<const CanStream> streams,
+                                                 const CanStream& stream, std::optional<Nanos> response, Nanos horizon,
+                                                 std::size_t top);
 
 }  // namespace cosmic

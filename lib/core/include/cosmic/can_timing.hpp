@@ -30,6 +30,10 @@ std::uint32_t classic_frame_bits(std::uint32_t payload, CanIdFormat format);
 
 // CAN FD frames carry 0..8, 12, 16, 20, 24, 32, 48 or 64 bytes; a payload is padded up.
 std::uint32_t fd_padded_length(std::uint32_t payload);
+// Whether a frame can carry exactly `length` data bytes (0..8; on CAN FD also the FD lengths).
+bool is_frame_length(std::uint32_t length, bool fd);
+// Data bytes of DLC code 0..15 (9..15: the CAN FD lengths 12..64).
+std::uint32_t dlc_length(std::uint32_t dlc);
 
 // Bits of a CAN FD frame sent at the nominal (arbitration) rate and at the data rate,
 // worst-case stuffing: dynamic stuff bits in arbitration and data, fixed stuff bits in the CRC.
