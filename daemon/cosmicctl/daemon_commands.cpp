@@ -88,6 +88,17 @@ void print_segments(const Json& r) {
               << pad_column(std::to_string(a["receive_errors"].get<std::uint64_t>() + a["send_errors"].get<std::uint64_t>()), 7)
               << pad_column(text(a["overflow_drops"]), 9) << text(s["detail"]) << "\n";
   }
+  // CAN frames no binding and no background declaration explains: admission did not count them.
+  for (const auto& s : r["segments"]) {
+    if (!s.contains("unexplained") || (s["unexplained"].empty() && s.value("unexplained_others", 0) == 0)) continue;
+    std::cout << "\n" << text(s["name"]) << ": unexplained frames (not in admission's analysis; declare them as background):\n";
+    for (const auto& f : s["unexplained"]) {
+      char rate[32];
+      std::snprintf(rate, sizeof rate, "%.1f Hz", f["rate_hz"].get<double>());
+      std::cout << "  " << pad_column(text(f["id"]), 12) << pad_column(rate, 12) << text(f["frames"]) << " frames\n";
+    }
+    if (s.value("unexplained_others", 0) > 0) std::cout << "  (and " << text(s["unexplained_others"]) << " frames of further identifiers)\n";
+  }
 }
 
 std::string drops_text(const Json& dropped) {
@@ -152,8 +163,12 @@ void print_channel(const Json& r) {
     std::cout << "  " << text(hop["role"]) << " " << text(hop["segment"]);
     if (hop.contains("can")) {
       const Json& can = hop["can"];
-      const auto layout = can.value("layout", "cosmic") == "famouso" ? cosmic::CanProfile::famouso : cosmic::CanProfile::cosmic;
-      std::cout << "  can_id " << cosmic::can_identifier_text(can["can_id"].get<std::uint32_t>(), layout);
+      cosmic::CanHopPlan plan;
+      plan.can_id = can["can_id"].get<std::uint32_t>();
+      plan.profile = can.value("layout", "cosmic") == "famouso" ? cosmic::CanProfile::famouso : cosmic::CanProfile::cosmic;
+      plan.native = can.value("layout", "cosmic") == "native";
+      plan.extended = can.value("extended", true);
+      std::cout << "  can_id " << cosmic::can_identifier_text(plan);
     }
     std::cout << "\n";
     for (const auto& check : hop["checks"]) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "cosmic/can_background.hpp"
 #include "cosmic/router_stats.hpp"
 
 namespace cosmicd {
@@ -119,6 +120,15 @@ void render_segment_counters(Exposition& out, const MetricsSnapshot& s) {
   }
   out.family("cosmic_segment_send_backlog_messages", MetricType::gauge, "Messages waiting in the adapter's own send queue.");
   for (const auto& seg : s.segments) out.sample(segment_labels(seg), seg.adapter.backlog);
+  out.family("cosmic_segment_unexplained_frames", MetricType::counter,
+             "CAN frames of an identifier no bound channel, binding protocol or background declaration explains.");
+  for (const auto& seg : s.segments) {
+    for (const auto& f : seg.adapter.unexplained) {
+      Labels labels = segment_labels(seg);
+      labels.emplace_back("can_id", cosmic::can_id_text(f.can_id, f.extended));
+      out.sample(labels, f.frames);
+    }
+  }
 }
 
 void render_channel_state(Exposition& out, const MetricsSnapshot& s) {

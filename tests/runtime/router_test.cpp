@@ -61,9 +61,10 @@ class RouterTest : public ::testing::Test {
 
   // Delivers straight into the router with a chosen receive time.
   // The header carries the channel's own subject (a foreign one is refused at ingress).
-  void deliver(ChannelId id, EventHeader header, Nanos at, std::vector<std::uint8_t> payload = {1, 2, 3}) {
+  // `raw`: as a format without origin delivers it (raw LCM), marked for the fingerprint loop guard.
+  void deliver(ChannelId id, EventHeader header, Nanos at, std::vector<std::uint8_t> payload = {1, 2, 3}, bool raw = false) {
     header.subject = subjects[id];
-    router.inbox(0).on_event(InboundEvent{id, header, payload, at});
+    router.inbox(0).on_event(InboundEvent{id, header, payload, at, raw});
   }
 
   const SegmentCountersSnapshot& counters(const std::string& channel, const std::string& segment) {
@@ -191,11 +192,18 @@ TEST_F(RouterTest, RawChannelsDropTheSamePayloadSeenAgainWithinTheLoopWindow) {
   raw.lcm_encoding = LcmEncoding::raw;
   bind({raw});
   const Nanos t0 = steady_now();
-  deliver(1, EventHeader{}, t0, {1, 2, 3});
-  deliver(1, EventHeader{}, t0 + Nanos(1'000'000), {1, 2, 3});  // came back around a loop
-  deliver(1, EventHeader{}, t0 + Nanos(2'000'000), {4, 5, 6});
+  deliver(1, EventHeader{}, t0, {1, 2, 3}, true);
+  deliver(1, EventHeader{}, t0 + Nanos(1'000'000), {1, 2, 3}, true);  // came back around a loop
+  deliver(1, EventHeader{}, t0 + Nanos(2'000'000), {4, 5, 6}, true);
   router.run_once(10);
   EXPECT_EQ(out.sent().size(), 2u);
+  EXPECT_EQ(dropped("pose", DropReason::duplicate), 1u);
+  // A format that carries no origin but cannot loop (a native CAN frame, repeating the same
+  // bytes every period): every repeat is forwarded.
+  deliver(1, EventHeader{}, t0 + Nanos(3'000'000), {7, 7}, false);
+  deliver(1, EventHeader{}, t0 + Nanos(4'000'000), {7, 7}, false);
+  router.run_once(10);
+  EXPECT_EQ(out.sent().size(), 4u);
   EXPECT_EQ(dropped("pose", DropReason::duplicate), 1u);
 }
 

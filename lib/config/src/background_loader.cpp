@@ -86,7 +86,7 @@ class BackgroundParser {
     bool ok = true;
     if (node["extended"]) ok = assign(reader_.boolean(node["extended"], key(path, "extended")), frame.extended) && ok;
     if (require(node, path, "can_id", "the frame's identifier, e.g. 0x123 (11 bits) or 0x18FF0001 with extended: true")) {
-      const std::uint64_t max = frame.extended ? 0x1FFFFFFF : 0x7FF;
+      const std::uint64_t max = frame.extended ? kExtendedIdMax : kStandardIdMax;
       std::uint64_t id = 0;
       ok = assign(reader_.unsigned_int(node["can_id"], key(path, "can_id"), 0, max), id) && ok;
       frame.can_id = static_cast<std::uint32_t>(id);

@@ -13,6 +13,7 @@
 #include "cosmic/admission.hpp"
 #include "background_loader.hpp"
 #include "components_loader.hpp"
+#include "native_loader.hpp"
 #include "realtime_loader.hpp"
 #include "segment_overlap.hpp"
 #include "yaml_reader.hpp"
@@ -92,6 +93,7 @@ class ConfigParser {
       derive_bindings_ = config_detail::has_components(*root);
       if (require(*root, "", "channels", "a list of channels")) parse_channel_list((*root)["channels"], "channels");
       config_detail::load_components(reader_, *root, config_);
+      native_.check_derived(reader_, config_);
     }
     result.config = std::move(config_);
     result.errors = reader_.take_errors();
@@ -384,6 +386,9 @@ class ConfigParser {
     auto channel = parse_channel(node, path);
     if (!channel) return;
     if (!check_unique(node, path, *channel)) return;
+    if (node["native"]) {
+      native_.add(reader_, node["native"], key(path, "native"), *channel, derive_bindings_ && !(node["publishers"] && node["subscribers"]));
+    }
     config_.channels.push_back(std::move(*channel));
   }
 
@@ -411,7 +416,7 @@ class ConfigParser {
 
   std::optional<ChannelSpec> parse_channel(const YAML::Node& node, const std::string& path) {
     if (!reader_.check_map(node, path, {"name", "subject", "class", "period", "max_rate", "reaction_time", "omission_degree",
-                                        "temp_validity", "payload", "etag", "encoding", "publishers", "subscribers"})) {
+                                        "temp_validity", "payload", "etag", "encoding", "publishers", "subscribers", "native"})) {
       return std::nullopt;
     }
     const std::size_t errors_before = reader_.error_count();
@@ -436,6 +441,13 @@ class ConfigParser {
       c.lcm_encoding = static_cast<LcmEncoding>(reader_.choice(node["encoding"], key(path, "encoding"), {"envelope", "raw"}).value_or(0));
     }
     parse_bindings(node, path, c);
+    if (node["native"]) {
+      config_detail::parse_native(reader_, node["native"], key(path, "native"), config_, c);
+      // With components, the lists are derived later (check_derived_native_segments).
+      if (!derive_bindings_ || (node["publishers"] && node["subscribers"])) {
+        config_detail::check_native_segments(reader_, node["native"], key(path, "native"), c);
+      }
+    }
     check_transport_limits(node, path, c);
     if (reader_.error_count() != errors_before) return std::nullopt;
     return c;
@@ -534,6 +546,7 @@ class ConfigParser {
   std::map<std::uint64_t, std::string> subjects_;
   std::map<std::uint16_t, std::string> etags_;
   std::vector<std::string> included_;  // files read besides the YAML (DBC)
+  config_detail::NativeDeclarations native_;
 };
 
 }  // namespace

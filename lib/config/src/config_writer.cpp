@@ -26,6 +26,20 @@ std::string channel_to_yaml(const ChannelSpec& channel) {
   out << YAML::Key << "encoding" << YAML::Value << (channel.lcm_encoding == LcmEncoding::raw ? "raw" : "envelope");
   out << YAML::Key << "publishers" << YAML::Value << channel.publishers;
   out << YAML::Key << "subscribers" << YAML::Value << channel.subscribers;
+  if (!channel.native.empty()) {
+    out << YAML::Key << "native" << YAML::Value << YAML::BeginMap;
+    for (const NativeBinding& binding : channel.native) {
+      out << YAML::Key << binding.segment << YAML::Value << YAML::BeginMap;
+      if (binding.can) {
+        char id[16];
+        std::snprintf(id, sizeof id, "0x%X", static_cast<unsigned>(binding.can->can_id));
+        out << YAML::Key << "can_id" << YAML::Value << id << YAML::Key << "extended" << YAML::Value << binding.can->extended;
+      }
+      if (binding.lcm_channel) out << YAML::Key << "channel" << YAML::Value << *binding.lcm_channel;
+      out << YAML::EndMap;
+    }
+    out << YAML::EndMap;
+  }
   out << YAML::EndMap;
   return out.c_str();
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "cosmic/can_background.hpp"
 #include "cosmic/report.hpp"
 
 namespace cosmic {
@@ -231,6 +232,13 @@ Json ControlProtocol::segments() const {
     if (s.spec.type == SegmentType::can) {
       entry["interface"] = s.spec.can.interface;
       entry["bitrate"] = s.spec.can.bitrate.bits_per_second;
+      Json unexplained = Json::array();
+      for (const UnexplainedFrames& f : s.adapter.unexplained) {
+        unexplained.push_back({{"can_id", f.can_id}, {"id", can_id_text(f.can_id, f.extended)}, {"extended", f.extended},
+                               {"frames", f.frames}, {"rate_hz", f.rate_hz}});
+      }
+      entry["unexplained"] = std::move(unexplained);
+      entry["unexplained_others"] = s.adapter.unexplained_others;
     } else if (s.spec.type == SegmentType::dds) {
       entry["domain"] = s.spec.dds.domain;
     } else {

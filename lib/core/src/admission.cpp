@@ -38,7 +38,7 @@ std::vector<BackgroundDelay> background_delaying(const SegmentSpec& segment, std
   constexpr std::size_t kNamed = 3;
   if (segment.can.background.empty() || channel.cls == ChannelClass::nrt || !channel.reaction_time) return {};
   if (plan.response_time && *plan.response_time <= *channel.reaction_time) return {};
-  const CanStream stream{arbitration_key(plan.can_id, CanIdFormat::extended29), plan.transmission, Nanos(0), plan.jitter};
+  const CanStream stream{arbitration_key(plan), plan.transmission, Nanos(0), plan.jitter};
   return dominant_background(segment.can, background, stream, plan.response_time, *channel.reaction_time, kNamed);
 }
 
@@ -48,14 +48,23 @@ Nanos stream_period(const ChannelSpec& channel, const CanHopPlan& plan) {
 }
 
 // Frame layout of a channel on a CAN bus: what does not depend on the other channels.
-CanHopPlan frame_plan(const CanSegmentProperties& bus, const ChannelSpec& channel) {
+// A native channel's frame is the event: never fragmented (admission's frame_fit refuses a payload
+// larger than one frame), its identifier fixed.
+CanHopPlan frame_plan(const SegmentSpec& segment, const ChannelSpec& channel) {
+  const CanSegmentProperties& bus = segment.can;
   CanHopPlan plan;
+  const std::optional<NativeCanFrame> native = channel.native_can(segment.name);
   const std::uint32_t capacity = max_frame_payload(bus);
-  const bool fits = channel.payload <= capacity;
+  const bool fits = channel.payload <= capacity || native;
   plan.frames_per_event = fits ? 1 : fragments_needed(channel.payload, capacity);
-  const auto data_bytes = static_cast<std::uint32_t>(fits ? channel.payload : capacity);
+  const auto data_bytes = static_cast<std::uint32_t>(std::min<std::uint64_t>(channel.payload, capacity));
   plan.frame_bytes = bus.fd ? fd_padded_length(data_bytes) : data_bytes;
-  plan.transmission = frame_time(bus, plan.frame_bytes, CanIdFormat::extended29);
+  if (native) {
+    plan.native = true;
+    plan.extended = native->extended;
+    plan.can_id = native->can_id;
+  }
+  plan.transmission = frame_time(bus, plan.frame_bytes, plan.extended ? CanIdFormat::extended29 : CanIdFormat::standard11);
   return plan;
 }
 
@@ -63,7 +72,7 @@ double hop_load(const SegmentSpec& segment, const ChannelSpec& channel) {
   if (!channel.period) return 0.0;
   const double period_s = to_seconds(*channel.period);
   if (segment.type == SegmentType::can) {
-    const CanHopPlan plan = frame_plan(segment.can, channel);
+    const CanHopPlan plan = frame_plan(segment, channel);
     return to_seconds(plan.transmission) * plan.frames_per_event / period_s;
   }
   const double bits = static_cast<double>(channel.payload + kIpOverheadBytes) * 8.0;
@@ -175,8 +184,9 @@ std::vector<CanHopPlan> AdmissionSet::plan_bus(std::size_t segment, const Trial*
   std::vector<std::size_t> ordered;
   for (std::size_t i = 0; i < members.size(); ++i) {
     CanHopPlan& plan = plans[i];
-    plan = frame_plan(bus, *members[i].spec);
+    plan = frame_plan(segment_specs_[segment], *members[i].spec);
     plan.profile = bus.profile;
+    if (plan.native) continue;  // its identifier is the devices' own
     plan.etag = members[i].data->etag;
     if (famouso && members[i].role == HopRole::publisher) {
       plan.priority = kFamousoProtocolPriority;
@@ -263,7 +273,7 @@ AdmissionSet::CanSide AdmissionSet::analyse_can(const Trial* newcomer, bool repl
       streams.reserve(side.plans[s].size() + background.size());
       for (std::size_t pos = 0; pos < side.plans[s].size(); ++pos) {
         const CanHopPlan& plan = side.plans[s][pos];
-        streams.push_back(CanStream{arbitration_key(plan.can_id, CanIdFormat::extended29), plan.transmission,
+        streams.push_back(CanStream{arbitration_key(plan), plan.transmission,
                                     stream_period(*member(s, pos, newcomer).spec, plan), plan.jitter});
       }
       // Other devices' frames after ours: the results read below are the first plans.size().

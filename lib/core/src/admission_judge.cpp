@@ -31,9 +31,10 @@ void add_frame_fit(const ChannelSpec& channel, const SegmentSpec& segment, HopRe
   double limit = 0;
   if (segment.type == SegmentType::can) {
     const std::uint32_t capacity = max_frame_payload(segment.can);
-    limit = channel.cls == ChannelClass::nrt && channel.payload > capacity
-                ? static_cast<double>(kMaxFragments * (capacity - kFragmentHeaderBytes))
-                : capacity;
+    // A native frame is the event: no fragmentation, whatever the class.
+    const bool fragmentable = channel.cls == ChannelClass::nrt && !channel.native_can(segment.name);
+    limit = fragmentable && channel.payload > capacity ? static_cast<double>(kMaxFragments * (capacity - kFragmentHeaderBytes))
+                                                       : capacity;
   } else {
     limit = channel.cls == ChannelClass::nrt ? static_cast<double>(kMaxIpEventBytes)
                                              : static_cast<double>(segment.max_message_size - kIpOverheadBytes);
@@ -55,8 +56,9 @@ std::string background_text(const HopReport& h) {
 std::string failure_text(const Check& check, const HopReport& h, const SegmentSpec& segment) {
   const std::string on = " on " + h.segment;
   if (check.check == "frame_fit") {
+    const bool native = h.can && h.can->native;
     return "payload " + std::to_string(static_cast<long long>(check.value)) + " B > " +
-           (segment.type == SegmentType::can ? "frame " : "message ") +
+           (native ? "native frame " : segment.type == SegmentType::can ? "frame " : "message ") +
            std::to_string(static_cast<long long>(check.limit)) + " B" + on;
   }
   if (check.check == "utilization") {

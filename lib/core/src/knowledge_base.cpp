@@ -21,12 +21,19 @@ KnowledgeBase::KnowledgeBase(GatewaySpec gateway, std::vector<SegmentSpec> segme
   for (const std::uint16_t etag : reserved_etags_) {
     if (etag <= kMaxEtag) etag_taken_.set(etag);
   }
+  for (const SegmentState& segment : segments_) {
+    for (const CanBackgroundFrame& frame : segment.spec.can.background) {
+      if (frame.extended) etag_taken_.set(frame.can_id & kEtagMask);
+    }
+  }
 }
 
-bool KnowledgeBase::touches_can(const ChannelSpec& channel) const {
+// A CAN hop in the COSMIC/FAMOUSO layout, which needs an etag (a native one does not).
+bool KnowledgeBase::needs_etag(const ChannelSpec& channel) const {
   auto is_can = [&](const std::string& name) {
-    return std::any_of(segments_.begin(), segments_.end(),
-                       [&](const auto& s) { return s.spec.name == name && s.spec.type == SegmentType::can; });
+    return !channel.native_can(name) && std::any_of(segments_.begin(), segments_.end(), [&](const auto& s) {
+      return s.spec.name == name && s.spec.type == SegmentType::can;
+    });
   };
   return std::any_of(channel.publishers.begin(), channel.publishers.end(), is_can) ||
          std::any_of(channel.subscribers.begin(), channel.subscribers.end(), is_can);
@@ -35,7 +42,7 @@ bool KnowledgeBase::touches_can(const ChannelSpec& channel) const {
 // The highest etag neither reserved nor bound.
 std::optional<std::uint16_t> KnowledgeBase::allocate_etag() const {
   for (std::uint16_t etag = kMaxEtag; etag > kHighestReservedEtag; --etag) {
-    if (!etag_taken_.test(etag)) return etag;
+    if (!etag_taken_.test(etag) && !native_etags_.count(etag)) return etag;
   }
   return std::nullopt;
 }
@@ -56,7 +63,30 @@ std::optional<std::string> static_etag_owner(const EtagMap& etags, std::uint16_t
   }
   return std::nullopt;
 }
+
+std::uint16_t etag_bits(const NativeCanFrame& frame) { return static_cast<std::uint16_t>(frame.can_id & kEtagMask); }
 }  // namespace
+
+// A native identity another bound channel holds, or an extended native identifier whose etag bits
+// a bound COSMIC channel uses (or the reverse): the reason, or nothing.
+std::optional<std::string> KnowledgeBase::native_clash(const ChannelSpec& channel, std::optional<std::uint16_t> etag) const {
+  for (const NativeBinding& binding : channel.native) {
+    const std::string identity = native_identity(binding);
+    if (const auto owner = native_owners_.find({binding.segment, identity}); owner != native_owners_.end()) {
+      return identity + " on segment " + binding.segment + " is already carried by bound channel " + owner->second;
+    }
+    if (!binding.can || !binding.can->extended) continue;
+    if (const auto owner = static_etag_owner(etags_, etag_bits(*binding.can))) {
+      return "extended identifier " + identity + " reads as etag " + std::to_string(etag_bits(*binding.can)) +
+             " of bound channel " + *owner + " to COSMIC devices";
+    }
+  }
+  if (const auto owner = etag ? native_etags_.find(*etag) : native_etags_.end(); owner != native_etags_.end()) {
+    return "etag " + std::to_string(*etag) + " is the etag bits of bound channel " + owner->second +
+           "'s native extended identifier";
+  }
+  return std::nullopt;
+}
 
 KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel) const {
   Attempt a;
@@ -68,7 +98,7 @@ KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel) const 
     a.report = rejection(channel, "subject already carried by bound channel " + other->second);
     return a;
   }
-  if (touches_can(channel)) {
+  if (needs_etag(channel)) {
     if (channel.etag) {
       if (const auto owner = static_etag_owner(etags_, *channel.etag)) {
         a.report = rejection(channel, "etag " + std::to_string(*channel.etag) + " is already used by channel " + *owner);
@@ -81,6 +111,10 @@ KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel) const 
       a.report = rejection(channel, "no free etag left (101..16383 all in use)");
       return a;
     }
+  }
+  if (const auto clash = native_clash(channel, channel.etag)) {
+    a.report = rejection(channel, *clash);
+    return a;
   }
   a.trial = set_.trial(channel, a.etag.value_or(0));
   a.report = a.trial->report;
@@ -101,6 +135,10 @@ BindOutcome KnowledgeBase::bind(const ChannelSpec& channel) {
       etag_taken_.set(*a.etag);
     }
     subjects_[channel.subject] = channel.name;
+    for (const NativeBinding& binding : channel.native) {
+      native_owners_[{binding.segment, native_identity(binding)}] = channel.name;
+      if (binding.can && binding.can->extended) native_etags_.emplace(etag_bits(*binding.can), channel.name);
+    }
     set_.commit(std::move(*a.trial));
   }
   return BindOutcome{std::move(a.report)};
@@ -112,6 +150,8 @@ bool KnowledgeBase::unbind(const std::string& name) {
   const ChannelSpec* spec = set_.find(name);
   if (!spec) return false;
   subjects_.erase(spec->subject);
+  for (const NativeBinding& binding : spec->native) native_owners_.erase({binding.segment, native_identity(binding)});
+  std::erase_if(native_etags_, [&](const auto& entry) { return entry.second == name; });
   if (const auto etag = etags_.find(name); etag != etags_.end()) {
     if (!reserved_etags_.count(etag->second)) etag_taken_.reset(etag->second);
     etags_.erase(etag);
@@ -152,12 +192,19 @@ std::optional<std::uint16_t> KnowledgeBase::etag_of(const std::string& channel) 
   return it->second;
 }
 
-AdmissionReport admit_all(const Config& config) {
+std::set<std::uint16_t> reserved_etags(const Config& config) {
   std::set<std::uint16_t> reserved;
   for (const auto& channel : config.channels) {
     if (channel.etag) reserved.insert(*channel.etag);
+    for (const NativeBinding& binding : channel.native) {
+      if (binding.can && binding.can->extended) reserved.insert(etag_bits(*binding.can));
+    }
   }
-  KnowledgeBase kb(config.gateway, config.segments, reserved);
+  return reserved;
+}
+
+AdmissionReport admit_all(const Config& config) {
+  KnowledgeBase kb(config.gateway, config.segments, reserved_etags(config));
   std::vector<const ChannelSpec*> rejected;
   for (const auto& channel : config.channels) {
     if (!kb.bind(channel).bound()) rejected.push_back(&channel);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "cosmic/can_background.hpp"
+
 namespace cosmic {
 
 const char* to_string(ChannelClass value) {
@@ -24,6 +26,21 @@ const char* to_string(SegmentType value) {
 
 const char* to_string(Reliability value) {
   return value == Reliability::reliable ? "reliable" : "best_effort";
+}
+
+std::string native_identity(const NativeBinding& binding) {
+  if (binding.can) return can_id_text(binding.can->can_id, binding.can->extended);
+  return binding.lcm_channel.value_or("");
+}
+
+const NativeBinding* ChannelSpec::native_on(const std::string& segment) const {
+  const auto it = std::find_if(native.begin(), native.end(), [&](const auto& n) { return n.segment == segment; });
+  return it == native.end() ? nullptr : &*it;
+}
+
+std::optional<NativeCanFrame> ChannelSpec::native_can(const std::string& segment) const {
+  const NativeBinding* binding = native_on(segment);
+  return binding ? binding->can : std::nullopt;
 }
 
 const SegmentSpec* Config::find_segment(const std::string& name) const {

@@ -28,18 +28,24 @@ nlohmann::json to_json(const HopReport& hop) {
   nlohmann::json out{{"segment", hop.segment}, {"role", to_string(hop.role)}, {"latency_s", seconds_or_null(hop.latency)}};
   if (hop.can) {
     const CanHopPlan& can = *hop.can;
-    const CanIdentifier fields = decode_can_id(can.can_id);  // TxNode and etag: same bits in both layouts
-    out["can"] = {{"layout", can.profile == CanProfile::famouso ? "famouso" : "cosmic"},
-                  {"priority", can.priority},
-                  {"can_id", can.can_id},
-                  {"tx_node", fields.tx_node},
-                  {"etag", can.etag},
-                  {"frame_bytes", can.frame_bytes},
+    if (can.native) {
+      // The devices' own identifier: no priority field, TxNode or etag.
+      out["can"] = {{"layout", "native"}, {"can_id", can.can_id}, {"extended", can.extended}};
+    } else {
+      const CanIdentifier fields = decode_can_id(can.can_id);  // TxNode and etag: same bits in both layouts
+      out["can"] = {{"layout", can.profile == CanProfile::famouso ? "famouso" : "cosmic"},
+                    {"priority", can.priority},
+                    {"can_id", can.can_id},
+                    {"extended", true},
+                    {"tx_node", fields.tx_node},
+                    {"etag", can.etag}};
+    }
+    out["can"].update({{"frame_bytes", can.frame_bytes},
                   {"frames_per_event", can.frames_per_event},
                   {"transmission_time_s", to_seconds(can.transmission)},
                   {"jitter_s", to_seconds(can.jitter)},
-                  {"response_time_s", seconds_or_null(can.response_time)}};
-    if (can.profile == CanProfile::famouso) out["can"]["fragment"] = decode_famouso_id(can.can_id).fragment;
+                       {"response_time_s", seconds_or_null(can.response_time)}});
+    if (!can.native && can.profile == CanProfile::famouso) out["can"]["fragment"] = decode_famouso_id(can.can_id).fragment;
   }
   out["checks"] = nlohmann::json::array();
   for (const auto& check : hop.checks) out["checks"].push_back(to_json(check));
@@ -72,8 +78,18 @@ std::string limit_text(const Check& check) {
 }  // namespace
 
 std::string can_identifier_text(std::uint32_t can_id, CanProfile profile) {
+  CanHopPlan plan;
+  plan.can_id = can_id;
+  plan.profile = profile;
+  return can_identifier_text(plan);
+}
+
+std::string can_identifier_text(const CanHopPlan& plan) {
+  const std::uint32_t can_id = plan.can_id;
   char text[96];
-  if (profile == CanProfile::famouso) {
+  if (plan.native) {
+    std::snprintf(text, sizeof text, plan.extended ? "0x%08X (native, extended)" : "0x%03X (native, standard)", can_id);
+  } else if (plan.profile == CanProfile::famouso) {
     const FamousoIdentifier id = decode_famouso_id(can_id);
     std::snprintf(text, sizeof text, "0x%08X (FAMOUSO layout: priority 0x%02X, fragment %d, TxNode %u, etag %u)", can_id,
                   static_cast<unsigned>(id.priority), id.fragment ? 1 : 0, static_cast<unsigned>(id.tx_node),
@@ -168,7 +184,7 @@ std::string render_channel_text(const ChannelReport& channel) {
   for (const auto& hop : channel.hops) {
     out << "  " << to_string(hop.role) << " " << hop.segment;
     if (hop.can) {
-      out << "  id " << can_identifier_text(hop.can->can_id, hop.can->profile) << " C "
+      out << "  id " << can_identifier_text(*hop.can) << " C "
           << format_duration(hop.can->transmission) << " x" << hop.can->frames_per_event;
     }
     out << "\n";

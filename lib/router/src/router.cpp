@@ -160,7 +160,7 @@ bool Router::admit(ChannelState& channel, SegmentCounters& counters, const Inbou
   const EventHeader& header = event.header;
   const ChannelSpec& spec = channel.route.spec;
   std::lock_guard lock(channel.policy_mutex);
-  const bool loop_copy = header.origin == 0 && spec.lcm_encoding == LcmEncoding::raw &&
+  const bool loop_copy = header.origin == 0 && event.guard_loops_by_fingerprint &&
                          channel.loop_guard.loop_copy(event.payload, event.received_at);
   if (loop_copy || (header.origin != 0 && channel.dedup.seen(header.origin, header.sequence))) {
     counters.drop(DropReason::duplicate);

@@ -1,6 +1,9 @@
 #include "cosmic/gateway.hpp"
 
+#include "cosmic/can_interference.hpp"
+
 #include <algorithm>
+#include <optional>
 #include <set>
 #include <string_view>
 #include <unordered_map>
@@ -13,14 +16,6 @@ Gateway::Gateway(AdapterFactory factory, Logger& log, std::uint64_t gateway_id)
 Gateway::~Gateway() { stop(); }
 
 namespace {
-
-std::set<std::uint16_t> reserved_etags(const Config& config) {
-  std::set<std::uint16_t> reserved;
-  for (const auto& channel : config.channels) {
-    if (channel.etag) reserved.insert(*channel.etag);
-  }
-  return reserved;
-}
 
 // Whether admitting `config` from scratch passes through the state admitting `base` left: the
 // same knowledge base to start from, and `base`'s channels bound first, in the same order.
@@ -413,18 +408,35 @@ std::vector<ChannelStatsSnapshot> Gateway::channel_stats() const {
   return stats;
 }
 
+std::map<std::string, std::string> Gateway::undeclared_interference() const {
+  std::map<std::string, std::string> out;
+  std::optional<AdmissionReport> report;  // built only when a bus shows unexplained frames
+  for (const auto& spec : config_.segments) {
+    const auto slot = slots_.find(spec.name);
+    if (spec.type != SegmentType::can || slot == slots_.end()) continue;
+    const AdapterStatistics stats = slot->second.adapter->statistics();
+    if (std::none_of(stats.unexplained.begin(), stats.unexplained.end(), [](const auto& f) { return f.rate_hz > 0; })) continue;
+    if (!report) report = kb_->report();
+    out.merge(cosmic::undeclared_interference(*report, spec.name, stats.unexplained));
+  }
+  return out;
+}
+
 void Gateway::refresh_runtime(Nanos now) {
   std::map<std::string, RuntimeTrack> next;
+  const std::map<std::string, std::string> foreign = undeclared_interference();
   auto judge_bound = [&](const ChannelMisses& counted) {
     const ChannelSpec* spec = kb_->find_bound(counted.name);
-    if (spec == nullptr) return;  // unbound since: its track ends
+    if (spec == nullptr || next.count(counted.name)) return;  // unbound since: its track ends
     const auto previous = runtime_.find(counted.name);
     RuntimeTrack track = previous != runtime_.end() ? previous->second : RuntimeTrack{};
-    judge(counted, *spec, track, now);
+    const auto reason = foreign.find(counted.name);
+    judge(counted, *spec, track, now, reason == foreign.end() ? nullptr : &reason->second);
     next.emplace(counted.name, track);
   };
   // Only channels that ever missed are tracked (every other one is `bound` at run time).
   for (const auto& counted : router_->misses()) judge_bound(counted);
+  for (const auto& [name, reason] : foreign) judge_bound(ChannelMisses{name, 0, 0});
   // A tracked channel the router reports no miss for any more (its route was applied afresh) is
   // judged with zero counts: a violation still ends only after a clean interval.
   for (const auto& [name, track] : runtime_) {
@@ -436,16 +448,17 @@ void Gateway::refresh_runtime(Nanos now) {
 // One channel: a new miss of an HRT hop starts (or extends) a violation episode; a clean
 // interval ends it. SRT and NRT channels count misses but keep their state (they were promised
 // no bound).
-void Gateway::judge(const ChannelMisses& counted, const ChannelSpec& spec, RuntimeTrack& track, Nanos now) {
+void Gateway::judge(const ChannelMisses& counted, const ChannelSpec& spec, RuntimeTrack& track, Nanos now,
+                    const std::string* foreign) {
   const std::uint64_t misses = counted.residence_miss + counted.deadline_miss;
-  const bool missed = misses > track.misses;
+  const bool missed = misses > track.misses || foreign;
   track.misses = misses;
   if (missed) track.last_miss = now;
   if (spec.cls != ChannelClass::hrt) return;
   if (missed && track.state == RuntimeState::bound) {
     track.state = RuntimeState::violated;
     ++track.violations;
-    log_.log(LogLevel::warning, violation_line(spec));
+    log_.log(LogLevel::warning, foreign ? "channel " + spec.name + " violated its admitted bounds: " + *foreign : violation_line(spec));
   } else if (!missed && track.state == RuntimeState::violated && now - track.last_miss >= config_.gateway.clean_interval) {
     track.state = RuntimeState::bound;
     log_.log(LogLevel::notice, "channel " + spec.name + " is within its admitted bounds again (no miss for " +

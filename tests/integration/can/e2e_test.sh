@@ -20,6 +20,10 @@
 #   can_fd          vcan1 in FD mode: LCM -> FD frames with BRS, padded to the next FD length;
 #                   FD (with/without BRS) and classic frames -> LCM, cut at the payload; too long:
 #                   counted
+#   native          native identifiers with can-utils while cangen runs a declared background
+#                   frame: cansend 123#... -> LCM and DDS; LCM -> candump 18FF1234#...; no etag
+#   unexplained     frames nothing explains are listed by cosmicctl segments (id, rate); one that
+#                   beats the HRT channel brake's identifier turns brake violated, logged once
 #   garbage         cangen (random 29-bit, 11-bit, mixed FD/remote, aimed at the bound etags,
 #                   malformed GET_ETAG) and hostile fragments: cosmicd survives, every frame is
 #                   accounted for (frames of unbound etags never reach it), errors are counted,

@@ -23,6 +23,7 @@
 #include <string>
 #include <thread>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "binding_guard.hpp"
@@ -35,6 +36,8 @@
 #include "famouso_afp.hpp"
 #include "famouso_ccp.hpp"
 #include "frame_backlog.hpp"
+#include "bus_census.hpp"
+#include "native_frames.hpp"
 
 namespace cosmic {
 namespace {
@@ -122,11 +125,14 @@ class CanAdapter final : public SegmentAdapter {
     std::uint16_t etag = 0;
     std::size_t payload = 0;
     bool fragmented = false;
+    std::optional<NativeCanFrame> native;  // a native channel: this frame, no etag (native_frames.hpp)
   };
   struct Table {
     std::unordered_map<std::uint16_t, RxChannel> rx;           // etag -> channel bound as publisher
     std::unordered_map<ChannelId, TxChannel> tx;               // channels bound as subscriber
     std::unordered_map<std::uint64_t, std::uint16_t> etag_of;  // subject -> etag, both roles
+    can_native::FrameTable native;                             // native channels, background frames
+    std::unordered_set<std::uint16_t> tx_etags;                // etags of the channels bound as subscriber
     std::optional<std::uint8_t> tx_node;                       // the gateway's TxNode on this bus
     std::vector<can_filter> filters;
     std::size_t backlog_frames = kMinBacklogFrames;
@@ -143,6 +149,10 @@ class CanAdapter final : public SegmentAdapter {
   bool open_socket(int ifindex);
   void close_socket();
   void read_frames();
+  // The census socket (bus_census.hpp): every frame on the bus, counted when nothing explains it.
+  void open_census_socket(int ifindex);
+  void read_census();
+  bool explains(const Table& table, canid_t can_id) const;
   void handle_read_error(int err);
   void handle_datagram(canfd_frame& frame, msghdr& msg, std::size_t bytes);
   void handle_frame(const canfd_frame& frame, bool fd_frame, Nanos now);
@@ -156,9 +166,13 @@ class CanAdapter final : public SegmentAdapter {
   void handle_afp(const RxChannel& channel, const CanIdentifier& id, std::span<const std::uint8_t> data, Nanos now);
   void handle_protocol_timeouts(Nanos now);
   void deliver(const RxChannel& channel, std::span<const std::uint8_t> payload, Nanos now);
+  void deliver_native(const can_native::RxChannel& channel, std::span<const std::uint8_t> data, bool fd_frame, Nanos now);
   void problem(ChannelId channel, InboundProblem what);
   void drain_backlog();
   void refresh_rx_table();  // the receive thread's snapshot of the bindings (rx_table_)
+  // configure(): a native channel's binding into `table`; the reason when it cannot be carried.
+  std::optional<std::string> bind_native(const ChannelBinding& b, Table& table) const;
+  SendStatus send_frame(const canfd_frame& frame);  // io_mutex_ held
 
   // --- health
   void set_link(Link link, std::string detail);
@@ -201,6 +215,8 @@ class CanAdapter final : public SegmentAdapter {
   // send(), configure() and the receive thread write through it holding io_mutex_.
   mutable std::mutex io_mutex_;
   int sock_ = -1;
+  int census_sock_ = -1;  // only the receive thread opens, reads and closes it
+  bool census_error_logged_ = false;
   std::shared_ptr<const Table> table_;
   std::atomic<std::uint64_t> generation_{0};
   FrameBacklog backlog_;
@@ -234,6 +250,7 @@ class CanAdapter final : public SegmentAdapter {
   std::atomic<std::uint64_t> overflow_socket_{0};  // SO_RXQ_OVFL of the open socket
   std::atomic<std::uint64_t> overflow_controller_{0};
   std::atomic<std::uint64_t> backlog_size_{0};
+  can_census::BusCensus census_;
 };
 
 // ------------------------------------------------------------------------------ lifecycle
@@ -318,9 +335,14 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
   auto refuse = [&](const ChannelBinding& b, const std::string& why) {
     errors += (errors.empty() ? "" : "; ") + ("channel " + b.spec.name + ": " + why);
   };
+  for (const CanBackgroundFrame& frame : segment_.can.background) table->native.add_background(frame);
   for (const auto& b : bindings) {
     if (!b.can) {
       refuse(b, "no CAN plan");
+      continue;
+    }
+    if (b.can->native) {
+      if (const auto why = bind_native(b, *table)) refuse(b, *why);
       continue;
     }
     if (b.can->profile != segment_.can.profile) {
@@ -352,7 +374,8 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
       // largest events).
       const std::uint32_t planned = b.can->can_id & CAN_EFF_MASK;
       const std::uint32_t can_id = famouso_ ? planned & ~kFamousoFragmentFlag : planned;
-      table->tx[b.id] = TxChannel{b.id, can_id, planned | kFamousoFragmentFlag, etag, payload, fragmented};
+      table->tx[b.id] = TxChannel{b.id, can_id, planned | kFamousoFragmentFlag, etag, payload, fragmented, std::nullopt};
+      table->tx_etags.insert(etag);
       if (fragmented) {
         const std::size_t frames = famouso_ ? famouso::afp_fragment_count(payload) : fragment_count(payload, capacity_);
         table->backlog_frames = std::max<std::size_t>(table->backlog_frames, 2 * frames);
@@ -367,11 +390,12 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
   // Kernel filters: the 14 etag bits of every etag bound as publisher, plus the protocols' etags;
   // extended frames only. Everything else stays in the kernel.
   table->filters = protocol_filters(famouso_);
-  if (table->rx.size() + table->filters.size() <= CAN_RAW_FILTER_MAX) {
+  const std::vector<can_filter> native_filters = table->native.filters();
+  if (table->rx.size() + native_filters.size() + table->filters.size() <= CAN_RAW_FILTER_MAX) {
     for (const auto& [etag, channel] : table->rx) table->filters.push_back(can_filter{etag | CAN_EFF_FLAG, kEtagFilterMask});
+    table->filters.insert(table->filters.end(), native_filters.begin(), native_filters.end());
   } else {
-    table->filters.clear();
-    table->filters.push_back(can_filter{CAN_EFF_FLAG, CAN_EFF_FLAG});  // too many: filter in user space
+    table->filters.assign(1, can_filter{0, 0});  // too many: every frame, filtered in user space
   }
 
   std::lock_guard lock(io_mutex_);
@@ -400,6 +424,23 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
     return Status::failure(errors);
   }
   return Status::success();
+}
+
+std::optional<std::string> CanAdapter::bind_native(const ChannelBinding& b, Table& table) const {
+  if (b.spec.payload > capacity_) {
+    return "payload " + std::to_string(b.spec.payload) + " B does not fit one native frame (" + std::to_string(capacity_) + " B)";
+  }
+  const NativeCanFrame frame{b.can->can_id, b.can->extended};
+  const auto payload = static_cast<std::size_t>(b.spec.payload);
+  if (b.role == HopRole::publisher) {
+    if (!table.native.add_publisher(frame, can_native::RxChannel{b.id, b.spec.subject, payload})) {
+      return "native identifier bound twice as publisher";
+    }
+  } else {
+    table.tx[b.id] = TxChannel{b.id, 0, 0, 0, payload, false, frame};
+    table.native.add_subscriber(frame);
+  }
+  return std::nullopt;
 }
 
 void CanAdapter::refresh_rx_table() {
@@ -484,12 +525,18 @@ AdapterStatistics CanAdapter::statistics() const {
   s.overflow_drops = overflow_closed_.load() + overflow_socket_.load() + overflow_controller_.load();
   s.backlog = backlog_size_.load();
   s.binding_requests_over_limit = refused_requests_.load();
+  s.unexplained = census_.snapshot(steady_now());
+  s.unexplained_others = census_.others();
   return s;
 }
 
 // ------------------------------------------------------------------------------ socket and link
 
 void CanAdapter::close_socket() {
+  if (census_sock_ >= 0) {
+    ::close(census_sock_);
+    census_sock_ = -1;
+  }
   std::lock_guard lock(io_mutex_);
   if (sock_ < 0) return;
   ::close(sock_);
@@ -561,7 +608,34 @@ bool CanAdapter::open_socket(int ifindex) {
   sock_ = s;
   bound_ifindex_ = ifindex;
   wait_pollout_ = false;
+  open_census_socket(ifindex);
   return true;
+}
+
+// Unfiltered and with a small receive buffer: when the receive thread falls behind, the kernel
+// drops census frames, never the channels' (they have their own socket, read first).
+void CanAdapter::open_census_socket(int ifindex) {
+  if (census_sock_ >= 0) ::close(census_sock_);
+  census_sock_ = -1;
+  const int s = ::socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
+  const int on = 1;
+  const int buffer = 64 * 1024;
+  sockaddr_can addr{};
+  addr.can_family = AF_CAN;
+  addr.can_ifindex = ifindex;
+  const bool ok = s >= 0 && (!segment_.can.fd || ::setsockopt(s, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on, sizeof on) == 0) &&
+                  ::setsockopt(s, SOL_SOCKET, SO_RCVBUF, &buffer, sizeof buffer) == 0 &&
+                  ::bind(s, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) == 0;
+  if (ok) {
+    census_sock_ = s;
+    return;
+  }
+  const int err = errno;
+  if (s >= 0) ::close(s);
+  if (!census_error_logged_) {
+    census_error_logged_ = true;
+    log_.log(LogLevel::warning, "segment " + segment_.name + ": no census socket (unexplained frames are not counted): " + errno_text(err));
+  }
 }
 
 void CanAdapter::check_link() {
@@ -626,7 +700,7 @@ void CanAdapter::run() {
     handle_protocol_timeouts(now);
     serve_deferred_requests(now);
 
-    pollfd fds[2] = {{wake_fd_, POLLIN, 0}, {-1, 0, 0}};
+    pollfd fds[3] = {{wake_fd_, POLLIN, 0}, {-1, 0, 0}, {census_sock_, POLLIN, 0}};
     Nanos deadline = next_link_check_;
     if (const auto d = reassembler_.next_deadline()) deadline = std::min(deadline, *d + Nanos(1));
     if (const auto d = afp_.next_deadline()) deadline = std::min(deadline, *d + Nanos(1));
@@ -643,7 +717,7 @@ void CanAdapter::run() {
       if (!backlog_.empty() && retry_at_) deadline = std::min(deadline, *retry_at_);
     }
     const auto wait_ms = std::chrono::ceil<milliseconds>(std::max(Nanos(0), deadline - now)).count();
-    const int ready = ::poll(fds, 2, static_cast<int>(std::min<std::int64_t>(wait_ms, 1000)));
+    const int ready = ::poll(fds, 3, static_cast<int>(std::min<std::int64_t>(wait_ms, 1000)));
     if (ready < 0 && errno != EINTR) {
       log_.log(LogLevel::error, "segment " + segment_.name + ": poll: " + errno_text(errno));
       std::this_thread::sleep_for(milliseconds(10));
@@ -657,6 +731,8 @@ void CanAdapter::run() {
     if (fds[1].fd >= 0 && (fds[1].revents & (POLLIN | POLLERR | POLLHUP))) read_frames();
     drain_backlog();
     drain_answers();
+    // After the channels' frames and the sends: the census never delays them.
+    if (fds[2].fd >= 0 && fds[2].fd == census_sock_ && (fds[2].revents & POLLIN)) read_census();
   }
 }
 
@@ -689,6 +765,38 @@ void CanAdapter::read_frames() {
     for (int i = 0; i < n; ++i) handle_datagram(slots[i].frame, messages[i].msg_hdr, messages[i].msg_len);
     if (static_cast<std::size_t>(n) < kReadBatch) return;  // drained
   }
+}
+
+void CanAdapter::read_census() {
+  std::array<canfd_frame, kReadBatch> frames;
+  std::array<iovec, kReadBatch> iovs;
+  std::array<mmsghdr, kReadBatch> messages;
+  for (int round = 0; round < kFramesPerWakeup / static_cast<int>(kReadBatch) && census_sock_ >= 0; ++round) {
+    for (std::size_t i = 0; i < kReadBatch; ++i) {
+      iovs[i] = iovec{&frames[i], sizeof(canfd_frame)};
+      messages[i] = mmsghdr{};
+      messages[i].msg_hdr.msg_iov = &iovs[i];
+      messages[i].msg_hdr.msg_iovlen = 1;
+    }
+    const int n = ::recvmmsg(census_sock_, messages.data(), kReadBatch, MSG_DONTWAIT, nullptr);
+    if (n <= 0) return;  // drained, or the interface went: check_link() reopens both sockets
+    refresh_rx_table();
+    const Nanos now = steady_now();
+    for (int i = 0; i < n; ++i) {
+      const canid_t id = frames[static_cast<std::size_t>(i)].can_id;
+      if (!(id & CAN_ERR_FLAG) && !explains(*rx_table_, id)) census_.count(id, now);
+    }
+    if (static_cast<std::size_t>(n) < kReadBatch) return;
+  }
+}
+
+// A bound channel's frame (either layout, either role), a binding protocol's or a declared
+// background frame.
+bool CanAdapter::explains(const Table& table, canid_t can_id) const {
+  if (table.native.explains(can_id)) return true;
+  if (!(can_id & CAN_EFF_FLAG)) return false;
+  const auto etag = static_cast<std::uint16_t>(can_id & kEtagMask);
+  return etag <= kHighestReservedEtag || table.rx.count(etag) != 0 || table.tx_etags.count(etag) != 0;
 }
 
 void CanAdapter::handle_read_error(int err) {
@@ -745,13 +853,19 @@ void CanAdapter::handle_frame(const canfd_frame& frame, bool fd_frame, Nanos now
   }
   ++received_;
   const std::size_t len = std::min<std::size_t>(frame.len, fd_frame ? CANFD_MAX_DLEN : CAN_MAX_DLEN);
+  refresh_rx_table();
+  const Table& table = *rx_table_;
+  // Native identifiers first: an extended one may have any bits in the etag field.
+  if (const can_native::RxChannel* native = table.native.find(frame.can_id)) {
+    deliver_native(*native, std::span<const std::uint8_t>(frame.data, len), fd_frame, now);
+    return;
+  }
+  if (table.native.is_background(frame.can_id)) return;  // another device's declared frame
   if (!(frame.can_id & CAN_EFF_FLAG)) {  // an 11-bit frame: not ours (only without kernel filters)
     problem(kNoChannel, InboundProblem::unknown_channel);
     return;
   }
   const CanIdentifier id = decode_can_id(frame.can_id & CAN_EFF_MASK);
-  refresh_rx_table();
-  const Table& table = *rx_table_;
   if (id.etag == kEtagGetEtag) {
     if (frame.can_id & CAN_RTR_FLAG) {
       problem(kNoChannel, InboundProblem::decode_error);
@@ -856,6 +970,16 @@ void CanAdapter::deliver(const RxChannel& channel, std::span<const std::uint8_t>
   event.payload = payload;
   event.received_at = now;
   if (sink_) sink_->on_event(event);
+}
+
+void CanAdapter::deliver_native(const can_native::RxChannel& channel, std::span<const std::uint8_t> data, bool fd_frame,
+                                Nanos now) {
+  const auto event = can_native::contents(channel, data, fd_frame);
+  if (!event) {
+    problem(channel.id, InboundProblem::decode_error);
+    return;
+  }
+  deliver(RxChannel{channel.id, channel.subject, channel.payload, false}, *event, now);
 }
 
 void CanAdapter::handle_error_frame(const canfd_frame& frame) {
@@ -1085,6 +1209,7 @@ SendStatus CanAdapter::send(const OutboundEvent& event) {
     }
     const TxChannel& channel = it->second;
     const bool fd = segment_.can.fd;
+    if (channel.native) return send_frame(can_native::encode(*channel.native, event.payload, fd, brs_));
     canfd_frame frame{};
     frame.can_id = channel.can_id | CAN_EFF_FLAG;
     frame.flags = fd && brs_ ? CANFD_BRS : 0;
@@ -1097,16 +1222,7 @@ SendStatus CanAdapter::send(const OutboundEvent& event) {
     if (!channel.fragmented || famouso_) {  // FAMOUSO: events of up to 8 bytes are plain frames
       std::memcpy(frame.data, event.payload.data(), event.payload.size());
       finish(event.payload.size());
-      switch (submit(frame, fd)) {
-        case WriteResult::written:
-        case WriteResult::queued:
-          return SendStatus::sent;
-        case WriteResult::full:
-          return SendStatus::queue_full;
-        case WriteResult::failed:
-          return SendStatus::failed;
-      }
-      return SendStatus::failed;
+      return send_frame(frame);
     }
     const std::uint32_t count = fragment_count(event.payload.size(), capacity_);
     if (!backlog_.empty() && !backlog_.room_for(count)) {
@@ -1134,6 +1250,19 @@ SendStatus CanAdapter::send(const OutboundEvent& event) {
     ++send_errors_;
     return SendStatus::failed;
   }
+}
+
+SendStatus CanAdapter::send_frame(const canfd_frame& frame) {
+  switch (submit(frame, segment_.can.fd)) {
+    case WriteResult::written:
+    case WriteResult::queued:
+      return SendStatus::sent;
+    case WriteResult::full:
+      return SendStatus::queue_full;
+    case WriteResult::failed:
+      return SendStatus::failed;
+  }
+  return SendStatus::failed;
 }
 
 // FAMOUSO: an event of more than 8 bytes as AFP fragments with the identifier's fragment flag.

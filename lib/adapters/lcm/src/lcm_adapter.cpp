@@ -236,7 +236,9 @@ class LcmAdapter final : public SegmentAdapter {
     std::unordered_map<ChannelId, Channel> wanted;
     std::unordered_map<std::string, ChannelId> names;
     for (const ChannelBinding& b : bindings) {
-      const std::string& name = b.spec.name;
+      // A native binding names the LCM channel and carries the contents raw.
+      const NativeBinding* native = b.spec.native_on(segment_.name);
+      const std::string& name = native && native->lcm_channel ? *native->lcm_channel : b.spec.name;
       if (b.id == kNoChannel || name.empty()) {
         add_error("channel '" + name + "' has no id or name");
         continue;
@@ -257,7 +259,7 @@ class LcmAdapter final : public SegmentAdapter {
         c.id = b.id;
         c.name = name;
         c.subject = b.spec.subject;
-        c.encoding = b.spec.lcm_encoding;
+        c.encoding = native && native->lcm_channel ? LcmEncoding::raw : b.spec.lcm_encoding;
       } else if (c.name != name) {
         add_error("channel id " + std::to_string(b.id) + " bound under two names");
         continue;
@@ -481,6 +483,7 @@ class LcmAdapter final : public SegmentAdapter {
       event.header.subject = channel.subject;
       event.header.created_ns = rbuf.recv_utime * 1000;  // wall clock, informational
       event.payload = bytes;
+      event.guard_loops_by_fingerprint = true;
       sink_->on_event(event);
       return;
     }

@@ -52,6 +52,10 @@ struct Check {
 // The response-time analysis orders the streams by can_id, so it sees the arbitration the bus does.
 struct CanHopPlan {
   CanProfile profile = CanProfile::cosmic;
+  // A native channel (ChannelSpec::native): its fixed identifier, standard or extended; no etag,
+  // priority field or fragmentation.
+  bool native = false;
+  bool extended = true;
   std::uint8_t priority = 0;  // the identifier's priority field (7 bits in the FAMOUSO profile)
   std::uint32_t can_id = 0;   // 29-bit identifier of the hop's frames
   std::uint16_t etag = 0;
@@ -61,6 +65,12 @@ struct CanHopPlan {
   Nanos jitter{0};                      // release jitter used in the analysis
   std::optional<Nanos> response_time;   // nullopt: unbounded
 };
+
+// The plan's identifier as the bus orders it (standard and extended identifiers compared the way
+// arbitration does).
+inline std::uint32_t arbitration_key(const CanHopPlan& plan) {
+  return arbitration_key(plan.can_id, plan.extended ? CanIdFormat::extended29 : CanIdFormat::standard11);
+}
 
 struct HopReport {
   std::string segment;

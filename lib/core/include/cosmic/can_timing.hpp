@@ -18,6 +18,10 @@ namespace cosmic {
 
 enum class CanIdFormat { standard11, extended29 };
 
+// Largest identifier of each format.
+inline constexpr std::uint32_t kStandardIdMax = 0x7FF;
+inline constexpr std::uint32_t kExtendedIdMax = 0x1FFFFFFF;
+
 // Largest payload of one frame.
 inline constexpr std::uint32_t kClassicMaxPayload = 8;
 inline constexpr std::uint32_t kFdMaxPayload = 64;

@@ -30,6 +30,11 @@ struct InboundEvent {
   EventHeader header;
   std::span<const std::uint8_t> payload;
   Nanos received_at{0};  // steady clock when the adapter got it
+  // Set by a wire format that carries no origin or sequence on a network that can hand a copy the
+  // gateway forwarded back to it (raw LCM: two gateways bridging one group in opposite directions).
+  // The router then cuts loops by payload fingerprint (RawLoopGuard). A native CAN frame needs
+  // none: an identifier has one sender, and CAN_RAW does not return a socket's own frames.
+  bool guard_loops_by_fingerprint = false;
 };
 
 // Handed by the router to an adapter (router thread).

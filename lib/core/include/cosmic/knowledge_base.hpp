@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <optional>
 #include <bitset>
+#include <map>
 #include <set>
 #include <string>
 #include <unordered_map>
@@ -44,8 +45,10 @@ struct BindOutcome {
 
 class KnowledgeBase {
  public:
-  // `reserved_etags`: static etags declared anywhere in the configuration, never handed out
-  // dynamically even while their channel is not bound.
+  // `reserved_etags`: static etags declared anywhere in the configuration (reserved_etags()),
+  // never handed out dynamically even while their channel is not bound. The etag bits of the
+  // segments' extended background frames are never handed out either: COSMIC devices would read
+  // those frames as the channel's.
   KnowledgeBase(GatewaySpec gateway, std::vector<SegmentSpec> segments, std::set<std::uint16_t> reserved_etags = {});
 
   // Tries to bind `channel` (its segments must exist). On rejection nothing changes.
@@ -78,7 +81,8 @@ class KnowledgeBase {
   };
   Attempt attempt(const ChannelSpec& channel) const;
   std::optional<std::uint16_t> allocate_etag() const;
-  bool touches_can(const ChannelSpec& channel) const;
+  bool needs_etag(const ChannelSpec& channel) const;
+  std::optional<std::string> native_clash(const ChannelSpec& channel, std::optional<std::uint16_t> etag) const;
 
   std::vector<SegmentState> segments_;
   AdmissionSet set_;
@@ -86,7 +90,15 @@ class KnowledgeBase {
   EtagMap etags_;                                         // bound CAN channels
   std::bitset<kMaxEtag + 1> etag_taken_;                  // reserved or bound: never handed out
   std::unordered_map<std::uint64_t, std::string> subjects_;  // subject -> bound channel
+  // Native identities of bound channels: (segment, identity) -> channel, and the etag bits of
+  // their extended CAN identifiers (never handed out while such a channel is bound).
+  std::map<std::pair<std::string, std::string>, std::string> native_owners_;
+  std::multimap<std::uint16_t, std::string> native_etags_;
 };
+
+// The etags a configuration reserves: its channels' static etags and the etag bits of their
+// native extended CAN identifiers.
+std::set<std::uint16_t> reserved_etags(const Config& config);
 
 // Binds every channel of `config` in order and reports the final set; each rejected channel is
 // reported as evaluated on top of the final set.

@@ -87,6 +87,23 @@ struct SegmentSpec {
   friend bool operator==(const SegmentSpec&, const SegmentSpec&) = default;
 };
 
+// A channel in a segment's own wire format (channel key `native`, issue 19): the identity that
+// the devices already on that network use, instead of this project's envelope or identifier layout.
+struct NativeCanFrame {
+  std::uint32_t can_id = 0;  // 11 or 29 bits, without flags; the frame's data bytes are the contents
+  bool extended = false;
+  friend bool operator==(const NativeCanFrame&, const NativeCanFrame&) = default;
+};
+
+struct NativeBinding {
+  std::string segment;
+  std::optional<NativeCanFrame> can;  // CAN segments: the channel is this frame
+  std::optional<std::string> lcm_channel;  // LCM segments: raw contents on this LCM channel name
+  friend bool operator==(const NativeBinding&, const NativeBinding&) = default;
+};
+// How errors and reports name a native identity: "0x123", "0x18FF0001" or the LCM channel name.
+std::string native_identity(const NativeBinding& binding);
+
 struct ChannelSpec {
   std::string name;
   std::uint64_t subject = 0;
@@ -100,7 +117,12 @@ struct ChannelSpec {
   LcmEncoding lcm_encoding = LcmEncoding::envelope;
   std::vector<std::string> publishers;   // P segments
   std::vector<std::string> subscribers;  // S segments
+  std::vector<NativeBinding> native;     // at most one per segment, each one of publishers/subscribers
   friend bool operator==(const ChannelSpec&, const ChannelSpec&) = default;
+
+  const NativeBinding* native_on(const std::string& segment) const;
+  // The native CAN frame of this channel on `segment`, if it has one there.
+  std::optional<NativeCanFrame> native_can(const std::string& segment) const;
 };
 
 // Opt-in HTTP endpoint serving the gateway's metrics (docs/metrics.md). Off unless configured.

@@ -95,6 +95,16 @@ struct HealthReport {
   std::string detail;
 };
 
+// Frames on a CAN bus that neither a bound channel, the binding protocols nor a declared background
+// frame explains, by identifier: traffic admission did not know about.
+struct UnexplainedFrames {
+  std::uint32_t can_id = 0;  // 11 or 29 bits, without flags
+  bool extended = false;
+  std::uint64_t frames = 0;  // since the adapter started
+  double rate_hz = 0;        // over the last full second; 0 once silent for two seconds
+  friend bool operator==(const UnexplainedFrames&, const UnexplainedFrames&) = default;
+};
+
 struct AdapterStatistics {
   std::uint64_t received = 0;        // messages/frames read from the network
   std::uint64_t sent = 0;            // messages/frames written to the network
@@ -105,6 +115,10 @@ struct AdapterStatistics {
   // Requests of the transport's binding protocol over its rate limit (CAN: GET_ETAG, answered
   // later or not at all; also counted in receive_errors); nullopt where there is no such protocol.
   std::optional<std::uint64_t> binding_requests_over_limit;
+  // CAN: the unexplained identifiers (at most 64, lowest identifier first) and the frames of any
+  // further ones; empty where the transport cannot see foreign traffic.
+  std::vector<UnexplainedFrames> unexplained;
+  std::uint64_t unexplained_others = 0;
 };
 
 class SegmentAdapter {

@@ -184,7 +184,10 @@ class Gateway {
   Refusals configure_adapters();
   // Makes `report` say `failed`, with the reasons, when a segment refused its channel.
   void mark_refused(ChannelReport& report) const;
-  void judge(const ChannelMisses& counted, const ChannelSpec& spec, RuntimeTrack& track, Nanos now);
+  // `foreign`: why the channel's analysis does not hold now (undeclared frames beat it), or null.
+  void judge(const ChannelMisses& counted, const ChannelSpec& spec, RuntimeTrack& track, Nanos now, const std::string* foreign);
+  // HRT channels that frames unknown to admission beat on a CAN bus: name -> reason.
+  std::map<std::string, std::string> undeclared_interference() const;
   std::string violation_line(const ChannelSpec& spec) const;
   void apply_routes();
   ChannelId id_for(const ChannelSpec& spec);

@@ -32,7 +32,8 @@ DOMAIN = "57"
 GW_NODE = 9                      # gateway.can_node_id
 DEV = 5                          # TxNode of the device this test plays on the bus
 SUBJ = {"sensor": 0x1000000A1, "command": 0x1000000B2, "bulk_up": 0x1000000C3, "bulk_down": 0x1000000C4,
-        "fd_down": 0x1000000D5, "fd_up": 0x1000000D6}
+        "fd_down": 0x1000000D5, "fd_up": 0x1000000D6, "wheel": 0x1000000E1, "lamp": 0x1000000E2,
+        "brake": 0x1000000E3}
 ETAG = {"sensor": 16383,         # dynamic: the first etag handed out (section 3)
         "command": 300, "bulk_up": 201, "bulk_down": 202, "fd_down": 501, "fd_up": 502}
 CHANNELS = ("sensor", "command", "bulk_up", "bulk_down")  # those on segment bus (vcan0)
@@ -41,6 +42,11 @@ SEGMENTS = 4
 PRIO_COMMAND = 0x10              # the only SRT channel on the bus: first SRT level (section 2)
 PRIO_BINDING = 0xFD              # binding protocol (sections 2 and 5)
 ETAG_GET, ETAG_SUPPLY = 2, 3
+WHEEL_ID = 0x123                 # native, standard (wheel: bus -> lan, viz)
+LAMP_ID = 0x18FF1234             # native, extended (lamp: viz -> bus)
+ENGINE_ID = 0x0C0                # declared background frame of segment bus
+BRAKE_ID = 0x0F0                 # native, standard, HRT (brake: bus -> viz)
+INTRUDER_ID = 0x0A0              # declared nowhere: beats brake's 0x0F0
 MARKER = "7FF#5A"                # 11-bit: never reaches cosmicd (its filters take 29-bit frames)
 
 
@@ -448,6 +454,67 @@ def scenario_fragments_down(s):
     s.notes.append("identifier %08X; headers 0000..00A9 + 08AA, 1000.., ..., F000.., 0000.., 1000..10A9 + 18AA" % ident)
 
 
+def scenario_native(s):
+    """Native identifiers with can-utils, both directions, while another ECU's declared background
+    frames run (cangen, 0x0C0 every 2 ms): cansend 123#... -> cosmicd -> LCM and DDS envelopes
+    carrying the frame's bytes; an LCM event -> cosmicd -> candump shows the extended frame
+    18FF1234 with the bytes; the reports show the native layout and no etag."""
+    gw = s.t.gw
+    hop = gw.can_hop("wheel")
+    expect_eq("wheel's CAN hop", (hop["layout"], hop["can_id"], hop["extended"]), ("native", WHEEL_ID, False))
+    expect_eq("lamp's CAN hop", (gw.can_hop("lamp")["layout"], gw.can_hop("lamp")["can_id"]), ("native", LAMP_ID))
+    chs = gw.channels(cli=True)
+    expect_eq("etags of the native channels", (chs["wheel"].get("etag"), chs["lamp"].get("etag")), (None, None))
+    errors0 = gw.segments()["bus"]["adapter"]["receive_errors"]
+    s.candump("engine", "%03X:7FF" % ENGINE_ID)
+    engine = s.spawn("cangen", ["cangen", IF, "-I", "%03X" % ENGINE_ID, "-L", "8", "-D", "i", "-g", "2"])
+    wait_until("background frames on the bus", 10, lambda: " %03X#" % ENGINE_ID in read_text(s.path("engine.out")))
+    lcm = s.lcm_sub("lcm", "wheel")
+    dds = s.dds_sub("dds", "wheel")
+    cansend("%03X#0102030405060708" % WHEEL_ID)
+    s.received("LCM subscriber", lcm, "0102030405060708", "wheel")
+    s.received("DDS subscriber", dds, "0102030405060708", "wheel")
+    s.candump("dump", "%08X:1FFFFFFF" % LAMP_ID)
+    s.lcm_pub("lamp", 2)
+    wait_until("lamp's frame on the bus", 10, lambda: len(s.frames("dump", LAMP_ID)) >= 1)
+    expect_eq("lamp's frames", s.classic("dump"), [frame_text(LAMP_ID, canlog.payload("lcm", 2, 1))])
+    check(engine.poll() is None, "the background frames ran throughout")
+    expect_eq("receive errors (background frames are no one's events)", gw.segments(cli=True)["bus"]["adapter"]["receive_errors"],
+              errors0)
+    s.notes.append("%d background frames meanwhile" % read_text(s.path("engine.out")).count(" %03X#" % ENGINE_ID))
+
+
+def scenario_unexplained(s):
+    """Frames nothing explains: cosmicctl segments counts them by identifier with their rate (the
+    declared background frame and the bound channels' frames are not counted); one that beats the
+    HRT channel brake's identifier turns brake `violated`, logged once with the numbers."""
+    gw = s.t.gw
+    expect_eq("brake before", gw.channels()["brake"]["runtime_state"], "bound")
+    cansend("%03X#01" % ENGINE_ID)                      # declared background: explained
+    cansend("%03X#01" % BRAKE_ID)                       # brake's own frame: explained
+    cansend("%08X#0102" % canlog.can_id(0xF0, DEV, ETAG["sensor"]))  # a bound channel's: explained
+    for k in range(3):
+        cansend("%03X#%02X" % (INTRUDER_ID, k))
+        cansend("%08X#%02X" % (0x1ABCDE00 | 0x3F00, k))  # extended, unbound etag 0x3F00, loses to brake
+
+    def unexplained():
+        seg = gw.segments()["bus"]
+        return {f["id"]: f for f in seg["unexplained"]} if len(seg["unexplained"]) >= 2 else None
+    found = wait_until("two unexplained identifiers", 20, unexplained)
+    expect_eq("unexplained identifiers", sorted(found), ["0x0A0", "0x1ABCFF00"])
+    expect_eq("frames of 0x0A0", found["0x0A0"]["frames"], 3)
+    check(found["0x0A0"]["rate_hz"] > 0, "0x0A0 has a rate")
+    wait_until("brake violated", 20, lambda: gw.channels()["brake"]["runtime_state"] == "violated")
+    expect_eq("wheel (SRT) keeps its state", gw.channels()["wheel"]["runtime_state"], "bound")
+    log = read_text(gw.log)
+    lines = [l for l in log.splitlines() if "channel brake violated" in l]
+    expect_eq("violation lines for brake", len(lines), 1)
+    check("0x0A0" in lines[0] and "0x0F0" in lines[0] and "0x1ABCFF00" not in lines[0], "the line names the frames: " + lines[0])
+    text = subprocess.run([gw.cosmicctl, "--socket", gw.sock, "segments"], capture_output=True, text=True, check=True).stdout
+    check("bus: unexplained frames" in text and "0x0A0" in text, "cosmicctl segments (text) lists them:\n" + text)
+    s.notes.append(lines[0].split("violated its admitted bounds: ")[-1][:120])
+
+
 def scenario_garbage(s):
     """cangen garbage and hostile fragments: cosmicd survives, every frame is accounted for
     (frames of unbound etags never reach it), errors are counted, traffic still flows."""
@@ -493,6 +560,10 @@ def scenario_garbage(s):
     # cosmicd's socket is classic CAN and filters 29-bit frames of its publisher etags + GET_ETAG.
     bound = {ETAG["sensor"], ETAG["bulk_up"], ETAG_GET}
     passing = [f for f in frames if f.eff and f.fd_flags is None and (f.id & 0x3FFF) in bound]
+    # ... and the native standard identifiers of wheel and brake (exact match, data frames only).
+    wheel = [f for f in frames if not f.eff and f.fd_flags is None and not f.rtr and f.id == WHEEL_ID]
+    brake = [f for f in frames if not f.eff and f.fd_flags is None and not f.rtr and f.id == BRAKE_ID]
+    passing += wheel + brake
     sensor = [f for f in passing if (f.id & 0x3FFF) == ETAG["sensor"]]
     sensor_bad = [f for f in sensor if f.rtr or len(f.data) > 4]  # remote, or longer than payload 4 B
     get_bad = [f for f in passing if (f.id & 0x3FFF) == ETAG_GET and (f.rtr or len(f.data) != 8)]
@@ -517,6 +588,7 @@ def scenario_garbage(s):
     if delta("overflow_drops") == 0:  # exact, frame by frame
         expect_eq("sensor decode errors (remote or longer than 4 B)", d_sensor, len(sensor_bad))
         expect_eq("sensor events", hop_delta("sensor", "rx"), len(sensor) - len(sensor_bad))
+        expect_eq("wheel events (random 11-bit frames that hit 0x123)", hop_delta("wheel", "rx"), len(wheel))
         check(d_bulk >= 20 + 3, "bulk_up decode errors %d >= 23 (20 remote frames, 3 hostile events)" % d_bulk)
         check(delta("receive_errors") >= len(sensor_bad) + len(get_bad) + d_bulk,
               "receive errors %d >= %d" % (delta("receive_errors"), len(sensor_bad) + len(get_bad) + d_bulk))
@@ -695,7 +767,7 @@ def scenario_link_down_up(s):
 
 
 SCENARIOS = [scenario_etags, scenario_get_etag, scenario_can_to_ip, scenario_ip_to_can, scenario_fragments_up,
-             scenario_fragments_down, scenario_can_fd, scenario_garbage, scenario_overflow, scenario_error_frames,
+             scenario_fragments_down, scenario_can_fd, scenario_native, scenario_unexplained, scenario_garbage, scenario_overflow, scenario_error_frames,
              scenario_link_down_up]
 
 

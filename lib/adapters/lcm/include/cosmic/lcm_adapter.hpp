@@ -1,11 +1,12 @@
 // LCM segment adapter: one lcm_t per segment (SegmentSpec::lcm.url) with its own receive thread.
 //
-// LCM channel name = COSMIC channel name. Per channel (ChannelSpec::lcm_encoding):
+// LCM channel name = COSMIC channel name, or the one a native binding names
+// (ChannelSpec::native: `{channel: NAME}`, always raw). Per channel (ChannelSpec::lcm_encoding):
 //   envelope  the cosmic::envelope type (lib/adapters/lcm/types/cosmic_envelope.lcm, generated
 //             by lcm-gen at build time) carrying the event header and the payload;
 //   raw       the payload bytes unchanged, so native LCM programs, lcm-logger and lcm-spy see
 //             their own type; inbound raw messages become events with origin 0, sequence 0,
-//             age 0 and the channel's subject.
+//             age 0 and the channel's subject, marked for the router's fingerprint loop guard.
 // The adapter never delivers its own publications (EventSink::on_problem(own_echo) instead).
 #pragma once
 

@@ -1,0 +1,152 @@
+#include "native_loader.hpp"
+
+#include <algorithm>
+
+#include "cosmic/can_background.hpp"
+#include "cosmic/can_wire.hpp"
+#include "cosmic/transport_limits.hpp"
+
+namespace cosmic::config_detail {
+namespace {
+
+std::string key(const std::string& path, const std::string& name) { return path + "." + name; }
+
+bool parse_can(YamlReader& reader, const YAML::Node& node, const std::string& path, const SegmentSpec& segment,
+               NativeBinding& binding) {
+  if (!reader.check_map(node, path, {"can_id", "extended"})) return false;
+  NativeCanFrame frame;
+  if (node["extended"]) {
+    const auto extended = reader.boolean(node["extended"], key(path, "extended"));
+    if (!extended) return false;
+    frame.extended = *extended;
+  }
+  if (!node["can_id"]) {
+    reader.error_at(node, key(path, "can_id"), "missing required key 'can_id'",
+                    "the frame's identifier, e.g. can_id: 0x123 (11 bits) or 0x18FF0001 with extended: true");
+    return false;
+  }
+  const auto id = reader.unsigned_int(node["can_id"], key(path, "can_id"), 0, frame.extended ? kExtendedIdMax : kStandardIdMax);
+  if (!id) return false;
+  frame.can_id = static_cast<std::uint32_t>(*id);
+  // COSMIC and FAMOUSO devices read an extended identifier's low 14 bits as an etag: one of the
+  // binding protocols' etags would be taken for a protocol message by every such device.
+  const auto etag = static_cast<std::uint16_t>(frame.can_id & kEtagMask);
+  if (frame.extended && etag <= kHighestReservedEtag) {
+    reader.error_at(node["can_id"], key(path, "can_id"),
+                    "extended identifier " + can_id_text(frame.can_id, true) + " has etag bits " + std::to_string(etag) +
+                        ", which the binding protocols use (0.." + std::to_string(kHighestReservedEtag) + ")",
+                    "an extended identifier whose low 14 bits are above " + std::to_string(kHighestReservedEtag) +
+                        ", or a standard identifier");
+    return false;
+  }
+  const auto& background = segment.can.background;
+  const auto declared = std::find_if(background.begin(), background.end(), [&](const CanBackgroundFrame& f) {
+    return f.can_id == frame.can_id && f.extended == frame.extended;
+  });
+  if (declared != background.end()) {
+    reader.error_at(node["can_id"], key(path, "can_id"),
+                    can_id_text(frame.can_id, frame.extended) + " is declared as background frame " + declared->name + " (" +
+                        declared->origin + ") of segment " + segment.name,
+                    "a frame is either background traffic or a channel: remove it from the background");
+    return false;
+  }
+  binding.can = frame;
+  return true;
+}
+
+bool parse_lcm(YamlReader& reader, const YAML::Node& node, const std::string& path, NativeBinding& binding) {
+  if (!reader.check_map(node, path, {"channel"})) return false;
+  if (!node["channel"]) {
+    reader.error_at(node, key(path, "channel"), "missing required key 'channel'", "the LCM channel name, e.g. channel: POSE");
+    return false;
+  }
+  const auto name = reader.string(node["channel"], key(path, "channel"));
+  if (!name) return false;
+  if (name->empty()) {
+    reader.error_at(node["channel"], key(path, "channel"), "empty LCM channel name", "the LCM channel name, e.g. channel: POSE");
+    return false;
+  }
+  if (const auto problem = transport_name_problem(SegmentType::lcm, *name)) {
+    reader.error_at(node["channel"], key(path, "channel"), *problem, "a shorter name");
+    return false;
+  }
+  binding.lcm_channel = *name;
+  return true;
+}
+
+}  // namespace
+
+void parse_native(YamlReader& reader, const YAML::Node& node, const std::string& path, const Config& config,
+                  ChannelSpec& channel) {
+  if (!node.IsMap()) {
+    reader.error_at(node, path, "expected a map of segment names to native identities",
+                    "native: {body: {can_id: 0x123}} or native: {viz: {channel: POSE}}");
+    return;
+  }
+  for (const auto& entry : node) {
+    const std::string name = entry.first.Scalar();
+    const std::string entry_path = key(path, name);
+    const SegmentSpec* segment = config.find_segment(name);
+    if (!segment) {
+      std::string known;
+      for (const auto& s : config.segments) known += (known.empty() ? "" : ", ") + s.name;
+      reader.error_at(entry.first, entry_path, "unknown segment '" + name + "'", "one of the segments: " + known);
+      continue;
+    }
+    NativeBinding binding;
+    binding.segment = name;
+    bool ok = false;
+    switch (segment->type) {
+      case SegmentType::can:
+        ok = parse_can(reader, entry.second, entry_path, *segment, binding);
+        break;
+      case SegmentType::lcm:
+        ok = parse_lcm(reader, entry.second, entry_path, binding);
+        break;
+      case SegmentType::dds:
+        reader.error_at(entry.first, entry_path, "native topics on DDS segments are not supported by this version",
+                        "a CAN or LCM segment; on DDS the channel travels as cosmic::Envelope on cosmic/<channel>");
+        break;
+    }
+    if (ok) channel.native.push_back(std::move(binding));
+  }
+}
+
+void check_native_segments(YamlReader& reader, const YAML::Node& node, const std::string& path, const ChannelSpec& channel) {
+  for (const NativeBinding& binding : channel.native) {
+    const bool used = std::count(channel.publishers.begin(), channel.publishers.end(), binding.segment) +
+                          std::count(channel.subscribers.begin(), channel.subscribers.end(), binding.segment) >
+                      0;
+    if (used) continue;
+    YAML::Node where = node;
+    for (const auto& entry : node) {
+      if (entry.first.Scalar() == binding.segment) where = entry.first;
+    }
+    reader.error_at(where, key(path, binding.segment),
+                    "segment '" + binding.segment + "' is neither a publisher nor a subscriber of channel " + channel.name,
+                    "a native identity on one of the channel's segments");
+  }
+}
+
+void NativeDeclarations::add(YamlReader& reader, const YAML::Node& node, const std::string& path, const ChannelSpec& channel,
+                             bool derived) {
+  if (derived) deferred_.push_back(Deferred{channel.name, node, path});
+  for (const NativeBinding& binding : channel.native) {
+    const std::string identity = native_identity(binding);
+    const int line = node[binding.segment].Mark().line + 1;
+    const auto [it, fresh] = identities_.emplace(std::pair(binding.segment, identity), Owner{channel.name, line});
+    if (fresh) continue;
+    reader.error_at(node[binding.segment], key(path, binding.segment),
+                    identity + " on segment " + binding.segment + " is already channel " + it->second.channel + "'s (line " +
+                        std::to_string(it->second.line) + ")",
+                    "one channel per native identity and segment");
+  }
+}
+
+void NativeDeclarations::check_derived(YamlReader& reader, const Config& config) const {
+  for (const Deferred& d : deferred_) {
+    if (const ChannelSpec* channel = config.find_channel(d.channel)) check_native_segments(reader, d.node, d.path, *channel);
+  }
+}
+
+}  // namespace cosmic::config_detail
