@@ -36,7 +36,8 @@ SUBJ = {"sensor": 0x1000000A1, "command": 0x1000000B2, "bulk_up": 0x1000000C3, "
         "brake": 0x1000000E3}
 ETAG = {"sensor": 16383,         # dynamic: the first etag handed out (section 3)
         "command": 300, "bulk_up": 201, "bulk_down": 202, "fd_down": 501, "fd_up": 502}
-CHANNELS = ("sensor", "command", "bulk_up", "bulk_down")  # those on segment bus (vcan0)
+CHANNELS = ("sensor", "command", "bulk_up", "bulk_down")  # those on segment bus (vcan0) with etags
+NATIVE_CHANNELS = ("wheel", "brake", "lamp")              # native identifiers on segment bus
 FD_CHANNELS = ("fd_down", "fd_up")                        # those on segment bus_fd (vcan1)
 SEGMENTS = 4
 PRIO_COMMAND = 0x10              # the only SRT channel on the bus: first SRT level (section 2)
@@ -47,7 +48,7 @@ LAMP_ID = 0x18FF1234             # native, extended (lamp: viz -> bus)
 ENGINE_ID = 0x0C0                # declared background frame of segment bus
 BRAKE_ID = 0x0F0                 # native, standard, HRT (brake: bus -> viz)
 INTRUDER_ID = 0x0A0              # declared nowhere: beats brake's 0x0F0
-MARKER = "7FF#5A"                # 11-bit: never reaches cosmicd (its filters take 29-bit frames)
+MARKER = "7FF#5A"                # 11-bit, no channel's: only cosmicd's census sees it (unexplained)
 
 
 class Fail(Exception):
@@ -489,19 +490,22 @@ def scenario_unexplained(s):
     declared background frame and the bound channels' frames are not counted); one that beats the
     HRT channel brake's identifier turns brake `violated`, logged once with the numbers."""
     gw = s.t.gw
+    # brake gets no event here: in the emulated VM one could miss its residence bound and turn it
+    # violated first, for that reason.
     expect_eq("brake before", gw.channels()["brake"]["runtime_state"], "bound")
     cansend("%03X#01" % ENGINE_ID)                      # declared background: explained
-    cansend("%03X#01" % BRAKE_ID)                       # brake's own frame: explained
+    cansend("%03X#0102030405060708" % WHEEL_ID)         # a native channel's frame: explained
     cansend("%08X#0102" % canlog.can_id(0xF0, DEV, ETAG["sensor"]))  # a bound channel's: explained
     for k in range(3):
         cansend("%03X#%02X" % (INTRUDER_ID, k))
         cansend("%08X#%02X" % (0x1ABCDE00 | 0x3F00, k))  # extended, unbound etag 0x3F00, loses to brake
 
     def unexplained():
-        seg = gw.segments()["bus"]
-        return {f["id"]: f for f in seg["unexplained"]} if len(seg["unexplained"]) >= 2 else None
+        found = {f["id"]: f for f in gw.segments()["bus"]["unexplained"]}
+        return found if "0x0A0" in found and "0x1ABCFF00" in found else None
     found = wait_until("two unexplained identifiers", 20, unexplained)
-    expect_eq("unexplained identifiers", sorted(found), ["0x0A0", "0x1ABCFF00"])
+    # 0x7FF: the marker frames this test sends to see that candump receives (no channel has it).
+    expect_eq("unexplained identifiers", sorted(found), ["0x0A0", "0x1ABCFF00", "0x7FF"])
     expect_eq("frames of 0x0A0", found["0x0A0"]["frames"], 3)
     check(found["0x0A0"]["rate_hz"] > 0, "0x0A0 has a rate")
     wait_until("brake violated", 20, lambda: gw.channels()["brake"]["runtime_state"] == "violated")
@@ -734,7 +738,7 @@ def scenario_link_down_up(s):
         check(all(chs[n]["verdict"] == "bound" for n in FD_CHANNELS), "cosmicctl channels: those of bus_fd stay bound")
         st = gw.status(cli=True)
         expect_eq("cosmicctl status: segments up", st["segments"]["up"], SEGMENTS - 1)
-        expect_eq("cosmicctl status: channels degraded", st["channels"]["degraded"], len(CHANNELS))
+        expect_eq("cosmicctl status: channels degraded", st["channels"]["degraded"], len(CHANNELS) + len(NATIVE_CHANNELS))
         # An event for the bus while it is down: counted as not sent, nothing breaks.
 
         def not_sent():
@@ -829,7 +833,7 @@ class Test:
         def ready():
             check(self.gw.alive(), "cosmicd exited: %s" % read_text(self.gw.log))
             st = self.gw.try_query("status")
-            return st if st and st["segments"]["up"] == SEGMENTS and st["channels"]["bound"] == len(ETAG) else None
+            return st if st and st["segments"]["up"] == SEGMENTS and st["channels"]["bound"] == len(SUBJ) else None
         try:
             st = wait_until("cosmicd answering with every segment up and its channels bound", 30, ready, interval=0.1)
         except Fail as e:

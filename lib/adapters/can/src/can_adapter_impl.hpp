@@ -1,0 +1,261 @@
+// The SocketCAN adapter's class, shared by its translation units (internal to the CAN adapter):
+//   can_adapter.cpp   lifecycle, configure (the binding tables), health, statistics
+//   can_socket.cpp    the sockets and the link, the receive thread's loop and reads, the census
+//   can_receive.cpp   frames to events: both layouts, native frames, FAMOUSO protocols, binding answers
+//   can_send.cpp      events to frames: single frames, fragments, AFP, the backlog
+// Threads: see cosmic/segment_adapter.hpp; the members say which thread owns them.
+#pragma once
+
+#include <linux/can.h>
+#include <linux/can/error.h>
+#include <linux/can/raw.h>
+#include <net/if.h>
+#include <net/if_arp.h>
+#include <poll.h>
+#include <sys/eventfd.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <deque>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+#include "binding_guard.hpp"
+#include "can_binding.hpp"
+#include "cosmic/arrival_clock.hpp"
+#include "cosmic/thread_policy.hpp"
+#include "cosmic/can_fragment.hpp"
+#include "cosmic/can_timing.hpp"
+#include "cosmic/can_wire.hpp"
+#include "famouso_afp.hpp"
+#include "famouso_ccp.hpp"
+#include "frame_backlog.hpp"
+#include "bus_census.hpp"
+#include "native_frames.hpp"
+#include "cosmic/can_adapter.hpp"
+
+namespace cosmic::can_detail {
+using std::chrono::milliseconds;
+
+constexpr std::size_t kMinBacklogFrames = 256;
+constexpr std::size_t kMaxPartialEvents = 32;
+// Idle time after which a partial event is dropped. NRT fragments have the lowest priorities and
+// may wait long on a loaded bus; memory stays bounded by kMaxPartialEvents either way.
+constexpr Nanos kReassemblyTimeout = milliseconds(1000);
+constexpr Nanos kLinkCheckWhileDown = milliseconds(200);
+constexpr Nanos kLinkCheckWhileUp = milliseconds(1000);
+constexpr Nanos kEnobufsRetry = milliseconds(1);
+constexpr int kFramesPerWakeup = 256;
+constexpr std::size_t kReadBatch = 32;  // frames per recvmmsg
+constexpr std::size_t kFdPaddingSlack = 15;  // 48 -> 64 is the largest step between FD lengths
+constexpr can_err_mask_t kErrorMask = CAN_ERR_CRTL | CAN_ERR_BUSOFF | CAN_ERR_RESTARTED;
+constexpr Nanos kDeferredRequestRetry = std::chrono::milliseconds(20);  // well below one token (100 ms)
+constexpr std::size_t kMaxPendingRequests = 64;     // FAMOUSO: unanswered GET_ETAGs kept for a later bind
+constexpr std::size_t kMaxAnnouncedSubscriptions = 256;  // FAMOUSO: subscriptions logged once each
+constexpr canid_t kEtagFilterMask = 0x3FFF | CAN_EFF_FLAG;
+
+inline Nanos steady_now() { return std::chrono::duration_cast<Nanos>(std::chrono::steady_clock::now().time_since_epoch()); }
+
+inline std::string errno_text(int err) { return std::strerror(err); }
+
+inline std::uint32_t source_key(const CanIdentifier& id) { return (static_cast<std::uint32_t>(id.tx_node) << 14) | id.etag; }
+
+// Binding answers leave one at a time, two frame times apart (an extended 8-byte frame is at
+// most 160 bits with stuffing), so at most one is in the kernel's FIFO ahead of a real-time frame.
+inline Nanos answer_gap(const CanSegmentProperties& can) {
+  const double bits = 2 * 160.0;
+  const double rate = static_cast<double>(std::max<std::uint64_t>(can.bitrate.bits_per_second, 10'000));
+  return std::max(Nanos(200'000), Nanos(static_cast<std::int64_t>(bits * 1e9 / rate)));
+}
+
+// Etags the socket receives whatever is bound: the binding protocol, and on a FAMOUSO segment
+// the configuration protocol and the SUBSCRIBE announcements.
+inline std::vector<can_filter> protocol_filters(bool famouso) {
+  std::vector<can_filter> f{can_filter{kEtagGetEtag | CAN_EFF_FLAG, kEtagFilterMask}};
+  if (famouso) {
+    f.push_back(can_filter{kEtagCcpRsi | CAN_EFF_FLAG, kEtagFilterMask});
+    f.push_back(can_filter{kEtagFamousoSubscribe | CAN_EFF_FLAG, kEtagFilterMask});
+  }
+  return f;
+}
+
+class CanAdapter final : public SegmentAdapter {
+ public:
+  CanAdapter(const SegmentSpec& segment, Logger& log)
+      : segment_(segment),
+        log_(log),
+        capacity_(max_frame_payload(segment.can)),
+        brs_(segment.can.fd && segment.can.data_bitrate > segment.can.bitrate),
+        famouso_(segment.can.profile == CanProfile::famouso),
+        reassembler_(ReassemblyLimits{kMaxPartialEvents, kReassemblyTimeout, segment.can.fd ? kFdPaddingSlack : 0}),
+        afp_(famouso::AfpLimits{kMaxPartialEvents, kReassemblyTimeout}),
+        ccp_(segment.can.profile == CanProfile::famouso ? std::optional<famouso::CcpBroker>(std::in_place)
+                                                        : std::nullopt),
+        table_(std::make_shared<const Table>()),
+        answers_(answer_gap(segment.can)) {}
+
+  ~CanAdapter() override { stop(); }
+
+  Status start(EventSink& sink) override;
+  Status configure(std::span<const ChannelBinding> bindings) override;
+  SendStatus send(const OutboundEvent& event) override;
+  HealthReport health() const override;
+  AdapterStatistics statistics() const override;
+  std::optional<std::size_t> matched_peers(ChannelId) const override { return std::nullopt; }  // broadcast bus
+  void stop() override;
+
+ private:
+  struct RxChannel {
+    ChannelId id = kNoChannel;
+    std::uint64_t subject = 0;
+    std::size_t payload = 0;
+    bool fragmented = false;
+  };
+  struct TxChannel {
+    ChannelId id = kNoChannel;
+    std::uint32_t can_id = 0;  // 29 bits, in the segment's profile
+    std::uint32_t afp_id = 0;  // FAMOUSO: the identifier with the fragment flag
+    std::uint16_t etag = 0;
+    std::size_t payload = 0;
+    bool fragmented = false;
+    std::optional<NativeCanFrame> native;  // a native channel: this frame, no etag (native_frames.hpp)
+  };
+  struct Table {
+    std::unordered_map<std::uint16_t, RxChannel> rx;           // etag -> channel bound as publisher
+    std::unordered_map<ChannelId, TxChannel> tx;               // channels bound as subscriber
+    std::unordered_map<std::uint64_t, std::uint16_t> etag_of;  // subject -> etag, both roles
+    can_native::FrameTable native;                             // native channels, background frames
+    std::unordered_set<std::uint16_t> tx_etags;                // etags of the channels bound as subscriber
+    std::optional<std::uint8_t> tx_node;                       // the gateway's TxNode on this bus
+    std::vector<can_filter> filters;
+    std::size_t backlog_frames = kMinBacklogFrames;
+  };
+
+  enum class Link { unknown, up, down };
+  enum class Controller { ok, warning, passive, bus_off };
+
+  enum class WriteResult { written, queued, full, failed };
+
+  // --- receive thread
+  void run();
+  void check_link();
+  bool open_socket(int ifindex);
+  void close_socket();
+  void read_frames();
+  // The census socket (bus_census.hpp): every frame on the bus, counted when nothing explains it.
+  void open_census_socket(int ifindex);
+  void read_census();
+  bool explains(const Table& table, canid_t can_id) const;
+  void handle_read_error(int err);
+  void handle_datagram(canfd_frame& frame, msghdr& msg, std::size_t bytes);
+  void handle_frame(const canfd_frame& frame, bool fd_frame, Nanos now);
+  void handle_error_frame(const canfd_frame& frame);
+  void handle_get_etag(const canfd_frame& frame, std::size_t len, Nanos now);
+  void answer_request(const can_binding::GetEtagRequest& request, const Table& table);  // io_mutex_ held
+  void defer_request(const can_binding::GetEtagRequest& request);                      // io_mutex_ held
+  void serve_deferred_requests(Nanos now);
+  void reassembly_losses(ChannelId channel, std::optional<std::uint32_t> displaced, bool lost);
+  void handle_famouso_protocol(const CanIdentifier& id, const canfd_frame& frame, std::size_t len, Nanos now);
+  void handle_afp(const RxChannel& channel, const CanIdentifier& id, std::span<const std::uint8_t> data, Nanos now);
+  void handle_protocol_timeouts(Nanos now);
+  void deliver(const RxChannel& channel, std::span<const std::uint8_t> payload, Nanos now);
+  void deliver_native(const can_native::RxChannel& channel, std::span<const std::uint8_t> data, bool fd_frame, Nanos now);
+  void problem(ChannelId channel, InboundProblem what);
+  void drain_backlog();
+  void refresh_rx_table();  // the receive thread's snapshot of the bindings (rx_table_)
+  // configure(): a native channel's binding into `table`; the reason when it cannot be carried.
+  std::optional<std::string> bind_native(const ChannelBinding& b, Table& table) const;
+  SendStatus send_frame(const canfd_frame& frame);  // io_mutex_ held
+
+  // --- health
+  void set_link(Link link, std::string detail);
+  void set_controller(Controller state);
+  void update_health();  // health_mutex_ held
+
+  // --- send side (io_mutex_ held)
+  WriteResult submit(const canfd_frame& frame, bool fd);
+  void queue_answer(std::uint32_t can_id, std::span<const std::uint8_t> data);
+  void queue_supply_etag(std::uint8_t requester, std::uint16_t etag, std::uint64_t subject, const Table& table);
+  void drain_answers();
+  SendStatus send_afp(const TxChannel& channel, std::span<const std::uint8_t> payload, std::unique_lock<std::mutex>& lock);
+  void wake();
+  void drop_backlog(const char* why);
+
+  const SegmentSpec segment_;
+  Logger& log_;
+  const std::uint32_t capacity_;  // data bytes of one frame on this bus
+  const bool brs_;
+  const bool famouso_;  // FAMOUSO profile: its identifier layout, CCP, etag-4 answers, AFP
+
+  EventSink* sink_ = nullptr;
+  std::thread thread_;
+  std::atomic<bool> stopping_{false};
+  std::atomic<bool> started_{false};
+  int wake_fd_ = -1;
+  int ctl_fd_ = -1;  // for interface ioctls (AF_UNIX: works without AF_CAN)
+
+  // Receive-thread state.
+  Reassembler reassembler_;
+  famouso::AfpReassembler afp_;
+  std::optional<famouso::CcpBroker> ccp_;  // FAMOUSO segments only
+  std::vector<std::pair<std::uint8_t, std::uint64_t>> announced_;  // FAMOUSO subscriptions seen (node, subject)
+  std::shared_ptr<const Table> rx_table_;
+  std::uint64_t rx_generation_ = ~0ull;
+  int bound_ifindex_ = 0;
+  Nanos next_link_check_{0};
+
+  // Socket and send side. The receive thread opens and closes the socket (holding io_mutex_);
+  // send(), configure() and the receive thread write through it holding io_mutex_.
+  mutable std::mutex io_mutex_;
+  int sock_ = -1;
+  int census_sock_ = -1;  // only the receive thread opens, reads and closes it
+  bool census_error_logged_ = false;
+  std::shared_ptr<const Table> table_;
+  std::atomic<std::uint64_t> generation_{0};
+  FrameBacklog backlog_;
+  ProtocolQueue answers_;  // binding and CCP answers: after the backlog, paced
+  BindingRateLimit request_limit_;
+  std::vector<can_binding::GetEtagRequest> pending_requests_;  // FAMOUSO: unknown subjects, answered on bind
+  // Requests over the rate limit, answered when the node's budget allows: a client that asks
+  // once (FAMOUSO's) must not lose its binding to a burst at start-up. One entry per (node,
+  // subject), bounded, so a flood costs a counter and at most one later answer.
+  std::deque<can_binding::GetEtagRequest> deferred_requests_;
+  std::atomic<std::uint64_t> refused_requests_{0};  // over the rate limit (deferred or dropped)
+  std::unordered_map<std::uint16_t, std::uint8_t> tx_sequence_;
+  bool wait_pollout_ = false;      // backlog waits for POLLOUT (EAGAIN)
+  std::optional<Nanos> retry_at_;  // backlog waits for the qdisc (ENOBUFS)
+  bool send_error_logged_ = false;
+  std::atomic<bool> link_up_{false};
+
+  // Health.
+  mutable std::mutex health_mutex_;
+  Link link_ = Link::unknown;
+  std::string link_detail_ = "not started";
+  Controller controller_ = Controller::ok;
+  HealthReport health_{SegmentHealth::down, "not started"};
+
+  // Statistics.
+  std::atomic<std::uint64_t> received_{0};
+  std::atomic<std::uint64_t> sent_{0};
+  std::atomic<std::uint64_t> receive_errors_{0};
+  std::atomic<std::uint64_t> send_errors_{0};
+  std::atomic<std::uint64_t> overflow_closed_{0};  // SO_RXQ_OVFL of sockets already closed
+  std::atomic<std::uint64_t> overflow_socket_{0};  // SO_RXQ_OVFL of the open socket
+  std::atomic<std::uint64_t> overflow_controller_{0};
+  std::atomic<std::uint64_t> backlog_size_{0};
+  can_census::BusCensus census_;
+};
+
+}  // namespace cosmic::can_detail
