@@ -193,11 +193,12 @@ class RecordingSink final : public EventSink {
     ChannelId channel;
     EventHeader header;
     Bytes payload;
+    bool fingerprint_guard = false;  // InboundEvent::guard_loops_by_fingerprint
   };
 
   void on_event(const InboundEvent& event) override {
     std::lock_guard lock(mutex_);
-    events_.push_back({event.channel, event.header, Bytes(event.payload.begin(), event.payload.end())});
+    events_.push_back({event.channel, event.header, Bytes(event.payload.begin(), event.payload.end()), event.guard_loops_by_fingerprint});
     changed_.notify_all();
   }
   void on_problem(ChannelId channel, InboundProblem problem) override {
@@ -466,6 +467,34 @@ TEST_F(LcmAdapterTest, RawFromNativePublisherKeepsBytes) {
   }
   EXPECT_EQ(adapter->statistics().received, static_cast<std::uint64_t>(kCount));
   EXPECT_EQ(sink_.problems(3, InboundProblem::own_echo), 0u);
+  adapter->stop();
+}
+
+// A native binding (issue 19, item 5) names the LCM channel; the contents travel raw, and the router
+// is told to guard loops by fingerprint (raw messages carry no origin).
+TEST_F(LcmAdapterTest, ANativeBindingNamesTheLcmChannelAndCarriesTheContentsRaw) {
+  const int port = 7711;
+  auto adapter = make(port);
+  ChannelBinding wheel = binding(9, "wheel", HopRole::publisher, LcmEncoding::envelope, 0x90);
+  wheel.spec.native.push_back(NativeBinding{"lcm0", std::nullopt, "WHEEL_SPEED"});
+  ASSERT_TRUE(adapter->configure(std::vector<ChannelBinding>{wheel}).ok);
+  ASSERT_TRUE(adapter->start(sink_).ok);
+  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "WHEEL_SPEED", "--raw", "--count", "5", "--size", "8", "--rate", "1000"});
+  ASSERT_EQ(pub.wait_exit(), std::optional<int>(0)) << pub.stderr_text();
+  ASSERT_TRUE(sink_.wait_events(9, 5)) << sink_.count(9);
+  const auto events = sink_.events(9);
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    EXPECT_EQ(events[i].payload, peer_pattern(i + 1, 8)) << "message " << i + 1;
+    EXPECT_EQ(events[i].header.subject, 0x90u);
+    EXPECT_TRUE(events[i].fingerprint_guard);
+  }
+  // Nothing is read on the channel's own name.
+  Child other({peer(), "pub", "--url", url_for(port), "--channel", "wheel", "--raw", "--count", "3", "--size", "8"});
+  ASSERT_EQ(other.wait_exit(), std::optional<int>(0)) << other.stderr_text();
+  Child marker({peer(), "pub", "--url", url_for(port), "--channel", "WHEEL_SPEED", "--raw", "--count", "1", "--size", "4"});
+  ASSERT_EQ(marker.wait_exit(), std::optional<int>(0)) << marker.stderr_text();
+  ASSERT_TRUE(sink_.wait_events(9, 6)) << sink_.count(9);
+  EXPECT_EQ(sink_.count(9), 6u);  // the marker after the three on "wheel": those were never delivered
   adapter->stop();
 }
 
