@@ -230,6 +230,7 @@ TEST(UndeclaredInterference, NamesTheHrtChannelsAFrameBeats) {
                 native_channel("wheel", 0x11, ChannelClass::srt, NativeCanFrame{0x050, false}),
                 channel("stop", 0x12, ChannelClass::hrt, {"lan"}, {"body"})};  // extended, priority 0x00: base bits 0x000
   const AdmissionReport report = admit_all(c);
+  for (const char* name : {"brake", "wheel", "stop"}) ASSERT_NE(report.find(name)->verdict, Verdict::rejected) << name;
   const std::vector<UnexplainedFrames> seen = {{0x0A0, false, 3, 100.0}, {0x1ABCFF00, true, 5, 10.0}, {0x010, false, 1, 0.0}};
   const auto hit = undeclared_interference(report, "body", seen);
   ASSERT_EQ(hit.size(), 1u);  // wheel is SRT; stop's identifier beats them all; 0x010 is silent

@@ -551,50 +551,8 @@ class ConfigParser {
 
 }  // namespace
 
-std::string ConfigError::to_string() const {
-  std::string out = file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": ";
-  if (!path.empty()) out += path + ": ";
-  out += message;
-  if (!valid.empty()) out += " (" + valid + ")";
-  return out;
-}
-
 ConfigResult parse_config(std::string_view text, const std::string& file_name) {
   return ConfigParser(file_name).parse_document(text);
-}
-
-ConfigResult load_config_file(const std::string& path) {
-  std::string text;
-  if (const std::string error = config_detail::read_yaml_file(path, text); !error.empty()) {
-    ConfigResult result;
-    result.errors.push_back(ConfigError{path, 0, 0, "", error, "a readable YAML file"});
-    return result;
-  }
-  return parse_config(text, path);
-}
-
-ConfigResult ConfigFileLoader::load(const std::string& path) {
-  last_unchanged_ = false;
-  std::string text;
-  if (const std::string error = config_detail::read_yaml_file(path, text); !error.empty()) {
-    text_.clear();
-    ConfigResult result;
-    result.errors.push_back(ConfigError{path, 0, 0, "", error, "a readable YAML file"});
-    return result;
-  }
-  if (!text_.empty() && path == path_ && text == text_) {
-    last_unchanged_ = true;
-    return ConfigResult{config_, {}, {}};
-  }
-  ConfigResult result = parse_config(text, path);
-  if (result.ok() && !text.empty() && result.included_files.empty()) {
-    path_ = path;
-    text_ = std::move(text);
-    config_ = result.config;
-  } else {
-    text_.clear();
-  }
-  return result;
 }
 
 ChannelsResult parse_channels(std::string_view text, const std::string& file_name, const Config& running) {
