@@ -170,6 +170,7 @@ void print_channel(const Json& r) {
       plan.extended = can.value("extended", true);
       std::cout << "  can_id " << cosmic::can_identifier_text(plan);
     }
+    if (hop.contains("dds")) std::cout << "  topic " << text(hop["dds"]["topic"]) << " type " << text(hop["dds"]["type"]);
     std::cout << "\n";
     for (const auto& check : hop["checks"]) {
       std::cout << "    " << (check["ok"].get<bool>() ? "ok   " : "FAIL ") << pad_column(text(check["check"]), 14) << text(check["value"])

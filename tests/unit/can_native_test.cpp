@@ -85,7 +85,7 @@ TEST(NativeCanConfig, EveryProblemIsLocatedAtOnce) {
       << text;
   EXPECT_NE(text.find("channels[2].native.body.can_id: 0x0C0 is declared as background frame Engine (gw.yaml:7:"), std::string::npos)
       << text;
-  EXPECT_NE(text.find("channels[3].native.lan: native topics on DDS segments are not supported"), std::string::npos) << text;
+  EXPECT_NE(text.find("channels[3].native.lan.type: missing required key 'type'"), std::string::npos) << text;
   EXPECT_NE(text.find("channels[3].native.nowhere: unknown segment 'nowhere'"), std::string::npos) << text;
   EXPECT_NE(text.find("channels[4].native.body: segment 'body' is neither a publisher nor a subscriber of channel e"), std::string::npos)
       << text;
@@ -106,7 +106,7 @@ Config native_bus() {
 ChannelSpec native_channel(const std::string& name, std::uint64_t subject, ChannelClass cls, NativeCanFrame frame, bool from_can = true,
                            std::uint64_t payload = 8) {
   ChannelSpec c = from_can ? channel(name, subject, cls, {"body"}, {"lan"}, payload) : channel(name, subject, cls, {"lan"}, {"body"}, payload);
-  c.native.push_back(NativeBinding{"body", frame, std::nullopt});
+  c.native.push_back(NativeBinding{"body", frame, std::nullopt, std::nullopt});
   return c;
 }
 

@@ -36,6 +36,10 @@ std::string channel_to_yaml(const ChannelSpec& channel) {
         out << YAML::Key << "can_id" << YAML::Value << id << YAML::Key << "extended" << YAML::Value << binding.can->extended;
       }
       if (binding.lcm_channel) out << YAML::Key << "channel" << YAML::Value << *binding.lcm_channel;
+      if (binding.dds) {
+        out << YAML::Key << "topic" << YAML::Value << binding.dds->topic << YAML::Key << "type" << YAML::Value
+            << binding.dds->type << YAML::Key << "representation" << YAML::Value << to_string(binding.dds->representation);
+      }
       out << YAML::EndMap;
     }
     out << YAML::EndMap;

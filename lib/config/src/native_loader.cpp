@@ -4,6 +4,7 @@
 
 #include "cosmic/can_background.hpp"
 #include "cosmic/can_wire.hpp"
+#include "cosmic/dds_names.hpp"
 #include "cosmic/transport_limits.hpp"
 
 namespace cosmic::config_detail {
@@ -74,13 +75,79 @@ bool parse_lcm(YamlReader& reader, const YAML::Node& node, const std::string& pa
   return true;
 }
 
+std::optional<std::string> name_at(YamlReader& reader, const YAML::Node& node, const std::string& path, const char* name,
+                                   const char* hint) {
+  if (!node[name]) {
+    reader.error_at(node, key(path, name), std::string("missing required key '") + name + "'", hint);
+    return std::nullopt;
+  }
+  return reader.string(node[name], key(path, name));
+}
+
+constexpr const char* kTopicHint = "a DDS topic name, e.g. topic: rt/cmd_vel (ROS 2 names its topics rt/<name>)";
+constexpr const char* kTypeHint = "the DDS type name, e.g. type: geometry_msgs::msg::dds_::Twist_ (ROS 2: <pkg>::msg::dds_::<Name>_)";
+
+bool parse_dds(YamlReader& reader, const YAML::Node& node, const std::string& path, NativeBinding& binding) {
+  if (!reader.check_map(node, path, {"topic", "type", "representation", "keyed"})) return false;
+  NativeDdsTopic topic;
+  bool ok = true;
+  if (const auto name = name_at(reader, node, path, "topic", kTopicHint)) {
+    if (const auto problem = dds_topic_name_problem(*name)) {
+      reader.error_at(node["topic"], key(path, "topic"), *problem, kTopicHint);
+      ok = false;
+    }
+    topic.topic = *name;
+  } else {
+    ok = false;
+  }
+  if (const auto name = name_at(reader, node, path, "type", kTypeHint)) {
+    if (const auto problem = dds_type_name_problem(*name)) {
+      reader.error_at(node["type"], key(path, "type"), *problem, kTypeHint);
+      ok = false;
+    } else if (*name == kEnvelopeTypeName) {
+      reader.error_at(node["type"], key(path, "type"), std::string(kEnvelopeTypeName) + " is the gateway's own envelope type",
+                      "leave out `native` on this segment to carry the channel as an envelope");
+      ok = false;
+    }
+    topic.type = *name;
+  } else {
+    ok = false;
+  }
+  if (node["representation"]) {
+    const auto text = reader.string(node["representation"], key(path, "representation"));
+    if (text && (*text == "xcdr1" || *text == "xcdr2")) {
+      topic.representation = *text == "xcdr2" ? DdsRepresentation::xcdr2 : DdsRepresentation::xcdr1;
+    } else {
+      if (text) {
+        reader.error_at(node["representation"], key(path, "representation"), "unknown representation '" + *text + "'",
+                        "xcdr1 (plain CDR, what ROS 2 and most types use) or xcdr2");
+      }
+      ok = false;
+    }
+  }
+  if (node["keyed"]) {
+    const auto keyed = reader.boolean(node["keyed"], key(path, "keyed"));
+    if (keyed && *keyed) {
+      reader.error_at(node["keyed"], key(path, "keyed"),
+                      "keyed types are not carried: an instance's key hash is computed from the type's key members, which "
+                      "the gateway does not know when it carries a sample as bytes",
+                      "a keyless type (ROS 2 messages are keyless), or carry the data as an envelope channel");
+      ok = false;
+    }
+    if (!keyed) ok = false;
+  }
+  if (ok) binding.dds = std::move(topic);
+  return ok;
+}
+
 }  // namespace
 
 void parse_native(YamlReader& reader, const YAML::Node& node, const std::string& path, const Config& config,
                   ChannelSpec& channel) {
   if (!node.IsMap()) {
     reader.error_at(node, path, "expected a map of segment names to native identities",
-                    "native: {body: {can_id: 0x123}} or native: {viz: {channel: POSE}}");
+                    "native: {body: {can_id: 0x123}}, native: {viz: {channel: POSE}} or native: {lan: {topic: rt/cmd_vel, type: "
+                    "geometry_msgs::msg::dds_::Twist_}}");
     return;
   }
   for (const auto& entry : node) {
@@ -104,8 +171,7 @@ void parse_native(YamlReader& reader, const YAML::Node& node, const std::string&
         ok = parse_lcm(reader, entry.second, entry_path, binding);
         break;
       case SegmentType::dds:
-        reader.error_at(entry.first, entry_path, "native topics on DDS segments are not supported by this version",
-                        "a CAN or LCM segment; on DDS the channel travels as cosmic::Envelope on cosmic/<channel>");
+        ok = parse_dds(reader, entry.second, entry_path, binding);
         break;
     }
     if (ok) channel.native.push_back(std::move(binding));

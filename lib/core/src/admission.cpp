@@ -1,5 +1,7 @@
 #include "cosmic/admission.hpp"
 
+#include "cosmic/dds_names.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -311,7 +313,7 @@ ChannelReport AdmissionSet::report_of(const ChannelSpec& spec, const ChannelData
   report.cls = spec.cls;
   for (const HopPlace& p : data.places) {
     const SegmentSpec& segment = segment_specs_[p.segment];
-    HopReport h{segment.name, p.role, std::nullopt, std::nullopt, {}, {}};
+    HopReport h{segment.name, p.role, std::nullopt, std::nullopt, std::nullopt, {}, {}};
     if (segment.type == SegmentType::can) {
       CanHopPlan plan = can ? can->plans[p.segment][p.position] : segments_[p.segment].plans[p.position];
       if (diverged && p.role == HopRole::subscriber) plan.response_time = std::nullopt;
@@ -320,6 +322,7 @@ ChannelReport AdmissionSet::report_of(const ChannelSpec& spec, const ChannelData
       h.can = plan;
     } else {
       h.latency = segment.latency_bound;
+      if (segment.type == SegmentType::dds) h.dds = dds_topic_of(spec, segment.name);
     }
     report.hops.push_back(std::move(h));
   }

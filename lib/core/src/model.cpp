@@ -28,8 +28,13 @@ const char* to_string(Reliability value) {
   return value == Reliability::reliable ? "reliable" : "best_effort";
 }
 
+const char* to_string(DdsRepresentation value) {
+  return value == DdsRepresentation::xcdr2 ? "xcdr2" : "xcdr1";
+}
+
 std::string native_identity(const NativeBinding& binding) {
   if (binding.can) return can_id_text(binding.can->can_id, binding.can->extended);
+  if (binding.dds) return binding.dds->topic;
   return binding.lcm_channel.value_or("");
 }
 
@@ -41,6 +46,11 @@ const NativeBinding* ChannelSpec::native_on(const std::string& segment) const {
 std::optional<NativeCanFrame> ChannelSpec::native_can(const std::string& segment) const {
   const NativeBinding* binding = native_on(segment);
   return binding ? binding->can : std::nullopt;
+}
+
+std::optional<NativeDdsTopic> ChannelSpec::native_dds(const std::string& segment) const {
+  const NativeBinding* binding = native_on(segment);
+  return binding ? binding->dds : std::nullopt;
 }
 
 const SegmentSpec* Config::find_segment(const std::string& name) const {

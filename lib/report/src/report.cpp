@@ -47,6 +47,10 @@ nlohmann::json to_json(const HopReport& hop) {
                        {"response_time_s", seconds_or_null(can.response_time)}});
     if (!can.native && can.profile == CanProfile::famouso) out["can"]["fragment"] = decode_famouso_id(can.can_id).fragment;
   }
+  if (hop.dds) {
+    out["dds"] = {{"topic", hop.dds->topic}, {"type", hop.dds->type}, {"layout", hop.dds->native ? "native" : "envelope"}};
+    if (hop.dds->native) out["dds"]["representation"] = to_string(hop.dds->representation);
+  }
   out["checks"] = nlohmann::json::array();
   for (const auto& check : hop.checks) out["checks"].push_back(to_json(check));
   if (!hop.background.empty()) {
@@ -187,6 +191,7 @@ std::string render_channel_text(const ChannelReport& channel) {
       out << "  id " << can_identifier_text(*hop.can) << " C "
           << format_duration(hop.can->transmission) << " x" << hop.can->frames_per_event;
     }
+    if (hop.dds) out << "  topic " << hop.dds->topic << " type " << hop.dds->type;
     out << "\n";
     for (const auto& check : hop.checks) {
       out << "    " << (check.ok ? "ok   " : "FAIL ") << pad_column(check.check, 14) << check_value_text(check) << " "

@@ -476,7 +476,7 @@ TEST_F(LcmAdapterTest, ANativeBindingNamesTheLcmChannelAndCarriesTheContentsRaw)
   const int port = 7711;
   auto adapter = make(port);
   ChannelBinding wheel = binding(9, "wheel", HopRole::publisher, LcmEncoding::envelope, 0x90);
-  wheel.spec.native.push_back(NativeBinding{"lcm0", std::nullopt, "WHEEL_SPEED"});
+  wheel.spec.native.push_back(NativeBinding{"lcm0", std::nullopt, "WHEEL_SPEED", std::nullopt});
   ASSERT_TRUE(adapter->configure(std::vector<ChannelBinding>{wheel}).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
   Child pub({peer(), "pub", "--url", url_for(port), "--channel", "WHEEL_SPEED", "--raw", "--count", "5", "--size", "8", "--rate", "1000"});

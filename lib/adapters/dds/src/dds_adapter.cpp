@@ -15,9 +15,10 @@
 //   takes it shared, configure()/stop() exclusive only to swap entries in or out. DDS entities
 //   are created before and deleted after that exclusive section, so the router never waits for
 //   Fast DDS discovery work.
-// - Each writer has its own envelope sample, reused for every send (its payload vector keeps its
-//   capacity: no allocation per event in steady state), guarded by the writer's mutex.
-// - Each reader has its own envelope sample and mutex; Fast DDS calls on_data_available on its
+// - Each writer has its own sample in its topic's format (dds_sample_format: envelope or opaque),
+//   reused for every send (its buffer keeps its capacity: no allocation per event in steady
+//   state), guarded by the writer's mutex.
+// - Each reader has its own sample and mutex; Fast DDS calls on_data_available on its
 //   receive threads. A reader is retired by clearing its `active` flag under its mutex (after
 //   which it never calls the sink) before Fast DDS deletes it; its listener object is kept until
 //   stop() so a late callback never touches freed memory.
@@ -28,6 +29,7 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <exception>
 #include <map>
 #include <mutex>
@@ -42,7 +44,6 @@
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
-#include <fastdds/dds/log/Log.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
@@ -55,35 +56,15 @@
 
 #include <cosmic_dds_idl/EnvelopePubSubTypes.h>
 
+#include "cosmic/dds_encapsulation.hpp"
+#include "cosmic/dds_names.hpp"
 #include "cosmic/thread_policy.hpp"
+#include "dds_log_router.hpp"
+#include "dds_opaque_type.hpp"
 #include "dds_qos.hpp"
+#include "dds_sample_format.hpp"
 
 namespace cosmic {
-
-std::string dds_topic_name(std::string_view channel_name) {
-  std::string name = "cosmic/";
-  for (const char c : channel_name) {
-    // Channel names allow [A-Za-z0-9_.-]; a DDS topic name only letters, digits, '_' and the
-    // '/' separator (Cyclone DDS refuses the rest).
-    const bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-                      c == '_';
-    name.push_back(keep ? c : '_');
-  }
-  return name;
-}
-
-std::optional<std::string> dds_topic_collision(std::span<const ChannelBinding> bindings) {
-  std::map<std::string, std::string_view> owner;  // topic -> channel name
-  for (const ChannelBinding& b : bindings) {
-    const auto [it, inserted] = owner.emplace(dds_topic_name(b.spec.name), b.spec.name);
-    if (!inserted && it->second != b.spec.name) {
-      return "channels '" + std::string(it->second) + "' and '" + b.spec.name +
-             "' both map to DDS topic " + it->first +
-             " ('-' and '.' become '_'); rename one of them";
-    }
-  }
-  return std::nullopt;
-}
 
 namespace {
 
@@ -91,8 +72,6 @@ namespace dds = eprosima::fastdds::dds;
 namespace rtps = eprosima::fastrtps::rtps;
 using dds_detail::EndpointShape;
 using eprosima::fastrtps::types::ReturnCode_t;
-
-constexpr const char* kTypeName = "cosmic::Envelope";
 
 const char* policy_name(dds::QosPolicyId_t id) {
   switch (id) {
@@ -107,68 +86,6 @@ const char* policy_name(dds::QosPolicyId_t id) {
     default: return "other";
   }
 }
-
-// ---- Fast DDS log -> cosmic::Logger ------------------------------------------------------------
-// Fast DDS logs through a process-wide singleton that prints to stdout by default. The first
-// adapter replaces that with one consumer forwarding to the Loggers of the running adapters
-// (each distinct Logger once): the library never prints.
-// Lock order: Fast DDS's log thread holds its own configuration mutex while it calls Consume(),
-// which takes mutex_; so mutex_ is never held while calling into dds::Log (Clear/Register/
-// SetVerbosity take that configuration mutex: holding mutex_ there could deadlock against a
-// message being consumed, as ThreadSanitizer's lock-order check showed).
-class LogRouter {
- public:
-  static LogRouter& instance() {
-    static LogRouter* router = new LogRouter();  // leaked: Fast DDS's log thread may outlive us
-    return *router;
-  }
-  void attach(Logger& log) {
-    {
-      std::lock_guard lock(mutex_);
-      ++loggers_[&log];
-    }
-    std::call_once(installed_, [] {
-      dds::Log::ClearConsumers();
-      dds::Log::RegisterConsumer(std::make_unique<Consumer>());
-      dds::Log::SetVerbosity(dds::Log::Warning);
-    });
-  }
-  void detach(Logger& log) {
-    std::lock_guard lock(mutex_);
-    auto it = loggers_.find(&log);
-    if (it != loggers_.end() && --it->second == 0) {
-      loggers_.erase(it);
-    }
-  }
-
- private:
-  class Consumer : public dds::LogConsumer {
-   public:
-    void Consume(const dds::Log::Entry& entry) override {
-      LogRouter::instance().forward(entry);
-    }
-  };
-  void forward(const dds::Log::Entry& entry) {
-    const LogLevel level = entry.kind == dds::Log::Error     ? LogLevel::error
-                           : entry.kind == dds::Log::Warning ? LogLevel::warning
-                                                             : LogLevel::debug;
-    std::string text = "fastdds";
-    if (entry.context.category != nullptr) {
-      text += " [";
-      text += entry.context.category;
-      text += "]";
-    }
-    text += ": ";
-    text += entry.message;
-    std::lock_guard lock(mutex_);
-    for (auto& [log, count] : loggers_) {
-      log->log(level, text);
-    }
-  }
-  std::once_flag installed_;  // the consumer is installed once per process
-  std::mutex mutex_;          // guards loggers_; never held while calling into dds::Log
-  std::map<Logger*, int> loggers_;
-};
 
 // ---- the adapter -------------------------------------------------------------------------------
 
@@ -189,8 +106,9 @@ struct ClassParticipant {
 };
 
 struct WriterEntry : dds::DataWriterListener {
-  WriterEntry(DdsAdapter& owner, ChannelId id, const ChannelSpec& spec)
-      : owner(owner), id(id), spec(spec), shape(dds_detail::shape_of(spec)) {}
+  WriterEntry(DdsAdapter& owner, ChannelId id, const ChannelSpec& spec, EndpointShape shape, std::uint64_t self)
+      : owner(owner), id(id), spec(spec), shape(std::move(shape)),
+        format(dds_detail::make_sample_format(this->shape.topic, spec, self)) {}
   void on_offered_incompatible_qos(dds::DataWriter*,
                                    const dds::OfferedIncompatibleQosStatus& status) override;
 
@@ -202,13 +120,15 @@ struct WriterEntry : dds::DataWriterListener {
   ClassParticipant* home = nullptr;  // the participant of the channel's class
   dds::Topic* topic = nullptr;
   dds::DataWriter* writer = nullptr;
-  std::mutex sample_mutex;
-  cosmic::Envelope sample;
+  std::mutex sample_mutex;  // guards format's sample
+  std::unique_ptr<dds_detail::DdsSampleFormat> format;
+  std::atomic<bool> refusal_logged{false};  // one log line for events the format cannot carry
 };
 
 struct ReaderEntry : dds::DataReaderListener {
-  ReaderEntry(DdsAdapter& owner, ChannelId id, const ChannelSpec& spec)
-      : owner(owner), id(id), spec(spec), shape(dds_detail::shape_of(spec)) {}
+  ReaderEntry(DdsAdapter& owner, ChannelId id, const ChannelSpec& spec, EndpointShape shape, std::uint64_t self)
+      : owner(owner), id(id), spec(spec), shape(std::move(shape)),
+        format(dds_detail::make_sample_format(this->shape.topic, spec, self)) {}
   void on_data_available(dds::DataReader* reader) override;
   void on_requested_incompatible_qos(dds::DataReader*,
                                      const dds::RequestedIncompatibleQosStatus& status) override;
@@ -225,9 +145,9 @@ struct ReaderEntry : dds::DataReaderListener {
   rtps::GuidPrefix_t own_prefix;
   dds::Topic* topic = nullptr;
   dds::DataReader* reader = nullptr;
-  std::mutex mutex;     // serialises callbacks; guards `active` and `sample`
+  std::mutex mutex;     // serialises callbacks; guards `active` and format's sample
   bool active = false;  // false: never calls the sink
-  cosmic::Envelope sample;
+  std::unique_ptr<dds_detail::DdsSampleFormat> format;
 };
 
 class DdsAdapter final : public DdsSegmentAdapter {
@@ -265,6 +185,8 @@ class DdsAdapter final : public DdsSegmentAdapter {
   }
   void count_lost(std::uint64_t n) { counters_.overflow_drops.fetch_add(n, std::memory_order_relaxed); }
   void warn(const std::string& text) { log_.log(LogLevel::warning, prefix() + text); }
+  void warn_refused(const WriterEntry& writer, dds_detail::FillRefusal refusal, std::uint16_t first_bytes,
+                    std::size_t size);
 
  private:
   std::string prefix() const { return "dds segment " + segment_.name + ": "; }
@@ -278,7 +200,7 @@ class DdsAdapter final : public DdsSegmentAdapter {
   Status open_participant(ChannelClass cls, const ThreadPolicy& threads, const std::string& thread_name);
   Status ensure_class_participant(ChannelClass cls);
   void close_participant(ClassParticipant& home);
-  dds::Topic* acquire_topic(ClassParticipant& home, const std::string& name);
+  dds::Topic* acquire_topic(ClassParticipant& home, const DdsTopicRef& ref, std::string& error);
   void release_topic(ClassParticipant& home, dds::Topic* topic);
   std::unique_ptr<WriterEntry> create_writer(const ChannelBinding& binding, std::string& error);
   std::unique_ptr<ReaderEntry> create_reader(const ChannelBinding& binding, std::string& error);
@@ -314,7 +236,7 @@ void WriterEntry::on_offered_incompatible_qos(dds::DataWriter*,
                                               const dds::OfferedIncompatibleQosStatus& status) {
   incompatible.fetch_add(static_cast<std::uint64_t>(status.total_count_change),
                          std::memory_order_relaxed);
-  owner.warn("a reader of " + shape.topic + " requests incompatible QoS (" +
+  owner.warn("a reader of " + shape.topic.topic + " requests incompatible QoS (" +
              policy_name(status.last_policy_id) + "); not matched");
 }
 
@@ -322,7 +244,7 @@ void ReaderEntry::on_requested_incompatible_qos(
     dds::DataReader*, const dds::RequestedIncompatibleQosStatus& status) {
   incompatible.fetch_add(static_cast<std::uint64_t>(status.total_count_change),
                          std::memory_order_relaxed);
-  owner.warn("a writer of " + shape.topic + " offers incompatible QoS (" +
+  owner.warn("a writer of " + shape.topic.topic + " offers incompatible QoS (" +
              policy_name(status.last_policy_id) + "); not matched");
 }
 
@@ -341,7 +263,7 @@ void ReaderEntry::on_data_available(dds::DataReader* dr) {
   for (;;) {
     ReturnCode_t rc = ReturnCode_t::RETCODE_ERROR;
     try {
-      rc = dr->take_next_sample(&sample, &info);
+      rc = dr->take_next_sample(format->sample(), &info);
     } catch (...) {
       owner.count_receive_error(*this);
       return;
@@ -359,11 +281,6 @@ void ReaderEntry::on_data_available(dds::DataReader* dr) {
   }
 }
 
-// The RTPS sequence number of the sample in its writer, truncated to the envelope's 32 bits.
-std::uint32_t native_sequence(const dds::SampleInfo& info) {
-  return static_cast<std::uint32_t>(info.sample_identity.sequence_number().to64long());
-}
-
 // Fast DDS stamps a sample with the realtime clock when its receive thread got it; the router
 // measures residence on the steady clock. Moved over by the current offset between the two and
 // never later than now, so residence counts from arrival rather than from this callback.
@@ -379,28 +296,38 @@ Nanos arrival_on_steady_clock(const eprosima::fastrtps::rtps::Time_t& reception)
 
 void DdsAdapter::deliver(ReaderEntry& entry, const dds::SampleInfo& info) {
   counters_.received.fetch_add(1, std::memory_order_relaxed);
-  const cosmic::Envelope& env = entry.sample;
-  if (info.sample_identity.writer_guid().guidPrefix == entry.own_prefix || env.origin() == self_.id) {
+  if (info.sample_identity.writer_guid().guidPrefix == entry.own_prefix) {
     sink_->on_problem(entry.id, InboundProblem::own_echo);
-    return;
-  }
-  if (env.payload().size() > segment_.max_message_size) {
-    count_receive_error(entry);
     return;
   }
   InboundEvent event;
   event.channel = entry.id;
-  event.header.subject = env.subject();
-  event.header.origin = env.origin();
-  // A native publisher (origin 0) has no envelope sequence of ours: its writer's own sample
-  // sequence number takes its place, so a loss on the hop from it stays visible downstream.
-  event.header.sequence = env.origin() == 0 ? native_sequence(info) : env.sequence();
-  event.header.hop_count = env.hop_count();
-  event.header.created_ns = env.created_ns();
-  event.header.age_ns = env.age_ns();
-  event.payload = std::span<const std::uint8_t>(env.payload().data(), env.payload().size());
+  switch (entry.format->decode(info, segment_.max_message_size, event)) {
+    case dds_detail::DecodeResult::own_echo:
+      sink_->on_problem(entry.id, InboundProblem::own_echo);
+      return;
+    case dds_detail::DecodeResult::too_large:
+      count_receive_error(entry);
+      return;
+    case dds_detail::DecodeResult::event:
+      break;
+  }
   event.received_at = arrival_on_steady_clock(info.reception_timestamp);
   sink_->on_event(event);
+}
+
+void DdsAdapter::warn_refused(const WriterEntry& writer, dds_detail::FillRefusal refusal, std::uint16_t first_bytes,
+                              std::size_t size) {
+  char id[8];
+  std::snprintf(id, sizeof id, "0x%04X", static_cast<unsigned>(first_bytes));
+  const char* wanted = to_string(writer.shape.topic.representation);
+  const std::string why = refusal == dds_detail::FillRefusal::wrong_representation
+                              ? std::string("its encapsulation ") + id + " is not " + wanted + ", which the writer announces"
+                              : size < kDdsEncapsulationBytes ? "it is shorter than an encapsulation header"
+                                                              : std::string("it starts with ") + id + ", no CDR encapsulation";
+  warn("channel " + writer.spec.name + ": an event of " + std::to_string(size) + " bytes is not a serialized " +
+       writer.shape.topic.type + " sample for " + writer.shape.topic.topic + " (" + why +
+       "); such events are not sent and count as send errors (logged once)");
 }
 
 // Fast DDS 2.9 has no thread settings, but Linux threads inherit the scheduling policy, priority,
@@ -448,7 +375,7 @@ Status DdsAdapter::open_participant(ChannelClass cls, const ThreadPolicy& thread
   dds::TypeSupport type(new cosmic::EnvelopePubSubType());
   if (type.register_type(home.participant) != ReturnCode_t::RETCODE_OK) {
     close_participant(home);
-    return Status::failure("cannot register type cosmic::Envelope");
+    return Status::failure(std::string("cannot register type ") + kEnvelopeTypeName);
   }
   home.publisher = home.participant->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
   home.subscriber = home.participant->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
@@ -509,7 +436,7 @@ Status DdsAdapter::start(EventSink& sink) {
                 std::to_string(dds_detail::kMaxDomainId));
   }
   if (!log_attached_) {
-    LogRouter::instance().attach(log_);
+    dds_detail::attach_fastdds_log(log_);
     log_attached_ = true;
   }
   try {
@@ -529,16 +456,31 @@ Status DdsAdapter::start(EventSink& sink) {
   return Status::success();
 }
 
-dds::Topic* DdsAdapter::acquire_topic(ClassParticipant& home, const std::string& name) {
-  auto it = home.topics.find(name);
+// The participant's topic `ref` (created with its first user), registering a native topic's type
+// as an opaque type the first time the participant meets it. Control thread.
+dds::Topic* DdsAdapter::acquire_topic(ClassParticipant& home, const DdsTopicRef& ref, std::string& error) {
+  auto it = home.topics.find(ref.topic);
   if (it != home.topics.end()) {
+    if (it->second.topic->get_type_name() != ref.type) {
+      error = "topic " + ref.topic + " already has type " + it->second.topic->get_type_name() + ", not " + ref.type;
+      return nullptr;
+    }
     ++it->second.users;
     return it->second.topic;
   }
-  dds::Topic* topic = home.participant->create_topic(name, kTypeName, dds::TOPIC_QOS_DEFAULT);
-  if (topic != nullptr) {
-    home.topics[name] = TopicRef{topic, 1};
+  if (ref.native && !home.participant->find_type(ref.type)) {
+    dds::TypeSupport type(new dds_detail::OpaqueType(ref.type));
+    if (type.register_type(home.participant) != ReturnCode_t::RETCODE_OK) {
+      error = "cannot register type " + ref.type;
+      return nullptr;
+    }
   }
+  dds::Topic* topic = home.participant->create_topic(ref.topic, ref.type, dds::TOPIC_QOS_DEFAULT);
+  if (topic == nullptr) {
+    error = "cannot create topic " + ref.topic + " of type " + ref.type;
+    return nullptr;
+  }
+  home.topics[ref.topic] = TopicRef{topic, 1};
   return topic;
 }
 
@@ -556,37 +498,33 @@ void DdsAdapter::release_topic(ClassParticipant& home, dds::Topic* topic) {
 
 std::unique_ptr<WriterEntry> DdsAdapter::create_writer(const ChannelBinding& binding,
                                                        std::string& error) {
-  auto entry = std::make_unique<WriterEntry>(*this, binding.id, binding.spec);
+  auto entry = std::make_unique<WriterEntry>(*this, binding.id, binding.spec, dds_detail::shape_of(segment_, binding.spec),
+                                             self_.id);
   entry->home = &home_of(binding.spec.cls);
-  entry->topic = acquire_topic(*entry->home, entry->shape.topic);
-  if (entry->topic == nullptr) {
-    error = "cannot create topic " + entry->shape.topic;
-    return nullptr;
-  }
+  entry->topic = acquire_topic(*entry->home, entry->shape.topic, error);
+  if (entry->topic == nullptr) return nullptr;
   entry->writer = entry->home->publisher->create_datawriter(entry->topic,
                                                 dds_detail::writer_qos(segment_, binding.spec),
                                                 entry.get(), dds::StatusMask::offered_incompatible_qos());
   if (entry->writer == nullptr) {
     release_topic(*entry->home, entry->topic);
-    error = "cannot create a DataWriter on " + entry->shape.topic;
+    error = "cannot create a DataWriter on " + entry->shape.topic.topic;
     return nullptr;
   }
-  entry->sample.payload().reserve(std::min<std::uint64_t>(binding.spec.payload, segment_.max_message_size));
+  entry->format->reserve(std::min<std::uint64_t>(binding.spec.payload, segment_.max_message_size));
   return entry;
 }
 
 std::unique_ptr<ReaderEntry> DdsAdapter::create_reader(const ChannelBinding& binding,
                                                        std::string& error) {
-  auto entry = std::make_unique<ReaderEntry>(*this, binding.id, binding.spec);
+  auto entry = std::make_unique<ReaderEntry>(*this, binding.id, binding.spec, dds_detail::shape_of(segment_, binding.spec),
+                                             self_.id);
   entry->home = &home_of(binding.spec.cls);
   entry->own_prefix = entry->home->prefix;
-  entry->topic = acquire_topic(*entry->home, entry->shape.topic);
-  if (entry->topic == nullptr) {
-    error = "cannot create topic " + entry->shape.topic;
-    return nullptr;
-  }
+  entry->topic = acquire_topic(*entry->home, entry->shape.topic, error);
+  if (entry->topic == nullptr) return nullptr;
   entry->active = true;  // before the reader exists: no callback can race with this
-  entry->sample.payload().reserve(std::min<std::uint64_t>(binding.spec.payload, segment_.max_message_size));
+  entry->format->reserve(std::min<std::uint64_t>(binding.spec.payload, segment_.max_message_size));
   const dds::StatusMask mask = dds::StatusMask::data_available() <<
                                dds::StatusMask::requested_incompatible_qos() <<
                                dds::StatusMask::sample_lost();
@@ -594,7 +532,7 @@ std::unique_ptr<ReaderEntry> DdsAdapter::create_reader(const ChannelBinding& bin
       entry->topic, dds_detail::reader_qos(segment_, binding.spec), entry.get(), mask);
   if (entry->reader == nullptr) {
     release_topic(*entry->home, entry->topic);
-    error = "cannot create a DataReader on " + entry->shape.topic;
+    error = "cannot create a DataReader on " + entry->shape.topic.topic;
     return nullptr;
   }
   return entry;
@@ -603,7 +541,7 @@ std::unique_ptr<ReaderEntry> DdsAdapter::create_reader(const ChannelBinding& bin
 void DdsAdapter::destroy_writer(std::unique_ptr<WriterEntry> entry) {
   if (entry->writer != nullptr &&
       entry->home->publisher->delete_datawriter(entry->writer) != ReturnCode_t::RETCODE_OK) {
-    warn("cannot delete the DataWriter of " + entry->shape.topic);
+    warn("cannot delete the DataWriter of " + entry->shape.topic.topic);
   }
   release_topic(*entry->home, entry->topic);
 }
@@ -617,11 +555,11 @@ void DdsAdapter::destroy_reader(std::unique_ptr<ReaderEntry> entry) {
   deactivate(*entry);
   if (entry->reader != nullptr &&
       entry->home->subscriber->delete_datareader(entry->reader) != ReturnCode_t::RETCODE_OK) {
-    warn("cannot delete the DataReader of " + entry->shape.topic);
+    warn("cannot delete the DataReader of " + entry->shape.topic.topic);
   }
   entry->reader = nullptr;
   release_topic(*entry->home, entry->topic);
-  entry->sample.payload() = {};  // release the buffer; the listener object itself stays
+  entry->format->release();  // release the buffer; the listener object itself stays
   retired_readers_.push_back(std::move(entry));
 }
 
@@ -646,7 +584,9 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
     }
   }
 
-  if (const auto collision = dds_topic_collision(bindings)) {
+  std::vector<const ChannelSpec*> specs;
+  for (const ChannelBinding& b : bindings) specs.push_back(&b.spec);
+  if (const auto collision = dds_topic_collision(specs, segment_.name)) {
     log_.log(LogLevel::error, prefix() + *collision);
     return Status::failure(*collision);
   }
@@ -670,7 +610,7 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
   try {
     for (const auto& [id, b] : want_writers) {
       auto it = writers_.find(id);  // only this (control) thread changes writers_
-      if (it != writers_.end() && it->second->shape == dds_detail::shape_of(b->spec) &&
+      if (it != writers_.end() && it->second->shape == dds_detail::shape_of(segment_, b->spec) &&
           it->second->home == &home_of(b->spec.cls)) {
         continue;
       }
@@ -685,7 +625,7 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
     for (const auto& [id, b] : want_readers) {
       auto it = readers_.find(id);
       if (it != readers_.end()) {
-        if (it->second->shape == dds_detail::shape_of(b->spec) && it->second->home == &home_of(b->spec.cls)) {
+        if (it->second->shape == dds_detail::shape_of(segment_, b->spec) && it->second->home == &home_of(b->spec.cls)) {
           continue;
         }
         // Changed QoS: stop the old reader first so that an event is never delivered twice.
@@ -757,15 +697,13 @@ SendStatus DdsAdapter::send(const OutboundEvent& event) {
     }
     WriterEntry& w = *it->second;
     std::lock_guard sample_lock(w.sample_mutex);
-    cosmic::Envelope& env = w.sample;
-    env.subject(event.header.subject);
-    env.origin(event.header.origin);
-    env.sequence(event.header.sequence);
-    env.hop_count(event.header.hop_count);
-    env.created_ns(event.header.created_ns);
-    env.age_ns(event.header.age_ns);
-    env.payload().assign(event.payload.begin(), event.payload.end());  // reuses capacity
-    const ReturnCode_t rc = w.writer->write(&env, dds::HANDLE_NIL);
+    std::uint16_t first_bytes = 0;
+    if (const auto refusal = w.format->fill(event, first_bytes); refusal != dds_detail::FillRefusal::none) {
+      counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
+      if (!w.refusal_logged.exchange(true, std::memory_order_relaxed)) warn_refused(w, refusal, first_bytes, event.payload.size());
+      return SendStatus::failed;
+    }
+    const ReturnCode_t rc = w.writer->write(w.format->sample(), dds::HANDLE_NIL);
     if (rc == ReturnCode_t::RETCODE_OK) {
       counters_.sent.fetch_add(1, std::memory_order_relaxed);
       return SendStatus::sent;
@@ -848,7 +786,7 @@ void DdsAdapter::teardown() {
   retired_readers_.clear();
   sink_ = nullptr;
   if (log_attached_) {
-    LogRouter::instance().detach(log_);
+    dds_detail::detach_fastdds_log(log_);
     log_attached_ = false;
   }
 }

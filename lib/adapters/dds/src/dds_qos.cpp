@@ -81,17 +81,23 @@ std::int32_t history_depth(std::uint32_t omission_degree) {
       std::min<std::uint64_t>(std::max<std::uint64_t>(depth, 1), kMaxHistoryDepth));
 }
 
-EndpointShape shape_of(const ChannelSpec& channel) {
+EndpointShape shape_of(const SegmentSpec& segment, const ChannelSpec& channel) {
   EndpointShape shape;
-  shape.topic = dds_topic_name(channel.name);
+  shape.topic = dds_topic_of(channel, segment.name);
   shape.depth = history_depth(channel.omission_degree);
   shape.validity = channel.temp_validity;
   shape.reaction_time = channel.reaction_time;
   return shape;
 }
 
-dds::DataWriterQos writer_qos(const SegmentSpec& /*segment*/, const ChannelSpec& channel) {
+dds::DataWriterQos writer_qos(const SegmentSpec& segment, const ChannelSpec& channel) {
   dds::DataWriterQos qos = dds::DATAWRITER_QOS_DEFAULT;
+  // A writer offers exactly one representation; a native topic's bytes carry the one declared
+  // (send() refuses others). The envelope keeps the default (XCDR), which every reader accepts.
+  if (const auto native = channel.native_dds(segment.name)) {
+    qos.representation().m_value = {native->representation == DdsRepresentation::xcdr2 ? dds::XCDR2_DATA_REPRESENTATION
+                                                                                        : dds::XCDR_DATA_REPRESENTATION};
+  }
   // Offered QoS is chosen so that any requested QoS a default reader can have is satisfied:
   // RELIABLE serves reliable and best-effort readers, TRANSIENT_LOCAL serves volatile and
   // transient-local readers, and neither deadline nor latency_budget is offered (a reader's
@@ -135,6 +141,10 @@ dds::DataReaderQos reader_qos(const SegmentSpec& segment, const ChannelSpec& cha
   // durability, no deadline, and a latency budget no writer's default (0) exceeds.
   qos.reliability().kind = reliability_of(segment);
   qos.durability().kind = dds::VOLATILE_DURABILITY_QOS;
+  // A native topic's reader takes the bytes as they come, in either extended CDR version.
+  if (channel.native_dds(segment.name)) {
+    qos.type_consistency().representation.m_value = {dds::XCDR_DATA_REPRESENTATION, dds::XCDR2_DATA_REPRESENTATION};
+  }
   qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
   // The reader's history only buffers between Fast DDS's receive thread and our listener's
   // take(): deeper than the channel's own depth so a burst does not fill it. A full reliable

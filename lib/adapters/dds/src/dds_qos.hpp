@@ -9,6 +9,7 @@
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
 #include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
 
+#include "cosmic/dds_names.hpp"
 #include "cosmic/model.hpp"
 #include "cosmic/segment_adapter.hpp"
 
@@ -38,17 +39,18 @@ std::int32_t history_depth(std::uint32_t omission_degree);
 
 // The QoS-relevant shape of one endpoint: two bindings with equal shapes can share an endpoint.
 struct EndpointShape {
-  std::string topic;
+  DdsTopicRef topic;  // topic, type and format (envelope or native)
   std::int32_t depth = 1;
   std::optional<Nanos> validity;
   std::optional<Nanos> reaction_time;
   bool operator==(const EndpointShape&) const = default;
 };
-EndpointShape shape_of(const ChannelSpec& channel);
+EndpointShape shape_of(const SegmentSpec& segment, const ChannelSpec& channel);
 
 // Writers offer the most (RELIABLE, TRANSIENT_LOCAL) and promise nothing a default reader does
 // not request (no deadline, latency_budget 0); readers request the least (the segment's
-// reliability, VOLATILE, no deadline). docs/dds-mapping.md lists every policy and why.
+// reliability, VOLATILE, no deadline). docs/dds-mapping.md lists every policy and why. A native
+// topic's writer announces its representation (XCDR or XCDR2); its reader accepts both.
 eprosima::fastdds::dds::DataWriterQos writer_qos(const SegmentSpec& segment,
                                                  const ChannelSpec& channel);
 eprosima::fastdds::dds::DataReaderQos reader_qos(const SegmentSpec& segment,

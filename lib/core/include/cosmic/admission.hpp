@@ -19,6 +19,7 @@
 
 #include "cosmic/can_background.hpp"
 #include "cosmic/can_timing.hpp"
+#include "cosmic/dds_names.hpp"
 #include "cosmic/model.hpp"
 
 namespace cosmic {
@@ -76,6 +77,7 @@ struct HopReport {
   std::string segment;
   HopRole role = HopRole::publisher;
   std::optional<CanHopPlan> can;
+  std::optional<DdsTopicRef> dds;  // DDS hops: the topic and type the channel travels as
   std::optional<Nanos> latency;  // worst-case latency this hop adds; nullopt: unbounded
   std::vector<Check> checks;
   // CAN hops whose response time misses the reaction time: the background frames delaying it most.

@@ -95,13 +95,28 @@ struct NativeCanFrame {
   friend bool operator==(const NativeCanFrame&, const NativeCanFrame&) = default;
 };
 
+// Which extended CDR version a native DDS writer announces (DataRepresentationQosPolicy); the bytes
+// it is given must carry an encapsulation identifier of that version.
+enum class DdsRepresentation { xcdr1, xcdr2 };
+const char* to_string(DdsRepresentation value);
+
+// A DDS topic of any type, carried as its serialized payload (encapsulation header included).
+struct NativeDdsTopic {
+  std::string topic;  // e.g. rt/cmd_vel (ROS 2: rt/<name>)
+  std::string type;   // e.g. geometry_msgs::msg::dds_::Twist_
+  DdsRepresentation representation = DdsRepresentation::xcdr1;  // what our writer announces
+  friend bool operator==(const NativeDdsTopic&, const NativeDdsTopic&) = default;
+};
+
 struct NativeBinding {
   std::string segment;
   std::optional<NativeCanFrame> can;  // CAN segments: the channel is this frame
   std::optional<std::string> lcm_channel;  // LCM segments: raw contents on this LCM channel name
+  std::optional<NativeDdsTopic> dds;  // DDS segments: the serialized samples of this topic
   friend bool operator==(const NativeBinding&, const NativeBinding&) = default;
 };
-// How errors and reports name a native identity: "0x123", "0x18FF0001" or the LCM channel name.
+// How errors and reports name a native identity: "0x123", "0x18FF0001", the LCM channel name or
+// the DDS topic name.
 std::string native_identity(const NativeBinding& binding);
 
 struct ChannelSpec {
@@ -123,6 +138,8 @@ struct ChannelSpec {
   const NativeBinding* native_on(const std::string& segment) const;
   // The native CAN frame of this channel on `segment`, if it has one there.
   std::optional<NativeCanFrame> native_can(const std::string& segment) const;
+  // The native DDS topic of this channel on `segment`, if it has one there.
+  std::optional<NativeDdsTopic> native_dds(const std::string& segment) const;
 };
 
 // Opt-in HTTP endpoint serving the gateway's metrics (docs/metrics.md). Off unless configured.

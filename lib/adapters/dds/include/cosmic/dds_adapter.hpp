@@ -4,11 +4,18 @@
 // - One DomainParticipant per class of channel in use on the segment (domain id =
 //   segment.dds.domain; the NRT one from start(), HRT and SRT with their first channel), each
 //   with one Publisher and one Subscriber, so no lower class shares Fast DDS's per-participant
-//   send lock or threads with a higher one. One topic per channel, named by dds_topic_name() ("cosmic/<channel name>" with
-//   '-' and '.' mapped to '_'; two channels mapping to one topic are refused by configure()),
-//   of type "cosmic::Envelope" (lib/adapters/dds/idl/Envelope.idl, @final, plain CDR). A
-//   channel bound with role subscriber (the gateway sends there) gets a DataWriter; with role
-//   publisher (the gateway receives there) a DataReader.
+//   send lock or threads with a higher one. One topic per channel, named by dds_topic_of()
+//   (cosmic/dds_names.hpp): an envelope channel's topic is "cosmic/<channel name>" with '-' and
+//   '.' mapped to '_', of type "cosmic::Envelope" (lib/adapters/dds/idl/Envelope.idl, @final,
+//   plain CDR); a native channel's is the topic and type it names, carried opaque (the serialized
+//   sample as is, encapsulation header included; keyless). Two channels mapping to one topic are
+//   refused by configure(). A channel bound with role subscriber (the gateway sends there) gets a
+//   DataWriter; with role publisher (the gateway receives there) a DataReader.
+// - Native topics: the writer announces the declared representation (XCDR or XCDR2) and send()
+//   refuses (failed, logged once per writer) an event whose bytes do not start with an
+//   encapsulation header of that version; the reader accepts both versions. A native sample
+//   carries no origin or sequence: it arrives as a native source's event (origin 0, sequence =
+//   its writer's RTPS sequence number).
 // - QoS: a default reader and a default writer of any vendor match our endpoints.
 //     writer  RELIABLE (max_blocking_time 100 us), TRANSIENT_LOCAL, KEEP_LAST depth
 //             max(1, omission_degree + 1) capped at 32, latency_budget 0, no deadline,
@@ -64,23 +71,15 @@
 #include <cstddef>
 #include <memory>
 #include <optional>
-#include <span>
 #include <string>
 #include <string_view>
 
+#include "cosmic/dds_names.hpp"
 #include "cosmic/log.hpp"
 #include "cosmic/model.hpp"
 #include "cosmic/segment_adapter.hpp"
 
 namespace cosmic {
-
-// "cosmic/<channel name>" with every character a DDS topic name cannot hold ('-', '.') mapped
-// to '_' (docs/dds-mapping.md).
-std::string dds_topic_name(std::string_view channel_name);
-
-// Why two distinct channels among `bindings` cannot share this segment (their names map to the
-// same topic), or nullopt. configure() refuses such a set; the configuration check may call it.
-std::optional<std::string> dds_topic_collision(std::span<const ChannelBinding> bindings);
 
 // The DDS adapter with DDS-specific observations that tools and tests use to wait for discovery
 // instead of sleeping. Not part of SegmentAdapter on purpose.

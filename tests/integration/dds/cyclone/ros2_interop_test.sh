@@ -1,0 +1,170 @@
+#!/usr/bin/env bash
+# ROS 2 nodes, as Eclipse Cyclone DDS programs put them on the wire (topic rt/<name>, type
+# geometry_msgs::msg::dds_::Twist_, ROS 2's default QoS RELIABLE/VOLATILE/KEEP_LAST 10, XCDR1),
+# against cosmicd's native DDS channels, inside a fresh network namespace (run through
+# scripts/netns-run):
+#   ros2_interop_test.sh COSMICD COSMICCTL COSMIC_CYCLONE_ROS2_PEER
+# One gateway between two DDS domains and two native channels carrying the serialized Twist
+# unchanged: cmd_vel (SRT) from the left domain to the right one, odom_twist (NRT) from the right
+# to the left. For each, a Cyclone "node" publishes 50 Twists on one domain and another receives
+# them through cosmicd on the other. Both hops are reliable, so nothing may be lost: the reader
+# must decode all 50 in order with exactly the values written, each sample byte for byte as the
+# writer serialized it (52 bytes, encapsulation CDR_LE 00 01 00 00); cosmicd must count each event
+# in and out exactly once; no endpoint may be refused for incompatible QoS.
+set -uo pipefail
+[ "${COSMIC_IN_NETNS:-}" = 1 ] || { echo "run me through scripts/netns-run" >&2; exit 2; }
+COSMICD=$1 COSMICCTL=$2 ROS2_PEER=$3
+WORK=$(mktemp -d /tmp/cosmic-ros2.XXXXXX)
+# shellcheck source=../../daemon/lib.sh
+source "$(dirname "$0")/../../daemon/lib.sh"
+trap 'cleanup; rm -rf "$WORK"' EXIT
+
+# The namespace's only interface is a multicast-capable loopback; Cyclone DDS does not use
+# multicast on loopback unless told so (Fast DDS does).
+export CYCLONEDDS_URI='<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface name="lo" multicast="true"/></Interfaces></General></Domain></CycloneDDS>'
+
+TWIST=geometry_msgs::msg::dds_::Twist_
+COUNT=50
+
+cat >"$WORK/gw.yaml" <<YAML
+gateway: {name: gw-ros2}
+segments:
+  - {name: left, type: dds, domain: 35, latency_bound: 1ms, realtime: true}
+  - {name: right, type: dds, domain: 36, latency_bound: 1ms, realtime: true}
+channels:
+  - name: cmd_vel
+    subject: 0x301
+    class: srt
+    period: 10ms
+    reaction_time: 50ms
+    omission_degree: 0
+    payload: 52B
+    publishers: [left]
+    subscribers: [right]
+    native:
+      left: {topic: rt/cmd_vel, type: "$TWIST"}
+      right: {topic: rt/cmd_vel, type: "$TWIST"}
+  - name: odom_twist
+    subject: 0x302
+    class: nrt
+    payload: 52B
+    publishers: [right]
+    subscribers: [left]
+    native:
+      left: {topic: rt/odom_twist, type: "$TWIST"}
+      right: {topic: rt/odom_twist, type: "$TWIST"}
+YAML
+
+domain_of() { [ "$1" = left ] && echo 35 || echo 36; }
+
+# check_samples FILE COUNT: what the Cyclone reader decoded, one JSON line per sample. Sample
+# i = 1..COUNT must be linear (i, i+0.5, -i), angular (0.25i, -0.125, 1000+i), all of them, in
+# order, no duplicates, and its serialized form exactly the XCDR1 one: 00 01 00 00 (CDR_LE,
+# options 0) followed by the six doubles little-endian, 52 bytes.
+check_samples() {
+  python3 - "$@" <<'PY'
+import json, struct, sys
+path, count = sys.argv[1], int(sys.argv[2])
+samples = [json.loads(l) for l in open(path) if l.strip()]
+order = [s["linear"][0] for s in samples]
+assert order == list(range(1, count + 1)), \
+    f"{len(samples)} samples, expected {count} in order (no loss on reliable hops); linear.x: {order}"
+for i, s in enumerate(samples, 1):
+    linear, angular = [float(i), i + 0.5, -float(i)], [0.25 * i, -0.125, 1000.0 + i]
+    assert s["linear"] == linear and s["angular"] == angular, \
+        f"sample {i}: linear {s['linear']} angular {s['angular']}, expected {linear} {angular}"
+    cdr = bytes.fromhex(s["cdr"])
+    expected = bytes([0x00, 0x01, 0x00, 0x00]) + struct.pack("<6d", *linear, *angular)
+    assert len(cdr) == 52, f"sample {i}: {len(cdr)} serialized bytes, expected 52"
+    assert cdr[:4] == expected[:4], f"sample {i}: encapsulation {cdr[:4].hex()}, expected 00010000 (CDR_LE, XCDR1)"
+    assert cdr == expected, f"sample {i}: serialized {cdr.hex()}, expected {expected.hex()}"
+print(f"checked: {count} samples decoded in order, values exact, each 52 bytes 00010000 + 6 LE doubles")
+PY
+}
+
+# check_pub_summary FILE COUNT: the publisher's JSON summary: every sample written and
+# acknowledged by the reliable reader (cosmicd's), XCDR1, the ROS 2 type name.
+check_pub_summary() {
+  python3 - "$@" <<'PY'
+import json, sys
+path, count = sys.argv[1], int(sys.argv[2])
+s = json.loads(open(path).read().strip().splitlines()[-1])
+assert s["type"] == "geometry_msgs::msg::dds_::Twist_", f"type {s['type']}"
+assert s["representation"] == "XCDR1", f"representation {s['representation']}"
+assert s["written"] == count and s["acked"] is True, f"written {s['written']} of {count}, acked {s['acked']}"
+print(f"checked: publisher wrote {count} {s['type']} ({s['representation']}), all acknowledged by cosmicd")
+PY
+}
+
+# No remote endpoint of CHANNEL refused on either segment (the counter is null when the
+# transport does not count: that is 0 here), and no mismatch reported for the channel.
+no_incompatible_peers() {
+  local channel=$1 segment n ok=1
+  for segment in left right; do
+    n=$(channel_field gw "$channel" "$segment" incompatible)
+    [ "$n" = 0 ] || { fail "$channel: cosmicctl reports $n incompatible peers on $segment"; ok=0; }
+  done
+  n=$(ctl gw --json channels | python3 -c '
+import json, sys
+for c in json.load(sys.stdin)["channels"]:
+    if c["name"] == sys.argv[1]:
+        print(len(c.get("mismatches", [])))' "$channel")
+  [ "$n" = 0 ] || { fail "$channel: cosmicctl reports mismatches: $(ctl gw channel "$channel" 2>&1 | head -5)"; ok=0; }
+  [ "$ok" = 0 ] || log "checked: $channel: no incompatible peers on left and right, no mismatches"
+}
+
+# One channel: Cyclone ROS 2 writer (segment FROM) -> cosmicd -> Cyclone ROS 2 reader (TO).
+run_channel() {
+  local channel=$1 topic=$2 from=$3 to=$4 count=$5
+  scenario "$channel: ROS 2 writer $topic (domain $(domain_of "$from")) -> cosmicd -> ROS 2 reader $topic (domain $(domain_of "$to"))"
+  "$ROS2_PEER" sub --domain "$(domain_of "$to")" --topic "$topic" --count "$count" --timeout-s 90 \
+    >"$WORK/$channel.out" 2>"$WORK/$channel.sub.err" &
+  local sub=$!
+  PIDS+=("$sub")
+  wait_until 30 "$channel: Cyclone reader created" stderr_has "$WORK/$channel.sub.err" ready || return
+  wait_until 30 "$channel: cosmicd's writer matched the Cyclone reader" field_at_least gw "$channel" "$to" matched 1 || return
+  wait_until 30 "$channel: Cyclone reader matched cosmicd's writer" stderr_has "$WORK/$channel.sub.err" MATCHED || return
+
+  # The writer is VOLATILE: it writes only once both sides know each other (the start gate).
+  mkfifo "$WORK/$channel.go"
+  "$ROS2_PEER" pub --domain "$(domain_of "$from")" --topic "$topic" --count "$count" --period-ms 10 \
+    --wait-readers 1 --timeout-s 60 --gate stdin \
+    <"$WORK/$channel.go" >"$WORK/$channel.pub.out" 2>"$WORK/$channel.pub.err" &
+  local pub=$!
+  PIDS+=("$pub")
+  local go
+  exec {go}>"$WORK/$channel.go"
+  wait_until 30 "$channel: Cyclone writer matched cosmicd's reader" stderr_has "$WORK/$channel.pub.err" MATCHED || { exec {go}>&-; return; }
+  wait_until 30 "$channel: cosmicd's reader matched the Cyclone writer" field_at_least gw "$channel" "$from" matched 1 || { exec {go}>&-; return; }
+  echo go >&"$go"
+  exec {go}>&-
+
+  wait "$pub" || fail "$channel: Cyclone publisher failed: $(cat "$WORK/$channel.pub.out" "$WORK/$channel.pub.err")"
+  check_pub_summary "$WORK/$channel.pub.out" "$count" >&2 || fail "$channel: publisher summary: $(cat "$WORK/$channel.pub.out")"
+  wait "$sub"
+  local sub_rc=$?
+  if ! check_samples "$WORK/$channel.out" "$count" >&2; then
+    fail "$channel: wrong samples (subscriber exit $sub_rc: $(cat "$WORK/$channel.sub.err"))"
+    log "--- where the events went (cosmicd's counters of $channel)"
+    ctl gw channel "$channel" >&2
+    return
+  fi
+  [ "$sub_rc" = 0 ] || fail "$channel: subscriber exit $sub_rc: $(cat "$WORK/$channel.sub.err")"
+  expect_field gw "$channel" "$from" rx "$count" && expect_field gw "$channel" "$to" tx "$count" &&
+    log "checked: $channel: cosmicd counted $count in on $from and $count out on $to"
+  no_incompatible_peers "$channel"
+  passed
+}
+
+start_daemon gw "$WORK/gw.yaml" || { tail -20 "$WORK/gw.log" >&2; exit 1; }
+# Both channels admitted and bound (a rejection would leave the test meaningless).
+[ "$(channel_count gw)" -eq 2 ] || fail "expected 2 bound channels, got $(channel_count gw)"
+
+run_channel cmd_vel rt/cmd_vel left right "$COUNT"
+run_channel odom_twist rt/odom_twist right left "$COUNT"
+
+if grep -q "incompatible QoS" "$WORK/gw.log"; then
+  fail "cosmicd refused a Cyclone endpoint: $(grep "incompatible QoS" "$WORK/gw.log" | head -3)"
+fi
+[ "$FAILED" = 0 ] || { log "--- cosmicd log"; tail -40 "$WORK/gw.log" >&2; exit 1; }
+log "all ROS 2 (Cyclone DDS) native-channel scenarios passed"
