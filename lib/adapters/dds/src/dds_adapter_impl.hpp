@@ -1,0 +1,187 @@
+// The DDS adapter's internals, shared by its units (internal to the DDS adapter):
+//   dds_adapter.cpp    lifecycle: start, configure (create, swap, delete), send, stop
+//   dds_endpoints.cpp  participants, topics, readers and writers, and Fast DDS's callbacks
+// The mapping is documented in cosmic/dds_adapter.hpp; threads and locks in dds_adapter.cpp.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <shared_mutex>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+
+#include "cosmic/adapter_counters.hpp"
+#include "cosmic/dds_adapter.hpp"
+#include "cosmic/dds_names.hpp"
+#include "cosmic/thread_policy.hpp"
+#include "dds_qos.hpp"
+#include "dds_sample_format.hpp"
+
+namespace cosmic::dds_detail {
+
+namespace dds = eprosima::fastdds::dds;
+namespace rtps = eprosima::fastrtps::rtps;
+using eprosima::fastrtps::types::ReturnCode_t;
+
+class DdsAdapter;
+
+struct TopicRef {
+  dds::Topic* topic = nullptr;
+  int users = 0;
+};
+
+// The DDS entities serving one class of channels on the segment (control thread only).
+struct ClassParticipant {
+  dds::DomainParticipant* participant = nullptr;
+  dds::Publisher* publisher = nullptr;
+  dds::Subscriber* subscriber = nullptr;
+  rtps::GuidPrefix_t prefix;
+  std::map<std::string, TopicRef> topics;
+};
+
+struct WriterEntry : dds::DataWriterListener {
+  WriterEntry(DdsAdapter& owner, ChannelId id, const ChannelSpec& spec, EndpointShape shape, std::uint64_t self)
+      : owner(owner), id(id), spec(spec), shape(std::move(shape)),
+        format(make_sample_format(this->shape.topic, spec, self)) {}
+  void on_offered_incompatible_qos(dds::DataWriter*,
+                                   const dds::OfferedIncompatibleQosStatus& status) override;
+
+  DdsAdapter& owner;
+  std::atomic<std::uint64_t> incompatible{0};  // remote readers refused for their QoS
+  ChannelId id;
+  ChannelSpec spec;
+  EndpointShape shape;
+  ClassParticipant* home = nullptr;  // the participant of the channel's class
+  dds::Topic* topic = nullptr;
+  dds::DataWriter* writer = nullptr;
+  std::mutex sample_mutex;  // guards format's sample
+  std::unique_ptr<DdsSampleFormat> format;
+  std::atomic<bool> refusal_logged{false};  // one log line for events the format cannot carry
+};
+
+struct ReaderEntry : dds::DataReaderListener {
+  ReaderEntry(DdsAdapter& owner, ChannelId id, const ChannelSpec& spec, EndpointShape shape, std::uint64_t self)
+      : owner(owner), id(id), spec(spec), shape(std::move(shape)),
+        format(make_sample_format(this->shape.topic, spec, self)) {}
+  void on_data_available(dds::DataReader* reader) override;
+  void on_requested_incompatible_qos(dds::DataReader*,
+                                     const dds::RequestedIncompatibleQosStatus& status) override;
+  void on_sample_lost(dds::DataReader*, const dds::SampleLostStatus& status) override;
+
+  DdsAdapter& owner;
+  std::atomic<std::uint64_t> incompatible{0};  // remote writers refused for their QoS
+  ChannelId id;
+  ChannelSpec spec;
+  EndpointShape shape;
+  ClassParticipant* home = nullptr;  // the participant of the channel's class
+  // GUID prefix of `home`: a sample whose writer has it is this gateway's own publication (a
+  // channel's reader and writer on one segment share the class, hence the participant).
+  rtps::GuidPrefix_t own_prefix;
+  dds::Topic* topic = nullptr;
+  dds::DataReader* reader = nullptr;
+  std::mutex mutex;     // serialises callbacks; guards `active` and format's sample
+  bool active = false;  // false: never calls the sink
+  std::unique_ptr<DdsSampleFormat> format;
+};
+
+class DdsAdapter final : public DdsSegmentAdapter {
+ public:
+  DdsAdapter(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log)
+      : segment_(segment), self_(self), log_(log) {
+    health_.state = SegmentHealth::down;
+    health_.detail = "not started";
+  }
+  ~DdsAdapter() override { stop(); }
+
+  Status start(EventSink& sink) override;
+  Status configure(std::span<const ChannelBinding> bindings) override;
+  SendStatus send(const OutboundEvent& event) override;
+  HealthReport health() const override {
+    std::lock_guard lock(health_mutex_);
+    return health_;
+  }
+  AdapterStatistics statistics() const override { return counters_.snapshot(); }
+  void stop() override;
+  std::size_t matched_endpoints(ChannelId channel, HopRole role) const override;
+  std::optional<std::size_t> matched_peers(ChannelId channel) const override {
+    // A channel is either written or read on one segment: the other count is 0.
+    return matched_endpoints(channel, HopRole::subscriber) + matched_endpoints(channel, HopRole::publisher);
+  }
+  std::optional<std::uint64_t> incompatible_peers(ChannelId channel) const override;
+
+  // Reader callbacks (Fast DDS threads, reader mutex held).
+  void deliver(ReaderEntry& entry, const dds::SampleInfo& info);
+  void count_receive_error(ReaderEntry& entry) {
+    counters_.receive_errors.fetch_add(1, std::memory_order_relaxed);
+    if (sink_ != nullptr) {
+      sink_->on_problem(entry.id, InboundProblem::decode_error);
+    }
+  }
+  void count_lost(std::uint64_t n) { counters_.overflow_drops.fetch_add(n, std::memory_order_relaxed); }
+  void warn(const std::string& text) { log_.log(LogLevel::warning, prefix() + text); }
+  void warn_refused(const WriterEntry& writer, FillRefusal refusal, std::uint16_t first_bytes,
+                    std::size_t size);
+
+ private:
+  std::string prefix() const { return "dds segment " + segment_.name + ": "; }
+  void set_health(SegmentHealth state, std::string detail) {
+    std::lock_guard lock(health_mutex_);
+    health_.state = state;
+    health_.detail = std::move(detail);
+  }
+  ClassParticipant& home_of(ChannelClass cls) { return classes_.at(static_cast<std::size_t>(cls)); }
+  bool started() const { return classes_[static_cast<std::size_t>(ChannelClass::nrt)].participant != nullptr; }
+  Status open_participant(ChannelClass cls, const ThreadPolicy& threads, const std::string& thread_name);
+  Status ensure_class_participant(ChannelClass cls);
+  void close_participant(ClassParticipant& home);
+  dds::Topic* acquire_topic(ClassParticipant& home, const DdsTopicRef& ref, std::string& error);
+  void release_topic(ClassParticipant& home, dds::Topic* topic);
+  std::unique_ptr<WriterEntry> create_writer(const ChannelBinding& binding, std::string& error);
+  std::unique_ptr<ReaderEntry> create_reader(const ChannelBinding& binding, std::string& error);
+  void destroy_writer(std::unique_ptr<WriterEntry> entry);
+  void deactivate(ReaderEntry& entry);
+  void destroy_reader(std::unique_ptr<ReaderEntry> entry);
+  void teardown();
+  dds::DomainParticipant* create_participant_as(const ThreadPolicy& threads, const dds::DomainParticipantQos& qos);
+
+  const SegmentSpec segment_;
+  const GatewayIdentity self_;
+  Logger& log_;
+
+  std::mutex control_mutex_;
+  EventSink* sink_ = nullptr;
+  std::array<ClassParticipant, 3> classes_;  // indexed by ChannelClass; entries point into it
+  bool log_attached_ = false;
+
+  mutable std::shared_mutex writers_mutex_;
+  std::unordered_map<ChannelId, std::unique_ptr<WriterEntry>> writers_;
+  // Readers: only the control thread changes this table; matched_endpoints() reads it shared.
+  mutable std::shared_mutex readers_mutex_;
+  std::unordered_map<ChannelId, std::unique_ptr<ReaderEntry>> readers_;
+  std::vector<std::unique_ptr<ReaderEntry>> retired_readers_;
+
+  mutable std::mutex health_mutex_;
+  AdapterCounters counters_;
+  HealthReport health_;
+
+};
+
+// Fast DDS's reception stamp (realtime clock) on the steady clock, never later than now.
+Nanos arrival_on_steady_clock(const eprosima::fastrtps::rtps::Time_t& reception);
+
+}  // namespace cosmic::dds_detail
