@@ -28,6 +28,7 @@
 #include "cosmic/adapter_counters.hpp"
 #include "cosmic/dds_adapter.hpp"
 #include "cosmic/dds_names.hpp"
+#include "cosmic/health_cell.hpp"
 #include "cosmic/thread_policy.hpp"
 #include "dds_qos.hpp"
 #include "dds_sample_format.hpp"
@@ -102,19 +103,13 @@ struct ReaderEntry : dds::DataReaderListener {
 class DdsAdapter final : public DdsSegmentAdapter {
  public:
   DdsAdapter(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log)
-      : segment_(segment), self_(self), log_(log) {
-    health_.state = SegmentHealth::down;
-    health_.detail = "not started";
-  }
+      : segment_(segment), self_(self), log_(log) {}
   ~DdsAdapter() override { stop(); }
 
   Status start(EventSink& sink) override;
   Status configure(std::span<const ChannelBinding> bindings) override;
   SendStatus send(const OutboundEvent& event) override;
-  HealthReport health() const override {
-    std::lock_guard lock(health_mutex_);
-    return health_;
-  }
+  HealthReport health() const override { return health_.get(); }
   AdapterStatistics statistics() const override { return counters_.snapshot(); }
   void stop() override;
   std::size_t matched_endpoints(ChannelId channel, HopRole role) const override;
@@ -139,11 +134,7 @@ class DdsAdapter final : public DdsSegmentAdapter {
 
  private:
   std::string prefix() const { return "dds segment " + segment_.name + ": "; }
-  void set_health(SegmentHealth state, std::string detail) {
-    std::lock_guard lock(health_mutex_);
-    health_.state = state;
-    health_.detail = std::move(detail);
-  }
+  void set_health(SegmentHealth state, std::string detail) { health_.set(state, std::move(detail)); }
   ClassParticipant& home_of(ChannelClass cls) { return classes_.at(static_cast<std::size_t>(cls)); }
   bool started() const { return classes_[static_cast<std::size_t>(ChannelClass::nrt)].participant != nullptr; }
   Status open_participant(ChannelClass cls, const ThreadPolicy& threads, const std::string& thread_name);
@@ -175,9 +166,8 @@ class DdsAdapter final : public DdsSegmentAdapter {
   std::unordered_map<ChannelId, std::unique_ptr<ReaderEntry>> readers_;
   std::vector<std::unique_ptr<ReaderEntry>> retired_readers_;
 
-  mutable std::mutex health_mutex_;
   AdapterCounters counters_;
-  HealthReport health_;
+  HealthCell health_;
 
 };
 

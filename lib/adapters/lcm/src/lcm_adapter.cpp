@@ -17,6 +17,7 @@
 #include "cosmic/lcm_adapter.hpp"
 
 #include "cosmic/adapter_counters.hpp"
+#include "cosmic/health_cell.hpp"
 #include "cosmic/arrival_clock.hpp"
 #include "cosmic/lcm_wire.hpp"
 #include "cosmic/thread_policy.hpp"
@@ -145,10 +146,7 @@ class EchoFilter {
 class LcmAdapter final : public SegmentAdapter {
  public:
   LcmAdapter(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log)
-      : segment_(segment), self_(self), log_(log) {
-    health_.state = SegmentHealth::down;
-    health_.detail = "not started";
-  }
+      : segment_(segment), self_(self), log_(log) {}
 
   ~LcmAdapter() override { stop(); }
 
@@ -343,8 +341,7 @@ class LcmAdapter final : public SegmentAdapter {
   }
 
   HealthReport health() const override {
-    std::lock_guard lock(health_mutex_);
-    return health_;
+    return health_.get();
   }
 
   std::optional<std::size_t> matched_peers(ChannelId) const override { return std::nullopt; }  // multicast: unknowable
@@ -513,11 +510,7 @@ class LcmAdapter final : public SegmentAdapter {
     return SendStatus::failed;
   }
 
-  void set_health(SegmentHealth state, std::string detail) {
-    std::lock_guard lock(health_mutex_);
-    health_.state = state;
-    health_.detail = std::move(detail);
-  }
+  void set_health(SegmentHealth state, std::string detail) { health_.set(state, std::move(detail)); }
 
   const SegmentSpec segment_;
   const GatewayIdentity self_;
@@ -542,9 +535,8 @@ class LcmAdapter final : public SegmentAdapter {
 
   EchoFilter echo_;
 
-  mutable std::mutex health_mutex_;
   AdapterCounters counters_;
-  HealthReport health_;
+  HealthCell health_;
 
   std::atomic<bool> send_failing_{false};
 };
