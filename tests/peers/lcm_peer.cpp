@@ -20,11 +20,13 @@
 #include <time.h>
 
 #include <CLI/CLI.hpp>
+#include <charconv>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -68,6 +70,7 @@ struct PubOptions {
   bool stamp = false;
   std::uint64_t subject = 0;
   std::uint64_t origin = 0;
+  std::string payload_hex;  // every message carries exactly these bytes (instead of the pattern)
 };
 
 struct SubOptions {
@@ -78,6 +81,19 @@ struct SubOptions {
   bool raw = false;
 };
 
+// "0a1B..." as bytes; nullopt for an odd length or a character that is not a hex digit.
+std::optional<std::vector<std::uint8_t>> from_hex(const std::string& text) {
+  if (text.size() % 2 != 0) return std::nullopt;
+  std::vector<std::uint8_t> out;
+  for (std::size_t i = 0; i < text.size(); i += 2) {
+    unsigned value = 0;
+    const auto [end, ec] = std::from_chars(text.data() + i, text.data() + i + 2, value, 16);
+    if (ec != std::errc() || end != text.data() + i + 2) return std::nullopt;
+    out.push_back(static_cast<std::uint8_t>(value));
+  }
+  return out;
+}
+
 int run_pub(const PubOptions& o) {
   lcm_t* lcm = lcm_create(o.url.c_str());
   if (lcm == nullptr) {
@@ -85,6 +101,13 @@ int run_pub(const PubOptions& o) {
     return 2;
   }
   std::vector<std::uint8_t> payload(o.size);
+  const std::optional<std::vector<std::uint8_t>> fixed = from_hex(o.payload_hex);
+  if (!fixed) {
+    std::fprintf(stderr, "--payload-hex: not an even number of hex digits\n");
+    lcm_destroy(lcm);
+    return 2;
+  }
+  if (!o.payload_hex.empty()) payload = *fixed;
   std::vector<std::uint8_t> buffer;
   cosmic::envelope e{};
   const auto start = std::chrono::steady_clock::now();
@@ -95,7 +118,7 @@ int run_pub(const PubOptions& o) {
           start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                       std::chrono::duration<double>(static_cast<double>(k - 1) / o.rate)));
     }
-    for (std::size_t i = 0; i < payload.size(); ++i)
+    for (std::size_t i = 0; o.payload_hex.empty() && i < payload.size(); ++i)
       payload[i] = static_cast<std::uint8_t>((k * 31 + i) & 0xff);
     if (o.stamp && payload.size() >= 8) {
       const auto t = static_cast<std::uint64_t>(clock_ns(CLOCK_MONOTONIC));
@@ -226,12 +249,13 @@ int main(int argc, char** argv) {
   pub_cmd->add_option("--url", pub.url, "LCM URL")->required();
   pub_cmd->add_option("--channel", pub.channel, "LCM channel")->required();
   pub_cmd->add_option("--count", pub.count, "number of messages")->required();
-  pub_cmd->add_option("--size", pub.size, "payload bytes")->required();
+  pub_cmd->add_option("--size", pub.size, "payload bytes (default 8; ignored with --payload-hex)");
   pub_cmd->add_option("--rate", pub.rate, "messages per second (0 = as fast as possible)");
   pub_cmd->add_flag("--raw", pub.raw, "bare payload bytes instead of the envelope");
   pub_cmd->add_flag("--stamp", pub.stamp, "first 8 payload bytes = CLOCK_MONOTONIC ns (LE)");
   pub_cmd->add_option("--subject", pub.subject, "envelope subject");
   pub_cmd->add_option("--origin", pub.origin, "envelope origin");
+  pub_cmd->add_option("--payload-hex", pub.payload_hex, "every message's payload, as hex (replaces --size's pattern)");
 
   SubOptions sub;
   CLI::App* sub_cmd = app.add_subcommand("sub", "receive N messages, one JSON line each");

@@ -3,7 +3,7 @@
 # geometry_msgs::msg::dds_::Twist_, ROS 2's default QoS RELIABLE/VOLATILE/KEEP_LAST 10, XCDR1),
 # against cosmicd's native DDS channels, inside a fresh network namespace (run through
 # scripts/netns-run):
-#   ros2_interop_test.sh COSMICD COSMICCTL COSMIC_CYCLONE_ROS2_PEER
+#   ros2_interop_test.sh COSMICD COSMICCTL COSMIC_CYCLONE_ROS2_PEER COSMIC_LCM_PEER
 # One gateway between two DDS domains and two native channels carrying the serialized Twist
 # unchanged: cmd_vel (SRT) from the left domain to the right one, odom_twist (NRT) from the right
 # to the left. For each, a Cyclone "node" publishes 50 Twists on one domain and another receives
@@ -11,9 +11,14 @@
 # must decode all 50 in order with exactly the values written, each sample byte for byte as the
 # writer serialized it (52 bytes, encapsulation CDR_LE 00 01 00 00); cosmicd must count each event
 # in and out exactly once; no endpoint may be refused for incompatible QoS.
+# Between formats (contents travel as bytes): teleop, a ROS 2 writer's Twists -> cosmicd -> raw on
+# LCM channel TELEOP (each message exactly the serialized sample); and from_lcm, an LCM publisher
+# sending a serialized Twist raw -> cosmicd -> native topic rt/from_lcm, decoded by a Cyclone
+# reader. Ten identical samples must all arrive: a native DDS topic has no fingerprint guard.
 set -uo pipefail
 [ "${COSMIC_IN_NETNS:-}" = 1 ] || { echo "run me through scripts/netns-run" >&2; exit 2; }
-COSMICD=$1 COSMICCTL=$2 ROS2_PEER=$3
+COSMICD=$1 COSMICCTL=$2 ROS2_PEER=$3 LCM_PEER=$4
+LCM_URL="udpm://239.255.76.67:7693?ttl=0"
 WORK=$(mktemp -d /tmp/cosmic-ros2.XXXXXX)
 # shellcheck source=../../daemon/lib.sh
 source "$(dirname "$0")/../../daemon/lib.sh"
@@ -31,6 +36,7 @@ gateway: {name: gw-ros2}
 segments:
   - {name: left, type: dds, domain: 35, latency_bound: 1ms, realtime: true}
   - {name: right, type: dds, domain: 36, latency_bound: 1ms, realtime: true}
+  - {name: viz, type: lcm, url: "$LCM_URL", latency_bound: 2ms}
 channels:
   - name: cmd_vel
     subject: 0x301
@@ -53,6 +59,24 @@ channels:
     native:
       left: {topic: rt/odom_twist, type: "$TWIST"}
       right: {topic: rt/odom_twist, type: "$TWIST"}
+  - name: teleop
+    subject: 0x303
+    class: nrt
+    payload: 52B
+    publishers: [left]
+    subscribers: [viz]
+    native:
+      left: {topic: rt/teleop, type: "$TWIST"}
+      viz: {channel: TELEOP}
+  - name: from_lcm
+    subject: 0x304
+    class: nrt
+    payload: 52B
+    publishers: [viz]
+    subscribers: [right]
+    native:
+      viz: {channel: FROM_LCM}
+      right: {topic: rt/from_lcm, type: "$TWIST"}
 YAML
 
 domain_of() { [ "$1" = left ] && echo 35 || echo 36; }
@@ -156,12 +180,78 @@ run_channel() {
   passed
 }
 
+# teleop: Cyclone ROS 2 writer (left) -> cosmicd -> LCM channel TELEOP, raw. Every message must be
+# the writer's serialized sample, byte for byte.
+run_to_lcm() {
+  local count=10
+  scenario "teleop: ROS 2 writer rt/teleop (domain 35) -> cosmicd -> raw LCM channel TELEOP"
+  "$LCM_PEER" sub --url "$LCM_URL" --channel TELEOP --count "$count" --timeout 60 --raw \
+    >"$WORK/teleop.out" 2>"$WORK/teleop.sub.err" &
+  local sub=$!
+  PIDS+=("$sub")
+  wait_until 30 "teleop: LCM subscriber ready" stderr_has "$WORK/teleop.sub.err" READY || return
+  mkfifo "$WORK/teleop.go"
+  "$ROS2_PEER" pub --domain 35 --topic rt/teleop --count "$count" --period-ms 10 --wait-readers 1 --timeout-s 60 \
+    --gate stdin <"$WORK/teleop.go" >"$WORK/teleop.pub.out" 2>"$WORK/teleop.pub.err" &
+  local pub=$! go
+  PIDS+=("$pub")
+  exec {go}>"$WORK/teleop.go"
+  wait_until 30 "teleop: cosmicd's reader matched the Cyclone writer" field_at_least gw teleop left matched 1 || { exec {go}>&-; return; }
+  wait_until 30 "teleop: Cyclone writer matched" stderr_has "$WORK/teleop.pub.err" MATCHED || { exec {go}>&-; return; }
+  echo go >&"$go"
+  exec {go}>&-
+  wait "$pub" || fail "teleop: Cyclone publisher failed: $(cat "$WORK/teleop.pub.err")"
+  wait "$sub" || fail "teleop: LCM subscriber: $(cat "$WORK/teleop.sub.err")"
+  python3 - "$WORK/teleop.out" "$count" >&2 <<'PY' || fail "teleop: LCM messages are not the serialized samples"
+import json, struct, sys
+lines = [json.loads(l) for l in open(sys.argv[1]) if l.strip()]
+count = int(sys.argv[2])
+assert len(lines) == count, f"{len(lines)} LCM messages, expected {count}"
+for i, line in enumerate(lines, 1):
+    linear, angular = [float(i), i + 0.5, -float(i)], [0.25 * i, -0.125, 1000.0 + i]
+    expected = bytes([0, 1, 0, 0]) + struct.pack("<6d", *linear, *angular)
+    assert bytes.fromhex(line["payload"]) == expected, f"message {i}: {line['payload']}, expected {expected.hex()}"
+print(f"checked: {count} LCM messages on TELEOP, each exactly the ROS 2 writer's serialized Twist")
+PY
+  passed
+}
+
+# from_lcm: an LCM publisher sends one serialized Twist (linear 7, 7.5, -7; angular 1.75, -0.125,
+# 1007) raw ten times -> cosmicd -> rt/from_lcm on the right domain -> Cyclone ROS 2 reader.
+run_from_lcm() {
+  local count=10
+  scenario "from_lcm: raw LCM FROM_LCM (serialized Twist) -> cosmicd -> ROS 2 reader rt/from_lcm (domain 36)"
+  local hex
+  hex=$(python3 -c 'import struct; print((bytes([0, 1, 0, 0]) + struct.pack("<6d", 7, 7.5, -7, 1.75, -0.125, 1007)).hex())')
+  "$ROS2_PEER" sub --domain 36 --topic rt/from_lcm --count "$count" --timeout-s 60 \
+    >"$WORK/from_lcm.out" 2>"$WORK/from_lcm.sub.err" &
+  local sub=$!
+  PIDS+=("$sub")
+  wait_until 30 "from_lcm: Cyclone reader matched cosmicd's writer" stderr_has "$WORK/from_lcm.sub.err" MATCHED || return
+  wait_until 30 "from_lcm: cosmicd's writer matched the Cyclone reader" field_at_least gw from_lcm right matched 1 || return
+  "$LCM_PEER" pub --url "$LCM_URL" --channel FROM_LCM --count "$count" --rate 20 --raw --payload-hex "$hex" \
+    || fail "from_lcm: LCM publisher failed"
+  wait "$sub" || fail "from_lcm: Cyclone reader: $(cat "$WORK/from_lcm.sub.err")"
+  python3 - "$WORK/from_lcm.out" "$count" >&2 <<'PY' || fail "from_lcm: the Cyclone reader did not decode the LCM bytes"
+import json, sys
+samples = [json.loads(l) for l in open(sys.argv[1]) if l.strip()]
+count = int(sys.argv[2])
+assert len(samples) == count, f"{len(samples)} samples, expected {count} (identical samples must all pass)"
+for s in samples:
+    assert s["linear"] == [7.0, 7.5, -7.0] and s["angular"] == [1.75, -0.125, 1007.0], f"decoded {s}"
+print(f"checked: a Cyclone ROS 2 reader decoded all {count} identical Twists sent raw on LCM")
+PY
+  passed
+}
+
 start_daemon gw "$WORK/gw.yaml" || { tail -20 "$WORK/gw.log" >&2; exit 1; }
-# Both channels admitted and bound (a rejection would leave the test meaningless).
-[ "$(channel_count gw)" -eq 2 ] || fail "expected 2 bound channels, got $(channel_count gw)"
+# Every channel admitted and bound (a rejection would leave the test meaningless).
+[ "$(channel_count gw)" -eq 4 ] || fail "expected 4 bound channels, got $(channel_count gw)"
 
 run_channel cmd_vel rt/cmd_vel left right "$COUNT"
 run_channel odom_twist rt/odom_twist right left "$COUNT"
+run_to_lcm
+run_from_lcm
 
 if grep -q "incompatible QoS" "$WORK/gw.log"; then
   fail "cosmicd refused a Cyclone endpoint: $(grep "incompatible QoS" "$WORK/gw.log" | head -3)"
