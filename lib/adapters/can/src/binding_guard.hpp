@@ -22,10 +22,10 @@
 
 namespace cosmic {
 
-class TokenBucket {
+class RequestBucket {
  public:
-  TokenBucket() = default;
-  TokenBucket(double per_second, double burst) : per_ns_(per_second / 1e9), burst_(burst), tokens_(burst) {}
+  RequestBucket() = default;
+  RequestBucket(double per_second, double burst) : per_ns_(per_second / 1e9), burst_(burst), tokens_(burst) {}
   bool take(Nanos now) {
     if (started_) tokens_ = std::min(burst_, tokens_ + static_cast<double>((now - last_).count()) * per_ns_);
     started_ = true;
@@ -48,7 +48,7 @@ class TokenBucket {
 class BindingRateLimit {
  public:
   explicit BindingRateLimit(double per_node = 10, double total = 100) : total_(total, 32) {
-    nodes_.fill(TokenBucket(per_node, 4));
+    nodes_.fill(RequestBucket(per_node, 4));
   }
   bool admit(std::uint8_t tx_node, Nanos now) {
     // The node's own budget first, so one noisy node does not use up the bus-wide one.
@@ -56,8 +56,8 @@ class BindingRateLimit {
   }
 
  private:
-  std::array<TokenBucket, 128> nodes_;
-  TokenBucket total_;
+  std::array<RequestBucket, 128> nodes_;
+  RequestBucket total_;
 };
 
 class ProtocolQueue {

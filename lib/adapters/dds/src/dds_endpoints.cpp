@@ -9,6 +9,7 @@
 
 #include <cosmic_dds_idl/EnvelopePubSubTypes.h>
 
+#include "cosmic/arrival_clock.hpp"
 #include "cosmic/dds_encapsulation.hpp"
 #include "dds_adapter_impl.hpp"
 #include "dds_opaque_type.hpp"
@@ -82,16 +83,12 @@ void ReaderEntry::on_data_available(dds::DataReader* dr) {
 }
 
 // Fast DDS stamps a sample with the realtime clock when its receive thread got it; the router
-// measures residence on the steady clock. Moved over by the current offset between the two and
-// never later than now, so residence counts from arrival rather than from this callback.
+// measures residence on the steady clock. Moved over by the current offset between the two,
+// clamped like every adapter's kernel timestamps (arrival_clock.hpp): never later than now, and a
+// stepped clock never invents more than a second of residence (which could mark an HRT channel
+// violated), so residence counts from arrival rather than from this callback.
 Nanos arrival_on_steady_clock(const eprosima::fastrtps::rtps::Time_t& reception) {
-  const Nanos steady_now = std::chrono::duration_cast<Nanos>(
-      std::chrono::steady_clock::now().time_since_epoch());
-  const Nanos realtime_now = std::chrono::duration_cast<Nanos>(
-      std::chrono::system_clock::now().time_since_epoch());
-  const Nanos arrived(reception.to_ns());
-  const Nanos waited = realtime_now - arrived;
-  return waited > Nanos(0) ? steady_now - waited : steady_now;
+  return steady_arrival_now(reception.to_ns());
 }
 
 void DdsAdapter::deliver(ReaderEntry& entry, const dds::SampleInfo& info) {
