@@ -8,7 +8,9 @@
 //                             [--dump FILE]
 //   cosmic-bench-peer dds-pub --domain D --topic T --count N --size B [--rate HZ] [--warmup W]
 //                             [--keep-last DEPTH] [--wait-go] [--match-timeout S] [--stall S]
+//                             [--native TYPE]
 //   cosmic-bench-peer dds-sub --domain D --topic T --count N [--timeout S] [--idle S] [--dump FILE]
+//                             [--native TYPE]
 //
 // Payload of every event (size >= 16): bytes 0..7 = CLOCK_MONOTONIC ns when the publisher hands
 // it to its library (little-endian), bytes 8..11 = index (measured events 1..N, warm-up events
@@ -16,7 +18,11 @@
 // which the gateway forwards unchanged, so one-way latency = receive time - stamp on every path
 // (all processes of one host read the same CLOCK_MONOTONIC). LCM events are the bare payload
 // (cosmicd channel encoding raw) unless --envelope; DDS events are cosmic::Envelope with origin 0
-// (a native source), sequence = index and created_ns = the stamp.
+// (a native source), sequence = index and created_ns = the stamp, or with --native TYPE samples of
+// a raw type announced as TYPE (a cosmicd native topic): the bytes written are a CDR
+// encapsulation header 00 01 00 00 (CDR_LE, XCDR1) followed by the B-byte payload, so the stamp
+// sits at bytes 4..11 of the sample (the receiver skips the header, and counts a sample without
+// exactly that header as malformed). The Fast DDS side is bench_dds.cpp.
 //
 // Publishers first send W warm-up events (default 200, paced at min(rate, 5000)/s; they let
 // discovery settle and warm caches and are ignored by the receiver), pause 200 ms, then the N
@@ -44,11 +50,9 @@
 #include <atomic>
 #include <chrono>
 #include <cinttypes>
-#include <condition_variable>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
-#include <iostream>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -56,36 +60,13 @@
 
 #include <CLI/CLI.hpp>
 
-#include <fastdds/dds/domain/DomainParticipant.hpp>
-#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/log/Log.hpp>
-#include <fastdds/dds/publisher/DataWriter.hpp>
-#include <fastdds/dds/publisher/DataWriterListener.hpp>
-#include <fastdds/dds/publisher/Publisher.hpp>
-#include <fastdds/dds/subscriber/DataReader.hpp>
-#include <fastdds/dds/subscriber/DataReaderListener.hpp>
-#include <fastdds/dds/subscriber/SampleInfo.hpp>
-#include <fastdds/dds/subscriber/Subscriber.hpp>
-#include <fastdds/dds/topic/Topic.hpp>
-#include <fastdds/dds/topic/TypeSupport.hpp>
 
-#include <cosmic_dds_idl/EnvelopePubSubTypes.h>
-
+#include "bench_dds.hpp"
+#include "bench_peer.hpp"
 #include "cosmic/envelope.hpp"  // lcm-gen
 
-namespace {
-
-namespace fdds = eprosima::fastdds::dds;
-using eprosima::fastrtps::types::ReturnCode_t;
-
-constexpr std::uint32_t kWarmupBit = 0x80000000u;
-constexpr std::size_t kMinSize = 16;
-
-std::atomic<bool> g_stop{false};
-void on_signal(int) { g_stop = true; }
-// Set by a publisher whose transport stopped taking events (dds-pub: no write succeeded for
-// --stall seconds): the run ends early and says so.
-bool g_stalled = false;
+namespace cosmic_bench {
 
 std::int64_t mono_ns() {
   timespec ts{};
@@ -123,150 +104,90 @@ void err_line(const std::string& text) {
   std::fflush(stderr);
 }
 
-// Drives a publisher: warm-up, pause, measured events. send(payload) returns false on failure.
-template <typename Send>
-int publish_all(std::uint64_t count, std::uint64_t size, double rate, std::uint64_t warmup, Send&& send) {
-  std::vector<std::uint8_t> payload(std::max<std::uint64_t>(size, kMinSize));
-  const double warm_rate = rate > 0 ? std::min(rate, 5000.0) : 5000.0;
-  std::int64_t start = mono_ns();
-  for (std::uint64_t k = 1; k <= warmup && !g_stop && !g_stalled; ++k) {
-    sleep_until_ns(start + static_cast<std::int64_t>(static_cast<double>(k - 1) * 1e9 / warm_rate));
-    fill(payload, kWarmupBit | static_cast<std::uint32_t>(k));
-    stamp(payload);
-    send(payload);
+void Recorder::record(const std::uint8_t* data, std::size_t size, std::int64_t now) {
+  std::lock_guard lock(mutex_);  // uncontended but for the final report
+  last_any_ns_.store(now, std::memory_order_relaxed);
+  if (size < kMinSize) {
+    ++malformed_;
+    return;
   }
-  if (warmup > 0) sleep_until_ns(mono_ns() + 200'000'000);
-  std::uint64_t sent = 0;
-  std::uint64_t failed = 0;
-  start = mono_ns();
-  for (std::uint64_t k = 1; k <= count && !g_stop && !g_stalled; ++k) {
-    if (rate > 0) sleep_until_ns(start + static_cast<std::int64_t>(static_cast<double>(k - 1) * 1e9 / rate));
-    fill(payload, static_cast<std::uint32_t>(k));
-    stamp(payload);
-    if (send(payload)) {
-      ++sent;
-    } else {
-      ++failed;
-    }
+  const auto index = static_cast<std::uint32_t>(get_le(data + 8, 4));
+  if ((index & kWarmupBit) != 0) {
+    ++warmup_received_;
+    return;
   }
-  const double seconds = static_cast<double>(mono_ns() - start) / 1e9;
-  std::printf("RESULT sent=%" PRIu64 " failed=%" PRIu64 " seconds=%.6f rate=%.0f stalled=%d\n", sent, failed,
-              seconds, seconds > 0 ? static_cast<double>(sent) / seconds : 0.0, g_stalled ? 1 : 0);
-  std::fflush(stdout);
-  if (g_stalled) return 5;
-  return failed == 0 && !g_stop ? 0 : 4;
+  if (index == 0 || index > count_) {
+    ++malformed_;
+    return;
+  }
+  if (seen_[index] != 0) {
+    ++duplicates_;
+    return;
+  }
+  seen_[index] = 1;
+  const auto sent = static_cast<std::int64_t>(get_le(data, 8));
+  latency_ns_.push_back(now - sent);
+  if (!dump_path.empty()) trace_.push_back({index, sent, now});
+  if (received_ == 0) first_ns_ = now;
+  last_ns_ = now;
+  measuring_.store(true, std::memory_order_relaxed);
+  if (++received_ >= count_) {
+    done_ = true;
+    cv_.notify_all();
+  }
 }
 
-// Receiver statistics. record() runs on one thread at a time (the transport's callback).
-class Recorder {
- public:
-  explicit Recorder(std::uint64_t count) : count_(count), seen_(count + 1, 0) { latency_ns_.reserve(count); }
+void Recorder::wait(double timeout_s, double idle_s) {
+  const std::int64_t deadline = mono_ns() + static_cast<std::int64_t>(timeout_s * 1e9);
+  const auto idle_ns = static_cast<std::int64_t>(idle_s * 1e9);
+  std::unique_lock lock(mutex_);
+  while (!done_ && !g_stop) {
+    cv_.wait_for(lock, std::chrono::milliseconds(20));
+    const std::int64_t now = mono_ns();
+    if (now >= deadline) break;
+    if (measuring_.load(std::memory_order_relaxed) && now - last_any_ns_.load(std::memory_order_relaxed) > idle_ns) break;
+  }
+}
 
-  void record(const std::uint8_t* data, std::size_t size, std::int64_t now) {
-    std::lock_guard lock(mutex_);  // uncontended but for the final report
-    last_any_ns_.store(now, std::memory_order_relaxed);
-    if (size < kMinSize) {
-      ++malformed_;
-      return;
-    }
-    const auto index = static_cast<std::uint32_t>(get_le(data + 8, 4));
-    if ((index & kWarmupBit) != 0) {
-      ++warmup_received_;
-      return;
-    }
-    if (index == 0 || index > count_) {
-      ++malformed_;
-      return;
-    }
-    if (seen_[index] != 0) {
-      ++duplicates_;
-      return;
-    }
-    seen_[index] = 1;
-    const auto sent = static_cast<std::int64_t>(get_le(data, 8));
-    latency_ns_.push_back(now - sent);
-    if (!dump_path.empty()) trace_.push_back({index, sent, now});
-    if (received_ == 0) first_ns_ = now;
-    last_ns_ = now;
-    measuring_.store(true, std::memory_order_relaxed);
-    if (++received_ >= count_) {
-      done_ = true;
-      cv_.notify_all();
+int Recorder::report() {
+  std::lock_guard lock(mutex_);  // record() may still run on the transport's thread
+  if (!dump_path.empty()) {
+    if (FILE* f = std::fopen(dump_path.c_str(), "w")) {
+      for (const auto& t : trace_)
+        std::fprintf(f, "%" PRIu32 " %" PRId64 " %" PRId64 " %.1f\n", t.index, t.sent_ns, t.recv_ns,
+                     static_cast<double>(t.recv_ns - t.sent_ns) / 1e3);
+      std::fclose(f);
     }
   }
-
-  // Waits until every measured event arrived, the flow went idle, or the timeout.
-  void wait(double timeout_s, double idle_s) {
-    const std::int64_t deadline = mono_ns() + static_cast<std::int64_t>(timeout_s * 1e9);
-    const auto idle_ns = static_cast<std::int64_t>(idle_s * 1e9);
-    std::unique_lock lock(mutex_);
-    while (!done_ && !g_stop) {
-      cv_.wait_for(lock, std::chrono::milliseconds(20));
-      const std::int64_t now = mono_ns();
-      if (now >= deadline) break;
-      if (measuring_.load(std::memory_order_relaxed) && now - last_any_ns_.load(std::memory_order_relaxed) > idle_ns) break;
-    }
-  }
-
-  int report() {
-    std::lock_guard lock(mutex_);  // record() may still run on the transport's thread
-    if (!dump_path.empty()) {
-      if (FILE* f = std::fopen(dump_path.c_str(), "w")) {
-        for (const auto& t : trace_)
-          std::fprintf(f, "%" PRIu32 " %" PRId64 " %" PRId64 " %.1f\n", t.index, t.sent_ns, t.recv_ns,
-                       static_cast<double>(t.recv_ns - t.sent_ns) / 1e3);
-        std::fclose(f);
-      }
-    }
-    std::vector<std::int64_t> lat(latency_ns_);
-    std::sort(lat.begin(), lat.end());
-    auto q = [&](double p) -> double {
-      if (lat.empty()) return 0;
-      const auto i = static_cast<std::size_t>(p * static_cast<double>(lat.size() - 1) + 0.5);
-      return static_cast<double>(lat[std::min(i, lat.size() - 1)]) / 1e3;
-    };
-    double mean = 0;
-    for (const auto v : lat) mean += static_cast<double>(v);
-    mean = lat.empty() ? 0 : mean / static_cast<double>(lat.size()) / 1e3;
-    const double span = received_ > 1 ? static_cast<double>(last_ns_ - first_ns_) / 1e9 : 0;
-    std::printf(
-        "RESULT expected=%" PRIu64 " received=%" PRIu64 " lost=%" PRIu64 " duplicates=%" PRIu64 " malformed=%" PRIu64
-        " p50_us=%.1f p90_us=%.1f p99_us=%.1f p999_us=%.1f max_us=%.1f mean_us=%.1f span_s=%.6f rate=%.0f"
-        " warmup_received=%" PRIu64 "\n",
-        count_, received_, count_ - received_, duplicates_, malformed_, q(0.50), q(0.90), q(0.99), q(0.999),
-        lat.empty() ? 0.0 : static_cast<double>(lat.back()) / 1e3, mean, span,
-        span > 0 ? static_cast<double>(received_ - 1) / span : 0.0, warmup_received_);
-    std::fflush(stdout);
-    return received_ > 0 ? 0 : 1;
-  }
-
- private:
-  struct Trace {
-    std::uint32_t index;
-    std::int64_t sent_ns;
-    std::int64_t recv_ns;
+  std::vector<std::int64_t> lat(latency_ns_);
+  std::sort(lat.begin(), lat.end());
+  auto q = [&](double p) -> double {
+    if (lat.empty()) return 0;
+    const auto i = static_cast<std::size_t>(p * static_cast<double>(lat.size() - 1) + 0.5);
+    return static_cast<double>(lat[std::min(i, lat.size() - 1)]) / 1e3;
   };
+  double mean = 0;
+  for (const auto v : lat) mean += static_cast<double>(v);
+  mean = lat.empty() ? 0 : mean / static_cast<double>(lat.size()) / 1e3;
+  const double span = received_ > 1 ? static_cast<double>(last_ns_ - first_ns_) / 1e9 : 0;
+  std::printf(
+      "RESULT expected=%" PRIu64 " received=%" PRIu64 " lost=%" PRIu64 " duplicates=%" PRIu64 " malformed=%" PRIu64
+      " p50_us=%.1f p90_us=%.1f p99_us=%.1f p999_us=%.1f max_us=%.1f mean_us=%.1f span_s=%.6f rate=%.0f"
+      " warmup_received=%" PRIu64 "\n",
+      count_, received_, count_ - received_, duplicates_, malformed_, q(0.50), q(0.90), q(0.99), q(0.999),
+      lat.empty() ? 0.0 : static_cast<double>(lat.back()) / 1e3, mean, span,
+      span > 0 ? static_cast<double>(received_ - 1) / span : 0.0, warmup_received_);
+  std::fflush(stdout);
+  return received_ > 0 ? 0 : 1;
+}
 
- public:
-  std::string dump_path;  // --dump: one line per measured event "index sent_ns recv_ns latency_us"
+}  // namespace cosmic_bench
 
- private:
-  std::vector<Trace> trace_;
-  std::uint64_t count_;
-  std::vector<std::uint8_t> seen_;
-  std::vector<std::int64_t> latency_ns_;
-  std::uint64_t received_ = 0;
-  std::uint64_t duplicates_ = 0;
-  std::uint64_t warmup_received_ = 0;
-  std::uint64_t malformed_ = 0;
-  std::int64_t first_ns_ = 0;
-  std::int64_t last_ns_ = 0;
-  std::atomic<std::int64_t> last_any_ns_{0};
-  std::atomic<bool> measuring_{false};
-  std::mutex mutex_;
-  std::condition_variable cv_;
-  bool done_ = false;
-};
+namespace {
+
+using namespace cosmic_bench;
+
+void on_signal(int) { g_stop = true; }
 
 // ---- LCM ---------------------------------------------------------------------------------------
 
@@ -376,202 +297,6 @@ int lcm_sub(const LcmOptions& o) {
   return rc;
 }
 
-// ---- Fast DDS ----------------------------------------------------------------------------------
-
-struct DdsOptions {
-  unsigned domain = 0;
-  std::string topic;
-  std::uint64_t count = 0;
-  std::uint64_t size = 64;
-  double rate = 0;
-  std::uint64_t warmup = 200;
-  int keep_last = 0;  // 0: KEEP_ALL
-  bool wait_go = false;
-  double match_timeout = 20;
-  double stall = 5;
-  double timeout = 60;
-  double idle = 1.5;
-  std::string dump;
-};
-
-struct Participant {
-  fdds::DomainParticipant* participant = nullptr;
-  fdds::Topic* topic = nullptr;
-  ~Participant() {
-    if (participant != nullptr) {
-      participant->delete_contained_entities();
-      fdds::DomainParticipantFactory::get_instance()->delete_participant(participant);
-    }
-  }
-  bool open(unsigned domain, const std::string& topic_name) {
-    fdds::DomainParticipantQos qos = fdds::PARTICIPANT_QOS_DEFAULT;
-    qos.name("cosmic-bench-peer");
-    participant = fdds::DomainParticipantFactory::get_instance()->create_participant(
-        static_cast<fdds::DomainId_t>(domain), qos);
-    if (participant == nullptr) return false;
-    fdds::TypeSupport type(new cosmic::EnvelopePubSubType());
-    type.register_type(participant);
-    topic = participant->create_topic(topic_name, type.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
-    return topic != nullptr;
-  }
-};
-
-class Matched {
- public:
-  void set(int n) {
-    {
-      std::lock_guard lock(mutex_);
-      count_ = n;
-    }
-    cv_.notify_all();
-  }
-  bool wait(int n, double timeout_s) {
-    std::unique_lock lock(mutex_);
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<int>(timeout_s * 1000));
-    while (count_ < n && !g_stop) {
-      if (cv_.wait_until(lock, std::min(deadline, std::chrono::steady_clock::now() + std::chrono::milliseconds(100))) ==
-              std::cv_status::timeout &&
-          std::chrono::steady_clock::now() >= deadline)
-        return false;
-    }
-    return count_ >= n;
-  }
-
- private:
-  std::mutex mutex_;
-  std::condition_variable cv_;
-  int count_ = 0;
-};
-
-class WriterListener : public fdds::DataWriterListener {
- public:
-  void on_publication_matched(fdds::DataWriter*, const fdds::PublicationMatchedStatus& status) override {
-    matched.set(status.current_count);
-  }
-  Matched matched;
-};
-
-int dds_pub(const DdsOptions& o) {
-  Participant p;
-  if (!p.open(o.domain, o.topic)) {
-    err_line("cannot create the DDS participant/topic");
-    return 3;
-  }
-  fdds::Publisher* publisher = p.participant->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
-  fdds::DataWriterQos qos = fdds::DATAWRITER_QOS_DEFAULT;
-  qos.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
-  qos.reliability().max_blocking_time = eprosima::fastrtps::Duration_t(1, 0);
-  qos.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 50'000'000);
-  qos.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
-  if (o.keep_last > 0) {
-    qos.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
-    qos.history().depth = o.keep_last;
-  } else {
-    qos.history().kind = fdds::KEEP_ALL_HISTORY_QOS;
-    qos.resource_limits().max_samples = 5000;
-    qos.resource_limits().allocated_samples = 500;
-    qos.resource_limits().max_samples_per_instance = 5000;
-  }
-  qos.publish_mode().kind = fdds::SYNCHRONOUS_PUBLISH_MODE;
-  qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
-  WriterListener listener;
-  fdds::DataWriter* writer =
-      publisher->create_datawriter(p.topic, qos, &listener, fdds::StatusMask::publication_matched());
-  if (writer == nullptr) {
-    err_line("cannot create the DataWriter");
-    return 3;
-  }
-  if (!listener.matched.wait(1, o.match_timeout)) {
-    err_line("no reader matched");
-    return 2;
-  }
-  err_line("MATCHED");
-  if (o.wait_go) {
-    err_line("WAITING");
-    std::string go;
-    std::getline(std::cin, go);
-  }
-  cosmic::Envelope env;
-  std::uint64_t retries = 0;
-  const int rc = publish_all(o.count, o.size, o.rate, o.warmup, [&](const std::vector<std::uint8_t>& payload) {
-    env.subject(0);
-    env.origin(0);
-    env.hop_count(0);
-    env.age_ns(0);
-    env.sequence(static_cast<std::uint32_t>(get_le(payload.data() + 8, 4)));
-    env.created_ns(static_cast<std::int64_t>(get_le(payload.data(), 8)));
-    env.payload() = payload;
-    ReturnCode_t r = writer->write(&env, fdds::HANDLE_NIL);
-    // A reliable KEEP_ALL writer blocks (max_blocking_time 1 s) while its history is full of
-    // unacknowledged samples; retry until --stall seconds pass without success.
-    const std::int64_t give_up = mono_ns() + static_cast<std::int64_t>(o.stall * 1e9);
-    while (!g_stop && (r == ReturnCode_t::RETCODE_TIMEOUT || r == ReturnCode_t::RETCODE_OUT_OF_RESOURCES)) {
-      if (mono_ns() >= give_up) {
-        g_stalled = true;
-        char text[160];
-        std::snprintf(text, sizeof text, "STALLED: no write accepted for %.1f s at event index %u%s", o.stall,
-                      env.sequence() & ~kWarmupBit, (env.sequence() & kWarmupBit) != 0 ? " (warm-up)" : "");
-        err_line(text);
-        return false;
-      }
-      ++retries;
-      r = writer->write(&env, fdds::HANDLE_NIL);
-    }
-    return r == ReturnCode_t::RETCODE_OK;
-  });
-  if (!g_stalled) writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0));
-  if (retries > 0) err_line("write retries: " + std::to_string(retries));
-  return rc;
-}
-
-class ReaderListener : public fdds::DataReaderListener {
- public:
-  explicit ReaderListener(Recorder& r) : recorder(r) {}
-  void on_data_available(fdds::DataReader* reader) override {
-    fdds::SampleInfo info;
-    while (reader->take_next_sample(&env, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data) continue;
-      const std::int64_t now = mono_ns();
-      recorder.record(env.payload().data(), env.payload().size(), now);
-    }
-  }
-  void on_subscription_matched(fdds::DataReader*, const fdds::SubscriptionMatchedStatus& status) override {
-    if (status.current_count_change > 0 && status.current_count >= 1) err_line("MATCHED");
-  }
-  Recorder& recorder;
-  cosmic::Envelope env;
-};
-
-int dds_sub(const DdsOptions& o) {
-  Participant p;
-  if (!p.open(o.domain, o.topic)) {
-    err_line("cannot create the DDS participant/topic");
-    return 3;
-  }
-  Recorder recorder(o.count);
-  recorder.dump_path = o.dump;
-  ReaderListener listener(recorder);
-  fdds::Subscriber* subscriber = p.participant->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
-  fdds::DataReaderQos qos = fdds::DATAREADER_QOS_DEFAULT;
-  qos.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
-  qos.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
-  qos.history().kind = fdds::KEEP_ALL_HISTORY_QOS;
-  qos.resource_limits().max_samples = 100000;
-  qos.resource_limits().allocated_samples = 1000;
-  qos.resource_limits().max_samples_per_instance = 100000;
-  qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
-  fdds::DataReader* reader = subscriber->create_datareader(
-      p.topic, qos, &listener, fdds::StatusMask::data_available() << fdds::StatusMask::subscription_matched());
-  if (reader == nullptr) {
-    err_line("cannot create the DataReader");
-    return 3;
-  }
-  recorder.wait(o.timeout, o.idle);
-  // Stop the callbacks before reporting: the listener must not outlive the reader.
-  reader->set_listener(nullptr);
-  return recorder.report();
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -580,7 +305,7 @@ int main(int argc, char** argv) {
   sigemptyset(&action.sa_mask);
   sigaction(SIGTERM, &action, nullptr);
   sigaction(SIGINT, &action, nullptr);
-  fdds::Log::SetVerbosity(fdds::Log::Error);
+  eprosima::fastdds::dds::Log::SetVerbosity(eprosima::fastdds::dds::Log::Error);
 
   CLI::App app{"cosmic-bench-peer: load generator and latency receiver for scripts/bench"};
   app.require_subcommand(1);
@@ -596,6 +321,8 @@ int main(int argc, char** argv) {
     c->add_option("--domain", dd.domain, "DDS domain")->required();
     c->add_option("--topic", dd.topic, "DDS topic (cosmicd: cosmic/<channel>)")->required();
     c->add_option("--count", dd.count, "measured events")->required();
+    c->add_option("--native", dd.native_type,
+                  "type name of a native topic: samples are 00 01 00 00 + payload instead of cosmic::Envelope");
   };
   CLI::App* lp = app.add_subcommand("lcm-pub", "publish on LCM");
   lcm_common(lp);
@@ -628,6 +355,6 @@ int main(int argc, char** argv) {
   if (ls->parsed()) rc = lcm_sub(lo);
   if (dp->parsed()) rc = dds_pub(dd);
   if (ds->parsed()) rc = dds_sub(dd);
-  fdds::Log::Flush();
+  eprosima::fastdds::dds::Log::Flush();
   return rc;
 }

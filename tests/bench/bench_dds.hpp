@@ -1,0 +1,32 @@
+// The Fast DDS side of cosmic-bench-peer (dds-pub, dds-sub; bench_peer.cpp's header comment says
+// what they do). A topic is either cosmic::Envelope (cosmicd's envelope topics cosmic/<channel>)
+// or, with a native type name, a raw type of the peer's own whose samples are the bytes it writes:
+// a CDR encapsulation header 00 01 00 00 (CDR_LE, XCDR1) followed by the event's payload.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace cosmic_bench {
+
+struct DdsOptions {
+  unsigned domain = 0;
+  std::string topic;
+  std::string native_type;  // empty: cosmic::Envelope; otherwise the raw type announced as this name
+  std::uint64_t count = 0;
+  std::uint64_t size = 64;
+  double rate = 0;
+  std::uint64_t warmup = 200;
+  int keep_last = 0;  // 0: KEEP_ALL
+  bool wait_go = false;
+  double match_timeout = 20;
+  double stall = 5;
+  double timeout = 60;
+  double idle = 1.5;
+  std::string dump;
+};
+
+int dds_pub(const DdsOptions& o);
+int dds_sub(const DdsOptions& o);
+
+}  // namespace cosmic_bench
