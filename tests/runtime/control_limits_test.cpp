@@ -4,6 +4,7 @@
 // the server keeps answering, a regular file at the socket path, logging of denied requests and
 // a change that cannot be saved.
 #include <gtest/gtest.h>
+#include <future>
 #include <poll.h>
 #include <sys/resource.h>
 #include <sys/socket.h>
@@ -228,11 +229,17 @@ TEST_F(ControlTest, AcceptAtTheDescriptorLimitRefusesInsteadOfSpinning) {
   const bool answered = connected && ::poll(&ready, 1, 5000) == 1;
   char buffer[512] = {};
   const ssize_t n = answered ? ::read(client, buffer, sizeof buffer - 1) : -1;
+  // Still out of descriptors, nothing pending: the server must be back in its loop, not retrying
+  // accept (which answers EMFILE even with an empty backlog) for ever. A posted task proves it.
+  auto looped = std::make_shared<std::promise<void>>();
+  server->post([looped] { looped->set_value(); });
+  const bool loop_runs = looped->get_future().wait_for(std::chrono::seconds(5)) == std::future_status::ready;
   for (const int fd : filler) ::close(fd);
   ::setrlimit(RLIMIT_NOFILE, &saved);
   ::close(client);
   ASSERT_TRUE(connected);
   ASSERT_TRUE(answered) << "the pending connection was never taken off the backlog";
+  EXPECT_TRUE(loop_runs) << "the server kept retrying accept at the descriptor limit";
   ASSERT_GT(n, 0);
   const Json answer = Json::parse(std::string(buffer, static_cast<std::size_t>(n)), nullptr, false);
   EXPECT_EQ(answer["error"]["code"], "busy");

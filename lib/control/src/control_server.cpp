@@ -190,10 +190,9 @@ void ControlServer::accept_clients() {
       continue;
     }
     if (errno == EINTR || errno == ECONNABORTED) continue;
-    if ((errno == EMFILE || errno == ENFILE) && spare_fd_ >= 0) {
-      refuse_at_fd_limit();
-      continue;
-    }
+    // accept4 takes a descriptor before it looks for a connection, so at the limit it answers
+    // EMFILE even with an empty backlog: go on only while the spare actually took one off it.
+    if ((errno == EMFILE || errno == ENFILE) && spare_fd_ >= 0 && refuse_at_fd_limit()) continue;
     // EAGAIN, or out of descriptors with no spare: a waiting connection stays in the backlog
     // and the level-triggered listener would wake us at once, so the next try waits for the
     // next run_for() (the spare is reopened there).
@@ -203,7 +202,8 @@ void ControlServer::accept_clients() {
 
 // Out of file descriptors: the pending connection would keep the listener readable and the loop
 // spinning. Give up the spare descriptor, take the connection, tell the peer why, close it.
-void ControlServer::refuse_at_fd_limit() {
+// False when there was no connection to take (the backlog is empty).
+bool ControlServer::refuse_at_fd_limit() {
   ::close(spare_fd_);
   spare_fd_ = -1;
   const int fd = ::accept4(listen_fd_, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
@@ -212,6 +212,7 @@ void ControlServer::refuse_at_fd_limit() {
     refuse(fd, error_line("busy", "cosmicd is out of file descriptors; try again later"));
   }
   spare_fd_ = open_spare_descriptor();
+  return fd >= 0;
 }
 
 std::optional<std::string> ControlServer::admit(const Client& client) const {

@@ -99,7 +99,7 @@ class ControlServer {
   };
   std::optional<std::string> admit(const Client& client) const;
   void accept_clients();
-  void refuse_at_fd_limit();
+  bool refuse_at_fd_limit();
   void add_client(int fd);
   void on_client(int fd, std::uint32_t events);
   void read_input(Client& client, int fd);
