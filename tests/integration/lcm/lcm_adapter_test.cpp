@@ -253,6 +253,15 @@ TEST_F(LcmAdapterTest, OwnEnvelopesAreNotReceivedBack) {
     EXPECT_EQ(events[i].payload, peer_pattern(i + 1, 16));
   }
   EXPECT_EQ(sink_.problems(5, InboundProblem::own_echo), 10u);
+
+  // Envelopes carrying this gateway's origin that it did not just publish (a loop through another
+  // gateway, or a spoof) are delivered, for the router's ingress check to drop and count.
+  Child spoof({peer(), "pub", "--url", url_for(port), "--channel", "LOOPED", "--count", "3", "--size",
+               "16", "--origin", std::to_string(self_.id), "--subject", "9"});
+  ASSERT_EQ(spoof.wait_exit(), std::optional<int>(0)) << spoof.stderr_text();
+  ASSERT_TRUE(sink_.wait_events(5, 8));
+  for (std::size_t i = 5; i < 8; ++i) EXPECT_EQ(sink_.events(5).at(i).header.origin, self_.id);
+  EXPECT_EQ(sink_.problems(5, InboundProblem::own_echo), 10u);
   adapter->stop();
 }
 

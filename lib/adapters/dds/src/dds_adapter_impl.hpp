@@ -56,9 +56,9 @@ struct ClassParticipant {
 };
 
 struct WriterEntry : dds::DataWriterListener {
-  WriterEntry(DdsAdapter& owner, ChannelId id, const ChannelSpec& spec, EndpointShape shape, std::uint64_t self)
+  WriterEntry(DdsAdapter& owner, ChannelId id, const ChannelSpec& spec, EndpointShape shape)
       : owner(owner), id(id), spec(spec), shape(std::move(shape)),
-        format(make_sample_format(this->shape.topic, spec, self)) {}
+        format(make_sample_format(this->shape.topic, spec)) {}
   void on_offered_incompatible_qos(dds::DataWriter*,
                                    const dds::OfferedIncompatibleQosStatus& status) override;
 
@@ -76,9 +76,9 @@ struct WriterEntry : dds::DataWriterListener {
 };
 
 struct ReaderEntry : dds::DataReaderListener {
-  ReaderEntry(DdsAdapter& owner, ChannelId id, const ChannelSpec& spec, EndpointShape shape, std::uint64_t self)
+  ReaderEntry(DdsAdapter& owner, ChannelId id, const ChannelSpec& spec, EndpointShape shape)
       : owner(owner), id(id), spec(spec), shape(std::move(shape)),
-        format(make_sample_format(this->shape.topic, spec, self)) {}
+        format(make_sample_format(this->shape.topic, spec)) {}
   void on_data_available(dds::DataReader* reader) override;
   void on_requested_incompatible_qos(dds::DataReader*,
                                      const dds::RequestedIncompatibleQosStatus& status) override;

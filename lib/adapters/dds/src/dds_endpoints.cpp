@@ -100,9 +100,6 @@ void DdsAdapter::deliver(ReaderEntry& entry, const dds::SampleInfo& info) {
   InboundEvent event;
   event.channel = entry.id;
   switch (entry.format->decode(info, segment_.max_message_size, event)) {
-    case DecodeResult::own_echo:
-      sink_->on_problem(entry.id, InboundProblem::own_echo);
-      return;
     case DecodeResult::too_large:
       count_receive_error(entry);
       return;
@@ -256,8 +253,7 @@ void DdsAdapter::release_topic(ClassParticipant& home, dds::Topic* topic) {
 
 std::unique_ptr<WriterEntry> DdsAdapter::create_writer(const ChannelBinding& binding,
                                                        std::string& error) {
-  auto entry = std::make_unique<WriterEntry>(*this, binding.id, binding.spec, shape_of(segment_, binding.spec),
-                                             self_.id);
+  auto entry = std::make_unique<WriterEntry>(*this, binding.id, binding.spec, shape_of(segment_, binding.spec));
   entry->home = &home_of(binding.spec.cls);
   entry->topic = acquire_topic(*entry->home, entry->shape.topic, error);
   if (entry->topic == nullptr) return nullptr;
@@ -275,8 +271,7 @@ std::unique_ptr<WriterEntry> DdsAdapter::create_writer(const ChannelBinding& bin
 
 std::unique_ptr<ReaderEntry> DdsAdapter::create_reader(const ChannelBinding& binding,
                                                        std::string& error) {
-  auto entry = std::make_unique<ReaderEntry>(*this, binding.id, binding.spec, shape_of(segment_, binding.spec),
-                                             self_.id);
+  auto entry = std::make_unique<ReaderEntry>(*this, binding.id, binding.spec, shape_of(segment_, binding.spec));
   entry->home = &home_of(binding.spec.cls);
   entry->own_prefix = entry->home->prefix;
   entry->topic = acquire_topic(*entry->home, entry->shape.topic, error);

@@ -17,7 +17,6 @@ std::uint32_t writer_sequence(const dds::SampleInfo& info) {
 
 class EnvelopeFormat final : public DdsSampleFormat {
  public:
-  explicit EnvelopeFormat(std::uint64_t self) : self_(self) {}
   void* sample() override { return &envelope_; }
   FillRefusal fill(const OutboundEvent& event, std::uint16_t&) override {
     envelope_.subject(event.header.subject);
@@ -30,8 +29,9 @@ class EnvelopeFormat final : public DdsSampleFormat {
     return FillRefusal::none;
   }
   DecodeResult decode(const dds::SampleInfo& info, std::uint64_t max_bytes, InboundEvent& event) override {
+    // An envelope carrying this gateway's origin from another participant (a loop through
+    // another gateway, or a spoof) goes on: the router counts and drops it (ingress check).
     const cosmic::Envelope& env = envelope_;
-    if (env.origin() == self_) return DecodeResult::own_echo;
     if (env.payload().size() > max_bytes) return DecodeResult::too_large;
     event.header.subject = env.subject();
     event.header.origin = env.origin();
@@ -48,7 +48,6 @@ class EnvelopeFormat final : public DdsSampleFormat {
   void release() override { envelope_.payload() = {}; }
 
  private:
-  std::uint64_t self_;
   cosmic::Envelope envelope_;
 };
 
@@ -88,10 +87,9 @@ class OpaqueFormat final : public DdsSampleFormat {
 
 }  // namespace
 
-std::unique_ptr<DdsSampleFormat> make_sample_format(const DdsTopicRef& topic, const ChannelSpec& channel,
-                                                    std::uint64_t self) {
+std::unique_ptr<DdsSampleFormat> make_sample_format(const DdsTopicRef& topic, const ChannelSpec& channel) {
   if (topic.native) return std::make_unique<OpaqueFormat>(channel.subject, topic.representation);
-  return std::make_unique<EnvelopeFormat>(self);
+  return std::make_unique<EnvelopeFormat>();
 }
 
 }  // namespace cosmic::dds_detail

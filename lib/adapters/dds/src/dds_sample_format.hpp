@@ -26,7 +26,7 @@ enum class FillRefusal {
   wrong_representation,    // opaque: the header names the other extended CDR version
 };
 
-enum class DecodeResult { event, own_echo, too_large };
+enum class DecodeResult { event, too_large };
 
 class DdsSampleFormat {
  public:
@@ -46,8 +46,6 @@ class DdsSampleFormat {
 };
 
 // The format of `topic` for `channel`: opaque for a native topic, the envelope otherwise.
-// `self`: this gateway's id (an envelope of its own origin is an echo).
-std::unique_ptr<DdsSampleFormat> make_sample_format(const DdsTopicRef& topic, const ChannelSpec& channel,
-                                                    std::uint64_t self);
+std::unique_ptr<DdsSampleFormat> make_sample_format(const DdsTopicRef& topic, const ChannelSpec& channel);
 
 }  // namespace cosmic::dds_detail

@@ -90,8 +90,10 @@ struct Channel {
   bool tx = false;
 };
 
-// Fingerprints of the raw messages we published in the last second, so the copy LCM loops back
-// to our own socket is not taken for a native publication (raw messages have no origin field).
+// Fingerprints of the messages we published in the last second on channels this segment also
+// receives, so the copy LCM loops back to our own socket is not taken for a native publication
+// (raw messages have no origin field) and is told apart from an envelope that merely carries our
+// origin (a loop through another gateway, or a spoof: the router counts those).
 // A received raw message that matches a live fingerprint (same channel, size and 64-bit hash,
 // sent within the window) consumes it and is reported as own_echo.
 // Limitation: a peer that publishes byte-identical content on the same channel within the window
@@ -332,6 +334,8 @@ class LcmAdapter final : public SegmentAdapter {
       const int size = e.getEncodedSize();
       if (encode_buffer_.size() < static_cast<std::size_t>(size)) encode_buffer_.resize(size);
       if (e.encode(encode_buffer_.data(), 0, size) != size) return send_failed(channel, "encode failed");
+      // Only a channel this segment also receives can come back to us through LCM's loopback.
+      if (channel.rx) echo_.remember(channel.id, event.payload, now_ns());
       rc = lcm_publish(lcm_, channel.name.c_str(), encode_buffer_.data(), static_cast<unsigned>(size));
     }
     if (rc != 0) return send_failed(channel, "lcm_publish failed");
@@ -492,7 +496,9 @@ class LcmAdapter final : public SegmentAdapter {
       sink_->on_problem(channel.id, InboundProblem::decode_error);
       return;
     }
-    if (decoded->header.origin == self_.id) {
+    // Our own publication looped back by LCM is expected; any other envelope with our origin
+    // goes on to the router, which counts it (ingress check: own origin).
+    if (decoded->header.origin == self_.id && echo_.consume(channel.id, decoded->payload, now_ns())) {
       sink_->on_problem(channel.id, InboundProblem::own_echo);
       return;
     }

@@ -50,8 +50,9 @@
 // - The gateway never receives its own publications: Fast DDS 2.9 has no
 //   "fastdds.ignore_local_endpoints" (it appeared in 2.10; the property is set anyway and takes
 //   over after an upgrade), so samples written by this participant are dropped on reception by
-//   GUID prefix; in addition every envelope whose origin is this gateway's id is dropped. Both
-//   are reported as InboundProblem::own_echo.
+//   GUID prefix and reported as InboundProblem::own_echo (expected, never counted as a loss). An
+//   envelope from another participant that carries this gateway's origin (a loop through another
+//   gateway, or a spoof) is delivered: the router's ingress check drops and counts it.
 // - Envelopes whose payload exceeds segment.max_message_size are refused by send() (failed) and
 //   dropped on reception (InboundProblem::decode_error).
 // - statistics(): received = envelopes taken from DDS (own echoes and malformed ones included),
