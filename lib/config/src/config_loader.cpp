@@ -1,4 +1,8 @@
 #include "cosmic/config_loader.hpp"
+
+#include <variant>
+
+#include "cosmic/lcm_url.hpp"
 #include "cosmic/transport_limits.hpp"
 
 #include <arpa/inet.h>
@@ -259,9 +263,8 @@ class ConfigParser {
     CanSegmentProperties& can = s.can;
     if (require(node, path, "interface", "a network interface such as can0")) {
       if (auto v = reader_.string(node["interface"], key(path, "interface"))) {
-        if (v->size() >= 16) {
-          reader_.error_at(node["interface"], key(path, "interface"), "interface name '" + *v + "' is too long",
-                           "at most 15 characters");
+        if (const auto problem = interface_name_problem(*v)) {
+          reader_.error_at(node["interface"], key(path, "interface"), *problem, "a network interface such as can0");
         }
         can.interface = *v;
       }
@@ -368,8 +371,9 @@ class ConfigParser {
     parse_ip_common(node, path, s);
     if (has(node, "url")) {
       if (auto v = reader_.string(node["url"], key(path, "url"))) {
-        if (v->rfind("udpm://", 0) != 0 && v->rfind("memq://", 0) != 0) {
-          reader_.error_at(node["url"], key(path, "url"), "unsupported LCM URL '" + *v + "'",
+        const auto lcm_url = parse_lcm_url(*v);
+        if (const auto* problem = std::get_if<std::string>(&lcm_url)) {
+          reader_.error_at(node["url"], key(path, "url"), "unsupported LCM URL " + *problem,
                            "udpm://GROUP:PORT?ttl=N or memq://");
         }
         s.lcm.url = *v;

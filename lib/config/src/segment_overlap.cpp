@@ -1,30 +1,22 @@
 #include "segment_overlap.hpp"
 
-#include <charconv>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <variant>
+
+#include "cosmic/lcm_url.hpp"
 
 namespace cosmic::config_detail {
 namespace {
 
-constexpr unsigned kLcmDefaultPort = 7667;
-
-// UDP port of an LCM udpm URL (udpm://GROUP:PORT?options); nullopt for other providers (memq://
-// is private to each instance) and for ports LCM itself would refuse.
+// UDP port of an LCM udpm URL, parsed canonically; nullopt for memq:// (private to each instance)
+// and for URLs the loader refuses anyway.
 std::optional<unsigned> lcm_port(const std::string& url) {
-  constexpr std::string_view kScheme = "udpm://";
-  std::string_view rest(url);
-  if (rest.substr(0, kScheme.size()) != kScheme) return std::nullopt;
-  rest.remove_prefix(kScheme.size());
-  rest = rest.substr(0, rest.find('?'));
-  const auto colon = rest.rfind(':');
-  if (colon == std::string_view::npos || colon + 1 == rest.size()) return kLcmDefaultPort;
-  const std::string_view digits = rest.substr(colon + 1);
-  unsigned port = 0;
-  const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), port);
-  if (ec != std::errc() || end != digits.data() + digits.size() || port > 65535) return std::nullopt;
-  return port;
+  const auto parsed = parse_lcm_url(url);
+  const auto* lcm = std::get_if<LcmUrl>(&parsed);
+  if (lcm == nullptr || lcm->memq) return std::nullopt;
+  return lcm->port;
 }
 
 struct Overlap {

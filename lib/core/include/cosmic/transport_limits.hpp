@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -24,6 +25,29 @@ inline std::optional<std::string> transport_name_problem(SegmentType type, std::
   if (type == SegmentType::lcm && channel.size() > kLcmMaxChannelName) {
     return "LCM channel names have at most " + std::to_string(kLcmMaxChannelName) + " characters, '" +
            std::string(channel.substr(0, 16)) + "...' has " + std::to_string(channel.size());
+  }
+  return std::nullopt;
+}
+
+// Why `name` cannot be a network interface name (CAN `interface`, DDS `interfaces`), if it
+// cannot: 1 to kMaxInterfaceName characters of [A-Za-z0-9_.@-], not "." or "..". Linux refuses
+// '/', ':' and white space itself; the rest of what it would take (quotes, control characters)
+// no interface of a real system has, and the gateway copies the name into logs and generated code.
+inline std::optional<std::string> interface_name_problem(std::string_view name) {
+  if (name.empty()) return std::string("empty interface name");
+  if (name.size() > kMaxInterfaceName) {
+    return "interface name '" + std::string(name.substr(0, 20)) + (name.size() > 20 ? "..." : "") + "' is too long (at most " +
+           std::to_string(kMaxInterfaceName) + " characters)";
+  }
+  if (name == "." || name == "..") return "'" + std::string(name) + "' is not an interface name";
+  for (const char c : name) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '.' ||
+                    c == '@' || c == '-';
+    if (!ok) {
+      char shown[8];
+      std::snprintf(shown, sizeof shown, c > ' ' && c < 0x7f ? "'%c'" : "0x%02X", static_cast<unsigned char>(c));
+      return std::string("interface names hold letters, digits, '_', '.', '@' and '-' only; this one has ") + shown;
+    }
   }
   return std::nullopt;
 }

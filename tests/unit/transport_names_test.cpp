@@ -1,0 +1,89 @@
+// What the configuration accepts as transport addresses (issue 22, items 4 and 9): LCM URLs parsed
+// once and canonically (every spelling LCM would read as another port is refused, and two
+// segments on one port are found whatever the spelling), and interface names that cannot carry
+// quotes or control characters into logs or generated code.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <variant>
+
+#include "cosmic/config_loader.hpp"
+#include "cosmic/lcm_url.hpp"
+#include "cosmic/transport_limits.hpp"
+
+namespace cosmic {
+namespace {
+
+std::string errors_text(const std::vector<ConfigError>& errors) {
+  std::string out;
+  for (const auto& e : errors) out += e.to_string() + "\n";
+  return out;
+}
+
+TEST(LcmUrl, CanonicalSpellingsAreRead) {
+  const auto url = parse_lcm_url("udpm://239.255.76.67:7671?ttl=0&recv_buf_size=2097152");
+  ASSERT_TRUE(std::holds_alternative<LcmUrl>(url)) << std::get<std::string>(url);
+  const LcmUrl& lcm = std::get<LcmUrl>(url);
+  EXPECT_EQ(lcm.group, "239.255.76.67");
+  EXPECT_EQ(lcm.port, 7671);
+  EXPECT_EQ(lcm.ttl, 0u);
+  EXPECT_EQ(lcm.recv_buf_size, 2097152u);
+  EXPECT_EQ(std::get<LcmUrl>(parse_lcm_url("udpm://239.255.76.67")).port, kLcmDefaultPort);
+  EXPECT_EQ(std::get<LcmUrl>(parse_lcm_url("udpm://")).group, "239.255.76.67");
+  EXPECT_TRUE(std::get<LcmUrl>(parse_lcm_url("memq://")).memq);
+}
+
+TEST(LcmUrl, EverySpellingLcmWouldReadAsAnotherPortIsRefused) {
+  for (const char* bad : {"udpm://239.255.76.67:7667/", "udpm://239.255.76.67:7667 ", "udpm://239.255.76.67:0x1df3",
+                          "udpm://239.255.76.67:+7667", "udpm://239.255.76.67:07667x", "udpm://239.255.76.67:0",
+                          "udpm://239.255.76.67:65536", "udpm://239.255.76.67:", "udpm://10.0.0.1:7667",
+                          "udpm://239.255.076.67:7667", "udpm://239.255.76:7667", "udpm://239.255.76.67:7667?ttl=256",
+                          "udpm://239.255.76.67:7667?ttl=0x1", "udpm://239.255.76.67:7667?evil=1",
+                          "udpm://239.255.76.67:7667?ttl=0&", "udp://239.255.76.67:7667", "memq://x",
+                          "udpm://239.255.76.67:7667\"\n"}) {
+    const auto url = parse_lcm_url(bad);
+    ASSERT_TRUE(std::holds_alternative<std::string>(url)) << bad << " was accepted";
+    EXPECT_EQ(std::get<std::string>(url).find('\n'), std::string::npos) << std::get<std::string>(url);
+  }
+}
+
+constexpr const char* kHead = "gateway: {name: gw, can_node_id: 1}\nsegments:\n";
+
+TEST(LcmUrl, TwoSegmentsOnOnePortAreFoundWhateverTheSpellingAndBadUrlsAreLocated) {
+  const ConfigResult r = parse_config(std::string(kHead) + R"(  - {name: a, type: lcm, url: "udpm://239.255.76.67:7667?ttl=0"}
+  - {name: b, type: lcm, url: "udpm://239.255.76.68?ttl=1"}
+  - {name: c, type: lcm, url: "udpm://239.255.76.67:7667/"}
+channels: []
+)",
+                                      "gw.yaml");
+  const std::string text = errors_text(r.errors);
+  EXPECT_NE(text.find("segments[1].url"), std::string::npos) << text;  // default port 7667 = a's port
+  EXPECT_NE(text.find("UDP port 7667"), std::string::npos) << text;
+  EXPECT_NE(text.find("gw.yaml:5:31: segments[2].url: unsupported LCM URL 'udpm://239.255.76.67:7667/': the port must be a decimal"),
+            std::string::npos)
+      << text;
+}
+
+TEST(InterfaceNames, QuotesAndControlCharactersAreRefusedWhereTheyAreWritten) {
+  EXPECT_EQ(interface_name_problem("can0"), std::nullopt);
+  EXPECT_EQ(interface_name_problem("eth0.100"), std::nullopt);
+  EXPECT_EQ(interface_name_problem("br-lan"), std::nullopt);
+  EXPECT_TRUE(interface_name_problem(""));
+  EXPECT_TRUE(interface_name_problem(".."));
+  EXPECT_TRUE(interface_name_problem("can0/x"));
+  EXPECT_TRUE(interface_name_problem("sixteen_chars_xx"));
+  const ConfigResult r = parse_config(std::string(kHead) + R"(  - {name: bus, type: can, interface: "vcan0\"\nint x;", bitrate: 500kbit/s}
+  - {name: lan, type: dds, interfaces: [eth0, "lo\"x"]}
+channels: []
+)",
+                                      "gw.yaml");
+  const std::string text = errors_text(r.errors);
+  EXPECT_NE(text.find("gw.yaml:3:39: segments[0].interface: interface names hold letters, digits, '_', '.', '@' and '-' only; this one has '\"'"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("segments[1].interfaces[1]: invalid name"), std::string::npos) << text;
+  EXPECT_EQ(text.find("int x;"), std::string::npos) << "the value itself is never echoed with its control characters: " << text;
+}
+
+}  // namespace
+}  // namespace cosmic
