@@ -101,6 +101,25 @@ LoadedState load_binding_state(const std::string& path) {
   return out;
 }
 
+SetAside set_aside_state_file(const std::string& path) {
+  constexpr int kMaxAside = 1000;
+  struct stat existing {};
+  if (::lstat(path.c_str(), &existing) != 0) return SetAside{};  // nothing there to protect
+  for (int n = 1; n <= kMaxAside; ++n) {
+    const std::string target = path + ".corrupt-" + std::to_string(n);
+    struct stat info {};
+    if (::lstat(target.c_str(), &info) == 0 || errno != ENOENT) continue;
+    // rename() would replace a file created in between; link() refuses to.
+    if (::link(path.c_str(), target.c_str()) != 0) {
+      if (errno == EEXIST) continue;
+      return SetAside{"", errno_text("link " + path + " to " + target)};
+    }
+    if (::unlink(path.c_str()) != 0) return SetAside{"", errno_text("unlink " + path)};
+    return SetAside{target, ""};
+  }
+  return SetAside{"", path + ": " + std::to_string(kMaxAside) + " set-aside copies exist already; remove old ones"};
+}
+
 std::string save_binding_state(const std::string& path, const BindingState& state) {
   Json doc{{"version", BindingState::kVersion}, {"bound", Json::array()}, {"unbound", state.unbound}};
   for (const auto& b : state.bound) doc["bound"].push_back({{"name", b.name}, {"yaml", b.yaml}});

@@ -36,6 +36,15 @@ LoadedState load_binding_state(const std::string& path);
 // Empty string on success, else why it failed (the previous file is then untouched).
 std::string save_binding_state(const std::string& path, const BindingState& state);
 
+// A state file that exists but cannot be used is renamed to "<path>.corrupt-<N>" (the first N
+// from 1 that is free), so the next save cannot overwrite the runtime bindings it may still hold.
+// Nothing at `path` (e.g. its directory is missing or not a directory): nothing moved, no error.
+struct SetAside {
+  std::string moved_to;  // the new name, when it was moved
+  std::string error;     // why it could not be moved
+};
+SetAside set_aside_state_file(const std::string& path);
+
 }  // namespace cosmicd
 
 namespace cosmicd {

@@ -120,7 +120,16 @@ class Daemon {
     file_config_ = config;  // before the channels unbound at run time are taken out
     const LoadedState persisted = load_binding_state(state_file_);
     if (!persisted.error.empty()) {
-      log_.log(cosmic::LogLevel::error, persisted.error + "; starting from the configuration alone");
+      // Never overwrite what may still hold runtime bindings: move it aside, or stop saving.
+      const SetAside aside = set_aside_state_file(state_file_);
+      if (aside.error.empty()) {
+        log_.log(cosmic::LogLevel::error, persisted.error + (aside.moved_to.empty() ? "" : "; kept aside as " + aside.moved_to) +
+                                              "; starting from the configuration alone");
+      } else {
+        state_file_usable_ = false;
+        log_.log(cosmic::LogLevel::error, persisted.error + "; cannot keep it aside (" + aside.error +
+                                              "): runtime changes will not be saved until it is repaired or removed");
+      }
     }
     state_ = persisted.state;
     std::erase_if(config.channels, [&](const cosmic::ChannelSpec& c) {
@@ -210,7 +219,8 @@ class Daemon {
   }
 
   std::string persist() {
-    const std::string error = save_binding_state(state_file_, state_);
+    const std::string error = state_file_usable_ ? save_binding_state(state_file_, state_)
+                                                 : state_file_ + " is unusable and could not be set aside; not overwritten";
     if (!error.empty()) log_.log(cosmic::LogLevel::error, "cannot save runtime bindings: " + error);
     return error;
   }
@@ -272,6 +282,7 @@ class Daemon {
   DaemonOptions options_;
   DaemonLogger log_;
   std::string state_file_;
+  bool state_file_usable_ = true;  // false: unusable at start and could not be set aside
   cosmic::Gateway gateway_;
   ServiceNotifier notifier_;
   BindingState state_;

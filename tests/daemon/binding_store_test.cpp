@@ -57,6 +57,28 @@ TEST_F(BindingStoreTest, CorruptedFilesGiveAClearErrorNotACrash) {
   }
 }
 
+// Issue 22, item 10: a state file cosmicd cannot use is moved aside before anything can overwrite
+// the runtime bindings it may still hold; each bad file gets its own name.
+TEST_F(BindingStoreTest, AnUnusableFileIsSetAsideNeverOverwritten) {
+  write("{\"version\":1,\"bound\":[{\"name\":\"extra\",\"yaml\":\"{name: extra}\"}],\"unbound\":[");  // truncated
+  ASSERT_FALSE(cosmicd::load_binding_state(path).error.empty());
+  const auto first = cosmicd::set_aside_state_file(path);
+  ASSERT_EQ(first.error, "");
+  EXPECT_EQ(first.moved_to, path + ".corrupt-1");
+  EXPECT_FALSE(std::filesystem::exists(path));
+  std::ifstream kept(first.moved_to);
+  EXPECT_NE(std::string(std::istreambuf_iterator<char>(kept), {}).find("extra"), std::string::npos);
+  // A save now writes a fresh file and leaves the set-aside one alone.
+  ASSERT_EQ(cosmicd::save_binding_state(path, cosmicd::BindingState{}), "");
+  EXPECT_TRUE(std::filesystem::exists(first.moved_to));
+  write("garbage");
+  const auto second = cosmicd::set_aside_state_file(path);
+  EXPECT_EQ(second.moved_to, path + ".corrupt-2");
+  const auto missing = cosmicd::set_aside_state_file(path);
+  EXPECT_EQ(missing.moved_to, "") << "nothing there: nothing moved";
+  EXPECT_EQ(missing.error, "");
+}
+
 TEST(ChannelYamlTest, ChannelSurvivesTheRoundTripThroughYaml) {
   const auto config = cosmic::parse_config(R"(
 segments: [{name: a, type: dds}, {name: b, type: lcm}]

@@ -111,8 +111,9 @@ start_daemon "${ARGS[@]}" || finish
 expect_channels "after reload and restart" "speed status"
 stop_daemon
 
-# corrupt NAME CONTENT EXPECTED_ERROR: cosmicd names the file and the problem, starts from its
-# configuration, keeps running, and writes a good file at the next change.
+# corrupt NAME CONTENT EXPECTED_ERROR: cosmicd names the file and the problem, keeps the file aside
+# unchanged (issue 22, item 10), starts from its configuration, keeps running, and writes a good
+# file at the next change.
 corrupt() {
   local name=$1 content=$2 expected=$3
   note "state file: $name"
@@ -120,6 +121,13 @@ corrupt() {
   start_daemon "${ARGS[@]}" || return
   log_contains "$STATE: $expected"
   log_contains "starting from the configuration alone"
+  # The unusable file is kept aside, unchanged, so no later save can overwrite what it holds.
+  local aside
+  aside=$(find "$(dirname "$STATE")" -name "$(basename "$STATE").corrupt-*" | head -1)
+  { [ -n "$aside" ] && cmp -s "$aside" <(printf '%s' "$content"); } ||
+    fail "$name: the unusable state file was not kept aside unchanged"
+  log_contains "kept aside as $aside"
+  rm -f "$aside"
   grep -F "$STATE: $expected" "$DAEMON_LOG" | grep -q " error " ||
     fail "$name: the state file problem is not logged at level error"
   expect_channels "$name" "speed status"
