@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "control_fixture.hpp"
+#include "cosmic/denial_log.hpp"
 #include "cosmic/control_server.hpp"
 
 namespace cosmic::control_test {
@@ -287,6 +288,43 @@ TEST_F(ControlTest, DeniedRequestsAreLoggedWithThePidAndNeverAlike) {
   ASSERT_EQ(denied.size(), 2u);
   EXPECT_NE(denied[0], denied[1]);  // a logger folding repeated lines cannot hide the second
   for (const auto& line : denied) EXPECT_NE(line.find("pid " + std::to_string(::getpid())), std::string::npos) << line;
+}
+
+// Issue 22, item 2: a flood of denied requests writes a logarithmic number of lines, the latest
+// always with the count; a quiet uid starts over; another uid has its own burst.
+TEST_F(ControlTest, AFloodOfDeniedRequestsIsSummarisedNotEchoed) {
+  AccessPolicy policy;
+  policy.may_modify = [](const PeerCredentials&) { return false; };
+  serve(policy);
+  Client client(socket_path);
+  for (int i = 0; i < 2000; ++i) {
+    ASSERT_EQ(client.call({{"command", "reload"}})["error"]["code"], "permission_denied") << "request " << i;
+  }
+  std::vector<std::string> denied;
+  {
+    std::lock_guard lock(log.mutex);
+    for (const auto& line : log.lines) {
+      if (line.find("denied") != std::string::npos) denied.push_back(line);
+    }
+  }
+  ASSERT_EQ(denied.size(), 11u) << "1, 2, 4, ..., 1024";
+  EXPECT_NE(denied.back().find("denial 1024 of uid " + std::to_string(::getuid())), std::string::npos) << denied.back();
+}
+
+TEST(DenialLogTest, PowersOfTwoPerUidAndAQuietUidStartsOver) {
+  DenialLog denials;
+  const auto t0 = std::chrono::steady_clock::time_point{} + std::chrono::hours(1);
+  std::vector<std::uint64_t> logged;
+  for (int i = 0; i < 20; ++i) {
+    if (const auto n = denials.deny(1000, t0 + std::chrono::milliseconds(i))) logged.push_back(*n);
+  }
+  EXPECT_EQ(logged, (std::vector<std::uint64_t>{1, 2, 4, 8, 16}));
+  EXPECT_EQ(denials.deny(2000, t0), 1u) << "another uid has its own burst";
+  EXPECT_EQ(denials.deny(1000, t0 + std::chrono::seconds(1)), std::nullopt);  // 21st of the burst
+  EXPECT_EQ(denials.deny(1000, t0 + std::chrono::seconds(1) + DenialLog::kQuiet), 1u) << "quiet for kQuiet: a new burst";
+  for (std::uint32_t uid = 0; uid < 2 * DenialLog::kTrackedUids; ++uid) {
+    EXPECT_EQ(denials.deny(10'000 + uid, t0 + std::chrono::minutes(5) + std::chrono::milliseconds(uid)), 1u);
+  }
 }
 
 TEST_F(ControlTest, AChangeThatCannotBeSavedIsNotOk) {

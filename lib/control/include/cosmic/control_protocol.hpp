@@ -11,6 +11,7 @@
 #include <string>
 #include <string_view>
 
+#include "cosmic/denial_log.hpp"
 #include "cosmic/config_loader.hpp"
 #include "cosmic/gateway.hpp"
 
@@ -90,6 +91,7 @@ class ControlProtocol {
   std::chrono::steady_clock::time_point started_;
   std::string running_;  // what admission runs off the control thread, for `busy` answers
   std::uint64_t log_sequence_ = 0;  // numbers audit and denial lines: no two are alike, none folded
+  DenialLog denials_;               // which denials are logged (a burst is summarised)
 };
 
 }  // namespace cosmic
