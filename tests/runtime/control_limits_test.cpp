@@ -308,7 +308,8 @@ TEST_F(ControlTest, AFloodOfDeniedRequestsIsSummarisedNotEchoed) {
     }
   }
   ASSERT_EQ(denied.size(), 11u) << "1, 2, 4, ..., 1024";
-  EXPECT_NE(denied.back().find("denial 1024 of uid " + std::to_string(::getuid())), std::string::npos) << denied.back();
+  EXPECT_NE(denied.back().find("denial 1024 of this command for uid " + std::to_string(::getuid())), std::string::npos)
+      << denied.back();
 }
 
 TEST(DenialLogTest, PowersOfTwoPerUidAndAQuietUidStartsOver) {
@@ -316,14 +317,17 @@ TEST(DenialLogTest, PowersOfTwoPerUidAndAQuietUidStartsOver) {
   const auto t0 = std::chrono::steady_clock::time_point{} + std::chrono::hours(1);
   std::vector<std::uint64_t> logged;
   for (int i = 0; i < 20; ++i) {
-    if (const auto n = denials.deny(1000, t0 + std::chrono::milliseconds(i))) logged.push_back(*n);
+    if (const auto n = denials.deny(1000, "reload", t0 + std::chrono::milliseconds(i))) logged.push_back(*n);
   }
   EXPECT_EQ(logged, (std::vector<std::uint64_t>{1, 2, 4, 8, 16}));
-  EXPECT_EQ(denials.deny(2000, t0), 1u) << "another uid has its own burst";
-  EXPECT_EQ(denials.deny(1000, t0 + std::chrono::seconds(1)), std::nullopt);  // 21st of the burst
-  EXPECT_EQ(denials.deny(1000, t0 + std::chrono::seconds(1) + DenialLog::kQuiet), 1u) << "quiet for kQuiet: a new burst";
-  for (std::uint32_t uid = 0; uid < 2 * DenialLog::kTrackedUids; ++uid) {
-    EXPECT_EQ(denials.deny(10'000 + uid, t0 + std::chrono::minutes(5) + std::chrono::milliseconds(uid)), 1u);
+  EXPECT_EQ(denials.deny(2000, "reload", t0), 1u) << "another uid has its own burst";
+  EXPECT_EQ(denials.deny(1000, "unbind", t0), 1u) << "another command has its own burst";
+  EXPECT_EQ(denials.deny(1000, "made-up", t0), 1u);
+  EXPECT_EQ(denials.deny(1000, "also-made-up", t0), 2u) << "unknown commands share one burst";
+  EXPECT_EQ(denials.deny(1000, "reload", t0 + std::chrono::seconds(1)), std::nullopt);  // 21st of the burst
+  EXPECT_EQ(denials.deny(1000, "reload", t0 + std::chrono::seconds(1) + DenialLog::kQuiet), 1u) << "quiet for kQuiet: a new burst";
+  for (std::uint32_t uid = 0; uid < 2 * DenialLog::kTracked; ++uid) {
+    EXPECT_EQ(denials.deny(10'000 + uid, "bind", t0 + std::chrono::minutes(5) + std::chrono::milliseconds(uid)), 1u);
   }
 }
 

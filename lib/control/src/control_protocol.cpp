@@ -127,10 +127,10 @@ ControlProtocol::Answer ControlProtocol::dispatch(const Json& request, const Pee
   const std::string command = request["command"].get<std::string>();
   const bool mutating = is_mutating(command);
   if (!(mutating ? policy_.may_modify(peer) : policy_.may_read(peer))) {
-    if (const auto count = denials_.deny(peer.uid, std::chrono::steady_clock::now())) {
+    if (const auto count = denials_.deny(peer.uid, command, std::chrono::steady_clock::now())) {
       std::string line = next_log_tag("denied", peer) + " may not run " + printable(command);
       if (*count > 1) {
-        line += " (denial " + std::to_string(*count) + " of uid " + std::to_string(peer.uid) +
+        line += " (denial " + std::to_string(*count) + " of this command for uid " + std::to_string(peer.uid) +
                 " in this burst; logged at powers of two)";
       }
       log_.log(LogLevel::warning, line);
