@@ -22,12 +22,10 @@ std::string escape(const std::string& text) {
   return out;
 }
 
-// DOT identifiers from names that may hold '-' and '.'.
-std::string id(const std::string& prefix, const std::string& name) {
-  std::string out = prefix;
-  for (char c : name) out += (std::isalnum(static_cast<unsigned char>(c)) ? c : '_');
-  return out;
-}
+// DOT identifiers: the kind's prefix and the name, quoted. Names hold [A-Za-z0-9_.-] only (the
+// loader checks), so quoting keeps every name its own node: arm-left and arm.left stay two
+// (issue 22, item 5), where mapping '-' and '.' to '_' made them one.
+std::string id(const std::string& prefix, const std::string& name) { return "\"" + prefix + name + "\""; }
 
 std::string hex_subject(std::uint64_t subject) {
   char buffer[24];

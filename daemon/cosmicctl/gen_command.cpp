@@ -51,6 +51,10 @@ int run_gen(const GenOptions& o) {
     std::cerr << "cosmicctl: no component '" << o.component << "' in " << o.file << " (one of: " << component_names(loaded.config) << ")\n";
     return kExitUsage;
   }
+  if (const auto collision = identifier_collision(loaded.config, *component)) {
+    std::cerr << o.file << ": " << *collision << "\n";
+    return kExitConfigError;
+  }
   std::error_code ec;
   std::filesystem::create_directories(o.output, ec);
   if (ec) {

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 
 #include "cosmic/model.hpp"
@@ -26,6 +27,10 @@ struct Skeleton {
 // `client_config_dir`: where cosmic_client-config.cmake lives (a hint; -Dcosmic_client_DIR wins).
 Skeleton generate_skeleton(const cosmic::Config& config, const cosmic::ComponentSpec& component, const std::string& model_file,
                            const std::string& client_config_dir);
+
+// Why `component`'s skeleton cannot be generated: two of its channels whose names differ only
+// in '-', '.' or '_' would become one C++ identifier (issue 22, item 5). nullopt when none.
+std::optional<std::string> identifier_collision(const cosmic::Config& config, const cosmic::ComponentSpec& component);
 
 // How a component on `segment` opens it with cosmic_open() (CAN: TxNode `can_node`).
 std::string client_segment(const cosmic::SegmentSpec& segment, unsigned can_node);

@@ -14,16 +14,28 @@ fail() { echo "FAIL: $*" >&2; status=1; }
 "$COSMICCTL" diagram --format dot "$ROBOT" >"$WORK/robot.dot" || fail "diagram --format dot exited $?"
 grep -q '^digraph event_channels' "$WORK/robot.dot" || fail "DOT has no digraph"
 for channel in distance acceleration odometry obstacle speed command actual_speed diagnostics; do
-  grep -q "channel_$channel \[" "$WORK/robot.dot" || fail "DOT lacks channel $channel"
+  grep -q "\"channel_$channel\" \[" "$WORK/robot.dot" || fail "DOT lacks channel $channel"
 done
-grep -q 'component_speed_controller -> channel_speed \[label="P"' "$WORK/robot.dot" || fail "no P tag speed_controller -> speed"
-grep -q 'channel_actual_speed -> component_speed_controller \[label="S"' "$WORK/robot.dot" || fail "no S tag actual_speed -> speed_controller"
+grep -q '"component_speed_controller" -> "channel_speed" \[label="P"' "$WORK/robot.dot" || fail "no P tag speed_controller -> speed"
+grep -q '"channel_actual_speed" -> "component_speed_controller" \[label="S"' "$WORK/robot.dot" || fail "no S tag actual_speed -> speed_controller"
 grep -q 'subject 0x0000000100000042' "$WORK/robot.dot" || fail "distance's subject missing"
 grep -q 'reaction_time 5 ms' "$WORK/robot.dot" || fail "distance's QoS list missing"
 
 "$COSMICCTL" diagram "$ROBOT" >"$WORK/robot.svg" || fail "diagram (svg) exited $?"
 grep -q '<svg' "$WORK/robot.svg" || fail "no SVG on stdout"
 grep -q '#a5d6a7' "$WORK/robot.svg" || fail "SVG has no 'bound' colour"
+
+# Names that differ only in '-' and '.' stay two nodes (issue 22, item 5).
+cat >"$WORK/twins.yaml" <<'YAML'
+segments: [{name: lan, type: dds}, {name: viz, type: lcm}]
+channels:
+  - {name: arm-left, subject: 1, class: nrt, payload: 8B, publishers: [lan], subscribers: [viz]}
+  - {name: arm.left, subject: 2, class: nrt, payload: 8B, publishers: [viz], subscribers: [lan]}
+YAML
+"$COSMICCTL" diagram --format dot "$WORK/twins.yaml" >"$WORK/twins.dot" || fail "twins: diagram exited $?"
+for channel in arm-left arm.left; do
+  grep -q "\"channel_$channel\" \[" "$WORK/twins.dot" || fail "twins: DOT lacks its own node for $channel"
+done
 
 # A configuration error is reported with its location, nothing on stdout.
 printf 'segments: []\nchannels: []\ncomponents: [{name: x, segment: nowhere, publishes: [a]}]\n' >"$WORK/bad.yaml"

@@ -36,4 +36,26 @@ grep -q 'kSegment = "can:vcan0?node=' "$WORK/drives/channels.hpp" || fail "drive
 "$COSMICCTL" gen "$ROBOT" --component nobody --output "$WORK/x" 2>"$WORK/unknown.err"
 [ $? -eq 64 ] || fail "unknown component: exit code is not 64"
 grep -q "no component 'nobody'.*speed_controller" "$WORK/unknown.err" || fail "unknown component: $(cat "$WORK/unknown.err")"
+# Channels whose names differ only in '-' or '.' would be one C++ identifier: refused, nothing written.
+cat >"$WORK/twins.yaml" <<'YAML'
+segments: [{name: lan, type: dds}, {name: viz, type: lcm}]
+channels:
+  - {name: arm-left, subject: 1, class: nrt, payload: 8B}
+  - {name: arm.left, subject: 2, class: nrt, payload: 8B}
+components:
+  - {name: arm, segment: viz, publishes: [arm-left, arm.left]}
+  - {name: plot, segment: lan, subscribes: [arm-left, arm.left]}
+YAML
+"$COSMICCTL" gen "$WORK/twins.yaml" --component arm --output "$WORK/twins" 2>"$WORK/twins.err"
+[ $? -eq 2 ] || fail "twin channel names: exit code is not 2"
+grep -q "twins.yaml: channels 'arm-left' and 'arm.left' of component arm both become the C++ identifier arm_left" "$WORK/twins.err" ||
+  fail "twin channel names: $(cat "$WORK/twins.err")"
+[ -e "$WORK/twins" ] && fail "twin channel names: files were written"
+
+# Components (and segments) whose names differ only so are refused where the second is written.
+printf 'segments: [{name: lan, type: dds}]\nchannels: [{name: c, subject: 1, class: nrt, payload: 8B}]\ncomponents:\n  - {name: a-b, segment: lan, publishes: [c]}\n  - {name: a_b, segment: lan, subscribes: [c]}\n' >"$WORK/ctwins.yaml"
+"$COSMICCTL" gen "$WORK/ctwins.yaml" --component a-b --output "$WORK/ctwins" 2>"$WORK/ctwins.err"
+[ $? -eq 2 ] || fail "twin component names: exit code is not 2"
+grep -q "ctwins.yaml:5:.*components\[1\].name: component name 'a_b' and component 'a-b' (line 4) differ only in" "$WORK/ctwins.err" ||
+  fail "twin component names: $(cat "$WORK/ctwins.err")"
 exit $status

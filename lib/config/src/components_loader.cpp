@@ -1,5 +1,7 @@
 #include "components_loader.hpp"
 
+#include "folded_names.hpp"
+
 #include <algorithm>
 #include <map>
 #include <set>
@@ -75,6 +77,7 @@ class ComponentsLoader {
                        "a name not used by another component (first at line " + std::to_string(it->second) + ")");
       return;
     }
+    if (!folded_.add(reader_, node["name"], path + ".name", "component", c.name)) return;
     tags_.emplace(c.name, Tags{node, path});
     config_.components.push_back(std::move(c));
   }
@@ -192,6 +195,7 @@ class ComponentsLoader {
   Config& config_;
   std::map<std::string, ChannelNode> channels_;
   std::map<std::string, int> names_;
+  FoldedNames folded_;
   std::map<std::string, Tags> tags_;
 };
 

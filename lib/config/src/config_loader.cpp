@@ -19,6 +19,7 @@
 #include "components_loader.hpp"
 #include "native_loader.hpp"
 #include "realtime_loader.hpp"
+#include "folded_names.hpp"
 #include "segment_overlap.hpp"
 #include "yaml_reader.hpp"
 
@@ -220,6 +221,7 @@ class ConfigParser {
                              std::to_string(first_seen[segment->name].line + 1) + ")");
         continue;
       }
+      if (!folded_segments_.add(reader_, node[i]["name"], key(path, "name"), "segment", segment->name)) continue;
       config_detail::check_segment_overlap(node, i, *segment, config_.segments, reader_);
       segment_names_.insert(segment->name);
       config_.segments.push_back(std::move(*segment));
@@ -547,6 +549,7 @@ class ConfigParser {
   bool derive_bindings_ = false;  // the document has components: P/S lists may be left out
   std::set<std::string> segment_names_;
   std::map<std::string, int> channel_names_;
+  config_detail::FoldedNames folded_segments_;
   std::map<std::uint64_t, std::string> subjects_;
   std::map<std::uint16_t, std::string> etags_;
   std::vector<std::string> included_;  // files read besides the YAML (DBC)
