@@ -87,7 +87,13 @@ int render_svg(const std::string& dot) {
     std::cerr << "cosmicctl: cannot run Graphviz's dot (apt-get install graphviz), or use --format dot\n";
     return kExitUnavailable;
   }
-  return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? kExitOk : kExitUnavailable;
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return kExitOk;
+  // dot's own message (if it wrote one) is already on stderr; say what happened in any case.
+  std::cerr << "cosmicctl: Graphviz's dot "
+            << (WIFSIGNALED(status) ? "was killed by signal " + std::to_string(WTERMSIG(status))
+                                    : "failed with exit status " + std::to_string(WEXITSTATUS(status)))
+            << " while drawing the diagram; `cosmicctl diagram --format dot` prints the DOT text itself\n";
+  return kExitUnavailable;
 }
 
 struct DiagramOptions {

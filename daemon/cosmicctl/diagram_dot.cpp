@@ -10,14 +10,40 @@
 namespace cosmicctl {
 namespace {
 
-// HTML-like labels: only &, < and > need escaping.
+// Text inside Graphviz HTML-like labels (an XML parser reads them): &, <, >, " as entities,
+// control characters and bytes that are not UTF-8 as U+FFFD, so any title or name (a file path
+// holds anything) keeps the DOT well formed for every model (issue 22, item 6).
 std::string escape(const std::string& text) {
+  static const std::string kReplacement = "\xEF\xBF\xBD";
   std::string out;
-  for (char c : text) {
+  for (std::size_t i = 0; i < text.size();) {
+    const auto c = static_cast<unsigned char>(text[i]);
     if (c == '&') out += "&amp;";
     else if (c == '<') out += "&lt;";
     else if (c == '>') out += "&gt;";
-    else out += c;
+    else if (c == '"') out += "&quot;";
+    if (c == '&' || c == '<' || c == '>' || c == '"') {
+      ++i;
+      continue;
+    }
+    if (c < 0x80) {
+      out += c < 0x20 || c == 0x7f ? kReplacement : std::string(1, static_cast<char>(c));
+      ++i;
+      continue;
+    }
+    // A well-formed UTF-8 sequence (no overlong forms, no surrogates, at most U+10FFFF) is kept.
+    const std::size_t length = c >= 0xF0 ? 4 : c >= 0xE0 ? 3 : c >= 0xC2 ? 2 : 0;
+    bool valid = length != 0 && c <= 0xF4 && i + length <= text.size();
+    for (std::size_t k = 1; valid && k < length; ++k) valid = (static_cast<unsigned char>(text[i + k]) & 0xC0) == 0x80;
+    if (valid && length >= 3) {
+      const auto second = static_cast<unsigned char>(text[i + 1]);
+      if ((c == 0xE0 && second < 0xA0) || (c == 0xED && second >= 0xA0) || (c == 0xF0 && second < 0x90) ||
+          (c == 0xF4 && second >= 0x90)) {
+        valid = false;
+      }
+    }
+    out += valid ? text.substr(i, length) : kReplacement;
+    i += valid ? length : 1;
   }
   return out;
 }

@@ -37,6 +37,13 @@ for channel in arm-left arm.left; do
   grep -q "\"channel_$channel\" \[" "$WORK/twins.dot" || fail "twins: DOT lacks its own node for $channel"
 done
 
+# Any file name, even one with markup, control characters or bytes that are not UTF-8, gives
+# well-formed DOT that Graphviz draws (issue 22, item 6).
+odd="$WORK/a&b<c>\"d\"&#1;$(printf '\x01\xff\xc3')e.yaml"
+cp "$WORK/twins.yaml" "$odd"
+"$COSMICCTL" diagram "$odd" >"$WORK/odd.svg" 2>"$WORK/odd.err" || fail "odd file name: diagram exited $?: $(cat "$WORK/odd.err")"
+grep -q '<svg' "$WORK/odd.svg" || fail "odd file name: no SVG"
+
 # A configuration error is reported with its location, nothing on stdout.
 printf 'segments: []\nchannels: []\ncomponents: [{name: x, segment: nowhere, publishes: [a]}]\n' >"$WORK/bad.yaml"
 "$COSMICCTL" diagram "$WORK/bad.yaml" >"$WORK/bad.out" 2>"$WORK/bad.err"
