@@ -31,6 +31,36 @@ std::string camel(const std::string& name) {
   return out.empty() ? "Component" : out;
 }
 
+// Text for a `//` or `#` comment: control characters (a newline would end the comment and let the
+// rest become code) shown as '?'.
+std::string comment_text(const std::string& text) {
+  std::string out = text;
+  for (char& c : out) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  return out;
+}
+
+// The body of a C++ string literal: '\\' and '"' escaped, anything not printable ASCII as a
+// three-digit octal escape (a hex escape would swallow the hex digits after it).
+std::string literal_text(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (c == '\\' || c == '"') {
+      out += '\\';
+      out += c;
+    } else if (byte < 0x20 || byte >= 0x7f) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\%03o", static_cast<unsigned>(byte));
+      out += escaped;
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 // Every {{KEY}} of `text` replaced by its value.
 std::string fill(std::string text, const std::map<std::string, std::string>& values) {
   for (const auto& [key, value] : values) {
@@ -139,8 +169,10 @@ Skeleton generate_skeleton(const cosmic::Config& config, const cosmic::Component
   const unsigned node = (config.gateway.can_node_id + 1 + position) % 128;
   const std::map<std::string, std::string> values{
       {"COMPONENT", component.name}, {"CLASS", cls},          {"FILE", file},
-      {"MODEL", model_file},         {"SEGMENT", component.segment},
-      {"CLIENT_SEGMENT", client_segment(*config.find_segment(component.segment), node)},
+      // Everything from outside the model's name grammar is escaped for where it lands (issue 22,
+      // item 4): the model's path goes into comments, the segment string into a literal.
+      {"MODEL", comment_text(model_file)}, {"SEGMENT", component.segment},
+      {"CLIENT_SEGMENT", literal_text(client_segment(*config.find_segment(component.segment), node))},
       {"CLIENT_CONFIG_DIR", client_config_dir},
       {"DESCS", p.descs}, {"ALL", p.all},            {"MEMBERS", p.members}, {"HANDLER_DECLS", p.handler_decls},
       {"PERIOD_DECLS", p.period_decls}, {"PUBLISH_DECLS", p.publish_decls}, {"ANNOUNCE", p.announce},

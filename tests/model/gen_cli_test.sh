@@ -58,4 +58,11 @@ printf 'segments: [{name: lan, type: dds}]\nchannels: [{name: c, subject: 1, cla
 [ $? -eq 2 ] || fail "twin component names: exit code is not 2"
 grep -q "ctwins.yaml:5:.*components\[1\].name: component name 'a_b' and component 'a-b' (line 4) differ only in" "$WORK/ctwins.err" ||
   fail "twin component names: $(cat "$WORK/ctwins.err")"
+# The model's path lands in comments: a newline in it cannot start a line of code (issue 22, item 4).
+odd_dir="$WORK/dir
+static int injected = 1;"
+mkdir -p "$odd_dir"
+cp "$ROBOT" "$odd_dir/robot.yaml"
+"$COSMICCTL" gen "$odd_dir/robot.yaml" --component speed_controller --output "$WORK/odd" 2>/dev/null || fail "odd path: gen exited $?"
+grep -q "^static int injected" "$WORK/odd/"* && fail "odd path: the model's path became code"
 exit $status
