@@ -99,14 +99,23 @@ int query_verdict(const std::string& socket_path, const std::string& name, std::
     const nlohmann::json request{{"command", "channel"}, {"name", name}};
     const std::string reply = exchange(socket_path, request.dump() + "\n", out);
     if (reply.empty()) return COSMIC_E_UNAVAILABLE;
+    return parse_verdict_answer(reply, out);
+  } catch (const std::exception& e) {  // out of memory, or a name that is not UTF-8 (dump throws)
+    out = std::string("control query failed: ") + e.what();
+    return COSMIC_E_UNAVAILABLE;
+  }
+}
+
+int parse_verdict_answer(std::string_view reply, std::string& out) {
+  try {
     const auto answer = nlohmann::json::parse(reply, nullptr, false);
     if (answer.is_discarded()) {
       out = "not a control protocol answer";
       return COSMIC_E_UNAVAILABLE;
     }
     return read_answer(answer, out);
-  } catch (const std::exception& e) {  // out of memory, or a name that is not UTF-8 (dump throws)
-    out = std::string("control query failed: ") + e.what();
+  } catch (const std::exception& e) {
+    out = std::string("control answer unreadable: ") + e.what();
     return COSMIC_E_UNAVAILABLE;
   }
 }
