@@ -1,5 +1,7 @@
 #include "cosmic/dds_names.hpp"
 
+#include "cosmic/escaped_text.hpp"
+
 #include <cstdio>
 #include <map>
 
@@ -11,22 +13,8 @@ bool is_digit(char c) { return c >= '0' && c <= '9'; }
 
 bool printable(char c) { return c > ' ' && c < 0x7f; }
 
-// A name as error messages show it: at most 40 characters, anything not printable ASCII as \xNN,
-// so a message stays one line whatever the configuration holds.
-std::string quoted(std::string_view text) {
-  constexpr std::size_t kShown = 40;
-  std::string out = "'";
-  for (const char c : text.substr(0, kShown)) {
-    if (printable(c) || c == ' ') {
-      out.push_back(c);
-    } else {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\x%02X", static_cast<unsigned>(static_cast<unsigned char>(c)));
-      out += escaped;
-    }
-  }
-  return out + (text.size() > kShown ? "...'" : "'");
-}
+// A name as error messages show it, quoted, at most 40 characters (escaped_text.hpp).
+std::string quoted(std::string_view text) { return "'" + escaped_text(text, 40) + "'"; }
 
 // One character, as text: 'c' when printable, 0xNN otherwise.
 std::string character_text(char c) {

@@ -1,7 +1,8 @@
 #include "cosmic/lcm_url.hpp"
 
+#include "cosmic/escaped_text.hpp"
+
 #include <charconv>
-#include <cstdio>
 
 namespace cosmic {
 namespace {
@@ -10,20 +11,8 @@ constexpr std::string_view kUdpm = "udpm://";
 constexpr std::string_view kMemq = "memq://";
 constexpr std::string_view kLcmDefaultGroup = "239.255.76.67";
 
-// The URL as an error message shows it: printable ASCII, anything else as \xNN, at most 80.
-std::string shown(std::string_view text) {
-  std::string out;
-  for (const char c : text.substr(0, 80)) {
-    if (c >= ' ' && c < 0x7f) {
-      out.push_back(c);
-    } else {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\x%02X", static_cast<unsigned>(static_cast<unsigned char>(c)));
-      out += escaped;
-    }
-  }
-  return text.size() > 80 ? out + "..." : out;
-}
+// The URL as an error message shows it (escaped_text.hpp), at most 80 characters.
+std::string shown(std::string_view text) { return escaped_text(text, 80); }
 
 // A decimal number in [min, max] spelled with digits only (no sign, no base prefix, no spaces).
 std::optional<unsigned> decimal(std::string_view text, unsigned min, unsigned max) {
