@@ -70,7 +70,11 @@ class IpTransport final : public Transport, private EventSink {
   }
 
   int send(std::size_t index, const EventHeader& header, std::span<const std::uint8_t> payload, std::string& error) override {
-    switch (adapter_->send(OutboundEvent{send_id(index), header, payload})) {
+    // The component's events carry its own origin on DDS and LCM alike, so every gateway that
+    // forwards them gives them the same identity (origin, sequence) and duplicates stay visible.
+    EventHeader stamped = header;
+    stamped.origin = self_.id;
+    switch (adapter_->send(OutboundEvent{send_id(index), stamped, payload})) {
       case SendStatus::sent: return COSMIC_OK;
       case SendStatus::queue_full: return COSMIC_E_AGAIN;
       case SendStatus::failed: break;

@@ -50,17 +50,26 @@ DdsTopicRef dds_topic_of(const ChannelSpec& channel, const std::string& segment)
   return DdsTopicRef{dds_topic_name(channel.name), kEnvelopeTypeName, false, DdsRepresentation::xcdr1};
 }
 
-std::optional<std::string> dds_topic_collision(std::span<const ChannelSpec* const> channels, const std::string& segment) {
+std::vector<std::pair<const ChannelSpec*, std::string>> dds_topic_collisions(std::span<const ChannelSpec* const> channels,
+                                                                             const std::string& segment) {
+  std::vector<std::pair<const ChannelSpec*, std::string>> collisions;
   std::map<std::string, std::string_view> owner;  // topic -> channel name
   for (const ChannelSpec* channel : channels) {
     const DdsTopicRef ref = dds_topic_of(*channel, segment);
     const auto [it, inserted] = owner.emplace(ref.topic, channel->name);
     if (!inserted && it->second != channel->name) {
-      return "channels '" + std::string(it->second) + "' and '" + channel->name + "' both map to DDS topic " + it->first +
-             (ref.native ? "" : " ('-' and '.' become '_')") + "; rename one of them";
+      collisions.emplace_back(channel, "channels '" + std::string(it->second) + "' and '" + channel->name +
+                                           "' both map to DDS topic " + it->first +
+                                           (ref.native ? "" : " ('-' and '.' become '_')") + "; rename one of them");
     }
   }
-  return std::nullopt;
+  return collisions;
+}
+
+std::optional<std::string> dds_topic_collision(std::span<const ChannelSpec* const> channels, const std::string& segment) {
+  auto collisions = dds_topic_collisions(channels, segment);
+  if (collisions.empty()) return std::nullopt;
+  return std::move(collisions.front().second);
 }
 
 std::optional<std::string> dds_topic_name_problem(std::string_view name) {

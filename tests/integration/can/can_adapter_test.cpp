@@ -461,5 +461,27 @@ TEST_F(CanAdapterTest, ConfigureChangesFiltersWhileRunning) {
   EXPECT_EQ(adapter_->statistics().received, 2u);  // etag 270's frame stayed in the kernel
 }
 
+// Issue 22, item 12 (SegmentAdapter::configure): a binding the adapter cannot carry is named in
+// Status::refused, and only it; the channels configured with it flow on the real bus. Before the
+// fix, the adapter reported the whole configuration failed while it forwarded the new channel.
+TEST_F(CanAdapterTest, ARefusedBindingLeavesTheRestFlowing) {
+  const auto seg = can_segment("vcan0");
+  ASSERT_NO_FATAL_FAILURE(open(seg, {can_binding(141, "a", 0x141, 8, HopRole::publisher, 0x30, 280, seg)}));
+  ChannelBinding no_plan = can_binding(143, "noplan", 0x143, 8, HopRole::publisher, 0x30, 282, seg);
+  no_plan.can.reset();
+  const Status status = adapter_->configure(
+      std::vector{can_binding(141, "a", 0x141, 8, HopRole::publisher, 0x30, 280, seg),
+                  can_binding(142, "b", 0x142, 8, HopRole::publisher, 0x30, 281, seg), no_plan});
+  EXPECT_FALSE(status.ok);
+  ASSERT_EQ(status.refused.size(), 1u) << status.error;
+  EXPECT_EQ(status.refused[0].channel, 143u);
+  EXPECT_EQ(status.refused[0].reason, "no CAN plan");
+  ASSERT_EQ(shell("cansend vcan0 " + device_id(280) + "#01; cansend vcan0 " + device_id(281) + "#02"), 0);
+  ASSERT_TRUE(sink_.wait_events(2, kWait));
+  const auto events = sink_.events();
+  EXPECT_EQ(events[0].channel, 141u);
+  EXPECT_EQ(events[1].channel, 142u);
+}
+
 }  // namespace
 }  // namespace cosmic::test

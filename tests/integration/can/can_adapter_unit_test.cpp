@@ -116,20 +116,37 @@ TEST(CanAdapterWithoutBus, StartsAndReportsAMissingInterface) {
   adapter->stop();  // idempotent
 }
 
+// Issue 22, item 12: the one configure() contract (SegmentAdapter::configure): each binding the
+// adapter cannot carry is named in Status::refused with its reason, and only those.
 TEST(CanAdapterWithoutBus, RejectsBindingsItCannotCarry) {
   NullLogger log;
   auto adapter = make_can_adapter(can_segment("nosuchcan7"), GatewayIdentity{1, "gw"}, log);
   ChannelBinding reserved;
+  reserved.id = 1;
   reserved.spec.name = "reserved";
   reserved.can = CanHopPlan{};
   reserved.can->etag = 3;
   ChannelBinding no_plan;
+  no_plan.id = 2;
   no_plan.spec.name = "noplan";
-  const std::array bindings{reserved, no_plan};
+  ChannelBinding fine;
+  fine.id = 3;
+  fine.spec.name = "fine";
+  fine.spec.payload = 4;
+  fine.role = HopRole::subscriber;
+  fine.can = CanHopPlan{};
+  fine.can->etag = 200;
+  fine.can->can_id = encode_can_id(CanIdentifier{0x10, 1, 200});
+  const std::array bindings{reserved, no_plan, fine};
   const Status status = adapter->configure(bindings);
   EXPECT_FALSE(status.ok);
   EXPECT_NE(status.error.find("reserved"), std::string::npos);
   EXPECT_NE(status.error.find("no CAN plan"), std::string::npos);
+  ASSERT_EQ(status.refused.size(), 2u) << status.error;
+  EXPECT_EQ(status.refused[0].channel, 1u);
+  EXPECT_EQ(status.refused[0].reason, "etag 3 is reserved or out of range");
+  EXPECT_EQ(status.refused[1].channel, 2u);
+  EXPECT_EQ(status.refused[1].reason, "no CAN plan");
 }
 
 // Admission plans each hop in its segment's identifier layout; a plan for the other layout would

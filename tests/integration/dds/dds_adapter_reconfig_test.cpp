@@ -47,6 +47,13 @@ TEST(DdsAdapter, ChannelsMappingToOneTopicAreRefused) {
   EXPECT_NE(st.error.find("'arm-left'"), std::string::npos) << st.error;
   EXPECT_NE(st.error.find("'arm.left'"), std::string::npos) << st.error;
   EXPECT_NE(st.error.find("cosmic/arm_left"), std::string::npos) << st.error;
+  // Issue 22, item 12 (SegmentAdapter::configure): the second channel on the topic is refused,
+  // alone; the first one and the running channel are carried.
+  ASSERT_EQ(st.refused.size(), 1u) << st.error;
+  EXPECT_EQ(st.refused[0].channel, 3u);
+  Child arm(peer({"sub", "--domain", "63", "--channel", "arm-left", "--count", "1", "--timeout", "30"}));
+  ASSERT_TRUE(f.matched(2, HopRole::subscriber)) << arm.describe();
+  EXPECT_EQ(f.adapter->matched_endpoints(3, HopRole::publisher), 0u);
   // The running channel is untouched; one channel in both roles is no collision.
   Child sub(peer({"sub", "--domain", "63", "--channel", "keep", "--count", "1", "--timeout",
                   "30"}));
@@ -326,9 +333,15 @@ TEST(DdsAdapter, ReportsBadConfigurationThroughStatus) {
     EXPECT_FALSE(adapter->start(sink).ok);  // twice
     const ChannelBinding dup[] = {binding(1, "x", HopRole::publisher),
                                   binding(1, "x", HopRole::publisher)};
-    EXPECT_FALSE(adapter->configure(dup).ok);
+    const Status twice = adapter->configure(dup);
+    EXPECT_FALSE(twice.ok);
+    ASSERT_EQ(twice.refused.size(), 1u) << twice.error;
+    EXPECT_EQ(twice.refused[0].channel, 1u);
     ChannelBinding nameless = binding(2, "", HopRole::subscriber);
-    EXPECT_FALSE(adapter->configure(std::span(&nameless, 1)).ok);
+    const Status no_name = adapter->configure(std::span(&nameless, 1));
+    EXPECT_FALSE(no_name.ok);
+    ASSERT_EQ(no_name.refused.size(), 1u) << no_name.error;
+    EXPECT_EQ(no_name.refused[0].channel, 2u);
     std::vector<std::uint8_t> storage;
     EXPECT_EQ(adapter->send(outbound(42, 1, storage)), SendStatus::failed);  // unknown channel
     EXPECT_EQ(adapter->statistics().send_errors, 1u);

@@ -188,6 +188,33 @@ TEST_F(LcmAdapterTest, ANameBeyondTheTransportLimitIsRefusedForItsChannelAlone) 
   adapter->stop();
 }
 
+// Issue 22, item 12: one configure() contract for every adapter (SegmentAdapter::configure).
+// Every problem of one binding names that channel in Status::refused, and the segment carries
+// every other binding, the ones it was given before included.
+TEST_F(LcmAdapterTest, EveryRefusedBindingIsNamedAndTheRestIsCarried) {
+  auto adapter = make(7711);
+  ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(std::vector<ChannelBinding>{binding(1, "KEPT", HopRole::subscriber)}).ok);
+  const std::vector<ChannelBinding> bindings{binding(1, "KEPT", HopRole::subscriber),
+                                             binding(2, "KEPT", HopRole::subscriber),  // a name taken by id 1
+                                             binding(3, "NEW", HopRole::subscriber),
+                                             binding(3, "OTHER", HopRole::publisher),  // id 3 under a second name
+                                             binding(4, "", HopRole::subscriber)};
+  const Status status = adapter->configure(bindings);
+  EXPECT_FALSE(status.ok);
+  std::map<ChannelId, std::string> refused;
+  for (const ChannelRefusal& r : status.refused) refused.emplace(r.channel, r.reason);
+  ASSERT_EQ(refused.size(), 3u) << status.error;
+  EXPECT_NE(refused[2].find("already bound by channel id 1"), std::string::npos) << refused[2];
+  EXPECT_NE(refused[3].find("already bound as LCM channel 'NEW'"), std::string::npos) << refused[3];
+  EXPECT_EQ(refused[4], "no channel id or name");
+  EXPECT_EQ(adapter->send(outbound(1, Bytes{1})), SendStatus::sent) << "the channel bound before keeps flowing";
+  // A refused channel is not carried in any role: id 3's first (valid) binding is not either.
+  EXPECT_EQ(adapter->send(outbound(3, Bytes{1})), SendStatus::failed);
+  EXPECT_EQ(adapter->send(outbound(2, Bytes{1})), SendStatus::failed);
+  adapter->stop();
+}
+
 // The envelope decoder the adapter runs (cosmic/lcm_wire.hpp) against what lcm-gen encodes.
 Bytes encoded(const ::cosmic::envelope& e) {
   Bytes out(static_cast<std::size_t>(e.getEncodedSize()));

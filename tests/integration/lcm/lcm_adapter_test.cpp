@@ -74,8 +74,9 @@ TEST_F(LcmAdapterTest, EnvelopeToNativeSubscriber) {
 
   for (std::uint32_t k = 1; k <= kCount; ++k) {
     const Bytes payload = own_pattern(k, 8 + k);
-    // Odd events originate here (origin 0: the adapter stamps its own id), even ones elsewhere.
-    const std::uint64_t origin = (k % 2 == 1) ? 0 : 777;
+    // Odd events originate here (the router stamped this gateway's id), even ones elsewhere. The
+    // adapter sends the header as given, as the DDS adapter does.
+    const std::uint64_t origin = (k % 2 == 1) ? self_.id : 777;
     ASSERT_EQ(adapter->send(outbound(7, payload, k, 0xC0FFEE, origin)), SendStatus::sent);
   }
   const auto code = sub.wait_exit();
@@ -234,7 +235,7 @@ TEST_F(LcmAdapterTest, OwnEnvelopesAreNotReceivedBack) {
   ASSERT_TRUE(adapter->start(sink_).ok);
 
   for (std::uint32_t k = 1; k <= 10; ++k)
-    ASSERT_EQ(adapter->send(outbound(5, own_pattern(k, 16), k)), SendStatus::sent);
+    ASSERT_EQ(adapter->send(outbound(5, own_pattern(k, 16), k, 0, self_.id)), SendStatus::sent);
   ASSERT_TRUE(sink_.wait_problems(5, InboundProblem::own_echo, 10))
       << sink_.problems(5, InboundProblem::own_echo) << " echoes, " << sink_.count(5) << " events, "
       << adapter->statistics().received << " received";

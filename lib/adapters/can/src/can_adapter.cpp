@@ -80,9 +80,11 @@ void CanAdapter::wake() {
 
 Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
   auto table = std::make_shared<Table>();
-  std::string errors;
+  Status status;
   auto refuse = [&](const ChannelBinding& b, const std::string& why) {
-    errors += (errors.empty() ? "" : "; ") + ("channel " + b.spec.name + ": " + why);
+    status.ok = false;
+    status.error += (status.error.empty() ? "" : "; ") + ("channel " + b.spec.name + ": " + why);
+    status.refused.push_back(ChannelRefusal{b.id, why});
   };
   for (const CanBackgroundFrame& frame : segment_.can.background) table->native.add_background(frame);
   for (const auto& b : bindings) {
@@ -150,7 +152,10 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
   std::lock_guard lock(io_mutex_);
   if (sock_ >= 0 && ::setsockopt(sock_, SOL_CAN_RAW, CAN_RAW_FILTER, table->filters.data(),
                                  static_cast<socklen_t>(table->filters.size() * sizeof(can_filter))) != 0) {
-    errors += (errors.empty() ? "" : "; ") + ("CAN_RAW_FILTER: " + errno_text(errno));
+    // The kernel keeps the old filters, so the old table stays: the whole segment failed.
+    const std::string error = "CAN_RAW_FILTER: " + errno_text(errno) + "; the previous channels stay";
+    log_.log(LogLevel::error, "segment " + segment_.name + ": " + error);
+    return Status::failure(error);
   }
   backlog_.set_capacity(table->backlog_frames);
   for (auto it = tx_sequence_.begin(); it != tx_sequence_.end();) {
@@ -168,11 +173,8 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
   table_ = std::move(table);
   generation_.fetch_add(1, std::memory_order_release);
   if (!answers_.empty()) wake();
-  if (!errors.empty()) {
-    log_.log(LogLevel::error, "segment " + segment_.name + ": " + errors);
-    return Status::failure(errors);
-  }
-  return Status::success();
+  if (!status.ok) log_.log(LogLevel::error, "segment " + segment_.name + ": " + status.error);
+  return status;
 }
 
 std::optional<std::string> CanAdapter::bind_native(const ChannelBinding& b, Table& table) const {

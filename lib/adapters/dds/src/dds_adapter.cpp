@@ -26,6 +26,7 @@
 
 #include <exception>
 #include <map>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -80,82 +81,90 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
   if (!started()) {
     return Status::failure("DDS segment " + segment_.name + " is not started");
   }
+  // Every other problem concerns one channel, which is refused in both roles (not carried at
+  // all); the rest of the segment is configured (SegmentAdapter::configure).
+  Status status;
+  std::set<ChannelId> refused;
+  auto refuse = [&](const ChannelBinding& b, const std::string& why) {
+    if (!refused.insert(b.id).second) return;
+    status.ok = false;
+    status.error += (status.error.empty() ? "" : "; ") + ("channel " + b.spec.name + ": " + why);
+    status.refused.push_back(ChannelRefusal{b.id, why});
+  };
   // Validate and index the wanted endpoints.
   std::map<ChannelId, const ChannelBinding*> want_writers;
   std::map<ChannelId, const ChannelBinding*> want_readers;
+  std::vector<const ChannelSpec*> specs;
   for (const ChannelBinding& b : bindings) {
-    if (b.id == kNoChannel) {
-      return Status::failure("binding of channel '" + b.spec.name + "' has no channel id");
-    }
-    if (b.spec.name.empty()) {
-      return Status::failure("binding " + std::to_string(b.id) + " has an empty channel name");
+    if (b.id == kNoChannel || b.spec.name.empty()) {
+      refuse(b, "the binding has no channel id or name");
+      continue;
     }
     auto& table = b.role == HopRole::subscriber ? want_writers : want_readers;
     if (!table.emplace(b.id, &b).second) {
-      return Status::failure("channel '" + b.spec.name + "' is bound twice in the same role");
+      refuse(b, "bound twice in the same role");
+      continue;
+    }
+    specs.push_back(&b.spec);
+  }
+  for (const auto& [channel, why] : dds_topic_collisions(specs, segment_.name)) {
+    for (const ChannelBinding& b : bindings) {
+      if (&b.spec == channel) refuse(b, why);
     }
   }
 
-  std::vector<const ChannelSpec*> specs;
-  for (const ChannelBinding& b : bindings) specs.push_back(&b.spec);
-  if (const auto collision = dds_topic_collision(specs, segment_.name)) {
-    log_.log(LogLevel::error, prefix() + *collision);
-    return Status::failure(*collision);
-  }
-
-  // 1. Create what is new or changed, before touching anything that runs: a failure leaves the
-  //    running configuration as it was.
+  // 1. Create what is new or changed, before touching anything that runs. A channel whose
+  //    endpoint cannot be created is refused; the others go on.
   std::vector<std::unique_ptr<WriterEntry>> new_writers;
   std::vector<std::unique_ptr<ReaderEntry>> new_readers;
-  std::vector<ReaderEntry*> replaced_readers;  // deactivated while their successor is created
-  std::string error;
-  auto rollback = [&]() {
-    for (auto& w : new_writers) destroy_writer(std::move(w));
-    for (auto& r : new_readers) destroy_reader(std::move(r));
-    for (ReaderEntry* r : replaced_readers) {
-      std::lock_guard lock(r->mutex);
-      r->active = true;
+  for (const auto& [id, b] : want_writers) {
+    if (refused.count(id)) continue;
+    auto it = writers_.find(id);  // only this (control) thread changes writers_
+    if (it != writers_.end() && it->second->shape == shape_of(segment_, b->spec) &&
+        it->second->home == &home_of(b->spec.cls)) {
+      continue;
     }
-    log_.log(LogLevel::error, prefix() + error);
-    return Status::failure(error);
-  };
-  try {
-    for (const auto& [id, b] : want_writers) {
-      auto it = writers_.find(id);  // only this (control) thread changes writers_
-      if (it != writers_.end() && it->second->shape == shape_of(segment_, b->spec) &&
-          it->second->home == &home_of(b->spec.cls)) {
+    std::string error;
+    if (auto entry = create_endpoint(*b, error, &DdsAdapter::create_writer)) {
+      new_writers.push_back(std::move(entry));
+    } else {
+      refuse(*b, error);
+    }
+  }
+  for (const auto& [id, b] : want_readers) {
+    if (refused.count(id)) continue;
+    auto it = readers_.find(id);
+    if (it != readers_.end()) {
+      if (it->second->shape == shape_of(segment_, b->spec) && it->second->home == &home_of(b->spec.cls)) {
         continue;
       }
-      if (Status st = ensure_class_participant(b->spec.cls); !st.ok) {
-        error = st.error;
-        return rollback();
-      }
-      auto entry = create_writer(*b, error);
-      if (!entry) return rollback();
-      new_writers.push_back(std::move(entry));
+      // Changed QoS: stop the old reader first so that an event is never delivered twice. If
+      // its successor cannot be created, the channel is refused and the old reader goes too.
+      deactivate(*it->second);
     }
-    for (const auto& [id, b] : want_readers) {
-      auto it = readers_.find(id);
-      if (it != readers_.end()) {
-        if (it->second->shape == shape_of(segment_, b->spec) && it->second->home == &home_of(b->spec.cls)) {
-          continue;
-        }
-        // Changed QoS: stop the old reader first so that an event is never delivered twice.
-        deactivate(*it->second);
-        replaced_readers.push_back(it->second.get());
-      }
-      if (Status st = ensure_class_participant(b->spec.cls); !st.ok) {
-        error = st.error;
-        return rollback();
-      }
-      auto entry = create_reader(*b, error);
-      if (!entry) return rollback();
+    std::string error;
+    if (auto entry = create_endpoint(*b, error, &DdsAdapter::create_reader)) {
       new_readers.push_back(std::move(entry));
+    } else {
+      refuse(*b, error);
     }
-  } catch (const std::exception& e) {
-    error = std::string("Fast DDS: ") + e.what();
-    return rollback();
   }
+  // A channel refused in one role is carried in neither.
+  for (const ChannelId id : refused) {
+    want_writers.erase(id);
+    want_readers.erase(id);
+  }
+  std::erase_if(new_writers, [&](std::unique_ptr<WriterEntry>& w) {
+    if (!refused.count(w->id)) return false;
+    destroy_writer(std::move(w));
+    return true;
+  });
+  std::erase_if(new_readers, [&](std::unique_ptr<ReaderEntry>& r) {
+    if (!refused.count(r->id)) return false;
+    destroy_reader(std::move(r));
+    return true;
+  });
+  if (!status.ok) log_.log(LogLevel::error, prefix() + status.error);
 
   // 2. Swap: the router sees the new writer table at once.
   std::vector<std::unique_ptr<WriterEntry>> old_writers;
@@ -196,7 +205,23 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
   // 3. Delete what is gone (no send() can still use these writers).
   for (auto& w : old_writers) destroy_writer(std::move(w));
   for (auto& r : old_readers) destroy_reader(std::move(r));
-  return Status::success();
+  return status;
+}
+
+template <typename Entry>
+std::unique_ptr<Entry> DdsAdapter::create_endpoint(
+    const ChannelBinding& binding, std::string& error,
+    std::unique_ptr<Entry> (DdsAdapter::*create)(const ChannelBinding&, std::string&)) {
+  try {
+    if (Status st = ensure_class_participant(binding.spec.cls); !st.ok) {
+      error = st.error;
+      return nullptr;
+    }
+    return (this->*create)(binding, error);
+  } catch (const std::exception& e) {
+    error = std::string("Fast DDS: ") + e.what();
+    return nullptr;
+  }
 }
 
 SendStatus DdsAdapter::send(const OutboundEvent& event) {

@@ -37,6 +37,8 @@
 #include <cstring>
 #include <exception>
 #include <mutex>
+#include <optional>
+#include <set>
 #include <shared_mutex>
 #include <string>
 #include <string_view>
@@ -214,59 +216,49 @@ class LcmAdapter final : public SegmentAdapter {
     set_health(SegmentHealth::up, "");
     log_.log(LogLevel::info, "LCM segment " + segment_.name + " up on " + segment_.lcm.url);
     // Channels configured before start() are subscribed now.
-    std::string errors = sync_subscriptions(lcm);
-    if (!errors.empty()) return Status::failure(errors);
-    return Status::success();
+    Status status;
+    for (const auto& [id, name] : sync_subscriptions(lcm)) {
+      status.ok = false;
+      status.error += (status.error.empty() ? "" : "; ") + ("channel " + name + ": lcm_subscribe failed");
+    }
+    return status;
   }
 
   Status configure(std::span<const ChannelBinding> bindings) override {
     std::lock_guard control(control_mutex_);
-    std::string errors;
-    std::size_t error_count = 0;
-    auto add_error = [&errors, &error_count](const std::string& e) {
-      if (!errors.empty()) errors += "; ";
-      errors += e;
-      ++error_count;
+    // Every problem here concerns one channel (Status::refused); LCM has no failure of the whole
+    // segment once started.
+    Status status;
+    auto refuse = [&status](ChannelId id, const std::string& name, const std::string& why) {
+      status.ok = false;
+      status.error += (status.error.empty() ? "" : "; ") + ("channel " + name + ": " + why);
+      status.refused.push_back(ChannelRefusal{id, why});
     };
-    // Channels refused for a name LCM cannot carry; they name the failure's channels only when
-    // nothing else failed (Status::refused).
-    std::vector<ChannelRefusal> refused;
 
     // The table the segment must carry.
     std::unordered_map<ChannelId, Channel> wanted;
     std::unordered_map<std::string, ChannelId> names;
+    std::set<ChannelId> refused_ids;
     for (const ChannelBinding& b : bindings) {
       // A native binding names the LCM channel and carries the contents raw.
       const NativeBinding* native = b.spec.native_on(segment_.name);
       const std::string& name = native && native->lcm_channel ? *native->lcm_channel : b.spec.name;
-      if (b.id == kNoChannel || name.empty()) {
-        add_error("channel '" + name + "' has no id or name");
+      if (const auto problem = binding_problem(b, name, names)) {
+        refuse(b.id, name.empty() ? b.spec.name : name, *problem);
+        refused_ids.insert(b.id);
         continue;
       }
-      if (const auto problem = transport_name_problem(SegmentType::lcm, name)) {
-        add_error("channel " + name + ": " + *problem);
-        refused.push_back(ChannelRefusal{b.id, *problem});
-        continue;
-      }
-      auto [nit, fresh_name] = names.emplace(name, b.id);
-      if (!fresh_name && nit->second != b.id) {
-        add_error("channel name '" + name + "' bound under two ids");
-        continue;
-      }
-      auto [it, fresh] = wanted.try_emplace(b.id);
-      Channel& c = it->second;
-      if (fresh) {
-        c.id = b.id;
-        c.name = name;
-        c.subject = b.spec.subject;
-        c.encoding = native && native->lcm_channel ? LcmEncoding::raw : b.spec.lcm_encoding;
-      } else if (c.name != name) {
-        add_error("channel id " + std::to_string(b.id) + " bound under two names");
-        continue;
-      }
+      names.emplace(name, b.id);
+      Channel& c = wanted[b.id];
+      c.id = b.id;
+      c.name = name;
+      c.subject = b.spec.subject;
+      c.encoding = native && native->lcm_channel ? LcmEncoding::raw : b.spec.lcm_encoding;
       if (b.role == HopRole::publisher) c.rx = true;
       if (b.role == HopRole::subscriber) c.tx = true;
     }
+    // A channel refused in one role is not carried in the other either.
+    for (const ChannelId id : refused_ids) wanted.erase(id);
 
     lcm_t* lcm = current_lcm();
     // 1. Drop subscriptions that are no longer wanted (before the table stops knowing them).
@@ -288,18 +280,29 @@ class LcmAdapter final : public SegmentAdapter {
       for (auto& [id, channel] : channels_) by_name.emplace(channel.name, &channel);
       by_name_ = std::move(by_name);
     }
-    // 3. Subscribe what is new.
+    // 3. Subscribe what is new; a channel whose subscription fails is refused (the next
+    //    configure() tries again).
     if (lcm != nullptr) {
-      const std::string sub_errors = sync_subscriptions(lcm);
-      if (!sub_errors.empty()) add_error(sub_errors);
+      for (const auto& [id, name] : sync_subscriptions(lcm)) refuse(id, name, "lcm_subscribe failed");
     }
-    if (!errors.empty()) {
-      log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + errors);
-      Status status = Status::failure(errors);
-      if (error_count == refused.size()) status.refused = std::move(refused);
-      return status;
+    if (!status.ok) log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + status.error);
+    return status;
+  }
+
+  // Why binding `b` under LCM channel `name` cannot be carried, given the names taken so far.
+  std::optional<std::string> binding_problem(const ChannelBinding& b, const std::string& name,
+                                             const std::unordered_map<std::string, ChannelId>& names) const {
+    if (b.id == kNoChannel || name.empty()) return std::string("no channel id or name");
+    if (auto problem = transport_name_problem(SegmentType::lcm, name)) return problem;
+    const auto taken = names.find(name);
+    if (taken != names.end() && taken->second != b.id) {
+      return "LCM channel '" + name + "' is already bound by channel id " + std::to_string(taken->second);
     }
-    return Status::success();
+    const auto same_id = std::find_if(names.begin(), names.end(), [&](const auto& n) { return n.second == b.id; });
+    if (same_id != names.end() && same_id->first != name) {
+      return "channel id " + std::to_string(b.id) + " is already bound as LCM channel '" + same_id->first + "'";
+    }
+    return std::nullopt;
   }
 
   SendStatus send(const OutboundEvent& event) override {
@@ -323,8 +326,9 @@ class LcmAdapter final : public SegmentAdapter {
       std::lock_guard encode(encode_mutex_);
       envelope& e = tx_envelope_;
       e.subject = static_cast<std::int64_t>(event.header.subject);
-      // An event this gateway originates carries its id, so it recognises it and cuts loops.
-      e.origin = static_cast<std::int64_t>(event.header.origin != 0 ? event.header.origin : self_.id);
+      // The header goes out as given, as on DDS: the router stamps what this gateway originates
+      // with its id, a component (libcosmic-client) stamps its own.
+      e.origin = static_cast<std::int64_t>(event.header.origin);
       e.sequence = static_cast<std::int32_t>(event.header.sequence);
       e.hop_count = static_cast<std::int8_t>(event.header.hop_count);
       e.created_ns = event.header.created_ns;
@@ -387,20 +391,23 @@ class LcmAdapter final : public SegmentAdapter {
 
   // Subscribes every rx channel of the table that has no subscription yet (control thread,
   // control_mutex_ held). Returns the errors, empty if none.
-  std::string sync_subscriptions(lcm_t* lcm) {
+  // Subscribes every receiving channel of the table that has no subscription yet; returns those
+  // liblcm refused (id, LCM channel name), which keep the segment degraded until they succeed.
+  std::vector<std::pair<ChannelId, std::string>> sync_subscriptions(lcm_t* lcm) {
     std::vector<std::pair<ChannelId, std::string>> missing;
     {
       std::shared_lock table(table_mutex_);
       for (const auto& [id, channel] : channels_)
         if (channel.rx && !subscriptions_.contains(id)) missing.emplace_back(id, channel.name);
     }
+    std::vector<std::pair<ChannelId, std::string>> failed;
     std::string errors;
     for (auto& [id, name] : missing) {
       lcm_subscription_t* handle =
           lcm_subscribe(lcm, channel_regex(name).c_str(), &LcmAdapter::on_message, this);
       if (handle == nullptr) {
-        if (!errors.empty()) errors += "; ";
-        errors += "lcm_subscribe failed for channel " + name;
+        errors += (errors.empty() ? "" : "; ") + ("lcm_subscribe failed for channel " + name);
+        failed.emplace_back(id, std::move(name));
         continue;
       }
       lcm_subscription_set_queue_capacity(handle, kSubscriptionQueueCapacity);
@@ -414,7 +421,7 @@ class LcmAdapter final : public SegmentAdapter {
       subscribe_failed_ = false;
       set_health(SegmentHealth::up, "");
     }
-    return errors;
+    return failed;
   }
 
   // The gateway's own loop over liblcm's descriptor (lcm_get_fileno) and our stop eventfd:

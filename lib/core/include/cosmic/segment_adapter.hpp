@@ -80,9 +80,8 @@ struct ChannelRefusal {
 struct Status {
   bool ok = true;
   std::string error;
-  // configure() only: when not empty, exactly the channels the failure concerns (the segment
-  // carries every other binding it was given). Empty with !ok: the adapter cannot say which, and
-  // the gateway holds every binding the segment did not already carry as refused.
+  // configure() only: the bindings the segment does not carry, each with its reason (see
+  // SegmentAdapter::configure for the contract every adapter keeps).
   std::vector<ChannelRefusal> refused;
   static Status success() { return {}; }
   static Status failure(std::string why) { return {false, std::move(why), {}}; }
@@ -126,9 +125,15 @@ class SegmentAdapter {
   virtual ~SegmentAdapter() = default;
   // Opens the transport; inbound events flow to `sink` (which must outlive stop()).
   virtual Status start(EventSink& sink) = 0;
-  // Makes the segment carry exactly `bindings`. Channels present before and after keep flowing.
-  // A failure names the channels it concerns in Status::refused where the adapter can tell; the
-  // gateway shows each of them as `failed` with the reason (never bound and silent).
+  // Makes the segment carry `bindings`. Channels present before and after keep flowing. One
+  // contract for every adapter (tests/integration/*/ check it per adapter):
+  //  - ok: the segment carries every binding.
+  //  - !ok with Status::refused: the segment carries every binding except exactly those named
+  //    (one entry per refused channel, with the transport's reason; a refused binding is not
+  //    carried at all, whether or not it was before). `error` sums the reasons up.
+  //  - !ok with refused empty: a failure of the whole segment (not started, the kernel refused
+  //    its filters, ...); the segment carries exactly what it carried before the call.
+  // The gateway shows each refused channel as `failed` with the reason (never bound and silent).
   virtual Status configure(std::span<const ChannelBinding> bindings) = 0;
   // Transmits one event of a channel bound here as subscriber. Never throws.
   virtual SendStatus send(const OutboundEvent& event) = 0;
