@@ -265,6 +265,11 @@ std::string incompatible_text(const HopReport& hop, std::uint64_t count) {
          " refused for incompatible QoS (not matched; the log names the policy)";
 }
 
+// A remote endpoint that the far side refuses (or neither side accepts), with the rule.
+std::string peer_conflict_text(const HopReport& hop, const PeerQosConflict& c) {
+  return "remote " + c.peer + " " + c.id + " of " + c.topic + " on " + hop.segment + ": " + c.policy + ": " + c.reason;
+}
+
 // Predicted (admission) next to measured (the lane) for one egress hop.
 Json hop_runtime(const HopReport& hop, const HopRuntimeSnapshot& measured) {
   return Json{{"predicted_latency_s", hop.latency ? Json(to_seconds(*hop.latency)) : Json(nullptr)},
@@ -296,6 +301,18 @@ Json ControlProtocol::channel_entry(const ChannelReport& verdict, const ChannelS
     const auto incompatible = gateway_.incompatible_peers(hop.segment, verdict.name);
     seg["incompatible"] = incompatible ? Json(*incompatible) : Json(nullptr);
     if (incompatible && *incompatible > 0) entry["mismatches"].push_back(incompatible_text(hop, *incompatible));
+    // Where the transport has discovery: the remote endpoints the far side refuses by rules
+    // the transport's own matching does not report (`matched` may count them).
+    if (matched) {
+      seg["peer_conflicts"] = Json::array();
+      for (const PeerQosConflict& c : gateway_.peer_qos_conflicts(hop.segment, verdict.name)) {
+        seg["peer_conflicts"].push_back(
+            {{"peer", c.peer}, {"id", c.id}, {"topic", c.topic}, {"policy", c.policy}, {"reason", c.reason}});
+        entry["mismatches"].push_back(peer_conflict_text(hop, c));
+      }
+    } else {
+      seg["peer_conflicts"] = nullptr;
+    }
     for (std::size_t r = 0; r < kDropReasonCount; ++r) seg["dropped"][to_string(static_cast<DropReason>(r))] = 0;
     if (stats) {
       for (const auto& counters : stats->segments) {

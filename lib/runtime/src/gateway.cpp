@@ -503,6 +503,13 @@ std::optional<std::uint64_t> Gateway::incompatible_peers(const std::string& segm
   return slot->second.adapter->incompatible_peers(id->second.second);
 }
 
+std::vector<PeerQosConflict> Gateway::peer_qos_conflicts(const std::string& segment, const std::string& channel) const {
+  const auto slot = slots_.find(segment);
+  const auto id = channel_ids_.find(channel);
+  if (slot == slots_.end() || id == channel_ids_.end()) return {};
+  return slot->second.adapter->peer_qos_conflicts(id->second.second);
+}
+
 bool Gateway::all_segments_up() const {
   return std::all_of(slots_.begin(), slots_.end(),
                      [](const auto& s) { return s.second.adapter->health().state == SegmentHealth::up; });

@@ -30,6 +30,7 @@
 #include "cosmic/dds_names.hpp"
 #include "cosmic/health_cell.hpp"
 #include "cosmic/thread_policy.hpp"
+#include "dds_discovery.hpp"
 #include "dds_qos.hpp"
 #include "dds_sample_format.hpp"
 
@@ -118,6 +119,7 @@ class DdsAdapter final : public DdsSegmentAdapter {
     return matched_endpoints(channel, HopRole::subscriber) + matched_endpoints(channel, HopRole::publisher);
   }
   std::optional<std::uint64_t> incompatible_peers(ChannelId channel) const override;
+  std::vector<PeerQosConflict> peer_qos_conflicts(ChannelId channel) const override;
 
   // Reader callbacks (Fast DDS threads, reader mutex held).
   void deliver(ReaderEntry& entry, const dds::SampleInfo& info);
@@ -173,6 +175,8 @@ class DdsAdapter final : public DdsSegmentAdapter {
 
   AdapterCounters counters_;
   HealthCell health_;
+  // Every participant's listener: the remote endpoints discovered, for peer_qos_conflicts().
+  DiscoveryBook discovery_;
 
 };
 

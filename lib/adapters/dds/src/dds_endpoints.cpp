@@ -110,6 +110,37 @@ void DdsAdapter::deliver(ReaderEntry& entry, const dds::SampleInfo& info) {
   sink_->on_event(event);
 }
 
+// Control thread, for reports: the tables are read under their shared locks only to copy what
+// the rules need; the rules run after, on copies (no Fast DDS call, no lock across them).
+std::vector<PeerQosConflict> DdsAdapter::peer_qos_conflicts(ChannelId channel) const {
+  try {
+    std::optional<std::pair<DdsTopicRef, ChannelSpec>> writer, reader;
+    {
+      std::shared_lock lock(writers_mutex_);
+      if (auto it = writers_.find(channel); it != writers_.end()) writer.emplace(it->second->shape.topic, it->second->spec);
+    }
+    {
+      std::shared_lock lock(readers_mutex_);
+      if (auto it = readers_.find(channel); it != readers_.end()) reader.emplace(it->second->shape.topic, it->second->spec);
+    }
+    std::vector<PeerQosConflict> out;
+    if (writer) {
+      const auto& [topic, spec] = *writer;
+      out = peer_conflicts(local_writer_qos(topic, writer_qos(segment_, spec)), DdsLocalRole::writer,
+                           discovery_.remote_of(topic.topic, true), false);
+    }
+    if (reader) {
+      const auto& [topic, spec] = *reader;
+      auto found = peer_conflicts(local_reader_qos(topic, reader_qos(segment_, spec)), DdsLocalRole::reader,
+                                  discovery_.remote_of(topic.topic, false), spec.reaction_time.has_value());
+      out.insert(out.end(), found.begin(), found.end());
+    }
+    return out;
+  } catch (...) {
+    return {};
+  }
+}
+
 void DdsAdapter::warn_refused(const WriterEntry& writer, FillRefusal refusal, std::uint16_t first_bytes,
                               std::size_t size) {
   char id[8];
@@ -137,7 +168,10 @@ dds::DomainParticipant* DdsAdapter::create_participant_as(const ThreadPolicy& th
   std::vector<std::string> problems;
   std::thread creator([&] {
     problems = apply_thread_policy(threads);
-    created = dds::DomainParticipantFactory::get_instance()->create_participant(domain, qos);
+    // The listener from the start: a remote endpoint discovered before it was set would never
+    // be checked. Mask none: only discovery reaches it, never an endpoint's status.
+    created = dds::DomainParticipantFactory::get_instance()->create_participant(domain, qos, &discovery_,
+                                                                                dds::StatusMask::none());
   });
   creator.join();
   for (const auto& problem : problems) {
@@ -161,6 +195,8 @@ Status DdsAdapter::open_participant(ChannelClass cls, const ThreadPolicy& thread
   }
   ThreadPolicy policy = threads;
   policy.name = thread_name;
+  // start() opens the NRT participant first: what an earlier run discovered is gone with it.
+  if (cls == ChannelClass::nrt) discovery_.clear();
   home.participant = create_participant_as(policy, qos);
   if (home.participant == nullptr) {
     return Status::failure("cannot create a DDS participant (" + std::string(kClassName[static_cast<std::size_t>(cls)]) +
@@ -178,6 +214,7 @@ Status DdsAdapter::open_participant(ChannelClass cls, const ThreadPolicy& thread
     return Status::failure("cannot create the DDS publisher/subscriber");
   }
   home.prefix = home.participant->guid().guidPrefix;
+  discovery_.add_own_participant(home.prefix);
   return Status::success();
 }
 

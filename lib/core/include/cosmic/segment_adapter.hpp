@@ -120,6 +120,16 @@ struct AdapterStatistics {
   std::uint64_t unexplained_others = 0;
 };
 
+// One rule a remote endpoint and the gateway's endpoint of a channel break (see
+// SegmentAdapter::peer_qos_conflicts).
+struct PeerQosConflict {
+  std::string peer;    // the remote endpoint's kind: "reader" or "writer"
+  std::string id;      // its identity on the transport (DDS: the GUID)
+  std::string topic;   // where (DDS: the topic)
+  std::string policy;  // e.g. "data_representation", "latency_budget"
+  std::string reason;  // its value against ours and what follows, e.g. "requests ..., this writer offers ..."
+};
+
 class SegmentAdapter {
  public:
   virtual ~SegmentAdapter() = default;
@@ -149,6 +159,11 @@ class SegmentAdapter {
   virtual std::optional<std::uint64_t> incompatible_peers(ChannelId /*channel*/) const {
     return std::nullopt;
   }
+  // Remote endpoints of `channel` discovered here whose QoS or type the far side refuses (or
+  // neither side accepts) by rules this transport's own matching does not apply or report, so
+  // that neither matched_peers nor incompatible_peers shows them (DDS: cosmic/dds_qos_match.hpp).
+  // Current, not cumulative: an endpoint that goes away takes its conflicts along.
+  virtual std::vector<PeerQosConflict> peer_qos_conflicts(ChannelId /*channel*/) const { return {}; }
   virtual void stop() = 0;
 };
 

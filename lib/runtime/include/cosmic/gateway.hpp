@@ -160,6 +160,9 @@ class Gateway {
   std::optional<std::size_t> matched_peers(const std::string& segment, const std::string& channel) const;
   // Remote endpoints of a bound channel refused on a segment for incompatible QoS (see SegmentAdapter).
   std::optional<std::uint64_t> incompatible_peers(const std::string& segment, const std::string& channel) const;
+  // Remote endpoints of a bound channel on a segment that the far side refuses by rules the
+  // transport does not report (see SegmentAdapter::peer_qos_conflicts).
+  std::vector<PeerQosConflict> peer_qos_conflicts(const std::string& segment, const std::string& channel) const;
 
  private:
   struct SegmentSlot {
