@@ -2,7 +2,9 @@
 // while traffic flows, reload keeping what did not change.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <map>
+#include <thread>
 
 #include "cosmic/config_loader.hpp"
 #include "cosmic/gateway.hpp"
@@ -106,6 +108,35 @@ TEST_F(GatewayTest, StartBindsEveryAdmittedChannelAndForwards) {
   expect_flow("speed", "lan", "viz");
   expect_flow("log", "viz", "lan");
   EXPECT_EQ(adapters["lan"]->bindings().size(), 2u);
+}
+
+// Issue 20, item 1: the rate bucket banks what the publisher segment's latency bound allows,
+// 1 + ceil(500 ms / 100 ms) = 6 events here (the gateway's floor is 3): six events bunched at
+// once pass, the seventh and eighth are cut.
+TEST_F(GatewayTest, RatePolicingBanksTheJitterOfThePublisherSegment) {
+  const auto result = gateway.start(parse(R"(
+gateway: {name: gw}
+segments:
+  - {name: slow, type: lcm, url: "udpm://239.255.76.67:7700?ttl=0", latency_bound: 500ms}
+  - {name: viz, type: lcm, latency_bound: 2ms}
+channels:
+  - {name: beacon, subject: 9, class: nrt, period: 100ms, publishers: [slow], subscribers: [viz]}
+)"));
+  ASSERT_TRUE(result.applied);
+  for (int i = 0; i < 8; ++i) ASSERT_TRUE(adapters["slow"]->inject("beacon", {1, 2}));
+  const auto rate_drops = [&] {
+    for (const auto& c : gateway.channel_stats()) {
+      if (c.name != "beacon") continue;
+      std::uint64_t n = 0;
+      for (const auto& s : c.segments) n += s.dropped[static_cast<std::size_t>(DropReason::rate)];
+      return n;
+    }
+    return std::uint64_t{0};
+  };
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (rate_drops() < 2 && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  EXPECT_EQ(rate_drops(), 2u);
+  EXPECT_EQ(adapters["viz"]->wait_sent(6, std::chrono::seconds(5)), 6u);
 }
 
 TEST_F(GatewayTest, RejectedRuntimeBindChangesNothing) {

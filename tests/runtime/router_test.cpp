@@ -42,13 +42,15 @@ class RouterTest : public ::testing::Test {
     return l;
   }
 
-  void bind(std::vector<ChannelSpec> specs) {
+  // `jitter`: what the ingress network may add (Route::ingress_jitter, the gateway's largest
+  // publisher latency bound).
+  void bind(std::vector<ChannelSpec> specs, Nanos jitter = Nanos(0)) {
     std::vector<Route> routes;
     std::vector<ChannelBinding> in_bindings;
     std::vector<ChannelBinding> out_bindings;
     ChannelId id = 1;
     for (auto& spec : specs) {
-      routes.push_back(Route{id, spec, {0}, {1}});
+      routes.push_back(Route{id, spec, {0}, {1}, jitter});
       subjects[id] = spec.subject;
       in_bindings.push_back(ChannelBinding{id, spec, HopRole::publisher, std::nullopt});
       out_bindings.push_back(ChannelBinding{id, spec, HopRole::subscriber, std::nullopt});
@@ -146,6 +148,56 @@ TEST_F(RouterTest, RateLimitHoldsTheReservedRateWithASmallBurst) {
   router.run_once(100);
   EXPECT_EQ(out.sent().size(), 4u);
   EXPECT_EQ(dropped("a", DropReason::rate), 7u);
+}
+
+// Issue 20, item 1: policing matches the contract. Events sent at exactly the channel's period
+// and each delayed by the ingress network within its latency bound (5 ms here, period 1 ms)
+// arrive bunched, six at a time; none of them may be dropped for rate.
+TEST_F(RouterTest, EventsBunchedWithinTheIngressLatencyBoundAreNeverPoliced) {
+  const Nanos period(1'000'000);
+  const Nanos bound(5'000'000);
+  bind({channel("a", ChannelClass::hrt, period)}, bound);
+  const Nanos t0 = steady_now();
+  constexpr int kEvents = 120;
+  TokenBucket fixed_burst(period, 3);  // the policing before: 3 events banked, whatever the jitter
+  int fixed_burst_drops = 0;
+  for (int k = 0; k < kEvents; ++k) {
+    // Sent at k ms, delayed by 5 - (k % 6) ms: groups of six arrive together at 6m + 5 ms.
+    const Nanos arrival = t0 + period * k + (bound - period * (k % 6));
+    deliver(1, EventHeader{}, arrival);
+    fixed_burst_drops += fixed_burst.admit(arrival) ? 0 : 1;
+    router.run_once(100);
+  }
+  EXPECT_GT(fixed_burst_drops, 0) << "the input must bunch beyond the old fixed burst";
+  EXPECT_EQ(out.sent().size(), static_cast<std::size_t>(kEvents));
+  EXPECT_EQ(dropped("a", DropReason::rate), 0u);
+}
+
+// ... while a publisher above its contract is still cut to it: at twice the rate for 100 ms, it
+// gets the bucket's depth (1 + 5 ms / 1 ms = 6) plus one event per period, no more.
+TEST_F(RouterTest, APublisherAboveItsContractIsCutToIt) {
+  const Nanos period(1'000'000);
+  bind({channel("a", ChannelClass::hrt, period)}, Nanos(5'000'000));
+  const Nanos t0 = steady_now();
+  for (int k = 0; k < 200; ++k) {
+    deliver(1, EventHeader{}, t0 + period * k / 2);
+    router.run_once(100);
+  }
+  const std::size_t forwarded = out.sent().size();
+  EXPECT_GE(forwarded, 100u);      // one per period over the 100 ms
+  EXPECT_LE(forwarded, 6u + 100u); // plus at most the bucket's depth
+  EXPECT_EQ(dropped("a", DropReason::rate), 200u - forwarded);
+}
+
+TEST(PolicingDepth, OnePlusTheJitterInPeriodsRoundedUp) {
+  const Nanos ms(1'000'000);
+  EXPECT_EQ(policing_depth(ms, Nanos(0), 1), 1u);
+  EXPECT_EQ(policing_depth(ms, ms * 5, 1), 6u);
+  EXPECT_EQ(policing_depth(ms, ms * 5 + Nanos(1), 1), 7u);
+  EXPECT_EQ(policing_depth(ms * 10, ms * 2, 1), 2u);
+  EXPECT_EQ(policing_depth(ms * 10, ms * 2, 3), 3u);  // gateway floor
+  EXPECT_EQ(policing_depth(Nanos(1), ms * 1000, 1), kMaxPolicingDepth);
+  EXPECT_EQ(policing_depth(Nanos(0), ms, 3), 3u);  // unlimited channel: the bucket is off anyway
 }
 
 TEST_F(RouterTest, DuplicatesOwnEchoesAndLoopsAreCut) {

@@ -18,7 +18,8 @@ namespace cosmic {
 struct ChannelState {
   ChannelState(Route r, std::size_t segment_count, std::uint32_t burst)
       : route(std::move(r)),
-        bucket(route.spec.period.value_or(Nanos(0)), burst),
+        bucket(route.spec.period.value_or(Nanos(0)),
+               policing_depth(route.spec.period.value_or(Nanos(0)), route.ingress_jitter, burst)),
         counters(segment_count),
         egress(route.subscribers.size()) {}
 

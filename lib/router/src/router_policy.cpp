@@ -7,6 +7,17 @@ namespace cosmic {
 TokenBucket::TokenBucket(Nanos period, std::uint32_t burst)
     : period_(period), capacity_ns_(period.count() * std::max<std::uint32_t>(1, burst)), credit_ns_(capacity_ns_) {}
 
+std::uint32_t policing_depth(Nanos period, Nanos jitter, std::uint32_t floor) {
+  std::uint64_t depth = 1;
+  if (period.count() > 0 && jitter.count() > 0) {
+    const auto p = static_cast<std::uint64_t>(period.count());
+    const auto j = static_cast<std::uint64_t>(jitter.count());
+    depth += std::min<std::uint64_t>(kMaxPolicingDepth, j / p + (j % p != 0 ? 1 : 0));
+  }
+  depth = std::max<std::uint64_t>(depth, floor);
+  return static_cast<std::uint32_t>(std::min<std::uint64_t>(depth, kMaxPolicingDepth));
+}
+
 bool TokenBucket::admit(Nanos now) {
   if (!limited()) return true;
   if (started_) {

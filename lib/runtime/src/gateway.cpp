@@ -207,7 +207,12 @@ void Gateway::apply_routes() {
   std::vector<Route> routes;
   for (const auto& channel : kb_->bound_channels()) {
     Route route{id_for(channel), channel, {}, {}};
-    for (const auto& p : channel.publishers) route.publishers.push_back(slots_.at(p).index);
+    for (const auto& p : channel.publishers) {
+      route.publishers.push_back(slots_.at(p).index);
+      if (const SegmentSpec* segment = config_.find_segment(p)) {
+        route.ingress_jitter = std::max(route.ingress_jitter, segment->latency_bound);
+      }
+    }
     for (const auto& s : channel.subscribers) route.subscribers.push_back(slots_.at(s).index);
     routes.push_back(std::move(route));
   }

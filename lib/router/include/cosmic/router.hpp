@@ -40,13 +40,17 @@ struct Route {
   std::vector<std::size_t> subscribers;  // segment indices
   friend bool operator==(const Route&, const Route&) = default;
 };
+  // How much later than its neighbours one event may arrive within the contract: the largest
+  // latency bound of the publisher segments. The rate bucket banks 1 + ceil(this / period)
+  // events, so a publisher at its period whose events the network bunches loses none.
+  Nanos ingress_jitter{0};
 
 struct RouterLimits {
   std::size_t hrt_queue = 256;  // events per egress lane of each class
   std::size_t srt_queue = 1024;
   std::size_t nrt_queue = 1024;
   std::size_t queue_bytes = 16u << 20;  // each lane is also bounded by bytes (large events)
-  std::uint32_t rate_burst = 3;         // events a channel may bank beyond its rate
+  std::uint32_t rate_burst = 3;         // the least a channel's rate bucket banks (see policing_depth)
   Nanos residence_bound{Nanos(1'000'000)};  // gateway.residence_bound: what each hop is checked against
   // How the lane threads of each class run (index: ChannelClass). The name is completed with the
   // segment's name. Without lane threads (false) nothing is sent until run_once() (tests).

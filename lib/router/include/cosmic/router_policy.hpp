@@ -29,6 +29,15 @@ class TokenBucket {
   bool started_ = false;
 };
 
+// How many events a channel's TokenBucket banks: 1 + ceil(jitter / period), at least `floor` and
+// at most kMaxPolicingDepth. Events sent at exactly `period` and each delayed by anything in
+// [0, jitter] arrive at most that many in any instant beyond the rate, so policing on arrival
+// drops none of them, while a source above its rate is cut to it after that many. (Creation
+// times would absorb any bunching, but they come from the sender's clock: a babbling or
+// misconfigured sender could claim any spacing, so the bucket runs on arrival.)
+inline constexpr std::uint32_t kMaxPolicingDepth = 4096;
+std::uint32_t policing_depth(Nanos period, Nanos jitter, std::uint32_t floor);
+
 // Remembers recently seen (origin, sequence) pairs: a window of the last 64 sequences for each of
 // up to 16 origins (least recently used origin evicted).
 //
