@@ -51,7 +51,7 @@ void DaemonLogger::log(cosmic::LogLevel level, std::string_view message) {
   const auto now = std::chrono::steady_clock::now();
   std::uint64_t folded = 0;
   {
-    std::lock_guard lock(mutex_);
+    cosmic::LockGuard lock(mutex_);
     auto it = recent_.find(message);
     if (it != recent_.end() && now - it->second.window_start < repeat_window_) {
       ++it->second.suppressed;

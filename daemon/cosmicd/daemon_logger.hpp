@@ -7,10 +7,11 @@
 #include <chrono>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <string>
 
 #include "cosmic/log.hpp"
+#include "cosmic/mutex.hpp"
+#include "cosmic/thread_annotations.hpp"
 
 namespace spdlog {
 class logger;
@@ -32,8 +33,8 @@ class DaemonLogger final : public cosmic::Logger {
   std::chrono::milliseconds repeat_window_;
   bool journald_;
   std::shared_ptr<spdlog::logger> sink_;
-  std::mutex mutex_;
-  std::map<std::string, Repeat, std::less<>> recent_;
+  cosmic::Mutex mutex_;
+  std::map<std::string, Repeat, std::less<>> recent_ COSMIC_GUARDED_BY(mutex_);
 };
 
 }  // namespace cosmicd

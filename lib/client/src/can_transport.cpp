@@ -12,12 +12,13 @@
 #include <condition_variable>
 #include <cstring>
 #include <map>
-#include <mutex>
 #include <thread>
 
 #include "cosmic/can_fragment.hpp"
 #include "cosmic/can_wire.hpp"
 #include "cosmic/client.h"
+#include "cosmic/mutex.hpp"
+#include "cosmic/thread_annotations.hpp"
 #include "transport.hpp"
 
 namespace cosmic::client_detail {
@@ -63,7 +64,7 @@ class CanTransport final : public Transport {
   }
 
   int announce(std::size_t index, const ChannelSpec& spec, int roles, int timeout_ms, std::string& error) override {
-    std::unique_lock lock(mutex_);
+    UniqueLock lock(mutex_);
     channels_[index] = CanChannel{spec, roles, spec.etag.value_or(0), 0};
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
     // Ask again every 500 ms (the gateway answers only once the channel is bound).
@@ -71,8 +72,9 @@ class CanTransport final : public Transport {
       lock.unlock();
       request_etag(spec.subject);
       lock.lock();
-      bound_.wait_until(lock, std::min(deadline, std::chrono::steady_clock::now() + std::chrono::milliseconds(500)),
-                        [&] { return channels_[index].etag != 0; });
+      const auto until = std::min(deadline, std::chrono::steady_clock::now() + std::chrono::milliseconds(500));
+      while (channels_[index].etag == 0 && lock.wait_until(bound_, until) != std::cv_status::timeout) {
+      }
     }
     if (channels_[index].etag != 0) return COSMIC_OK;
     error = "no gateway on " + interface_ + " answered GET_ETAG for channel '" + spec.name + "'";
@@ -81,7 +83,7 @@ class CanTransport final : public Transport {
   }
 
   int send(std::size_t index, const EventHeader&, std::span<const std::uint8_t> payload, std::string& error) override {
-    std::unique_lock lock(mutex_);
+    UniqueLock lock(mutex_);
     CanChannel& c = channels_.at(index);
     const std::uint32_t id = encode_can_id({band_of(c.spec.cls).first, node_, c.etag}) | CAN_EFF_FLAG;
     if (!needs_fragmentation(c.spec.payload, kClassicCapacity)) return write_frame(id, payload, error);
@@ -136,7 +138,7 @@ class CanTransport final : public Transport {
     std::uint32_t half = 0;
     for (int i = 4; i < 8; ++i) half = half << 8 | f.data[i];
     const auto etag = static_cast<std::uint16_t>((f.data[2] & 0x3F) << 8 | f.data[3]);
-    std::lock_guard lock(mutex_);
+    LockGuard lock(mutex_);
     if (f.data[1] == 0) {
       supply_high_[etag] = half;
       return;
@@ -151,7 +153,7 @@ class CanTransport final : public Transport {
   }
 
   void on_event(const CanIdentifier& id, std::span<const std::uint8_t> data) {
-    std::unique_lock lock(mutex_);
+    UniqueLock lock(mutex_);
     for (auto& [index, c] : channels_) {
       if (c.etag != id.etag || !(c.roles & COSMIC_SUBSCRIBE)) continue;
       EventHeader header;
@@ -177,11 +179,11 @@ class CanTransport final : public Transport {
   Delivery* delivery_ = nullptr;
   std::atomic<bool> running_{false};
   std::thread reader_;
-  std::mutex mutex_;
+  Mutex mutex_;
   std::condition_variable bound_;
-  std::map<std::size_t, CanChannel> channels_;
-  std::map<std::uint16_t, std::uint32_t> supply_high_;  // etag -> first half of a SUPPLY_ETAG
-  Reassembler reassembler_;
+  std::map<std::size_t, CanChannel> channels_ COSMIC_GUARDED_BY(mutex_);
+  std::map<std::uint16_t, std::uint32_t> supply_high_ COSMIC_GUARDED_BY(mutex_);  // etag -> first half of a SUPPLY_ETAG
+  Reassembler reassembler_ COSMIC_GUARDED_BY(mutex_);
 };
 
 }  // namespace

@@ -1,12 +1,13 @@
 // DDS and LCM for a component: the gateway's adapters with the roles mirrored, so topics, envelope
 // and QoS are exactly what cosmicd expects (one implementation of the mapping, not two).
 #include <random>
-#include <mutex>
 #include <vector>
 
 #include "cosmic/client.h"
 #include "cosmic/dds_adapter.hpp"
 #include "cosmic/lcm_adapter.hpp"
+#include "cosmic/mutex.hpp"
+#include "cosmic/thread_annotations.hpp"
 #include "transport.hpp"
 
 namespace cosmic::client_detail {
@@ -17,17 +18,17 @@ class QuietLogger : public Logger {
  public:
   void log(LogLevel level, std::string_view message) override {
     if (level < LogLevel::warning) return;
-    std::lock_guard lock(mutex_);
+    LockGuard lock(mutex_);
     last_ = message;
   }
   std::string last() {
-    std::lock_guard lock(mutex_);
+    LockGuard lock(mutex_);
     return last_;
   }
 
  private:
-  std::mutex mutex_;
-  std::string last_;
+  Mutex mutex_;
+  std::string last_ COSMIC_GUARDED_BY(mutex_);
 };
 
 // A channel announced as `index` has binding id 2*index (the component publishes: the adapter
@@ -56,7 +57,7 @@ class IpTransport final : public Transport, private EventSink {
   }
 
   int announce(std::size_t index, const ChannelSpec& spec, int roles, int, std::string& error) override {
-    std::lock_guard lock(mutex_);
+    LockGuard lock(mutex_);
     auto next = bindings_;
     if (roles & COSMIC_PUBLISH) next.push_back(ChannelBinding{send_id(index), spec, HopRole::subscriber, std::nullopt});
     if (roles & COSMIC_SUBSCRIBE) next.push_back(ChannelBinding{receive_id(index), spec, HopRole::publisher, std::nullopt});
@@ -94,8 +95,8 @@ class IpTransport final : public Transport, private EventSink {
   QuietLogger log_;
   Delivery* delivery_ = nullptr;
   std::unique_ptr<SegmentAdapter> adapter_;
-  std::mutex mutex_;
-  std::vector<ChannelBinding> bindings_;
+  Mutex mutex_;
+  std::vector<ChannelBinding> bindings_ COSMIC_GUARDED_BY(mutex_);
 };
 
 }  // namespace

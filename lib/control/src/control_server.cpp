@@ -109,7 +109,7 @@ void ControlServer::watch(int fd, std::function<void()> on_ready) {
 
 void ControlServer::post(std::function<void()> task) {
   {
-    std::lock_guard lock(posted_mutex_);
+    LockGuard lock(posted_mutex_);
     posted_.push_back(std::move(task));
   }
   const std::uint64_t one = 1;
@@ -118,7 +118,7 @@ void ControlServer::post(std::function<void()> task) {
 
 Offload ControlServer::offload() {
   return [this](std::function<void()> work, std::function<void()> done) {
-    std::lock_guard lock(jobs_mutex_);
+    LockGuard lock(jobs_mutex_);
     if (stopping_) return;
     jobs_.emplace_back(std::move(work), std::move(done));
     if (!worker_.joinable()) worker_ = std::thread([this] { work_loop(); });
@@ -130,8 +130,8 @@ void ControlServer::work_loop() {
   while (true) {
     std::pair<std::function<void()>, std::function<void()>> job;
     {
-      std::unique_lock lock(jobs_mutex_);
-      jobs_ready_.wait(lock, [this] { return stopping_ || !jobs_.empty(); });
+      UniqueLock lock(jobs_mutex_);
+      while (!stopping_ && jobs_.empty()) lock.wait(jobs_ready_);
       if (stopping_) return;
       job = std::move(jobs_.front());
       jobs_.pop_front();
@@ -142,13 +142,15 @@ void ControlServer::work_loop() {
 }
 
 void ControlServer::stop_worker() {
+  std::thread worker;  // joined outside the lock, which the worker takes to see stopping_
   {
-    std::lock_guard lock(jobs_mutex_);
+    LockGuard lock(jobs_mutex_);
     stopping_ = true;
     jobs_.clear();
+    worker = std::move(worker_);
   }
   jobs_ready_.notify_all();
-  if (worker_.joinable()) worker_.join();
+  if (worker.joinable()) worker.join();
 }
 
 void ControlServer::run_posted() {
@@ -156,7 +158,7 @@ void ControlServer::run_posted() {
   [[maybe_unused]] const auto drained = ::read(wake_fd_, &count, sizeof count);
   std::vector<std::function<void()>> tasks;
   {
-    std::lock_guard lock(posted_mutex_);
+    LockGuard lock(posted_mutex_);
     tasks.swap(posted_);
   }
   for (auto& task : tasks) task();

@@ -12,6 +12,7 @@
 #include "cosmic/router.hpp"
 #include "cosmic/router_policy.hpp"
 #include "cosmic/router_stats.hpp"
+#include "cosmic/thread_annotations.hpp"
 
 namespace cosmic {
 
@@ -25,9 +26,9 @@ struct ChannelState {
 
   const Route route;
   PiMutex policy_mutex;  // guards bucket, dedup and loop_guard (ingress threads of several segments)
-  TokenBucket bucket;
-  DuplicateFilter dedup;
-  RawLoopGuard loop_guard;  // raw LCM channels: their events carry no origin to cut loops by
+  TokenBucket bucket COSMIC_GUARDED_BY(policy_mutex);
+  DuplicateFilter dedup COSMIC_GUARDED_BY(policy_mutex);
+  RawLoopGuard loop_guard COSMIC_GUARDED_BY(policy_mutex);  // raw LCM channels: their events carry no origin to cut loops by
   std::vector<SegmentCounters> counters;  // indexed by segment slot
   std::vector<EgressStats> egress;        // parallel to route.subscribers
   LatencyHistogram residence;             // over every egress hop

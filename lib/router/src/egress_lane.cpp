@@ -13,7 +13,7 @@ EgressLane::~EgressLane() { deactivate(); }
 bool EgressLane::push(LaneItem&& item) noexcept {
   const std::size_t size = item.payload->bytes().size();
   {
-    std::lock_guard lock(mutex_);
+    PiLock lock(mutex_);
     if (!active_ || count_ == ring_.size() || bytes_ + size > byte_budget_) return false;
     item.generation = generation_;
     ring_[(head_ + count_) % ring_.size()] = std::move(item);
@@ -25,7 +25,7 @@ bool EgressLane::push(LaneItem&& item) noexcept {
 }
 
 bool EgressLane::pop(LaneItem& out) noexcept {
-  std::lock_guard lock(mutex_);
+  PiLock lock(mutex_);
   if (count_ == 0) return false;
   out = std::move(ring_[head_]);
   bytes_ -= out.payload->bytes().size();
@@ -35,14 +35,14 @@ bool EgressLane::pop(LaneItem& out) noexcept {
 }
 
 std::size_t EgressLane::size() const {
-  std::lock_guard lock(mutex_);
+  PiLock lock(mutex_);
   return count_;
 }
 
 void EgressLane::activate(SegmentAdapter* adapter, const ThreadPolicy& policy, bool threaded) {
   deactivate();
   {
-    std::lock_guard lock(mutex_);
+    PiLock lock(mutex_);
     if (ring_.empty()) ring_.resize(depth_);
     active_ = true;
     current_generation_.store(generation_, std::memory_order_release);
@@ -61,7 +61,7 @@ void EgressLane::deactivate() {
   }
   std::vector<LaneItem> dropped;
   {
-    std::lock_guard lock(mutex_);
+    PiLock lock(mutex_);
     active_ = false;
     ++generation_;  // an event pushed while this runs is discarded when next seen
     while (count_ > 0) {

@@ -11,13 +11,14 @@
 
 #include <atomic>
 #include <functional>
-#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "channel_state.hpp"
+#include "cosmic/pi_mutex.hpp"
 #include "cosmic/segment_adapter.hpp"
+#include "cosmic/thread_annotations.hpp"
 #include "cosmic/thread_policy.hpp"
 #include "payload_pool.hpp"
 #include "wake_signal.hpp"
@@ -50,17 +51,17 @@ class EgressLane {
   EgressLane& operator=(const EgressLane&) = delete;
 
   // False when the lane is full (by count or bytes) or not active: the caller counts queue_full.
-  bool push(LaneItem&& item) noexcept;
+  bool push(LaneItem&& item) noexcept COSMIC_EXCLUDES(mutex_);
   // Starts sending to `adapter`; with `threaded`, on a new thread run under `policy`.
-  void activate(SegmentAdapter* adapter, const ThreadPolicy& policy, bool threaded);
+  void activate(SegmentAdapter* adapter, const ThreadPolicy& policy, bool threaded) COSMIC_EXCLUDES(mutex_);
   // Stops sending: joins the thread (after its send in progress) and drops what is queued.
-  void deactivate();
+  void deactivate() COSMIC_EXCLUDES(mutex_);
   // Without a thread: handles up to `budget` queued events now; returns how many.
-  std::size_t run_once(std::size_t budget);
-  std::size_t size() const;
+  std::size_t run_once(std::size_t budget) COSMIC_EXCLUDES(mutex_);
+  std::size_t size() const COSMIC_EXCLUDES(mutex_);
 
  private:
-  bool pop(LaneItem& out) noexcept;
+  bool pop(LaneItem& out) noexcept COSMIC_EXCLUDES(mutex_);
   void forward(LaneItem& item) noexcept;
   void discard(LaneItem& item) noexcept;
   void worker(ThreadPolicy policy);
@@ -71,12 +72,12 @@ class EgressLane {
   const std::size_t byte_budget_;
 
   mutable PiMutex mutex_;  // the ring; held for moves only, never across send()
-  std::vector<LaneItem> ring_;  // allocated at the first activation
-  std::size_t head_ = 0;
-  std::size_t count_ = 0;
-  std::size_t bytes_ = 0;
-  bool active_ = false;
-  std::uint64_t generation_ = 0;
+  std::vector<LaneItem> ring_ COSMIC_GUARDED_BY(mutex_);  // allocated at the first activation
+  std::size_t head_ COSMIC_GUARDED_BY(mutex_) = 0;
+  std::size_t count_ COSMIC_GUARDED_BY(mutex_) = 0;
+  std::size_t bytes_ COSMIC_GUARDED_BY(mutex_) = 0;
+  bool active_ COSMIC_GUARDED_BY(mutex_) = false;
+  std::uint64_t generation_ COSMIC_GUARDED_BY(mutex_) = 0;
 
   std::atomic<SegmentAdapter*> adapter_{nullptr};
   std::atomic<std::uint64_t> current_generation_{0};

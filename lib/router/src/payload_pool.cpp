@@ -11,7 +11,7 @@ PayloadPool::PayloadPool(std::size_t max_buffers, std::size_t retained_bytes)
 }
 
 PayloadBuffer* PayloadPool::pop_free() noexcept {
-  std::lock_guard lock(mutex_);
+  PiLock lock(mutex_);
   if (free_ != nullptr) return std::exchange(free_, free_->next_free_);
   if (all_.size() >= max_buffers_) return nullptr;
   auto* fresh = new (std::nothrow) PayloadBuffer();
@@ -21,7 +21,7 @@ PayloadBuffer* PayloadPool::pop_free() noexcept {
 }
 
 void PayloadPool::push_free(PayloadBuffer* buffer) noexcept {
-  std::lock_guard lock(mutex_);
+  PiLock lock(mutex_);
   buffer->next_free_ = free_;
   free_ = buffer;
 }

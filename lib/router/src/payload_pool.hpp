@@ -10,11 +10,11 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
-#include <mutex>
 #include <span>
 #include <vector>
 
 #include "cosmic/pi_mutex.hpp"
+#include "cosmic/thread_annotations.hpp"
 
 namespace cosmic {
 
@@ -26,7 +26,7 @@ class PayloadBuffer {
   friend class PayloadPool;
   std::vector<std::uint8_t> bytes_;
   std::atomic<std::uint32_t> references_{0};
-  PayloadBuffer* next_free_ = nullptr;
+  PayloadBuffer* next_free_ = nullptr;  // the pool's free list (under PayloadPool::mutex_)
 };
 
 class PayloadPool {
@@ -44,14 +44,14 @@ class PayloadPool {
   void release(PayloadBuffer* buffer) noexcept;
 
  private:
-  PayloadBuffer* pop_free() noexcept;
-  void push_free(PayloadBuffer* buffer) noexcept;
+  PayloadBuffer* pop_free() noexcept COSMIC_EXCLUDES(mutex_);
+  void push_free(PayloadBuffer* buffer) noexcept COSMIC_EXCLUDES(mutex_);
 
   const std::size_t max_buffers_;
   const std::size_t retained_bytes_;
   PiMutex mutex_;
-  PayloadBuffer* free_ = nullptr;
-  std::vector<std::unique_ptr<PayloadBuffer>> all_;  // ownership; grows up to max_buffers_
+  PayloadBuffer* free_ COSMIC_GUARDED_BY(mutex_) = nullptr;
+  std::vector<std::unique_ptr<PayloadBuffer>> all_ COSMIC_GUARDED_BY(mutex_);  // ownership; grows up to max_buffers_
 };
 
 }  // namespace cosmic

@@ -54,7 +54,7 @@ Router::Router(GatewayIdentity self, std::size_t segment_capacity, RouterLimits 
                                           kRetainedPayloadBytes)) {
   lane_context_.reset(new LaneContext{
       clock_, limits_.residence_bound.count(), *pool_, progress_, [this](const std::vector<std::string>& problems) {
-        std::lock_guard lock(problems_mutex_);
+        LockGuard lock(problems_mutex_);
         thread_problems_.insert(thread_problems_.end(), problems.begin(), problems.end());
       }});
   const std::size_t depth[kClassCount] = {limits_.hrt_queue, limits_.srt_queue, limits_.nrt_queue};
@@ -88,7 +88,7 @@ void Router::set_segment(std::size_t index, std::string name, SegmentAdapter* ad
 }
 
 void Router::apply(std::vector<Route> routes) {
-  std::lock_guard serial(apply_mutex_);
+  LockGuard serial(apply_mutex_);
   const std::shared_ptr<const Table> current = load_table();
   auto next = std::make_shared<Table>();
   next->channels.reserve(routes.size());
@@ -112,13 +112,13 @@ void Router::apply(std::vector<Route> routes) {
   // Readers holding the old snapshot keep it alive until they let go (their last event of it).
   std::shared_ptr<const Table> retired;
   {
-    std::lock_guard lock(table_mutex_);
+    PiLock lock(table_mutex_);
     retired = std::exchange(table_, std::move(next));
   }
 }
 
 std::shared_ptr<const Router::Table> Router::load_table() const {
-  std::lock_guard lock(table_mutex_);
+  PiLock lock(table_mutex_);
   return table_;
 }
 
@@ -244,7 +244,7 @@ void Router::set_residence_bound(Nanos bound) {
 }
 
 std::vector<std::string> Router::take_thread_problems() {
-  std::lock_guard lock(problems_mutex_);
+  LockGuard lock(problems_mutex_);
   return std::exchange(thread_problems_, {});
 }
 

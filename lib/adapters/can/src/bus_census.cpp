@@ -20,7 +20,7 @@ UnexplainedFrames identifier_of(std::uint32_t key) {
 }  // namespace
 
 void BusCensus::count(canid_t can_id, Nanos now) {
-  std::lock_guard lock(mutex_);
+  LockGuard lock(mutex_);
   const std::uint32_t key = key_of(can_id);
   auto it = tallies_.find(key);
   if (it == tallies_.end()) {
@@ -45,7 +45,7 @@ void BusCensus::count(canid_t can_id, Nanos now) {
 }
 
 std::vector<UnexplainedFrames> BusCensus::snapshot(Nanos now) const {
-  std::lock_guard lock(mutex_);
+  LockGuard lock(mutex_);
   std::vector<UnexplainedFrames> out;
   out.reserve(tallies_.size());
   for (const auto& [key, t] : tallies_) {
@@ -60,12 +60,12 @@ std::vector<UnexplainedFrames> BusCensus::snapshot(Nanos now) const {
 }
 
 std::uint64_t BusCensus::others() const {
-  std::lock_guard lock(mutex_);
+  LockGuard lock(mutex_);
   return others_;
 }
 
 void BusCensus::clear() {
-  std::lock_guard lock(mutex_);
+  LockGuard lock(mutex_);
   tallies_.clear();
   others_ = 0;
 }

@@ -12,10 +12,11 @@
 
 #include <cstdint>
 #include <map>
-#include <mutex>
 #include <vector>
 
+#include "cosmic/mutex.hpp"
 #include "cosmic/segment_adapter.hpp"
+#include "cosmic/thread_annotations.hpp"
 #include "cosmic/units.hpp"
 
 namespace cosmic::can_census {
@@ -41,9 +42,9 @@ class BusCensus {
     Nanos last_seen{0};
     double rate_hz = 0;  // of the last full window
   };
-  mutable std::mutex mutex_;
-  std::map<std::uint32_t, Tally> tallies_;  // by arbitration key
-  std::uint64_t others_ = 0;
+  mutable Mutex mutex_;
+  std::map<std::uint32_t, Tally> tallies_ COSMIC_GUARDED_BY(mutex_);  // by arbitration key
+  std::uint64_t others_ COSMIC_GUARDED_BY(mutex_) = 0;
 };
 
 }  // namespace cosmic::can_census

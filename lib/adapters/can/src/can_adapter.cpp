@@ -48,7 +48,7 @@ void CanAdapter::stop() {
   if (thread_.joinable()) thread_.join();
   close_socket();
   {
-    std::lock_guard lock(io_mutex_);
+    LockGuard lock(io_mutex_);
     backlog_.clear();
     answers_.clear();
     pending_requests_.clear();
@@ -63,7 +63,7 @@ void CanAdapter::stop() {
   sink_ = nullptr;
   started_ = false;
   link_up_ = false;
-  std::lock_guard lock(health_mutex_);
+  LockGuard lock(health_mutex_);
   link_ = Link::unknown;
   link_detail_ = "stopped";
   controller_ = Controller::ok;
@@ -149,7 +149,7 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
     table->filters.assign(1, can_filter{0, 0});  // too many: every frame, filtered in user space
   }
 
-  std::lock_guard lock(io_mutex_);
+  LockGuard lock(io_mutex_);
   if (sock_ >= 0 && ::setsockopt(sock_, SOL_CAN_RAW, CAN_RAW_FILTER, table->filters.data(),
                                  static_cast<socklen_t>(table->filters.size() * sizeof(can_filter))) != 0) {
     // The kernel keeps the old filters, so the old table stays: the whole segment failed.
@@ -164,7 +164,7 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
     it = bound ? std::next(it) : tx_sequence_.erase(it);
   }
   // FAMOUSO nodes ask once and wait: requests for subjects bound only now are answered now.
-  std::erase_if(pending_requests_, [&](const can_binding::GetEtagRequest& r) {
+  std::erase_if(pending_requests_, [&](const can_binding::GetEtagRequest& r) COSMIC_REQUIRES(io_mutex_) {
     const auto found = table->etag_of.find(r.subject);
     if (found == table->etag_of.end()) return false;
     queue_supply_etag(r.requester, found->second, r.subject, *table);
@@ -197,7 +197,7 @@ std::optional<std::string> CanAdapter::bind_native(const ChannelBinding& b, Tabl
 void CanAdapter::refresh_rx_table() {
   const std::uint64_t generation = generation_.load(std::memory_order_acquire);
   if (generation != rx_generation_) {
-    std::lock_guard lock(io_mutex_);
+    LockGuard lock(io_mutex_);
     rx_table_ = table_;
     rx_generation_ = generation;
   }
@@ -233,7 +233,7 @@ void CanAdapter::set_link(Link link, std::string detail) {
   bool went_down = false;
   bool came_up = false;
   {
-    std::lock_guard lock(health_mutex_);
+    LockGuard lock(health_mutex_);
     went_down = link != Link::up && link_ == Link::up;
     came_up = link == Link::up && link_ != Link::up;
     link_ = link;
@@ -243,7 +243,7 @@ void CanAdapter::set_link(Link link, std::string detail) {
   }
   link_up_ = link == Link::up;
   if (went_down || (link != Link::up && backlog_size_ > 0)) {
-    std::lock_guard lock(io_mutex_);
+    LockGuard lock(io_mutex_);
     drop_backlog("interface not up");
   }
   if (came_up || went_down) {
@@ -251,19 +251,19 @@ void CanAdapter::set_link(Link link, std::string detail) {
     afp_.clear();
   }
   if (came_up) {
-    std::lock_guard lock(io_mutex_);
+    LockGuard lock(io_mutex_);
     send_error_logged_ = false;
   }
 }
 
 void CanAdapter::set_controller(Controller state) {
-  std::lock_guard lock(health_mutex_);
+  LockGuard lock(health_mutex_);
   controller_ = state;
   update_health();
 }
 
 HealthReport CanAdapter::health() const {
-  std::lock_guard lock(health_mutex_);
+  LockGuard lock(health_mutex_);
   return health_;
 }
 

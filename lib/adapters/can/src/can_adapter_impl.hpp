@@ -25,7 +25,6 @@
 #include <cstdio>
 #include <cstring>
 #include <deque>
-#include <mutex>
 #include <string>
 #include <thread>
 #include <unordered_map>
@@ -35,6 +34,8 @@
 #include "binding_guard.hpp"
 #include "can_binding.hpp"
 #include "cosmic/arrival_clock.hpp"
+#include "cosmic/mutex.hpp"
+#include "cosmic/thread_annotations.hpp"
 #include "cosmic/thread_policy.hpp"
 #include "cosmic/can_fragment.hpp"
 #include "cosmic/can_timing.hpp"
@@ -152,8 +153,10 @@ class CanAdapter final : public SegmentAdapter {
   void run();
   void check_link();
   bool open_socket(int ifindex);
-  void close_socket();
+  void close_socket() COSMIC_EXCLUDES(io_mutex_);
   void read_frames();
+  // sock_ as the receive thread sees it without io_mutex_: it is the only thread that changes sock_.
+  int receive_socket() const COSMIC_NO_THREAD_SAFETY_ANALYSIS { return sock_; }
   // The census socket (bus_census.hpp): every frame on the bus, counted when nothing explains it.
   void open_census_socket(int ifindex);
   void read_census();
@@ -163,9 +166,9 @@ class CanAdapter final : public SegmentAdapter {
   void handle_frame(const canfd_frame& frame, bool fd_frame, Nanos now);
   void handle_error_frame(const canfd_frame& frame);
   void handle_get_etag(const canfd_frame& frame, std::size_t len, Nanos now);
-  void answer_request(const can_binding::GetEtagRequest& request, const Table& table);  // io_mutex_ held
-  void defer_request(const can_binding::GetEtagRequest& request);                      // io_mutex_ held
-  void serve_deferred_requests(Nanos now);
+  void answer_request(const can_binding::GetEtagRequest& request, const Table& table) COSMIC_REQUIRES(io_mutex_);
+  void defer_request(const can_binding::GetEtagRequest& request) COSMIC_REQUIRES(io_mutex_);
+  void serve_deferred_requests(Nanos now) COSMIC_EXCLUDES(io_mutex_);
   void reassembly_losses(ChannelId channel, std::optional<std::uint32_t> displaced, bool lost);
   void handle_famouso_protocol(const CanIdentifier& id, const canfd_frame& frame, std::size_t len, Nanos now);
   void handle_afp(const RxChannel& channel, const CanIdentifier& id, std::span<const std::uint8_t> data, Nanos now);
@@ -173,25 +176,29 @@ class CanAdapter final : public SegmentAdapter {
   void deliver(const RxChannel& channel, std::span<const std::uint8_t> payload, Nanos now);
   void deliver_native(const can_native::RxChannel& channel, std::span<const std::uint8_t> data, bool fd_frame, Nanos now);
   void problem(ChannelId channel, InboundProblem what);
-  void drain_backlog();
-  void refresh_rx_table();  // the receive thread's snapshot of the bindings (rx_table_)
+  void drain_backlog() COSMIC_EXCLUDES(io_mutex_);
+  void refresh_rx_table() COSMIC_EXCLUDES(io_mutex_);  // the receive thread's snapshot of the bindings (rx_table_)
   // configure(): a native channel's binding into `table`; the reason when it cannot be carried.
   std::optional<std::string> bind_native(const ChannelBinding& b, Table& table) const;
-  SendStatus send_frame(const canfd_frame& frame);  // io_mutex_ held
+  SendStatus send_frame(const canfd_frame& frame) COSMIC_REQUIRES(io_mutex_);
 
   // --- health
   void set_link(Link link, std::string detail);
   void set_controller(Controller state);
-  void update_health();  // health_mutex_ held
+  void update_health() COSMIC_REQUIRES(health_mutex_);
 
-  // --- send side (io_mutex_ held)
-  WriteResult submit(const canfd_frame& frame, bool fd);
-  void queue_answer(std::uint32_t can_id, std::span<const std::uint8_t> data);
-  void queue_supply_etag(std::uint8_t requester, std::uint16_t etag, std::uint64_t subject, const Table& table);
-  void drain_answers();
-  SendStatus send_afp(const TxChannel& channel, std::span<const std::uint8_t> payload, std::unique_lock<std::mutex>& lock);
+  // --- send side
+  WriteResult submit(const canfd_frame& frame, bool fd) COSMIC_REQUIRES(io_mutex_);
+  void queue_answer(std::uint32_t can_id, std::span<const std::uint8_t> data) COSMIC_REQUIRES(io_mutex_);
+  void queue_supply_etag(std::uint8_t requester, std::uint16_t etag, std::uint64_t subject, const Table& table)
+      COSMIC_REQUIRES(io_mutex_);
+  void drain_answers() COSMIC_EXCLUDES(io_mutex_);
+  // `lock` holds io_mutex_; it is given up between fragments. Escape: the analysis cannot tell
+  // that the lock handed in by reference is io_mutex_'s (callers are still checked for it).
+  SendStatus send_afp(const TxChannel& channel, std::span<const std::uint8_t> payload, UniqueLock& lock)
+      COSMIC_REQUIRES(io_mutex_) COSMIC_NO_THREAD_SAFETY_ANALYSIS;
   void wake();
-  void drop_backlog(const char* why);
+  void drop_backlog(const char* why) COSMIC_REQUIRES(io_mutex_);
 
   const SegmentSpec segment_;
   Logger& log_;
@@ -218,33 +225,34 @@ class CanAdapter final : public SegmentAdapter {
 
   // Socket and send side. The receive thread opens and closes the socket (holding io_mutex_);
   // send(), configure() and the receive thread write through it holding io_mutex_.
-  mutable std::mutex io_mutex_;
-  int sock_ = -1;
+  mutable Mutex io_mutex_;
+  int sock_ COSMIC_GUARDED_BY(io_mutex_) = -1;  // the receive thread reads it unlocked: receive_socket()
   int census_sock_ = -1;  // only the receive thread opens, reads and closes it
   bool census_error_logged_ = false;
-  std::shared_ptr<const Table> table_;
+  std::shared_ptr<const Table> table_ COSMIC_GUARDED_BY(io_mutex_);
   std::atomic<std::uint64_t> generation_{0};
-  FrameBacklog backlog_;
-  ProtocolQueue answers_;  // binding and CCP answers: after the backlog, paced
-  BindingRateLimit request_limit_;
-  std::vector<can_binding::GetEtagRequest> pending_requests_;  // FAMOUSO: unknown subjects, answered on bind
+  FrameBacklog backlog_ COSMIC_GUARDED_BY(io_mutex_);
+  ProtocolQueue answers_ COSMIC_GUARDED_BY(io_mutex_);  // binding and CCP answers: after the backlog, paced
+  BindingRateLimit request_limit_ COSMIC_GUARDED_BY(io_mutex_);
+  // FAMOUSO: unknown subjects, answered on bind
+  std::vector<can_binding::GetEtagRequest> pending_requests_ COSMIC_GUARDED_BY(io_mutex_);
   // Requests over the rate limit, answered when the node's budget allows: a client that asks
   // once (FAMOUSO's) must not lose its binding to a burst at start-up. One entry per (node,
   // subject), bounded, so a flood costs a counter and at most one later answer.
-  std::deque<can_binding::GetEtagRequest> deferred_requests_;
+  std::deque<can_binding::GetEtagRequest> deferred_requests_ COSMIC_GUARDED_BY(io_mutex_);
   std::atomic<std::uint64_t> refused_requests_{0};  // over the rate limit (deferred or dropped)
-  std::unordered_map<std::uint16_t, std::uint8_t> tx_sequence_;
-  bool wait_pollout_ = false;      // backlog waits for POLLOUT (EAGAIN)
-  std::optional<Nanos> retry_at_;  // backlog waits for the qdisc (ENOBUFS)
-  bool send_error_logged_ = false;
+  std::unordered_map<std::uint16_t, std::uint8_t> tx_sequence_ COSMIC_GUARDED_BY(io_mutex_);
+  bool wait_pollout_ COSMIC_GUARDED_BY(io_mutex_) = false;      // backlog waits for POLLOUT (EAGAIN)
+  std::optional<Nanos> retry_at_ COSMIC_GUARDED_BY(io_mutex_);  // backlog waits for the qdisc (ENOBUFS)
+  bool send_error_logged_ COSMIC_GUARDED_BY(io_mutex_) = false;
   std::atomic<bool> link_up_{false};
 
   // Health.
-  mutable std::mutex health_mutex_;
-  Link link_ = Link::unknown;
-  std::string link_detail_ = "not started";
-  Controller controller_ = Controller::ok;
-  HealthReport health_{SegmentHealth::down, "not started"};
+  mutable Mutex health_mutex_;
+  Link link_ COSMIC_GUARDED_BY(health_mutex_) = Link::unknown;
+  std::string link_detail_ COSMIC_GUARDED_BY(health_mutex_) = "not started";
+  Controller controller_ COSMIC_GUARDED_BY(health_mutex_) = Controller::ok;
+  HealthReport health_ COSMIC_GUARDED_BY(health_mutex_){SegmentHealth::down, "not started"};
 
   // Statistics.
   std::atomic<std::uint64_t> received_{0};

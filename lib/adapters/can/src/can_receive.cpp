@@ -95,7 +95,7 @@ void CanAdapter::handle_famouso_protocol(const CanIdentifier& id, const canfd_fr
     if (table.tx_node) ccp_->reserve(*table.tx_node);
     const auto answer = ccp_->on_request(frame.can_id & CAN_EFF_MASK, now);
     if (answer) {
-      std::lock_guard lock(io_mutex_);
+      LockGuard lock(io_mutex_);
       queue_answer(answer->can_id, answer->data);
     } else if (ccp_->exhausted()) {
       problem(kNoChannel, InboundProblem::decode_error);
@@ -171,7 +171,7 @@ void CanAdapter::handle_get_etag(const canfd_frame& frame, std::size_t len, Nano
     return;
   }
   const Table& table = *rx_table_;
-  std::lock_guard lock(io_mutex_);
+  LockGuard lock(io_mutex_);
   if (!request_limit_.admit(request->requester, now)) {
     ++receive_errors_;
     defer_request(*request);
@@ -196,10 +196,10 @@ void CanAdapter::defer_request(const can_binding::GetEtagRequest& request) {
 }
 
 void CanAdapter::serve_deferred_requests(Nanos now) {
-  std::lock_guard lock(io_mutex_);
+  LockGuard lock(io_mutex_);
   if (deferred_requests_.empty()) return;
   const Table& table = *rx_table_;
-  std::erase_if(deferred_requests_, [&](const can_binding::GetEtagRequest& r) {
+  std::erase_if(deferred_requests_, [&](const can_binding::GetEtagRequest& r) COSMIC_REQUIRES(io_mutex_) {
     if (!request_limit_.admit(r.requester, now)) return false;
     answer_request(r, table);
     return true;
@@ -246,7 +246,7 @@ void CanAdapter::queue_answer(std::uint32_t can_id, std::span<const std::uint8_t
 
 // One answer per call, only when no real-time frame waits in the backlog.
 void CanAdapter::drain_answers() {
-  std::lock_guard lock(io_mutex_);
+  LockGuard lock(io_mutex_);
   if (sock_ < 0 || !backlog_.empty()) return;
   const Nanos now = steady_now();
   const can_frame* answer = answers_.due(now);
@@ -270,7 +270,7 @@ void CanAdapter::handle_protocol_timeouts(Nanos now) {
   afp_.expire(now, [this](std::uint32_t source) { reassembly_losses(kNoChannel, source, false); });
   if (!ccp_) return;
   if (const auto reset = ccp_->expire(now)) {
-    std::lock_guard lock(io_mutex_);
+    LockGuard lock(io_mutex_);
     queue_answer(reset->can_id, reset->data);
   }
 }

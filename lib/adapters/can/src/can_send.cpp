@@ -53,7 +53,7 @@ CanAdapter::WriteResult CanAdapter::submit(const canfd_frame& frame, bool fd) {
 }
 
 void CanAdapter::drain_backlog() {
-  std::lock_guard lock(io_mutex_);
+  LockGuard lock(io_mutex_);
   if (backlog_.empty() || sock_ < 0) return;
   if (retry_at_ && steady_now() < *retry_at_) return;
   retry_at_.reset();
@@ -88,7 +88,7 @@ void CanAdapter::drain_backlog() {
 
 SendStatus CanAdapter::send(const OutboundEvent& event) {
   try {
-    std::unique_lock lock(io_mutex_);
+    UniqueLock lock(io_mutex_);
     const std::shared_ptr<const Table> table = table_;  // kept alive while the lock is given up
     const auto it = table->tx.find(event.channel);
     if (it == table->tx.end() || !started_ || !link_up_ || sock_ < 0 || event.payload.size() > it->second.payload) {
@@ -155,7 +155,7 @@ SendStatus CanAdapter::send_frame(const canfd_frame& frame) {
 
 // FAMOUSO: an event of more than 8 bytes as AFP fragments with the identifier's fragment flag.
 SendStatus CanAdapter::send_afp(const TxChannel& channel, std::span<const std::uint8_t> payload,
-                                std::unique_lock<std::mutex>& lock) {
+                                UniqueLock& lock) {
   if (!backlog_.empty() && !backlog_.room_for(famouso::afp_fragment_count(payload.size()))) {
     ++send_errors_;
     return SendStatus::queue_full;

@@ -9,7 +9,7 @@ void CanAdapter::close_socket() {
     ::close(census_sock_);
     census_sock_ = -1;
   }
-  std::lock_guard lock(io_mutex_);
+  LockGuard lock(io_mutex_);
   if (sock_ < 0) return;
   ::close(sock_);
   sock_ = -1;
@@ -48,7 +48,7 @@ bool CanAdapter::open_socket(int ifindex) {
   for (;;) {
     std::vector<can_filter> filters;
     {
-      std::lock_guard lock(io_mutex_);
+      LockGuard lock(io_mutex_);
       generation = generation_.load();
       filters = table_->filters;
     }
@@ -57,14 +57,14 @@ bool CanAdapter::open_socket(int ifindex) {
                      static_cast<socklen_t>(filters.size() * sizeof(can_filter))) != 0) {
       return fail("CAN_RAW_FILTER");
     }
-    std::lock_guard lock(io_mutex_);
+    LockGuard lock(io_mutex_);
     if (generation == generation_.load()) break;
   }
   sockaddr_can addr{};
   addr.can_family = AF_CAN;
   addr.can_ifindex = ifindex;
   if (::bind(s, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0) return fail("bind");
-  std::lock_guard lock(io_mutex_);
+  LockGuard lock(io_mutex_);
   if (generation != generation_.load() &&
       ::setsockopt(s, SOL_CAN_RAW, CAN_RAW_FILTER, table_->filters.data(),
                    static_cast<socklen_t>(table_->filters.size() * sizeof(can_filter))) != 0) {
@@ -134,7 +134,7 @@ void CanAdapter::check_link() {
   const short flags = ifr.ifr_flags;
   bool have_socket = false;
   {
-    std::lock_guard lock(io_mutex_);
+    LockGuard lock(io_mutex_);
     have_socket = sock_ >= 0 && bound_ifindex_ == ifindex;
   }
   if (!have_socket && !open_socket(ifindex)) return;  // open_socket set the health
@@ -178,7 +178,7 @@ void CanAdapter::run() {
     if (const auto d = afp_.next_deadline()) deadline = std::min(deadline, *d + Nanos(1));
     if (const auto d = ccp_ ? ccp_->deadline() : std::nullopt) deadline = std::min(deadline, *d);
     {
-      std::lock_guard lock(io_mutex_);
+      LockGuard lock(io_mutex_);
       if (const auto d = answers_.deadline(); d && backlog_.empty()) deadline = std::min(deadline, *d);
       if (!deferred_requests_.empty()) deadline = std::min(deadline, now + kDeferredRequestRetry);
       if (sock_ >= 0) {
@@ -211,7 +211,7 @@ void CanAdapter::run() {
 // Reads what the socket holds in batches of kReadBatch frames per system call (recvmmsg), each
 // with its kernel arrival time (SO_TIMESTAMPNS) and the socket's drop count (SO_RXQ_OVFL).
 void CanAdapter::read_frames() {
-  const int s = sock_;  // only this thread changes sock_
+  const int s = receive_socket();
   constexpr std::size_t kControlBytes = CMSG_SPACE(sizeof(timespec)) + CMSG_SPACE(sizeof(std::uint32_t));
   struct Slot {
     canfd_frame frame;
@@ -220,7 +220,7 @@ void CanAdapter::read_frames() {
   };
   std::array<Slot, kReadBatch> slots;
   std::array<mmsghdr, kReadBatch> messages;
-  for (int round = 0; round < kFramesPerWakeup / static_cast<int>(kReadBatch) && s >= 0 && sock_ == s; ++round) {
+  for (int round = 0; round < kFramesPerWakeup / static_cast<int>(kReadBatch) && s >= 0 && receive_socket() == s; ++round) {
     for (std::size_t i = 0; i < kReadBatch; ++i) {
       slots[i].iov = iovec{&slots[i].frame, sizeof(canfd_frame)};
       messages[i] = mmsghdr{};

@@ -9,7 +9,6 @@ namespace {
 // Fragments whose header is 1 (2) bytes carry 7 (6) event bytes; FAMOUSO sizes an event's
 // fragments from the last one backwards: 32 one-byte-header fragments, then up to 4064 more.
 constexpr std::uint32_t kShortHeaderFragments = 32;
-constexpr std::uint32_t kTwoByteHeaderFragments = 4096 - kShortHeaderFragments;
 
 std::size_t payload_of(std::uint32_t remaining) { return kAfpMtu - afp_header_length(remaining); }
 

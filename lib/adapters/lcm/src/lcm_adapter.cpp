@@ -18,6 +18,8 @@
 
 #include "cosmic/adapter_counters.hpp"
 #include "cosmic/health_cell.hpp"
+#include "cosmic/mutex.hpp"
+#include "cosmic/thread_annotations.hpp"
 #include "cosmic/arrival_clock.hpp"
 #include "cosmic/lcm_wire.hpp"
 #include "cosmic/thread_policy.hpp"
@@ -36,10 +38,8 @@
 #include <cerrno>
 #include <cstring>
 #include <exception>
-#include <mutex>
 #include <optional>
 #include <set>
-#include <shared_mutex>
 #include <string>
 #include <string_view>
 #include <thread>
@@ -104,7 +104,7 @@ class EchoFilter {
  public:
   void remember(ChannelId channel, std::span<const std::uint8_t> bytes, std::int64_t now) {
     const std::uint64_t hash = hash_of(bytes);
-    std::lock_guard lock(mutex_);
+    LockGuard lock(mutex_);
     ring_[next_] = Print{channel, static_cast<std::uint32_t>(bytes.size()), hash, now, true};
     next_ = (next_ + 1) % ring_.size();
     last_remembered_.store(now, std::memory_order_release);
@@ -115,7 +115,7 @@ class EchoFilter {
     if (now - last_remembered_.load(std::memory_order_acquire) > kWindowNs) return false;
     const std::uint64_t hash = hash_of(bytes);
     const auto size = static_cast<std::uint32_t>(bytes.size());
-    std::lock_guard lock(mutex_);
+    LockGuard lock(mutex_);
     for (Print& p : ring_) {
       if (p.live && p.channel == channel && p.size == size && p.hash == hash &&
           now - p.sent_ns <= kWindowNs) {
@@ -141,9 +141,9 @@ class EchoFilter {
         std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
   }
 
-  std::mutex mutex_;
-  std::array<Print, 256> ring_{};
-  std::size_t next_ = 0;
+  Mutex mutex_;
+  std::array<Print, 256> ring_ COSMIC_GUARDED_BY(mutex_){};
+  std::size_t next_ COSMIC_GUARDED_BY(mutex_) = 0;
   std::atomic<std::int64_t> last_remembered_{INT64_MIN / 2};
 };
 
@@ -158,7 +158,7 @@ class LcmAdapter final : public SegmentAdapter {
   LcmAdapter& operator=(const LcmAdapter&) = delete;
 
   Status start(EventSink& sink) override {
-    std::lock_guard control(control_mutex_);
+    LockGuard control(control_mutex_);
     if (thread_.joinable()) return Status::failure("LCM segment " + segment_.name + " already started");
     lcm_t* lcm = lcm_create(segment_.lcm.url.c_str());
     if (lcm == nullptr) {
@@ -191,7 +191,7 @@ class LcmAdapter final : public SegmentAdapter {
       return Status::failure(why);
     }
     {
-      std::unique_lock table(table_mutex_);
+      LockGuard table(table_mutex_);
       lcm_ = lcm;
       sink_ = &sink;
     }
@@ -204,7 +204,7 @@ class LcmAdapter final : public SegmentAdapter {
       running_.store(false);
       ::close(std::exchange(stop_fd_, -1));
       {
-        std::unique_lock table(table_mutex_);
+        LockGuard table(table_mutex_);
         lcm_ = nullptr;
         sink_ = nullptr;
       }
@@ -225,7 +225,7 @@ class LcmAdapter final : public SegmentAdapter {
   }
 
   Status configure(std::span<const ChannelBinding> bindings) override {
-    std::lock_guard control(control_mutex_);
+    LockGuard control(control_mutex_);
     // Every problem here concerns one channel (Status::refused); LCM has no failure of the whole
     // segment once started.
     Status status;
@@ -275,7 +275,7 @@ class LcmAdapter final : public SegmentAdapter {
     // 2. Swap the table (brief exclusive lock; channels kept keep flowing through it).
     {
       std::unordered_map<std::string, Channel*, StringHash, std::equal_to<>> by_name;
-      std::unique_lock table(table_mutex_);
+      LockGuard table(table_mutex_);
       channels_ = std::move(wanted);
       for (auto& [id, channel] : channels_) by_name.emplace(channel.name, &channel);
       by_name_ = std::move(by_name);
@@ -306,7 +306,7 @@ class LcmAdapter final : public SegmentAdapter {
   }
 
   SendStatus send(const OutboundEvent& event) override {
-    std::shared_lock table(table_mutex_);
+    SharedLock table(table_mutex_);
     const auto it = channels_.find(event.channel);
     if (lcm_ == nullptr || it == channels_.end() || !it->second.tx) {
       counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
@@ -323,7 +323,7 @@ class LcmAdapter final : public SegmentAdapter {
     } else {
       if (event.payload.size() > static_cast<std::size_t>(INT32_MAX) - kLcmEnvelopeHeaderSize)
         return send_failed(channel, "payload too large");
-      std::lock_guard encode(encode_mutex_);
+      LockGuard encode(encode_mutex_);
       envelope& e = tx_envelope_;
       e.subject = static_cast<std::int64_t>(event.header.subject);
       // The header goes out as given, as on DDS: the router stamps what this gateway originates
@@ -357,7 +357,7 @@ class LcmAdapter final : public SegmentAdapter {
   AdapterStatistics statistics() const override { return counters_.snapshot(); }
 
   void stop() override {
-    std::lock_guard control(control_mutex_);
+    LockGuard control(control_mutex_);
     if (!thread_.joinable()) return;
     running_.store(false, std::memory_order_release);
     const std::uint64_t one = 1;
@@ -366,7 +366,7 @@ class LcmAdapter final : public SegmentAdapter {
     ::close(std::exchange(stop_fd_, -1));
     lcm_t* lcm = nullptr;
     {
-      std::unique_lock table(table_mutex_);  // waits for sends in flight
+      LockGuard table(table_mutex_);  // waits for sends in flight
       lcm = std::exchange(lcm_, nullptr);
       sink_ = nullptr;
     }
@@ -384,19 +384,18 @@ class LcmAdapter final : public SegmentAdapter {
     lcm_subscription_t* handle = nullptr;
   };
 
-  lcm_t* current_lcm() {
-    std::shared_lock table(table_mutex_);
+  lcm_t* current_lcm() COSMIC_EXCLUDES(table_mutex_) {
+    SharedLock table(table_mutex_);
     return lcm_;
   }
 
-  // Subscribes every rx channel of the table that has no subscription yet (control thread,
-  // control_mutex_ held). Returns the errors, empty if none.
-  // Subscribes every receiving channel of the table that has no subscription yet; returns those
-  // liblcm refused (id, LCM channel name), which keep the segment degraded until they succeed.
-  std::vector<std::pair<ChannelId, std::string>> sync_subscriptions(lcm_t* lcm) {
+  // Subscribes every receiving channel of the table that has no subscription yet (control
+  // thread, control_mutex_ held); returns those liblcm refused (id, LCM channel name), which keep
+  // the segment degraded until they succeed.
+  std::vector<std::pair<ChannelId, std::string>> sync_subscriptions(lcm_t* lcm) COSMIC_REQUIRES(control_mutex_) {
     std::vector<std::pair<ChannelId, std::string>> missing;
     {
-      std::shared_lock table(table_mutex_);
+      SharedLock table(table_mutex_);
       for (const auto& [id, channel] : channels_)
         if (channel.rx && !subscriptions_.contains(id)) missing.emplace_back(id, channel.name);
     }
@@ -472,7 +471,7 @@ class LcmAdapter final : public SegmentAdapter {
     // liblcm's reader thread stamps each datagram with the kernel's arrival time (SO_TIMESTAMP,
     // microseconds, realtime clock): residence starts there, not when this thread got to it.
     const Nanos received_at = steady_arrival_now(rbuf.recv_utime * 1000);
-    std::shared_lock table(table_mutex_);
+    SharedLock table(table_mutex_);
     const auto it = by_name_.find(std::string_view(channel_name));
     if (it == by_name_.end() || !it->second->rx || sink_ == nullptr) return;  // no longer bound
     const Channel& channel = *it->second;
@@ -529,22 +528,23 @@ class LcmAdapter final : public SegmentAdapter {
   const GatewayIdentity self_;
   Logger& log_;
 
-  std::mutex control_mutex_;
-  std::unordered_map<ChannelId, Subscription> subscriptions_;  // control thread
-  bool subscribe_failed_ = false;                              // control thread
-  std::thread thread_;
+  Mutex control_mutex_;
+  std::unordered_map<ChannelId, Subscription> subscriptions_ COSMIC_GUARDED_BY(control_mutex_);
+  bool subscribe_failed_ COSMIC_GUARDED_BY(control_mutex_) = false;
+  std::thread thread_ COSMIC_GUARDED_BY(control_mutex_);
   std::atomic<bool> running_{false};
-  int stop_fd_ = -1;  // eventfd: stop() wakes the receive loop; owned by start()/stop()
+  // eventfd: stop() wakes the receive loop; owned by start()/stop()
+  int stop_fd_ COSMIC_GUARDED_BY(control_mutex_) = -1;
 
-  mutable std::shared_mutex table_mutex_;
-  lcm_t* lcm_ = nullptr;
-  EventSink* sink_ = nullptr;
-  std::unordered_map<ChannelId, Channel> channels_;
-  std::unordered_map<std::string, Channel*, StringHash, std::equal_to<>> by_name_;
+  mutable SharedMutex table_mutex_;
+  lcm_t* lcm_ COSMIC_GUARDED_BY(table_mutex_) = nullptr;
+  EventSink* sink_ COSMIC_GUARDED_BY(table_mutex_) = nullptr;
+  std::unordered_map<ChannelId, Channel> channels_ COSMIC_GUARDED_BY(table_mutex_);
+  std::unordered_map<std::string, Channel*, StringHash, std::equal_to<>> by_name_ COSMIC_GUARDED_BY(table_mutex_);
 
-  std::mutex encode_mutex_;
-  envelope tx_envelope_{};
-  std::vector<std::uint8_t> encode_buffer_ = std::vector<std::uint8_t>(4096);
+  Mutex encode_mutex_;
+  envelope tx_envelope_ COSMIC_GUARDED_BY(encode_mutex_){};
+  std::vector<std::uint8_t> encode_buffer_ COSMIC_GUARDED_BY(encode_mutex_) = std::vector<std::uint8_t>(4096);
 
   EchoFilter echo_;
 

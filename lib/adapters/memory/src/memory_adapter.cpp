@@ -7,13 +7,13 @@
 namespace cosmic {
 
 Status MemoryAdapter::start(EventSink& sink) {
-  std::lock_guard lock(mutex_);
+  LockGuard lock(mutex_);
   sink_ = &sink;
   return Status::success();
 }
 
 Status MemoryAdapter::configure(std::span<const ChannelBinding> bindings) {
-  std::lock_guard lock(mutex_);
+  LockGuard lock(mutex_);
   if (!fail_configure_.empty()) return Status::failure(fail_configure_);
   Status status;
   bindings_.clear();
@@ -31,7 +31,7 @@ Status MemoryAdapter::configure(std::span<const ChannelBinding> bindings) {
 }
 
 void MemoryAdapter::refuse_channel(const std::string& name, std::string reason) {
-  std::lock_guard lock(mutex_);
+  LockGuard lock(mutex_);
   if (reason.empty()) {
     refuse_.erase(name);
   } else {
@@ -40,7 +40,7 @@ void MemoryAdapter::refuse_channel(const std::string& name, std::string reason) 
 }
 
 void MemoryAdapter::fail_configure(std::string reason) {
-  std::lock_guard lock(mutex_);
+  LockGuard lock(mutex_);
   fail_configure_ = std::move(reason);
 }
 
@@ -50,8 +50,8 @@ const ChannelBinding* MemoryAdapter::find(const std::string& name) const {
 }
 
 SendStatus MemoryAdapter::send(const OutboundEvent& event) {
-  std::unique_lock lock(mutex_);
-  released_.wait(lock, [&] { return !held_; });
+  UniqueLock lock(mutex_);
+  while (held_) lock.wait(released_);
   const auto it = std::find_if(bindings_.begin(), bindings_.end(), [&](const auto& b) {
     return b.id == event.channel && b.role == HopRole::subscriber;
   });
@@ -70,7 +70,7 @@ bool MemoryAdapter::inject(const std::string& channel, std::vector<std::uint8_t>
   EventSink* sink = nullptr;
   ChannelId id = kNoChannel;
   {
-    std::lock_guard lock(mutex_);
+    LockGuard lock(mutex_);
     const ChannelBinding* binding = find(channel);
     sink = sink_;
     ++stats_.received;
@@ -92,7 +92,7 @@ void MemoryAdapter::inject_garbage(const std::string& channel) {
   EventSink* sink = nullptr;
   ChannelId id = kNoChannel;
   {
-    std::lock_guard lock(mutex_);
+    LockGuard lock(mutex_);
     sink = sink_;
     ++stats_.receive_errors;
     if (const ChannelBinding* binding = find(channel)) id = binding->id;
@@ -101,49 +101,51 @@ void MemoryAdapter::inject_garbage(const std::string& channel) {
 }
 
 std::vector<RecordedEvent> MemoryAdapter::sent() const {
-  std::lock_guard lock(mutex_);
+  LockGuard lock(mutex_);
   return sent_;
 }
 
 std::size_t MemoryAdapter::wait_sent(std::size_t count, std::chrono::milliseconds timeout) const {
-  std::unique_lock lock(mutex_);
-  sent_changed_.wait_for(lock, timeout, [&] { return sent_.size() >= count; });
+  UniqueLock lock(mutex_);
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (sent_.size() < count && lock.wait_until(sent_changed_, deadline) != std::cv_status::timeout) {
+  }
   return sent_.size();
 }
 
 HealthReport MemoryAdapter::health() const {
-  std::lock_guard lock(mutex_);
+  LockGuard lock(mutex_);
   return health_;
 }
 
 AdapterStatistics MemoryAdapter::statistics() const {
-  std::lock_guard lock(mutex_);
+  LockGuard lock(mutex_);
   return stats_;
 }
 
 void MemoryAdapter::stop() {
-  std::lock_guard lock(mutex_);
+  LockGuard lock(mutex_);
   sink_ = nullptr;
 }
 
 void MemoryAdapter::set_health(SegmentHealth state, std::string detail) {
-  std::lock_guard lock(mutex_);
+  LockGuard lock(mutex_);
   health_ = HealthReport{state, std::move(detail)};
 }
 
 void MemoryAdapter::hold_sends(bool hold) {
-  std::lock_guard lock(mutex_);
+  LockGuard lock(mutex_);
   held_ = hold;
   released_.notify_all();
 }
 
 void MemoryAdapter::set_congested(bool congested) {
-  std::lock_guard lock(mutex_);
+  LockGuard lock(mutex_);
   congested_ = congested;
 }
 
 std::vector<ChannelBinding> MemoryAdapter::bindings() const {
-  std::lock_guard lock(mutex_);
+  LockGuard lock(mutex_);
   return bindings_;
 }
 

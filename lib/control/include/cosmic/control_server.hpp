@@ -15,7 +15,6 @@
 #include <deque>
 #include <functional>
 #include <map>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -25,6 +24,8 @@
 #include <vector>
 
 #include "cosmic/control_protocol.hpp"
+#include "cosmic/mutex.hpp"
+#include "cosmic/thread_annotations.hpp"
 
 namespace cosmic {
 
@@ -72,7 +73,7 @@ class ControlServer {
   // Adds another descriptor to the loop (e.g. a signalfd); `on_ready` runs when it is readable.
   void watch(int fd, std::function<void()> on_ready);
   // Any thread: runs `task` on the control thread during run_for().
-  void post(std::function<void()> task);
+  void post(std::function<void()> task) COSMIC_EXCLUDES(posted_mutex_);
   // Jobs for the server's worker thread, one at a time in order: `work` there, then `done`
   // posted to the control thread. Jobs not started by close_all() are dropped.
   Offload offload();
@@ -109,10 +110,10 @@ class ControlServer {
   void deliver(int fd, std::uint64_t id, std::string line);
   void drop(int fd);
   void expire();
-  void run_posted();
+  void run_posted() COSMIC_EXCLUDES(posted_mutex_);
   void update_interest(int fd, const Client& client);
-  void work_loop();
-  void stop_worker();
+  void work_loop() COSMIC_EXCLUDES(jobs_mutex_);
+  void stop_worker() COSMIC_EXCLUDES(jobs_mutex_);
 
   ControlServerOptions options_;
   Handler handler_;
@@ -125,13 +126,13 @@ class ControlServer {
   std::uint64_t refused_at_fd_limit_ = 0;
   std::map<int, Client> clients_;
   std::map<int, std::function<void()>> watches_;
-  std::mutex posted_mutex_;
-  std::vector<std::function<void()>> posted_;
-  std::mutex jobs_mutex_;
+  Mutex posted_mutex_;
+  std::vector<std::function<void()>> posted_ COSMIC_GUARDED_BY(posted_mutex_);
+  Mutex jobs_mutex_;
   std::condition_variable jobs_ready_;
-  std::deque<std::pair<std::function<void()>, std::function<void()>>> jobs_;
-  bool stopping_ = false;
-  std::thread worker_;  // started by the first job
+  std::deque<std::pair<std::function<void()>, std::function<void()>>> jobs_ COSMIC_GUARDED_BY(jobs_mutex_);
+  bool stopping_ COSMIC_GUARDED_BY(jobs_mutex_) = false;
+  std::thread worker_ COSMIC_GUARDED_BY(jobs_mutex_);  // started by the first job
 };
 
 }  // namespace cosmic

@@ -3,29 +3,30 @@
 // that were set together. Starts down, "not started".
 #pragma once
 
-#include <mutex>
 #include <string>
 #include <utility>
 
+#include "cosmic/mutex.hpp"
 #include "cosmic/segment_adapter.hpp"
+#include "cosmic/thread_annotations.hpp"
 
 namespace cosmic {
 
 class HealthCell {
  public:
   HealthReport get() const {
-    std::lock_guard lock(mutex_);
+    LockGuard lock(mutex_);
     return report_;
   }
   void set(SegmentHealth state, std::string detail) {
-    std::lock_guard lock(mutex_);
+    LockGuard lock(mutex_);
     report_.state = state;
     report_.detail = std::move(detail);
   }
 
  private:
-  mutable std::mutex mutex_;
-  HealthReport report_{SegmentHealth::down, "not started"};
+  mutable Mutex mutex_;
+  HealthReport report_ COSMIC_GUARDED_BY(mutex_){SegmentHealth::down, "not started"};
 };
 
 }  // namespace cosmic

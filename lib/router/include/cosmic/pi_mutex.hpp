@@ -7,13 +7,19 @@
 // scheduler leaves it off the CPU (milliseconds on a loaded machine): a lower class delaying a
 // higher one. With priority inheritance the kernel runs the holder at the waiter's priority
 // until it unlocks. Uncontended, it costs what a plain mutex costs (a user-space atomic).
+//
+// A capability for clang's thread safety analysis (cosmic/thread_annotations.hpp): take it with
+// PiLock (cosmic::LockGuard), which the analysis sees, not std::lock_guard, which it does not.
 #pragma once
 
 #include <pthread.h>
 
+#include "cosmic/mutex.hpp"
+#include "cosmic/thread_annotations.hpp"
+
 namespace cosmic {
 
-class PiMutex {
+class COSMIC_CAPABILITY("mutex") PiMutex {
  public:
   PiMutex() noexcept {
     pthread_mutexattr_t attr;
@@ -29,12 +35,18 @@ class PiMutex {
 
   // Locking a valid, initialised, non-recursive mutex that this thread does not hold cannot fail
   // (EDEADLK/EINVAL are programming errors), so the results are not checked on the hot path.
-  void lock() noexcept { pthread_mutex_lock(&mutex_); }
-  bool try_lock() noexcept { return pthread_mutex_trylock(&mutex_) == 0; }
-  void unlock() noexcept { pthread_mutex_unlock(&mutex_); }
+  // Escape: the bodies call the unannotated pthread functions; they are what the analysis trusts.
+  void lock() noexcept COSMIC_ACQUIRE() COSMIC_NO_THREAD_SAFETY_ANALYSIS { pthread_mutex_lock(&mutex_); }
+  bool try_lock() noexcept COSMIC_TRY_ACQUIRE(true) COSMIC_NO_THREAD_SAFETY_ANALYSIS {
+    return pthread_mutex_trylock(&mutex_) == 0;
+  }
+  void unlock() noexcept COSMIC_RELEASE() COSMIC_NO_THREAD_SAFETY_ANALYSIS { pthread_mutex_unlock(&mutex_); }
 
  private:
   pthread_mutex_t mutex_;
 };
+
+// The scoped lock of a PiMutex: `PiLock lock(mutex_);`.
+using PiLock = LockGuard<PiMutex>;
 
 }  // namespace cosmic

@@ -3,13 +3,15 @@
 // Thread-safe: inject() may run on any thread (it stands for the adapter's receive thread).
 #pragma once
 
+#include <chrono>
 #include <condition_variable>
 #include <map>
-#include <mutex>
 #include <string>
 #include <vector>
 
+#include "cosmic/mutex.hpp"
 #include "cosmic/segment_adapter.hpp"
+#include "cosmic/thread_annotations.hpp"
 
 namespace cosmic {
 
@@ -53,19 +55,19 @@ class MemoryAdapter final : public SegmentAdapter {
   void fail_configure(std::string reason);
 
  private:
-  const ChannelBinding* find(const std::string& name) const;
+  const ChannelBinding* find(const std::string& name) const COSMIC_REQUIRES(mutex_);
   std::string segment_name_;
-  mutable std::mutex mutex_;
+  mutable Mutex mutex_;
   mutable std::condition_variable sent_changed_;
-  EventSink* sink_ = nullptr;
-  std::vector<ChannelBinding> bindings_;
-  std::vector<RecordedEvent> sent_;
-  HealthReport health_;
-  AdapterStatistics stats_;
-  std::map<std::string, std::string> refuse_;  // channel name -> reason
-  std::string fail_configure_;
-  bool congested_ = false;
-  bool held_ = false;
+  EventSink* sink_ COSMIC_GUARDED_BY(mutex_) = nullptr;
+  std::vector<ChannelBinding> bindings_ COSMIC_GUARDED_BY(mutex_);
+  std::vector<RecordedEvent> sent_ COSMIC_GUARDED_BY(mutex_);
+  HealthReport health_ COSMIC_GUARDED_BY(mutex_);
+  AdapterStatistics stats_ COSMIC_GUARDED_BY(mutex_);
+  std::map<std::string, std::string> refuse_ COSMIC_GUARDED_BY(mutex_);  // channel name -> reason
+  std::string fail_configure_ COSMIC_GUARDED_BY(mutex_);
+  bool congested_ COSMIC_GUARDED_BY(mutex_) = false;
+  bool held_ COSMIC_GUARDED_BY(mutex_) = false;
   mutable std::condition_variable released_;
 };
 
