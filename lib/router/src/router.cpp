@@ -159,7 +159,7 @@ void Router::receive(std::size_t segment, const InboundEvent& event) {
 bool Router::admit(ChannelState& channel, SegmentCounters& counters, const InboundEvent& event) {
   const EventHeader& header = event.header;
   const ChannelSpec& spec = channel.route.spec;
-  std::lock_guard lock(channel.policy_mutex);
+  PiLock lock(channel.policy_mutex);
   const bool loop_copy = header.origin == 0 && event.guard_loops_by_fingerprint &&
                          channel.loop_guard.loop_copy(event.payload, event.received_at);
   if (loop_copy || (header.origin != 0 && channel.dedup.seen(header.origin, header.sequence))) {

@@ -40,12 +40,12 @@ struct Route {
   ChannelSpec spec;
   std::vector<std::size_t> publishers;   // segment indices
   std::vector<std::size_t> subscribers;  // segment indices
-  friend bool operator==(const Route&, const Route&) = default;
-};
   // How much later than its neighbours one event may arrive within the contract: the largest
   // latency bound of the publisher segments. The rate bucket banks 1 + ceil(this / period)
   // events, so a publisher at its period whose events the network bunches loses none.
   Nanos ingress_jitter{0};
+  friend bool operator==(const Route&, const Route&) = default;
+};
 
 struct RouterLimits {
   std::size_t hrt_queue = 256;  // events per egress lane of each class
@@ -115,11 +115,7 @@ class Router {
 
   void receive(std::size_t segment, const InboundEvent& event);
   void problem(std::size_t segment, ChannelId channel, InboundProblem what);
-  // Escape: admit() takes channel.policy_mutex through std::lock_guard, which the analysis cannot
-  // see, so its reads of the guarded bucket, dedup and loop_guard would be reported. To be dropped
-  // when the rate-policing rework of admit() takes the lock with PiLock.
-  bool admit(ChannelState& channel, SegmentCounters& counters, const InboundEvent& event)
-      COSMIC_NO_THREAD_SAFETY_ANALYSIS;
+  bool admit(ChannelState& channel, SegmentCounters& counters, const InboundEvent& event);
   void enqueue(const std::shared_ptr<ChannelState>& channel, const InboundEvent& event);
   std::shared_ptr<ChannelState> find(ChannelId id) const;
   EgressLane& lane(std::size_t segment, ChannelClass cls);
