@@ -146,13 +146,13 @@ class DdsAdapter final : public DdsSegmentAdapter {
   void release_topic(ClassParticipant& home, dds::Topic* topic);
   std::unique_ptr<WriterEntry> create_writer(const ChannelBinding& binding, std::string& error);
   std::unique_ptr<ReaderEntry> create_reader(const ChannelBinding& binding, std::string& error);
-  void destroy_writer(std::unique_ptr<WriterEntry> entry);
-  void deactivate(ReaderEntry& entry);
   // The class participant of `binding`, then `create`; every failure (an exception of Fast DDS
   // included) comes back as nullptr and `error`.
   template <typename Entry>
   std::unique_ptr<Entry> create_endpoint(const ChannelBinding& binding, std::string& error,
                                          std::unique_ptr<Entry> (DdsAdapter::*create)(const ChannelBinding&, std::string&));
+  void destroy_writer(std::unique_ptr<WriterEntry> entry);
+  void deactivate(ReaderEntry& entry);
   void destroy_reader(std::unique_ptr<ReaderEntry> entry);
   void teardown();
   dds::DomainParticipant* create_participant_as(const ThreadPolicy& threads, const dds::DomainParticipantQos& qos);
