@@ -1,40 +1,18 @@
 #include "metrics_server.hpp"
 
-#include <httplib.h>
 #include <pthread.h>
 
 #include <cerrno>
 #include <cstring>
 #include <thread>
 
+#include "metrics_http_server.hpp"
 #include "metrics_render.hpp"
 
 namespace cosmicd {
 namespace {
 
-constexpr const char* kThreadName = "cosmic-metrics";
-// Two scrapers at once (Prometheus and an operator's curl); an idle keep-alive connection
-// gives its worker back after a second.
-constexpr std::size_t kWorkers = 2;
-constexpr time_t kKeepAliveSeconds = 1;
-constexpr time_t kIoTimeoutSeconds = 5;
-
-void name_this_thread() { pthread_setname_np(pthread_self(), kThreadName); }
-
-// httplib's pool, with every worker named after us (its threads start anonymous).
-class NamedPool : public httplib::TaskQueue {
- public:
-  void enqueue(std::function<void()> task) override {
-    pool_.enqueue([task = std::move(task)] {
-      name_this_thread();
-      task();
-    });
-  }
-  void shutdown() override { pool_.shutdown(); }
-
- private:
-  httplib::ThreadPool pool_{kWorkers};
-};
+void name_this_thread() { pthread_setname_np(pthread_self(), "cosmic-metrics"); }
 
 std::string url_of(const cosmic::MetricsSpec& spec) {
   const bool v6 = spec.host.find(':') != std::string::npos;
@@ -45,10 +23,12 @@ std::string url_of(const cosmic::MetricsSpec& spec) {
 
 class MetricsServer::Endpoint {
  public:
-  httplib::Server http;
+  explicit Endpoint(cosmic::Logger& log) : http(HttpLimits{}, name_this_thread, &log) {}
+  MetricsHttpServer http;
   std::thread thread;
 
   ~Endpoint() {
+    http.close_connections();
     http.stop();
     if (thread.joinable()) thread.join();
   }
@@ -59,28 +39,15 @@ MetricsServer::MetricsServer(cosmic::Logger& log) : log_(log) {}
 MetricsServer::~MetricsServer() { endpoint_.reset(); }
 
 std::unique_ptr<MetricsServer::Endpoint> MetricsServer::open(const cosmic::MetricsSpec& spec, std::string& error) {
-  auto endpoint = std::make_unique<Endpoint>();
-  httplib::Server& http = endpoint->http;
-  http.new_task_queue = [] { return new NamedPool(); };
-  http.set_keep_alive_timeout(kKeepAliveSeconds);
-  http.set_read_timeout(kIoTimeoutSeconds);
-  http.set_write_timeout(kIoTimeoutSeconds);
-  http.set_payload_max_length(4096);
-  http.Get("/metrics", [this](const httplib::Request& request, httplib::Response& response) {
+  auto endpoint = std::make_unique<Endpoint>(log_);
+  MetricsHttpServer& http = endpoint->http;
+  http.serve_metrics([this](ExpositionFormat format) -> std::optional<std::string> {
     const auto snapshot = relay_.get();
-    if (!snapshot) {
-      response.status = 503;
-      response.set_content("cosmicd did not answer with a snapshot in time\n", "text/plain");
-      return;
-    }
-    const ExpositionFormat format = format_for_accept(request.get_header_value("Accept"));
-    response.set_content(render_metrics(*snapshot, format), content_type(format));
-  });
-  http.Get("/", [](const httplib::Request&, httplib::Response& response) {
-    response.set_content("cosmicd: metrics at /metrics\n", "text/plain");
+    if (!snapshot) return std::nullopt;
+    return render_metrics(*snapshot, format);
   });
   errno = 0;
-  if (!http.bind_to_port(spec.host, spec.port)) {
+  if (!http.bind(spec.host, spec.port)) {
     error = "cannot listen on " + url_of(spec) + (errno ? std::string(": ") + std::strerror(errno) : std::string());
     return nullptr;
   }

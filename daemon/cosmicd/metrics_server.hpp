@@ -1,4 +1,5 @@
-// The opt-in HTTP endpoint of gateway.metrics (docs/metrics.md), on cpp-httplib.
+// The opt-in HTTP endpoint of gateway.metrics (docs/metrics.md), on cpp-httplib with our own
+// connection handling (metrics_http_server.hpp: deadlines, head limit, connection cap).
 //
 // Threads: follow(), attach(), detach() and publish() are called by the control thread only. HTTP
 // is served by the endpoint's own threads, all named "cosmic-metrics"; they never touch the
