@@ -6,8 +6,12 @@
 //                   receive thread take it shared for the duration of one event; configure() and
 //                   stop() take it exclusively only to swap the table / take lcm_ away, never
 //                   while calling into LCM.
-//   encode_mutex_   the envelope encode buffer (send() may in principle be called concurrently).
-//   EchoFilter      its own small mutex.
+//   senders_[class] one transmit handle (lcm_t), envelope and encode buffer per channel class,
+//                   each under its own mutex held across lcm_publish: liblcm serialises
+//                   publishing on one handle and its sendmsg may block, so an NRT send stalled
+//                   in the kernel never holds what an HRT send needs (issue 20, item 2). The
+//                   receive handle lcm_ is never used for sending.
+//   EchoFilter      its own small mutex (no I/O under it).
 // lcm_unsubscribe() may return while LCM is still inside our callback for that subscription
 // (lcm_dispatch_handlers drops its lock around the call), so the callback never trusts per
 // subscription user data: it looks the channel up by name in the current table and ignores
@@ -88,6 +92,7 @@ struct Channel {
   std::string name;
   std::uint64_t subject = 0;
   LcmEncoding encoding = LcmEncoding::envelope;
+  ChannelClass cls = ChannelClass::nrt;  // which transmit handle sends it
   bool rx = false;
   bool tx = false;
 };
@@ -182,9 +187,16 @@ class LcmAdapter final : public SegmentAdapter {
       log_.log(LogLevel::error, "LCM segment " + segment_.name + ": " + why);
       return Status::failure(why);
     }
+    if (const auto why = open_senders()) {
+      lcm_destroy(lcm);
+      set_health(SegmentHealth::down, *why);
+      log_.log(LogLevel::error, "LCM segment " + segment_.name + ": " + *why);
+      return Status::failure(*why);
+    }
     stop_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
     if (stop_fd_ < 0) {
       const std::string why = std::string("eventfd for the receive loop: ") + std::strerror(errno);
+      close_senders();
       lcm_destroy(lcm);
       set_health(SegmentHealth::down, why);
       log_.log(LogLevel::error, "LCM segment " + segment_.name + ": " + why);
@@ -209,6 +221,7 @@ class LcmAdapter final : public SegmentAdapter {
         sink_ = nullptr;
       }
       lcm_destroy(lcm);
+      close_senders();
       const std::string why = std::string("cannot start the LCM receive thread: ") + e.what();
       set_health(SegmentHealth::down, why);
       return Status::failure(why);
@@ -254,6 +267,7 @@ class LcmAdapter final : public SegmentAdapter {
       c.name = name;
       c.subject = b.spec.subject;
       c.encoding = native && native->lcm_channel ? LcmEncoding::raw : b.spec.lcm_encoding;
+      c.cls = b.spec.cls;
       if (b.role == HopRole::publisher) c.rx = true;
       if (b.role == HopRole::subscriber) c.tx = true;
     }
@@ -313,18 +327,20 @@ class LcmAdapter final : public SegmentAdapter {
       return SendStatus::failed;
     }
     const Channel& channel = it->second;
+    ClassSender& sender = senders_.at(static_cast<std::size_t>(channel.cls));
+    LockGuard transmit(sender.mutex);
+    if (sender.lcm == nullptr) return send_failed(channel, "not started");
     int rc = -1;
     if (channel.encoding == LcmEncoding::raw) {
       if (event.payload.size() > UINT_MAX) return send_failed(channel, "payload too large");
       // Remember before publishing: LCM may loop the copy back before lcm_publish returns.
       echo_.remember(channel.id, event.payload, now_ns());
-      rc = lcm_publish(lcm_, channel.name.c_str(), event.payload.data(),
+      rc = lcm_publish(sender.lcm, channel.name.c_str(), event.payload.data(),
                        static_cast<unsigned>(event.payload.size()));
     } else {
       if (event.payload.size() > static_cast<std::size_t>(INT32_MAX) - kLcmEnvelopeHeaderSize)
         return send_failed(channel, "payload too large");
-      LockGuard encode(encode_mutex_);
-      envelope& e = tx_envelope_;
+      envelope& e = sender.tx_envelope;
       e.subject = static_cast<std::int64_t>(event.header.subject);
       // The header goes out as given, as on DDS: the router stamps what this gateway originates
       // with its id, a component (libcosmic-client) stamps its own.
@@ -336,11 +352,12 @@ class LcmAdapter final : public SegmentAdapter {
       e.payload_size = static_cast<std::int32_t>(event.payload.size());
       e.payload.assign(event.payload.begin(), event.payload.end());  // keeps its capacity
       const int size = e.getEncodedSize();
-      if (encode_buffer_.size() < static_cast<std::size_t>(size)) encode_buffer_.resize(size);
-      if (e.encode(encode_buffer_.data(), 0, size) != size) return send_failed(channel, "encode failed");
+      std::vector<std::uint8_t>& buffer = sender.encode_buffer;
+      if (buffer.size() < static_cast<std::size_t>(size)) buffer.resize(size);
+      if (e.encode(buffer.data(), 0, size) != size) return send_failed(channel, "encode failed");
       // Only a channel this segment also receives can come back to us through LCM's loopback.
       if (channel.rx) echo_.remember(channel.id, event.payload, now_ns());
-      rc = lcm_publish(lcm_, channel.name.c_str(), encode_buffer_.data(), static_cast<unsigned>(size));
+      rc = lcm_publish(sender.lcm, channel.name.c_str(), buffer.data(), static_cast<unsigned>(size));
     }
     if (rc != 0) return send_failed(channel, "lcm_publish failed");
     counters_.sent.fetch_add(1, std::memory_order_relaxed);
@@ -372,6 +389,7 @@ class LcmAdapter final : public SegmentAdapter {
     }
     subscriptions_.clear();  // lcm_destroy frees them
     if (lcm != nullptr) lcm_destroy(lcm);
+    close_senders();
     set_health(SegmentHealth::down, "stopped");
     log_.log(LogLevel::info, "LCM segment " + segment_.name + " stopped");
   }
@@ -383,6 +401,32 @@ class LcmAdapter final : public SegmentAdapter {
     std::string name;
     lcm_subscription_t* handle = nullptr;
   };
+
+  // One publish-only handle per class (start(), control thread); the reason when one fails.
+  std::optional<std::string> open_senders() {
+    for (ClassSender& sender : senders_) {
+      lcm_t* lcm = lcm_create(segment_.lcm.url.c_str());
+      if (lcm == nullptr) {
+        close_senders();
+        return "lcm_create failed for a transmit handle on " + segment_.lcm.url;
+      }
+      LockGuard lock(sender.mutex);
+      sender.lcm = lcm;
+    }
+    return std::nullopt;
+  }
+
+  // After the receive side is gone; waits for a send in flight on each handle.
+  void close_senders() {
+    for (ClassSender& sender : senders_) {
+      lcm_t* lcm = nullptr;
+      {
+        LockGuard lock(sender.mutex);
+        lcm = std::exchange(sender.lcm, nullptr);
+      }
+      if (lcm != nullptr) lcm_destroy(lcm);
+    }
+  }
 
   lcm_t* current_lcm() COSMIC_EXCLUDES(table_mutex_) {
     SharedLock table(table_mutex_);
@@ -542,9 +586,14 @@ class LcmAdapter final : public SegmentAdapter {
   std::unordered_map<ChannelId, Channel> channels_ COSMIC_GUARDED_BY(table_mutex_);
   std::unordered_map<std::string, Channel*, StringHash, std::equal_to<>> by_name_ COSMIC_GUARDED_BY(table_mutex_);
 
-  Mutex encode_mutex_;
-  envelope tx_envelope_ COSMIC_GUARDED_BY(encode_mutex_){};
-  std::vector<std::uint8_t> encode_buffer_ COSMIC_GUARDED_BY(encode_mutex_) = std::vector<std::uint8_t>(4096);
+  // What one channel class sends with (see the top of this file).
+  struct ClassSender {
+    Mutex mutex;
+    lcm_t* lcm COSMIC_GUARDED_BY(mutex) = nullptr;  // publish only: it never subscribes
+    envelope tx_envelope COSMIC_GUARDED_BY(mutex){};
+    std::vector<std::uint8_t> encode_buffer COSMIC_GUARDED_BY(mutex) = std::vector<std::uint8_t>(4096);
+  };
+  std::array<ClassSender, 3> senders_;  // indexed by ChannelClass
 
   EchoFilter echo_;
 
