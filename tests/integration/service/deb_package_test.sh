@@ -71,6 +71,7 @@ def run(*args):
 def owners(path):
     candidates = [path, os.path.realpath(path)]
     candidates += [c.replace("/lib/", "/usr/lib/", 1) for c in candidates if c.startswith("/lib/")]
+    candidates += [c.replace("/usr/lib/", "/lib/", 1) for c in candidates if c.startswith("/usr/lib/")]
     for c in candidates:
         out = run("dpkg", "-S", c)
         if out:
@@ -79,7 +80,12 @@ def owners(path):
 bad = 0
 for binary in sys.argv[2:]:
     needed = re.findall(r"NEEDED\s+(\S+)", run("objdump", "-p", binary))
-    resolved = dict(re.findall(r"^\s*(\S+) => (/\S+)", run("ldd", binary), re.M))
+    listing = run("ldd", binary)
+    resolved = dict(re.findall(r"^\s*(\S+) => (/\S+)", listing, re.M))
+    # The dynamic loader is listed by path alone; it is NEEDED too where code uses dynamic TLS
+    # (__tls_get_addr, e.g. thread_local in position-independent code).
+    for loader in re.findall(r"^\s*(/\S+) \(0x", listing, re.M):
+        resolved.setdefault(os.path.basename(loader), loader)
     for soname in needed:
         path = resolved.get(soname)
         packages = owners(path) if path else set()
