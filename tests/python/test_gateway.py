@@ -3,6 +3,7 @@ publisher on one segment reaches a Python subscriber on the other; check_channel
 from __future__ import annotations
 
 import json
+import time
 
 import numpy as np
 import pytest
@@ -38,8 +39,9 @@ def test_lcm_publisher_reaches_dds_subscriber_through_cosmicd(gateway):
         wait_until(lambda: b"probe" in seen, 20, "the gateway's DDS writer matched",
                    step=lambda: (publisher.publish(b"probe"), poll()))
         ranges = [np.array([k * 0.5, k * 0.25], dtype="<f8") for k in range(30)]
-        for r in ranges:
+        for r in ranges:  # paced: the gateway's DDS writer keeps omission_degree + 1 samples for repair
             assert publisher.publish(r)
+            time.sleep(0.002)
         wait_until(lambda: {r.tobytes() for r in ranges} <= seen, 15, "all 30 ranges on DDS", step=poll)
     assert gateway_counter(gateway, "py_range", "viz", "rx") >= 31
     assert gateway_counter(gateway, "py_range", "lan", "tx") >= 31
@@ -55,6 +57,7 @@ def test_dds_publisher_reaches_lcm_subscriber_through_cosmicd(gateway):
         commands = [f"cmd {k}".encode() for k in range(30)]
         for c in commands:
             publisher.publish(c)
+            time.sleep(0.002)
         wait_until(lambda: set(commands) <= set(received), 15, "all 30 commands on LCM")
 
 

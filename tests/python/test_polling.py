@@ -1,6 +1,7 @@
 """get_event(): polling as a fixed-step tool does (Fig. 9), timeouts, and waiting without the GIL."""
 from __future__ import annotations
 
+import os
 import threading
 import time
 
@@ -34,9 +35,11 @@ def test_timeouts(pair):
     start = time.monotonic()
     event = into.get_event(timeout=20)
     assert event is not None and event.payload == b"late" and time.monotonic() - start < 10
-    # timeout=None waits as long as it takes.
+    # timeout=None, or one too long to matter, waits as long as it takes.
     threading.Timer(0.2, lambda: out.publish(b"later")).start()
     assert into.get_event(timeout=None).payload == b"later"
+    threading.Timer(0.2, lambda: out.publish(b"last")).start()
+    assert into.get_event(timeout=1e300).payload == b"last"
 
 
 def test_other_threads_run_while_get_event_waits(pair):
@@ -115,3 +118,33 @@ def test_subscribe_and_unsubscribe_switch_between_callback_and_queue(pair):
     into.unsubscribe()
     out.publish(b"again")  # after unsubscribe() events are queued for get_event() again
     wait_until(lambda: (e := into.get_event(timeout=0.1)) is not None and e.payload == b"again", 10, "a queued event")
+
+
+def test_the_last_reference_dropped_inside_a_callback_closes_the_client():
+    """The client's last reference goes inside its own callback, on the receive thread that
+    cosmic_close() joins: it is closed from another thread once the callback returned, and its
+    threads end (a self-join would leave them hanging)."""
+    def threads() -> int:
+        return len(os.listdir("/proc/self/task"))
+
+    with cosmic.Client(LCM) as publisher:
+        out = publisher.announce("py_poll_last", 0x2333, payload=8, roles="publish")
+        before = threads()
+        done = threading.Event()
+        holder = {}
+        client = cosmic.Client(LCM)
+        holder["channel"] = client.announce("py_poll_last", 0x2333, payload=8, roles="subscribe")
+
+        def callback(event: cosmic.Event) -> None:
+            holder.clear()  # the Channel, and with it the client, go here
+            done.set()
+
+        holder["channel"].subscribe(callback)
+        del client
+        assert threads() > before
+        wait_until(done.is_set, 10, "the callback ran", step=lambda: out.publish(b"x"))
+        wait_until(lambda: threads() == before, 10, "the client's threads ended")
+        # The process carries on: a new client on the same group works.
+        with cosmic.Client(LCM) as again:
+            into = again.announce("py_poll_last", 0x2333, payload=8, roles="subscribe")
+            wait_until(lambda: into.get_event(timeout=0.05) is not None, 10, "an event", step=lambda: out.publish(b"y"))

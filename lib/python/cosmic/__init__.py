@@ -173,7 +173,7 @@ class Client(_native.Client):
         return self._announce(
             desc.name, desc.subject, _class(desc.cls), _ns(desc.period, "period"),
             _ns(desc.reaction_time, "reaction_time"), _ns(desc.temp_validity, "temp_validity"),
-            desc.omission_degree, desc.payload, _roles(roles), _ns(timeout, "timeout") // 1_000_000)
+            desc.omission_degree, desc.payload, _roles(roles), min(_ns(timeout, "timeout") // 1_000_000, 2**31 - 1))
 
     def announce_from(self, yaml_file: str, name: str, *, roles: Roles, timeout: Duration = 5.0) -> Channel:
         """announce() of channel ``name`` as the gateway configuration ``yaml_file`` describes it."""

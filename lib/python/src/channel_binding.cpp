@@ -121,8 +121,10 @@ py::object get_event(const ChannelRef& self, std::optional<double> timeout) {
     lock.unlock();
     return e ? py::cast(make_event(e->info, e->data.data(), channel.name)) : py::none();
   }
-  const auto deadline = timeout ? Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(*timeout))
-                                : Clock::time_point::max();
+  constexpr double kForever = 1e9;  // s (31 years): longer waits are endless, and the arithmetic cannot overflow
+  const auto deadline = timeout && *timeout < kForever
+                            ? Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(*timeout))
+                            : Clock::time_point::max();
   while (true) {
     std::optional<QueuedEvent> e;
     bool timed_out = false;
