@@ -114,4 +114,43 @@ TEST(ClientIdentity, LcmComponentsStampTheirOwnOrigin) {
   expect_component_identity("lcm:udpm://239.255.76.67:7791?ttl=0", lcm);
 }
 
+// One client holding both roles of a channel (before, on LCM the two roles took two binding ids
+// under one channel name and the announce failed): it receives another component's events, not
+// its own.
+void expect_both_roles(const char* segment) {
+  char error[256] = "";
+  cosmic_client* both = cosmic_open(segment, error, sizeof error);
+  ASSERT_NE(both, nullptr) << error;
+  cosmic_client* other = cosmic_open(segment, error, sizeof error);
+  ASSERT_NE(other, nullptr) << error;
+  cosmic_channel_desc desc = kSpeed;
+  desc.roles = COSMIC_PUBLISH | COSMIC_SUBSCRIBE;
+  cosmic_channel* mine = cosmic_announce(both, &desc, 1000);
+  ASSERT_NE(mine, nullptr) << segment << ": " << cosmic_last_error(both);
+  cosmic_channel* theirs = cosmic_announce(other, &kSpeed, 1000);
+  ASSERT_NE(theirs, nullptr) << cosmic_last_error(other);
+  const std::int32_t own = 1;
+  const std::int32_t foreign = 2;
+  cosmic_event_info info{};
+  std::int32_t got = 0;
+  int rc = COSMIC_E_AGAIN;
+  const auto deadline = std::chrono::steady_clock::now() + 20s;
+  while (rc == COSMIC_E_AGAIN && std::chrono::steady_clock::now() < deadline) {
+    EXPECT_EQ(cosmic_publish(mine, &own, sizeof own), COSMIC_OK);
+    cosmic_publish(theirs, &foreign, sizeof foreign);
+    std::this_thread::sleep_for(20ms);  // a poll period
+    rc = cosmic_get_event(mine, &info, &got, sizeof got);
+  }
+  ASSERT_EQ(rc, COSMIC_OK) << segment << ": nothing received within 20 s";
+  EXPECT_EQ(got, foreign) << segment << ": a client received its own event";
+  while (cosmic_get_event(mine, &info, &got, sizeof got) == COSMIC_OK) EXPECT_EQ(got, foreign);
+  cosmic_close(other);
+  cosmic_close(both);
+}
+
+TEST(ClientIdentity, OneClientMayPublishAndSubscribeOneChannel) {
+  expect_both_roles("dds:0");
+  expect_both_roles("lcm:udpm://239.255.76.67:7792?ttl=0");
+}
+
 }  // namespace

@@ -31,10 +31,11 @@ class QuietLogger : public Logger {
   std::string last_ COSMIC_GUARDED_BY(mutex_);
 };
 
-// A channel announced as `index` has binding id 2*index (the component publishes: the adapter
-// sends) and 2*index + 1 (the component subscribes: the adapter receives).
-ChannelId send_id(std::size_t index) { return static_cast<ChannelId>(2 * index); }
-ChannelId receive_id(std::size_t index) { return static_cast<ChannelId>(2 * index + 1); }
+// A channel announced as `index` is binding id index + 1 in both roles (publisher: the adapter
+// sends; subscriber: the adapter receives), as the gateway binds a channel it both receives and
+// sends on one segment: LCM carries one channel name under one id only.
+ChannelId binding_id(std::size_t index) { return static_cast<ChannelId>(index + 1); }
+std::size_t index_of(ChannelId id) { return static_cast<std::size_t>(id - 1); }
 
 class IpTransport final : public Transport, private EventSink {
  public:
@@ -59,8 +60,8 @@ class IpTransport final : public Transport, private EventSink {
   int announce(std::size_t index, const ChannelSpec& spec, int roles, int, std::string& error) override {
     LockGuard lock(mutex_);
     auto next = bindings_;
-    if (roles & COSMIC_PUBLISH) next.push_back(ChannelBinding{send_id(index), spec, HopRole::subscriber, std::nullopt});
-    if (roles & COSMIC_SUBSCRIBE) next.push_back(ChannelBinding{receive_id(index), spec, HopRole::publisher, std::nullopt});
+    if (roles & COSMIC_PUBLISH) next.push_back(ChannelBinding{binding_id(index), spec, HopRole::subscriber, std::nullopt});
+    if (roles & COSMIC_SUBSCRIBE) next.push_back(ChannelBinding{binding_id(index), spec, HopRole::publisher, std::nullopt});
     const Status s = adapter_->configure(next);
     if (!s.ok) {
       error = s.error;
@@ -75,7 +76,7 @@ class IpTransport final : public Transport, private EventSink {
     // forwards them gives them the same identity (origin, sequence) and duplicates stay visible.
     EventHeader stamped = header;
     stamped.origin = self_.id;
-    switch (adapter_->send(OutboundEvent{send_id(index), stamped, payload})) {
+    switch (adapter_->send(OutboundEvent{binding_id(index), stamped, payload})) {
       case SendStatus::sent: return COSMIC_OK;
       case SendStatus::queue_full: return COSMIC_E_AGAIN;
       case SendStatus::failed: break;
@@ -86,7 +87,8 @@ class IpTransport final : public Transport, private EventSink {
 
  private:
   void on_event(const InboundEvent& event) override {
-    if (event.channel % 2 == 1) delivery_->deliver(event.channel / 2, event.header, event.payload);
+    // Only channels announced to subscribe are bound for receiving.
+    if (event.channel != kNoChannel) delivery_->deliver(index_of(event.channel), event.header, event.payload);
   }
   void on_problem(ChannelId, InboundProblem) override {}
 
