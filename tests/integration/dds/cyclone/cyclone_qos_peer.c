@@ -28,6 +28,7 @@
 #include "dds/dds.h"
 
 #include PEER_TYPE_HEADER
+#include "peer_args.h"
 
 struct options {
   bool writer;
@@ -37,14 +38,6 @@ struct options {
   long latency_budget_ms;
   long timeout_s;
 };
-
-static bool parse_long(const char *text, long *out) {
-  char *end = NULL;
-  const long value = strtol(text, &end, 10);
-  if (end == text || *end != '\0') return false;
-  *out = value;
-  return true;
-}
 
 static bool parse(int argc, char **argv, struct options *o) {
   memset(o, 0, sizeof *o);

@@ -37,6 +37,7 @@
 #include "dds/ddsi/ddsi_serdata.h"
 
 #include "ros2_twist.h"
+#include "peer_args.h"
 
 /* A Twist in XCDR1: 4-byte encapsulation header + 6 doubles. */
 #define TWIST_CDR_SIZE 52u
@@ -51,14 +52,6 @@ struct options {
   long timeout_s;
   bool gate;
 };
-
-static bool parse_long(const char *text, long *out) {
-  char *end = NULL;
-  const long value = strtol(text, &end, 10);
-  if (end == text || *end != '\0') return false;
-  *out = value;
-  return true;
-}
 
 static bool parse(int argc, char **argv, struct options *o) {
   memset(o, 0, sizeof *o);
