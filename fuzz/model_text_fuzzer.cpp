@@ -151,9 +151,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!loaded.ok()) return 0;
 
   const cosmicctl::DiagramStatus no_status;
-  const std::string dot = cosmicctl::render_dot(loaded.config, no_status, path);
-  require_clean_dot(dot);
-  require(lines(dot) == lines(cosmicctl::render_dot(loaded.config, no_status, "title")));
+  for (const auto detail : {cosmicctl::DiagramDetail::compact, cosmicctl::DiagramDetail::tables}) {
+    const std::string dot = cosmicctl::render_dot(loaded.config, no_status, path, detail);
+    require_clean_dot(dot);
+    require(lines(dot) == lines(cosmicctl::render_dot(loaded.config, no_status, "title", detail)));
+  }
 
   for (const auto& component : loaded.config.components) {
     if (cosmicctl::identifier_collision(loaded.config, component)) continue;

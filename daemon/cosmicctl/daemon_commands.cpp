@@ -68,6 +68,22 @@ void print_verdicts(const Json& channels) {
   }
 }
 
+// What a replacement changed per channel, and which hops kept their endpoints.
+void print_replaced(const Json& replaced) {
+  auto hops = [](const Json& list) {
+    std::string out;
+    for (const auto& h : list) out += (out.empty() ? "" : ", ") + text(h["segment"]) + (h["role"] == "publisher" ? " (P)" : " (S)");
+    return out.empty() ? std::string("-") : out;
+  };
+  for (const auto& c : replaced) {
+    std::cout << "replaced " << text(c["name"]) << ":\n";
+    for (const auto& change : c["changes"]) std::cout << "    " << text(change) << "\n";
+    if (c["changes"].empty()) std::cout << "    (the same definition)\n";
+    std::cout << "    hops kept: " << hops(c["hops"]["kept"]) << "; added: " << hops(c["hops"]["added"])
+              << "; removed: " << hops(c["hops"]["removed"]) << "\n";
+  }
+}
+
 void print_status(const Json& r) {
   const Json& g = r["gateway"];
   std::cout << text(g["name"]) << " (id " << text(g["id"]) << "), up " << static_cast<long>(g["uptime_s"].get<double>()) << " s\n"
@@ -240,8 +256,12 @@ std::vector<CommandRunner> add_daemon_commands(CLI::App& app, const GlobalOption
 
   auto* bind = app.add_subcommand("bind", "Bind channel definitions from a YAML file (admission decides)");
   auto bind_file = std::make_shared<std::string>();
+  auto replace = std::make_shared<bool>(false);
   bind->add_option("FILE", *bind_file, "YAML with channel definitions")->required();
-  runners.push_back(add_request_command(app, options, bind, [bind_file](Json& req) {
+  bind->add_flag("--replace", *replace,
+                 "Replace the definitions of bound channels of the same names in one step (admission on the new whole "
+                 "set; rejected: nothing changes; subscribers that stay keep receiving)");
+  runners.push_back(add_request_command(app, options, bind, [bind_file, replace](Json& req) {
     std::ifstream in(*bind_file);
     if (!in) {
       std::cerr << "cosmicctl: cannot read " << *bind_file << "\n";
@@ -251,9 +271,12 @@ std::vector<CommandRunner> add_daemon_commands(CLI::App& app, const GlobalOption
     content << in.rdbuf();
     if (!is_utf8("file name " + *bind_file, *bind_file)) return kExitUsage;
     if (!is_utf8(*bind_file, content.str())) return kExitConfigError;
-    req = {{"command", "bind"}, {"yaml", content.str()}, {"file", *bind_file}};
+    req = {{"command", *replace ? "replace" : "bind"}, {"yaml", content.str()}, {"file", *bind_file}};
     return kExitOk;
-  }, [](const Json& r) { print_verdicts(r["channels"]); }));
+  }, [](const Json& r) {
+    print_verdicts(r["channels"]);
+    if (r.contains("replaced")) print_replaced(r["replaced"]);
+  }));
   return runners;
 }
 

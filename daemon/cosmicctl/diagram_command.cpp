@@ -1,6 +1,7 @@
 // `cosmicctl diagram FILE`: the Event-Channel Diagram of a configuration as SVG (Graphviz's dot)
 // or DOT. Offline, channels are coloured by what admission of FILE says; with --socket, by the
-// running gateway's verdicts, with its live counters and measured residence.
+// running gateway's verdicts and runtime state, with its live counters and measured residence.
+// Compact by default (the details in tooltips); --detail draws every channel as a full table.
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -13,9 +14,8 @@
 #include "commands.hpp"
 #include "control_client.hpp"
 #include "cosmic/config_loader.hpp"
-#include "cosmic/knowledge_base.hpp"
-#include "cosmic/report.hpp"
 #include "diagram_dot.hpp"
+#include "diagram_status.hpp"
 
 extern char** environ;
 
@@ -23,48 +23,6 @@ namespace cosmicctl {
 namespace {
 
 using Json = nlohmann::json;
-
-std::string micros(double seconds) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.0f us", seconds * 1e6);
-  return buffer;
-}
-
-// What admission of the file promises: the verdict and the end-to-end bound.
-DiagramStatus offline_status(const cosmic::Config& config) {
-  DiagramStatus out;
-  for (const auto& c : cosmic::admit_all(config).channels) {
-    ChannelStatus s{cosmic::to_string(c.verdict), {}};
-    const auto& e2e = c.end_to_end;
-    if (e2e.latency) {
-      std::string promise = "end-to-end <= " + cosmic::format_duration(*e2e.latency);
-      if (e2e.reaction_time) promise += " (reaction " + cosmic::format_duration(*e2e.reaction_time) + ")";
-      s.notes.push_back(promise);
-    }
-    for (const auto& r : c.reasons) s.notes.push_back(r);
-    out[c.name] = std::move(s);
-  }
-  return out;
-}
-
-// What the running gateway reports (`channels` of the control protocol).
-DiagramStatus live_status(const Json& channels) {
-  DiagramStatus out;
-  for (const auto& c : channels) {
-    ChannelStatus s{c.value("verdict", "bound"), {}};
-    s.notes.push_back("forwarded " + std::to_string(c.value("forwarded", 0ull)));
-    const Json& r = c.value("residence", Json::object());
-    if (r.contains("p50_s") && r["p50_s"].is_number()) {
-      s.notes.push_back("residence p50 " + micros(r["p50_s"].get<double>()) + ", p99 " + micros(r.value("p99_s", 0.0)));
-    }
-    for (const auto& seg : c.value("segments", Json::array())) {
-      s.notes.push_back(seg.value("segment", "?") + " " + seg.value("role", "?") + ": rx " + std::to_string(seg.value("rx", 0ull)) +
-                        ", tx " + std::to_string(seg.value("tx", 0ull)));
-    }
-    out[c.value("name", "")] = std::move(s);
-  }
-  return out;
-}
 
 // dot -Tsvg on a temporary file, its output straight to our standard output.
 int render_svg(const std::string& dot) {
@@ -99,6 +57,7 @@ int render_svg(const std::string& dot) {
 struct DiagramOptions {
   std::string file;
   std::string format = "svg";
+  bool detail = false;
 };
 
 int run_diagram(const DiagramOptions& o, const GlobalOptions& global, bool live) {
@@ -121,7 +80,7 @@ int run_diagram(const DiagramOptions& o, const GlobalOptions& global, bool live)
     status = offline_status(loaded.config);
     title += " (admission offline)";
   }
-  const std::string dot = render_dot(loaded.config, status, title);
+  const std::string dot = render_dot(loaded.config, status, title, o.detail ? DiagramDetail::tables : DiagramDetail::compact);
   if (o.format == "dot") {
     std::cout << dot;
     return kExitOk;
@@ -136,6 +95,7 @@ CommandRunner add_diagram_command(CLI::App& app, const GlobalOptions& options) {
   auto o = std::make_shared<DiagramOptions>();
   command->add_option("FILE", o->file, "Configuration file (YAML)")->required();
   command->add_option("--format", o->format, "svg (needs Graphviz) or dot")->check(CLI::IsMember({"svg", "dot"}))->capture_default_str();
+  command->add_flag("--detail", o->detail, "Every channel as a table (subject, QoS list, verdict, notes) instead of one row");
   return [command, o, &options, &app]() -> int {
     if (!command->parsed()) return -1;
     // --socket given (or COSMIC_SOCKET set): the running gateway's view.

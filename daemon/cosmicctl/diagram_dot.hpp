@@ -1,29 +1,21 @@
-// The Event-Channel Diagram (Kaiser et al., Fig. 6) as Graphviz DOT: channels in the middle with
-// subject, class and QoS list; components (and segments without a modelled component) around
-// them, tied to each channel by P (publishes) and S (subscribes) edges; every channel coloured
-// by its admission verdict. Pure text building; the caller renders it (dot -Tsvg).
+// The Event-Channel Diagram (Kaiser et al., Fig. 6) as Graphviz DOT, read left to right:
+// publishing components, the channels in the middle tied to them by P tags, then the subscribing
+// components tied by S tags. A component that does both is drawn on both sides, so no edge runs
+// back across the page. Components sit in a cluster of their segment on each side (a segment
+// where a channel has a P/S tag that no modelled component accounts for is a node of its own
+// there). Channels are coloured by verdict and read as diagram_labels.hpp says. Pure text
+// building; the caller renders it (dot -Tsvg).
 #pragma once
 
-#include <map>
 #include <string>
-#include <vector>
 
 #include "cosmic/model.hpp"
+#include "diagram_labels.hpp"
+#include "diagram_status.hpp"
 
 namespace cosmicctl {
 
-// What the diagram says about one channel beyond its model: the verdict ("bound", "degraded",
-// "rejected", "failed", "violated", or "not bound" for a channel the gateway does not carry) and
-// extra lines (admission's promise offline; live counters and measured residence from cosmicd).
-struct ChannelStatus {
-  std::string verdict = "not bound";
-  std::vector<std::string> notes;
-};
-using DiagramStatus = std::map<std::string, ChannelStatus>;
-
-std::string render_dot(const cosmic::Config& config, const DiagramStatus& status, const std::string& title);
-
-// Fill colour of a verdict (also used by the legend).
-const char* verdict_colour(const std::string& verdict);
+std::string render_dot(const cosmic::Config& config, const DiagramStatus& status, const std::string& title,
+                       DiagramDetail detail = DiagramDetail::compact);
 
 }  // namespace cosmicctl

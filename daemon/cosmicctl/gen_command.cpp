@@ -10,8 +10,19 @@
 #include "cosmic/config_loader.hpp"
 #include "gen_skeleton.hpp"
 
+// Where the skeleton's find_package(cosmic_client) looks first (daemon/CMakeLists.txt defines them):
+// a cosmicctl in its build tree (COSMICCTL_BUILD_DIR) hints that tree's libcosmic-client
+// (COSMIC_CLIENT_CONFIG_DIR); an installed one, the library installed beside it (PREFIX/bin/cosmicctl
+// -> PREFIX/COSMIC_CLIENT_INSTALL_CONFIG_DIR, /usr/lib/<triplet>/cmake/cosmic_client from the
+// package libcosmic-client-dev), never the tree it was built in.
 #ifndef COSMIC_CLIENT_CONFIG_DIR
 #define COSMIC_CLIENT_CONFIG_DIR ""
+#endif
+#ifndef COSMICCTL_BUILD_DIR
+#define COSMICCTL_BUILD_DIR ""
+#endif
+#ifndef COSMIC_CLIENT_INSTALL_CONFIG_DIR
+#define COSMIC_CLIENT_INSTALL_CONFIG_DIR "lib/cmake/cosmic_client"
 #endif
 
 namespace cosmicctl {
@@ -35,6 +46,14 @@ std::string component_names(const cosmic::Config& config) {
   std::string out;
   for (const auto& c : config.components) out += (out.empty() ? "" : ", ") + c.name;
   return out.empty() ? "(the file has no components: section)" : out;
+}
+
+std::string client_config_dir() {
+  std::error_code ec;
+  const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) return "";
+  if (std::filesystem::equivalent(self.parent_path(), COSMICCTL_BUILD_DIR, ec)) return COSMIC_CLIENT_CONFIG_DIR;
+  return (self.parent_path().parent_path() / COSMIC_CLIENT_INSTALL_CONFIG_DIR).string();
 }
 
 int run_gen(const GenOptions& o) {
@@ -61,7 +80,7 @@ int run_gen(const GenOptions& o) {
     std::cerr << "cosmicctl: cannot create " << o.output << ": " << ec.message() << "\n";
     return kExitUnavailable;
   }
-  const Skeleton skeleton = generate_skeleton(loaded.config, *component, o.file, COSMIC_CLIENT_CONFIG_DIR);
+  const Skeleton skeleton = generate_skeleton(loaded.config, *component, o.file, client_config_dir());
   for (const auto& [name, content] : skeleton.files) {
     const auto path = std::filesystem::path(o.output) / name;
     if (name == skeleton.logic_file && std::filesystem::exists(path)) {

@@ -10,7 +10,9 @@ cmake_minimum_required(VERSION 3.16)
 project({{FILE}} LANGUAGES CXX)
 set(CMAKE_CXX_STANDARD 20)
 set(CMAKE_CXX_STANDARD_REQUIRED ON)
-# libcosmic-client; -Dcosmic_client_DIR=<cosmic build>/cosmic-client selects another build.
+# libcosmic-client: the cosmicctl that generated this file hints its own (its build tree's, or the
+# installed package libcosmic-client-dev's); -Dcosmic_client_DIR=DIR selects another, e.g. a build
+# tree's <cosmic build>/cosmic-client. Without CMake: pkg-config --cflags --libs cosmic-client.
 find_package(cosmic_client CONFIG REQUIRED HINTS "{{CLIENT_CONFIG_DIR}}")
 add_executable({{FILE}} main.cpp {{FILE}}.cpp {{FILE}}_logic.cpp)
 target_link_libraries({{FILE}} PRIVATE cosmic::client)

@@ -3,9 +3,11 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "cosmic/version.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"cosmicctl: control and inspect the cosmic-gateway daemon"};
+  app.set_version_flag("--version", "cosmicctl " COSMIC_VERSION);
   app.require_subcommand(1);
   app.fallthrough();
   cosmicctl::GlobalOptions options;
@@ -20,7 +22,7 @@ int main(int argc, char** argv) {
   for (auto& command : cosmicctl::add_daemon_commands(app, options)) commands.push_back(std::move(command));
   try {
     app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
+  } catch (const CLI::Success& e) {  // --help, --version
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     app.exit(e);

@@ -198,8 +198,10 @@ class Daemon {
     if (command == "reload") {
       state_ = {};  // the file is the truth again
       file_config_ = gateway_.config();
-    } else if (command == "bind") {
-      const auto parsed = cosmic::parse_channels(request["yaml"].get<std::string>(), "bind", gateway_.config());
+    } else if (command == "bind" || command == "replace") {
+      // A replacement is saved as a bind of the new definitions: at the next start they are
+      // bound in place of the file's (or the earlier runtime) definitions of the same names.
+      const auto parsed = cosmic::parse_channels(request["yaml"].get<std::string>(), command, gateway_.config());
       for (const auto& channel : parsed.channels) {
         std::erase_if(state_.bound, [&](const RuntimeBinding& b) { return b.name == channel.name; });
         std::erase(state_.unbound, channel.name);

@@ -1,10 +1,12 @@
 // cosmicd: the cosmic-gateway daemon. Parses the command line and hands over to the daemon.
 #include <CLI/CLI.hpp>
 
+#include "cosmic/version.hpp"
 #include "daemon.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"cosmicd: event-channel gateway between CAN, DDS and LCM"};
+  app.set_version_flag("--version", "cosmicd " COSMIC_VERSION);
   cosmicd::DaemonOptions options;
   app.add_option("-c,--config", options.config, "Configuration file")->capture_default_str();
   app.add_option("-s,--socket", options.socket, "Control socket path (overrides gateway.control_socket)");

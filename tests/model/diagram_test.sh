@@ -16,10 +16,21 @@ grep -q '^digraph event_channels' "$WORK/robot.dot" || fail "DOT has no digraph"
 for channel in distance acceleration odometry obstacle speed command actual_speed diagnostics; do
   grep -q "\"channel_$channel\" \[" "$WORK/robot.dot" || fail "DOT lacks channel $channel"
 done
-grep -q '"component_speed_controller" -> "channel_speed" \[label="P"' "$WORK/robot.dot" || fail "no P tag speed_controller -> speed"
-grep -q '"channel_actual_speed" -> "component_speed_controller" \[label="S"' "$WORK/robot.dot" || fail "no S tag actual_speed -> speed_controller"
-grep -q 'subject 0x0000000100000042' "$WORK/robot.dot" || fail "distance's subject missing"
-grep -q 'reaction_time 5 ms' "$WORK/robot.dot" || fail "distance's QoS list missing"
+# Left to right as the paper's Fig. 6: publishers (P_ nodes) -> channels -> subscribers (S_ nodes);
+# a component that does both is drawn on both sides, each side in clusters of its segments.
+grep -q 'rankdir=LR' "$WORK/robot.dot" || fail "not drawn left to right"
+grep -q '"P_component_speed_controller" -> "channel_speed" \[headlabel="P"' "$WORK/robot.dot" || fail "no P tag speed_controller -> speed"
+grep -q '"channel_actual_speed" -> "S_component_speed_controller" \[taillabel="S"' "$WORK/robot.dot" || fail "no S tag actual_speed -> speed_controller"
+grep -qE -- '-> "P_component_|"S_component_[a-z_]*" ->' "$WORK/robot.dot" && fail "an edge runs back across the page"
+grep -q 'subgraph "cluster_P_body-can"' "$WORK/robot.dot" || fail "no cluster of the publishers on body-can"
+grep -q 'subgraph "cluster_S_viz"' "$WORK/robot.dot" || fail "no cluster of the subscribers on viz"
+# Compact by default: one row a channel (name, class, verdict, end-to-end bound), the rest as tooltip.
+grep -q '"channel_distance" \[[^]]*tooltip="distance: HRT, subject 0x0000000100000042' "$WORK/robot.dot" || fail "distance's subject is not in its tooltip"
+grep -q '"channel_distance" \[[^]]*reaction_time 5 ms' "$WORK/robot.dot" || fail "distance's QoS list is not in its tooltip"
+rows() { grep '^  "channel_' "$1" | grep -o '<TR>' | wc -l; }
+[ "$(rows "$WORK/robot.dot")" -eq 8 ] || fail "compact: not one row per channel ($(rows "$WORK/robot.dot") rows for 8 channels)"
+"$COSMICCTL" diagram --format dot --detail "$ROBOT" >"$WORK/detail.dot" || fail "diagram --detail exited $?"
+[ "$(rows "$WORK/detail.dot")" -gt 16 ] || fail "--detail: channels are not drawn as tables"
 
 "$COSMICCTL" diagram "$ROBOT" >"$WORK/robot.svg" || fail "diagram (svg) exited $?"
 grep -q '<svg' "$WORK/robot.svg" || fail "no SVG on stdout"
@@ -50,6 +61,16 @@ printf 'segments: []\nchannels: []\ncomponents: [{name: x, segment: nowhere, pub
 [ $? -eq 2 ] || fail "bad file: exit code is not 2"
 grep -q "bad.yaml:3:.*components\[0\].segment: unknown segment 'nowhere'" "$WORK/bad.err" || fail "bad file: no located error: $(cat "$WORK/bad.err")"
 [ -s "$WORK/bad.out" ] && fail "bad file: something on stdout"
+
+# Compact enough to read: the robot's 8 channels fit a screen (before: 1,601 pt tall), and a
+# model of 50 channels stays one readable column of channels.
+svg_height() { sed -n 's/^<svg width="[0-9.]*pt" height="\([0-9.]*\)pt".*/\1/p' "$1" | head -1 | cut -d. -f1; }
+height=$(svg_height "$WORK/robot.svg")
+[ -n "$height" ] && [ "$height" -lt 900 ] || fail "the robot's diagram is ${height:-?} pt tall (at most 900)"
+python3 "$HERE/generate_model.py" 50 >"$WORK/wide.yaml" || fail "generate_model.py failed"
+"$COSMICCTL" diagram "$WORK/wide.yaml" >"$WORK/wide.svg" 2>"$WORK/wide.err" || fail "50 channels: diagram exited $?: $(cat "$WORK/wide.err")"
+[ "$(grep -c 'class="node channel' "$WORK/wide.svg")" -eq 50 ] || fail "50 channels: $(grep -c 'class="node channel' "$WORK/wide.svg") channel nodes"
+echo "robot: ${height} pt tall; 50 channels: $(svg_height "$WORK/wide.svg") pt tall"
 
 # A real browser draws it.
 timeout 120 chromium --headless --no-sandbox --disable-gpu --disable-background-networking --disable-component-update \

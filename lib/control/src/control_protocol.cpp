@@ -63,6 +63,43 @@ const ChannelStatsSnapshot* find_stats(const std::vector<ChannelStatsSnapshot>& 
   return it == stats.end() ? nullptr : &*it;
 }
 
+void replace_or_bind(BindPlan& plan) {
+  if (plan.replacing) {
+    Gateway::plan_replace(plan);
+  } else {
+    Gateway::plan_bind(plan);
+  }
+}
+
+// A replacement's answer says per channel what changed and which hops stay (their endpoints and
+// the subscribers behind them keep running), which are new and which are gone.
+Json replaced_answer(const BindResult& result) {
+  Json out = Json::array();
+  for (const ReplacedChannel& replaced : result.replaced) {
+    const ChannelSpec& before = replaced.before;
+    const auto now = std::find_if(result.channels.begin(), result.channels.end(),
+                                  [&](const ChannelReport& c) { return c.name == before.name; });
+    Json hops{{"kept", Json::array()}, {"added", Json::array()}, {"removed", Json::array()}};
+    std::vector<std::pair<std::string, HopRole>> old_hops;
+    for (const auto& p : before.publishers) old_hops.emplace_back(p, HopRole::publisher);
+    for (const auto& s : before.subscribers) old_hops.emplace_back(s, HopRole::subscriber);
+    std::vector<std::pair<std::string, HopRole>> new_hops;
+    if (now != result.channels.end()) {
+      for (const auto& hop : now->hops) new_hops.emplace_back(hop.segment, hop.role);
+    }
+    auto hop_json = [](const std::pair<std::string, HopRole>& h) { return Json{{"segment", h.first}, {"role", to_string(h.second)}}; };
+    for (const auto& h : old_hops) {
+      const bool kept = std::find(new_hops.begin(), new_hops.end(), h) != new_hops.end();
+      hops[kept ? "kept" : "removed"].push_back(hop_json(h));
+    }
+    for (const auto& h : new_hops) {
+      if (std::find(old_hops.begin(), old_hops.end(), h) == old_hops.end()) hops["added"].push_back(hop_json(h));
+    }
+    out.push_back({{"name", before.name}, {"changes", replaced.changes}, {"hops", std::move(hops)}});
+  }
+  return out;
+}
+
 Json bind_answer(const BindResult& result) {
   Json out{{"ok", result.applied}, {"applied", result.applied}, {"channels", Json::array()}};
   for (const auto& c : result.channels) out["channels"].push_back(to_json(c));
@@ -85,7 +122,7 @@ ControlProtocol::ControlProtocol(Gateway& gateway, std::function<ConfigResult()>
       started_(std::chrono::steady_clock::now()) {}
 
 bool ControlProtocol::is_mutating(std::string_view command) {
-  return command == "bind" || command == "unbind" || command == "reload";
+  return command == "bind" || command == "replace" || command == "unbind" || command == "reload";
 }
 
 std::optional<std::string> ControlProtocol::handle(std::string_view request_line, const PeerCredentials& peer,
@@ -144,7 +181,7 @@ ControlProtocol::Answer ControlProtocol::dispatch(const Json& request, const Pee
   if (command == "channel") return channel(request);
   if (mutating) return mutate(command, request, peer, later);
   return failure("unknown_command", "unknown command '" + printable(command) +
-                                        "' (status, segments, channels, channel, bind, unbind, reload)");
+                                        "' (status, segments, channels, channel, bind, replace, unbind, reload)");
 }
 
 ControlProtocol::Answer ControlProtocol::mutate(const std::string& command, const Json& request, const PeerCredentials& peer,
@@ -155,7 +192,7 @@ ControlProtocol::Answer ControlProtocol::mutate(const std::string& command, cons
   if (admission_running()) {
     return failure("busy", "an admission is running (" + running_ + "); " + command + " refused, try again when it finishes");
   }
-  if (command == "bind") return bind(request, later);
+  if (command == "bind" || command == "replace") return bind(request, command == "replace", later);
   if (command == "reload") return reload(later);
   return finish(command, request, unbind(request));
 }
@@ -373,7 +410,7 @@ Json ControlProtocol::channel(const Json& request) const {
   return Json{{"ok", true}, {"channel", entry}};
 }
 
-ControlProtocol::Answer ControlProtocol::bind(const Json& request, const Reply& later) {
+ControlProtocol::Answer ControlProtocol::bind(const Json& request, bool replace, const Reply& later) {
   if (!request.contains("yaml") || !request["yaml"].is_string()) {
     return failure("bad_request", "\"yaml\" (string with channel definitions) is required");
   }
@@ -384,11 +421,31 @@ ControlProtocol::Answer ControlProtocol::bind(const Json& request, const Reply& 
     out["errors"] = to_json(parsed.errors);
     return out;
   }
-  const std::string what = "bind of " + names_of(parsed.channels);
-  auto plan = std::make_shared<BindPlan>(gateway_.bind_plan_input(std::move(parsed.channels)));
+  if (replace) {
+    // A replacement of something not bound is most likely a wrong name: binding it would leave
+    // the channel meant to be replaced running as it was.
+    std::string unbound;
+    for (const auto& c : parsed.channels) {
+      if (!gateway_.knowledge_base().find_bound(c.name)) unbound += (unbound.empty() ? "'" : ", '") + c.name + "'";
+    }
+    if (!unbound.empty()) {
+      return failure("not_found", "no bound channel named " + unbound +
+                                      " to replace; nothing changed (bind a new channel without --replace)");
+    }
+  }
+  const std::string command = replace ? "replace" : "bind";
+  const std::string what = command + " of " + names_of(parsed.channels);
+  auto plan = std::make_shared<BindPlan>(replace ? gateway_.replace_plan_input(std::move(parsed.channels))
+                                                 : gateway_.bind_plan_input(std::move(parsed.channels)));
   return run_admission(
-      what, [plan] { Gateway::plan_bind(*plan); },
-      [this, plan, request] { return finish("bind", request, bind_answer(gateway_.commit_bind(std::move(*plan)))); }, later);
+      what, [plan] { replace_or_bind(*plan); },
+      [this, plan, request, command] {
+        const BindResult result = gateway_.commit_bind(std::move(*plan));
+        Json answer = bind_answer(result);
+        if (result.replaced.size() > 0) answer["replaced"] = replaced_answer(result);
+        return finish(command, request, std::move(answer));
+      },
+      later);
 }
 
 Json ControlProtocol::unbind(const Json& request) {

@@ -8,7 +8,7 @@ namespace {
 
 // Known commands by name; any other text is one key, so made-up commands cannot multiply bursts.
 std::string command_key(std::string_view command) {
-  for (const char* known : {"status", "segments", "channels", "channel", "bind", "unbind", "reload"}) {
+  for (const char* known : {"status", "segments", "channels", "channel", "bind", "replace", "unbind", "reload"}) {
     if (command == known) return known;
   }
   return "?";

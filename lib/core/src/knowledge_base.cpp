@@ -88,7 +88,7 @@ std::optional<std::string> KnowledgeBase::native_clash(const ChannelSpec& channe
   return std::nullopt;
 }
 
-KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel) const {
+KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel, std::optional<std::uint16_t> preferred_etag) const {
   Attempt a;
   if (find_bound(channel.name)) {
     a.report = rejection(channel, "channel " + channel.name + " is already bound");
@@ -105,6 +105,9 @@ KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel) const 
         return a;
       }
       a.etag = *channel.etag;
+    } else if (preferred_etag && *preferred_etag > kHighestReservedEtag && *preferred_etag <= kMaxEtag &&
+               !etag_taken_.test(*preferred_etag) && !native_etags_.count(*preferred_etag)) {
+      a.etag = *preferred_etag;
     } else if (const auto etag = allocate_etag()) {
       a.etag = *etag;
     } else {
@@ -127,8 +130,8 @@ KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel) const 
   return a;
 }
 
-BindOutcome KnowledgeBase::bind(const ChannelSpec& channel) {
-  Attempt a = attempt(channel);
+BindOutcome KnowledgeBase::bind(const ChannelSpec& channel, std::optional<std::uint16_t> preferred_etag) {
+  Attempt a = attempt(channel, preferred_etag);
   if (a.report.verdict != Verdict::rejected) {
     if (a.etag) {
       etags_[channel.name] = *a.etag;

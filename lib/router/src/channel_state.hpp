@@ -22,7 +22,8 @@ struct ChannelState {
         bucket(route.spec.period.value_or(Nanos(0)),
                policing_depth(route.spec.period.value_or(Nanos(0)), route.ingress_jitter, burst)),
         counters(segment_count),
-        egress(route.subscribers.size()) {}
+        egress(route.subscribers.size()),
+        retired_egress(segment_count) {}
 
   const Route route;
   PiMutex policy_mutex;  // guards bucket, dedup and loop_guard (ingress threads of several segments)
@@ -35,6 +36,10 @@ struct ChannelState {
   std::atomic<std::uint32_t> next_sequence{0};
   std::atomic<std::uint64_t> forwarded{0};
   std::atomic<bool> removed{false};
+  // Set when the route was changed under the same channel id (a replaced definition): events
+  // already queued still go to the subscriber segments the new route keeps, not to the others
+  // (indexed by segment slot).
+  std::vector<std::atomic<bool>> retired_egress;
 };
 
 }  // namespace cosmic

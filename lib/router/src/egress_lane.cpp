@@ -121,7 +121,7 @@ void EgressLane::forward(LaneItem& item) noexcept {
   context_.progress.fetch_add(1, std::memory_order_relaxed);
   ChannelState& channel = *item.channel;
   SegmentAdapter* adapter = adapter_.load(std::memory_order_acquire);
-  if (channel.removed.load(std::memory_order_relaxed) ||
+  if (channel.removed.load(std::memory_order_relaxed) || channel.retired_egress[segment_].load(std::memory_order_relaxed) ||
       item.generation != current_generation_.load(std::memory_order_acquire)) {
     discard(item);
     return;

@@ -101,13 +101,30 @@ void Router::apply(std::vector<Route> routes) {
       next->channels.push_back(*existing);
     } else {
       next->channels.push_back(std::make_shared<ChannelState>(std::move(route), segment_names_.size(), limits_.rate_burst));
+      // The same channel under a changed route goes on numbering what this gateway originates:
+      // a receiver's duplicate window must not take the restarted numbers for copies.
+      if (existing != current->channels.end() && (*existing)->route.id == next->channels.back()->route.id) {
+        next->channels.back()->next_sequence.store((*existing)->next_sequence.load());
+      }
     }
   }
   std::sort(next->channels.begin(), next->channels.end(), [](const auto& a, const auto& b) { return a->route.id < b->route.id; });
   for (const auto& old : current->channels) {
     const auto kept = std::lower_bound(next->channels.begin(), next->channels.end(), old->route.id,
                                        [](const auto& s, ChannelId v) { return s->route.id < v; });
-    if (kept == next->channels.end() || *kept != old) old->removed.store(true);
+    if (kept != next->channels.end() && *kept == old) continue;
+    if (kept == next->channels.end() || (*kept)->route.id != old->route.id) {
+      old->removed.store(true);
+      continue;
+    }
+    // The same channel under a changed route: what is queued for a subscriber segment the new
+    // route keeps is the channel's own traffic, and the segment still carries the channel id.
+    const auto& stays = (*kept)->route.subscribers;
+    for (const std::size_t segment : old->route.subscribers) {
+      if (std::find(stays.begin(), stays.end(), segment) == stays.end() && segment < old->retired_egress.size()) {
+        old->retired_egress[segment].store(true);
+      }
+    }
   }
   // Readers holding the old snapshot keep it alive until they let go (their last event of it).
   std::shared_ptr<const Table> retired;

@@ -1,6 +1,7 @@
 #include "cosmic/gateway.hpp"
 
 #include "cosmic/can_interference.hpp"
+#include "cosmic/channel_changes.hpp"
 
 #include <algorithm>
 #include <optional>
@@ -226,7 +227,7 @@ BindResult Gateway::bind(const std::vector<ChannelSpec>& channels) {
 }
 
 BindPlan Gateway::bind_plan_input(std::vector<ChannelSpec> channels) const {
-  return BindPlan{generation_, std::move(channels), std::make_shared<KnowledgeBase>(*kb_), {}, false};
+  return BindPlan{generation_, std::move(channels), std::make_shared<KnowledgeBase>(*kb_), {}, false, false, {}};
 }
 
 void Gateway::plan_bind(BindPlan& plan) {
@@ -242,6 +243,11 @@ BindResult Gateway::commit_bind(BindPlan plan) {
   BindResult result;
   result.channels = std::move(plan.reports);
   const auto& channels = plan.channels;
+  for (auto& before : plan.replaced) {
+    const auto now = std::find_if(channels.begin(), channels.end(), [&](const ChannelSpec& c) { return c.name == before.name; });
+    std::vector<std::string> changes = now != channels.end() ? definition_changes(before, *now) : std::vector<std::string>{};
+    result.replaced.push_back(ReplacedChannel{std::move(before), std::move(changes)});
+  }
   if (plan.generation != generation_) {
     result.error = "the bindings changed while admission ran; nothing changed, try again";
     return result;
@@ -253,6 +259,8 @@ BindResult Gateway::commit_bind(BindPlan plan) {
   ++generation_;
   KnowledgeBase previous = *kb_;
   *kb_ = std::move(*plan.kb);
+  // Replaced channels keep their ids, so the adapters see changed bindings, not new channels.
+  auto ids_before = plan.replacing ? take_over_ids(channels) : decltype(take_over_ids(channels)){};
   // A segment refusing one of the new channels undoes the whole bind; refusals of channels
   // bound before are theirs to show and do not block it.
   const Refusals refusals = configure_adapters();
@@ -267,12 +275,21 @@ BindResult Gateway::commit_bind(BindPlan plan) {
   }
   if (!refused.empty()) {
     *kb_ = std::move(previous);
+    if (plan.replacing) undo_takeover(std::move(ids_before));
     configure_adapters();
     result.error = refused + "; nothing changed";
     return result;
   }
   apply_routes();
-  for (const auto& channel : channels) log_.log(LogLevel::notice, "bound channel " + channel.name);
+  if (!plan.replacing) {
+    for (const auto& channel : channels) log_.log(LogLevel::notice, "bound channel " + channel.name);
+  }
+  for (const auto& replaced : result.replaced) {
+    std::string changes;
+    for (const auto& change : replaced.changes) changes += (changes.empty() ? "" : "; ") + change;
+    log_.log(LogLevel::notice, "replaced the definition of channel " + replaced.before.name + " (" +
+                                   (changes.empty() ? std::string("unchanged") : changes) + ")");
+  }
   result.applied = true;
   return result;
 }

@@ -11,6 +11,7 @@
 #include "cosmic/can_adapter.hpp"
 #include "cosmic/can_wire.hpp"
 #include "frame_backlog.hpp"
+#include "receive_buffer.hpp"
 
 namespace cosmic {
 namespace {
@@ -65,6 +66,69 @@ TEST(CanBacklog, LowestIdentifierFirstAndFifoWithinOneIdentifier) {
     backlog.pop();
   }
   EXPECT_EQ(order, (std::vector<int>{2, 4, 1, 3, 5}));
+}
+
+// A standard frame beats an extended one with the same 11 base bits (its RTR meets the extended
+// frame's recessive SRR), and loses to a lower base: the backlog orders them as the bus does.
+TEST(CanBacklog, StandardAndExtendedFramesLeaveInArbitrationOrder) {
+  FrameBacklog backlog(4);
+  canfd_frame standard{};
+  standard.can_id = 0x123;  // base 0x123
+  standard.data[0] = 1;
+  ASSERT_TRUE(backlog.push(frame_with(0x123u << 18 | 0x5, 2), false));  // base 0x123, extended
+  ASSERT_TRUE(backlog.push(standard, false));
+  ASSERT_TRUE(backlog.push(frame_with(0x122u << 18 | 0x3FFFF, 3), false));  // base 0x122: first
+  std::vector<int> order;
+  while (!backlog.empty()) order.push_back(backlog.take().frame.data[0]);
+  EXPECT_EQ(order, (std::vector<int>{3, 1, 2}));
+}
+
+// The receive thread takes a frame out to write it without the lock; it keeps its place in the
+// count meanwhile, and a frame the kernel refused goes back ahead of later frames of its identifier.
+TEST(CanBacklog, ARestoredFrameKeepsItsPlaceAheadOfLaterFramesOfItsIdentifier) {
+  FrameBacklog backlog(3);
+  ASSERT_TRUE(backlog.push(frame_with(0x100, 1), false));
+  const FrameBacklog::Entry taken = backlog.take();
+  ASSERT_TRUE(backlog.push(frame_with(0x100, 2), false));
+  ASSERT_TRUE(backlog.push(frame_with(0x100, 3), false));
+  EXPECT_FALSE(backlog.room_for(1));  // the taken frame holds its place
+  backlog.restore(taken);
+  EXPECT_EQ(backlog.size(), 3u);
+  EXPECT_EQ(backlog.taken(), 0u);
+  std::vector<int> order;
+  while (!backlog.empty()) order.push_back(backlog.take().frame.data[0]);
+  EXPECT_EQ(order, (std::vector<int>{1, 2, 3}));
+}
+
+// Frames the kernel took free their places; the backlog never exceeds its capacity.
+TEST(CanBacklog, SettledFramesFreeTheirPlaces) {
+  FrameBacklog backlog(2);
+  ASSERT_TRUE(backlog.push(frame_with(0x100, 1), false));
+  ASSERT_TRUE(backlog.push(frame_with(0x100, 2), false));
+  (void)backlog.take();
+  (void)backlog.take();
+  EXPECT_FALSE(backlog.room_for(1));
+  backlog.settle(1);
+  EXPECT_TRUE(backlog.room_for(1));
+  EXPECT_FALSE(backlog.room_for(2));
+  backlog.settle(5);  // never below zero
+  EXPECT_EQ(backlog.taken(), 0u);
+  EXPECT_TRUE(backlog.room_for(2));
+}
+
+// The receive socket is sized for the bus: what it carries in kReceiveHold at its shortest frame.
+TEST(CanReceiveBuffer, HoldsWhatTheBusCarriesInTheHoldTime) {
+  CanSegmentProperties bus;
+  bus.bitrate = BitRate{1'000'000};
+  EXPECT_EQ(receive_buffer_frames(bus), 5320u);  // 1e6 / 47 frames/s for 250 ms, rounded up
+  bus.bitrate = BitRate{125'000};
+  EXPECT_EQ(receive_buffer_frames(bus), 665u);
+  bus.bitrate = BitRate{10'000};
+  EXPECT_EQ(receive_buffer_frames(bus), kMinReceiveFrames);
+  // The request is half the memory (the kernel doubles it); what a granted buffer holds.
+  EXPECT_EQ(receive_buffer_request(5320), 5320 * 768 / 2);
+  EXPECT_EQ(frames_held(5320 * 768), 5320u);
+  EXPECT_EQ(frames_held(212992), 277u);  // Linux's default buffer
 }
 
 class NullSink final : public EventSink {

@@ -1,10 +1,15 @@
 #!/usr/bin/env bash
-# `cpack -G DEB` builds an installable package (issue 5, item 8): it holds the binaries, the
-# unit, the sysusers file and the example configuration (a conffile); its Depends come from
-# dpkg-shlibdeps and cover every library cosmicd and cosmicctl load; it installs, keeps a
-# locally changed configuration on reinstall, and purges cleanly. Installation goes into a
-# scratch root (dpkg --root with chrootless maintainer scripts, which honour DPKG_ROOT), never
-# into this machine's /.
+# `cpack -G DEB` builds installable packages (issue 5, item 8; split as Debian does in issue 23,
+# item 7): cosmic-gateway holds the binaries, the unit, the sysusers file, the example
+# configuration (a conffile), the manual pages and the bash completion; libcosmic-client0 the
+# shared library (with a shlibs file), libcosmic-client-dev what building a component needs,
+# python3-cosmic the Python package; every binary is stripped and its debug symbols are in the
+# PACKAGE-dbgsym .ddeb under its build id. Every package's Depends (dpkg-shlibdeps) cover every
+# library its binaries load; the library exports exactly the functions of cosmic/client.h.
+# cosmic-gateway installs, keeps a locally changed configuration on reinstall, and purges
+# cleanly. Installation goes into a scratch root (dpkg --root with chrootless maintainer scripts,
+# which honour DPKG_ROOT), never into this machine's /. installed_build_test.sh builds a
+# component against the packages.
 #
 # Usage: deb_package_test.sh BUILD_DIR
 set -u
@@ -29,13 +34,16 @@ if ! cpack -G DEB --config "$BUILD/CPackConfig.cmake" -B "$WORK/pkg" >"$WORK/cpa
   exit 1
 fi
 grep -qi "warning" "$WORK/cpack.log" && { fail "cpack warned"; sed 's/^/    /' "$WORK/cpack.log" >&2; }
-mapfile -t debs < <(find "$WORK/pkg" -maxdepth 1 -name '*.deb')
-[ "${#debs[@]}" -eq 1 ] || { fail "expected one .deb, found ${#debs[@]}"; exit 1; }
-DEB=${debs[0]}
 ARCH=$(dpkg --print-architecture)
 VERSION=$(sed -n 's/^set(CPACK_PACKAGE_VERSION "\(.*\)")$/\1/p' "$BUILD/CPackConfig.cmake")
-[ "$(basename "$DEB")" = "cosmic-gateway_${VERSION}_$ARCH.deb" ] ||
-  fail "package file is $(basename "$DEB"), expected cosmic-gateway_${VERSION}_$ARCH.deb"
+PACKAGES="cosmic-gateway libcosmic-client0 libcosmic-client-dev python3-cosmic"
+expected_files=$(for p in $PACKAGES; do echo "${p}_${VERSION}_$ARCH.deb"; done
+                 for p in cosmic-gateway libcosmic-client0 python3-cosmic; do echo "$p-dbgsym_${VERSION}_$ARCH.ddeb"; done)
+actual_files=$(find "$WORK/pkg" -maxdepth 1 -name '*.*deb' -printf '%f\n')
+[ "$(sort <<<"$expected_files")" = "$(sort <<<"$actual_files")" ] ||
+  fail "package files: $(echo $actual_files), expected $(echo $expected_files)"
+DEB=$WORK/pkg/cosmic-gateway_${VERSION}_$ARCH.deb
+[ -f "$DEB" ] || exit 1
 
 note "contents"
 dpkg-deb -c "$DEB" >"$WORK/contents"
@@ -50,6 +58,9 @@ expect_entry -rw-r--r-- /usr/lib/sysusers.d/cosmic.conf
 expect_entry -rw-r--r-- /etc/cosmic/cosmicd.yaml
 expect_entry -rw-r--r-- /usr/share/doc/cosmic-gateway/operations.md
 expect_entry -rw-r--r-- /usr/share/doc/cosmic-gateway/examples/overloaded.yaml
+expect_entry -rw-r--r-- /usr/share/man/man8/cosmicd.8.gz
+expect_entry -rw-r--r-- /usr/share/man/man1/cosmicctl.1.gz
+expect_entry -rw-r--r-- /usr/share/bash-completion/completions/cosmicctl
 strays=$(awk '{ print $6 }' "$WORK/contents" | grep -vE '^\./(etc/|etc/cosmic/.*|usr/.*)$')
 [ -z "$strays" ] || fail "files outside /etc/cosmic and /usr: $strays"
 
@@ -60,10 +71,16 @@ field() { dpkg-deb -f "$DEB" "$1"; }
 [ "$(field Architecture)" = "$ARCH" ] || fail "Architecture: $(field Architecture), expected $ARCH"
 DEPENDS=$(field Depends)
 [ -n "$DEPENDS" ] || fail "no Depends"
-# Every library the two binaries link directly (DT_NEEDED) comes from a package that Depends
-# names, itself or through its Provides (libspdlog1.10 provides libspdlog1.10-fmt9).
-dpkg-deb -x "$DEB" "$WORK/extracted"
-if ! python3 - "$DEPENDS" "$WORK/extracted/usr/sbin/cosmicd" "$WORK/extracted/usr/bin/cosmicctl" <<'PY'
+# Every library each binary of each package links directly (DT_NEEDED) comes from a package that
+# its Depends names, itself or through its Provides (libspdlog1.10 provides libspdlog1.10-fmt9).
+# depends_cover PACKAGE: extracts it to $WORK/extracted/PACKAGE and checks its ELF files.
+depends_cover() {
+  local deb=$WORK/pkg/${1}_${VERSION}_$ARCH.deb dir=$WORK/extracted/$1 elves
+  mkdir -p "$dir"
+  dpkg-deb -x "$deb" "$dir"
+  mapfile -t elves < <(find "$dir" -type f -exec sh -c 'head -c 4 "$1" | grep -q "ELF"' _ {} \; -print | sort)
+  [ "${#elves[@]}" -gt 0 ] || return 0
+  python3 - "$(dpkg-deb -f "$deb" Depends)" "${elves[@]}" <<'PY' || fail "$1: Depends ($(dpkg-deb -f "$deb" Depends)) misses libraries its binaries need"
 import os, re, subprocess, sys
 depends = {re.sub(r"[ (].*", "", alt.strip()) for part in sys.argv[1].split(",") for alt in part.split("|")}
 def run(*args):
@@ -100,9 +117,58 @@ for binary in sys.argv[2:]:
             print(f"   {os.path.basename(binary)}: {soname} <- {sorted(names & depends)[0]}")
 sys.exit(1 if bad else 0)
 PY
-then
-  fail "Depends ($DEPENDS) misses libraries the binaries need"
-fi
+}
+for package in $PACKAGES; do
+  depends_cover "$package"
+done
+
+note "libcosmic-client0, libcosmic-client-dev, python3-cosmic"
+X=$WORK/extracted
+LIB=usr/lib/$(gcc -print-multiarch)
+[ -f "$X/libcosmic-client0/$LIB/libcosmic-client.so.$VERSION" ] || fail "libcosmic-client0 lacks /$LIB/libcosmic-client.so.$VERSION"
+[ "$(readlink "$X/libcosmic-client0/$LIB/libcosmic-client.so.0")" = "libcosmic-client.so.$VERSION" ] ||
+  fail "libcosmic-client0: libcosmic-client.so.0 is not a link to libcosmic-client.so.$VERSION"
+[ "$(objdump -p "$X/libcosmic-client0/$LIB/libcosmic-client.so.$VERSION" | awk '/SONAME/ { print $2 }')" = libcosmic-client.so.0 ] ||
+  fail "the library's SONAME is not libcosmic-client.so.0"
+dpkg-deb -e "$WORK/pkg/libcosmic-client0_${VERSION}_$ARCH.deb" "$WORK/control-lib"
+grep -qx "libcosmic-client 0 libcosmic-client0 (>= $VERSION)" "$WORK/control-lib/shlibs" 2>/dev/null ||
+  fail "libcosmic-client0 has no shlibs line for libcosmic-client.so.0: $(cat "$WORK/control-lib/shlibs" 2>&1)"
+grep -qx "activate-noawait ldconfig" "$WORK/control-lib/triggers" 2>/dev/null || fail "libcosmic-client0 does not trigger ldconfig"
+# The ABI is the C API: the functions client.h declares, every one of them and nothing else.
+declared=$(gcc -E -P -x c "$X/libcosmic-client-dev/usr/include/cosmic/client.h" | grep -oE '\bcosmic_[a-z_]+ *\(' | tr -d ' (' | sort -u)
+# (the version node COSMIC_CLIENT_0 is listed as an absolute symbol: it names the ABI, it is no function)
+exported=$(nm -D --defined-only "$X/libcosmic-client0/$LIB/libcosmic-client.so.$VERSION" | awk '$2 != "A" { print $3 }' | sed 's/@.*//' | sort -u)
+[ -n "$declared" ] && [ "$declared" = "$exported" ] ||
+  fail "the library exports $(comm -13 <(echo "$declared") <(echo "$exported") | tr '\n' ' ')beyond client.h and lacks $(comm -23 <(echo "$declared") <(echo "$exported") | tr '\n' ' ')"
+for f in usr/include/cosmic/client.h usr/include/cosmic/client.hpp $LIB/pkgconfig/cosmic-client.pc \
+         $LIB/cmake/cosmic_client/cosmic_client-config.cmake $LIB/cmake/cosmic_client/cosmic_client-config-version.cmake \
+         $LIB/cmake/cosmic_client/cosmic_client-targets.cmake; do
+  [ -f "$X/libcosmic-client-dev/$f" ] || fail "libcosmic-client-dev lacks /$f"
+done
+[ "$(readlink "$X/libcosmic-client-dev/$LIB/libcosmic-client.so")" = libcosmic-client.so.0 ] ||
+  fail "libcosmic-client-dev: libcosmic-client.so is not a link to libcosmic-client.so.0"
+grep -qx "prefix=/usr" "$X/libcosmic-client-dev/$LIB/pkgconfig/cosmic-client.pc" || fail "cosmic-client.pc: the prefix is not /usr"
+ls "$X/python3-cosmic/usr/lib/python3/dist-packages/cosmic/"_native.cpython-*.so >/dev/null 2>&1 &&
+  [ -f "$X/python3-cosmic/usr/lib/python3/dist-packages/cosmic/__init__.py" ] ||
+  fail "python3-cosmic lacks the package cosmic in /usr/lib/python3/dist-packages"
+dpkg-deb -f "$WORK/pkg/python3-cosmic_${VERSION}_$ARCH.deb" Depends | grep -qE "python3 \(<< 3\.[0-9]+\)" ||
+  fail "python3-cosmic does not bound the python3 its extension is built for"
+# No file in two packages (dpkg would refuse to install the second).
+for p in $PACKAGES; do dpkg-deb -c "$WORK/pkg/${p}_${VERSION}_$ARCH.deb" | awk '$1 !~ /^d/ { print $6 }'; done | sort | uniq -d >"$WORK/shared"
+[ -s "$WORK/shared" ] && fail "files in more than one package: $(tr '\n' ' ' <"$WORK/shared")"
+
+note "stripped binaries, debug symbols in the -dbgsym packages"
+for p in cosmic-gateway libcosmic-client0 python3-cosmic; do
+  dpkg-deb -x "$WORK/pkg/$p-dbgsym_${VERSION}_$ARCH.ddeb" "$WORK/dbgsym"
+done
+while read -r elf; do
+  [ -L "$elf" ] && continue
+  readelf -S "$elf" | grep -q '\.debug_info' && fail "${elf#"$X"/} is not stripped"
+  id=$(readelf -n "$elf" | sed -n 's/^ *Build ID: //p')
+  [ -n "$id" ] || { fail "${elf#"$X"/} has no build id"; continue; }
+  debug=$WORK/dbgsym/usr/lib/debug/.build-id/${id:0:2}/${id:2}.debug
+  readelf -S "$debug" 2>/dev/null | grep -q '\.debug_info' || fail "no debug symbols for ${elf#"$X"/} ($debug)"
+done < <(find "$X" -type f -exec sh -c 'head -c 4 "$1" | grep -q "ELF"' _ {} \; -print)
 dpkg-deb -e "$DEB" "$WORK/control"
 [ "$(cat "$WORK/control/conffiles")" = /etc/cosmic/cosmicd.yaml ] || fail "conffiles: $(cat "$WORK/control/conffiles")"
 for script in postinst prerm postrm; do

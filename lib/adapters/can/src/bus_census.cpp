@@ -1,14 +1,10 @@
 #include "bus_census.hpp"
 
 #include "cosmic/can_timing.hpp"
+#include "frame_key.hpp"
 
 namespace cosmic::can_census {
 namespace {
-
-std::uint32_t key_of(canid_t can_id) {
-  return (can_id & CAN_EFF_FLAG) ? arbitration_key(can_id & CAN_EFF_MASK, CanIdFormat::extended29)
-                                 : arbitration_key(can_id & CAN_SFF_MASK, CanIdFormat::standard11);
-}
 
 // The identifier back from an arbitration key (see arbitration_key in can_timing.hpp).
 UnexplainedFrames identifier_of(std::uint32_t key) {
@@ -21,7 +17,7 @@ UnexplainedFrames identifier_of(std::uint32_t key) {
 
 void BusCensus::count(canid_t can_id, Nanos now) {
   LockGuard lock(mutex_);
-  const std::uint32_t key = key_of(can_id);
+  const std::uint32_t key = frame_arbitration_key(can_id);
   auto it = tallies_.find(key);
   if (it == tallies_.end()) {
     if (tallies_.size() >= kMaxIdentifiers) {

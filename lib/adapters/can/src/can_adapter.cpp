@@ -48,7 +48,7 @@ void CanAdapter::stop() {
   if (thread_.joinable()) thread_.join();
   close_socket();
   {
-    LockGuard lock(io_mutex_);
+    PiLock lock(io_mutex_);
     backlog_.clear();
     answers_.clear();
     pending_requests_.clear();
@@ -149,7 +149,7 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
     table->filters.assign(1, can_filter{0, 0});  // too many: every frame, filtered in user space
   }
 
-  LockGuard lock(io_mutex_);
+  PiLock lock(io_mutex_);
   if (sock_ >= 0 && ::setsockopt(sock_, SOL_CAN_RAW, CAN_RAW_FILTER, table->filters.data(),
                                  static_cast<socklen_t>(table->filters.size() * sizeof(can_filter))) != 0) {
     // The kernel keeps the old filters, so the old table stays: the whole segment failed.
@@ -197,7 +197,7 @@ std::optional<std::string> CanAdapter::bind_native(const ChannelBinding& b, Tabl
 void CanAdapter::refresh_rx_table() {
   const std::uint64_t generation = generation_.load(std::memory_order_acquire);
   if (generation != rx_generation_) {
-    LockGuard lock(io_mutex_);
+    PiLock lock(io_mutex_);
     rx_table_ = table_;
     rx_generation_ = generation;
   }
@@ -243,15 +243,19 @@ void CanAdapter::set_link(Link link, std::string detail) {
   }
   link_up_ = link == Link::up;
   if (went_down || (link != Link::up && backlog_size_ > 0)) {
-    LockGuard lock(io_mutex_);
-    drop_backlog("interface not up");
+    std::string dropped;
+    {
+      PiLock lock(io_mutex_);
+      dropped = drop_backlog("interface not up");
+    }
+    log_unlocked(dropped);
   }
   if (came_up || went_down) {
     reassembler_.clear();
     afp_.clear();
   }
   if (came_up) {
-    LockGuard lock(io_mutex_);
+    PiLock lock(io_mutex_);
     send_error_logged_ = false;
   }
 }

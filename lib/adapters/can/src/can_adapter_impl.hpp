@@ -25,6 +25,7 @@
 #include <cstdio>
 #include <cstring>
 #include <deque>
+#include <memory>
 #include <string>
 #include <thread>
 #include <unordered_map>
@@ -35,6 +36,7 @@
 #include "can_binding.hpp"
 #include "cosmic/arrival_clock.hpp"
 #include "cosmic/mutex.hpp"
+#include "cosmic/pi_mutex.hpp"
 #include "cosmic/thread_annotations.hpp"
 #include "cosmic/thread_policy.hpp"
 #include "cosmic/can_fragment.hpp"
@@ -45,6 +47,7 @@
 #include "frame_backlog.hpp"
 #include "bus_census.hpp"
 #include "native_frames.hpp"
+#include "receive_buffer.hpp"
 #include "cosmic/can_adapter.hpp"
 
 namespace cosmic::can_detail {
@@ -60,6 +63,7 @@ constexpr Nanos kLinkCheckWhileUp = milliseconds(1000);
 constexpr Nanos kEnobufsRetry = milliseconds(1);
 constexpr int kFramesPerWakeup = 256;
 constexpr std::size_t kReadBatch = 32;  // frames per recvmmsg
+constexpr std::size_t kWriteBatch = FrameBacklog::kMaxTaken;  // frames per sendmmsg
 constexpr std::size_t kFdPaddingSlack = 15;  // 48 -> 64 is the largest step between FD lengths
 constexpr can_err_mask_t kErrorMask = CAN_ERR_CRTL | CAN_ERR_BUSOFF | CAN_ERR_RESTARTED;
 constexpr Nanos kDeferredRequestRetry = std::chrono::milliseconds(20);  // well below one token (100 ms)
@@ -91,6 +95,23 @@ inline std::vector<can_filter> protocol_filters(bool famouso) {
   }
   return f;
 }
+
+// The adapter's CAN_RAW socket. Senders write without holding the I/O lock, each with a
+// reference taken under it; the descriptor is closed when the last reference goes, so the receive
+// thread may give the socket up (interface gone, reopened) while a write is in flight without the
+// number being reused under that write.
+class TxSocket {
+ public:
+  explicit TxSocket(int fd) : fd_(fd) {}
+  ~TxSocket() { ::close(fd_); }
+  TxSocket(const TxSocket&) = delete;
+  TxSocket& operator=(const TxSocket&) = delete;
+  int fd() const { return fd_; }
+
+ private:
+  int fd_;
+};
+using TxSocketRef = std::shared_ptr<const TxSocket>;
 
 class CanAdapter final : public SegmentAdapter {
  public:
@@ -153,6 +174,7 @@ class CanAdapter final : public SegmentAdapter {
   void run();
   void check_link();
   bool open_socket(int ifindex);
+  void size_receive_buffer(int s);  // receive_buffer.hpp
   void close_socket() COSMIC_EXCLUDES(io_mutex_);
   void read_frames();
   // sock_ as the receive thread sees it without io_mutex_: it is the only thread that changes sock_.
@@ -180,25 +202,35 @@ class CanAdapter final : public SegmentAdapter {
   void refresh_rx_table() COSMIC_EXCLUDES(io_mutex_);  // the receive thread's snapshot of the bindings (rx_table_)
   // configure(): a native channel's binding into `table`; the reason when it cannot be carried.
   std::optional<std::string> bind_native(const ChannelBinding& b, Table& table) const;
-  SendStatus send_frame(const canfd_frame& frame) COSMIC_REQUIRES(io_mutex_);
 
   // --- health
   void set_link(Link link, std::string detail);
   void set_controller(Controller state);
   void update_health() COSMIC_REQUIRES(health_mutex_);
 
-  // --- send side
-  WriteResult submit(const canfd_frame& frame, bool fd) COSMIC_REQUIRES(io_mutex_);
+  // --- send side (can_send.cpp). No lock is held across a write: a lower class's sender held
+  // up inside the kernel cannot hold up a higher class's sender, which waits at most for another
+  // sender's few-instruction critical section (io_mutex_ inherits priority).
+  // Frames of one event, in order, to the kernel or the backlog; takes io_mutex_ briefly.
+  WriteResult submit(std::span<const canfd_frame> frames, bool fd) COSMIC_EXCLUDES(io_mutex_);
+  // Whether a frame must wait behind the backlog: a queued or in-flight backlog frame would win
+  // arbitration over it (or has its identifier), so writing it now would overtake that frame.
+  bool behind_backlog(canid_t can_id) const COSMIC_REQUIRES(io_mutex_);
+  WriteResult queue_frames(std::span<const canfd_frame> frames, bool fd) COSMIC_REQUIRES(io_mutex_);
+  static SendStatus to_send_status(WriteResult result);
+  void note_refusal(int err) COSMIC_REQUIRES(io_mutex_);  // EAGAIN/ENOBUFS: how the backlog waits
+  // Counts; the first time, returns the line to log once io_mutex_ is given up (log_unlocked).
+  std::string count_send_error(int err) COSMIC_REQUIRES(io_mutex_);
+  void log_unlocked(const std::string& line) COSMIC_EXCLUDES(io_mutex_);  // a warning; nothing when empty
+  SendStatus send_fragments(const TxChannel& channel, std::span<const std::uint8_t> payload, std::uint8_t sequence);
   void queue_answer(std::uint32_t can_id, std::span<const std::uint8_t> data) COSMIC_REQUIRES(io_mutex_);
   void queue_supply_etag(std::uint8_t requester, std::uint16_t etag, std::uint64_t subject, const Table& table)
       COSMIC_REQUIRES(io_mutex_);
   void drain_answers() COSMIC_EXCLUDES(io_mutex_);
-  // `lock` holds io_mutex_; it is given up between fragments. Escape: the analysis cannot tell
-  // that the lock handed in by reference is io_mutex_'s (callers are still checked for it).
-  SendStatus send_afp(const TxChannel& channel, std::span<const std::uint8_t> payload, UniqueLock& lock)
-      COSMIC_REQUIRES(io_mutex_) COSMIC_NO_THREAD_SAFETY_ANALYSIS;
+  SendStatus send_afp(const TxChannel& channel, std::span<const std::uint8_t> payload);
   void wake();
-  void drop_backlog(const char* why) COSMIC_REQUIRES(io_mutex_);
+  // Returns the warning to log once io_mutex_ is given up (empty when nothing was queued).
+  std::string drop_backlog(const char* why) COSMIC_REQUIRES(io_mutex_);
 
   const SegmentSpec segment_;
   Logger& log_;
@@ -224,14 +256,20 @@ class CanAdapter final : public SegmentAdapter {
   Nanos next_link_check_{0};
 
   // Socket and send side. The receive thread opens and closes the socket (holding io_mutex_);
-  // send(), configure() and the receive thread write through it holding io_mutex_.
-  mutable Mutex io_mutex_;
+  // send() and the receive thread take a reference to it under io_mutex_ and write outside it.
+  // A priority-inheriting mutex: the lanes of all three classes and the receive thread take it.
+  mutable PiMutex io_mutex_;
   int sock_ COSMIC_GUARDED_BY(io_mutex_) = -1;  // the receive thread reads it unlocked: receive_socket()
+  TxSocketRef tx_socket_ COSMIC_GUARDED_BY(io_mutex_);  // owns sock_'s descriptor
   int census_sock_ = -1;  // only the receive thread opens, reads and closes it
   bool census_error_logged_ = false;
+  bool receive_buffer_warned_ = false;  // receive thread
   std::shared_ptr<const Table> table_ COSMIC_GUARDED_BY(io_mutex_);
   std::atomic<std::uint64_t> generation_{0};
   FrameBacklog backlog_ COSMIC_GUARDED_BY(io_mutex_);
+  // The arbitration key of the first backlog frame the receive thread is writing (taken out of
+  // the backlog, not yet accepted by the kernel): it still counts as queued for behind_backlog().
+  std::optional<std::uint32_t> draining_key_ COSMIC_GUARDED_BY(io_mutex_);
   ProtocolQueue answers_ COSMIC_GUARDED_BY(io_mutex_);  // binding and CCP answers: after the backlog, paced
   BindingRateLimit request_limit_ COSMIC_GUARDED_BY(io_mutex_);
   // FAMOUSO: unknown subjects, answered on bind

@@ -95,7 +95,7 @@ void CanAdapter::handle_famouso_protocol(const CanIdentifier& id, const canfd_fr
     if (table.tx_node) ccp_->reserve(*table.tx_node);
     const auto answer = ccp_->on_request(frame.can_id & CAN_EFF_MASK, now);
     if (answer) {
-      LockGuard lock(io_mutex_);
+      PiLock lock(io_mutex_);
       queue_answer(answer->can_id, answer->data);
     } else if (ccp_->exhausted()) {
       problem(kNoChannel, InboundProblem::decode_error);
@@ -171,7 +171,7 @@ void CanAdapter::handle_get_etag(const canfd_frame& frame, std::size_t len, Nano
     return;
   }
   const Table& table = *rx_table_;
-  LockGuard lock(io_mutex_);
+  PiLock lock(io_mutex_);
   if (!request_limit_.admit(request->requester, now)) {
     ++receive_errors_;
     defer_request(*request);
@@ -196,7 +196,7 @@ void CanAdapter::defer_request(const can_binding::GetEtagRequest& request) {
 }
 
 void CanAdapter::serve_deferred_requests(Nanos now) {
-  LockGuard lock(io_mutex_);
+  PiLock lock(io_mutex_);
   if (deferred_requests_.empty()) return;
   const Table& table = *rx_table_;
   std::erase_if(deferred_requests_, [&](const can_binding::GetEtagRequest& r) COSMIC_REQUIRES(io_mutex_) {
@@ -244,20 +244,31 @@ void CanAdapter::queue_answer(std::uint32_t can_id, std::span<const std::uint8_t
   wake();
 }
 
-// One answer per call, only when no real-time frame waits in the backlog.
+// One answer per call, only when no real-time frame waits in the backlog. Written outside the
+// lock like every frame (can_send.cpp); only this thread takes answers out of the queue, so the
+// one written is still the queue's first when the result is noted.
 void CanAdapter::drain_answers() {
-  LockGuard lock(io_mutex_);
-  if (sock_ < 0 || !backlog_.empty()) return;
-  const Nanos now = steady_now();
-  const can_frame* answer = answers_.due(now);
-  if (!answer) return;
-  const ssize_t n = ::write(sock_, answer, CAN_MTU);
+  TxSocketRef socket;
+  can_frame answer{};
+  Nanos now{0};
+  {
+    PiLock lock(io_mutex_);
+    if (!tx_socket_ || !backlog_.empty() || draining_key_) return;
+    now = steady_now();
+    const can_frame* due = answers_.due(now);
+    if (!due) return;
+    answer = *due;
+    socket = tx_socket_;
+  }
+  const ssize_t n = ::write(socket->fd(), &answer, CAN_MTU);
+  const int err = n < 0 ? errno : EIO;
+  PiLock lock(io_mutex_);
+  if (answers_.empty()) return;  // stop() cleared the queue meanwhile
   if (n == static_cast<ssize_t>(CAN_MTU)) {
     ++sent_;
     answers_.sent(now);
     return;
   }
-  const int err = n < 0 ? errno : EIO;
   if (err == EAGAIN || err == EWOULDBLOCK || err == ENOBUFS) {
     answers_.wait(now);  // the kernel's queue is full: try again one gap later
     return;
@@ -270,7 +281,7 @@ void CanAdapter::handle_protocol_timeouts(Nanos now) {
   afp_.expire(now, [this](std::uint32_t source) { reassembly_losses(kNoChannel, source, false); });
   if (!ccp_) return;
   if (const auto reset = ccp_->expire(now)) {
-    LockGuard lock(io_mutex_);
+    PiLock lock(io_mutex_);
     queue_answer(reset->can_id, reset->data);
   }
 }

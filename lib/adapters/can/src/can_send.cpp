@@ -3,145 +3,96 @@
 namespace cosmic::can_detail {
 
 // ------------------------------------------------------------------------------ send side
+//
+// The lanes of every class and the receive thread (backlog, binding answers) write to the one
+// CAN_RAW socket. None of them holds io_mutex_ across a system call: under it they only decide
+// (write now or queue behind the backlog) and take a reference to the socket. An NRT sender held
+// up in the kernel or preempted mid-write therefore never delays an HRT sender, which writes in
+// parallel; the kernel keeps each frame whole.
 
-void CanAdapter::drop_backlog(const char* why) {
-  if (backlog_.empty()) return;
+namespace {
+
+bool kernel_full(int err) { return err == EAGAIN || err == EWOULDBLOCK || err == ENOBUFS; }
+
+// Writes `frames` in one system call where there are several; returns how many the kernel took
+// (the error of the first refused one in `err`).
+std::size_t write_frames(int fd, std::span<const canfd_frame> frames, bool fd_frames, int& err) {
+  const std::size_t mtu = fd_frames ? CANFD_MTU : CAN_MTU;
+  err = 0;
+  if (frames.size() == 1) {
+    const ssize_t n = ::write(fd, frames.data(), mtu);
+    if (n == static_cast<ssize_t>(mtu)) return 1;
+    err = n < 0 ? errno : EIO;
+    return 0;
+  }
+  std::array<iovec, kWriteBatch> iovs;
+  std::array<mmsghdr, kWriteBatch> messages;
+  const std::size_t count = std::min(frames.size(), kWriteBatch);
+  for (std::size_t i = 0; i < count; ++i) {
+    iovs[i] = iovec{const_cast<canfd_frame*>(&frames[i]), mtu};
+    messages[i] = mmsghdr{};
+    messages[i].msg_hdr.msg_iov = &iovs[i];
+    messages[i].msg_hdr.msg_iovlen = 1;
+  }
+  const int n = ::sendmmsg(fd, messages.data(), static_cast<unsigned>(count), MSG_DONTWAIT);
+  if (n < 0) {
+    err = errno;
+    return 0;
+  }
+  // A short count means the next frame was refused; its error shows on the next write.
+  if (static_cast<std::size_t>(n) < count) err = EAGAIN;
+  return static_cast<std::size_t>(n);
+}
+
+}  // namespace
+
+std::string CanAdapter::drop_backlog(const char* why) {
+  if (backlog_.empty()) return {};
   send_errors_ += backlog_.size();
-  log_.log(LogLevel::warning, "segment " + segment_.name + ": dropped " + std::to_string(backlog_.size()) +
-                                  " queued frames (" + why + ")");
+  std::string line = "segment " + segment_.name + ": dropped " + std::to_string(backlog_.size()) +
+                     " queued frames (" + why + ")";
   backlog_.clear();
   backlog_size_ = 0;
   wait_pollout_ = false;
   retry_at_.reset();
+  return line;
 }
 
-CanAdapter::WriteResult CanAdapter::submit(const canfd_frame& frame, bool fd) {
-  if (sock_ < 0) {
-    ++send_errors_;
-    return WriteResult::failed;
-  }
-  if (!backlog_.empty()) {
-    if (!backlog_.push(frame, fd)) {
-      ++send_errors_;
-      return WriteResult::full;
-    }
-    backlog_size_ = backlog_.size();
-    return WriteResult::queued;
-  }
-  const std::size_t mtu = fd ? CANFD_MTU : CAN_MTU;
-  const ssize_t n = ::write(sock_, &frame, mtu);
-  if (n == static_cast<ssize_t>(mtu)) {
-    ++sent_;
-    return WriteResult::written;
-  }
-  const int err = n < 0 ? errno : EIO;
-  if (err == EAGAIN || err == EWOULDBLOCK || err == ENOBUFS) {
-    backlog_.push(frame, fd);  // the backlog is empty here: there is room
-    backlog_size_ = backlog_.size();
-    wait_pollout_ = err != ENOBUFS;
-    if (err == ENOBUFS) retry_at_ = steady_now() + kEnobufsRetry;
-    wake();
-    return WriteResult::queued;
-  }
-  ++send_errors_;
-  if (!send_error_logged_) {
-    send_error_logged_ = true;
-    log_.log(LogLevel::warning, "segment " + segment_.name + ": write to " + segment_.can.interface + ": " +
-                                    errno_text(err) + " (further errors counted, not logged)");
-  }
-  return WriteResult::failed;
+void CanAdapter::log_unlocked(const std::string& line) {
+  if (!line.empty()) log_.log(LogLevel::warning, line);
 }
 
-void CanAdapter::drain_backlog() {
-  LockGuard lock(io_mutex_);
-  if (backlog_.empty() || sock_ < 0) return;
-  if (retry_at_ && steady_now() < *retry_at_) return;
-  retry_at_.reset();
-  wait_pollout_ = false;
-  while (!backlog_.empty()) {
-    const auto& entry = backlog_.top();
-    const std::size_t mtu = entry.fd ? CANFD_MTU : CAN_MTU;
-    const ssize_t n = ::write(sock_, &entry.frame, mtu);
-    if (n == static_cast<ssize_t>(mtu)) {
-      ++sent_;
-      backlog_.pop();
-      continue;
-    }
-    const int err = n < 0 ? errno : EIO;
-    if (err == EAGAIN || err == EWOULDBLOCK) {
-      wait_pollout_ = true;
-      break;
-    }
-    if (err == ENOBUFS) {
-      retry_at_ = steady_now() + kEnobufsRetry;
-      break;
-    }
-    if (err == ENETDOWN) {
-      drop_backlog("interface down");
-      break;
-    }
-    ++send_errors_;
-    backlog_.pop();
+bool CanAdapter::behind_backlog(canid_t can_id) const {
+  const std::uint32_t mine = frame_arbitration_key(can_id);
+  if (!backlog_.empty() && frame_arbitration_key(backlog_.top().frame.can_id) <= mine) return true;
+  return draining_key_ && *draining_key_ <= mine;
+}
+
+CanAdapter::WriteResult CanAdapter::queue_frames(std::span<const canfd_frame> frames, bool fd) {
+  if (!backlog_.room_for(frames.size())) {
+    send_errors_ += frames.size();
+    return WriteResult::full;
   }
+  for (const canfd_frame& frame : frames) backlog_.push(frame, fd);
   backlog_size_ = backlog_.size();
+  return WriteResult::queued;
 }
 
-SendStatus CanAdapter::send(const OutboundEvent& event) {
-  try {
-    UniqueLock lock(io_mutex_);
-    const std::shared_ptr<const Table> table = table_;  // kept alive while the lock is given up
-    const auto it = table->tx.find(event.channel);
-    if (it == table->tx.end() || !started_ || !link_up_ || sock_ < 0 || event.payload.size() > it->second.payload) {
-      ++send_errors_;
-      return SendStatus::failed;
-    }
-    const TxChannel& channel = it->second;
-    const bool fd = segment_.can.fd;
-    if (channel.native) return send_frame(can_native::encode(*channel.native, event.payload, fd, brs_));
-    canfd_frame frame{};
-    frame.can_id = channel.can_id | CAN_EFF_FLAG;
-    frame.flags = fd && brs_ ? CANFD_BRS : 0;
-    auto finish = [&](std::size_t len) {
-      const std::size_t wire = fd ? fd_padded_length(static_cast<std::uint32_t>(len)) : len;
-      std::memset(frame.data + len, 0, sizeof frame.data - len);
-      frame.len = static_cast<std::uint8_t>(wire);
-    };
-    if (famouso_ && event.payload.size() > famouso::kAfpMtu) return send_afp(channel, event.payload, lock);
-    if (!channel.fragmented || famouso_) {  // FAMOUSO: events of up to 8 bytes are plain frames
-      std::memcpy(frame.data, event.payload.data(), event.payload.size());
-      finish(event.payload.size());
-      return send_frame(frame);
-    }
-    const std::uint32_t count = fragment_count(event.payload.size(), capacity_);
-    if (!backlog_.empty() && !backlog_.room_for(count)) {
-      ++send_errors_;
-      return SendStatus::queue_full;
-    }
-    std::uint8_t& sequence = tx_sequence_[channel.etag];
-    Fragmenter fragments(event.payload, capacity_, sequence);
-    sequence = static_cast<std::uint8_t>((sequence + 1) % kFragmentSequenceModulo);
-    // The lock is given up between fragments, so a higher class sending on this bus from its own
-    // thread waits for at most one frame write, not for a whole fragmented event.
-    while (!fragments.done()) {
-      const std::size_t len = fragments.next(std::span<std::uint8_t>(frame.data, capacity_));
-      finish(len);
-      const WriteResult r = submit(frame, fd);
-      if (r == WriteResult::failed || r == WriteResult::full) return SendStatus::failed;
-      if (!fragments.done()) {
-        lock.unlock();
-        lock.lock();
-        if (sock_ < 0) return SendStatus::failed;
-      }
-    }
-    return SendStatus::sent;
-  } catch (...) {
-    ++send_errors_;
-    return SendStatus::failed;
-  }
+void CanAdapter::note_refusal(int err) {
+  wait_pollout_ = err != ENOBUFS;
+  if (err == ENOBUFS) retry_at_ = steady_now() + kEnobufsRetry;
 }
 
-SendStatus CanAdapter::send_frame(const canfd_frame& frame) {
-  switch (submit(frame, segment_.can.fd)) {
+std::string CanAdapter::count_send_error(int err) {
+  ++send_errors_;
+  if (send_error_logged_) return {};
+  send_error_logged_ = true;
+  return "segment " + segment_.name + ": write to " + segment_.can.interface + ": " + errno_text(err) +
+         " (further errors counted, not logged)";
+}
+
+SendStatus CanAdapter::to_send_status(WriteResult result) {
+  switch (result) {
     case WriteResult::written:
     case WriteResult::queued:
       return SendStatus::sent;
@@ -153,25 +104,199 @@ SendStatus CanAdapter::send_frame(const canfd_frame& frame) {
   return SendStatus::failed;
 }
 
-// FAMOUSO: an event of more than 8 bytes as AFP fragments with the identifier's fragment flag.
-SendStatus CanAdapter::send_afp(const TxChannel& channel, std::span<const std::uint8_t> payload,
-                                UniqueLock& lock) {
-  if (!backlog_.empty() && !backlog_.room_for(famouso::afp_fragment_count(payload.size()))) {
-    ++send_errors_;
-    return SendStatus::queue_full;
-  }
-  famouso::AfpFragmenter fragments(payload);
-  canfd_frame frame{};
-  frame.can_id = channel.afp_id | CAN_EFF_FLAG;
-  while (!fragments.done()) {
-    frame.len = static_cast<std::uint8_t>(fragments.next(std::span<std::uint8_t>(frame.data, famouso::kAfpMtu)));
-    const WriteResult r = submit(frame, false);
-    if (r == WriteResult::failed || r == WriteResult::full) return SendStatus::failed;
-    if (!fragments.done()) {  // as in send(): a higher class waits for at most one frame
-      lock.unlock();
-      lock.lock();
-      if (sock_ < 0) return SendStatus::failed;
+CanAdapter::WriteResult CanAdapter::submit(std::span<const canfd_frame> frames, bool fd) {
+  TxSocketRef socket;
+  std::optional<WriteResult> queued;
+  {
+    PiLock lock(io_mutex_);
+    if (!tx_socket_) {
+      send_errors_ += frames.size();
+      return WriteResult::failed;
     }
+    if (behind_backlog(frames.front().can_id)) {
+      queued = queue_frames(frames, fd);
+    } else {
+      socket = tx_socket_;
+    }
+  }
+  if (queued) {
+    wake();  // the receive thread may be past its last look at the backlog
+    return *queued;
+  }
+  std::size_t written = 0;
+  int err = 0;
+  while (written < frames.size()) {
+    const std::size_t n = write_frames(socket->fd(), frames.subspan(written), fd, err);
+    written += n;
+    sent_ += n;
+    if (err != 0) break;
+  }
+  if (written == frames.size()) return WriteResult::written;
+  WriteResult result = WriteResult::failed;
+  std::string log_line;  // logged after the lock is given up: the log may block
+  {
+    PiLock lock(io_mutex_);
+    if (!kernel_full(err) || !tx_socket_) {
+      // Refused for good, or the socket went away mid-event: the rest of the event is worthless.
+      log_line = count_send_error(err);
+      send_errors_ += frames.size() - written - 1;
+    } else {
+      // The kernel's queue is full: the rest waits in the backlog (in order: one identifier).
+      result = queue_frames(frames.subspan(written), fd);
+      if (result == WriteResult::queued) note_refusal(err);
+    }
+  }
+  log_unlocked(log_line);
+  if (result == WriteResult::queued) wake();
+  return result;
+}
+
+// Receive thread: the backlog in arbitration order, a batch of frames per system call. The
+// frames being written count as queued (draining_key_) so no sender overtakes them meanwhile.
+void CanAdapter::drain_backlog() {
+  std::array<FrameBacklog::Entry, kWriteBatch> taken;
+  std::array<canfd_frame, kWriteBatch> frames;
+  for (int round = 0; round < kFramesPerWakeup / static_cast<int>(kWriteBatch); ++round) {
+    TxSocketRef socket;
+    std::size_t count = 0;
+    bool fd = false;
+    {
+      PiLock lock(io_mutex_);
+      if (backlog_.empty() || !tx_socket_) return;
+      if (retry_at_ && steady_now() < *retry_at_) return;
+      retry_at_.reset();
+      wait_pollout_ = false;
+      fd = backlog_.top().fd;
+      // One batch writes one MTU: classic and FD frames are not mixed in it.
+      while (count < kWriteBatch && !backlog_.empty() && backlog_.top().fd == fd) taken[count++] = backlog_.take();
+      draining_key_ = frame_arbitration_key(taken[0].frame.can_id);
+      socket = tx_socket_;
+    }
+    for (std::size_t i = 0; i < count; ++i) frames[i] = taken[i].frame;
+    int err = 0;
+    const std::size_t written = write_frames(socket->fd(), std::span(frames.data(), count), fd, err);
+    sent_ += written;
+    std::string log_line;
+    {
+      PiLock lock(io_mutex_);
+      draining_key_.reset();
+      std::size_t next = written;
+      if (err != 0 && !kernel_full(err) && err != ENETDOWN && next < count) {
+        ++send_errors_;  // this frame cannot be sent; the others may
+        ++next;
+      }
+      backlog_.settle(next);
+      for (std::size_t i = next; i < count; ++i) backlog_.restore(taken[i]);
+      backlog_size_ = backlog_.size();
+      if (err == ENETDOWN) {
+        log_line = drop_backlog("interface down");
+      } else if (kernel_full(err)) {
+        note_refusal(err);
+        return;
+      }
+    }
+    if (err == ENETDOWN) {
+      log_unlocked(log_line);
+      return;
+    }
+  }
+  // A full round's worth written and frames still queued: nothing else may wake the receive
+  // thread (no POLLOUT wait, no retry time), so it comes back at once.
+  bool more = false;
+  {
+    PiLock lock(io_mutex_);
+    more = !backlog_.empty();
+  }
+  if (more) wake();
+}
+
+SendStatus CanAdapter::send(const OutboundEvent& event) {
+  try {
+    std::shared_ptr<const Table> table;  // keeps `channel` alive without the lock
+    std::uint8_t sequence = 0;
+    const TxChannel* found = nullptr;
+    {
+      PiLock lock(io_mutex_);
+      table = table_;
+      const auto it = table->tx.find(event.channel);
+      if (it == table->tx.end() || !started_ || !link_up_ || !tx_socket_ || event.payload.size() > it->second.payload) {
+        ++send_errors_;
+        return SendStatus::failed;
+      }
+      found = &it->second;
+      const std::size_t frames = famouso_ && event.payload.size() > famouso::kAfpMtu
+                                     ? famouso::afp_fragment_count(event.payload.size())
+                                 : found->fragmented && !famouso_ && !found->native
+                                     ? fragment_count(event.payload.size(), capacity_)
+                                     : 1;
+      if (frames > 1 && !backlog_.empty() && !backlog_.room_for(frames)) {
+        ++send_errors_;
+        return SendStatus::queue_full;
+      }
+      if (found->fragmented && !famouso_ && !found->native) {  // every event of the channel is numbered
+        std::uint8_t& next = tx_sequence_[found->etag];
+        sequence = next;
+        next = static_cast<std::uint8_t>((next + 1) % kFragmentSequenceModulo);
+      }
+    }
+    const TxChannel& channel = *found;
+    const bool fd = segment_.can.fd;
+    if (channel.native) {
+      const canfd_frame frame = can_native::encode(*channel.native, event.payload, fd, brs_);
+      return to_send_status(submit(std::span(&frame, 1), fd));
+    }
+    if (famouso_ && event.payload.size() > famouso::kAfpMtu) return send_afp(channel, event.payload);
+    if (channel.fragmented && !famouso_) return send_fragments(channel, event.payload, sequence);
+    // FAMOUSO: events of up to 8 bytes are plain frames.
+    canfd_frame frame{};
+    frame.can_id = channel.can_id | CAN_EFF_FLAG;
+    frame.flags = fd && brs_ ? CANFD_BRS : 0;
+    std::memcpy(frame.data, event.payload.data(), event.payload.size());
+    frame.len = static_cast<std::uint8_t>(fd ? fd_padded_length(static_cast<std::uint32_t>(event.payload.size()))
+                                             : event.payload.size());
+    return to_send_status(submit(std::span(&frame, 1), fd));
+  } catch (...) {
+    ++send_errors_;
+    return SendStatus::failed;
+  }
+}
+
+// A fragmented event, kWriteBatch fragments per submit (one system call each).
+SendStatus CanAdapter::send_fragments(const TxChannel& channel, std::span<const std::uint8_t> payload,
+                                      std::uint8_t sequence) {
+  const bool fd = segment_.can.fd;
+  std::array<canfd_frame, kWriteBatch> batch{};
+  Fragmenter fragments(payload, capacity_, sequence);
+  while (!fragments.done()) {
+    std::size_t count = 0;
+    for (; count < kWriteBatch && !fragments.done(); ++count) {
+      canfd_frame& frame = batch[count];
+      frame = canfd_frame{};
+      frame.can_id = channel.can_id | CAN_EFF_FLAG;
+      frame.flags = fd && brs_ ? CANFD_BRS : 0;
+      const std::size_t len = fragments.next(std::span<std::uint8_t>(frame.data, capacity_));
+      frame.len = static_cast<std::uint8_t>(fd ? fd_padded_length(static_cast<std::uint32_t>(len)) : len);
+    }
+    const WriteResult r = submit(std::span(batch.data(), count), fd);
+    if (r == WriteResult::failed || r == WriteResult::full) return SendStatus::failed;
+  }
+  return SendStatus::sent;
+}
+
+// FAMOUSO: an event of more than 8 bytes as AFP fragments with the identifier's fragment flag.
+SendStatus CanAdapter::send_afp(const TxChannel& channel, std::span<const std::uint8_t> payload) {
+  std::array<canfd_frame, kWriteBatch> batch{};
+  famouso::AfpFragmenter fragments(payload);
+  while (!fragments.done()) {
+    std::size_t count = 0;
+    for (; count < kWriteBatch && !fragments.done(); ++count) {
+      canfd_frame& frame = batch[count];
+      frame = canfd_frame{};
+      frame.can_id = channel.afp_id | CAN_EFF_FLAG;
+      frame.len = static_cast<std::uint8_t>(fragments.next(std::span<std::uint8_t>(frame.data, famouso::kAfpMtu)));
+    }
+    const WriteResult r = submit(std::span(batch.data(), count), false);
+    if (r == WriteResult::failed || r == WriteResult::full) return SendStatus::failed;
   }
   return SendStatus::sent;
 }

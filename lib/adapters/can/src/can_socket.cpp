@@ -9,9 +9,9 @@ void CanAdapter::close_socket() {
     ::close(census_sock_);
     census_sock_ = -1;
   }
-  LockGuard lock(io_mutex_);
+  PiLock lock(io_mutex_);
   if (sock_ < 0) return;
-  ::close(sock_);
+  tx_socket_.reset();  // closes the descriptor, or the last sender still writing to it does
   sock_ = -1;
   bound_ifindex_ = 0;
   overflow_closed_ += overflow_socket_.exchange(0);
@@ -41,6 +41,7 @@ bool CanAdapter::open_socket(int ifindex) {
   }
   if (::setsockopt(s, SOL_SOCKET, SO_RXQ_OVFL, &on, sizeof on) != 0) return fail("SO_RXQ_OVFL");
   if (::setsockopt(s, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on) != 0) return fail("SO_TIMESTAMPNS");
+  size_receive_buffer(s);
 
   // Filters go on before bind: no frame of an unbound etag is ever queued to this socket. A
   // configure() racing with this is caught below by the generation check.
@@ -48,7 +49,7 @@ bool CanAdapter::open_socket(int ifindex) {
   for (;;) {
     std::vector<can_filter> filters;
     {
-      LockGuard lock(io_mutex_);
+      PiLock lock(io_mutex_);
       generation = generation_.load();
       filters = table_->filters;
     }
@@ -57,14 +58,14 @@ bool CanAdapter::open_socket(int ifindex) {
                      static_cast<socklen_t>(filters.size() * sizeof(can_filter))) != 0) {
       return fail("CAN_RAW_FILTER");
     }
-    LockGuard lock(io_mutex_);
+    PiLock lock(io_mutex_);
     if (generation == generation_.load()) break;
   }
   sockaddr_can addr{};
   addr.can_family = AF_CAN;
   addr.can_ifindex = ifindex;
   if (::bind(s, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) != 0) return fail("bind");
-  LockGuard lock(io_mutex_);
+  PiLock lock(io_mutex_);
   if (generation != generation_.load() &&
       ::setsockopt(s, SOL_CAN_RAW, CAN_RAW_FILTER, table_->filters.data(),
                    static_cast<socklen_t>(table_->filters.size() * sizeof(can_filter))) != 0) {
@@ -73,15 +74,44 @@ bool CanAdapter::open_socket(int ifindex) {
     log_.log(LogLevel::error, "segment " + segment_.name + ": CAN_RAW_FILTER: " + errno_text(err));
     return false;
   }
-  if (sock_ >= 0) {
-    ::close(sock_);
-    overflow_closed_ += overflow_socket_.exchange(0);
+  if (sock_ >= 0) overflow_closed_ += overflow_socket_.exchange(0);
+  try {
+    tx_socket_ = std::make_shared<const TxSocket>(s);
+  } catch (const std::bad_alloc&) {
+    ::close(s);
+    tx_socket_.reset();
+    sock_ = -1;
+    return false;
   }
   sock_ = s;
   bound_ifindex_ = ifindex;
   wait_pollout_ = false;
   open_census_socket(ifindex);
   return true;
+}
+
+// SO_RCVBUFFORCE where the process may (CAP_NET_ADMIN), else SO_RCVBUF, which the kernel caps at
+// net.core.rmem_max. Short of receive_buffer_frames(), one warning says what the socket holds
+// and what would give it the rest; it runs on regardless.
+void CanAdapter::size_receive_buffer(int s) {
+  const std::size_t wanted = receive_buffer_frames(segment_.can);
+  const int request = receive_buffer_request(wanted);
+  if (::setsockopt(s, SOL_SOCKET, SO_RCVBUFFORCE, &request, sizeof request) != 0) {
+    ::setsockopt(s, SOL_SOCKET, SO_RCVBUF, &request, sizeof request);  // an error leaves the default
+  }
+  int granted = 0;
+  socklen_t length = sizeof granted;
+  if (::getsockopt(s, SOL_SOCKET, SO_RCVBUF, &granted, &length) != 0) granted = 0;
+  const std::size_t held = frames_held(granted);
+  if (held >= wanted || receive_buffer_warned_) return;
+  receive_buffer_warned_ = true;
+  log_.log(LogLevel::warning,
+           "segment " + segment_.name + ": the receive buffer of " + segment_.can.interface + " holds " +
+               std::to_string(held) + " frames, not the " + std::to_string(wanted) + " the bus carries in " +
+               std::to_string(kReceiveHold.count() / 1'000'000) +
+               " ms: frames of a longer burst are lost when the receive thread falls behind (counted as "
+               "overflow drops). Set net.core.rmem_max to at least " + std::to_string(request) +
+               " or give cosmicd CAP_NET_ADMIN (SO_RCVBUFFORCE); see docs/operations.md");
 }
 
 // Unfiltered and with a small receive buffer: when the receive thread falls behind, the kernel
@@ -134,7 +164,7 @@ void CanAdapter::check_link() {
   const short flags = ifr.ifr_flags;
   bool have_socket = false;
   {
-    LockGuard lock(io_mutex_);
+    PiLock lock(io_mutex_);
     have_socket = sock_ >= 0 && bound_ifindex_ == ifindex;
   }
   if (!have_socket && !open_socket(ifindex)) return;  // open_socket set the health
@@ -178,7 +208,7 @@ void CanAdapter::run() {
     if (const auto d = afp_.next_deadline()) deadline = std::min(deadline, *d + Nanos(1));
     if (const auto d = ccp_ ? ccp_->deadline() : std::nullopt) deadline = std::min(deadline, *d);
     {
-      LockGuard lock(io_mutex_);
+      PiLock lock(io_mutex_);
       if (const auto d = answers_.deadline(); d && backlog_.empty()) deadline = std::min(deadline, *d);
       if (!deferred_requests_.empty()) deadline = std::min(deadline, now + kDeferredRequestRetry);
       if (sock_ >= 0) {

@@ -77,7 +77,8 @@ class ControlProtocol {
   Json channels() const;
   Json channel(const Json& request) const;
   Json unbound_channel(const std::string& name) const;
-  Answer bind(const Json& request, const Reply& later);
+  // `replace`: the channels take the place of bound ones of the same names (Gateway::replace).
+  Answer bind(const Json& request, bool replace, const Reply& later);
   Json unbind(const Json& request);
   Answer reload(const Reply& later);
   Json channel_entry(const ChannelReport& verdict, const ChannelStatsSnapshot* stats) const;

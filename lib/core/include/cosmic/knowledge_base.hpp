@@ -52,7 +52,10 @@ class KnowledgeBase {
   KnowledgeBase(GatewaySpec gateway, std::vector<SegmentSpec> segments, std::set<std::uint16_t> reserved_etags = {});
 
   // Tries to bind `channel` (its segments must exist). On rejection nothing changes.
-  BindOutcome bind(const ChannelSpec& channel);
+  // `preferred_etag`: taken when the channel needs a dynamic etag and that one is free. A channel
+  // whose definition is replaced keeps its etag this way, so CAN devices that learned it through
+  // GET_ETAG keep sending and receiving under it.
+  BindOutcome bind(const ChannelSpec& channel, std::optional<std::uint16_t> preferred_etag = std::nullopt);
   // Frees the channel's reservations and etag. False when no such channel is bound.
   bool unbind(const std::string& name);
   // What admission would answer for `channel` on top of the current set, without binding it.
@@ -79,7 +82,7 @@ class KnowledgeBase {
     ChannelReport report;                      // the newcomer's report, including "would break" reasons
     std::optional<std::uint16_t> etag;         // CAN channels: the etag it would take
   };
-  Attempt attempt(const ChannelSpec& channel) const;
+  Attempt attempt(const ChannelSpec& channel, std::optional<std::uint16_t> preferred_etag = std::nullopt) const;
   std::optional<std::uint16_t> allocate_etag() const;
   bool needs_etag(const ChannelSpec& channel) const;
   std::optional<std::string> native_clash(const ChannelSpec& channel, std::optional<std::uint16_t> etag) const;

@@ -36,10 +36,18 @@ namespace cosmic {
 using AdapterFactory =
     std::function<std::unique_ptr<SegmentAdapter>(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log)>;
 
+// A channel whose definition a replacement takes the place of.
+struct ReplacedChannel {
+  ChannelSpec before;                // the definition bound before
+  std::vector<std::string> changes;  // one line per field the new definition changes (channel_changes.hpp)
+};
+
 struct BindResult {
   bool applied = false;                 // false: nothing changed
   std::vector<ChannelReport> channels;  // verdict of each requested channel
   std::string error;                    // why nothing changed, when not a rejection
+  // A replacement: the channels it concerns that were bound, in the order of `channels`.
+  std::vector<ReplacedChannel> replaced;
 };
 
 struct SegmentInfo {
@@ -59,6 +67,10 @@ struct BindPlan {
   std::shared_ptr<KnowledgeBase> kb;      // the copy; holds `channels` once planned and admitted
   std::vector<ChannelReport> reports;     // verdict of each channel, once planned
   bool admitted = false;                  // every channel bound in `kb`
+  // A replacement (Gateway::replace): `channels` take the place of the bound definitions of the
+  // same names, which are `replaced` (taken with the copy).
+  bool replacing = false;
+  std::vector<ChannelSpec> replaced;
 };
 
 // What the running bindings were admitted from (at start or by the last reload): the
@@ -99,6 +111,12 @@ class Gateway {
   BindResult start(const Config& config);
   // Binds the channels together, or none of them when any is rejected.
   BindResult bind(const std::vector<ChannelSpec>& channels);
+  // Replaces the definitions of bound channels (cosmicctl bind --replace): admission runs once on
+  // the bound set less the replaced channels plus their new definitions; when any is rejected (or
+  // not bound) nothing changes. A replaced channel keeps its channel id, so adapters keep the
+  // endpoints of its hops whose segment, role and transport QoS stay, and its etag where it still
+  // needs one; events already queued for subscriber segments that stay are still sent.
+  BindResult replace(const std::vector<ChannelSpec>& channels);
   // False when no such channel is bound.
   bool unbind(const std::string& name);
   // Validated configuration in, running one swapped: unchanged segments and channels keep
@@ -112,6 +130,9 @@ class Gateway {
   // Control thread: applies an admitted plan. Refused (nothing changes) when the bindings
   // changed since the plan's copy was taken.
   BindResult commit_bind(BindPlan plan);
+  // replace() in the same steps; commit_bind() commits either kind of plan.
+  BindPlan replace_plan_input(std::vector<ChannelSpec> channels) const;
+  static void plan_replace(BindPlan& plan);
   // reload() in steps: the plan on any thread (no I/O), the commit on the control thread.
   // With `base` (reload_base(), taken on the control thread) a configuration with the base's
   // gateway, segments and reserved etags whose channels begin with the base's, in order, starts
@@ -194,6 +215,10 @@ class Gateway {
   std::string violation_line(const ChannelSpec& spec) const;
   void apply_routes();
   ChannelId id_for(const ChannelSpec& spec);
+  // A replacement's new definitions take over their channels' ids; returns the entries they
+  // replaced, for undo_takeover().
+  std::map<std::string, std::pair<ChannelSpec, ChannelId>> take_over_ids(const std::vector<ChannelSpec>& channels);
+  void undo_takeover(std::map<std::string, std::pair<ChannelSpec, ChannelId>> previous);
   // Lowest slot index used neither by a running segment nor by one in `also_taken`.
   std::size_t free_slot(const std::set<std::size_t>& also_taken = {}) const;
   static std::unique_ptr<KnowledgeBase> knowledge_base_for(const Config& config);

@@ -1,0 +1,95 @@
+# bash completion for cosmicctl (installed as /usr/share/bash-completion/completions/cosmicctl).
+# Commands and options are those `cosmicctl --help` and `cosmicctl COMMAND --help` list:
+# tests/cli/man_completion_test.sh fails when a command or option is missing here or no longer
+# exists. Values: FILE arguments complete to YAML files, --output to directories, --format to its
+# choices, --component to the components: of the FILE on the line, channel NAMEs (channel,
+# unbind) to the channels of the running gateway (`cosmicctl --json channels`, silent when it
+# cannot be reached). Needs nothing from the bash-completion package.
+
+_cosmicctl_commands="bind calibrate channel channels check diagram gen reload segments status top unbind"
+_cosmicctl_global_options="--help --json --socket --version"
+
+# The options of one command (besides the global ones, which may follow it too).
+_cosmicctl_command_options() {
+  case $1 in
+    bind) echo "--replace" ;;
+    calibrate) echo "--seconds --rate" ;;
+    diagram) echo "--format --detail" ;;
+    gen) echo "--component --output" ;;
+    top) echo "--interval --iterations" ;;
+  esac
+}
+
+# The names of the components: section of a YAML file (both `- name: x` and `- {name: x, ...}`).
+_cosmicctl_components() {
+  [ -r "$1" ] || return
+  sed -n '/^components:/,/^[^[:space:]#-]/p' "$1" 2>/dev/null |
+    sed -n 's/^[[:space:]]*-[[:space:]]*{\{0,1\}[[:space:]]*name:[[:space:]]*\([^,}[:space:]]*\).*/\1/p'
+}
+
+_cosmicctl() {
+  local cur=${COMP_WORDS[COMP_CWORD]} prev=${COMP_WORDS[COMP_CWORD - 1]}
+  local command="" socket=() file="" i word
+  for ((i = 1; i < COMP_CWORD; i++)); do
+    word=${COMP_WORDS[i]}
+    case $word in
+      --socket) socket=(--socket "${COMP_WORDS[i + 1]}"); ((i++)) ;;
+      --format | --component | --output | --interval | --iterations | --seconds | --rate) ((i++)) ;;
+      -*) ;;
+      *)
+        if [ -z "$command" ]; then
+          command=$word
+        elif [ -z "$file" ]; then
+          file=$word
+        fi
+        ;;
+    esac
+  done
+
+  case $prev in
+    --socket)
+      compopt -o filenames 2>/dev/null
+      mapfile -t COMPREPLY < <(compgen -f -- "$cur")
+      return ;;
+    --output)
+      compopt -o filenames 2>/dev/null
+      mapfile -t COMPREPLY < <(compgen -d -- "$cur")
+      return ;;
+    --format)
+      mapfile -t COMPREPLY < <(compgen -W "svg dot" -- "$cur")
+      return ;;
+    --component)
+      mapfile -t COMPREPLY < <(compgen -W "$(_cosmicctl_components "$file")" -- "$cur")
+      return ;;
+    --interval | --iterations | --seconds | --rate)
+      return ;;
+  esac
+
+  if [ -z "$command" ]; then
+    if [[ $cur == -* ]]; then
+      mapfile -t COMPREPLY < <(compgen -W "$_cosmicctl_global_options" -- "$cur")
+    else
+      mapfile -t COMPREPLY < <(compgen -W "$_cosmicctl_commands" -- "$cur")
+    fi
+    return
+  fi
+  if [[ $cur == -* ]]; then
+    mapfile -t COMPREPLY < <(compgen -W "$(_cosmicctl_command_options "$command") --help --json --socket" -- "$cur")
+    return
+  fi
+  case $command in
+    check | diagram | gen | bind | calibrate)
+      [ -n "$file" ] && return
+      compopt -o filenames 2>/dev/null
+      mapfile -t COMPREPLY < <(compgen -f -X '!*.yaml' -- "$cur"; compgen -f -X '!*.yml' -- "$cur"; compgen -d -- "$cur")
+      ;;
+    channel | unbind)
+      [ -n "$file" ] && return
+      local names
+      names=$(cosmicctl "${socket[@]}" --json channels 2>/dev/null | grep -o '"name": *"[^"]*"' | sed 's/.*"\([^"]*\)"$/\1/')
+      mapfile -t COMPREPLY < <(compgen -W "$names" -- "$cur")
+      ;;
+  esac
+}
+
+complete -F _cosmicctl cosmicctl
