@@ -1,6 +1,8 @@
 #include "egress_lane.hpp"
 
 #include <algorithm>
+#include <array>
+#include <optional>
 #include <limits>
 
 namespace cosmic {
@@ -24,14 +26,16 @@ bool EgressLane::push(LaneItem&& item) noexcept {
   return true;
 }
 
-bool EgressLane::pop(LaneItem& out) noexcept {
+std::size_t EgressLane::pop_batch(std::span<LaneItem> out) noexcept {
   PiLock lock(mutex_);
-  if (count_ == 0) return false;
-  out = std::move(ring_[head_]);
-  bytes_ -= out.payload->bytes().size();
-  head_ = (head_ + 1) % ring_.size();
-  --count_;
-  return true;
+  std::size_t n = 0;
+  for (; n < out.size() && count_ > 0; ++n) {
+    out[n] = std::move(ring_[head_]);
+    bytes_ -= out[n].payload->bytes().size();
+    head_ = (head_ + 1) % ring_.size();
+    --count_;
+  }
+  return n;
 }
 
 std::size_t EgressLane::size() const {
@@ -77,10 +81,16 @@ void EgressLane::deactivate() {
 
 std::size_t EgressLane::run_once(std::size_t budget) {
   std::size_t handled = 0;
-  LaneItem item;
-  while (handled < budget && pop(item)) {
-    forward(item);
-    ++handled;
+  std::array<LaneItem, kSendBatch> batch;
+  while (handled < budget) {
+    const std::size_t n = pop_batch(std::span(batch.data(), std::min(kSendBatch, budget - handled)));
+    if (n == 0) break;
+    if (n == 1) {
+      forward(batch[0]);
+    } else {
+      forward_batch(std::span(batch.data(), n));
+    }
+    handled += n;
   }
   return handled;
 }
@@ -90,11 +100,18 @@ void EgressLane::worker(ThreadPolicy policy) {
     for (auto& p : problems) p = "thread " + policy.name + ": " + p;
     context_.report_thread_problems(problems);
   }
-  LaneItem item;
+  // What queued up while the last send ran goes to the adapter together: one hand-over (and on
+  // CAN one system call) for up to kSendBatch events. A lone event goes out alone, at once.
+  std::array<LaneItem, kSendBatch> batch;
   while (running_.load(std::memory_order_acquire)) {
     const std::uint32_t seen = wake_.current();
-    if (pop(item)) {
-      forward(item);
+    const std::size_t n = pop_batch(batch);
+    if (n == 1) {
+      forward(batch[0]);
+      continue;
+    }
+    if (n > 1) {
+      forward_batch(std::span(batch.data(), n));
       continue;
     }
     wake_.wait(seen);
@@ -117,38 +134,42 @@ std::int64_t saturating_add(std::int64_t a, std::int64_t b) {
 }
 }  // namespace
 
-void EgressLane::forward(LaneItem& item) noexcept {
+std::optional<OutboundEvent> EgressLane::still_wanted(LaneItem& item) noexcept {
   context_.progress.fetch_add(1, std::memory_order_relaxed);
   ChannelState& channel = *item.channel;
-  SegmentAdapter* adapter = adapter_.load(std::memory_order_acquire);
   if (channel.removed.load(std::memory_order_relaxed) || channel.retired_egress[segment_].load(std::memory_order_relaxed) ||
       item.generation != current_generation_.load(std::memory_order_acquire)) {
     discard(item);
-    return;
+    return std::nullopt;
   }
   const ChannelSpec& spec = channel.route.spec;
-  SegmentCounters& counters = channel.counters[segment_];
-  EgressStats& hop = channel.egress[item.hop];
   const Nanos waited = context_.clock() - item.received;
   const Nanos age(saturating_add(item.header.age_ns, waited.count()));
   if (spec.temp_validity && age >= *spec.temp_validity) {
-    counters.drop(DropReason::expired);
-    if (spec.reaction_time && age > *spec.reaction_time) hop.deadline_miss.fetch_add(1, std::memory_order_relaxed);
+    channel.counters[segment_].drop(DropReason::expired);
+    if (spec.reaction_time && age > *spec.reaction_time) channel.egress[item.hop].deadline_miss.fetch_add(1, std::memory_order_relaxed);
     discard(item);
-    return;
+    return std::nullopt;
   }
   OutboundEvent out{channel.route.id, item.header, item.payload->bytes()};
   out.header.age_ns = age.count();
   // Counted before the send, taken back if it fails: whoever sees the event on the wire sees the
   // counter already moved.
-  counters.tx.fetch_add(1, std::memory_order_relaxed);
-  const SendStatus status = adapter != nullptr ? adapter->send(out) : SendStatus::failed;
+  channel.counters[segment_].tx.fetch_add(1, std::memory_order_relaxed);
+  return out;
+}
+
+void EgressLane::account(LaneItem& item, SendStatus status) noexcept {
+  ChannelState& channel = *item.channel;
+  SegmentCounters& counters = channel.counters[segment_];
   if (status != SendStatus::sent) {
     counters.tx.fetch_sub(1, std::memory_order_relaxed);
     counters.drop(status == SendStatus::queue_full ? DropReason::queue_full : DropReason::send_failed);
     discard(item);
     return;
   }
+  const ChannelSpec& spec = channel.route.spec;
+  EgressStats& hop = channel.egress[item.hop];
   const Nanos residence = context_.clock() - item.received;
   hop.residence.record(residence);
   channel.residence.record(residence);
@@ -156,6 +177,33 @@ void EgressLane::forward(LaneItem& item) noexcept {
   if (spec.reaction_time && Nanos(saturating_add(item.header.age_ns, residence.count())) > *spec.reaction_time)
     hop.deadline_miss.fetch_add(1, std::memory_order_relaxed);
   discard(item);
+}
+
+void EgressLane::forward(LaneItem& item) noexcept {
+  const std::optional<OutboundEvent> out = still_wanted(item);
+  if (!out) return;
+  SegmentAdapter* adapter = adapter_.load(std::memory_order_acquire);
+  account(item, adapter != nullptr ? adapter->send(*out) : SendStatus::failed);
+}
+
+// The residence of each event is taken when the whole batch is handed over: an event waits for
+// the ones before it in the batch as it would have in the lane.
+void EgressLane::forward_batch(std::span<LaneItem> items) noexcept {
+  std::array<OutboundEvent, kSendBatch> outs;
+  std::array<std::size_t, kSendBatch> which{};  // index in `items` of each event in `outs`
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < items.size() && n < kSendBatch; ++i) {
+    if (auto out = still_wanted(items[i])) {
+      outs[n] = *out;
+      which[n++] = i;
+    }
+  }
+  if (n == 0) return;
+  std::array<SendStatus, kSendBatch> statuses;
+  statuses.fill(SendStatus::failed);
+  SegmentAdapter* adapter = adapter_.load(std::memory_order_acquire);
+  if (adapter != nullptr) adapter->send_batch(std::span(outs.data(), n), std::span(statuses.data(), n));
+  for (std::size_t k = 0; k < n; ++k) account(items[which[k]], statuses[k]);
 }
 
 }  // namespace cosmic

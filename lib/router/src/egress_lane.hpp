@@ -11,6 +11,8 @@
 
 #include <atomic>
 #include <functional>
+#include <optional>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
@@ -61,8 +63,18 @@ class EgressLane {
   std::size_t size() const COSMIC_EXCLUDES(mutex_);
 
  private:
-  bool pop(LaneItem& out) noexcept COSMIC_EXCLUDES(mutex_);
+  // At most this many queued events go to the adapter at once (SegmentAdapter::send_batch).
+  static constexpr std::size_t kSendBatch = 16;
+  // Moves up to `out.size()` queued events out in one lock; returns how many.
+  std::size_t pop_batch(std::span<LaneItem> out) noexcept COSMIC_EXCLUDES(mutex_);
   void forward(LaneItem& item) noexcept;
+  // forward() for several events, handed to the adapter in one send_batch().
+  void forward_batch(std::span<LaneItem> items) noexcept;
+  // Before a send: the event as it leaves, or nullopt (the item discarded, its drop counted)
+  // when it is not to be sent (channel gone, lane reset, expired).
+  std::optional<OutboundEvent> still_wanted(LaneItem& item) noexcept;
+  // After a send: counters and residence by the adapter's answer; the item is released.
+  void account(LaneItem& item, SendStatus status) noexcept;
   void discard(LaneItem& item) noexcept;
   void worker(ThreadPolicy policy);
 

@@ -120,6 +120,36 @@ TEST_F(CanAdapterTest, SentEventShowsTheCosmicIdentifierInCandump) {
   EXPECT_EQ(send(12, std::vector<std::uint8_t>(9)), SendStatus::failed);
 }
 
+// A lane's batch (send_batch): one-frame events of several channels leave in their order, a
+// fragmented one among them as its fragments in between, one of an unbound channel fails alone.
+TEST_F(CanAdapterTest, ABatchOfEventsLeavesInItsOrder) {
+  const auto seg = can_segment("vcan0");
+  ASSERT_NO_FATAL_FAILURE(open(seg, {
+                                        can_binding(41, "steer", 0x41, 8, HopRole::subscriber, 0x05, 310, seg),
+                                        can_binding(42, "log", 0x42, 1024, HopRole::subscriber, 0xF0, 311, seg),
+                                        can_binding(43, "lamp", 0x43, 8, HopRole::subscriber, 0x10, 312, seg),
+                                    }));
+  const std::uint32_t steer = encode_can_id(CanIdentifier{0x05, kGatewayNode, 310});
+  const std::uint32_t lamp = encode_can_id(CanIdentifier{0x10, kGatewayNode, 312});
+  // The one-frame events only (the fragments' count depends on the fragment layout).
+  Candump dump("vcan0", "vcan0," + hex_id(steer) + ":1FFFFFFF," + hex_id(lamp) + ":1FFFFFFF", 3);
+  const std::vector<std::uint8_t> one{1}, two{2}, three{3}, big(20, 0xAB), stray{9};
+  const std::vector<OutboundEvent> events{{41, {}, one}, {43, {}, two}, {42, {}, big}, {41, {}, three}, {99, {}, stray}};
+  std::vector<SendStatus> results(events.size(), SendStatus::failed);
+  adapter_->send_batch(events, results);
+  EXPECT_EQ(results, (std::vector<SendStatus>{SendStatus::sent, SendStatus::sent, SendStatus::sent, SendStatus::sent,
+                                              SendStatus::failed}));
+  const auto lines = dump.wait(kWait);
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0].id, steer);
+  EXPECT_EQ(lines[0].data, one);
+  EXPECT_EQ(lines[1].id, lamp);
+  EXPECT_EQ(lines[1].data, two);
+  EXPECT_EQ(lines[2].id, steer);
+  EXPECT_EQ(lines[2].data, three);
+  EXPECT_GE(adapter_->statistics().sent, 3u + 2u);  // and the 20-byte event's fragments (on `log`)
+}
+
 // CAN FD on a vcan with mtu 72: padded FD frames with bit-rate switch out, FD frames in.
 TEST_F(CanAdapterTest, CanFdFramesBothWays) {
   ASSERT_EQ(shell("ip link set vcan1 down && ip link set vcan1 mtu 72 && ip link set vcan1 up"), 0);

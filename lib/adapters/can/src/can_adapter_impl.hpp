@@ -133,6 +133,9 @@ class CanAdapter final : public SegmentAdapter {
   Status start(EventSink& sink) override;
   Status configure(std::span<const ChannelBinding> bindings) override;
   SendStatus send(const OutboundEvent& event) override;
+  // Runs of events that are one frame each (native, unfragmented, FAMOUSO up to 8 bytes) go out
+  // in one submit (one sendmmsg); the others as send() sends them.
+  void send_batch(std::span<const OutboundEvent> events, std::span<SendStatus> results) override;
   HealthReport health() const override;
   AdapterStatistics statistics() const override;
   std::optional<std::size_t> matched_peers(ChannelId) const override { return std::nullopt; }  // broadcast bus
@@ -212,6 +215,8 @@ class CanAdapter final : public SegmentAdapter {
   // up inside the kernel cannot hold up a higher class's sender, which waits at most for another
   // sender's few-instruction critical section (io_mutex_ inherits priority).
   // Frames of one event, in order, to the kernel or the backlog; takes io_mutex_ briefly.
+  // Frames of several identifiers (a batch of events) go to the backlog whole while it holds
+  // frames, which then leave in arbitration order.
   WriteResult submit(std::span<const canfd_frame> frames, bool fd) COSMIC_EXCLUDES(io_mutex_);
   // Whether a frame must wait behind the backlog: a queued or in-flight backlog frame would win
   // arbitration over it (or has its identifier), so writing it now would overtake that frame.
@@ -223,6 +228,9 @@ class CanAdapter final : public SegmentAdapter {
   std::string count_send_error(int err) COSMIC_REQUIRES(io_mutex_);
   void log_unlocked(const std::string& line) COSMIC_EXCLUDES(io_mutex_);  // a warning; nothing when empty
   SendStatus send_fragments(const TxChannel& channel, std::span<const std::uint8_t> payload, std::uint8_t sequence);
+  // The event's channel when it can go out now as exactly one frame (send() takes the others).
+  const TxChannel* single_frame_channel(const Table& table, const OutboundEvent& event) const COSMIC_REQUIRES(io_mutex_);
+  canfd_frame single_frame(const TxChannel& channel, std::span<const std::uint8_t> payload) const;
   void queue_answer(std::uint32_t can_id, std::span<const std::uint8_t> data) COSMIC_REQUIRES(io_mutex_);
   void queue_supply_etag(std::uint8_t requester, std::uint16_t etag, std::uint64_t subject, const Table& table)
       COSMIC_REQUIRES(io_mutex_);

@@ -113,7 +113,10 @@ CanAdapter::WriteResult CanAdapter::submit(std::span<const canfd_frame> frames, 
       send_errors_ += frames.size();
       return WriteResult::failed;
     }
-    if (behind_backlog(frames.front().can_id)) {
+    const bool one_identifier = std::all_of(frames.begin(), frames.end(),
+                                            [&](const canfd_frame& f) { return f.can_id == frames.front().can_id; });
+    const bool backlog_busy = !backlog_.empty() || draining_key_.has_value();
+    if (behind_backlog(frames.front().can_id) || (backlog_busy && !one_identifier)) {
       queued = queue_frames(frames, fd);
     } else {
       socket = tx_socket_;
@@ -248,16 +251,60 @@ SendStatus CanAdapter::send(const OutboundEvent& event) {
     if (famouso_ && event.payload.size() > famouso::kAfpMtu) return send_afp(channel, event.payload);
     if (channel.fragmented && !famouso_) return send_fragments(channel, event.payload, sequence);
     // FAMOUSO: events of up to 8 bytes are plain frames.
-    canfd_frame frame{};
-    frame.can_id = channel.can_id | CAN_EFF_FLAG;
-    frame.flags = fd && brs_ ? CANFD_BRS : 0;
-    std::memcpy(frame.data, event.payload.data(), event.payload.size());
-    frame.len = static_cast<std::uint8_t>(fd ? fd_padded_length(static_cast<std::uint32_t>(event.payload.size()))
-                                             : event.payload.size());
+    const canfd_frame frame = single_frame(channel, event.payload);
     return to_send_status(submit(std::span(&frame, 1), fd));
   } catch (...) {
     ++send_errors_;
     return SendStatus::failed;
+  }
+}
+
+canfd_frame CanAdapter::single_frame(const TxChannel& channel, std::span<const std::uint8_t> payload) const {
+  const bool fd = segment_.can.fd;
+  if (channel.native) return can_native::encode(*channel.native, payload, fd, brs_);
+  canfd_frame frame{};
+  frame.can_id = channel.can_id | CAN_EFF_FLAG;
+  frame.flags = fd && brs_ ? CANFD_BRS : 0;
+  std::memcpy(frame.data, payload.data(), payload.size());
+  frame.len = static_cast<std::uint8_t>(fd ? fd_padded_length(static_cast<std::uint32_t>(payload.size())) : payload.size());
+  return frame;
+}
+
+const CanAdapter::TxChannel* CanAdapter::single_frame_channel(const Table& table, const OutboundEvent& event) const {
+  const auto it = table.tx.find(event.channel);
+  if (it == table.tx.end() || event.payload.size() > it->second.payload) return nullptr;
+  const TxChannel& channel = it->second;
+  if (channel.native) return &channel;
+  if (famouso_) return event.payload.size() <= famouso::kAfpMtu ? &channel : nullptr;
+  return channel.fragmented ? nullptr : &channel;
+}
+
+void CanAdapter::send_batch(std::span<const OutboundEvent> events, std::span<SendStatus> results) {
+  const bool fd = segment_.can.fd;
+  std::array<canfd_frame, kWriteBatch> frames;
+  std::size_t i = 0;
+  while (i < events.size() && i < results.size()) {
+    std::shared_ptr<const Table> table;  // keeps the channels alive without the lock
+    const std::size_t first = i;
+    std::size_t count = 0;
+    {
+      PiLock lock(io_mutex_);
+      if (started_ && link_up_ && tx_socket_) {
+        table = table_;
+        for (; i < events.size() && i < results.size() && count < kWriteBatch; ++i) {
+          const TxChannel* channel = single_frame_channel(*table, events[i]);
+          if (channel == nullptr) break;
+          frames[count++] = single_frame(*channel, events[i].payload);
+        }
+      }
+    }
+    if (count == 0) {  // not one frame, or not sendable now: send() sends or counts it
+      results[i] = send(events[i]);
+      ++i;
+      continue;
+    }
+    const SendStatus status = to_send_status(submit(std::span(frames.data(), count), fd));
+    std::fill(results.begin() + static_cast<std::ptrdiff_t>(first), results.begin() + static_cast<std::ptrdiff_t>(i), status);
   }
 }
 

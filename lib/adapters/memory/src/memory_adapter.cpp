@@ -66,6 +66,19 @@ SendStatus MemoryAdapter::send(const OutboundEvent& event) {
   return SendStatus::sent;
 }
 
+void MemoryAdapter::send_batch(std::span<const OutboundEvent> events, std::span<SendStatus> results) {
+  {
+    LockGuard lock(mutex_);
+    batches_.push_back(events.size());
+  }
+  for (std::size_t i = 0; i < events.size() && i < results.size(); ++i) results[i] = send(events[i]);
+}
+
+std::vector<std::size_t> MemoryAdapter::batches() const {
+  LockGuard lock(mutex_);
+  return batches_;
+}
+
 bool MemoryAdapter::inject(const std::string& channel, std::vector<std::uint8_t> payload, EventHeader header) {
   EventSink* sink = nullptr;
   ChannelId id = kNoChannel;

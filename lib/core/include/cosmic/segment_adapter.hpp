@@ -147,6 +147,13 @@ class SegmentAdapter {
   virtual Status configure(std::span<const ChannelBinding> bindings) = 0;
   // Transmits one event of a channel bound here as subscriber. Never throws.
   virtual SendStatus send(const OutboundEvent& event) = 0;
+  // Transmits `events` in their order, as send() one after the other would; `results[i]` is
+  // events[i]'s status (results.size() == events.size()). An egress lane hands over what queued
+  // up behind a send in progress, so a transport that can write several events in one system
+  // call (CAN: sendmmsg) overrides this. Called by the same lane threads as send(). Never throws.
+  virtual void send_batch(std::span<const OutboundEvent> events, std::span<SendStatus> results) {
+    for (std::size_t i = 0; i < events.size() && i < results.size(); ++i) results[i] = send(events[i]);
+  }
   virtual HealthReport health() const = 0;
   virtual AdapterStatistics statistics() const = 0;
   // Remote endpoints discovered for `channel` here, for transports with discovery (DDS);

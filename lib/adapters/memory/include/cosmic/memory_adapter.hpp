@@ -28,6 +28,8 @@ class MemoryAdapter final : public SegmentAdapter {
   Status start(EventSink& sink) override;
   Status configure(std::span<const ChannelBinding> bindings) override;
   SendStatus send(const OutboundEvent& event) override;
+  // Records how many events each hand-over held (batches()), then sends them one by one.
+  void send_batch(std::span<const OutboundEvent> events, std::span<SendStatus> results) override;
   HealthReport health() const override;
   AdapterStatistics statistics() const override;
   std::optional<std::size_t> matched_peers(ChannelId) const override { return std::nullopt; }
@@ -39,6 +41,8 @@ class MemoryAdapter final : public SegmentAdapter {
   // Delivers bytes that fail to decode.
   void inject_garbage(const std::string& channel);
   std::vector<RecordedEvent> sent() const;
+  // The size of each send_batch() hand-over so far (a single send() is not one).
+  std::vector<std::size_t> batches() const;
   // Waits until at least `count` events were sent, or the deadline passes; returns the count.
   std::size_t wait_sent(std::size_t count, std::chrono::milliseconds timeout) const;
   void set_health(SegmentHealth state, std::string detail);
@@ -62,6 +66,7 @@ class MemoryAdapter final : public SegmentAdapter {
   EventSink* sink_ COSMIC_GUARDED_BY(mutex_) = nullptr;
   std::vector<ChannelBinding> bindings_ COSMIC_GUARDED_BY(mutex_);
   std::vector<RecordedEvent> sent_ COSMIC_GUARDED_BY(mutex_);
+  std::vector<std::size_t> batches_ COSMIC_GUARDED_BY(mutex_);
   HealthReport health_ COSMIC_GUARDED_BY(mutex_);
   AdapterStatistics stats_ COSMIC_GUARDED_BY(mutex_);
   std::map<std::string, std::string> refuse_ COSMIC_GUARDED_BY(mutex_);  // channel name -> reason
