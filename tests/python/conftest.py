@@ -84,17 +84,24 @@ def peer() -> Iterator[Callable[..., Peer]]:
 
 
 class Gateway:
-    def __init__(self, work: Path) -> None:
+    """cosmicd on `config` in `work`, with a state file that outlives restarts (stop(), start())."""
+
+    def __init__(self, work: Path, config: str = GATEWAY_YAML) -> None:
+        self.work = work
         self.socket = str(work / "control.sock")
-        config = work / "gateway.yaml"
-        config.write_text(GATEWAY_YAML)
-        self.log = open(work / "cosmicd.log", "w")
+        (work / "gateway.yaml").write_text(config)
+        self.log_path = work / "cosmicd.log"
+        self.process: Optional[subprocess.Popen] = None
+        self.start()
+
+    def start(self) -> None:
+        self.log = open(self.log_path, "a")
         self.process = subprocess.Popen(
-            [COSMICD, "--config", str(config), "--socket", self.socket, "--state-file", str(work / "state")],
+            [COSMICD, "--config", str(self.work / "gateway.yaml"), "--socket", self.socket, "--state-file", str(self.work / "state")],
             stdout=self.log, stderr=subprocess.STDOUT)
         wait_until(lambda: self.ctl("status").returncode == 0 or self.process.poll() is not None, 30, "cosmicd answering")
         if self.process.poll() is not None:
-            pytest.fail(f"cosmicd exited: {(work / 'cosmicd.log').read_text()}")
+            pytest.fail(f"cosmicd exited: {self.log_path.read_text()}")
 
     def ctl(self, *args: str) -> subprocess.CompletedProcess:
         return subprocess.run([COSMICCTL, "--socket", self.socket, *args], capture_output=True, text=True)
@@ -104,6 +111,10 @@ class Gateway:
         self.process.wait(timeout=20)
         self.log.close()
 
+    def print_log_if_it_failed(self) -> None:
+        if self.process.returncode not in (0, -15):
+            print(self.log_path.read_text(), file=sys.stderr)
+
 
 @pytest.fixture(scope="session")
 def gateway() -> Iterator[Gateway]:
@@ -111,5 +122,4 @@ def gateway() -> Iterator[Gateway]:
         g = Gateway(Path(work))
         yield g
         g.stop()
-        if g.process.returncode not in (0, -15):
-            print(Path(work, "cosmicd.log").read_text(), file=sys.stderr)
+        g.print_log_if_it_failed()

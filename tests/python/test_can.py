@@ -5,7 +5,6 @@ inside scripts/can-vm; elsewhere (python.client on a host without vcan0) it is s
 from __future__ import annotations
 
 import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -15,7 +14,7 @@ import numpy as np
 import pytest
 
 import cosmic
-from conftest import COSMICCTL, COSMICD, wait_until
+from conftest import Gateway, wait_until
 
 pytestmark = pytest.mark.skipif(not Path("/sys/class/net/vcan0").exists(),
                                 reason="needs vcan0 (ctest python.can runs this file in scripts/can-vm)")
@@ -33,35 +32,14 @@ channels:
 """
 
 
-class CanGateway:
-    def __init__(self, work: Path) -> None:
-        self.socket = str(work / "control.sock")
-        (work / "gateway.yaml").write_text(CONFIG)
-        self.log_path = work / "cosmicd.log"
-        self.log = open(self.log_path, "w")
-        subprocess.run(["ip", "link", "set", "vcan0", "up"], check=False)
-        self.process = subprocess.Popen([COSMICD, "--config", str(work / "gateway.yaml"), "--socket", self.socket],
-                                        stdout=self.log, stderr=subprocess.STDOUT)
-        wait_until(lambda: self.ctl("status").returncode == 0 or self.process.poll() is not None, 30, "cosmicd answering")
-        assert self.process.poll() is None, self.log_path.read_text()
-
-    def ctl(self, *args: str) -> subprocess.CompletedProcess:
-        return subprocess.run([COSMICCTL, "--socket", self.socket, *args], capture_output=True, text=True)
-
-    def stop(self) -> None:
-        self.process.terminate()
-        self.process.wait(timeout=20)
-        self.log.close()
-
-
 @pytest.fixture(scope="module")
-def can_gateway() -> Iterator[CanGateway]:
+def can_gateway() -> Iterator[Gateway]:
+    subprocess.run(["ip", "link", "set", "vcan0", "up"], check=False)
     with tempfile.TemporaryDirectory(prefix="cosmic-py-can-") as work:
-        g = CanGateway(Path(work))
+        g = Gateway(Path(work), CONFIG)
         yield g
         g.stop()
-        if g.process.returncode not in (0, -15):
-            print(g.log_path.read_text(), file=sys.stderr)
+        g.print_log_if_it_failed()
 
 
 def test_a_python_can_sensor_reaches_an_lcm_subscriber(can_gateway):

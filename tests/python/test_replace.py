@@ -13,10 +13,8 @@ paused; the figures are in docs/control-protocol.md (`replace`).
 from __future__ import annotations
 
 import json
-import os
 import struct
 import subprocess
-import sys
 import tempfile
 import threading
 import time
@@ -26,7 +24,7 @@ from typing import Iterator
 import pytest
 
 import cosmic
-from conftest import COSMICCTL, COSMICD, wait_until
+from conftest import Gateway, wait_until
 
 STEADY_URL = "udpm://239.255.76.67:7951?ttl=0"
 WIRE_URL = "udpm://239.255.76.67:7952?ttl=0"
@@ -56,30 +54,11 @@ channels:
   - {feed_yaml("steady", "wire")}"""
 
 
-class OwnGateway:
-    """cosmicd on CONFIG with a state file that outlives restarts."""
+class OwnGateway(Gateway):
+    """cosmicd on CONFIG (conftest.Gateway), with what the replacement tests ask of it."""
 
     def __init__(self, work: Path) -> None:
-        self.work = work
-        self.socket = str(work / "control.sock")
-        (work / "gateway.yaml").write_text(CONFIG)
-        self.process: subprocess.Popen | None = None
-        self.start()
-
-    def start(self) -> None:
-        self.log = open(self.work / "cosmicd.log", "a")
-        self.process = subprocess.Popen([COSMICD, "--config", str(self.work / "gateway.yaml"), "--socket", self.socket,
-                                         "--state-file", str(self.work / "state")], stdout=self.log, stderr=subprocess.STDOUT)
-        wait_until(lambda: self.ctl("status").returncode == 0 or self.process.poll() is not None, 30, "cosmicd answering")
-        assert self.process.poll() is None, (self.work / "cosmicd.log").read_text()
-
-    def stop(self) -> None:
-        self.process.terminate()
-        self.process.wait(timeout=20)
-        self.log.close()
-
-    def ctl(self, *args: str) -> subprocess.CompletedProcess:
-        return subprocess.run([COSMICCTL, "--socket", self.socket, *args], capture_output=True, text=True)
+        super().__init__(work, CONFIG)
 
     def replace(self, yaml: str, name: str) -> tuple[subprocess.CompletedProcess, float]:
         path = self.work / name
@@ -99,8 +78,7 @@ def own_gateway() -> Iterator[OwnGateway]:
         g = OwnGateway(Path(work))
         yield g
         g.stop()
-        if g.process.returncode not in (0, -15):
-            print(Path(work, "cosmicd.log").read_text(), file=sys.stderr)
+        g.print_log_if_it_failed()
 
 
 class Sources:

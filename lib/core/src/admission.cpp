@@ -99,6 +99,15 @@ bool AdmissionReport::any_rejected() const {
   return std::any_of(channels.begin(), channels.end(), [](const auto& c) { return c.verdict == Verdict::rejected; });
 }
 
+ChannelReport rejected_report(const ChannelSpec& channel, std::string reason) {
+  ChannelReport report;
+  report.name = channel.name;
+  report.cls = channel.cls;
+  report.verdict = Verdict::rejected;
+  report.reasons.push_back(std::move(reason));
+  return report;
+}
+
 const ChannelReport* AdmissionReport::find(const std::string& name) const {
   const auto it = std::find_if(channels.begin(), channels.end(), [&](const auto& c) { return c.name == name; });
   return it == channels.end() ? nullptr : &*it;

@@ -48,14 +48,6 @@ std::optional<std::uint16_t> KnowledgeBase::allocate_etag() const {
 }
 
 namespace {
-ChannelReport rejection(const ChannelSpec& channel, std::string reason) {
-  ChannelReport report;
-  report.name = channel.name;
-  report.cls = channel.cls;
-  report.verdict = Verdict::rejected;
-  report.reasons.push_back(std::move(reason));
-  return report;
-}
 
 std::optional<std::string> static_etag_owner(const EtagMap& etags, std::uint16_t etag) {
   for (const auto& [name, e] : etags) {
@@ -91,17 +83,17 @@ std::optional<std::string> KnowledgeBase::native_clash(const ChannelSpec& channe
 KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel, std::optional<std::uint16_t> preferred_etag) const {
   Attempt a;
   if (find_bound(channel.name)) {
-    a.report = rejection(channel, "channel " + channel.name + " is already bound");
+    a.report = rejected_report(channel, "channel " + channel.name + " is already bound");
     return a;
   }
   if (const auto other = subjects_.find(channel.subject); other != subjects_.end()) {
-    a.report = rejection(channel, "subject already carried by bound channel " + other->second);
+    a.report = rejected_report(channel, "subject already carried by bound channel " + other->second);
     return a;
   }
   if (needs_etag(channel)) {
     if (channel.etag) {
       if (const auto owner = static_etag_owner(etags_, *channel.etag)) {
-        a.report = rejection(channel, "etag " + std::to_string(*channel.etag) + " is already used by channel " + *owner);
+        a.report = rejected_report(channel, "etag " + std::to_string(*channel.etag) + " is already used by channel " + *owner);
         return a;
       }
       a.etag = *channel.etag;
@@ -111,12 +103,12 @@ KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel, std::o
     } else if (const auto etag = allocate_etag()) {
       a.etag = *etag;
     } else {
-      a.report = rejection(channel, "no free etag left (101..16383 all in use)");
+      a.report = rejected_report(channel, "no free etag left (101..16383 all in use)");
       return a;
     }
   }
   if (const auto clash = native_clash(channel, channel.etag)) {
-    a.report = rejection(channel, *clash);
+    a.report = rejected_report(channel, *clash);
     return a;
   }
   a.trial = set_.trial(channel, a.etag.value_or(0));

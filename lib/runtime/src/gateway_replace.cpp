@@ -5,18 +5,6 @@
 #include "cosmic/gateway.hpp"
 
 namespace cosmic {
-namespace {
-
-ChannelReport not_replaced(const ChannelSpec& channel, std::string reason) {
-  ChannelReport report;
-  report.name = channel.name;
-  report.cls = channel.cls;
-  report.verdict = Verdict::rejected;
-  report.reasons.push_back(std::move(reason));
-  return report;
-}
-
-}  // namespace
 
 BindResult Gateway::replace(const std::vector<ChannelSpec>& channels) {
   BindPlan plan = replace_plan_input(channels);
@@ -46,7 +34,7 @@ void Gateway::plan_replace(BindPlan& plan) {
     plan.admitted = false;
     for (const auto& channel : plan.channels) {
       const bool missing = std::find(unbound.begin(), unbound.end(), channel.name) != unbound.end();
-      plan.reports.push_back(not_replaced(channel, missing ? "channel " + channel.name +
+      plan.reports.push_back(rejected_report(channel, missing ? "channel " + channel.name +
                                                                  " is not bound: there is nothing to replace (bind it instead)"
                                                            : "not replaced: the replacement names channels that are not bound (" +
                                                                  names + ")"));

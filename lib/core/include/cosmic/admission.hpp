@@ -102,6 +102,10 @@ struct ChannelReport {
   EndToEnd end_to_end;
 };
 
+// A rejection of `channel` for one reason, before any hop is judged (already bound, not bound
+// where a replacement needs it, no etag left, ...).
+ChannelReport rejected_report(const ChannelSpec& channel, std::string reason);
+
 struct SegmentLoad {
   std::string name;
   SegmentType type = SegmentType::dds;
