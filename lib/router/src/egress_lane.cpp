@@ -103,8 +103,13 @@ void EgressLane::worker(ThreadPolicy policy) {
   // What queued up while the last send ran goes to the adapter together: one hand-over (and on
   // CAN one system call) for up to kSendBatch events. A lone event goes out alone, at once.
   std::array<LaneItem, kSendBatch> batch;
-  while (running_.load(std::memory_order_acquire)) {
+  for (;;) {
+    // The wake-up sequence is read before running_: deactivate() clears running_ and then bumps
+    // the sequence, so either this sees running_ cleared or the wait below returns at once. (The
+    // other order lost that wake-up when the stop fell between the two reads: the thread slept
+    // for ever and deactivate() waited for it, seen under ASan in gateway_test.)
     const std::uint32_t seen = wake_.current();
+    if (!running_.load(std::memory_order_acquire)) break;
     const std::size_t n = pop_batch(batch);
     if (n == 1) {
       forward(batch[0]);
