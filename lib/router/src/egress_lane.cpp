@@ -35,12 +35,22 @@ std::size_t EgressLane::pop_batch(std::span<LaneItem> out) noexcept {
     head_ = (head_ + 1) % ring_.size();
     --count_;
   }
+  in_hand_.store(n, std::memory_order_relaxed);  // still counted as queued until handed over
   return n;
 }
 
 std::size_t EgressLane::size() const {
   PiLock lock(mutex_);
-  return count_;
+  return count_ + in_hand_.load(std::memory_order_relaxed);
+}
+
+void EgressLane::hand_over(std::span<LaneItem> items) noexcept {
+  if (items.size() == 1) {
+    forward(items[0]);
+  } else if (items.size() > 1) {
+    forward_batch(items);
+  }
+  in_hand_.store(0, std::memory_order_relaxed);
 }
 
 void EgressLane::activate(SegmentAdapter* adapter, const ThreadPolicy& policy, bool threaded) {
@@ -85,11 +95,7 @@ std::size_t EgressLane::run_once(std::size_t budget) {
   while (handled < budget) {
     const std::size_t n = pop_batch(std::span(batch.data(), std::min(kSendBatch, budget - handled)));
     if (n == 0) break;
-    if (n == 1) {
-      forward(batch[0]);
-    } else {
-      forward_batch(std::span(batch.data(), n));
-    }
+    hand_over(std::span(batch.data(), n));
     handled += n;
   }
   return handled;
@@ -111,19 +117,17 @@ void EgressLane::worker(ThreadPolicy policy) {
     const std::uint32_t seen = wake_.current();
     if (!running_.load(std::memory_order_acquire)) break;
     const std::size_t n = pop_batch(batch);
-    if (n == 1) {
-      forward(batch[0]);
-      continue;
-    }
-    if (n > 1) {
-      forward_batch(std::span(batch.data(), n));
+    if (n > 0) {
+      hand_over(std::span(batch.data(), n));
       continue;
     }
     wake_.wait(seen);
   }
 }
 
+// Every item ends here, sent or dropped: that is the progress the watchdog measures.
 void EgressLane::discard(LaneItem& item) noexcept {
+  context_.progress.fetch_add(1, std::memory_order_relaxed);
   context_.pool.release(item.payload);
   item.payload = nullptr;
   item.channel.reset();
@@ -140,7 +144,6 @@ std::int64_t saturating_add(std::int64_t a, std::int64_t b) {
 }  // namespace
 
 std::optional<OutboundEvent> EgressLane::still_wanted(LaneItem& item) noexcept {
-  context_.progress.fetch_add(1, std::memory_order_relaxed);
   ChannelState& channel = *item.channel;
   if (channel.removed.load(std::memory_order_relaxed) || channel.retired_egress[segment_].load(std::memory_order_relaxed) ||
       item.generation != current_generation_.load(std::memory_order_acquire)) {

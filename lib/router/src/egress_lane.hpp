@@ -70,6 +70,8 @@ class EgressLane {
   void forward(LaneItem& item) noexcept;
   // forward() for several events, handed to the adapter in one send_batch().
   void forward_batch(std::span<LaneItem> items) noexcept;
+  // Forwards what pop_batch() took (one event alone, several as a batch); then none is in hand.
+  void hand_over(std::span<LaneItem> items) noexcept;
   // Before a send: the event as it leaves, or nullopt (the item discarded, its drop counted)
   // when it is not to be sent (channel gone, lane reset, expired).
   std::optional<OutboundEvent> still_wanted(LaneItem& item) noexcept;
@@ -89,6 +91,9 @@ class EgressLane {
   std::size_t count_ COSMIC_GUARDED_BY(mutex_) = 0;
   std::size_t bytes_ COSMIC_GUARDED_BY(mutex_) = 0;
   bool active_ COSMIC_GUARDED_BY(mutex_) = false;
+  // Taken out by pop_batch() and not yet handed to the adapter and accounted: size() counts
+  // them, so a lane blocked inside a send shows its events as queued (the watchdog's stall).
+  std::atomic<std::size_t> in_hand_{0};
   std::uint64_t generation_ COSMIC_GUARDED_BY(mutex_) = 0;
 
   std::atomic<SegmentAdapter*> adapter_{nullptr};
