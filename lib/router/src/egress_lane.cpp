@@ -44,6 +44,11 @@ std::size_t EgressLane::size() const {
   return count_ + in_hand_.load(std::memory_order_relaxed);
 }
 
+std::size_t EgressLane::batch_limit() const noexcept {
+  const SegmentAdapter* adapter = adapter_.load(std::memory_order_acquire);
+  return adapter != nullptr && adapter->batches_sends() ? kSendBatch : 1;
+}
+
 void EgressLane::hand_over(std::span<LaneItem> items) noexcept {
   if (items.size() == 1) {
     forward(items[0]);
@@ -93,7 +98,7 @@ std::size_t EgressLane::run_once(std::size_t budget) {
   std::size_t handled = 0;
   std::array<LaneItem, kSendBatch> batch;
   while (handled < budget) {
-    const std::size_t n = pop_batch(std::span(batch.data(), std::min(kSendBatch, budget - handled)));
+    const std::size_t n = pop_batch(std::span(batch.data(), std::min(batch_limit(), budget - handled)));
     if (n == 0) break;
     hand_over(std::span(batch.data(), n));
     handled += n;
@@ -106,8 +111,8 @@ void EgressLane::worker(ThreadPolicy policy) {
     for (auto& p : problems) p = "thread " + policy.name + ": " + p;
     context_.report_thread_problems(problems);
   }
-  // What queued up while the last send ran goes to the adapter together: one hand-over (and on
-  // CAN one system call) for up to kSendBatch events. A lone event goes out alone, at once.
+  // What queued up while the last send ran goes to an adapter that batches together: one
+  // hand-over (on CAN one system call) for up to kSendBatch events; the others get one at a time.
   std::array<LaneItem, kSendBatch> batch;
   for (;;) {
     // The wake-up sequence is read before running_: deactivate() clears running_ and then bumps
@@ -116,7 +121,7 @@ void EgressLane::worker(ThreadPolicy policy) {
     // for ever and deactivate() waited for it, seen under ASan in gateway_test.)
     const std::uint32_t seen = wake_.current();
     if (!running_.load(std::memory_order_acquire)) break;
-    const std::size_t n = pop_batch(batch);
+    const std::size_t n = pop_batch(std::span(batch.data(), batch_limit()));
     if (n > 0) {
       hand_over(std::span(batch.data(), n));
       continue;

@@ -70,6 +70,8 @@ class EgressLane {
   void forward(LaneItem& item) noexcept;
   // forward() for several events, handed to the adapter in one send_batch().
   void forward_batch(std::span<LaneItem> items) noexcept;
+  // How many events to take at once: kSendBatch for an adapter that batches sends, else 1.
+  std::size_t batch_limit() const noexcept;
   // Forwards what pop_batch() took (one event alone, several as a batch); then none is in hand.
   void hand_over(std::span<LaneItem> items) noexcept;
   // Before a send: the event as it leaves, or nullopt (the item discarded, its drop counted)

@@ -136,6 +136,7 @@ class CanAdapter final : public SegmentAdapter {
   // Runs of events that are one frame each (native, unfragmented, FAMOUSO up to 8 bytes) go out
   // in one submit (one sendmmsg); the others as send() sends them.
   void send_batch(std::span<const OutboundEvent> events, std::span<SendStatus> results) override;
+  bool batches_sends() const override { return true; }
   HealthReport health() const override;
   AdapterStatistics statistics() const override;
   std::optional<std::size_t> matched_peers(ChannelId) const override { return std::nullopt; }  // broadcast bus

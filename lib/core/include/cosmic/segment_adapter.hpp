@@ -154,6 +154,11 @@ class SegmentAdapter {
   virtual void send_batch(std::span<const OutboundEvent> events, std::span<SendStatus> results) {
     for (std::size_t i = 0; i < events.size() && i < results.size(); ++i) results[i] = send(events[i]);
   }
+  // True where send_batch() costs less than send() one by one (CAN: one sendmmsg). Lanes hand
+  // only such an adapter several events at once. The others (DDS, LCM: no batched write) get
+  // one event at a time, so each event's residence is taken right after its own send, not
+  // after the sends of a whole batch.
+  virtual bool batches_sends() const { return false; }
   virtual HealthReport health() const = 0;
   virtual AdapterStatistics statistics() const = 0;
   // Remote endpoints discovered for `channel` here, for transports with discovery (DDS);

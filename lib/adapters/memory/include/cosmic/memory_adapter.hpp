@@ -30,6 +30,7 @@ class MemoryAdapter final : public SegmentAdapter {
   SendStatus send(const OutboundEvent& event) override;
   // Records how many events each hand-over held (batches()), then sends them one by one.
   void send_batch(std::span<const OutboundEvent> events, std::span<SendStatus> results) override;
+  bool batches_sends() const override { return true; }  // so router tests see the lanes' batches
   HealthReport health() const override;
   AdapterStatistics statistics() const override;
   std::optional<std::size_t> matched_peers(ChannelId) const override { return std::nullopt; }
