@@ -237,6 +237,8 @@ class CanAdapter final : public SegmentAdapter {
       COSMIC_REQUIRES(io_mutex_);
   void drain_answers() COSMIC_EXCLUDES(io_mutex_);
   SendStatus send_afp(const TxChannel& channel, std::span<const std::uint8_t> payload);
+  template <typename Done, typename FillNext>
+  SendStatus submit_in_batches(bool fd, Done done, FillNext fill_next);  // send_fragments, send_afp
   void wake();
   // Returns the warning to log once io_mutex_ is given up (empty when nothing was queued).
   std::string drop_backlog(const char* why) COSMIC_REQUIRES(io_mutex_);

@@ -308,21 +308,16 @@ void CanAdapter::send_batch(std::span<const OutboundEvent> events, std::span<Sen
   }
 }
 
-// A fragmented event, kWriteBatch fragments per submit (one system call each).
-SendStatus CanAdapter::send_fragments(const TxChannel& channel, std::span<const std::uint8_t> payload,
-                                      std::uint8_t sequence) {
-  const bool fd = segment_.can.fd;
+// The frames `fill_next` writes (one per call, until `done`), kWriteBatch per submit (one system
+// call each); the first refused batch fails the event.
+template <typename Done, typename FillNext>
+SendStatus CanAdapter::submit_in_batches(bool fd, Done done, FillNext fill_next) {
   std::array<canfd_frame, kWriteBatch> batch{};
-  Fragmenter fragments(payload, capacity_, sequence);
-  while (!fragments.done()) {
+  while (!done()) {
     std::size_t count = 0;
-    for (; count < kWriteBatch && !fragments.done(); ++count) {
-      canfd_frame& frame = batch[count];
-      frame = canfd_frame{};
-      frame.can_id = channel.can_id | CAN_EFF_FLAG;
-      frame.flags = fd && brs_ ? CANFD_BRS : 0;
-      const std::size_t len = fragments.next(std::span<std::uint8_t>(frame.data, capacity_));
-      frame.len = static_cast<std::uint8_t>(fd ? fd_padded_length(static_cast<std::uint32_t>(len)) : len);
+    for (; count < kWriteBatch && !done(); ++count) {
+      batch[count] = canfd_frame{};
+      fill_next(batch[count]);
     }
     const WriteResult r = submit(std::span(batch.data(), count), fd);
     if (r == WriteResult::failed || r == WriteResult::full) return SendStatus::failed;
@@ -330,22 +325,26 @@ SendStatus CanAdapter::send_fragments(const TxChannel& channel, std::span<const 
   return SendStatus::sent;
 }
 
+// A fragmented event in the COSMIC layout.
+SendStatus CanAdapter::send_fragments(const TxChannel& channel, std::span<const std::uint8_t> payload,
+                                      std::uint8_t sequence) {
+  const bool fd = segment_.can.fd;
+  Fragmenter fragments(payload, capacity_, sequence);
+  return submit_in_batches(fd, [&] { return fragments.done(); }, [&](canfd_frame& frame) {
+    frame.can_id = channel.can_id | CAN_EFF_FLAG;
+    frame.flags = fd && brs_ ? CANFD_BRS : 0;
+    const std::size_t len = fragments.next(std::span<std::uint8_t>(frame.data, capacity_));
+    frame.len = static_cast<std::uint8_t>(fd ? fd_padded_length(static_cast<std::uint32_t>(len)) : len);
+  });
+}
+
 // FAMOUSO: an event of more than 8 bytes as AFP fragments with the identifier's fragment flag.
 SendStatus CanAdapter::send_afp(const TxChannel& channel, std::span<const std::uint8_t> payload) {
-  std::array<canfd_frame, kWriteBatch> batch{};
   famouso::AfpFragmenter fragments(payload);
-  while (!fragments.done()) {
-    std::size_t count = 0;
-    for (; count < kWriteBatch && !fragments.done(); ++count) {
-      canfd_frame& frame = batch[count];
-      frame = canfd_frame{};
-      frame.can_id = channel.afp_id | CAN_EFF_FLAG;
-      frame.len = static_cast<std::uint8_t>(fragments.next(std::span<std::uint8_t>(frame.data, famouso::kAfpMtu)));
-    }
-    const WriteResult r = submit(std::span(batch.data(), count), false);
-    if (r == WriteResult::failed || r == WriteResult::full) return SendStatus::failed;
-  }
-  return SendStatus::sent;
+  return submit_in_batches(false, [&] { return fragments.done(); }, [&](canfd_frame& frame) {
+    frame.can_id = channel.afp_id | CAN_EFF_FLAG;
+    frame.len = static_cast<std::uint8_t>(fragments.next(std::span<std::uint8_t>(frame.data, famouso::kAfpMtu)));
+  });
 }
 
 }  // namespace cosmic::can_detail
