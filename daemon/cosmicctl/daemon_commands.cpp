@@ -117,6 +117,39 @@ void print_segments(const Json& r) {
   }
 }
 
+// Seconds as a short age: "0.4s ago", "12s ago".
+std::string age_text(double seconds) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, seconds < 10 ? "%.1fs ago" : "%.0fs ago", seconds);
+  return buffer;
+}
+
+void print_peers(const Json& r) {
+  const Json& f = r["federation"];
+  if (!f["enabled"].get<bool>()) {
+    const std::string error = f.value("error", "");
+    std::cout << "federation: off" << (error.empty() ? std::string(" (gateway.federation is not set)") : ": " + error) << "\n";
+    return;
+  }
+  std::cout << "federation over segment " << text(f["segment"]) << ", lease " << f["lease_s"].get<double>() << "s\n";
+  std::cout << pad_column("GATEWAY", 16) << pad_column("ID", 18) << pad_column("STATE", 7) << pad_column("HEARD", 11)
+            << pad_column("CHANNELS", 9) << "SEGMENTS\n";
+  for (const auto& p : r["peers"]) {
+    std::string segments;
+    for (const auto& s : p.value("segments", Json::array())) {
+      const std::string network = s.value("network", "");
+      segments += (segments.empty() ? "" : ", ") + text(s["name"]) + (network.empty() ? "" : " [" + network + "]") + " " +
+                  format_percent(s["load"].get<double>());
+    }
+    std::cout << pad_column(text(p["name"]), 16) << pad_column(text(p["id"]), 18) << pad_column(text(p["state"]), 7)
+              << pad_column(age_text(p["last_heard_s"].get<double>()), 11) << pad_column(text(p["channels"]), 9) << segments << "\n";
+  }
+  const Json& c = r["counters"];
+  if (c["refused"].get<std::uint64_t>() > 0 || c["dropped"].get<std::uint64_t>() > 0) {
+    std::cout << "refused " << c["refused"] << ", dropped " << c["dropped"] << "; last refusal: " << text(c["last_refusal"]) << "\n";
+  }
+}
+
 std::string drops_text(const Json& dropped) {
   std::string out;
   for (const auto& [reason, count] : dropped.items()) {
@@ -233,6 +266,7 @@ std::vector<CommandRunner> add_daemon_commands(CLI::App& app, const GlobalOption
   simple("status", "Show the gateway's state in one screen", print_status);
   simple("segments", "List segments with health, load and counters", print_segments);
   simple("channels", "List channels with verdict, counters and drops by reason", print_channels);
+  simple("peers", "List the other gateways of the federation as this one sees them", print_peers);
   simple("reload", "Re-read the daemon's configuration file (validated before it is swapped in)",
          [](const Json& r) { std::cout << "reloaded\n"; print_verdicts(r["channels"]); });
 

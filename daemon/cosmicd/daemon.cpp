@@ -16,7 +16,9 @@
 #include "binding_store.hpp"
 #include "cosmic/config_loader.hpp"
 #include "cosmic/control_server.hpp"
+#include "cosmic/dds_federation_link.hpp"
 #include "daemon_logger.hpp"
+#include "federation_member.hpp"
 #include "metrics_server.hpp"
 #include "service_notifier.hpp"
 
@@ -64,13 +66,18 @@ int signal_descriptor() {
   return signalfd(-1, &signals, SFD_NONBLOCK | SFD_CLOEXEC);
 }
 
+cosmic::Nanos steady_now() {
+  return std::chrono::duration_cast<cosmic::Nanos>(std::chrono::steady_clock::now().time_since_epoch());
+}
+
 class Daemon {
  public:
   explicit Daemon(const DaemonOptions& options)
       : options_(options),
         log_(parse_level(options.log_level)),
         state_file_(options.state_file.empty() ? default_state_file() : options.state_file),
-        gateway_(make_adapter, log_, random_gateway_id()) {}
+        gateway_(make_adapter, log_, random_gateway_id()),
+        federation_(gateway_, log_, cosmic::make_dds_federation_link) {}
 
   int run() {
     const int signal_fd = signal_descriptor();
@@ -96,6 +103,7 @@ class Daemon {
         [this](const std::string& command, const nlohmann::json& request) { return remember(command, request); },
         server.offload());
     protocol_ = &protocol;
+    protocol.add_reader("peers", [this] { return federation_.peers_json(steady_now()); });
     server.watch(signal_fd, [&] { on_signals(signal_fd); });
     if (const auto opened = server.open(); !opened.ok) {
       log_.log(cosmic::LogLevel::error, "control socket: " + opened.error);
@@ -104,12 +112,19 @@ class Daemon {
     }
     log_.log(cosmic::LogLevel::notice, "cosmicd " + loaded.config.gateway.name + " running; control socket " + server_options.path);
     // /metrics asks for a snapshot only when scraped; it is taken here, on the control thread.
-    metrics_.attach([this, &server] { server.post([this] { metrics_.publish(take_metrics_snapshot(gateway_, started_)); }); });
+    metrics_.attach([this, &server] {
+      server.post([this] {
+        MetricsSnapshot snapshot = take_metrics_snapshot(gateway_, started_);
+        snapshot.federation = federation_.snapshot(steady_now());
+        metrics_.publish(std::move(snapshot));
+      });
+    });
     loop(server);
     metrics_.detach();  // before `server` goes: scrapes stop posting to it
     notifier_.stopping();
     server.close_all();  // joins the admission worker before `protocol` goes
     protocol_ = nullptr;
+    federation_.leave();  // peers release this gateway's reservations now, not after the lease
     gateway_.stop();
     log_.log(cosmic::LogLevel::notice, "cosmicd stopped");
     return kExitOk;
@@ -270,9 +285,10 @@ class Daemon {
     auto last_health = std::chrono::steady_clock::now() - std::chrono::seconds(1);
     while (running_) {
       server.run_for(std::chrono::milliseconds(100));
+      federation_.tick(steady_now());
       if (std::chrono::steady_clock::now() - last_health >= std::chrono::milliseconds(250)) {
         gateway_.refresh_health();
-        gateway_.refresh_runtime(std::chrono::duration_cast<cosmic::Nanos>(std::chrono::steady_clock::now().time_since_epoch()));
+        gateway_.refresh_runtime(steady_now());
         for (const auto& problem : gateway_.take_thread_problems()) log_.log(cosmic::LogLevel::warning, "realtime: " + problem);
         notifier_.tick(gateway_);
         metrics_.follow(gateway_.config().gateway.metrics);  // a reload may move or close the endpoint
@@ -286,6 +302,7 @@ class Daemon {
   std::string state_file_;
   bool state_file_usable_ = true;  // false: unusable at start and could not be set aside
   cosmic::Gateway gateway_;
+  FederationMember federation_;  // after gateway_: it uses the gateway until it is destroyed
   ServiceNotifier notifier_;
   BindingState state_;
   cosmic::Config file_config_;  // the configuration file as last loaded

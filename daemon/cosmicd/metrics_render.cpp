@@ -267,6 +267,28 @@ std::vector<std::uint64_t> rebucket_residence(const std::vector<std::uint64_t>& 
   return counts;
 }
 
+// Present only while the gateway is in a federation (gateway.federation).
+void render_federation(Exposition& out, const FederationSnapshot& f) {
+  if (!f.enabled) return;
+  out.family("cosmic_federation_peers", MetricType::gauge, "Other gateways of the federation by state (alive, lost, left).");
+  for (const char* state : {"alive", "lost", "left"}) {
+    const auto count = std::count_if(f.peers.begin(), f.peers.end(), [&](const auto& p) { return p.state == state; });
+    out.sample({{"state", state}}, static_cast<std::uint64_t>(count));
+  }
+  out.family("cosmic_federation_peer_last_heard_seconds", MetricType::gauge,
+             "Time since the last announcement or liveliness change of each known gateway.");
+  for (const auto& p : f.peers) out.sample({{"peer", p.name}, {"id", p.id}, {"state", p.state}}, p.last_heard_age_seconds);
+  out.family("cosmic_federation_messages_received", MetricType::counter, "Federation messages received (announcements and liveliness).");
+  out.sample({}, f.view.received);
+  out.family("cosmic_federation_announcements_refused", MetricType::counter,
+             "Announcements refused as malformed, out of range or claiming another gateway's identity.");
+  out.sample({}, f.view.refused);
+  out.family("cosmic_federation_messages_dropped", MetricType::counter, "Federation messages dropped by a full queue (a flood).");
+  out.sample({}, f.link.dropped);
+  out.family("cosmic_federation_announcements_published", MetricType::counter, "This gateway's announcements written.");
+  out.sample({}, f.link.published);
+}
+
 std::string render_metrics(const MetricsSnapshot& snapshot, ExpositionFormat format) {
   Exposition out(format);
   render_gateway(out, snapshot);
@@ -278,6 +300,7 @@ std::string render_metrics(const MetricsSnapshot& snapshot, ExpositionFormat for
   render_hop_admission(out, hops);
   render_hop_counters(out, hops);
   render_residence(out, hops);
+  render_federation(out, snapshot.federation);
   return out.finish();
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cosmic/gateway.hpp"
+#include "federation_member.hpp"
 
 namespace cosmicd {
 
@@ -21,6 +22,7 @@ struct MetricsSnapshot {
   std::vector<cosmic::SegmentInfo> segments;
   std::vector<cosmic::ChannelReport> channels;     // admission's verdicts and numbers
   std::vector<cosmic::ChannelStatsSnapshot> stats;  // the router's counters, by channel name
+  FederationSnapshot federation;                    // filled in by the daemon
 };
 
 // Control thread only.

@@ -18,6 +18,7 @@
 #include "background_loader.hpp"
 #include "components_loader.hpp"
 #include "native_loader.hpp"
+#include "federation_loader.hpp"
 #include "realtime_loader.hpp"
 #include "folded_names.hpp"
 #include "segment_overlap.hpp"
@@ -97,6 +98,9 @@ class ConfigParser {
       if (require(*root, "", "segments", "a list of segments (type can, dds or lcm)")) parse_segments((*root)["segments"]);
       derive_bindings_ = config_detail::has_components(*root);
       if (require(*root, "", "channels", "a list of channels")) parse_channel_list((*root)["channels"], "channels");
+      if (has(*root, "gateway") && has((*root)["gateway"], "federation")) {
+        config_detail::check_federation_segment(reader_, (*root)["gateway"]["federation"], "gateway.federation", config_);
+      }
       config_detail::load_components(reader_, *root, config_);
       native_.check_derived(reader_, config_);
     }
@@ -144,7 +148,10 @@ class ConfigParser {
 
   void parse_gateway(const YAML::Node& node) {
     const std::string path = "gateway";
-    if (!reader_.check_map(node, path, {"name", "can_node_id", "residence_bound", "clean_interval", "realtime", "control_socket", "metrics"})) return;
+    if (!reader_.check_map(node, path, {"name", "can_node_id", "residence_bound", "clean_interval", "realtime", "control_socket", "metrics",
+                                        "federation"})) {
+      return;
+    }
     GatewaySpec& g = config_.gateway;
     if (has(node, "name")) {
       if (auto v = reader_.name(node["name"], key(path, "name"))) g.name = *v;
@@ -175,6 +182,7 @@ class ConfigParser {
       }
     }
     if (has(node, "metrics")) parse_metrics(node["metrics"], key(path, "metrics"));
+    if (has(node, "federation")) config_detail::parse_federation(reader_, node["federation"], key(path, "federation"), g.federation);
   }
 
   // A host outside loopback shows the gateway's channels and load to the network, so it needs
@@ -243,12 +251,15 @@ class ConfigParser {
     if (!type) {
       reader_.check_map(node, path, {"name", "type", "interface", "profile", "bitrate", "fd", "data_bitrate", "errors", "max_utilization",
                                      "background", "domain", "latency_bound", "bandwidth", "reliability", "realtime", "max_message_size",
-                                     "interfaces", "discovery_server", "url"});
+                                     "interfaces", "discovery_server", "url", "network"});
       return std::nullopt;
     }
     s.type = static_cast<SegmentType>(*type);
     if (has(node, "max_utilization")) {
       if (auto v = reader_.percent(node["max_utilization"], key(path, "max_utilization"))) s.max_utilization = *v;
+    }
+    if (has(node, "network")) {
+      if (auto v = reader_.name(node["network"], key(path, "network"))) s.network = *v;
     }
     switch (s.type) {
       case SegmentType::can: parse_can(node, path, s); break;
@@ -261,7 +272,7 @@ class ConfigParser {
 
   void parse_can(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
     reader_.check_map(node, path, {"name", "type", "interface", "profile", "bitrate", "fd", "data_bitrate", "errors", "max_utilization",
-                                   "background"});
+                                   "background", "network"});
     CanSegmentProperties& can = s.can;
     if (require(node, path, "interface", "a network interface such as can0")) {
       if (auto v = reader_.string(node["interface"], key(path, "interface"))) {
@@ -341,7 +352,7 @@ class ConfigParser {
 
   void parse_dds(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
     reader_.check_map(node, path, {"name", "type", "domain", "latency_bound", "bandwidth", "reliability", "realtime",
-                                   "max_message_size", "interfaces", "discovery_server", "max_utilization"});
+                                   "max_message_size", "interfaces", "discovery_server", "max_utilization", "network"});
     parse_ip_common(node, path, s);
     if (has(node, "domain")) {
       if (auto v = reader_.unsigned_int(node["domain"], key(path, "domain"), 0, 232)) s.dds.domain = static_cast<std::uint32_t>(*v);
@@ -368,7 +379,7 @@ class ConfigParser {
 
   void parse_lcm(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
     reader_.check_map(node, path, {"name", "type", "url", "latency_bound", "bandwidth", "realtime", "max_message_size",
-                                   "max_utilization"});
+                                   "max_utilization", "network"});
     s.reliability = Reliability::best_effort;
     parse_ip_common(node, path, s);
     if (has(node, "url")) {

@@ -27,6 +27,9 @@ struct Overlap {
 
 std::optional<Overlap> overlap(const SegmentSpec& a, const SegmentSpec& b) {
   if (a.type != b.type) return std::nullopt;
+  if (!a.network.empty() && a.network == b.network) {
+    return Overlap{"network", std::string(to_string(a.type)) + " network " + a.network, "a different network name for each segment"};
+  }
   switch (a.type) {
     case SegmentType::lcm: {
       const auto port = lcm_port(a.lcm.url);

@@ -3,6 +3,8 @@
 #include <algorithm>
 
 #include "cosmic/can_background.hpp"
+#include "cosmic/federation.hpp"
+#include "cosmic/json_nesting.hpp"
 #include "cosmic/report.hpp"
 
 namespace cosmic {
@@ -16,32 +18,6 @@ Json failure(const std::string& code, const std::string& message) {
 
 // Texts quoted from files or interfaces may hold invalid UTF-8: replace it, never throw.
 std::string render(const Json& response) { return response.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n"; }
-
-// True when no array or object in `text` nests deeper than `limit`, judged without parsing (a
-// linear scan that skips strings) so a hostile request never reaches a recursive walk.
-bool nesting_within(std::string_view text, int limit) {
-  int depth = 0;
-  bool in_string = false;
-  bool escaped = false;
-  for (const char c : text) {
-    if (in_string) {
-      if (escaped) {
-        escaped = false;
-      } else if (c == '\\') {
-        escaped = true;
-      } else if (c == '"') {
-        in_string = false;
-      }
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '[' || c == '{') {
-      if (++depth > limit) return false;
-    } else if (c == ']' || c == '}') {
-      --depth;
-    }
-  }
-  return true;
-}
 
 // A client-chosen text fit for one log line: printable ASCII, at most kMaxLoggedText characters.
 std::string printable(std::string_view text) {
@@ -128,7 +104,7 @@ bool ControlProtocol::is_mutating(std::string_view command) {
 std::optional<std::string> ControlProtocol::handle(std::string_view request_line, const PeerCredentials& peer,
                                                    Reply later) {
   Answer response;
-  const bool shallow = nesting_within(request_line, kMaxRequestNesting);
+  const bool shallow = json_nesting_within(request_line, kMaxRequestNesting);
   const Json request = shallow ? Json::parse(request_line, nullptr, false) : Json(Json::value_t::discarded);
   if (!shallow) {
     response = failure("bad_request", "the request nests deeper than " + std::to_string(kMaxRequestNesting) + " levels");
@@ -180,8 +156,10 @@ ControlProtocol::Answer ControlProtocol::dispatch(const Json& request, const Pee
   if (command == "channels") return channels();
   if (command == "channel") return channel(request);
   if (mutating) return mutate(command, request, peer, later);
-  return failure("unknown_command", "unknown command '" + printable(command) +
-                                        "' (status, segments, channels, channel, bind, replace, unbind, reload)");
+  if (const auto reader = readers_.find(command); reader != readers_.end()) return reader->second();
+  std::string known = "status, segments, channels, channel";
+  for (const auto& [name, answer] : readers_) known += ", " + name;
+  return failure("unknown_command", "unknown command '" + printable(command) + "' (" + known + ", bind, replace, unbind, reload)");
 }
 
 ControlProtocol::Answer ControlProtocol::mutate(const std::string& command, const Json& request, const PeerCredentials& peer,
@@ -260,6 +238,8 @@ Json ControlProtocol::segments() const {
                {"health", to_string(s.health.state)},
                {"detail", s.health.detail},
                {"utilization", s.utilization},
+               {"peers", s.peers},
+               {"network", network_identity(s.spec)},
                {"max_utilization", s.spec.max_utilization},
                {"channels", s.channels},
                {"unrouted", s.unrouted},

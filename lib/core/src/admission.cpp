@@ -122,11 +122,15 @@ Evaluation evaluate(const GatewaySpec& gateway, std::span<const SegmentSpec> seg
 
 AdmissionSet::AdmissionSet(GatewaySpec gateway, std::vector<SegmentSpec> segments)
     : gateway_(std::move(gateway)), segment_specs_(std::move(segments)), segments_(segment_specs_.size()) {
-  // What a CAN bus carries before any channel is bound: its background frames.
+  // What a network carries before any channel is bound: a CAN bus its background frames (other
+  // gateways' frames among them), an IP network what other gateways reserve there.
   for (std::size_t s = 0; s < segments_.size(); ++s) {
-    if (segment_specs_[s].type != SegmentType::can) continue;
-    segments_[s].background = background_streams(segment_specs_[s].can);
-    segments_[s].background_load = utilization(segments_[s].background);
+    if (segment_specs_[s].type == SegmentType::can) {
+      segments_[s].background = background_streams(segment_specs_[s].can);
+      segments_[s].background_load = utilization(segments_[s].background);
+    } else {
+      segments_[s].background_load = segment_specs_[s].peer_load;
+    }
     segments_[s].load = segments_[s].background_load;
   }
 }
@@ -467,8 +471,9 @@ std::vector<SegmentLoad> AdmissionSet::loads() const {
   std::vector<SegmentLoad> out;
   for (std::size_t s = 0; s < segments_.size(); ++s) {
     const SegmentSpec& spec = segment_specs_[s];
-    out.push_back(SegmentLoad{spec.name, spec.type, segments_[s].load, spec.max_utilization, segments_[s].background_load,
-                              spec.type == SegmentType::can ? spec.can.background.size() : 0});
+    const bool can = spec.type == SegmentType::can;
+    out.push_back(SegmentLoad{spec.name, spec.type, segments_[s].load, spec.max_utilization, can ? segments_[s].background_load : 0.0,
+                              can ? spec.can.background.size() : 0, spec.peer_load});
   }
   return out;
 }

@@ -63,8 +63,10 @@ std::string failure_text(const Check& check, const HopReport& h, const SegmentSp
   }
   if (check.check == "utilization") {
     const bool background = segment.type == SegmentType::can && !segment.can.background.empty();
+    const bool peers = segment.peer_load > 0;
     return "utilization " + format_percent(check.value) +
            (background ? " (background " + format_percent(background_utilization(segment.can)) + ")" : std::string()) +
+           (peers ? " (other gateways " + format_percent(segment.peer_load) + ")" : std::string()) +
            " > max_utilization " + format_percent(check.limit) + on;
   }
   if (check.check == "response_time") {

@@ -42,7 +42,7 @@ bool KnowledgeBase::needs_etag(const ChannelSpec& channel) const {
 // The highest etag neither reserved nor bound.
 std::optional<std::uint16_t> KnowledgeBase::allocate_etag() const {
   for (std::uint16_t etag = kMaxEtag; etag > kHighestReservedEtag; --etag) {
-    if (!etag_taken_.test(etag) && !native_etags_.count(etag)) return etag;
+    if (!etag_taken_.test(etag) && !peer_etags_.test(etag) && !native_etags_.count(etag)) return etag;
   }
   return std::nullopt;
 }
@@ -96,9 +96,14 @@ KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel, std::o
         a.report = rejected_report(channel, "etag " + std::to_string(*channel.etag) + " is already used by channel " + *owner);
         return a;
       }
+      if (*channel.etag <= kMaxEtag && peer_etags_.test(*channel.etag)) {
+        a.report = rejected_report(channel, "etag " + std::to_string(*channel.etag) +
+                                                " is used by another gateway's frames on a shared CAN bus (cosmicctl peers)");
+        return a;
+      }
       a.etag = *channel.etag;
     } else if (preferred_etag && *preferred_etag > kHighestReservedEtag && *preferred_etag <= kMaxEtag &&
-               !etag_taken_.test(*preferred_etag) && !native_etags_.count(*preferred_etag)) {
+               !etag_taken_.test(*preferred_etag) && !peer_etags_.test(*preferred_etag) && !native_etags_.count(*preferred_etag)) {
       a.etag = *preferred_etag;
     } else if (const auto etag = allocate_etag()) {
       a.etag = *etag;
@@ -155,6 +160,33 @@ bool KnowledgeBase::unbind(const std::string& name) {
   return true;
 }
 
+std::vector<SegmentSpec> KnowledgeBase::analysed_segments() const {
+  std::vector<SegmentSpec> specs;
+  for (const SegmentState& state : segments_) {
+    SegmentSpec spec = state.spec;
+    if (const auto peer = peers_.find(spec.name); peer != peers_.end()) {
+      spec.peer_load = peer->second.load;
+      if (spec.type == SegmentType::can) {
+        spec.can.background.insert(spec.can.background.end(), peer->second.frames.begin(), peer->second.frames.end());
+      }
+    }
+    specs.push_back(std::move(spec));
+  }
+  return specs;
+}
+
+void KnowledgeBase::set_peer_reservations(std::map<std::string, PeerReservations> peers) {
+  if (peers == peers_) return;
+  peers_ = std::move(peers);
+  peer_etags_.reset();
+  for (const auto& [segment, reservations] : peers_) {
+    for (const CanBackgroundFrame& frame : reservations.frames) {
+      if (frame.extended) peer_etags_.set(frame.can_id & kEtagMask);
+    }
+  }
+  set_ = AdmissionSet::whole(set_.gateway(), analysed_segments(), set_.channels(), etags_);
+}
+
 void KnowledgeBase::set_health(const std::string& segment, SegmentHealth health, std::string detail) {
   for (auto& state : segments_) {
     if (state.spec.name != segment) continue;
@@ -168,6 +200,10 @@ AdmissionReport KnowledgeBase::report() const {
   out.segments = set_.loads();
   out.channels = set_.reports();
   for (auto& channel : out.channels) {
+    if (channel.verdict == Verdict::rejected) {  // only with other gateways' reservations
+      channel.verdict = Verdict::degraded;
+      channel.reasons.push_back("bound before other gateways' reservations on the same networks were known");
+    }
     for (const auto& hop : channel.hops) {
       const auto state = std::find_if(segments_.begin(), segments_.end(), [&](const auto& s) { return s.spec.name == hop.segment; });
       if (state == segments_.end() || state->health == SegmentHealth::up) continue;

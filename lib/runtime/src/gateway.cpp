@@ -294,6 +294,31 @@ BindResult Gateway::commit_bind(BindPlan plan) {
   return result;
 }
 
+namespace {
+// The identifier of every bound channel's CAN hops, in report order.
+std::vector<std::uint32_t> can_identifiers(const KnowledgeBase& kb) {
+  std::vector<std::uint32_t> ids;
+  for (const ChannelReport& channel : kb.report().channels) {
+    for (const HopReport& hop : channel.hops) {
+      if (hop.can) ids.push_back(hop.can->can_id);
+    }
+  }
+  return ids;
+}
+}  // namespace
+
+void Gateway::set_peer_reservations(std::map<std::string, PeerReservations> peers) {
+  if (peers == kb_->peer_reservations()) return;
+  const auto ids_before = can_identifiers(*kb_);
+  kb_->set_peer_reservations(std::move(peers));
+  ++generation_;  // a bind planned without them is planned again
+  // The analysis from scratch may spread a bus's priorities afresh (after unbinds kept them).
+  if (router_ && can_identifiers(*kb_) != ids_before) {
+    configure_adapters();
+    apply_routes();
+  }
+}
+
 bool Gateway::unbind(const std::string& name) {
   if (!kb_->unbind(name)) return false;
   ++generation_;
@@ -385,6 +410,8 @@ BindResult Gateway::commit_reload(ReloadPlan plan) {
   router_->set_residence_bound(config.gateway.residence_bound);
   config_ = config;
   identity_.name = config.gateway.name;
+  // What other gateways reserve carries over; the federation updates it for changed networks.
+  next_kb->set_peer_reservations(kb_->peer_reservations());
   kb_ = std::move(next_kb);
   // As in bind(): adapters carry the new channels before the router sends to them.
   configure_adapters();
@@ -549,6 +576,7 @@ std::vector<SegmentInfo> Gateway::segments() const {
     for (std::size_t s = 0; s < loads.size() && s < hops.size(); ++s) {
       if (loads[s].name != spec.name) continue;
       info.utilization = loads[s].utilization;
+      info.peers = loads[s].peers;
       info.channels = hops[s];
     }
     out.push_back(std::move(info));

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <nlohmann/json.hpp>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -59,6 +60,9 @@ class ControlProtocol {
   // The same for callers without an Offload (every answer is immediate).
   std::string handle(std::string_view request_line, const PeerCredentials& peer);
   bool admission_running() const { return !running_.empty(); }
+  // Adds a read-only command (may_read applies) answered by `answer` on the control thread, e.g.
+  // `peers` from the daemon's federation; its answer carries "ok" itself.
+  void add_reader(std::string command, std::function<nlohmann::json()> answer) { readers_[std::move(command)] = std::move(answer); }
 
   static bool is_mutating(std::string_view command);
 
@@ -93,6 +97,7 @@ class ControlProtocol {
   std::string running_;  // what admission runs off the control thread, for `busy` answers
   std::uint64_t log_sequence_ = 0;  // numbers audit and denial lines: no two are alike, none folded
   DenialLog denials_;               // which denials are logged (a burst is summarised)
+  std::map<std::string, std::function<Json()>> readers_;  // add_reader()
 };
 
 }  // namespace cosmic

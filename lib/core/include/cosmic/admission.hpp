@@ -111,8 +111,9 @@ struct SegmentLoad {
   SegmentType type = SegmentType::dds;
   double utilization = 0;  // everything the bus carries: the bound channels plus the background
   double max_utilization = 0;
-  double background = 0;   // CAN: the other devices' frames (segment key `background`)
+  double background = 0;   // CAN: the other devices' frames (segment key `background`), other gateways' included
   std::size_t background_frames = 0;
+  double peers = 0;        // what other gateways of the federation reserve (SegmentSpec::peer_load)
 };
 
 struct AdmissionReport {

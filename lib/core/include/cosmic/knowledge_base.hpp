@@ -38,6 +38,14 @@ struct SegmentState {
   std::string health_detail;
 };
 
+// What the other gateways of a federation reserve on a network one of this gateway's segments
+// attaches (docs/federation.md).
+struct PeerReservations {
+  double load = 0;  // their share of the network (CAN: the share of their `frames`)
+  std::vector<CanBackgroundFrame> frames;  // CAN: their frames, analysed like background frames
+  friend bool operator==(const PeerReservations&, const PeerReservations&) = default;
+};
+
 struct BindOutcome {
   ChannelReport report;  // the channel's verdict with its numbers
   bool bound() const { return report.verdict != Verdict::rejected; }
@@ -63,6 +71,13 @@ class KnowledgeBase {
 
   void set_health(const std::string& segment, SegmentHealth health, std::string detail);
 
+  // Replaces what other gateways reserve (by segment name; a segment not named: nothing) and
+  // analyses the bound set again with it (O(bound channels + hops)). Bound channels stay bound: one
+  // that no longer passes shows `degraded` with the analysis's reasons (two binds that raced on two
+  // gateways); newcomers are admitted against it. Their CAN frames' etags are not handed out.
+  void set_peer_reservations(std::map<std::string, PeerReservations> peers);
+  const std::map<std::string, PeerReservations>& peer_reservations() const { return peers_; }
+
   // Verdicts of the bound set (live health applied) and the load of every segment.
   AdmissionReport report() const;
   // The load of every segment and how many hops of bound channels it carries (same order),
@@ -87,8 +102,13 @@ class KnowledgeBase {
   bool needs_etag(const ChannelSpec& channel) const;
   std::optional<std::string> native_clash(const ChannelSpec& channel, std::optional<std::uint16_t> etag) const;
 
+  // The segments as admission sees them: the configured ones plus what other gateways reserve.
+  std::vector<SegmentSpec> analysed_segments() const;
+
   std::vector<SegmentState> segments_;
   AdmissionSet set_;
+  std::map<std::string, PeerReservations> peers_;
+  std::bitset<kMaxEtag + 1> peer_etags_;  // etag bits of other gateways' extended frames
   std::set<std::uint16_t> reserved_etags_;
   EtagMap etags_;                                         // bound CAN channels
   std::bitset<kMaxEtag + 1> etag_taken_;                  // reserved or bound: never handed out

@@ -84,6 +84,13 @@ struct SegmentSpec {
   CanSegmentProperties can;
   DdsSegmentProperties dds;
   LcmSegmentProperties lcm;
+  // Segment key `network`: the name of the network this segment attaches, the same on every
+  // gateway attached to it (federation, docs/federation.md). CAN buses are shared only through it.
+  std::string network;
+  // Never configured: the share of the network that other gateways of the federation reserve
+  // (IP segments; their CAN frames enter `can.background` instead). Set on the knowledge base's
+  // copy of the segments only.
+  double peer_load = 0;
   friend bool operator==(const SegmentSpec&, const SegmentSpec&) = default;
 };
 
@@ -164,6 +171,15 @@ struct RealtimeSpec {
   friend bool operator==(const RealtimeSpec&, const RealtimeSpec&) = default;
 };
 
+// gateway.federation (docs/federation.md): the DDS segment over which this gateway announces
+// itself and hears the others; off when `segment` is empty.
+struct FederationSpec {
+  std::string segment;
+  Nanos lease{Nanos(3'000'000'000)};  // a peer not heard (DDS liveliness) for this long is lost
+  bool enabled() const { return !segment.empty(); }
+  friend bool operator==(const FederationSpec&, const FederationSpec&) = default;
+};
+
 struct GatewaySpec {
   std::string name = "cosmicd";
   std::uint8_t can_node_id = 1;
@@ -172,6 +188,7 @@ struct GatewaySpec {
   RealtimeSpec realtime;
   std::string control_socket = "/run/cosmicd/control.sock";
   MetricsSpec metrics;
+  FederationSpec federation;
   friend bool operator==(const GatewaySpec&, const GatewaySpec&) = default;
 };
 

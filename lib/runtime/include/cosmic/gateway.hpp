@@ -54,7 +54,8 @@ struct SegmentInfo {
   SegmentSpec spec;
   HealthReport health;
   AdapterStatistics adapter;
-  double utilization = 0;
+  double utilization = 0;  // other gateways' reservations included
+  double peers = 0;        // what other gateways of the federation reserve here
   std::size_t channels = 0;
   std::uint64_t unrouted = 0;
 };
@@ -150,6 +151,11 @@ class Gateway {
   // Changes with every applied bind, unbind and reload.
   std::uint64_t generation() const { return generation_; }
   void stop();
+
+  // What other gateways of the federation reserve on this gateway's networks (by segment name;
+  // FederationView::reservations_for): admission counts it from now on, the bound set is analysed
+  // again with it and a bind planned before is planned again. Kept across reloads.
+  void set_peer_reservations(std::map<std::string, PeerReservations> peers);
 
   // Reads adapter health into the knowledge base (call periodically).
   void refresh_health();

@@ -1,0 +1,160 @@
+#include "federation_member.hpp"
+
+namespace cosmicd {
+namespace {
+
+// Lost and left peers stay listed this many leases, then are forgotten.
+constexpr int kForgetAfterLeases = 20;
+
+double seconds_between(cosmic::Nanos from, cosmic::Nanos to) { return std::chrono::duration<double>(to - from).count(); }
+
+}  // namespace
+
+FederationMember::FederationMember(cosmic::Gateway& gateway, cosmic::Logger& log, FederationLinkFactory factory)
+    : gateway_(gateway), log_(log), factory_(std::move(factory)) {}
+
+FederationMember::~FederationMember() {
+  if (link_) link_->withdraw();
+}
+
+void FederationMember::leave() {
+  if (link_) link_->withdraw();
+  link_.reset();
+  view_.reset();
+  announced_.reset();
+  gateway_.set_peer_reservations({});
+}
+
+void FederationMember::follow_configuration() {
+  const cosmic::Config& config = gateway_.config();
+  const cosmic::FederationSpec& spec = config.gateway.federation;
+  const cosmic::SegmentSpec* segment = spec.enabled() ? config.find_segment(spec.segment) : nullptr;
+  const cosmic::SegmentSpec wanted = segment ? *segment : cosmic::SegmentSpec{};
+  if (spec == spec_ && wanted == segment_ && (link_ || !spec.enabled() || !start_error_.empty())) return;
+  if (link_) {
+    log_.log(cosmic::LogLevel::notice, "federation: leaving (over segment " + spec_.segment + ")");
+    leave();
+  }
+  spec_ = spec;
+  segment_ = wanted;
+  start_error_.clear();
+  if (!segment) return;
+  auto link = factory_(*segment, gateway_.identity(), spec.lease, log_);
+  if (const std::string error = link->start(); !error.empty()) {
+    start_error_ = error;
+    log_.log(cosmic::LogLevel::error, "federation: cannot join over segment " + spec.segment + ": " + error +
+                                          "; this gateway admits as if alone");
+    return;
+  }
+  link_ = std::move(link);
+  view_ = std::make_unique<cosmic::FederationView>(gateway_.identity().id);
+  announced_generation_ = UINT64_MAX;
+  log_.log(cosmic::LogLevel::notice, "federation: joined over segment " + spec.segment + " (DDS domain " +
+                                         std::to_string(segment->dds.domain) + ", lease " + cosmic::format_duration(spec.lease) + ")");
+}
+
+void FederationMember::log_transitions(const std::map<std::uint64_t, cosmic::PeerState>& before) {
+  for (const auto& [id, peer] : view_->peers()) {
+    const auto was = before.find(id);
+    if (was != before.end() && was->second == peer.state) continue;
+    const std::string who = "gateway " + peer.announcement.name + " (" + cosmic::gateway_id_text(id) + ")";
+    if (peer.state == cosmic::PeerState::alive) {
+      log_.log(cosmic::LogLevel::notice, "federation: " + who + (was == before.end() ? " joined" : " is back") + " with " +
+                                             std::to_string(peer.announcement.segments.size()) + " segments and " +
+                                             std::to_string(peer.announcement.channels.size()) + " channels");
+    } else {
+      log_.log(cosmic::LogLevel::warning, "federation: " + who + (peer.state == cosmic::PeerState::left ? " left" : " was lost (lease expired)") +
+                                              "; its reservations are released");
+    }
+  }
+}
+
+void FederationMember::hear(cosmic::Nanos now) {
+  std::map<std::uint64_t, cosmic::PeerState> before;
+  for (const auto& [id, peer] : view_->peers()) before[id] = peer.state;
+  bool changed = false;
+  std::string refusal;
+  for (const cosmic::FederationMessage& message : link_->take()) {
+    changed |= view_->apply(message, now, &refusal);
+    // A hostile or broken peer may repeat itself: the first refusals are logged, then every 1000th.
+    if (!refusal.empty() && (refusals_logged_++ < 10 || refusals_logged_ % 1000 == 0)) {
+      log_.log(cosmic::LogLevel::warning, "federation: refused an announcement: " + refusal + " (" +
+                                              std::to_string(view_->counters().refused) + " refused so far)");
+    }
+  }
+  view_->forget_before(now - spec_.lease * kForgetAfterLeases);
+  if (!changed) return;
+  log_transitions(before);
+  gateway_.set_peer_reservations(view_->reservations_for(gateway_.config().segments));
+  peers_changed_ = true;
+}
+
+void FederationMember::announce() {
+  if (gateway_.generation() == announced_generation_ && !peers_changed_) return;
+  cosmic::Announcement now = cosmic::announcement_of(gateway_.identity(), gateway_.knowledge_base(), 0);
+  if (announced_ && *announced_ == now) {
+    announced_generation_ = gateway_.generation();
+    peers_changed_ = false;
+    return;
+  }
+  cosmic::Announcement numbered = now;
+  numbered.revision = ++revision_;
+  if (!link_->publish(numbered.gateway, cosmic::encode(numbered))) {
+    log_.log(cosmic::LogLevel::warning, "federation: cannot publish this gateway's announcement; trying again");
+    return;
+  }
+  announced_ = std::move(now);
+  announced_generation_ = gateway_.generation();
+  peers_changed_ = false;
+}
+
+void FederationMember::tick(cosmic::Nanos now) {
+  follow_configuration();
+  if (!link_) return;
+  hear(now);
+  announce();
+}
+
+nlohmann::json FederationMember::peers_json(cosmic::Nanos now) const {
+  const FederationSnapshot s = snapshot(now);
+  nlohmann::json peers = nlohmann::json::array();
+  for (const auto& p : s.peers) {
+    peers.push_back({{"id", p.id}, {"name", p.name}, {"state", p.state}, {"last_heard_s", p.last_heard_age_seconds},
+                     {"revision", p.revision}, {"channels", p.channels}});
+  }
+  if (view_) {
+    std::size_t i = 0;
+    for (const auto& [id, peer] : view_->peers()) {
+      nlohmann::json segments = nlohmann::json::array();
+      for (const auto& seg : peer.announcement.segments) {
+        segments.push_back({{"name", seg.name}, {"type", cosmic::to_string(seg.type)}, {"network", seg.network}, {"load", seg.load},
+                            {"frames", seg.frames.size()}});
+      }
+      peers[i++]["segments"] = segments;
+    }
+  }
+  return {{"ok", true},
+          {"federation", {{"enabled", s.enabled}, {"segment", s.segment}, {"lease_s", std::chrono::duration<double>(spec_.lease).count()},
+                          {"error", start_error_}}},
+          {"peers", peers},
+          {"counters",
+           {{"received", s.view.received}, {"applied", s.view.applied}, {"stale", s.view.stale}, {"refused", s.view.refused},
+            {"last_refusal", s.view.last_refusal}, {"dropped", s.link.dropped}, {"published", s.link.published},
+            {"publish_errors", s.link.publish_errors}}}};
+}
+
+FederationSnapshot FederationMember::snapshot(cosmic::Nanos now) const {
+  FederationSnapshot s;
+  s.enabled = link_ != nullptr;
+  s.segment = spec_.segment;
+  if (!view_) return s;
+  for (const auto& [id, peer] : view_->peers()) {
+    s.peers.push_back({cosmic::gateway_id_text(id), peer.announcement.name, cosmic::to_string(peer.state), seconds_between(peer.last_heard, now),
+                       peer.announcement.revision, peer.announcement.channels.size()});
+  }
+  s.view = view_->counters();
+  s.link = link_->counters();
+  return s;
+}
+
+}  // namespace cosmicd

@@ -1,0 +1,75 @@
+// This gateway as a member of a federation (gateway.federation, docs/federation.md): follows the
+// configuration (joins, rejoins on a changed segment or lease, leaves), announces the gateway's
+// state when it changes, applies what the other gateways announce to the gateway's admission
+// (Gateway::set_peer_reservations) and logs who joined, left or was lost.
+//
+// Threads: the control thread only (tick() from the daemon's loop, peers_json() from the control
+// protocol, snapshot() for /metrics); the link's own threads only queue messages for it.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "cosmic/federation_link.hpp"
+#include "cosmic/federation_view.hpp"
+#include "cosmic/gateway.hpp"
+
+namespace cosmicd {
+
+using FederationLinkFactory = std::function<std::unique_ptr<cosmic::FederationLink>(
+    const cosmic::SegmentSpec& segment, const cosmic::GatewayIdentity& self, cosmic::Nanos lease, cosmic::Logger& log)>;
+
+struct FederationSnapshot {
+  bool enabled = false;
+  std::string segment;
+  struct Peer {
+    std::string id;
+    std::string name;
+    std::string state;
+    double last_heard_age_seconds = 0;
+    std::uint64_t revision = 0;
+    std::size_t channels = 0;
+  };
+  std::vector<Peer> peers;
+  cosmic::FederationCounters view;
+  cosmic::FederationLinkCounters link;
+};
+
+class FederationMember {
+ public:
+  FederationMember(cosmic::Gateway& gateway, cosmic::Logger& log, FederationLinkFactory factory);
+  ~FederationMember();
+
+  // Control thread, every tick of the daemon's loop.
+  void tick(cosmic::Nanos now);
+  // Withdraws this gateway's announcement (peers release its reservations at once) and closes the link.
+  void leave();
+
+  // The answer of the control command `peers` (docs/control-protocol.md).
+  nlohmann::json peers_json(cosmic::Nanos now) const;
+  FederationSnapshot snapshot(cosmic::Nanos now) const;
+
+ private:
+  void follow_configuration();
+  void hear(cosmic::Nanos now);
+  void announce();
+  void log_transitions(const std::map<std::uint64_t, cosmic::PeerState>& before);
+
+  cosmic::Gateway& gateway_;
+  cosmic::Logger& log_;
+  FederationLinkFactory factory_;
+  // What the running link was made for; an empty segment name when off.
+  cosmic::FederationSpec spec_;
+  cosmic::SegmentSpec segment_;
+  std::string start_error_;  // the last failure to join, logged once
+  std::unique_ptr<cosmic::FederationLink> link_;
+  std::unique_ptr<cosmic::FederationView> view_;
+  std::uint64_t revision_ = 0;
+  std::optional<cosmic::Announcement> announced_;  // with revision 0, to compare
+  std::uint64_t announced_generation_ = UINT64_MAX;
+  bool peers_changed_ = false;
+  std::uint64_t refusals_logged_ = 0;
+};
+
+}  // namespace cosmicd

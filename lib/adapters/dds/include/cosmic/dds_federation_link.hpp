@@ -1,0 +1,28 @@
+// The federation transport over Fast DDS 2.9 (docs/federation.md): one participant of its own in
+// the federation segment's domain (the segment's transports and discovery), topic
+// "cosmic/federation" of type cosmic_federation::Announcement.
+//   writer  RELIABLE, TRANSIENT_LOCAL, KEEP_LAST 1, liveliness AUTOMATIC with lease_duration =
+//           gateway.federation.lease, asynchronous publishing (announcements are fragmented)
+//   reader  the same, with at most FederationView::kDefaultMaxPeers instances of one sample each
+// What the reader hears becomes FederationMessages: a sample -> announcement (filed under its
+// key, the source being its writer's GUID), a disposed instance -> withdrawn, a writer whose
+// liveliness lapsed or that was unmatched -> lost, liveliness regained -> alive. This gateway's own
+// samples are dropped by GUID prefix.
+//
+// Threads: Fast DDS's listener threads queue messages under a mutex (never touching anything
+// else); start/publish/withdraw/take run on the owner's control thread.
+#pragma once
+
+#include <memory>
+
+#include "cosmic/federation_link.hpp"
+#include "cosmic/log.hpp"
+#include "cosmic/model.hpp"
+
+namespace cosmic {
+
+// `segment` is the DDS segment named by gateway.federation.segment.
+std::unique_ptr<FederationLink> make_dds_federation_link(const SegmentSpec& segment, const GatewayIdentity& self, Nanos lease,
+                                                         Logger& log);
+
+}  // namespace cosmic

@@ -1,0 +1,261 @@
+#include "cosmic/dds_federation_link.hpp"
+
+#include <pthread.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <mutex>
+#include <thread>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include "cosmic_dds_idl/FederationPubSubTypes.h"
+#include "dds_qos.hpp"
+
+namespace cosmic {
+namespace {
+
+namespace dds = eprosima::fastdds::dds;
+using eprosima::fastrtps::types::ReturnCode_t;
+
+constexpr const char* kTopic = "cosmic/federation";
+// Messages queued between two take() calls; beyond it a flood is dropped and counted.
+constexpr std::size_t kMaxQueued = 4096;
+
+eprosima::fastrtps::Duration_t duration_of(Nanos value) {
+  return eprosima::fastrtps::Duration_t(static_cast<std::int32_t>(value.count() / 1'000'000'000),
+                                        static_cast<std::uint32_t>(value.count() % 1'000'000'000));
+}
+
+// A writer's handle as text: its GUID's 16 bytes in hexadecimal.
+std::string handle_text(const dds::InstanceHandle_t& handle) {
+  std::string out;
+  char byte[3];
+  for (std::size_t i = 0; i < 16; ++i) {
+    std::snprintf(byte, sizeof byte, "%02x", static_cast<unsigned>(handle.value[i]));
+    out += byte;
+  }
+  return out;
+}
+
+bool from_prefix(const dds::InstanceHandle_t& handle, const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) {
+  for (std::size_t i = 0; i < eprosima::fastrtps::rtps::GuidPrefix_t::size; ++i) {
+    if (prefix.value[i] != handle.value[i]) return false;
+  }
+  return true;
+}
+
+class DdsFederationLink final : public FederationLink, private dds::DataReaderListener {
+ public:
+  DdsFederationLink(SegmentSpec segment, GatewayIdentity self, Nanos lease, Logger& log)
+      : segment_(std::move(segment)), self_(std::move(self)), lease_(lease), log_(log) {}
+
+  ~DdsFederationLink() override { close(); }
+
+  std::string start() override {
+    dds::DomainParticipantQos qos;
+    if (Status st = dds_detail::participant_qos(segment_, (self_.name.empty() ? "cosmicd" : self_.name) + "/federation", qos); !st.ok) {
+      return st.error;
+    }
+    qos.wire_protocol().builtin.discovery_config.leaseDuration = duration_of(std::max(lease_, Nanos(1'000'000'000)));
+    qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod = duration_of(std::max(lease_, Nanos(1'000'000'000)) / 3);
+    participant_ = create_participant(qos);
+    if (participant_ == nullptr) return "cannot create the federation's DDS participant in domain " + std::to_string(segment_.dds.domain);
+    own_prefix_ = participant_->guid().guidPrefix;
+    dds::TypeSupport type(new cosmic_federation::AnnouncementPubSubType());
+    if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK) return fail("cannot register the federation type");
+    topic_ = participant_->create_topic(kTopic, type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+    publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+    subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+    if (!topic_ || !publisher_ || !subscriber_) return fail("cannot create the federation topic, publisher or subscriber");
+    writer_ = publisher_->create_datawriter(topic_, writer_qos());
+    const dds::StatusMask mask = dds::StatusMask::data_available() << dds::StatusMask::subscription_matched()
+                                                                      << dds::StatusMask::liveliness_changed();
+    reader_ = subscriber_->create_datareader(topic_, reader_qos(), this, mask);
+    if (!writer_ || !reader_) return fail("cannot create the federation writer or reader");
+    return {};
+  }
+
+  bool publish(std::uint64_t gateway, const std::string& body) override {
+    if (!writer_) return false;
+    cosmic_federation::Announcement sample;
+    sample.gateway(gateway);
+    sample.body(body);
+    const bool ok = writer_->write(&sample);
+    std::lock_guard lock(mutex_);
+    ++(ok ? counters_.published : counters_.publish_errors);
+    if (ok) announced_ = gateway;
+    return ok;
+  }
+
+  void withdraw() override {
+    if (!writer_ || announced_ == 0) return;
+    cosmic_federation::Announcement sample;
+    sample.gateway(announced_);
+    if (writer_->dispose(&sample, dds::HANDLE_NIL) != ReturnCode_t::RETCODE_OK) {
+      log_.log(LogLevel::warning, "federation: cannot withdraw this gateway's announcement; peers release it after the lease");
+    }
+    // Asynchronous publishing: give the dispose a moment to leave before the writer goes.
+    writer_->wait_for_acknowledgments(duration_of(Nanos(500'000'000)));
+    announced_ = 0;
+  }
+
+  std::vector<FederationMessage> take() override {
+    std::lock_guard lock(mutex_);
+    std::vector<FederationMessage> out;
+    out.swap(queue_);
+    return out;
+  }
+
+  FederationLinkCounters counters() const override {
+    std::lock_guard lock(mutex_);
+    return counters_;
+  }
+
+ private:
+  dds::DataWriterQos writer_qos() const {
+    dds::DataWriterQos qos = dds::DATAWRITER_QOS_DEFAULT;
+    qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+    qos.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
+    qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+    qos.history().depth = 1;
+    qos.liveliness().kind = dds::AUTOMATIC_LIVELINESS_QOS;
+    qos.liveliness().lease_duration = duration_of(lease_);
+    qos.liveliness().announcement_period = duration_of(lease_ / 3);
+    qos.publish_mode().kind = dds::ASYNCHRONOUS_PUBLISH_MODE;
+    qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+    return qos;
+  }
+
+  dds::DataReaderQos reader_qos() const {
+    dds::DataReaderQos qos = dds::DATAREADER_QOS_DEFAULT;
+    qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
+    qos.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
+    qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
+    qos.history().depth = 1;
+    qos.liveliness().kind = dds::AUTOMATIC_LIVELINESS_QOS;
+    qos.liveliness().lease_duration = duration_of(lease_);
+    const auto peers = static_cast<std::int32_t>(FederationView::kDefaultMaxPeers);
+    qos.resource_limits().max_instances = peers;
+    qos.resource_limits().max_samples_per_instance = 1;
+    qos.resource_limits().max_samples = peers;
+    qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+    return qos;
+  }
+
+  // Fast DDS threads inherit their creator's name: they show as fed:<segment> in ps and top.
+  dds::DomainParticipant* create_participant(const dds::DomainParticipantQos& qos) {
+    dds::DomainParticipant* created = nullptr;
+    const std::string name = ("fed:" + segment_.name).substr(0, 15);
+    std::thread creator([&] {
+      pthread_setname_np(pthread_self(), name.c_str());
+      created = dds::DomainParticipantFactory::get_instance()->create_participant(static_cast<dds::DomainId_t>(segment_.dds.domain), qos);
+    });
+    creator.join();
+    return created;
+  }
+
+  std::string fail(std::string why) {
+    close();
+    return why;
+  }
+
+  void close() {
+    if (!participant_) return;
+    participant_->delete_contained_entities();
+    dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+    participant_ = nullptr;
+    writer_ = nullptr;
+    reader_ = nullptr;
+    topic_ = nullptr;
+    publisher_ = nullptr;
+    subscriber_ = nullptr;
+  }
+
+  // Listener thread, mutex_ held.
+  void queue(FederationMessage message) {
+    ++counters_.received;
+    if (message.kind == FederationMessage::Kind::announcement) {
+      for (FederationMessage& queued : queue_) {
+        if (queued.kind == message.kind && queued.key == message.key && queued.source == message.source) {
+          queued.body = std::move(message.body);
+          return;
+        }
+      }
+    }
+    if (queue_.size() >= kMaxQueued) {
+      ++counters_.dropped;
+      return;
+    }
+    queue_.push_back(std::move(message));
+  }
+
+  void on_data_available(dds::DataReader* reader) override {
+    cosmic_federation::Announcement sample;
+    dds::SampleInfo info;
+    while (reader->take_next_sample(&sample, &info) == ReturnCode_t::RETCODE_OK) {
+      if (from_prefix(info.publication_handle, own_prefix_)) continue;
+      FederationMessage m;
+      m.source = handle_text(info.publication_handle);
+      if (info.valid_data) {
+        m.key = sample.gateway();
+        m.body = std::move(sample.body());
+      } else {
+        m.kind = info.instance_state == dds::NOT_ALIVE_DISPOSED_INSTANCE_STATE ? FederationMessage::Kind::withdrawn
+                                                                              : FederationMessage::Kind::lost;
+      }
+      std::lock_guard lock(mutex_);
+      queue(std::move(m));
+    }
+  }
+
+  void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& status) override {
+    if (status.current_count_change >= 0 || from_prefix(status.last_publication_handle, own_prefix_)) return;
+    std::lock_guard lock(mutex_);
+    queue(FederationMessage{FederationMessage::Kind::lost, handle_text(status.last_publication_handle), 0, {}});
+  }
+
+  void on_liveliness_changed(dds::DataReader*, const dds::LivelinessChangedStatus& status) override {
+    if (from_prefix(status.last_publication_handle, own_prefix_)) return;
+    const auto kind = status.not_alive_count_change > 0 ? FederationMessage::Kind::lost
+                      : status.alive_count_change > 0   ? FederationMessage::Kind::alive
+                                                        : FederationMessage::Kind::announcement;
+    if (kind == FederationMessage::Kind::announcement) return;
+    std::lock_guard lock(mutex_);
+    queue(FederationMessage{kind, handle_text(status.last_publication_handle), 0, {}});
+  }
+
+  SegmentSpec segment_;
+  GatewayIdentity self_;
+  Nanos lease_;
+  Logger& log_;
+  dds::DomainParticipant* participant_ = nullptr;
+  dds::Topic* topic_ = nullptr;
+  dds::Publisher* publisher_ = nullptr;
+  dds::Subscriber* subscriber_ = nullptr;
+  dds::DataWriter* writer_ = nullptr;
+  dds::DataReader* reader_ = nullptr;
+  eprosima::fastrtps::rtps::GuidPrefix_t own_prefix_;
+  std::uint64_t announced_ = 0;  // the key of our instance, once written
+
+  mutable std::mutex mutex_;
+  std::vector<FederationMessage> queue_;
+  FederationLinkCounters counters_;
+};
+
+}  // namespace
+
+std::unique_ptr<FederationLink> make_dds_federation_link(const SegmentSpec& segment, const GatewayIdentity& self, Nanos lease,
+                                                         Logger& log) {
+  return std::make_unique<DdsFederationLink>(segment, self, lease, log);
+}
+
+}  // namespace cosmic

@@ -1,0 +1,53 @@
+#include "federation_loader.hpp"
+
+#include <algorithm>
+
+namespace cosmic::config_detail {
+namespace {
+
+// A lease shorter than this would mark peers lost on ordinary scheduling delays; a longer one
+// than an hour keeps a dead gateway's reservations far too long.
+constexpr Nanos kMinLease{100'000'000};
+constexpr Nanos kMaxLease{3'600'000'000'000};
+
+std::string key(const std::string& path, const char* name) { return path + "." + name; }
+bool has(const YAML::Node& map, const char* name) { return map.IsMap() && map[name] && !map[name].IsNull(); }
+
+}  // namespace
+
+void parse_federation(YamlReader& reader, const YAML::Node& node, const std::string& path, FederationSpec& out) {
+  if (!reader.check_map(node, path, {"segment", "lease"})) return;
+  if (!has(node, "segment")) {
+    reader.error_at(node, key(path, "segment"), "missing required key 'segment'", "the name of a DDS segment to federate over");
+    return;
+  }
+  if (auto v = reader.name(node["segment"], key(path, "segment"))) out.segment = *v;
+  if (has(node, "lease")) {
+    if (auto v = reader.duration(node["lease"], key(path, "lease"), false)) {
+      if (*v < kMinLease || *v > kMaxLease) {
+        reader.error_at(node["lease"], key(path, "lease"), "lease out of range", "from 100ms to 1h, e.g. 3s");
+      } else {
+        out.lease = *v;
+      }
+    }
+  }
+}
+
+void check_federation_segment(YamlReader& reader, const YAML::Node& node, const std::string& path, const Config& config) {
+  const FederationSpec& federation = config.gateway.federation;
+  if (!federation.enabled() || !has(node, "segment")) return;
+  const SegmentSpec* segment = config.find_segment(federation.segment);
+  if (!segment) {
+    std::string dds;
+    for (const auto& s : config.segments) {
+      if (s.type == SegmentType::dds) dds += (dds.empty() ? "" : ", ") + s.name;
+    }
+    reader.error_at(node["segment"], key(path, "segment"), "unknown segment '" + federation.segment + "'",
+                    dds.empty() ? "a DDS segment (none is configured)" : "a DDS segment: " + dds);
+  } else if (segment->type != SegmentType::dds) {
+    reader.error_at(node["segment"], key(path, "segment"), "segment '" + federation.segment + "' is " + to_string(segment->type),
+                    "a DDS segment: gateways federate over DDS");
+  }
+}
+
+}  // namespace cosmic::config_detail

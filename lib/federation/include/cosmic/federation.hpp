@@ -1,0 +1,109 @@
+// Federation of several gateways (docs/federation.md): what one gateway announces about itself to
+// the others, and the codec of that announcement. Pure values and functions, no I/O: the transport
+// (a DDS topic, see federation_link.hpp) moves the encoded text, FederationView keeps what was heard.
+//
+// An announcement says who the gateway is, which networks its segments attach (a network identity
+// that is the same on every gateway attached to it), what its own channels reserve there (IP: the
+// share of the bandwidth; CAN: the frames with their identifiers, lengths and periods, which the
+// others' response-time analysis counts like background frames) and each channel's hops with their
+// bounds. A gateway describes only itself: decode() refuses what is malformed or out of range, and
+// FederationView refuses what claims another gateway's identity.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cosmic/admission.hpp"
+#include "cosmic/log.hpp"
+#include "cosmic/model.hpp"
+
+namespace cosmic {
+
+class KnowledgeBase;
+
+// Bounds of an announcement the codec accepts (each refusal names the one exceeded).
+inline constexpr std::size_t kMaxAnnouncementBytes = 1u << 20;
+inline constexpr std::size_t kMaxAnnouncedSegments = 64;
+inline constexpr std::size_t kMaxAnnouncedChannels = 4096;
+inline constexpr std::size_t kMaxAnnouncedFrames = 4096;  // per segment
+inline constexpr std::size_t kMaxAnnouncedHops = 64;      // per channel
+inline constexpr std::size_t kMaxAnnouncedName = 128;     // characters of a name or network identity
+inline constexpr std::string_view kFederationFormat = "cosmic-federation/1";
+
+// One frame a gateway's channel puts on a shared CAN bus.
+struct AnnouncedFrame {
+  std::string channel;
+  std::uint32_t can_id = 0;  // 11 or 29 bits
+  bool extended = true;
+  std::uint32_t length = 8;  // data bytes of one frame
+  Nanos period{0};           // minimum inter-arrival time of the frame (> 0)
+  Nanos jitter{0};
+  friend bool operator==(const AnnouncedFrame&, const AnnouncedFrame&) = default;
+};
+
+struct AnnouncedSegment {
+  std::string name;     // the gateway's own name for it
+  SegmentType type = SegmentType::dds;
+  std::string network;  // network_identity(); empty: not shared with other gateways
+  double max_utilization = 0.7;
+  double load = 0;      // share of the network the gateway's channels reserve (background excluded)
+  std::vector<AnnouncedFrame> frames;  // CAN: the frames behind `load`
+  friend bool operator==(const AnnouncedSegment&, const AnnouncedSegment&) = default;
+};
+
+struct AnnouncedHop {
+  std::string segment;
+  HopRole role = HopRole::publisher;
+  std::optional<Nanos> latency;  // nullopt: unbounded
+  friend bool operator==(const AnnouncedHop&, const AnnouncedHop&) = default;
+};
+
+struct AnnouncedChannel {
+  std::string name;
+  std::uint64_t subject = 0;
+  ChannelClass cls = ChannelClass::nrt;
+  Verdict verdict = Verdict::bound;
+  std::vector<AnnouncedHop> hops;
+  std::optional<Nanos> end_to_end;  // nullopt: unbounded
+  friend bool operator==(const AnnouncedChannel&, const AnnouncedChannel&) = default;
+};
+
+struct Announcement {
+  std::uint64_t gateway = 0;  // GatewayIdentity::id, never 0
+  std::string name;
+  std::uint64_t revision = 0;  // grows with every change the gateway announces
+  std::vector<AnnouncedSegment> segments;
+  std::vector<AnnouncedChannel> channels;
+  friend bool operator==(const Announcement&, const Announcement&) = default;
+};
+
+// The identity of the network a segment attaches, equal on every gateway attached to it:
+//   dds: "dds:domain=N" (plus ";server=IP:PORT" with a discovery server)
+//   lcm: "lcm:GROUP:PORT" (memq:// is process-local: empty)
+//   can: "can:NAME" from the segment's `network` key (interface names are local: without the key
+//        the bus is taken to be this gateway's alone, empty)
+// A `network` key on an IP segment overrides the derived identity.
+std::string network_identity(const SegmentSpec& segment);
+
+// What this gateway announces: its segments' networks and reservations and its bound channels'
+// hops, from the knowledge base. `revision` is the caller's counter.
+Announcement announcement_of(const GatewayIdentity& self, const KnowledgeBase& kb, std::uint64_t revision);
+
+std::string encode(const Announcement& announcement);
+
+struct DecodedAnnouncement {
+  std::optional<Announcement> announcement;
+  std::string error;  // why not, when announcement is empty
+};
+// Never throws; refuses malformed JSON, unknown formats, missing or mistyped fields, negative or
+// non-finite numbers, loads outside 0..1, identifiers outside 29 bits, zero periods and anything
+// over the kMaxAnnounced* bounds.
+DecodedAnnouncement decode_announcement(std::string_view text);
+
+// "00000000deadbeef": how ids are written in announcements, logs and `cosmicctl peers`.
+std::string gateway_id_text(std::uint64_t id);
+
+}  // namespace cosmic

@@ -1,0 +1,91 @@
+// What a gateway announces about itself, taken from its knowledge base.
+#include <algorithm>
+#include <variant>
+
+#include "cosmic/federation.hpp"
+#include "cosmic/knowledge_base.hpp"
+#include "cosmic/lcm_url.hpp"
+
+namespace cosmic {
+namespace {
+
+// The frames a bound channel's CAN hop puts on the bus: one stream per hop, an event of n
+// fragments counted as n frames per period (the same load; the spacing is the sender's).
+std::optional<AnnouncedFrame> frame_of(const ChannelSpec& spec, const HopReport& hop) {
+  if (!hop.can || !spec.period || spec.period->count() <= 0) return std::nullopt;
+  const auto frames = std::max<std::uint32_t>(1, hop.can->frames_per_event);
+  AnnouncedFrame f;
+  f.channel = spec.name;
+  f.can_id = hop.can->can_id;
+  f.extended = hop.can->extended;
+  f.length = hop.can->frame_bytes;
+  f.period = std::max(Nanos(1000), *spec.period / frames);
+  f.jitter = hop.can->jitter;
+  return f;
+}
+
+AnnouncedChannel channel_of(const ChannelReport& report, const ChannelSpec& spec) {
+  AnnouncedChannel c;
+  c.name = report.name;
+  c.subject = spec.subject;
+  c.cls = report.cls;
+  c.verdict = report.verdict == Verdict::rejected ? Verdict::failed : report.verdict;
+  for (const HopReport& hop : report.hops) c.hops.push_back(AnnouncedHop{hop.segment, hop.role, hop.latency});
+  c.end_to_end = report.end_to_end.latency;
+  return c;
+}
+
+}  // namespace
+
+std::string network_identity(const SegmentSpec& segment) {
+  if (!segment.network.empty()) return std::string(to_string(segment.type)) + ":" + segment.network;
+  switch (segment.type) {
+    case SegmentType::can: return {};
+    case SegmentType::dds:
+      return "dds:domain=" + std::to_string(segment.dds.domain) +
+             (segment.dds.discovery_server.empty() ? "" : ";server=" + segment.dds.discovery_server);
+    case SegmentType::lcm: {
+      const auto url = parse_lcm_url(segment.lcm.url);
+      const auto* parsed = std::get_if<LcmUrl>(&url);
+      if (!parsed || parsed->memq) return {};
+      return "lcm:" + parsed->group + ":" + std::to_string(parsed->port);
+    }
+  }
+  return {};
+}
+
+Announcement announcement_of(const GatewayIdentity& self, const KnowledgeBase& kb, std::uint64_t revision) {
+  Announcement a;
+  a.gateway = self.id;
+  a.name = self.name;
+  a.revision = revision;
+  const AdmissionReport report = kb.report();
+  for (std::size_t i = 0; i < kb.segments().size() && i < report.segments.size(); ++i) {
+    const SegmentSpec& spec = kb.segments()[i].spec;
+    const SegmentLoad& load = report.segments[i];
+    AnnouncedSegment s;
+    s.name = spec.name;
+    s.type = spec.type;
+    s.network = network_identity(spec);
+    s.max_utilization = spec.max_utilization;
+    const double others = spec.type == SegmentType::can ? load.background : load.peers;
+    s.load = std::clamp(load.utilization - others, 0.0, 1.0);
+    a.segments.push_back(std::move(s));
+  }
+  for (const ChannelReport& channel : report.channels) {
+    const ChannelSpec* spec = kb.find_bound(channel.name);
+    if (!spec) continue;
+    // Past the bound a peer accepts, channels are left out of the list; their load and frames stay.
+    if (a.channels.size() < kMaxAnnouncedChannels) a.channels.push_back(channel_of(channel, *spec));
+    for (const HopReport& hop : channel.hops) {
+      const auto frame = frame_of(*spec, hop);
+      if (!frame) continue;
+      for (AnnouncedSegment& s : a.segments) {
+        if (s.name == hop.segment && s.frames.size() < kMaxAnnouncedFrames) s.frames.push_back(*frame);
+      }
+    }
+  }
+  return a;
+}
+
+}  // namespace cosmic
