@@ -6,7 +6,7 @@
 # unbind) to the channels of the running gateway (`cosmicctl --json channels`, silent when it
 # cannot be reached). Needs nothing from the bash-completion package.
 
-_cosmicctl_commands="bind calibrate channel channels check diagram gen reload segments status top unbind"
+_cosmicctl_commands="bind calibrate channel channels check diagram gen peers reload segments status top unbind"
 _cosmicctl_global_options="--help --json --socket --version"
 
 # The options of one command (besides the global ones, which may follow it too).

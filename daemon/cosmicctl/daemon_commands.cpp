@@ -132,7 +132,7 @@ void print_peers(const Json& r) {
     return;
   }
   std::cout << "federation over segment " << text(f["segment"]) << ", lease " << f["lease_s"].get<double>() << "s\n";
-  std::cout << pad_column("GATEWAY", 16) << pad_column("ID", 18) << pad_column("STATE", 7) << pad_column("HEARD", 11)
+  std::cout << pad_column("GATEWAY", 16) << pad_column("ID", 18) << pad_column("STATE", 7) << pad_column("ANNOUNCED", 11)
             << pad_column("CHANNELS", 9) << "SEGMENTS\n";
   for (const auto& p : r["peers"]) {
     std::string segments;

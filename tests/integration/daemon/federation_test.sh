@@ -1,0 +1,137 @@
+#!/usr/bin/env bash
+# Federation (issue 21), end to end over real Fast DDS: three gateways on one DDS domain (the
+# backbone, 1 Mbit/s, 50% for reservations), each with an LCM edge of its own.
+#   - each gateway lists the two others as alive (cosmicctl peers, text and --json) and counts their
+#     reservations on the shared backbone (cosmicctl segments --json: peers, utilization);
+#   - a bind that fits this gateway alone but not with the others' reservations is rejected, naming
+#     the other gateways' share; nothing changes;
+#   - a gateway killed with SIGKILL is `lost` within the lease (plus a tick) and its reservations
+#     are released: the same bind is then bound;
+#   - a gateway stopped cleanly is `left` at once (no lease to wait);
+#   - hostile announcements (another gateway's id, a key that is not the id it names, malformed,
+#     out of range) are refused and counted, and the local channels stay bound.
+#   federation_test.sh COSMICD COSMICCTL COSMIC_FEDERATION_PEER
+set -uo pipefail
+[ "${COSMIC_IN_NETNS:-}" = 1 ] || { echo "run me through scripts/netns-run" >&2; exit 2; }
+COSMICD=$1 COSMICCTL=$2 FED_PEER=$3
+WORK=$(mktemp -d /tmp/cosmic-federation.XXXXXX)
+# shellcheck source=lib.sh
+source "$(dirname "$0")/lib.sh"
+trap 'cleanup; [ -n "${KEEP_WORK:-}" ] || rm -rf "$WORK"' EXIT
+
+DOMAIN=41
+LEASE_S=1
+for i in 1 2 3; do
+  cat >"$WORK/gw$i.yaml" <<YAML
+gateway:
+  name: gw$i
+  federation: {segment: backbone, lease: ${LEASE_S}s}
+segments:
+  - {name: backbone, type: dds, domain: $DOMAIN, bandwidth: 1Mbit/s, max_utilization: 50%, latency_bound: 2ms, realtime: true}
+  - {name: edge, type: lcm, url: "udpm://239.255.76.67:$((7940 + i))?ttl=0", latency_bound: 2ms, realtime: true}
+channels:
+  # 29 B + 96 B of envelope and headers every 10 ms: 10% of the backbone.
+  - {name: telemetry$i, subject: 0x410$i, class: hrt, period: 10ms, reaction_time: 50ms, omission_degree: 1, payload: 29B,
+     publishers: [edge], subscribers: [backbone]}
+YAML
+done
+# 25% of the backbone: fits gw1 alone (10% + 25%), not with gw2 and gw3 (10% + 20% + 25% > 50%).
+cat >"$WORK/big.yaml" <<'YAML'
+- {name: video, subject: 0x4200, class: hrt, period: 4ms, reaction_time: 50ms, omission_degree: 1, payload: 29B,
+   publishers: [edge], subscribers: [backbone]}
+YAML
+
+# peers_state NAME PEER: the state gateway NAME shows for gateway PEER ("" when not listed).
+peers_state() {
+  ctl "$1" --json peers | python3 -c '
+import json, sys
+print(next((p["state"] for p in json.load(sys.stdin)["peers"] if p["name"] == sys.argv[1]), ""))' "$2"
+}
+state_is() { [ "$(peers_state "$1" "$2")" = "$3" ]; }
+# backbone_field NAME FIELD: a field of the backbone in `segments --json`.
+backbone_field() {
+  ctl "$1" --json segments | python3 -c '
+import json, sys
+print(next(s[sys.argv[1]] for s in json.load(sys.stdin)["segments"] if s["name"] == "backbone"))' "$2"
+}
+near() { python3 -c 'import sys; sys.exit(0 if abs(float(sys.argv[1]) - float(sys.argv[2])) < 0.005 else 1)' "$1" "$2"; }
+peers_load_is() { near "$(backbone_field "$1" peers)" "$2"; }
+
+for i in 1 2 3; do start_daemon "gw$i" "$WORK/gw$i.yaml" || exit 1; done
+
+scenario "three gateways see each other and the others' reservations on the shared backbone"
+for i in 1 2 3; do
+  for j in 1 2 3; do
+    [ "$i" = "$j" ] && continue
+    wait_until 20 "gw$i sees gw$j alive" state_is "gw$i" "gw$j" alive
+  done
+done
+wait_until 10 "gw1 counts 20% of the backbone for gw2 and gw3" peers_load_is gw1 0.2
+near "$(backbone_field gw1 utilization)" 0.3 || fail "gw1 backbone utilization $(backbone_field gw1 utilization), want 0.3"
+ctl gw1 peers >"$WORK/peers.txt" || fail "cosmicctl peers failed"
+grep -Eq '^gw2 +[0-9a-f]{16} +alive ' "$WORK/peers.txt" || fail "cosmicctl peers: gw2 not listed alive: $(cat "$WORK/peers.txt")"
+grep -q 'backbone \[dds:domain=41\] 10.0%' "$WORK/peers.txt" || fail "cosmicctl peers: no backbone load: $(cat "$WORK/peers.txt")"
+passed
+
+scenario "a bind that only the other gateways' reservations break is rejected, naming their share"
+ctl gw1 bind "$WORK/big.yaml" >"$WORK/bind1.txt" 2>&1 && fail "bind of video was not rejected: $(cat "$WORK/bind1.txt")"
+grep -q 'other gateways 20.0%' "$WORK/bind1.txt" || fail "rejection does not name the other gateways' share: $(cat "$WORK/bind1.txt")"
+ctl gw1 --json channels | grep -q '"video"' && fail "video is listed after a rejected bind"
+passed
+
+scenario "a gateway killed is lost within the lease and its reservations are released"
+kill -KILL "$PID_gw2"
+killed_at=$(date +%s.%N)
+wait_until 15 "gw1 shows gw2 lost" state_is gw1 gw2 lost
+noticed=$(python3 -c "import sys,time; print(f'{time.time() - float(sys.argv[1]):.2f}')" "$killed_at")
+log "gw2 noticed lost after ${noticed} s (lease ${LEASE_S} s)"
+python3 -c 'import sys; sys.exit(0 if float(sys.argv[1]) < float(sys.argv[2]) + 2 else 1)' "$noticed" "$LEASE_S" ||
+  fail "gw2 noticed lost after $noticed s, lease $LEASE_S s"
+wait_until 5 "gw1 counts 10% for gw3 alone" peers_load_is gw1 0.1
+ctl gw1 bind "$WORK/big.yaml" >"$WORK/bind2.txt" 2>&1 || fail "bind of video after gw2 was lost: $(cat "$WORK/bind2.txt")"
+wait_until 10 "gw3 counts gw1's new reservation (35%)" peers_load_is gw3 0.35
+passed
+
+scenario "hostile announcements are refused and counted; local channels stay bound"
+gw1_id=$(ctl gw1 --json status | python3 -c 'import json,sys; print(json.load(sys.stdin)["gateway"]["id"])')
+ok_body() { # ok_body ID NAME LOAD
+  printf '{"format":"cosmic-federation/1","gateway":"%s","name":"%s","revision":1,"segments":[{"name":"b","type":"dds","network":"dds:domain=%s","max_utilization":0.5,"load":%s,"frames":[]}],"channels":[]}' "$1" "$2" "$DOMAIN" "$3"
+}
+ok_body "$gw1_id" spoof 0.3 >"$WORK/h1.json"             # this gateway's own id
+ok_body 00000000000000aa mismatch 0.3 >"$WORK/h2.json"    # filed under another key below
+printf '{"format":"cosmic-federation/1","gateway":' >"$WORK/h3.json"  # malformed
+ok_body 00000000000000cc huge 5.0 >"$WORK/h4.json"        # load out of range
+before=$(ctl gw1 --json peers | python3 -c 'import json,sys; print(json.load(sys.stdin)["counters"]["refused"])')
+start_peer() { # start_peer KEY FILE
+  "$FED_PEER" --domain "$DOMAIN" --key "$1" --body-file "$2" </dev/null >"$WORK/$1.out" 2>"$WORK/$1.err" &
+  PIDS+=($!)
+}
+start_peer "$gw1_id" "$WORK/h1.json"
+start_peer 00000000000000ab "$WORK/h2.json"
+start_peer 00000000000000bb "$WORK/h3.json"
+start_peer 00000000000000cc "$WORK/h4.json"
+refused_at_least() {
+  local now
+  now=$(ctl gw1 --json peers | python3 -c 'import json,sys; print(json.load(sys.stdin)["counters"]["refused"])')
+  [ "$now" -ge $((before + 4)) ]
+}
+wait_until 20 "gw1 refused the four hostile announcements" refused_at_least ||
+  log "gw1 peers: $(ctl gw1 --json peers); peer errors: $(cat "$WORK"/*.err)"
+ctl gw1 --json peers | python3 -c '
+import json, sys
+names = sorted(p["name"] for p in json.load(sys.stdin)["peers"])
+assert set(names) <= {"gw2", "gw3"}, names' || fail "a hostile announcement became a peer"
+peers_load_is gw1 0.1 || fail "hostile announcements changed the peers' load: $(backbone_field gw1 peers)"
+verdicts=$(ctl gw1 --json channels | python3 -c 'import json,sys; print(" ".join(sorted(c["name"] + "=" + c["verdict"] for c in json.load(sys.stdin)["channels"])))')
+[ "$verdicts" = "telemetry1=bound video=bound" ] || fail "local channels after hostile announcements: $verdicts"
+grep -q 'federation: refused an announcement' "$WORK/gw1.log" || fail "no refusal logged"
+passed
+
+scenario "a gateway stopped cleanly is left at once"
+kill -TERM "$PID_gw3"
+wait "$PID_gw3"
+wait_until 3 "gw1 shows gw3 left" state_is gw1 gw3 left
+wait_until 3 "gw1 counts nothing for other gateways" peers_load_is gw1 0
+passed
+
+exit "$FAILED"
