@@ -53,6 +53,8 @@ TEST(FederationView, PeersJoinAreLostComeBackAndLeave) {
   EXPECT_TRUE(view.apply({Kind::withdrawn, "w3", 0, {}}, Nanos(7s)));
   EXPECT_EQ(view.peers().at(0x33).state, PeerState::left);
   EXPECT_FALSE(view.apply({Kind::lost, "w3", 0, {}}, Nanos(8s))) << "left stays left";
+  EXPECT_FALSE(view.apply({Kind::alive, "w3", 0, {}}, Nanos(8s))) << "left stays left until it announces again";
+  EXPECT_EQ(view.peers().at(0x33).state, PeerState::left);
   EXPECT_NEAR(view.reservations_for({lan()}).at("lan").load, 0.1, 1e-9);
   view.forget_before(Nanos(100s));
   EXPECT_EQ(view.peers().size(), 1u);

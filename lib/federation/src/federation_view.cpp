@@ -89,7 +89,7 @@ bool FederationView::apply(const FederationMessage& message, Nanos now, std::str
                                                                           : PeerState::left;
   peer->last_heard = now;
   if (peer->state == next) return false;
-  if (peer->state == PeerState::left && next == PeerState::lost) return false;  // left is final until it announces again
+  if (peer->state == PeerState::left) return false;  // left is final until it announces again
   peer->state = next;
   peer->state_since = now;
   return true;

@@ -6,6 +6,7 @@
 // that does not decode, one filed under another gateway's id than it names, one naming this
 // gateway's id, one naming a gateway another writer announces while that writer is alive, and a
 // new gateway beyond max_peers. An older or repeated revision is ignored (counted as stale).
+// A gateway that left (withdrew) stays `left` until it announces again; lost comes back on liveliness.
 #pragma once
 
 #include <cstdint>
