@@ -121,33 +121,33 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
   }
 
  private:
-  dds::DataWriterQos writer_qos() const {
-    dds::DataWriterQos qos = dds::DATAWRITER_QOS_DEFAULT;
+  // Both ends: reliable, durable for late joiners, the newest announcement per gateway, the lease.
+  template <typename EndpointQos>
+  void common_qos(EndpointQos& qos) const {
     qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
     qos.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
     qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
     qos.history().depth = 1;
     qos.liveliness().kind = dds::AUTOMATIC_LIVELINESS_QOS;
     qos.liveliness().lease_duration = duration_of(lease_);
+    qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+  }
+
+  dds::DataWriterQos writer_qos() const {
+    dds::DataWriterQos qos = dds::DATAWRITER_QOS_DEFAULT;
+    common_qos(qos);
     qos.liveliness().announcement_period = duration_of(lease_ / 3);
     qos.publish_mode().kind = dds::ASYNCHRONOUS_PUBLISH_MODE;
-    qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
     return qos;
   }
 
   dds::DataReaderQos reader_qos() const {
     dds::DataReaderQos qos = dds::DATAREADER_QOS_DEFAULT;
-    qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
-    qos.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
-    qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
-    qos.history().depth = 1;
-    qos.liveliness().kind = dds::AUTOMATIC_LIVELINESS_QOS;
-    qos.liveliness().lease_duration = duration_of(lease_);
+    common_qos(qos);
     const auto peers = static_cast<std::int32_t>(FederationView::kDefaultMaxPeers);
     qos.resource_limits().max_instances = peers;
     qos.resource_limits().max_samples_per_instance = 1;
     qos.resource_limits().max_samples = peers;
-    qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
     return qos;
   }
 
