@@ -85,7 +85,7 @@ void FederationMember::hear(cosmic::Nanos now) {
   view_->forget_before(now - spec_.lease * kForgetAfterLeases);
   if (!changed) return;
   log_transitions(before);
-  gateway_.set_peer_reservations(view_->reservations_for(gateway_.config().segments));
+  gateway_.set_peer_reservations(view_->reservations());
   peers_changed_ = true;
 }
 
@@ -140,7 +140,8 @@ nlohmann::json FederationMember::peers_json(cosmic::Nanos now) const {
           {"counters",
            {{"received", s.view.received}, {"applied", s.view.applied}, {"stale", s.view.stale}, {"refused", s.view.refused},
             {"last_refusal", s.view.last_refusal}, {"dropped", s.link.dropped}, {"published", s.link.published},
-            {"publish_errors", s.link.publish_errors}}}};
+            {"publish_errors", s.link.publish_errors}, {"pending_takeovers", view_ ? view_->pending_takeovers() : 0},
+            {"frames_over_cap", s.view.frames_over_cap}}}};
 }
 
 FederationSnapshot FederationMember::snapshot(cosmic::Nanos now) const {

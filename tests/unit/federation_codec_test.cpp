@@ -18,8 +18,8 @@ Announcement sample_announcement() {
   a.gateway = 0x1234abcd5678ef01;
   a.name = "gw2";
   a.revision = 7;
-  AnnouncedSegment lan{"lan", SegmentType::dds, "dds:domain=0", 0.7, 0.125, {}};
-  AnnouncedSegment body{"body", SegmentType::can, "can:body", 0.6, 0.2, {}};
+  AnnouncedSegment lan{"lan", SegmentType::dds, "dds:domain=0", 0.7, 0.125, 12'500'000, {}};
+  AnnouncedSegment body{"body", SegmentType::can, "can:body", 0.6, 0.2, 0, {}};
   body.frames.push_back(AnnouncedFrame{"steer", 0x0C0FFFFF, true, 8, Nanos(10ms), Nanos(250us)});
   body.frames.push_back(AnnouncedFrame{"ecu", 0x123, false, 4, Nanos(20ms), Nanos(0)});
   a.segments = {lan, body};
@@ -65,6 +65,9 @@ TEST(FederationCodec, RefusesMalformedAndOutOfRangeAnnouncements) {
       {"standard identifier over 11 bits", [](Json& j) { j["segments"][1]["frames"][1]["can_id"] = 0x800; }, "can_id"},
       {"zero period", [](Json& j) { j["segments"][1]["frames"][0]["period_ns"] = 0; }, "below 1 us"},
       {"negative jitter", [](Json& j) { j["segments"][1]["frames"][0]["jitter_ns"] = -5; }, "jitter_ns"},
+      {"jitter of an hour", [](Json& j) { j["segments"][1]["frames"][0]["jitter_ns"] = 3'600'000'000'000LL; }, "above 1 s"},
+      {"bandwidth beyond a terabit", [](Json& j) { j["segments"][0]["reserved_bps"] = 2e12; }, "reserved_bps is outside"},
+      {"negative bandwidth", [](Json& j) { j["segments"][0]["reserved_bps"] = -1; }, "reserved_bps is outside"},
       {"frame of 65 bytes", [](Json& j) { j["segments"][1]["frames"][0]["length"] = 65; }, "length"},
       {"negative latency", [](Json& j) { j["channels"][0]["hops"][0]["latency_ns"] = -1; }, "latency_ns"},
       {"latency of years", [](Json& j) { j["channels"][0]["end_to_end_ns"] = 86'400'000'000'001LL; }, "is above 86400000000000"},

@@ -3,6 +3,8 @@
 // into this gateway's admission (IP load, CAN frames in the response-time analysis).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "cosmic/federation.hpp"
 #include "cosmic/federation_view.hpp"
 #include "cosmic/knowledge_base.hpp"
@@ -22,7 +24,7 @@ Announcement peer(std::uint64_t id, const std::string& name, double lan_load, st
   a.gateway = id;
   a.name = name;
   a.revision = revision;
-  a.segments.push_back(AnnouncedSegment{"backbone", SegmentType::dds, "dds:domain=0", 0.5, lan_load, {}});
+  a.segments.push_back(AnnouncedSegment{"backbone", SegmentType::dds, "dds:domain=0", 0.5, lan_load, lan_load * 1e6, {}});
   return a;
 }
 
@@ -37,25 +39,32 @@ SegmentSpec lan() {
   return s;
 }
 
+// What the alive peers reserve on domain 0, as a share of a 1 Mbit/s network.
+double lan_bps(const FederationView& view) {
+  const PeerNetworks r = view.reservations();
+  const auto found = r.find("dds:domain=0");
+  return found == r.end() ? 0.0 : found->second.bits_per_second / 1e6;
+}
+
 TEST(FederationView, PeersJoinAreLostComeBackAndLeave) {
   FederationView view(kSelf);
   EXPECT_TRUE(view.apply(said(peer(0x22, "gw2", 0.1), "w2"), Nanos(1s)));
   EXPECT_TRUE(view.apply(said(peer(0x33, "gw3", 0.2), "w3"), Nanos(1s)));
   ASSERT_EQ(view.alive_peers(), 2u);
-  EXPECT_NEAR(view.reservations_for({lan()}).at("lan").load, 0.3, 1e-9);
+  EXPECT_NEAR(lan_bps(view), 0.3, 1e-9);
 
   EXPECT_TRUE(view.apply({Kind::lost, "w2", 0, {}}, Nanos(5s)));
   EXPECT_EQ(view.peers().at(0x22).state, PeerState::lost);
-  EXPECT_NEAR(view.reservations_for({lan()}).at("lan").load, 0.2, 1e-9) << "a lost gateway's reservations are released";
+  EXPECT_NEAR(lan_bps(view), 0.2, 1e-9) << "a lost gateway's reservations are released";
   EXPECT_TRUE(view.apply({Kind::alive, "w2", 0, {}}, Nanos(6s)));
-  EXPECT_NEAR(view.reservations_for({lan()}).at("lan").load, 0.3, 1e-9) << "and taken again when it is back";
+  EXPECT_NEAR(lan_bps(view), 0.3, 1e-9) << "and taken again when it is back";
 
   EXPECT_TRUE(view.apply({Kind::withdrawn, "w3", 0, {}}, Nanos(7s)));
   EXPECT_EQ(view.peers().at(0x33).state, PeerState::left);
   EXPECT_FALSE(view.apply({Kind::lost, "w3", 0, {}}, Nanos(8s))) << "left stays left";
   EXPECT_FALSE(view.apply({Kind::alive, "w3", 0, {}}, Nanos(8s))) << "left stays left until it announces again";
   EXPECT_EQ(view.peers().at(0x33).state, PeerState::left);
-  EXPECT_NEAR(view.reservations_for({lan()}).at("lan").load, 0.1, 1e-9);
+  EXPECT_NEAR(lan_bps(view), 0.1, 1e-9);
   view.forget_before(Nanos(100s));
   EXPECT_EQ(view.peers().size(), 1u);
   EXPECT_FALSE(view.apply({Kind::lost, "unknown-writer", 0, {}}, Nanos(9s)));
@@ -86,7 +95,7 @@ TEST(FederationView, APeerDescribesOnlyItself) {
   EXPECT_FALSE(view.apply(said(peer(0x88, "gw8", 0.0), "w8"), Nanos(2s), &why));
   EXPECT_NE(why.find("more than 3 gateways"), std::string::npos) << why;
   EXPECT_EQ(view.counters().refused, 5u);
-  EXPECT_NEAR(view.reservations_for({lan()}).at("lan").load, 0.1, 1e-9) << "nothing refused reached admission";
+  EXPECT_NEAR(lan_bps(view), 0.1, 1e-9) << "nothing refused reached admission";
 }
 
 TEST(FederationView, OlderRevisionsAreStale) {
@@ -96,31 +105,68 @@ TEST(FederationView, OlderRevisionsAreStale) {
   EXPECT_FALSE(view.apply(said(peer(0x22, "gw2", 0.4, 5), "w2"), Nanos(2s)));
   EXPECT_EQ(view.counters().stale, 2u);
   EXPECT_TRUE(view.apply(said(peer(0x22, "gw2", 0.2, 6), "w2"), Nanos(3s)));
-  EXPECT_NEAR(view.reservations_for({lan()}).at("lan").load, 0.2, 1e-9);
+  EXPECT_NEAR(lan_bps(view), 0.2, 1e-9);
+}
+
+TEST(FederationView, OneGatewayPerWriterAndTakeoverWhenTheOldWriterGoes) {
+  FederationView view(kSelf);
+  ASSERT_TRUE(view.apply(said(peer(0x22, "gw2", 0.1), "w2"), Nanos(1s)));
+  std::string why;
+  // The same writer filing a second gateway: refused before its body is even decoded.
+  EXPECT_FALSE(view.apply({Kind::announcement, "w2", 0x23, "not even JSON"}, Nanos(2s), &why));
+  EXPECT_NE(why.find("one gateway per writer"), std::string::npos) << why;
+  // gw2 rejoined with a new writer while the old one is still matched: waits, then takes over.
+  EXPECT_FALSE(view.apply(said(peer(0x22, "gw2", 0.3, 1), "w2-new"), Nanos(3s), &why));
+  EXPECT_NEAR(lan_bps(view), 0.1, 1e-9);
+  EXPECT_TRUE(view.apply({Kind::lost, "w2", 0, {}}, Nanos(4s)));
+  EXPECT_EQ(view.peers().at(0x22).state, PeerState::alive);
+  EXPECT_EQ(view.peers().at(0x22).source, "w2-new");
+  EXPECT_NEAR(lan_bps(view), 0.3, 1e-9);
+  EXPECT_EQ(view.pending_takeovers(), 0u);
+}
+
+TEST(FederationView, ASpooferThatWentTakesNothingOver) {
+  FederationView view(kSelf);
+  ASSERT_TRUE(view.apply(said(peer(0x22, "gw2", 0.1), "w2"), Nanos(1s)));
+  EXPECT_FALSE(view.apply(said(peer(0x22, "gw2", 0.9, 9), "w-evil"), Nanos(2s)));
+  EXPECT_EQ(view.pending_takeovers(), 1u);
+  EXPECT_FALSE(view.apply({Kind::lost, "w-evil", 0, {}}, Nanos(3s)));
+  EXPECT_EQ(view.pending_takeovers(), 0u);
+  EXPECT_TRUE(view.apply({Kind::withdrawn, "w2", 0, {}}, Nanos(4s)));
+  EXPECT_EQ(view.peers().at(0x22).state, PeerState::left);
+  EXPECT_NEAR(lan_bps(view), 0.0, 1e-9);
 }
 
 TEST(FederationView, SharedNetworksAreMatchedByIdentity) {
   FederationView view(kSelf);
   Announcement a = peer(0x22, "gw2", 0.1);
-  a.segments.push_back(AnnouncedSegment{"other-domain", SegmentType::dds, "dds:domain=5", 0.5, 0.3, {}});
-  AnnouncedSegment bus{"chassis", SegmentType::can, "can:body", 0.7, 0.05, {}};
+  a.segments.push_back(AnnouncedSegment{"other-domain", SegmentType::dds, "dds:domain=5", 0.5, 0.3, 300'000, {}});
+  a.segments.push_back(AnnouncedSegment{"private", SegmentType::can, "", 0.7, 0.2, 0, {AnnouncedFrame{"x", 0x10, false, 8, Nanos(1ms), Nanos(0)}}});
+  AnnouncedSegment bus{"chassis", SegmentType::can, "can:body", 0.7, 0.05, 0, {}};
   bus.frames.push_back(AnnouncedFrame{"steer", 0x00A0FFFF, true, 8, Nanos(10ms), Nanos(0)});
   a.segments.push_back(bus);
+  // gw3 announces the same identifier lighter (a longer period) and heavier (a larger jitter): it
+  // counts once, with the heavier of each, so no peer can hide another's frame.
   Announcement b = peer(0x33, "gw3", 0.0);
-  b.segments.push_back(bus);  // the same frame announced twice counts once
-  b.segments.back().frames.push_back(AnnouncedFrame{"door", 0x300, false, 2, Nanos(100ms), Nanos(0)});
+  AnnouncedSegment their_bus{"chassis", SegmentType::can, "can:body", 0.7, 0.05, 0, {}};
+  their_bus.frames.push_back(AnnouncedFrame{"steer", 0x00A0FFFF, true, 4, Nanos(1s), Nanos(2ms)});
+  their_bus.frames.push_back(AnnouncedFrame{"door", 0x300, false, 2, Nanos(100ms), Nanos(0)});
+  b.segments.push_back(their_bus);
   ASSERT_TRUE(view.apply(said(a, "w2"), Nanos(1s)));
   ASSERT_TRUE(view.apply(said(b, "w3"), Nanos(1s)));
 
-  SegmentSpec body = can_segment("body-can");
-  body.network = "body";
-  SegmentSpec alone = can_segment("private-can");  // no network key: this gateway's alone
-  const auto r = view.reservations_for({lan(), body, alone});
-  EXPECT_NEAR(r.at("lan").load, 0.1, 1e-9) << "domain 5 is another network";
-  ASSERT_EQ(r.at("body-can").frames.size(), 2u);
-  EXPECT_EQ(r.at("body-can").frames[0].name, "gw2:steer");
-  EXPECT_GT(r.at("body-can").load, 0.0);
-  EXPECT_EQ(r.count("private-can"), 0u);
+  const PeerNetworks r = view.reservations();
+  EXPECT_NEAR(r.at("dds:domain=0").bits_per_second, 100'000, 1e-6);
+  EXPECT_NEAR(r.at("dds:domain=5").bits_per_second, 300'000, 1e-6) << "domain 5 is another network";
+  EXPECT_EQ(r.count(""), 0u) << "a bus without a network name is its gateway's alone";
+  const auto& frames = r.at("can:body").frames;
+  ASSERT_EQ(frames.size(), 2u);
+  const auto steer = std::find_if(frames.begin(), frames.end(), [](const auto& f) { return f.can_id == 0x00A0FFFF; });
+  ASSERT_NE(steer, frames.end());
+  EXPECT_EQ(steer->name, "gw2:steer");
+  EXPECT_EQ(steer->period, Nanos(10ms));
+  EXPECT_EQ(steer->length, 8u);
+  EXPECT_EQ(steer->jitter, Nanos(2ms));
 }
 
 TEST(FederationAdmission, OtherGatewaysLoadOnASharedNetworkCounts) {
@@ -129,7 +175,9 @@ TEST(FederationAdmission, OtherGatewaysLoadOnASharedNetworkCounts) {
   ChannelSpec mine = channel("mine", 1, ChannelClass::srt, {"viz"}, {"lan"}, 29, Nanos(10ms), Nanos(50ms));
   mine.omission_degree = 1;
   ASSERT_TRUE(kb.bind(mine).bound());
-  kb.set_peer_reservations({{"lan", PeerReservations{0.35, {}}}});
+  // 350 kbit/s of this 1 Mbit/s network, wherever the others declared its bandwidth; another
+  // network (domain 1) is not this segment's.
+  kb.set_peer_reservations({{"dds:domain=0", PeerReservations{350'000, {}}}, {"dds:domain=1", PeerReservations{900'000, {}}}});
   ChannelSpec more = mine;
   more.name = "more";
   more.subject = 2;
@@ -140,7 +188,7 @@ TEST(FederationAdmission, OtherGatewaysLoadOnASharedNetworkCounts) {
   EXPECT_NEAR(kb.loads()[0].utilization, 0.45, 1e-9);
 
   // A peer that joins with more makes a bound channel's numbers fail: shown degraded, still bound.
-  kb.set_peer_reservations({{"lan", PeerReservations{0.45, {}}}});
+  kb.set_peer_reservations({{"dds:domain=0", PeerReservations{450'000, {}}}});
   const AdmissionReport report = kb.report();
   const ChannelReport* shown = report.find("mine");
   ASSERT_NE(shown, nullptr);
@@ -159,24 +207,39 @@ TEST(FederationAdmission, OtherGatewaysFramesDelayCanChannelsAndKeepTheirEtags) 
   // HRT, reaction 2.5 ms: alone R = 1.28 ms on the 125 kbit/s bus.
   const ChannelSpec brake = channel("brake", 0x100, ChannelClass::hrt, {"body"}, {"lan"}, 8, Nanos(10ms), Nanos(2500us));
   EXPECT_EQ(kb.probe(brake).verdict, Verdict::bound) << reasons_text(kb.probe(brake));
-  // Another gateway's two frames of higher priority (identifiers below any COSMIC HRT one).
+  // Another gateway's two frames that win arbitration against ours (priority 0, TxNode 0).
   PeerReservations theirs;
-  theirs.frames.push_back(CanBackgroundFrame{"gw2:steer", 0x001, false, 8, Nanos(5ms), Nanos(0), "gateway gw2"});
-  theirs.frames.push_back(CanBackgroundFrame{"gw2:yaw", 0x00000FFF & 0x1FFFFFFF, true, 8, Nanos(5ms), Nanos(0), "gateway gw2"});
-  kb.set_peer_reservations({{"body", theirs}});
+  theirs.frames.push_back(CanBackgroundFrame{"gw2:steer", 0x00000001, true, 8, Nanos(5ms), Nanos(0), "gateway gw2"});
+  theirs.frames.push_back(CanBackgroundFrame{"gw2:yaw", 0x00000002, true, 8, Nanos(5ms), Nanos(0), "gateway gw2"});
+  kb.set_peer_reservations({{"can:body", theirs}});
   const ChannelReport refused = kb.probe(brake);
   EXPECT_EQ(refused.verdict, Verdict::rejected);
   EXPECT_TRUE(has_reason(refused, "gw2:steer")) << reasons_text(refused);
-  // The etag bits of the peer's extended frame (0xFFF) are not handed out.
-  kb.set_peer_reservations({{"body", PeerReservations{0, {theirs.frames[1]}}}});
+  EXPECT_GT(kb.loads()[0].peers, 0.1);
+  // The etag bits of the peer's extended frame (16383, the first this gateway would hand out) are not.
+  const CanBackgroundFrame top{"gw2:log", 0x1F000000 | 16383, true, 8, Nanos(100ms), Nanos(0), "gateway gw2"};
+  kb.set_peer_reservations({{"can:body", PeerReservations{0, {top}}}});
   ChannelSpec slow = channel("slow", 0x200, ChannelClass::nrt, {"lan"}, {"body"}, 8, Nanos(100ms));
   ASSERT_TRUE(kb.bind(slow).bound());
-  EXPECT_NE(kb.etag_of("slow"), std::optional<std::uint16_t>(0xFFF));
+  EXPECT_EQ(kb.etag_of("slow"), std::optional<std::uint16_t>(16382));
   ChannelSpec fixed = slow;
   fixed.name = "fixed";
   fixed.subject = 0x201;
-  fixed.etag = 0xFFF;
-  EXPECT_TRUE(has_reason(kb.probe(fixed), "another gateway's frames")) << reasons_text(kb.probe(fixed));
+  fixed.etag = 16383;
+  EXPECT_TRUE(has_reason(kb.probe(fixed), "another gateway's frame gw2:log")) << reasons_text(kb.probe(fixed));
+  // A channel bound here before the peer's frame was known (at start) is shown with the clash.
+  kb.set_peer_reservations({});
+  ChannelSpec early = slow;
+  early.name = "early";
+  early.subject = 0x202;
+  ASSERT_TRUE(kb.bind(early).bound());
+  ASSERT_EQ(kb.etag_of("early"), std::optional<std::uint16_t>(16383));
+  kb.set_peer_reservations({{"can:body", PeerReservations{0, {top}}}});
+  const AdmissionReport report = kb.report();
+  ASSERT_NE(report.find("early"), nullptr);
+  EXPECT_EQ(report.find("early")->verdict, Verdict::degraded);
+  EXPECT_TRUE(has_reason(*report.find("early"), "etag 16383 is also carried by another gateway's frame gw2:log"))
+      << reasons_text(*report.find("early"));
 }
 
 TEST(FederationAnnouncement, SaysWhatThisGatewayReservesWhere) {
@@ -184,7 +247,8 @@ TEST(FederationAnnouncement, SaysWhatThisGatewayReservesWhere) {
   body.network = "body";
   KnowledgeBase kb(gateway(), {body, lan()});
   ASSERT_TRUE(kb.bind(channel("brake", 0x100, ChannelClass::srt, {"lan"}, {"body"}, 8, Nanos(10ms), Nanos(20ms))).bound());
-  kb.set_peer_reservations({{"lan", PeerReservations{0.2, {}}}});
+  const double alone = kb.loads()[1].utilization;
+  kb.set_peer_reservations({{"dds:domain=0", PeerReservations{200'000, {}}}});
   const Announcement a = announcement_of(GatewayIdentity{0x42, "gw1"}, kb, 3);
   EXPECT_EQ(a.gateway, 0x42u);
   EXPECT_EQ(a.revision, 3u);
@@ -195,7 +259,8 @@ TEST(FederationAnnouncement, SaysWhatThisGatewayReservesWhere) {
   EXPECT_EQ(a.segments[0].frames[0].period, Nanos(10ms));
   EXPECT_GT(a.segments[0].load, 0.0);
   EXPECT_EQ(a.segments[1].network, "dds:domain=0");
-  EXPECT_LT(a.segments[1].load, 0.2) << "other gateways' load is not announced as this one's";
+  EXPECT_NEAR(a.segments[1].load, alone, 1e-9) << "other gateways' load is not announced as this one's";
+  EXPECT_NEAR(a.segments[1].reserved_bps, alone * 1e6, 1e-3);
   ASSERT_EQ(a.channels.size(), 1u);
   EXPECT_EQ(a.channels[0].hops.size(), 2u);
   EXPECT_TRUE(decode_announcement(encode(a)).announcement) << decode_announcement(encode(a)).error;

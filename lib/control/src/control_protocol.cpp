@@ -440,9 +440,9 @@ ControlProtocol::Answer ControlProtocol::reload(const Reply& later) {
   auto loaded = std::make_shared<ConfigResult>();
   auto plan = std::make_shared<ReloadPlan>();
   // Channels unchanged since the running bindings were admitted are not admitted again.
-  auto work = [this, loaded, plan, base = gateway_.reload_base()] {
+  auto work = [this, loaded, plan, base = gateway_.reload_base(), peers = gateway_.knowledge_base().peer_reservations()] {
     *loaded = reload_source_();
-    if (loaded->ok()) *plan = Gateway::plan_reload(loaded->config, base);
+    if (loaded->ok()) *plan = Gateway::plan_reload(loaded->config, base, peers);
   };
   auto done = [this, loaded, plan] {
     if (!loaded->ok()) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "cosmic/can_background.hpp"
 #include "cosmic/can_wire.hpp"
 
 namespace cosmic {
@@ -42,7 +43,7 @@ bool KnowledgeBase::needs_etag(const ChannelSpec& channel) const {
 // The highest etag neither reserved nor bound.
 std::optional<std::uint16_t> KnowledgeBase::allocate_etag() const {
   for (std::uint16_t etag = kMaxEtag; etag > kHighestReservedEtag; --etag) {
-    if (!etag_taken_.test(etag) && !peer_etags_.test(etag) && !native_etags_.count(etag)) return etag;
+    if (!etag_taken_.test(etag) && !peer_etags_.count(etag) && !native_etags_.count(etag)) return etag;
   }
   return std::nullopt;
 }
@@ -96,14 +97,14 @@ KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel, std::o
         a.report = rejected_report(channel, "etag " + std::to_string(*channel.etag) + " is already used by channel " + *owner);
         return a;
       }
-      if (*channel.etag <= kMaxEtag && peer_etags_.test(*channel.etag)) {
-        a.report = rejected_report(channel, "etag " + std::to_string(*channel.etag) +
-                                                " is used by another gateway's frames on a shared CAN bus (cosmicctl peers)");
+      if (const auto peer = peer_etags_.find(*channel.etag); peer != peer_etags_.end()) {
+        a.report = rejected_report(channel, "etag " + std::to_string(*channel.etag) + " is carried by another gateway's frame " +
+                                                peer->second + " on a shared CAN bus (cosmicctl peers)");
         return a;
       }
       a.etag = *channel.etag;
     } else if (preferred_etag && *preferred_etag > kHighestReservedEtag && *preferred_etag <= kMaxEtag &&
-               !etag_taken_.test(*preferred_etag) && !peer_etags_.test(*preferred_etag) && !native_etags_.count(*preferred_etag)) {
+               !etag_taken_.test(*preferred_etag) && !peer_etags_.count(*preferred_etag) && !native_etags_.count(*preferred_etag)) {
       a.etag = *preferred_etag;
     } else if (const auto etag = allocate_etag()) {
       a.etag = *etag;
@@ -160,14 +161,25 @@ bool KnowledgeBase::unbind(const std::string& name) {
   return true;
 }
 
+const PeerReservations* KnowledgeBase::peers_on(const SegmentSpec& segment) const {
+  const std::string network = network_identity(segment);
+  if (network.empty()) return nullptr;
+  const auto found = peers_.find(network);
+  return found == peers_.end() ? nullptr : &found->second;
+}
+
 std::vector<SegmentSpec> KnowledgeBase::analysed_segments() const {
   std::vector<SegmentSpec> specs;
   for (const SegmentState& state : segments_) {
     SegmentSpec spec = state.spec;
-    if (const auto peer = peers_.find(spec.name); peer != peers_.end()) {
-      spec.peer_load = peer->second.load;
+    if (const PeerReservations* peer = peers_on(spec)) {
       if (spec.type == SegmentType::can) {
-        spec.can.background.insert(spec.can.background.end(), peer->second.frames.begin(), peer->second.frames.end());
+        CanSegmentProperties theirs = spec.can;
+        theirs.background = peer->frames;
+        spec.peer_load = background_utilization(theirs);
+        spec.can.background.insert(spec.can.background.end(), peer->frames.begin(), peer->frames.end());
+      } else if (spec.bandwidth.bits_per_second > 0) {
+        spec.peer_load = peer->bits_per_second / static_cast<double>(spec.bandwidth.bits_per_second);
       }
     }
     specs.push_back(std::move(spec));
@@ -175,13 +187,15 @@ std::vector<SegmentSpec> KnowledgeBase::analysed_segments() const {
   return specs;
 }
 
-void KnowledgeBase::set_peer_reservations(std::map<std::string, PeerReservations> peers) {
+void KnowledgeBase::set_peer_reservations(PeerNetworks peers) {
   if (peers == peers_) return;
   peers_ = std::move(peers);
-  peer_etags_.reset();
-  for (const auto& [segment, reservations] : peers_) {
-    for (const CanBackgroundFrame& frame : reservations.frames) {
-      if (frame.extended) peer_etags_.set(frame.can_id & kEtagMask);
+  peer_etags_.clear();
+  for (const SegmentState& state : segments_) {
+    const PeerReservations* peer = state.spec.type == SegmentType::can ? peers_on(state.spec) : nullptr;
+    if (!peer) continue;
+    for (const CanBackgroundFrame& frame : peer->frames) {
+      if (frame.extended) peer_etags_.emplace(static_cast<std::uint16_t>(frame.can_id & kEtagMask), frame.name);
     }
   }
   set_ = AdmissionSet::whole(set_.gateway(), analysed_segments(), set_.channels(), etags_);
@@ -203,6 +217,13 @@ AdmissionReport KnowledgeBase::report() const {
     if (channel.verdict == Verdict::rejected) {  // only with other gateways' reservations
       channel.verdict = Verdict::degraded;
       channel.reasons.push_back("bound before other gateways' reservations on the same networks were known");
+    }
+    if (const auto etag = etags_.find(channel.name); etag != etags_.end()) {
+      if (const auto peer = peer_etags_.find(etag->second); peer != peer_etags_.end()) {
+        channel.verdict = std::max(channel.verdict, Verdict::degraded);
+        channel.reasons.push_back("etag " + std::to_string(etag->second) + " is also carried by another gateway's frame " + peer->second +
+                                  " on a shared CAN bus: devices bound to one read the other's; give it a static etag");
+      }
     }
     for (const auto& hop : channel.hops) {
       const auto state = std::find_if(segments_.begin(), segments_.end(), [&](const auto& s) { return s.spec.name == hop.segment; });

@@ -1,10 +1,8 @@
 // What a gateway announces about itself, taken from its knowledge base.
 #include <algorithm>
-#include <variant>
 
 #include "cosmic/federation.hpp"
 #include "cosmic/knowledge_base.hpp"
-#include "cosmic/lcm_url.hpp"
 
 namespace cosmic {
 namespace {
@@ -37,23 +35,6 @@ AnnouncedChannel channel_of(const ChannelReport& report, const ChannelSpec& spec
 
 }  // namespace
 
-std::string network_identity(const SegmentSpec& segment) {
-  if (!segment.network.empty()) return std::string(to_string(segment.type)) + ":" + segment.network;
-  switch (segment.type) {
-    case SegmentType::can: return {};
-    case SegmentType::dds:
-      return "dds:domain=" + std::to_string(segment.dds.domain) +
-             (segment.dds.discovery_server.empty() ? "" : ";server=" + segment.dds.discovery_server);
-    case SegmentType::lcm: {
-      const auto url = parse_lcm_url(segment.lcm.url);
-      const auto* parsed = std::get_if<LcmUrl>(&url);
-      if (!parsed || parsed->memq) return {};
-      return "lcm:" + parsed->group + ":" + std::to_string(parsed->port);
-    }
-  }
-  return {};
-}
-
 Announcement announcement_of(const GatewayIdentity& self, const KnowledgeBase& kb, std::uint64_t revision) {
   Announcement a;
   a.gateway = self.id;
@@ -70,6 +51,7 @@ Announcement announcement_of(const GatewayIdentity& self, const KnowledgeBase& k
     s.max_utilization = spec.max_utilization;
     const double others = spec.type == SegmentType::can ? load.background : load.peers;
     s.load = std::clamp(load.utilization - others, 0.0, 1.0);
+    if (spec.type != SegmentType::can) s.reserved_bps = s.load * static_cast<double>(spec.bandwidth.bits_per_second);
     a.segments.push_back(std::move(s));
   }
   for (const ChannelReport& channel : report.channels) {

@@ -19,6 +19,9 @@ constexpr int kMaxNesting = 6;
 // Longest period or latency an announcement may state (a day): beyond it a number is a mistake.
 constexpr std::int64_t kMaxAnnouncedNanos = 86'400'000'000'000;
 
+// 1 -> "1", 1e12 -> "1e+12": a bound as a refusal quotes it.
+std::string format_number(double value) { return Json(value).dump(); }
+
 const char* role_text(HopRole role) { return role == HopRole::publisher ? "publisher" : "subscriber"; }
 
 Json nanos_or_null(const std::optional<Nanos>& value) { return value ? Json(value->count()) : Json(nullptr); }
@@ -32,7 +35,7 @@ Json segment_json(const AnnouncedSegment& s) {
   Json frames = Json::array();
   for (const auto& f : s.frames) frames.push_back(frame_json(f));
   return {{"name", s.name}, {"type", to_string(s.type)}, {"network", s.network}, {"max_utilization", s.max_utilization},
-          {"load", s.load}, {"frames", frames}};
+          {"load", s.load}, {"reserved_bps", s.reserved_bps}, {"frames", frames}};
 }
 
 Json channel_json(const AnnouncedChannel& c) {
@@ -82,13 +85,14 @@ class Reader {
     if (field(object, key, where).is_null()) return std::nullopt;
     return nanos(object, key, where);
   }
-  double ratio(const Json& object, const char* key, const std::string& where) const {
+  double number(const Json& object, const char* key, const std::string& where, double max) const {
     const Json& v = field(object, key, where);
     if (!v.is_number()) throw Refusal{where + "." + key + " is not a number"};
     const double d = v.get<double>();
-    if (!std::isfinite(d) || d < 0 || d > 1) throw Refusal{where + "." + key + " is outside 0..1"};
+    if (!std::isfinite(d) || d < 0 || d > max) throw Refusal{where + "." + key + " is outside 0.." + format_number(max)};
     return d;
   }
+  double ratio(const Json& object, const char* key, const std::string& where) const { return number(object, key, where, 1); }
   bool flag(const Json& object, const char* key, const std::string& where) const {
     const Json& v = field(object, key, where);
     if (!v.is_boolean()) throw Refusal{where + "." + key + " is not true or false"};
@@ -119,6 +123,8 @@ AnnouncedFrame read_frame(const Reader& r, const Json& j, const std::string& whe
   f.period = r.nanos(j, "period_ns", where);
   if (f.period < Nanos(1000)) throw Refusal{where + ".period_ns is below 1 us"};
   f.jitter = r.nanos(j, "jitter_ns", where);
+  // A release jitter beyond a second is no CAN frame's: it would only make every analysis diverge.
+  if (f.jitter > Nanos(1'000'000'000)) throw Refusal{where + ".jitter_ns is above 1 s"};
   return f;
 }
 
@@ -129,6 +135,7 @@ AnnouncedSegment read_segment(const Reader& r, const Json& j, const std::string&
   s.network = r.text(j, "network", where, true);
   s.max_utilization = r.ratio(j, "max_utilization", where);
   s.load = r.ratio(j, "load", where);
+  s.reserved_bps = r.number(j, "reserved_bps", where, kMaxAnnouncedBitsPerSecond);
   const Json& frames = r.list(j, "frames", where, kMaxAnnouncedFrames);
   if (s.type != SegmentType::can && !frames.empty()) throw Refusal{where + ".frames is not empty on a " + to_string(s.type) + " segment"};
   for (std::size_t i = 0; i < frames.size(); ++i) s.frames.push_back(read_frame(r, frames[i], where + ".frames[" + std::to_string(i) + "]"));

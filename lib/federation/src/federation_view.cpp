@@ -1,9 +1,6 @@
 #include "cosmic/federation_view.hpp"
 
 #include <algorithm>
-#include <set>
-
-#include "cosmic/can_background.hpp"
 
 namespace cosmic {
 namespace {
@@ -13,6 +10,13 @@ std::string quoted_source(const std::string& source) {
   std::string out;
   for (const char c : source.substr(0, 64)) out += (c >= 0x20 && c < 0x7f) ? c : '?';
   return out;
+}
+
+// Two announcements of one CAN identifier: the heavier of each property, so neither hides load.
+void merge_heaviest(CanBackgroundFrame& kept, const CanBackgroundFrame& other) {
+  kept.period = std::min(kept.period, other.period);
+  kept.length = std::max(kept.length, other.length);
+  kept.jitter = std::max(kept.jitter, other.jitter);
 }
 
 }  // namespace
@@ -42,23 +46,31 @@ PeerRecord* FederationView::by_source(const std::string& source) {
   return nullptr;
 }
 
+std::string FederationView::cheap_refusal(const FederationMessage& message) {
+  if (message.key == self_) return "announcement claims this gateway's own id " + gateway_id_text(self_);
+  if (const PeerRecord* own = by_source(message.source); own && own->announcement.gateway != message.key) {
+    return "writer announces gateway " + gateway_id_text(own->announcement.gateway) + " (" + own->announcement.name +
+           ") and now also " + gateway_id_text(message.key) + ": one gateway per writer";
+  }
+  const auto it = peers_.find(message.key);
+  if (it != peers_.end() && it->second.source != message.source && it->second.state == PeerState::alive) {
+    pending_[message.key] = message;  // taken over once that writer is gone
+    return "gateway " + gateway_id_text(message.key) + " (" + it->second.announcement.name + ") is announced by another writer";
+  }
+  if (it == peers_.end() && peers_.size() >= max_peers_) return "more than " + std::to_string(max_peers_) + " gateways in the federation";
+  return {};
+}
+
 bool FederationView::take_announcement(const FederationMessage& message, Nanos now, std::string* refusal) {
+  if (std::string why = cheap_refusal(message); !why.empty()) return refuse(message, std::move(why), refusal);
   DecodedAnnouncement decoded = decode_announcement(message.body);
   if (!decoded.announcement) return refuse(message, decoded.error, refusal);
   Announcement& a = *decoded.announcement;
   if (a.gateway != message.key) {
     return refuse(message, "announcement of gateway " + gateway_id_text(a.gateway) + " filed under " + gateway_id_text(message.key), refusal);
   }
-  if (a.gateway == self_) return refuse(message, "announcement claims this gateway's own id " + gateway_id_text(self_), refusal);
   auto it = peers_.find(a.gateway);
-  if (it != peers_.end() && it->second.source != message.source && it->second.state == PeerState::alive) {
-    return refuse(message, "gateway " + gateway_id_text(a.gateway) + " (" + it->second.announcement.name +
-                               ") is announced by another writer", refusal);
-  }
   if (it == peers_.end()) {
-    if (peers_.size() >= max_peers_) {
-      return refuse(message, "more than " + std::to_string(max_peers_) + " gateways in the federation", refusal);
-    }
     it = peers_.emplace(a.gateway, PeerRecord{}).first;
     it->second.first_heard = now;
   } else if (it->second.source == message.source && a.revision <= it->second.announcement.revision && it->second.state == PeerState::alive) {
@@ -67,14 +79,14 @@ bool FederationView::take_announcement(const FederationMessage& message, Nanos n
     return false;
   }
   PeerRecord& peer = it->second;
-  const bool was_alive = peer.state == PeerState::alive;
+  if (peer.state != PeerState::alive || peer.announcements == 0) peer.state_since = now;
   peer.announcement = std::move(a);
   peer.source = message.source;
   peer.last_heard = now;
-  if (!was_alive || peer.announcements == 0) peer.state_since = now;
   peer.state = PeerState::alive;
   ++peer.announcements;
   ++counters_.applied;
+  pending_.erase(peer.announcement.gateway);
   return true;
 }
 
@@ -83,15 +95,28 @@ bool FederationView::apply(const FederationMessage& message, Nanos now, std::str
   if (refusal) refusal->clear();
   if (message.kind == FederationMessage::Kind::announcement) return take_announcement(message, now, refusal);
   PeerRecord* peer = by_source(message.source);
-  if (!peer) return false;  // a writer never heard from (or a foreign topic's writer): nothing to change
+  if (!peer) {
+    // A writer that was refused: what it left waiting for a takeover goes with it.
+    if (message.kind != FederationMessage::Kind::alive) {
+      std::erase_if(pending_, [&](const auto& p) { return p.second.source == message.source; });
+    }
+    return false;
+  }
   const PeerState next = message.kind == FederationMessage::Kind::alive ? PeerState::alive
                          : message.kind == FederationMessage::Kind::lost ? PeerState::lost
                                                                           : PeerState::left;
   peer->last_heard = now;
-  if (peer->state == next) return false;
-  if (peer->state == PeerState::left) return false;  // left is final until it announces again
+  if (peer->state == next || peer->state == PeerState::left) return false;  // left is final until it announces again
   peer->state = next;
   peer->state_since = now;
+  // A newer writer of the same gateway waited for this one to go.
+  if (next != PeerState::alive) {
+    if (const auto pending = pending_.find(peer->announcement.gateway); pending != pending_.end()) {
+      const FederationMessage takeover = std::move(pending->second);
+      pending_.erase(pending);
+      take_announcement(takeover, now, refusal);
+    }
+  }
   return true;
 }
 
@@ -101,39 +126,36 @@ std::size_t FederationView::alive_peers() const {
 
 void FederationView::forget_before(Nanos when) {
   std::erase_if(peers_, [&](const auto& p) { return p.second.state != PeerState::alive && p.second.state_since < when; });
+  std::erase_if(pending_, [&](const auto& p) { return !peers_.count(p.first); });
 }
 
-std::map<std::string, PeerReservations> FederationView::reservations_for(const std::vector<SegmentSpec>& segments) const {
-  std::map<std::string, PeerReservations> out;
-  for (const SegmentSpec& segment : segments) {
-    const std::string network = network_identity(segment);
-    if (network.empty()) continue;
-    PeerReservations r;
-    std::set<std::pair<std::uint32_t, bool>> seen;
-    bool any = false;
-    for (const auto& [id, peer] : peers_) {
-      if (peer.state != PeerState::alive) continue;
-      for (const AnnouncedSegment& theirs : peer.announcement.segments) {
-        if (theirs.network != network || theirs.type != segment.type) continue;
-        any = true;
-        if (segment.type != SegmentType::can) {
-          r.load += theirs.load;
-          continue;
-        }
-        for (const AnnouncedFrame& f : theirs.frames) {
-          if (!seen.emplace(f.can_id, f.extended).second) continue;
-          r.frames.push_back(CanBackgroundFrame{peer.announcement.name + ":" + f.channel, f.can_id, f.extended, f.length, f.period,
-                                                f.jitter, "gateway " + peer.announcement.name + " (" + gateway_id_text(id) + ")"});
-        }
+PeerNetworks FederationView::reservations() const {
+  PeerNetworks out;
+  std::map<std::string, std::map<std::pair<std::uint32_t, bool>, CanBackgroundFrame>> frames;  // by network, by identifier
+  for (const auto& [id, peer] : peers_) {
+    if (peer.state != PeerState::alive) continue;
+    for (const AnnouncedSegment& theirs : peer.announcement.segments) {
+      if (theirs.network.empty()) continue;
+      PeerReservations& r = out[theirs.network];
+      r.bits_per_second += theirs.reserved_bps;
+      for (const AnnouncedFrame& f : theirs.frames) {
+        CanBackgroundFrame frame{peer.announcement.name + ":" + f.channel, f.can_id, f.extended, f.length, f.period, f.jitter,
+                                 "gateway " + peer.announcement.name + " (" + gateway_id_text(id) + ")"};
+        const auto [kept, fresh] = frames[theirs.network].emplace(std::make_pair(f.can_id, f.extended), frame);
+        if (!fresh) merge_heaviest(kept->second, frame);
       }
     }
-    if (!any) continue;
-    if (segment.type == SegmentType::can) {
-      CanSegmentProperties bus = segment.can;
-      bus.background = r.frames;
-      r.load = background_utilization(bus);
+  }
+  counters_.frames_over_cap = 0;
+  for (auto& [network, by_id] : frames) {
+    std::vector<CanBackgroundFrame>& list = out[network].frames;
+    for (auto& [key, frame] : by_id) {
+      if (list.size() >= kMaxPeerFramesPerNetwork) {
+        ++counters_.frames_over_cap;
+        continue;
+      }
+      list.push_back(std::move(frame));
     }
-    out.emplace(segment.name, std::move(r));
   }
   return out;
 }

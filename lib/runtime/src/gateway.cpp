@@ -307,7 +307,7 @@ std::vector<std::uint32_t> can_identifiers(const KnowledgeBase& kb) {
 }
 }  // namespace
 
-void Gateway::set_peer_reservations(std::map<std::string, PeerReservations> peers) {
+void Gateway::set_peer_reservations(PeerNetworks peers) {
   if (peers == kb_->peer_reservations()) return;
   const auto ids_before = can_identifiers(*kb_);
   kb_->set_peer_reservations(std::move(peers));
@@ -330,15 +330,16 @@ bool Gateway::unbind(const std::string& name) {
 
 BindResult Gateway::reload(const Config& config) { return commit_reload(plan_reload(config)); }
 
-ReloadPlan Gateway::plan_reload(Config config, std::shared_ptr<const ReloadBase> base) {
+ReloadPlan Gateway::plan_reload(Config config, std::shared_ptr<const ReloadBase> base, PeerNetworks peers) {
   ReloadPlan plan;
-  const bool from_base = base && extends(config, base->config);
+  const bool from_base = base && extends(config, base->config) && base->kb.peer_reservations() == peers;
   if (from_base) {
     plan.kb = std::make_shared<KnowledgeBase>(base->kb);
     plan.reports = base->reports;
     plan.reused = base->config.channels.size();
   } else {
     plan.kb = knowledge_base_for(config);
+    plan.kb->set_peer_reservations(std::move(peers));
   }
   plan.config = std::move(config);
   for (std::size_t c = plan.reused; c < plan.config.channels.size(); ++c) {
@@ -410,7 +411,7 @@ BindResult Gateway::commit_reload(ReloadPlan plan) {
   router_->set_residence_bound(config.gateway.residence_bound);
   config_ = config;
   identity_.name = config.gateway.name;
-  // What other gateways reserve carries over; the federation updates it for changed networks.
+  // Other gateways' reservations that changed while the plan was made (no-op otherwise).
   next_kb->set_peer_reservations(kb_->peer_reservations());
   kb_ = std::move(next_kb);
   // As in bind(): adapters carry the new channels before the router sends to them.

@@ -65,8 +65,10 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
     if (Status st = dds_detail::participant_qos(segment_, (self_.name.empty() ? "cosmicd" : self_.name) + "/federation", qos); !st.ok) {
       return st.error;
     }
-    qos.wire_protocol().builtin.discovery_config.leaseDuration = duration_of(std::max(lease_, Nanos(1'000'000'000)));
-    qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod = duration_of(std::max(lease_, Nanos(1'000'000'000)) / 3);
+    // The participant's lease is what the others judge this gateway by: each reader drops a remote
+    // participant after the lease *that participant* announced, so gateways may differ in lease.
+    qos.wire_protocol().builtin.discovery_config.leaseDuration = duration_of(lease_);
+    qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod = duration_of(lease_ / 3);
     participant_ = create_participant(qos);
     if (participant_ == nullptr) return "cannot create the federation's DDS participant in domain " + std::to_string(segment_.dds.domain);
     own_prefix_ = participant_->guid().guidPrefix;
@@ -77,8 +79,7 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
     subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
     if (!topic_ || !publisher_ || !subscriber_) return fail("cannot create the federation topic, publisher or subscriber");
     writer_ = publisher_->create_datawriter(topic_, writer_qos());
-    const dds::StatusMask mask = dds::StatusMask::data_available() << dds::StatusMask::subscription_matched()
-                                                                      << dds::StatusMask::liveliness_changed();
+    const dds::StatusMask mask = dds::StatusMask::data_available() << dds::StatusMask::subscription_matched();
     reader_ = subscriber_->create_datareader(topic_, reader_qos(), this, mask);
     if (!writer_ || !reader_) return fail("cannot create the federation writer or reader");
     return {};
@@ -121,22 +122,21 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
   }
 
  private:
-  // Both ends: reliable, durable for late joiners, the newest announcement per gateway, the lease.
+  // Both ends: reliable, durable for late joiners, the newest announcement per gateway. Liveliness
+  // stays DDS's default (automatic, infinite): a reader's requested lease would have to be at least
+  // every writer's, and Fast DDS times writers by the reader's; the participant lease does it instead.
   template <typename EndpointQos>
   void common_qos(EndpointQos& qos) const {
     qos.reliability().kind = dds::RELIABLE_RELIABILITY_QOS;
     qos.durability().kind = dds::TRANSIENT_LOCAL_DURABILITY_QOS;
     qos.history().kind = dds::KEEP_LAST_HISTORY_QOS;
     qos.history().depth = 1;
-    qos.liveliness().kind = dds::AUTOMATIC_LIVELINESS_QOS;
-    qos.liveliness().lease_duration = duration_of(lease_);
     qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
   }
 
   dds::DataWriterQos writer_qos() const {
     dds::DataWriterQos qos = dds::DATAWRITER_QOS_DEFAULT;
     common_qos(qos);
-    qos.liveliness().announcement_period = duration_of(lease_ / 3);
     qos.publish_mode().kind = dds::ASYNCHRONOUS_PUBLISH_MODE;
     return qos;
   }
@@ -217,18 +217,11 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
     }
   }
 
+  // A writer unmatched: its participant's lease expired (killed, cut off) or it was deleted without
+  // withdrawing first. Matched again: back (its durable announcement follows).
   void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& status) override {
-    if (status.current_count_change >= 0 || from_prefix(status.last_publication_handle, own_prefix_)) return;
-    std::lock_guard lock(mutex_);
-    queue(FederationMessage{FederationMessage::Kind::lost, handle_text(status.last_publication_handle), 0, {}});
-  }
-
-  void on_liveliness_changed(dds::DataReader*, const dds::LivelinessChangedStatus& status) override {
-    if (from_prefix(status.last_publication_handle, own_prefix_)) return;
-    const auto kind = status.not_alive_count_change > 0 ? FederationMessage::Kind::lost
-                      : status.alive_count_change > 0   ? FederationMessage::Kind::alive
-                                                        : FederationMessage::Kind::announcement;
-    if (kind == FederationMessage::Kind::announcement) return;
+    if (status.current_count_change == 0 || from_prefix(status.last_publication_handle, own_prefix_)) return;
+    const auto kind = status.current_count_change < 0 ? FederationMessage::Kind::lost : FederationMessage::Kind::alive;
     std::lock_guard lock(mutex_);
     queue(FederationMessage{kind, handle_text(status.last_publication_handle), 0, {}});
   }

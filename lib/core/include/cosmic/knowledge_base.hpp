@@ -26,6 +26,7 @@
 #include "cosmic/admission.hpp"
 #include "cosmic/can_wire.hpp"
 #include "cosmic/model.hpp"
+#include "cosmic/network_identity.hpp"
 
 namespace cosmic {
 
@@ -38,13 +39,14 @@ struct SegmentState {
   std::string health_detail;
 };
 
-// What the other gateways of a federation reserve on a network one of this gateway's segments
-// attaches (docs/federation.md).
+// What the other gateways of a federation reserve on one network (docs/federation.md).
 struct PeerReservations {
-  double load = 0;  // their share of the network (CAN: the share of their `frames`)
+  double bits_per_second = 0;  // DDS and LCM: the bandwidth their channels reserve
   std::vector<CanBackgroundFrame> frames;  // CAN: their frames, analysed like background frames
   friend bool operator==(const PeerReservations&, const PeerReservations&) = default;
 };
+// By network identity (cosmic/network_identity.hpp).
+using PeerNetworks = std::map<std::string, PeerReservations>;
 
 struct BindOutcome {
   ChannelReport report;  // the channel's verdict with its numbers
@@ -71,12 +73,15 @@ class KnowledgeBase {
 
   void set_health(const std::string& segment, SegmentHealth health, std::string detail);
 
-  // Replaces what other gateways reserve (by segment name; a segment not named: nothing) and
-  // analyses the bound set again with it (O(bound channels + hops)). Bound channels stay bound: one
-  // that no longer passes shows `degraded` with the analysis's reasons (two binds that raced on two
-  // gateways); newcomers are admitted against it. Their CAN frames' etags are not handed out.
-  void set_peer_reservations(std::map<std::string, PeerReservations> peers);
-  const std::map<std::string, PeerReservations>& peer_reservations() const { return peers_; }
+  // Replaces what other gateways reserve on the networks this gateway's segments attach (segments
+  // are matched by network_identity(); networks no segment attaches are ignored) and analyses the
+  // bound set again from scratch with it (as AdmissionSet::whole: a CAN bus's priorities may be
+  // spread afresh). Bound channels stay bound: one that no longer passes shows `degraded` with the
+  // analysis's reasons (two binds that raced on two gateways), as does one whose etag another
+  // gateway's frames on a shared bus carry; newcomers are admitted against it. The etags of the
+  // peers' extended frames are never handed out.
+  void set_peer_reservations(PeerNetworks peers);
+  const PeerNetworks& peer_reservations() const { return peers_; }
 
   // Verdicts of the bound set (live health applied) and the load of every segment.
   AdmissionReport report() const;
@@ -104,11 +109,15 @@ class KnowledgeBase {
 
   // The segments as admission sees them: the configured ones plus what other gateways reserve.
   std::vector<SegmentSpec> analysed_segments() const;
+  // What other gateways reserve on the network `segment` attaches, or null.
+  const PeerReservations* peers_on(const SegmentSpec& segment) const;
 
   std::vector<SegmentState> segments_;
   AdmissionSet set_;
-  std::map<std::string, PeerReservations> peers_;
-  std::bitset<kMaxEtag + 1> peer_etags_;  // etag bits of other gateways' extended frames
+  PeerNetworks peers_;
+  // Etag bits of other gateways' extended frames on the networks of this gateway's segments, with
+  // the name of one frame carrying each.
+  std::map<std::uint16_t, std::string> peer_etags_;
   std::set<std::uint16_t> reserved_etags_;
   EtagMap etags_;                                         // bound CAN channels
   std::bitset<kMaxEtag + 1> etag_taken_;                  // reserved or bound: never handed out

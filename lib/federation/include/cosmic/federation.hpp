@@ -19,12 +19,14 @@
 #include "cosmic/admission.hpp"
 #include "cosmic/log.hpp"
 #include "cosmic/model.hpp"
+#include "cosmic/network_identity.hpp"
 
 namespace cosmic {
 
 class KnowledgeBase;
 
 // Bounds of an announcement the codec accepts (each refusal names the one exceeded).
+inline constexpr double kMaxAnnouncedBitsPerSecond = 1e12;
 inline constexpr std::size_t kMaxAnnouncementBytes = 1u << 20;
 inline constexpr std::size_t kMaxAnnouncedSegments = 64;
 inline constexpr std::size_t kMaxAnnouncedChannels = 4096;
@@ -50,6 +52,9 @@ struct AnnouncedSegment {
   std::string network;  // network_identity(); empty: not shared with other gateways
   double max_utilization = 0.7;
   double load = 0;      // share of the network the gateway's channels reserve (background excluded)
+  // DDS and LCM: the bandwidth behind `load`, which other gateways relate to their own `bandwidth`
+  // of the network (their shares would differ where the gateways declare different bandwidths).
+  double reserved_bps = 0;
   std::vector<AnnouncedFrame> frames;  // CAN: the frames behind `load`
   friend bool operator==(const AnnouncedSegment&, const AnnouncedSegment&) = default;
 };
@@ -80,14 +85,6 @@ struct Announcement {
   friend bool operator==(const Announcement&, const Announcement&) = default;
 };
 
-// The identity of the network a segment attaches, equal on every gateway attached to it:
-//   dds: "dds:domain=N" (plus ";server=IP:PORT" with a discovery server)
-//   lcm: "lcm:GROUP:PORT" (memq:// is process-local: empty)
-//   can: "can:NAME" from the segment's `network` key (interface names are local: without the key
-//        the bus is taken to be this gateway's alone, empty)
-// A `network` key on an IP segment overrides the derived identity.
-std::string network_identity(const SegmentSpec& segment);
-
 // What this gateway announces: its segments' networks and reservations and its bound channels'
 // hops, from the knowledge base. `revision` is the caller's counter.
 Announcement announcement_of(const GatewayIdentity& self, const KnowledgeBase& kb, std::uint64_t revision);
@@ -99,8 +96,8 @@ struct DecodedAnnouncement {
   std::string error;  // why not, when announcement is empty
 };
 // Never throws; refuses malformed JSON, unknown formats, missing or mistyped fields, negative or
-// non-finite numbers, loads outside 0..1, identifiers outside 29 bits, zero periods and anything
-// over the kMaxAnnounced* bounds.
+// non-finite numbers, loads outside 0..1, identifiers outside 29 bits, periods under 1 us, a
+// frame's jitter above 1 s and anything over the kMaxAnnounced* bounds.
 DecodedAnnouncement decode_announcement(std::string_view text);
 
 // "00000000deadbeef": how ids are written in announcements, logs and `cosmicctl peers`.

@@ -1,5 +1,5 @@
 // The transport of a federation (docs/federation.md): carries this gateway's encoded announcement
-// to the other gateways and theirs, with liveliness, to it. The DDS implementation is
+// to the other gateways and theirs, with whether each is still there, to it. The DDS implementation is
 // make_dds_federation_link() (lib/adapters/dds); tests may use their own.
 //
 // Threads: start(), publish(), withdraw() and take() are called by the owner's one control thread;

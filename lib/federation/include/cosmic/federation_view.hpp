@@ -4,9 +4,14 @@
 //
 // A peer is trusted to describe itself only. Refused and counted (never applied): an announcement
 // that does not decode, one filed under another gateway's id than it names, one naming this
-// gateway's id, one naming a gateway another writer announces while that writer is alive, and a
-// new gateway beyond max_peers. An older or repeated revision is ignored (counted as stale).
-// A gateway that left (withdrew) stays `left` until it announces again; lost comes back on liveliness.
+// gateway's id, one from a writer that already announces another gateway (one gateway per writer),
+// one naming a gateway another writer announces while that writer is alive, and a new gateway
+// beyond max_peers. The cheap checks (ids, writer) run before the body is decoded. The latest
+// announcement refused only because its gateway's writer is alive is kept (one per gateway) and
+// applied once that writer is lost or left: a gateway that rejoined with a new writer before its old
+// one was gone is taken over then. An older or repeated revision is ignored (counted as stale).
+// A gateway that left (withdrew) stays `left` until it announces again; a lost one comes back when
+// its writer is matched again.
 #pragma once
 
 #include <cstdint>
@@ -23,8 +28,8 @@ struct FederationMessage {
   enum class Kind {
     announcement,  // `body` is an encoded Announcement filed under `key`
     withdrawn,     // the writer disposed its announcement: the gateway left
-    lost,          // the writer's liveliness lapsed (lease): stopped, killed or cut off
-    alive,         // the writer's liveliness is back
+    lost,          // the writer is gone without withdrawing (its lease expired): killed or cut off
+    alive,         // the writer is back (matched again)
   };
   Kind kind = Kind::announcement;
   std::string source;     // the writer (DDS: its GUID), as the transport identifies it
@@ -40,7 +45,7 @@ struct PeerRecord {
   std::string source;
   PeerState state = PeerState::alive;
   Nanos first_heard{0};
-  Nanos last_heard{0};   // last announcement or liveliness change
+  Nanos last_heard{0};   // last announcement or change of state
   Nanos state_since{0};
   std::uint64_t announcements = 0;  // applied
 };
@@ -51,6 +56,7 @@ struct FederationCounters {
   std::uint64_t stale = 0;     // older or repeated revisions
   std::uint64_t refused = 0;
   std::string last_refusal;    // why, with the source
+  mutable std::uint64_t frames_over_cap = 0;  // at the last reservations()
 };
 
 class FederationView {
@@ -68,19 +74,29 @@ class FederationView {
   // Drops peers lost or left before `when` from peers().
   void forget_before(Nanos when);
   const FederationCounters& counters() const { return counters_; }
+  // Announcements waiting for their gateway's current writer to go (a rejoin, or a spoof whose
+  // writer is still there).
+  std::size_t pending_takeovers() const { return pending_.size(); }
 
-  // What the alive peers reserve on the networks of `segments` (by segment name; segments with no
-  // network identity or no peer on it are absent). Frames announced by two peers count once.
-  std::map<std::string, PeerReservations> reservations_for(const std::vector<SegmentSpec>& segments) const;
+  // What the alive peers reserve, by network identity (for KnowledgeBase::set_peer_reservations).
+  // A CAN identifier announced by several peers counts once, as the heaviest of them (shortest
+  // period, longest frame, largest jitter), so no peer can hide another's frame; at most
+  // kMaxPeerFramesPerNetwork identifiers per network (the lowest, which delay the most), the rest
+  // counted in counters().frames_over_cap.
+  static constexpr std::size_t kMaxPeerFramesPerNetwork = 4096;
+  PeerNetworks reservations() const;
 
  private:
   bool refuse(const FederationMessage& message, std::string why, std::string* refusal);
   bool take_announcement(const FederationMessage& message, Nanos now, std::string* refusal);
+  // The ids, the writer and the room for a new gateway, before decoding: the reason, or empty.
+  std::string cheap_refusal(const FederationMessage& message);
   PeerRecord* by_source(const std::string& source);
 
   std::uint64_t self_;
   std::size_t max_peers_;
   std::map<std::uint64_t, PeerRecord> peers_;
+  std::map<std::uint64_t, FederationMessage> pending_;  // takeovers waiting for the old writer to go
   FederationCounters counters_;
 };
 

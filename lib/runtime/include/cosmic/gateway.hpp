@@ -140,7 +140,9 @@ class Gateway {
   // from the base's admission and admits only the channels after them: an unchanged file is not
   // admitted again. The plan is the one admission from scratch gives (binding is incremental and
   // deterministic); any other configuration is admitted from scratch.
-  static ReloadPlan plan_reload(Config config, std::shared_ptr<const ReloadBase> base = nullptr);
+  // `peers`: what other gateways reserve (knowledge_base().peer_reservations(), copied on the
+  // control thread), counted by the new configuration's admission.
+  static ReloadPlan plan_reload(Config config, std::shared_ptr<const ReloadBase> base = nullptr, PeerNetworks peers = {});
   BindResult commit_reload(ReloadPlan plan);
   // Control thread: what the running bindings were admitted from; null once a bind or unbind
   // changed them since start or the last reload.
@@ -152,10 +154,11 @@ class Gateway {
   std::uint64_t generation() const { return generation_; }
   void stop();
 
-  // What other gateways of the federation reserve on this gateway's networks (by segment name;
-  // FederationView::reservations_for): admission counts it from now on, the bound set is analysed
-  // again with it and a bind planned before is planned again. Kept across reloads.
-  void set_peer_reservations(std::map<std::string, PeerReservations> peers);
+  // What other gateways of the federation reserve, by network (FederationView::reservations):
+  // admission counts it from now on on the segments attaching those networks, the bound set is
+  // analysed again with it, and a bind whose admission ran meanwhile is refused ("try again").
+  // Kept across reloads (a renamed segment on the same network keeps them).
+  void set_peer_reservations(PeerNetworks peers);
 
   // Reads adapter health into the knowledge base (call periodically).
   void refresh_health();

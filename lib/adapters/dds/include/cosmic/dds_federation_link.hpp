@@ -1,13 +1,14 @@
 // The federation transport over Fast DDS 2.9 (docs/federation.md): one participant of its own in
 // the federation segment's domain (the segment's transports and discovery), topic
 // "cosmic/federation" of type cosmic_federation::Announcement.
-//   writer  RELIABLE, TRANSIENT_LOCAL, KEEP_LAST 1, liveliness AUTOMATIC with lease_duration =
-//           gateway.federation.lease, asynchronous publishing (announcements are fragmented)
+//   participant  lease = gateway.federation.lease (announced every lease / 3): the others drop this
+//                gateway's participant, and with it its writer, when it is silent that long
+//   writer  RELIABLE, TRANSIENT_LOCAL, KEEP_LAST 1, asynchronous publishing (announcements are fragmented)
 //   reader  the same, with at most FederationView::kDefaultMaxPeers instances of one sample each
 // What the reader hears becomes FederationMessages: a sample -> announcement (filed under its
-// key, the source being its writer's GUID), a disposed instance -> withdrawn, a writer whose
-// liveliness lapsed or that was unmatched -> lost, liveliness regained -> alive. This gateway's own
-// samples are dropped by GUID prefix.
+// key, the source being its writer's GUID), a disposed instance -> withdrawn, a writer unmatched
+// (its participant's lease expired) -> lost, matched again -> alive. This gateway's own samples
+// are dropped by GUID prefix.
 //
 // Threads: Fast DDS's listener threads queue messages under a mutex (never touching anything
 // else); start/publish/withdraw/take run on the owner's control thread.

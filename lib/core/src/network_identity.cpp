@@ -1,0 +1,26 @@
+#include "cosmic/network_identity.hpp"
+
+#include <variant>
+
+#include "cosmic/lcm_url.hpp"
+
+namespace cosmic {
+
+std::string network_identity(const SegmentSpec& segment) {
+  if (!segment.network.empty()) return std::string(to_string(segment.type)) + ":" + segment.network;
+  switch (segment.type) {
+    case SegmentType::can: return {};
+    case SegmentType::dds:
+      return "dds:domain=" + std::to_string(segment.dds.domain) +
+             (segment.dds.discovery_server.empty() ? "" : ";server=" + segment.dds.discovery_server);
+    case SegmentType::lcm: {
+      const auto url = parse_lcm_url(segment.lcm.url);
+      const auto* parsed = std::get_if<LcmUrl>(&url);
+      if (!parsed || parsed->memq) return {};
+      return "lcm:" + parsed->group + ":" + std::to_string(parsed->port);
+    }
+  }
+  return {};
+}
+
+}  // namespace cosmic
