@@ -69,6 +69,23 @@ void FederationMember::log_transitions(const std::map<std::uint64_t, cosmic::Pee
   }
 }
 
+// What the other gateways now reserve or send changed a local channel's verdict: say so, with why.
+void FederationMember::log_verdict_changes(const cosmic::AdmissionReport& was, const cosmic::AdmissionReport& now) {
+  for (const cosmic::ChannelReport& channel : now.channels) {
+    const cosmic::ChannelReport* before = was.find(channel.name);
+    if (!before || (before->verdict == channel.verdict && before->reasons == channel.reasons &&
+                    before->end_to_end.latency == channel.end_to_end.latency)) {
+      continue;
+    }
+    std::string line = "federation: channel " + channel.name + " is " + cosmic::to_string(channel.verdict) + " (was " +
+                       cosmic::to_string(before->verdict) + ")";
+    line += ", end to end " + (channel.end_to_end.latency ? cosmic::format_duration(*channel.end_to_end.latency) : std::string("unbounded"));
+    if (!channel.upstream.empty()) line += " through gateway " + channel.upstream.front().gateway;
+    for (const auto& reason : channel.reasons) line += "; " + reason;
+    log_.log(channel.verdict == cosmic::Verdict::bound ? cosmic::LogLevel::notice : cosmic::LogLevel::warning, line);
+  }
+}
+
 void FederationMember::hear(cosmic::Nanos now) {
   std::map<std::uint64_t, cosmic::PeerState> before;
   for (const auto& [id, peer] : view_->peers()) before[id] = peer.state;
@@ -85,7 +102,9 @@ void FederationMember::hear(cosmic::Nanos now) {
   view_->forget_before(now - spec_.lease * kForgetAfterLeases);
   if (!changed) return;
   log_transitions(before);
+  const cosmic::AdmissionReport was = gateway_.admission();
   gateway_.set_peer_reservations(view_->reservations());
+  log_verdict_changes(was, gateway_.admission());
   peers_changed_ = true;
 }
 

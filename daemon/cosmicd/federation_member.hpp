@@ -55,6 +55,7 @@ class FederationMember {
   void hear(cosmic::Nanos now);
   void announce();
   void log_transitions(const std::map<std::uint64_t, cosmic::PeerState>& before);
+  void log_verdict_changes(const cosmic::AdmissionReport& was, const cosmic::AdmissionReport& now);
 
   cosmic::Gateway& gateway_;
   cosmic::Logger& log_;

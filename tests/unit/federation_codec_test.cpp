@@ -18,14 +18,31 @@ Announcement sample_announcement() {
   a.gateway = 0x1234abcd5678ef01;
   a.name = "gw2";
   a.revision = 7;
+  a.residence = Nanos(500us);
   AnnouncedSegment lan{"lan", SegmentType::dds, "dds:domain=0", 0.7, 0.125, 12'500'000, {}};
   AnnouncedSegment body{"body", SegmentType::can, "can:body", 0.6, 0.2, 0, {}};
   body.frames.push_back(AnnouncedFrame{"steer", 0x0C0FFFFF, true, 8, Nanos(10ms), Nanos(250us)});
   body.frames.push_back(AnnouncedFrame{"ecu", 0x123, false, 4, Nanos(20ms), Nanos(0)});
   a.segments = {lan, body};
-  AnnouncedChannel steer{"steer", 0x100000042, ChannelClass::hrt, Verdict::bound, {}, Nanos(3ms)};
+  AnnouncedChannel steer;
+  steer.name = "steer";
+  steer.subject = 0x100000042;
+  steer.cls = ChannelClass::hrt;
   steer.hops = {AnnouncedHop{"lan", HopRole::publisher, Nanos(1ms)}, AnnouncedHop{"body", HopRole::subscriber, Nanos(1500us)}};
-  AnnouncedChannel log{"log", 7, ChannelClass::nrt, Verdict::degraded, {AnnouncedHop{"lan", HopRole::subscriber, std::nullopt}}, std::nullopt};
+  steer.end_to_end = Nanos(5ms);
+  steer.period = Nanos(10ms);
+  steer.reaction_time = Nanos(20ms);
+  steer.temp_validity = Nanos(50ms);
+  steer.payload = 8;
+  steer.upstream = {PathHop{"gw1", "front-can", HopRole::publisher, Nanos(1ms)}};
+  steer.upstream_age = Nanos(2ms);
+  AnnouncedChannel log;
+  log.name = "log";
+  log.subject = 7;
+  log.verdict = Verdict::degraded;
+  log.hops = {AnnouncedHop{"lan", HopRole::subscriber, std::nullopt}};
+  log.end_to_end = std::nullopt;
+  log.upstream_age = std::nullopt;
   a.channels = {steer, log};
   return a;
 }
@@ -78,6 +95,9 @@ TEST(FederationCodec, RefusesMalformedAndOutOfRangeAnnouncements) {
       {"missing field", [](Json& j) { j.erase("segments"); }, "segments is missing"},
       {"segment not an object", [](Json& j) { j["segments"][0] = 3; }, "is not an object"},
       {"too many segments", [](Json& j) { j["segments"] = Json::array(); for (int i = 0; i < 65; ++i) j["segments"].push_back(j["segments"].size()); }, "more than 64"},
+      {"negative residence", [](Json& j) { j["residence_ns"] = -1; }, "residence_ns"},
+      {"upstream hop without gateway", [](Json& j) { j["channels"][0]["upstream"][0].erase("gateway"); }, "gateway is missing"},
+      {"fractional payload", [](Json& j) { j["channels"][0]["payload"] = 1.5; }, "payload"},
       {"too many channels", [](Json& j) { j["channels"] = Json(std::vector<int>(kMaxAnnouncedChannels + 1, 0)); }, "more than 4096"},
   };
   const Json good = Json::parse(encode(sample_announcement()));

@@ -177,7 +177,7 @@ TEST(FederationAdmission, OtherGatewaysLoadOnASharedNetworkCounts) {
   ASSERT_TRUE(kb.bind(mine).bound());
   // 350 kbit/s of this 1 Mbit/s network, wherever the others declared its bandwidth; another
   // network (domain 1) is not this segment's.
-  kb.set_peer_reservations({{"dds:domain=0", PeerReservations{350'000, {}}}, {"dds:domain=1", PeerReservations{900'000, {}}}});
+  kb.set_peer_reservations({{"dds:domain=0", PeerReservations{350'000, {}, {}}}, {"dds:domain=1", PeerReservations{900'000, {}, {}}}});
   ChannelSpec more = mine;
   more.name = "more";
   more.subject = 2;
@@ -188,7 +188,7 @@ TEST(FederationAdmission, OtherGatewaysLoadOnASharedNetworkCounts) {
   EXPECT_NEAR(kb.loads()[0].utilization, 0.45, 1e-9);
 
   // A peer that joins with more makes a bound channel's numbers fail: shown degraded, still bound.
-  kb.set_peer_reservations({{"dds:domain=0", PeerReservations{450'000, {}}}});
+  kb.set_peer_reservations({{"dds:domain=0", PeerReservations{450'000, {}, {}}}});
   const AdmissionReport report = kb.report();
   const ChannelReport* shown = report.find("mine");
   ASSERT_NE(shown, nullptr);
@@ -218,7 +218,7 @@ TEST(FederationAdmission, OtherGatewaysFramesDelayCanChannelsAndKeepTheirEtags) 
   EXPECT_GT(kb.loads()[0].peers, 0.1);
   // The etag bits of the peer's extended frame (16383, the first this gateway would hand out) are not.
   const CanBackgroundFrame top{"gw2:log", 0x1F000000 | 16383, true, 8, Nanos(100ms), Nanos(0), "gateway gw2"};
-  kb.set_peer_reservations({{"can:body", PeerReservations{0, {top}}}});
+  kb.set_peer_reservations({{"can:body", PeerReservations{0, {top}, {}}}});
   ChannelSpec slow = channel("slow", 0x200, ChannelClass::nrt, {"lan"}, {"body"}, 8, Nanos(100ms));
   ASSERT_TRUE(kb.bind(slow).bound());
   EXPECT_EQ(kb.etag_of("slow"), std::optional<std::uint16_t>(16382));
@@ -234,7 +234,7 @@ TEST(FederationAdmission, OtherGatewaysFramesDelayCanChannelsAndKeepTheirEtags) 
   early.subject = 0x202;
   ASSERT_TRUE(kb.bind(early).bound());
   ASSERT_EQ(kb.etag_of("early"), std::optional<std::uint16_t>(16383));
-  kb.set_peer_reservations({{"can:body", PeerReservations{0, {top}}}});
+  kb.set_peer_reservations({{"can:body", PeerReservations{0, {top}, {}}}});
   const AdmissionReport report = kb.report();
   ASSERT_NE(report.find("early"), nullptr);
   EXPECT_EQ(report.find("early")->verdict, Verdict::degraded);
@@ -248,7 +248,7 @@ TEST(FederationAnnouncement, SaysWhatThisGatewayReservesWhere) {
   KnowledgeBase kb(gateway(), {body, lan()});
   ASSERT_TRUE(kb.bind(channel("brake", 0x100, ChannelClass::srt, {"lan"}, {"body"}, 8, Nanos(10ms), Nanos(20ms))).bound());
   const double alone = kb.loads()[1].utilization;
-  kb.set_peer_reservations({{"dds:domain=0", PeerReservations{200'000, {}}}});
+  kb.set_peer_reservations({{"dds:domain=0", PeerReservations{200'000, {}, {}}}});
   const Announcement a = announcement_of(GatewayIdentity{0x42, "gw1"}, kb, 3);
   EXPECT_EQ(a.gateway, 0x42u);
   EXPECT_EQ(a.revision, 3u);
@@ -264,6 +264,80 @@ TEST(FederationAnnouncement, SaysWhatThisGatewayReservesWhere) {
   ASSERT_EQ(a.channels.size(), 1u);
   EXPECT_EQ(a.channels[0].hops.size(), 2u);
   EXPECT_TRUE(decode_announcement(encode(a)).announcement) << decode_announcement(encode(a)).error;
+}
+
+// gw1 receives `steer` from its front CAN bus and sends it onto the backbone; this gateway receives
+// it from the backbone and sends it to its rear bus.
+Announcement upstream_gateway(Nanos front_latency, Nanos period = Nanos(10ms)) {
+  Announcement a = peer(0x22, "gw1", 0.0);
+  a.residence = Nanos(500us);
+  AnnouncedChannel steer;
+  steer.name = "steer-front";
+  steer.subject = 0x77;
+  steer.cls = ChannelClass::srt;
+  steer.hops = {AnnouncedHop{"front", HopRole::publisher, front_latency}, AnnouncedHop{"backbone", HopRole::subscriber, Nanos(1ms)}};
+  steer.period = period;
+  steer.reaction_time = Nanos(20ms);
+  steer.payload = 8;
+  a.channels.push_back(steer);
+  return a;
+}
+
+TEST(FederationEndToEnd, AChannelCrossingTwoGatewaysIsAdmittedOverTheWholePath) {
+  FederationView view(kSelf);
+  // Its events leave gw1 at most 4 ms + 0.5 ms after they were sent on the front bus.
+  ASSERT_TRUE(view.apply(said(upstream_gateway(Nanos(4ms)), "w1"), Nanos(1s)));
+  const PeerNetworks peers = view.reservations();
+  ASSERT_EQ(peers.at("dds:domain=0").senders.size(), 1u);
+  EXPECT_EQ(peers.at("dds:domain=0").senders[0].age, std::optional<Nanos>(Nanos(4500us)));
+
+  SegmentSpec backbone = dds_segment("backbone", 1ms, false);
+  KnowledgeBase kb(gateway(500us), {backbone, lcm_segment("rear", 2ms)});
+  kb.set_peer_reservations(peers);
+  ChannelSpec steer = channel("steer", 0x77, ChannelClass::srt, {"backbone"}, {"rear"}, 8, Nanos(10ms), Nanos(20ms));
+  // Here alone: 1 + 0.5 + 2 = 3.5 ms; over both gateways 4.5 + 3.5 = 8 ms <= 20 ms.
+  const BindOutcome bound = kb.bind(steer);
+  ASSERT_TRUE(bound.bound()) << reasons_text(bound.report);
+  EXPECT_EQ(bound.report.verdict, Verdict::bound) << reasons_text(bound.report);
+  EXPECT_EQ(bound.report.end_to_end.latency, std::optional<Nanos>(Nanos(8ms)));
+  EXPECT_EQ(bound.report.end_to_end.local, std::optional<Nanos>(Nanos(3500us)));
+  ASSERT_EQ(bound.report.upstream.size(), 1u);
+  EXPECT_EQ(bound.report.upstream[0].gateway, "gw1");
+  EXPECT_EQ(bound.report.upstream[0].segment, "front");
+
+  // gw1's front bus gets slower (a rebind there): 18 + 0.5 + 3.5 = 22 ms > 20 ms, shown at once.
+  view.apply(said(upstream_gateway(Nanos(18ms)), "w1"), Nanos(2s));
+  view.apply(said([] { auto a = upstream_gateway(Nanos(18ms)); a.revision = 2; return a; }(), "w1"), Nanos(2s));
+  kb.set_peer_reservations(view.reservations());
+  const AdmissionReport now = kb.report();
+  ASSERT_NE(now.find("steer"), nullptr);
+  EXPECT_EQ(now.find("steer")->verdict, Verdict::degraded);
+  EXPECT_TRUE(has_reason(*now.find("steer"), "end-to-end latency through gateway gw1 22 ms > reaction_time 20 ms"))
+      << reasons_text(*now.find("steer"));
+  // An HRT newcomer on the same path is rejected.
+  ChannelSpec hrt = steer;
+  hrt.name = "steer-hrt";
+  kb.unbind("steer");
+  hrt.cls = ChannelClass::hrt;
+  const ChannelReport refused = kb.probe(hrt);
+  EXPECT_EQ(refused.verdict, Verdict::rejected);
+  EXPECT_TRUE(has_reason(refused, "through gateway gw1")) << reasons_text(refused);
+}
+
+TEST(FederationEndToEnd, ConflictingDefinitionsOfOneSubjectAreMismatchesWithReasons) {
+  FederationView view(kSelf);
+  // gw1 sends it every 5 ms; this gateway admitted one every 10 ms.
+  ASSERT_TRUE(view.apply(said(upstream_gateway(Nanos(1ms), Nanos(5ms)), "w1"), Nanos(1s)));
+  KnowledgeBase kb(gateway(500us), {dds_segment("backbone", 1ms, false), lcm_segment("rear", 2ms)});
+  kb.set_peer_reservations(view.reservations());
+  ChannelSpec steer = channel("steer", 0x77, ChannelClass::srt, {"backbone"}, {"rear"}, 8, Nanos(10ms), Nanos(30ms));
+  const ChannelReport report = kb.probe(steer);
+  EXPECT_EQ(report.verdict, Verdict::degraded);
+  EXPECT_TRUE(has_reason(report, "period 5 ms at gateway gw1 (channel steer-front) < 10 ms here")) << reasons_text(report);
+  EXPECT_TRUE(has_reason(report, "reaction_time 20 ms at gateway gw1 (channel steer-front), 30 ms here")) << reasons_text(report);
+  // Another subject on the same network is not on that path.
+  steer.subject = 0x78;
+  EXPECT_TRUE(kb.probe(steer).upstream.empty());
 }
 
 TEST(FederationAnnouncement, NetworkIdentities) {

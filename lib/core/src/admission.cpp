@@ -113,6 +113,11 @@ const ChannelReport* AdmissionReport::find(const std::string& name) const {
   return it == channels.end() ? nullptr : &*it;
 }
 
+Verdict consequence_of(const std::string& check, ChannelClass cls) {
+  if (cls == ChannelClass::hrt || check == "frame_fit") return Verdict::rejected;
+  return Verdict::degraded;
+}
+
 Evaluation evaluate(const GatewaySpec& gateway, std::span<const SegmentSpec> segments,
                     std::span<const ChannelSpec> channels, const EtagMap& etags) {
   const AdmissionSet set =

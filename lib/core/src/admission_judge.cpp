@@ -82,11 +82,6 @@ std::string failure_text(const Check& check, const HopReport& h, const SegmentSp
   return "hrt" + on + ", which declares no real-time guarantee (realtime: false)";
 }
 
-// How a failing criterion affects the verdict of a channel of this class.
-Verdict consequence(const std::string& check, ChannelClass cls) {
-  if (cls == ChannelClass::hrt || check == "frame_fit") return Verdict::rejected;
-  return Verdict::degraded;
-}
 }  // namespace
 
 void Judge::judge(const ChannelSpec& channel, ChannelReport& report) const {
@@ -98,7 +93,7 @@ void Judge::judge(const ChannelSpec& channel, ChannelReport& report) const {
     const SegmentSpec& segment = segment_named(segments_, h.segment);
     add_hop_checks(channel, segment, h);
     for (const Check& check : h.checks) {
-      if (!check.ok) worsen(consequence(check.check, channel.cls), failure_text(check, h, segment));
+      if (!check.ok) worsen(consequence_of(check.check, channel.cls), failure_text(check, h, segment));
     }
   }
   EndToEnd& e2e = report.end_to_end;
@@ -108,12 +103,12 @@ void Judge::judge(const ChannelSpec& channel, ChannelReport& report) const {
   const double latency = seconds_or_infinity(e2e.latency);
   if (channel.cls != ChannelClass::nrt && channel.reaction_time && latency > to_seconds(*channel.reaction_time)) {
     e2e.latency_ok = false;
-    worsen(consequence("latency", channel.cls), "end-to-end latency " + format_seconds(latency) +
+    worsen(consequence_of("latency", channel.cls), "end-to-end latency " + format_seconds(latency) +
                                                     " > reaction_time " + format_duration(*channel.reaction_time));
   }
   if (channel.temp_validity && latency >= to_seconds(*channel.temp_validity)) {
     e2e.validity_ok = false;
-    worsen(consequence("validity", channel.cls), "end-to-end latency " + format_seconds(latency) +
+    worsen(consequence_of("validity", channel.cls), "end-to-end latency " + format_seconds(latency) +
                                                      " >= temp_validity " + format_duration(*channel.temp_validity) +
                                                      ": events would arrive stale");
   }

@@ -119,6 +119,7 @@ KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel, std::o
   }
   a.trial = set_.trial(channel, a.etag.value_or(0));
   a.report = a.trial->report;
+  add_upstream(channel, a.report);
   for (const ChannelReport& existing : a.trial->broken_hrt) {
     a.report.verdict = Verdict::rejected;
     for (const auto& reason : existing.reasons) {
@@ -159,6 +160,23 @@ bool KnowledgeBase::unbind(const std::string& name) {
   }
   set_.remove(name);
   return true;
+}
+
+void KnowledgeBase::add_upstream(const ChannelSpec& channel, ChannelReport& report) const {
+  if (peers_.empty()) return;
+  const UpstreamPath* slowest = nullptr;
+  for (const std::string& publisher : channel.publishers) {
+    const auto segment = std::find_if(segments_.begin(), segments_.end(), [&](const auto& s) { return s.spec.name == publisher; });
+    const PeerReservations* peer = segment == segments_.end() ? nullptr : peers_on(segment->spec);
+    if (!peer) continue;
+    for (const UpstreamPath& path : peer->senders) {
+      if (path.subject != channel.subject) continue;
+      if (!slowest || !path.age || (slowest->age && *path.age > *slowest->age)) slowest = &path;
+    }
+  }
+  if (!slowest) return;
+  apply_upstream(channel, *slowest, report);
+  report.gateway = set_.gateway().name;
 }
 
 const PeerReservations* KnowledgeBase::peers_on(const SegmentSpec& segment) const {
@@ -214,6 +232,7 @@ AdmissionReport KnowledgeBase::report() const {
   out.segments = set_.loads();
   out.channels = set_.reports();
   for (auto& channel : out.channels) {
+    if (const ChannelSpec* spec = set_.find(channel.name)) add_upstream(*spec, channel);
     if (channel.verdict == Verdict::rejected) {  // only with other gateways' reservations
       channel.verdict = Verdict::degraded;
       channel.reasons.push_back("bound before other gateways' reservations on the same networks were known");

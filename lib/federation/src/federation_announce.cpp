@@ -30,6 +30,12 @@ AnnouncedChannel channel_of(const ChannelReport& report, const ChannelSpec& spec
   c.verdict = report.verdict == Verdict::rejected ? Verdict::failed : report.verdict;
   for (const HopReport& hop : report.hops) c.hops.push_back(AnnouncedHop{hop.segment, hop.role, hop.latency});
   c.end_to_end = report.end_to_end.latency;
+  c.period = spec.period;
+  c.reaction_time = spec.reaction_time;
+  c.temp_validity = spec.temp_validity;
+  c.payload = spec.payload;
+  c.upstream = report.upstream;
+  c.upstream_age = report.end_to_end.upstream;
   return c;
 }
 
@@ -40,6 +46,7 @@ Announcement announcement_of(const GatewayIdentity& self, const KnowledgeBase& k
   a.gateway = self.id;
   a.name = self.name;
   a.revision = revision;
+  a.residence = kb.gateway().residence_bound;
   const AdmissionReport report = kb.report();
   for (std::size_t i = 0; i < kb.segments().size() && i < report.segments.size(); ++i) {
     const SegmentSpec& spec = kb.segments()[i].spec;

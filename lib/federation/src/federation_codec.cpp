@@ -41,8 +41,14 @@ Json segment_json(const AnnouncedSegment& s) {
 Json channel_json(const AnnouncedChannel& c) {
   Json hops = Json::array();
   for (const auto& h : c.hops) hops.push_back({{"segment", h.segment}, {"role", role_text(h.role)}, {"latency_ns", nanos_or_null(h.latency)}});
+  Json upstream = Json::array();
+  for (const auto& h : c.upstream) {
+    upstream.push_back({{"gateway", h.gateway}, {"segment", h.segment}, {"role", role_text(h.role)}, {"latency_ns", nanos_or_null(h.latency)}});
+  }
   return {{"name", c.name}, {"subject", c.subject}, {"class", to_string(c.cls)}, {"verdict", to_string(c.verdict)},
-          {"hops", hops}, {"end_to_end_ns", nanos_or_null(c.end_to_end)}};
+          {"hops", hops}, {"end_to_end_ns", nanos_or_null(c.end_to_end)}, {"period_ns", nanos_or_null(c.period)},
+          {"reaction_time_ns", nanos_or_null(c.reaction_time)}, {"temp_validity_ns", nanos_or_null(c.temp_validity)},
+          {"payload", c.payload}, {"upstream", upstream}, {"upstream_ns", nanos_or_null(c.upstream_age)}};
 }
 
 // Reads one announcement; the first problem throws Refusal (caught by decode_announcement only).
@@ -142,6 +148,10 @@ AnnouncedSegment read_segment(const Reader& r, const Json& j, const std::string&
   return s;
 }
 
+HopRole read_role(const Reader& r, const Json& j, const std::string& where) {
+  return r.choice<HopRole>(j, "role", where, {{"publisher", HopRole::publisher}, {"subscriber", HopRole::subscriber}});
+}
+
 AnnouncedChannel read_channel(const Reader& r, const Json& j, const std::string& where) {
   AnnouncedChannel c;
   c.name = r.text(j, "name", where, false);
@@ -153,11 +163,26 @@ AnnouncedChannel read_channel(const Reader& r, const Json& j, const std::string&
     const std::string at = where + ".hops[" + std::to_string(i) + "]";
     AnnouncedHop h;
     h.segment = r.text(hops[i], "segment", at, false);
-    h.role = r.choice<HopRole>(hops[i], "role", at, {{"publisher", HopRole::publisher}, {"subscriber", HopRole::subscriber}});
+    h.role = read_role(r, hops[i], at);
     h.latency = r.nanos_or_unbounded(hops[i], "latency_ns", at);
     c.hops.push_back(std::move(h));
   }
   c.end_to_end = r.nanos_or_unbounded(j, "end_to_end_ns", where);
+  c.period = r.nanos_or_unbounded(j, "period_ns", where);
+  c.reaction_time = r.nanos_or_unbounded(j, "reaction_time_ns", where);
+  c.temp_validity = r.nanos_or_unbounded(j, "temp_validity_ns", where);
+  c.payload = r.whole(j, "payload", where, 64ull << 20);
+  const Json& upstream = r.list(j, "upstream", where, kMaxAnnouncedHops);
+  for (std::size_t i = 0; i < upstream.size(); ++i) {
+    const std::string at = where + ".upstream[" + std::to_string(i) + "]";
+    PathHop h;
+    h.gateway = r.text(upstream[i], "gateway", at, false);
+    h.segment = r.text(upstream[i], "segment", at, false);
+    h.role = read_role(r, upstream[i], at);
+    h.latency = r.nanos_or_unbounded(upstream[i], "latency_ns", at);
+    c.upstream.push_back(std::move(h));
+  }
+  c.upstream_age = r.nanos_or_unbounded(j, "upstream_ns", where);
   return c;
 }
 
@@ -183,6 +208,7 @@ Announcement read_announcement(const Json& j) {
   a.gateway = read_gateway_id(r, j);
   a.name = r.text(j, "name", "announcement", false);
   a.revision = r.whole(j, "revision", "announcement", UINT64_MAX);
+  a.residence = r.nanos(j, "residence_ns", "announcement");
   const Json& segments = r.list(j, "segments", "announcement", kMaxAnnouncedSegments);
   for (std::size_t i = 0; i < segments.size(); ++i) a.segments.push_back(read_segment(r, segments[i], "segments[" + std::to_string(i) + "]"));
   const Json& channels = r.list(j, "channels", "announcement", kMaxAnnouncedChannels);
@@ -204,7 +230,7 @@ std::string encode(const Announcement& a) {
   Json channels = Json::array();
   for (const auto& c : a.channels) channels.push_back(channel_json(c));
   const Json j = {{"format", kFederationFormat}, {"gateway", gateway_id_text(a.gateway)}, {"name", a.name},
-                  {"revision", a.revision}, {"segments", segments}, {"channels", channels}};
+                  {"revision", a.revision}, {"residence_ns", a.residence.count()}, {"segments", segments}, {"channels", channels}};
   return j.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 

@@ -19,6 +19,29 @@ void merge_heaviest(CanBackgroundFrame& kept, const CanBackgroundFrame& other) {
   kept.jitter = std::max(kept.jitter, other.jitter);
 }
 
+// The path `channel` gives its events before `hop` (one of its subscriber hops): its upstream,
+// its own publisher hops, and the age its events leave it with.
+UpstreamPath path_before(const Announcement& peer, const AnnouncedChannel& channel) {
+  UpstreamPath path{peer.name, channel.name, channel.subject, channel.cls, channel.period, channel.reaction_time,
+                    channel.temp_validity, channel.payload, channel.upstream, channel.upstream_age};
+  Nanos slowest{0};
+  for (const AnnouncedHop& hop : channel.hops) {
+    if (hop.role != HopRole::publisher) continue;
+    path.hops.push_back(PathHop{peer.name, hop.segment, hop.role, hop.latency});
+    if (!hop.latency) path.age.reset();
+    if (hop.latency) slowest = std::max(slowest, *hop.latency);
+  }
+  if (path.age) path.age = *path.age + slowest + peer.residence;
+  return path;
+}
+
+const std::string* network_of(const Announcement& peer, const std::string& segment) {
+  for (const AnnouncedSegment& s : peer.segments) {
+    if (s.name == segment) return s.network.empty() ? nullptr : &s.network;
+  }
+  return nullptr;
+}
+
 }  // namespace
 
 const char* to_string(PeerState value) {
@@ -134,6 +157,12 @@ PeerNetworks FederationView::reservations() const {
   std::map<std::string, std::map<std::pair<std::uint32_t, bool>, CanBackgroundFrame>> frames;  // by network, by identifier
   for (const auto& [id, peer] : peers_) {
     if (peer.state != PeerState::alive) continue;
+    for (const AnnouncedChannel& channel : peer.announcement.channels) {
+      for (const AnnouncedHop& hop : channel.hops) {
+        const std::string* network = hop.role == HopRole::subscriber ? network_of(peer.announcement, hop.segment) : nullptr;
+        if (network) out[*network].senders.push_back(path_before(peer.announcement, channel));
+      }
+    }
     for (const AnnouncedSegment& theirs : peer.announcement.segments) {
       if (theirs.network.empty()) continue;
       PeerReservations& r = out[theirs.network];

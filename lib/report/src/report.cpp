@@ -114,14 +114,29 @@ nlohmann::json to_json(const ChannelReport& channel) {
   nlohmann::json out{{"name", channel.name}, {"class", to_string(channel.cls)}, {"verdict", to_string(channel.verdict)},
                      {"reasons", channel.reasons}};
   out["hops"] = nlohmann::json::array();
-  for (const auto& hop : channel.hops) out["hops"].push_back(to_json(hop));
+  for (const auto& hop : channel.hops) {
+    out["hops"].push_back(to_json(hop));
+    if (!channel.upstream.empty()) out["hops"].back()["gateway"] = channel.gateway;
+  }
   const EndToEnd& e2e = channel.end_to_end;
+  if (!channel.upstream.empty()) {
+    // The path on other gateways before this one's (federation): each hop names its gateway.
+    out["upstream"] = nlohmann::json::array();
+    for (const PathHop& hop : channel.upstream) {
+      out["upstream"].push_back({{"gateway", hop.gateway}, {"segment", hop.segment}, {"role", to_string(hop.role)},
+                                 {"latency_s", seconds_or_null(hop.latency)}});
+    }
+  }
   out["end_to_end"] = {{"latency_s", seconds_or_null(e2e.latency)},
                        {"reaction_time_s", seconds_or_null(e2e.reaction_time)},
                        {"temp_validity_s", seconds_or_null(e2e.temp_validity)},
                        {"latency_ok", e2e.latency_ok},
                        {"validity_ok", e2e.validity_ok},
                        {"ok", e2e.ok()}};
+  if (!channel.upstream.empty()) {
+    out["end_to_end"]["upstream_s"] = seconds_or_null(e2e.upstream);
+    out["end_to_end"]["local_s"] = seconds_or_null(e2e.local);
+  }
   return out;
 }
 
@@ -185,6 +200,10 @@ std::string render_channel_text(const ChannelReport& channel) {
   std::ostringstream out;
   out << channel.name << " (" << to_string(channel.cls) << "): " << to_string(channel.verdict) << "\n";
   for (const auto& reason : channel.reasons) out << "  - " << reason << "\n";
+  for (const PathHop& hop : channel.upstream) {
+    out << "  " << to_string(hop.role) << " " << hop.segment << " on gateway " << hop.gateway << "  "
+        << (hop.latency ? format_duration(*hop.latency) : std::string("unbounded")) << "\n";
+  }
   for (const auto& hop : channel.hops) {
     out << "  " << to_string(hop.role) << " " << hop.segment;
     if (hop.can) {
@@ -200,6 +219,9 @@ std::string render_channel_text(const ChannelReport& channel) {
   }
   const EndToEnd& e2e = channel.end_to_end;
   out << "  end-to-end " << (e2e.latency ? format_duration(*e2e.latency) : std::string("unbounded"));
+  if (!channel.upstream.empty()) {
+    out << " (" << (e2e.upstream ? format_duration(*e2e.upstream) : std::string("unbounded")) << " before this gateway)";
+  }
   if (e2e.reaction_time) out << ", reaction_time " << format_duration(*e2e.reaction_time);
   if (e2e.temp_validity) out << ", temp_validity " << format_duration(*e2e.temp_validity);
   out << (e2e.ok() ? "  ok" : "  FAIL") << "\n";

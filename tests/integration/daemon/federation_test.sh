@@ -11,7 +11,10 @@
 #   - hostile announcements (this gateway's id, an alive gateway's id from another writer, a key
 #     that is not the id it names, malformed, out of range) are refused and counted, the local
 #     channels stay bound, and a spoofer that went takes nothing over when the real gateway leaves;
-#   - gateways with different leases hear each other (gw3 runs with 2 s): each is judged by its own.
+#   - gateways with different leases hear each other (gw3 runs with 2 s): each is judged by its own;
+#   - a channel crossing two gateways (gw1 edge -> backbone -> gw2 edge) is rejected when the whole
+#     path misses its reaction_time and bound when it fits, `channel --json` lists every hop with its
+#     gateway, and when the upstream goes the downstream verdict is recomputed and logged.
 #   federation_test.sh COSMICD COSMICCTL COSMIC_FEDERATION_PEER
 set -uo pipefail
 [ "${COSMIC_IN_NETNS:-}" = 1 ] || { echo "run me through scripts/netns-run" >&2; exit 2; }
@@ -39,6 +42,21 @@ channels:
      publishers: [edge], subscribers: [backbone]}
 YAML
 done
+# gw1 also sends `relay` from its edge onto the backbone: its events leave gw1 at most 2 ms (edge) +
+# 1 ms (residence) after they were sent.
+cat >>"$WORK/gw1.yaml" <<'YAML'
+  - {name: relay, subject: 0x4300, class: srt, period: 100ms, reaction_time: 50ms, omission_degree: 1, payload: 8B,
+     publishers: [edge], subscribers: [backbone]}
+YAML
+# gw2 receives it from the backbone for its edge: 2 + 1 + 2 = 5 ms here, 8 ms over both gateways.
+cat >"$WORK/relay-tight.yaml" <<'YAML'
+- {name: relay, subject: 0x4300, class: hrt, period: 100ms, reaction_time: 6ms, omission_degree: 1, payload: 8B,
+   publishers: [backbone], subscribers: [edge]}
+YAML
+cat >"$WORK/relay.yaml" <<'YAML'
+- {name: relay, subject: 0x4300, class: srt, period: 100ms, reaction_time: 50ms, omission_degree: 1, payload: 8B,
+   publishers: [backbone], subscribers: [edge]}
+YAML
 # 25% of the backbone: fits gw1 alone (10% + 25%), not with gw2 and gw3 (10% + 20% + 25% > 50%).
 cat >"$WORK/big.yaml" <<'YAML'
 - {name: video, subject: 0x4200, class: hrt, period: 4ms, reaction_time: 50ms, omission_degree: 1, payload: 29B,
@@ -71,7 +89,8 @@ for i in 1 2 3; do
   done
 done
 wait_until 10 "gw1 counts 20% of the backbone for gw2 and gw3" peers_load_is gw1 0.2
-near "$(backbone_field gw1 utilization)" 0.3 || fail "gw1 backbone utilization $(backbone_field gw1 utilization), want 0.3"
+# 10% telemetry1 + 0.832% relay (8 B + 96 B every 100 ms) + 20% for gw2 and gw3.
+near "$(backbone_field gw1 utilization)" 0.30832 || fail "gw1 backbone utilization $(backbone_field gw1 utilization), want 0.30832"
 ctl gw1 peers >"$WORK/peers.txt" || fail "cosmicctl peers failed"
 grep -Eq '^gw2 +[0-9a-f]{16} +alive ' "$WORK/peers.txt" || fail "cosmicctl peers: gw2 not listed alive: $(cat "$WORK/peers.txt")"
 grep -q 'backbone \[dds:domain=41\] 10.0%' "$WORK/peers.txt" || fail "cosmicctl peers: no backbone load: $(cat "$WORK/peers.txt")"
@@ -81,6 +100,29 @@ scenario "a bind that only the other gateways' reservations break is rejected, n
 ctl gw1 bind "$WORK/big.yaml" >"$WORK/bind1.txt" 2>&1 && fail "bind of video was not rejected: $(cat "$WORK/bind1.txt")"
 grep -q 'other gateways 20.0%' "$WORK/bind1.txt" || fail "rejection does not name the other gateways' share: $(cat "$WORK/bind1.txt")"
 ctl gw1 --json channels | grep -q '"video"' && fail "video is listed after a rejected bind"
+passed
+
+scenario "a channel crossing two gateways is admitted over the whole path, and follows its upstream"
+ctl gw2 bind "$WORK/relay-tight.yaml" >"$WORK/relay1.txt" 2>&1 && fail "relay with a 6 ms reaction_time was bound: $(cat "$WORK/relay1.txt")"
+grep -q 'end-to-end latency through gateway gw1 8 ms > reaction_time 6 ms' "$WORK/relay1.txt" ||
+  fail "the rejection does not give the whole path: $(cat "$WORK/relay1.txt")"
+ctl gw2 bind "$WORK/relay.yaml" >"$WORK/relay2.txt" 2>&1 || fail "relay with a 50 ms reaction_time: $(cat "$WORK/relay2.txt")"
+ctl gw2 --json channel relay | python3 -c '
+import json, sys
+a = json.load(sys.stdin)["channel"]["admission"]
+assert a["verdict"] == "bound", a
+up = a["upstream"]
+assert [h["gateway"] for h in up] == ["gw1"] and up[0]["segment"] == "edge" and up[0]["role"] == "publisher", up
+assert all(h["gateway"] == "gw2" for h in a["hops"]), a["hops"]
+e = a["end_to_end"]
+assert abs(e["latency_s"] - 0.008) < 1e-9 and abs(e["upstream_s"] - 0.003) < 1e-9 and abs(e["local_s"] - 0.005) < 1e-9, e' ||
+  fail "cosmicctl channel relay --json does not show the path over both gateways"
+# The upstream goes: gw2 recomputes the verdict and says so.
+ctl gw1 unbind relay >/dev/null || fail "unbind relay on gw1"
+no_upstream() { ctl gw2 --json channel relay | python3 -c 'import json,sys; sys.exit("upstream" in json.load(sys.stdin)["channel"]["admission"])'; }
+wait_until 10 "gw2 drops gw1 from relay's path" no_upstream
+wait_until 5 "gw2 logs the change" grep -q "federation: channel relay is bound (was bound), end to end 5 ms" "$WORK/gw2.log"
+ctl gw2 unbind relay >/dev/null || fail "unbind relay on gw2"
 passed
 
 # Strangers first: a Fast DDS process killed with SIGKILL (below) can leave the host's shared-memory

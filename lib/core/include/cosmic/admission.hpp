@@ -84,8 +84,22 @@ struct HopReport {
   std::vector<BackgroundDelay> background;
 };
 
+// A hop of a channel's path on another gateway of the federation (cosmic/upstream_path.hpp).
+struct PathHop {
+  std::string gateway;  // that gateway's name
+  std::string segment;  // its name for the segment
+  HopRole role = HopRole::publisher;
+  std::optional<Nanos> latency;  // nullopt: unbounded
+  friend bool operator==(const PathHop&, const PathHop&) = default;
+};
+
 struct EndToEnd {
-  std::optional<Nanos> latency;  // P hop + gateway residence + S hop, worst pair; nullopt: unbounded
+  // P hop + gateway residence + S hop, worst pair; nullopt: unbounded. For a channel whose events
+  // reach this gateway through other gateways (`upstream`), the whole path: their age on arrival
+  // plus this gateway's part (`local`).
+  std::optional<Nanos> latency;
+  std::optional<Nanos> upstream{Nanos(0)};  // age of the events when they reach this gateway's P network
+  std::optional<Nanos> local;               // this gateway's part, when there is an upstream path
   std::optional<Nanos> reaction_time;
   std::optional<Nanos> temp_validity;
   bool latency_ok = true;
@@ -99,8 +113,16 @@ struct ChannelReport {
   Verdict verdict = Verdict::bound;
   std::vector<std::string> reasons;
   std::vector<HopReport> hops;
+  // The hops on other gateways before this one's, in path order (empty: the events start here),
+  // and then this gateway's name for its own hops.
+  std::vector<PathHop> upstream;
+  std::string gateway;
   EndToEnd end_to_end;
 };
+
+// How a failing criterion ("frame_fit", "latency", ...) affects the verdict of a channel of `cls`:
+// rejected for HRT channels and for a frame that does not fit, degraded otherwise.
+Verdict consequence_of(const std::string& check, ChannelClass cls);
 
 // A rejection of `channel` for one reason, before any hop is judged (already bound, not bound
 // where a replacement needs it, no etag left, ...).

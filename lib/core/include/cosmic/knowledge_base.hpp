@@ -27,6 +27,7 @@
 #include "cosmic/can_wire.hpp"
 #include "cosmic/model.hpp"
 #include "cosmic/network_identity.hpp"
+#include "cosmic/upstream_path.hpp"
 
 namespace cosmic {
 
@@ -43,6 +44,9 @@ struct SegmentState {
 struct PeerReservations {
   double bits_per_second = 0;  // DDS and LCM: the bandwidth their channels reserve
   std::vector<CanBackgroundFrame> frames;  // CAN: their frames, analysed like background frames
+  // Channels they send onto the network: a channel of this gateway with the same subject that it
+  // receives from there is admitted over the whole path (cosmic/upstream_path.hpp).
+  std::vector<UpstreamPath> senders;
   friend bool operator==(const PeerReservations&, const PeerReservations&) = default;
 };
 // By network identity (cosmic/network_identity.hpp).
@@ -111,6 +115,9 @@ class KnowledgeBase {
   std::vector<SegmentSpec> analysed_segments() const;
   // What other gateways reserve on the network `segment` attaches, or null.
   const PeerReservations* peers_on(const SegmentSpec& segment) const;
+  // The path another gateway gives `channel`'s events before a network this gateway receives it
+  // from (the slowest, when several do), applied to its report.
+  void add_upstream(const ChannelSpec& channel, ChannelReport& report) const;
 
   std::vector<SegmentState> segments_;
   AdmissionSet set_;

@@ -72,7 +72,16 @@ struct AnnouncedChannel {
   ChannelClass cls = ChannelClass::nrt;
   Verdict verdict = Verdict::bound;
   std::vector<AnnouncedHop> hops;
-  std::optional<Nanos> end_to_end;  // nullopt: unbounded
+  std::optional<Nanos> end_to_end;  // the whole path, upstream included; nullopt: unbounded
+  // The definition, for gateways downstream to compare with theirs.
+  std::optional<Nanos> period;
+  std::optional<Nanos> reaction_time;
+  std::optional<Nanos> temp_validity;
+  std::uint64_t payload = 0;
+  // Where its events come from before this gateway: the hops on gateways upstream, and the age the
+  // events arrive with (0: they start here; nullopt: unbounded).
+  std::vector<PathHop> upstream;
+  std::optional<Nanos> upstream_age{Nanos(0)};
   friend bool operator==(const AnnouncedChannel&, const AnnouncedChannel&) = default;
 };
 
@@ -80,6 +89,7 @@ struct Announcement {
   std::uint64_t gateway = 0;  // GatewayIdentity::id, never 0
   std::string name;
   std::uint64_t revision = 0;  // grows with every change the gateway announces
+  Nanos residence{0};          // its gateway.residence_bound
   std::vector<AnnouncedSegment> segments;
   std::vector<AnnouncedChannel> channels;
   friend bool operator==(const Announcement&, const Announcement&) = default;

@@ -82,7 +82,8 @@ class FederationView {
   // A CAN identifier announced by several peers counts once, as the heaviest of them (shortest
   // period, longest frame, largest jitter), so no peer can hide another's frame; at most
   // kMaxPeerFramesPerNetwork identifiers per network (the lowest, which delay the most), the rest
-  // counted in counters().frames_over_cap.
+  // counted in counters().frames_over_cap. `senders`: every channel a peer sends onto the network,
+  // with the path before it.
   static constexpr std::size_t kMaxPeerFramesPerNetwork = 4096;
   PeerNetworks reservations() const;
 
