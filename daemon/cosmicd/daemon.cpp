@@ -104,6 +104,7 @@ class Daemon {
         server.offload());
     protocol_ = &protocol;
     protocol.add_reader("peers", [this] { return federation_.peers_json(steady_now()); });
+    protocol.set_bind_gate([this](const cosmic::BindPlan& plan, std::function<void()> commit) { federation_.gate(plan, std::move(commit)); });
     server.watch(signal_fd, [&] { on_signals(signal_fd); });
     if (const auto opened = server.open(); !opened.ok) {
       log_.log(cosmic::LogLevel::error, "control socket: " + opened.error);

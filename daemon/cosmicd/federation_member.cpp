@@ -18,6 +18,7 @@ FederationMember::~FederationMember() {
 }
 
 void FederationMember::leave() {
+  claim_.reset();
   if (link_) link_->withdraw();
   link_.reset();
   view_.reset();
@@ -33,6 +34,7 @@ void FederationMember::follow_configuration() {
   if (spec == spec_ && wanted == segment_ && (link_ || !spec.enabled() || !start_error_.empty())) return;
   if (link_) {
     log_.log(cosmic::LogLevel::notice, "federation: leaving (over segment " + spec_.segment + ")");
+    end_claim();  // the claim is void: the bind commits against what is known
     leave();
   }
   spec_ = spec;
@@ -111,6 +113,7 @@ void FederationMember::hear(cosmic::Nanos now) {
 void FederationMember::announce() {
   if (gateway_.generation() == announced_generation_ && !peers_changed_) return;
   cosmic::Announcement now = cosmic::announcement_of(gateway_.identity(), gateway_.knowledge_base(), 0);
+  if (claim_) now.claim = claim_->segments;
   if (announced_ && *announced_ == now) {
     announced_generation_ = gateway_.generation();
     peers_changed_ = false;
@@ -131,6 +134,39 @@ void FederationMember::tick(cosmic::Nanos now) {
   follow_configuration();
   if (!link_) return;
   hear(now);
+  if (claim_ && now >= claim_->deadline) end_claim();
+  announce();
+}
+
+void FederationMember::end_claim() {
+  if (!claim_) return;
+  auto commit = std::move(claim_->commit);
+  claim_.reset();
+  peers_changed_ = true;  // the claim is over: announce without it, committed or not
+  commit();  // admits again if what the others reserve or claim changed meanwhile
+}
+
+bool FederationMember::touches_shared_network(const cosmic::BindPlan& plan) const {
+  const cosmic::Config& config = gateway_.config();
+  for (const cosmic::ChannelSpec& channel : plan.channels) {
+    for (const auto* names : {&channel.publishers, &channel.subscribers}) {
+      for (const std::string& name : *names) {
+        const cosmic::SegmentSpec* segment = config.find_segment(name);
+        if (segment && view_->shared(cosmic::network_identity(*segment))) return true;
+      }
+    }
+  }
+  return false;
+}
+
+void FederationMember::gate(const cosmic::BindPlan& plan, std::function<void()> commit) {
+  if (!link_ || !view_ || claim_ || !plan.kb || !touches_shared_network(plan)) {
+    commit();
+    return;
+  }
+  const auto now = std::chrono::duration_cast<cosmic::Nanos>(std::chrono::steady_clock::now().time_since_epoch());
+  claim_ = Claim{now + spec_.claim_window, std::move(commit), cosmic::announcement_of(gateway_.identity(), *plan.kb, 0).segments};
+  peers_changed_ = true;  // announce() publishes the claim now, not at the next change
   announce();
 }
 

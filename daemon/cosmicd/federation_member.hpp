@@ -43,8 +43,14 @@ class FederationMember {
 
   // Control thread, every tick of the daemon's loop.
   void tick(cosmic::Nanos now);
-  // Withdraws this gateway's announcement (peers release its reservations at once) and closes the link.
+  // Withdraws this gateway's announcement (peers release its reservations at once) and closes the
+  // link. A bind waiting in its claim window is dropped unanswered (the daemon is stopping).
   void leave();
+
+  // The control protocol's BindGate: a plan that adds load to a network an alive peer attaches is
+  // announced as a claim and committed after gateway.federation.claim_window (at the first tick
+  // after it), against what the others reserve and claim by then; any other plan at once.
+  void gate(const cosmic::BindPlan& plan, std::function<void()> commit);
 
   // The answer of the control command `peers` (docs/control-protocol.md).
   nlohmann::json peers_json(cosmic::Nanos now) const;
@@ -56,6 +62,8 @@ class FederationMember {
   void announce();
   void log_transitions(const std::map<std::uint64_t, cosmic::PeerState>& before);
   void log_verdict_changes(const cosmic::AdmissionReport& was, const cosmic::AdmissionReport& now);
+  bool touches_shared_network(const cosmic::BindPlan& plan) const;
+  void end_claim();  // commits the bind waiting in its claim window
 
   cosmic::Gateway& gateway_;
   cosmic::Logger& log_;
@@ -70,6 +78,12 @@ class FederationMember {
   std::optional<cosmic::Announcement> announced_;  // with revision 0, to compare
   std::uint64_t announced_generation_ = UINT64_MAX;
   bool peers_changed_ = false;
+  struct Claim {
+    cosmic::Nanos deadline{0};
+    std::function<void()> commit;
+    std::vector<cosmic::AnnouncedSegment> segments;  // what this gateway will reserve once committed
+  };
+  std::optional<Claim> claim_;
   std::uint64_t refusals_logged_ = 0;
 };
 

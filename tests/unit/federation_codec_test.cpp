@@ -44,6 +44,8 @@ Announcement sample_announcement() {
   log.end_to_end = std::nullopt;
   log.upstream_age = std::nullopt;
   a.channels = {steer, log};
+  a.claim = a.segments;
+  a.claim->front().load = 0.3;
   return a;
 }
 
@@ -95,6 +97,8 @@ TEST(FederationCodec, RefusesMalformedAndOutOfRangeAnnouncements) {
       {"missing field", [](Json& j) { j.erase("segments"); }, "segments is missing"},
       {"segment not an object", [](Json& j) { j["segments"][0] = 3; }, "is not an object"},
       {"too many segments", [](Json& j) { j["segments"] = Json::array(); for (int i = 0; i < 65; ++i) j["segments"].push_back(j["segments"].size()); }, "more than 64"},
+      {"claim not a list", [](Json& j) { j["claim"] = 3; }, "claim is not a list"},
+      {"claim with a bad load", [](Json& j) { j["claim"][0]["load"] = 2; }, "claim[0].load is outside"},
       {"negative residence", [](Json& j) { j["residence_ns"] = -1; }, "residence_ns"},
       {"upstream hop without gateway", [](Json& j) { j["channels"][0]["upstream"][0].erase("gateway"); }, "gateway is missing"},
       {"fractional payload", [](Json& j) { j["channels"][0]["payload"] = 1.5; }, "payload"},

@@ -137,6 +137,22 @@ TEST(FederationView, ASpooferThatWentTakesNothingOver) {
   EXPECT_NEAR(lan_bps(view), 0.0, 1e-9);
 }
 
+TEST(FederationView, AClaimOfALowerIdCountsAtOnceOneOfAHigherIdOnlyWhenCommitted) {
+  FederationView view(0x50);
+  Announcement lower = peer(0x10, "gw-low", 0.1);
+  lower.claim = lower.segments;
+  lower.claim->front().reserved_bps = 250'000;  // 10% now, 25% once its bind is committed
+  Announcement higher = peer(0x90, "gw-high", 0.1);
+  higher.claim = higher.segments;
+  higher.claim->front().reserved_bps = 400'000;
+  ASSERT_TRUE(view.apply(said(lower, "w-low"), Nanos(1s)));
+  ASSERT_TRUE(view.apply(said(higher, "w-high"), Nanos(1s)));
+  // The lower id goes first: its claim counts; the higher one waits for this gateway's bind.
+  EXPECT_NEAR(lan_bps(view), 0.25 + 0.1, 1e-9);
+  EXPECT_TRUE(view.shared("dds:domain=0"));
+  EXPECT_FALSE(view.shared("dds:domain=9"));
+}
+
 TEST(FederationView, SharedNetworksAreMatchedByIdentity) {
   FederationView view(kSelf);
   Announcement a = peer(0x22, "gw2", 0.1);

@@ -9,6 +9,9 @@ namespace {
 // than an hour keeps a dead gateway's reservations far too long.
 constexpr Nanos kMinLease{100'000'000};
 constexpr Nanos kMaxLease{3'600'000'000'000};
+// Shorter than a DDS round trip on a loaded host decides nothing; longer keeps binds waiting.
+constexpr Nanos kMinClaimWindow{10'000'000};
+constexpr Nanos kMaxClaimWindow{10'000'000'000};
 
 std::string key(const std::string& path, const char* name) { return path + "." + name; }
 bool has(const YAML::Node& map, const char* name) { return map.IsMap() && map[name] && !map[name].IsNull(); }
@@ -16,7 +19,7 @@ bool has(const YAML::Node& map, const char* name) { return map.IsMap() && map[na
 }  // namespace
 
 void parse_federation(YamlReader& reader, const YAML::Node& node, const std::string& path, FederationSpec& out) {
-  if (!reader.check_map(node, path, {"segment", "lease"})) return;
+  if (!reader.check_map(node, path, {"segment", "lease", "claim_window"})) return;
   if (!has(node, "segment")) {
     reader.error_at(node, key(path, "segment"), "missing required key 'segment'", "the name of a DDS segment to federate over");
     return;
@@ -28,6 +31,15 @@ void parse_federation(YamlReader& reader, const YAML::Node& node, const std::str
         reader.error_at(node["lease"], key(path, "lease"), "lease out of range", "from 100ms to 1h, e.g. 3s");
       } else {
         out.lease = *v;
+      }
+    }
+  }
+  if (has(node, "claim_window")) {
+    if (auto v = reader.duration(node["claim_window"], key(path, "claim_window"), false)) {
+      if (*v < kMinClaimWindow || *v > kMaxClaimWindow) {
+        reader.error_at(node["claim_window"], key(path, "claim_window"), "claim_window out of range", "from 10ms to 10s, e.g. 300ms");
+      } else {
+        out.claim_window = *v;
       }
     }
   }

@@ -187,7 +187,7 @@ Json ControlProtocol::finish(const std::string& command, const Json& request, Js
 }
 
 ControlProtocol::Answer ControlProtocol::run_admission(std::string what, std::function<void()> work,
-                                                       std::function<Json()> done, const Reply& later) {
+                                                       std::function<Answer()> done, const Reply& later) {
   if (!offload_ || !later) {
     work();
     return done();
@@ -203,13 +203,13 @@ ControlProtocol::Answer ControlProtocol::run_admission(std::string what, std::fu
   };
   offload_(std::move(guarded), [this, done = std::move(done), later, failed] {
     running_.clear();
-    Json answer;
+    Answer answer;
     try {
       answer = failed->empty() ? done() : failure("internal_error", "admission failed: " + *failed);
     } catch (const std::exception& e) {
       answer = failure("internal_error", e.what());
     }
-    later(render(answer));
+    if (answer) later(render(*answer));
   });
   return std::nullopt;
 }
@@ -417,15 +417,39 @@ ControlProtocol::Answer ControlProtocol::bind(const Json& request, bool replace,
   const std::string what = command + " of " + names_of(parsed.channels);
   auto plan = std::make_shared<BindPlan>(replace ? gateway_.replace_plan_input(std::move(parsed.channels))
                                                  : gateway_.bind_plan_input(std::move(parsed.channels)));
+  const bool gated = gate_ && offload_ && later;
   return run_admission(
       what, [plan] { replace_or_bind(*plan); },
-      [this, plan, request, command] {
-        const BindResult result = gateway_.commit_bind(std::move(*plan));
-        Json answer = bind_answer(result);
-        if (result.replaced.size() > 0) answer["replaced"] = replaced_answer(result);
-        return finish(command, request, std::move(answer));
+      [this, plan, request, command, gated, what, later]() -> Answer {
+        if (!gated || !plan->admitted) return commit_planned(std::move(*plan), request, command, false);
+        running_ = what + " (claiming the federation's shared networks)";
+        gate_(*plan, [this, plan, request, command, later] {
+          running_.clear();
+          Json answer;
+          try {
+            answer = commit_planned(std::move(*plan), request, command, true);
+          } catch (const std::exception& e) {
+            answer = failure("internal_error", e.what());
+          }
+          later(render(answer));
+        });
+        return std::nullopt;
       },
       later);
+}
+
+Json ControlProtocol::commit_planned(BindPlan plan, const Json& request, const std::string& command, bool replan) {
+  if (replan && plan.generation != gateway_.generation()) {
+    // Other gateways' reservations (or claims) changed while the bind waited: admit it again, here
+    // on the control thread (milliseconds), against what is known now.
+    BindPlan fresh = plan.replacing ? gateway_.replace_plan_input(plan.channels) : gateway_.bind_plan_input(plan.channels);
+    replace_or_bind(fresh);
+    plan = std::move(fresh);
+  }
+  const BindResult result = gateway_.commit_bind(std::move(plan));
+  Json answer = bind_answer(result);
+  if (result.replaced.size() > 0) answer["replaced"] = replaced_answer(result);
+  return finish(command, request, std::move(answer));
 }
 
 Json ControlProtocol::unbind(const Json& request) {

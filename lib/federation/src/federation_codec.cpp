@@ -211,6 +211,11 @@ Announcement read_announcement(const Json& j) {
   a.residence = r.nanos(j, "residence_ns", "announcement");
   const Json& segments = r.list(j, "segments", "announcement", kMaxAnnouncedSegments);
   for (std::size_t i = 0; i < segments.size(); ++i) a.segments.push_back(read_segment(r, segments[i], "segments[" + std::to_string(i) + "]"));
+  if (!r.field(j, "claim", "announcement").is_null()) {
+    const Json& claim = r.list(j, "claim", "announcement", kMaxAnnouncedSegments);
+    a.claim.emplace();
+    for (std::size_t i = 0; i < claim.size(); ++i) a.claim->push_back(read_segment(r, claim[i], "claim[" + std::to_string(i) + "]"));
+  }
   const Json& channels = r.list(j, "channels", "announcement", kMaxAnnouncedChannels);
   for (std::size_t i = 0; i < channels.size(); ++i) a.channels.push_back(read_channel(r, channels[i], "channels[" + std::to_string(i) + "]"));
   return a;
@@ -229,8 +234,14 @@ std::string encode(const Announcement& a) {
   for (const auto& s : a.segments) segments.push_back(segment_json(s));
   Json channels = Json::array();
   for (const auto& c : a.channels) channels.push_back(channel_json(c));
+  Json claim = nullptr;
+  if (a.claim) {
+    claim = Json::array();
+    for (const auto& s : *a.claim) claim.push_back(segment_json(s));
+  }
   const Json j = {{"format", kFederationFormat}, {"gateway", gateway_id_text(a.gateway)}, {"name", a.name},
-                  {"revision", a.revision}, {"residence_ns", a.residence.count()}, {"segments", segments}, {"channels", channels}};
+                  {"revision", a.revision}, {"residence_ns", a.residence.count()}, {"segments", segments}, {"channels", channels},
+                  {"claim", claim}};
   return j.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 

@@ -152,6 +152,17 @@ void FederationView::forget_before(Nanos when) {
   std::erase_if(pending_, [&](const auto& p) { return !peers_.count(p.first); });
 }
 
+bool FederationView::shared(const std::string& network) const {
+  if (network.empty()) return false;
+  for (const auto& [id, peer] : peers_) {
+    if (peer.state != PeerState::alive) continue;
+    for (const AnnouncedSegment& s : peer.announcement.segments) {
+      if (s.network == network) return true;
+    }
+  }
+  return false;
+}
+
 PeerNetworks FederationView::reservations() const {
   PeerNetworks out;
   std::map<std::string, std::map<std::pair<std::uint32_t, bool>, CanBackgroundFrame>> frames;  // by network, by identifier
@@ -163,7 +174,9 @@ PeerNetworks FederationView::reservations() const {
         if (network) out[*network].senders.push_back(path_before(peer.announcement, channel));
       }
     }
-    for (const AnnouncedSegment& theirs : peer.announcement.segments) {
+    // A bind in its claim window on a gateway with a lower id goes first: count it already.
+    const bool claim_first = peer.announcement.claim && id < self_;
+    for (const AnnouncedSegment& theirs : claim_first ? *peer.announcement.claim : peer.announcement.segments) {
       if (theirs.network.empty()) continue;
       PeerReservations& r = out[theirs.network];
       r.bits_per_second += theirs.reserved_bps;

@@ -12,6 +12,8 @@
 #     that is not the id it names, malformed, out of range) are refused and counted, the local
 #     channels stay bound, and a spoofer that went takes nothing over when the real gateway leaves;
 #   - gateways with different leases hear each other (gw3 runs with 2 s): each is judged by its own;
+#   - two binds at once on two gateways that together overload the backbone: exactly one is bound
+#     (the lower gateway id's), the other is rejected naming the others' share (claim window);
 #   - a channel crossing two gateways (gw1 edge -> backbone -> gw2 edge) is rejected when the whole
 #     path misses its reaction_time and bound when it fits, `channel --json` lists every hop with its
 #     gateway, and when the upstream goes the downstream verdict is recomputed and logged.
@@ -57,6 +59,14 @@ cat >"$WORK/relay.yaml" <<'YAML'
 - {name: relay, subject: 0x4300, class: srt, period: 100ms, reaction_time: 50ms, omission_degree: 1, payload: 8B,
    publishers: [backbone], subscribers: [edge]}
 YAML
+# 15% of the backbone each (1,000 bits every 6.667 ms): one fits beside the three telemetry channels
+# (45%), both do not (60%).
+for i in 1 2; do
+  cat >"$WORK/surge$i.yaml" <<YAML
+- {name: surge$i, subject: 0x440$i, class: hrt, period: 6667us, reaction_time: 50ms, omission_degree: 1, payload: 29B,
+   publishers: [edge], subscribers: [backbone]}
+YAML
+done
 # 25% of the backbone: fits gw1 alone (10% + 25%), not with gw2 and gw3 (10% + 20% + 25% > 50%).
 cat >"$WORK/big.yaml" <<'YAML'
 - {name: video, subject: 0x4200, class: hrt, period: 4ms, reaction_time: 50ms, omission_degree: 1, payload: 29B,
@@ -123,6 +133,29 @@ no_upstream() { ctl gw2 --json channel relay | python3 -c 'import json,sys; sys.
 wait_until 10 "gw2 drops gw1 from relay's path" no_upstream
 wait_until 5 "gw2 logs the change" grep -q "federation: channel relay is bound (was bound), end to end 5 ms" "$WORK/gw2.log"
 ctl gw2 unbind relay >/dev/null || fail "unbind relay on gw2"
+passed
+
+scenario "two binds at once on two gateways that together overload the backbone: exactly one succeeds"
+ctl gw1 bind "$WORK/surge1.yaml" >"$WORK/surge1.txt" 2>&1 &
+race1=$!
+ctl gw2 bind "$WORK/surge2.yaml" >"$WORK/surge2.txt" 2>&1 &
+race2=$!
+wait "$race1"; rc1=$?
+wait "$race2"; rc2=$?
+log "surge1 on gw1: exit $rc1; surge2 on gw2: exit $rc2"
+if [ "$rc1" = 0 ] && [ "$rc2" = 0 ]; then
+  fail "both binds succeeded: $(cat "$WORK/surge1.txt" "$WORK/surge2.txt")"
+elif [ "$rc1" != 0 ] && [ "$rc2" != 0 ]; then
+  fail "neither bind succeeded: $(cat "$WORK/surge1.txt" "$WORK/surge2.txt")"
+else
+  loser=$([ "$rc1" = 0 ] && echo 2 || echo 1)
+  grep -q 'other gateways' "$WORK/surge$loser.txt" || fail "the loser's rejection does not name the other gateways: $(cat "$WORK/surge$loser.txt")"
+  # The winner is the lower gateway id.
+  lower=$(for g in gw1 gw2; do ctl "$g" --json status | python3 -c 'import json,sys; print(json.load(sys.stdin)["gateway"]["id"], sys.argv[1])' "$g"; done | sort | head -1 | cut -d' ' -f2)
+  winner=$([ "$rc1" = 0 ] && echo gw1 || echo gw2)
+  [ "$winner" = "$lower" ] || fail "$winner won the race, but $lower has the lower id"
+  ctl "$winner" unbind "surge${winner#gw}" >/dev/null || fail "unbind the winner's surge"
+fi
 passed
 
 # Strangers first: a Fast DDS process killed with SIGKILL (below) can leave the host's shared-memory

@@ -42,6 +42,12 @@ using Offload = std::function<void(std::function<void()> work, std::function<voi
 // Delivers a deferred answer line; called once, on the control thread.
 using Reply = std::function<void(std::string line)>;
 
+// Called on the control thread with an admitted bind or replacement before it is committed; calls
+// `commit` once, on the control thread, at once or later (the federation first claims the networks
+// the plan adds load to, for gateway.federation.claim_window). Until then other changes are `busy`.
+// The commit admits the channels again when anything changed meanwhile.
+using BindGate = std::function<void(const BindPlan& plan, std::function<void()> commit)>;
+
 // Bounds of a request the parser accepts (no recursion over attacker-chosen nesting).
 inline constexpr int kMaxRequestNesting = 16;
 // Characters of a client-chosen text (command, channel name) quoted in a log line.
@@ -63,6 +69,8 @@ class ControlProtocol {
   // Adds a read-only command (may_read applies) answered by `answer` on the control thread, e.g.
   // `peers` from the daemon's federation; its answer carries "ok" itself.
   void add_reader(std::string command, std::function<nlohmann::json()> answer) { readers_[std::move(command)] = std::move(answer); }
+  // Installs the gate binds pass before their commit (only with an Offload: inline binds commit at once).
+  void set_bind_gate(BindGate gate) { gate_ = std::move(gate); }
 
   static bool is_mutating(std::string_view command);
 
@@ -74,7 +82,11 @@ class ControlProtocol {
   Answer mutate(const std::string& command, const Json& request, const PeerCredentials& peer, const Reply& later);
   Json finish(const std::string& command, const Json& request, Json answer);
   // Runs `work` through offload_ (or inline) and answers with `done`'s result.
-  Answer run_admission(std::string what, std::function<void()> work, std::function<Json()> done, const Reply& later);
+  // `done` returns the answer, or nothing when it arranged to give it through `later` itself.
+  Answer run_admission(std::string what, std::function<void()> work, std::function<Answer()> done, const Reply& later);
+  // Commits a bind plan and answers. `replan`: admit it again first if the bindings changed since
+  // it was made (after a claim window); otherwise such a commit is refused ("try again").
+  Json commit_planned(BindPlan plan, const Json& request, const std::string& command, bool replan);
   std::string next_log_tag(const char* kind, const PeerCredentials& peer);
   Json status() const;
   Json segments() const;
@@ -98,6 +110,7 @@ class ControlProtocol {
   std::uint64_t log_sequence_ = 0;  // numbers audit and denial lines: no two are alike, none folded
   DenialLog denials_;               // which denials are logged (a burst is summarised)
   std::map<std::string, std::function<Json()>> readers_;  // add_reader()
+  BindGate gate_;
 };
 
 }  // namespace cosmic

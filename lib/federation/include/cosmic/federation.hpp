@@ -92,6 +92,10 @@ struct Announcement {
   Nanos residence{0};          // its gateway.residence_bound
   std::vector<AnnouncedSegment> segments;
   std::vector<AnnouncedChannel> channels;
+  // A bind in its claim window: the segments as they will be once it is committed (a superset of
+  // `segments`' reservations). Gateways with a higher id count it at once, so of two binds racing
+  // for one network the lower id goes first (docs/federation.md, "Concurrent binds").
+  std::optional<std::vector<AnnouncedSegment>> claim;
   friend bool operator==(const Announcement&, const Announcement&) = default;
 };
 

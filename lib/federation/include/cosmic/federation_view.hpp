@@ -83,9 +83,12 @@ class FederationView {
   // period, longest frame, largest jitter), so no peer can hide another's frame; at most
   // kMaxPeerFramesPerNetwork identifiers per network (the lowest, which delay the most), the rest
   // counted in counters().frames_over_cap. `senders`: every channel a peer sends onto the network,
-  // with the path before it.
+  // with the path before it. A peer with a lower gateway id than this one's that is claiming (a
+  // bind in its claim window) counts with what it claims.
   static constexpr std::size_t kMaxPeerFramesPerNetwork = 4096;
   PeerNetworks reservations() const;
+  // Whether an alive peer attaches `network` (a bind adding load there must claim it first).
+  bool shared(const std::string& network) const;
 
  private:
   bool refuse(const FederationMessage& message, std::string why, std::string* refusal);
