@@ -14,6 +14,7 @@ trap 'cleanup; rm -rf "$WORK"' EXIT
 LCM_A="udpm://239.255.76.67:7811?ttl=0"
 LCM_B="udpm://239.255.76.67:7812?ttl=0"
 LCM_X="udpm://239.255.76.67:7821?ttl=0"
+LCM_R="udpm://239.255.76.67:7822?ttl=0"
 
 write_gateway_a() {
   cat >"$WORK/a.yaml" <<YAML
@@ -106,6 +107,42 @@ YAML
   expect_field c x lcm rx $((2 * n))
   expect_field c x lan tx "$n"
   expect_field d x lan rx "$n"
+  passed
+}
+
+# Three gateways in a ring (LCM X -> gw-e -> DDS 24 -> gw-f -> DDS 25 -> gw-g -> LCM X): every event
+# crosses each network once and the loop is cut where it started: gw-e drops every copy coming
+# back with its own origin (issue 21, item 4).
+test_three_gateways_in_a_ring() {
+  scenario "three gateways in a ring forward each event once around and cut the loop"
+  local n=200
+  ring_gateway() { # ring_gateway NAME FROM_SEGMENT_YAML TO_SEGMENT_YAML FROM TO
+    cat >"$WORK/$1.yaml" <<YAML
+gateway: {name: gw-$1}
+segments:
+  - $2
+  - $3
+channels:
+  - {name: ring, subject: 0x210, class: nrt, payload: 16B, omission_degree: 3, publishers: [$4], subscribers: [$5]}
+YAML
+  }
+  ring_gateway e "{name: lcm, type: lcm, url: \"$LCM_R\", latency_bound: 2ms}" "{name: a, type: dds, domain: 24, latency_bound: 2ms}" lcm a
+  ring_gateway f "{name: a, type: dds, domain: 24, latency_bound: 2ms}" "{name: b, type: dds, domain: 25, latency_bound: 2ms}" a b
+  ring_gateway g "{name: b, type: dds, domain: 25, latency_bound: 2ms}" "{name: lcm, type: lcm, url: \"$LCM_R\", latency_bound: 2ms}" b lcm
+  start_daemon e "$WORK/e.yaml" || return
+  start_daemon f "$WORK/f.yaml" || return
+  start_daemon g "$WORK/g.yaml" || return
+  wait_until 20 "gw-f reader matched gw-e's writer" field_at_least f ring a matched 1 || return
+  wait_until 20 "gw-g reader matched gw-f's writer" field_at_least g ring b matched 1 || return
+  "$LCM_PEER" pub --url "$LCM_R" --channel ring --count "$n" --size 16 --rate 1000 || fail "publisher failed"
+  wait_until 20 "gw-g sent every event back onto LCM" field_equals g ring lcm tx "$n" || return
+  wait_until 10 "gw-e counted the copies that came around" field_equals e ring lcm dropped.duplicate "$n" || return
+  wait_until 10 "counters settled" settled e
+  expect_field e ring lcm rx $((2 * n))
+  expect_field e ring a tx "$n"
+  expect_field f ring a rx "$n"
+  expect_field f ring b tx "$n"
+  expect_field g ring b rx "$n"
   passed
 }
 
@@ -255,7 +292,7 @@ start_daemon a "$WORK/a.yaml" || exit 1
 start_daemon b "$WORK/b.yaml" || exit 1
 
 scenarios=("$@")
-[ ${#scenarios[@]} -gt 0 ] || scenarios=(raw_lcm_across_dds cross_connected_gateways expired_events_are_dropped
+[ ${#scenarios[@]} -gt 0 ] || scenarios=(raw_lcm_across_dds cross_connected_gateways three_gateways_in_a_ring expired_events_are_dropped
   rate_limit_holds bind_unbind_while_traffic_flows hrt_bind_over_lcm_is_rejected
   incompatible_peer_is_a_visible_mismatch reload_of_broken_file_keeps_running_configuration)
 for s in "${scenarios[@]}"; do
