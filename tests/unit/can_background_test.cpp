@@ -197,7 +197,7 @@ TEST(CanBackgroundConfig, FrameValuesAreChecked) {
 std::vector<CanBackgroundFrame> sixteen_frames(std::uint32_t first_id) {
   std::vector<CanBackgroundFrame> frames;
   for (std::uint32_t i = 0; i < 16; ++i) {
-    frames.push_back(CanBackgroundFrame{"F" + std::to_string(i), first_id + i, false, 8, Nanos(5ms), Nanos(0), "test"});
+    frames.push_back(CanBackgroundFrame{"F" + std::to_string(i), first_id + i, false, 8, Nanos(5ms), Nanos(0), "test", std::nullopt});
   }
   return frames;
 }
@@ -243,12 +243,12 @@ TEST(CanBackgroundAdmission, OnEqualBaseBitsTheStandardFrameWins) {
   // A jitter of one period releases a winning frame twice in our queuing delay (2 x 270 us), while
   // a losing one only blocks once (270 us): the two outcomes differ, so the tie rule is what decides.
   // Base bits 0x080 as ours: the standard frame wins the tie (RTR/IDE dominant), so it interferes.
-  const Evaluation tie = speed_on_a_bus_with({CanBackgroundFrame{"Tie", 0x080, false, 8, Nanos(5ms), Nanos(5ms), "test"}});
+  const Evaluation tie = speed_on_a_bus_with({CanBackgroundFrame{"Tie", 0x080, false, 8, Nanos(5ms), Nanos(5ms), "test", std::nullopt}});
   EXPECT_EQ(find_hop(tie.channels[0], "body")->can->response_time, Nanos(1'500'000 + 2 * 270'000 + 320'000));
   // An extended frame with the same base bits and higher low bits than ours loses: it blocks once
   // (0 data bytes, extended: 80 bits = 160 us).
   const Evaluation ext =
-      speed_on_a_bus_with({CanBackgroundFrame{"Ext", (0x080u << 18) | 0x3FFFF, true, 0, Nanos(5ms), Nanos(5ms), "test"}});
+      speed_on_a_bus_with({CanBackgroundFrame{"Ext", (0x080u << 18) | 0x3FFFF, true, 0, Nanos(5ms), Nanos(5ms), "test", std::nullopt}});
   EXPECT_EQ(find_hop(ext.channels[0], "body")->can->response_time, Nanos(1'500'000 + 160'000 + 320'000));
 }
 

@@ -149,7 +149,7 @@ TEST(NativeCanAdmission, ANativeChannelWeighsLikeTheSameBackgroundFrame) {
     Config with_background = native_bus();
     with_background.channels = {with_native.channels[0]};
     with_background.segments[0].can.background.push_back(
-        CanBackgroundFrame{"wheel", frame.can_id, frame.extended, 8, Nanos(10ms), Nanos(0), "test"});
+        CanBackgroundFrame{"wheel", frame.can_id, frame.extended, 8, Nanos(10ms), Nanos(0), "test", std::nullopt});
     const Evaluation a = evaluate(with_native.gateway, with_native.segments, with_native.channels, {});
     const Evaluation b = evaluate(with_background.gateway, with_background.segments, with_background.channels, {});
     EXPECT_EQ(can_hop(a.channels[0]).response_time, can_hop(b.channels[0]).response_time) << std::hex << frame.can_id;
@@ -174,7 +174,7 @@ TEST(NativeCanAdmission, APayloadThatDoesNotFitOneFrameIsRefusedWhateverTheClass
 
 TEST(NativeCanKnowledgeBase, IdentitiesAndEtagBitsAreNeverShared) {
   Config c = native_bus();
-  c.segments[0].can.background.push_back(CanBackgroundFrame{"J1939", 0x18EFFF01, true, 8, Nanos(100ms), Nanos(0), "test"});
+  c.segments[0].can.background.push_back(CanBackgroundFrame{"J1939", 0x18EFFF01, true, 8, Nanos(100ms), Nanos(0), "test", std::nullopt});
   KnowledgeBase kb(c.gateway, c.segments, {});
   ASSERT_TRUE(kb.bind(native_channel("wheel", 0x10, ChannelClass::srt, NativeCanFrame{0x00FF3FFF, true})).bound());
   // A dynamic etag skips 16383 (the native identifier's etag bits) and the background frame's 16129.

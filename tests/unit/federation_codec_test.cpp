@@ -21,8 +21,8 @@ Announcement sample_announcement() {
   a.residence = Nanos(500us);
   AnnouncedSegment lan{"lan", SegmentType::dds, "dds:domain=0", 0.7, 0.125, 12'500'000, {}};
   AnnouncedSegment body{"body", SegmentType::can, "can:body", 0.6, 0.2, 0, {}};
-  body.frames.push_back(AnnouncedFrame{"steer", 0x0C0FFFFF, true, 8, Nanos(10ms), Nanos(250us)});
-  body.frames.push_back(AnnouncedFrame{"ecu", 0x123, false, 4, Nanos(20ms), Nanos(0)});
+  body.frames.push_back(AnnouncedFrame{"steer", 0x0C0FFFFF, true, 8, Nanos(10ms), Nanos(250us), Nanos(3ms)});
+  body.frames.push_back(AnnouncedFrame{"ecu", 0x123, false, 4, Nanos(20ms), Nanos(0), std::nullopt});
   a.segments = {lan, body};
   AnnouncedChannel steer;
   steer.name = "steer";

@@ -157,16 +157,16 @@ TEST(FederationView, SharedNetworksAreMatchedByIdentity) {
   FederationView view(kSelf);
   Announcement a = peer(0x22, "gw2", 0.1);
   a.segments.push_back(AnnouncedSegment{"other-domain", SegmentType::dds, "dds:domain=5", 0.5, 0.3, 300'000, {}});
-  a.segments.push_back(AnnouncedSegment{"private", SegmentType::can, "", 0.7, 0.2, 0, {AnnouncedFrame{"x", 0x10, false, 8, Nanos(1ms), Nanos(0)}}});
+  a.segments.push_back(AnnouncedSegment{"private", SegmentType::can, "", 0.7, 0.2, 0, {AnnouncedFrame{"x", 0x10, false, 8, Nanos(1ms), Nanos(0), std::nullopt}}});
   AnnouncedSegment bus{"chassis", SegmentType::can, "can:body", 0.7, 0.05, 0, {}};
-  bus.frames.push_back(AnnouncedFrame{"steer", 0x00A0FFFF, true, 8, Nanos(10ms), Nanos(0)});
+  bus.frames.push_back(AnnouncedFrame{"steer", 0x00A0FFFF, true, 8, Nanos(10ms), Nanos(0), std::nullopt});
   a.segments.push_back(bus);
   // gw3 announces the same identifier lighter (a longer period) and heavier (a larger jitter): it
   // counts once, with the heavier of each, so no peer can hide another's frame.
   Announcement b = peer(0x33, "gw3", 0.0);
   AnnouncedSegment their_bus{"chassis", SegmentType::can, "can:body", 0.7, 0.05, 0, {}};
-  their_bus.frames.push_back(AnnouncedFrame{"steer", 0x00A0FFFF, true, 4, Nanos(1s), Nanos(2ms)});
-  their_bus.frames.push_back(AnnouncedFrame{"door", 0x300, false, 2, Nanos(100ms), Nanos(0)});
+  their_bus.frames.push_back(AnnouncedFrame{"steer", 0x00A0FFFF, true, 4, Nanos(1s), Nanos(2ms), std::nullopt});
+  their_bus.frames.push_back(AnnouncedFrame{"door", 0x300, false, 2, Nanos(100ms), Nanos(0), std::nullopt});
   b.segments.push_back(their_bus);
   ASSERT_TRUE(view.apply(said(a, "w2"), Nanos(1s)));
   ASSERT_TRUE(view.apply(said(b, "w3"), Nanos(1s)));
@@ -225,15 +225,15 @@ TEST(FederationAdmission, OtherGatewaysFramesDelayCanChannelsAndKeepTheirEtags) 
   EXPECT_EQ(kb.probe(brake).verdict, Verdict::bound) << reasons_text(kb.probe(brake));
   // Another gateway's two frames that win arbitration against ours (priority 0, TxNode 0).
   PeerReservations theirs;
-  theirs.frames.push_back(CanBackgroundFrame{"gw2:steer", 0x00000001, true, 8, Nanos(5ms), Nanos(0), "gateway gw2"});
-  theirs.frames.push_back(CanBackgroundFrame{"gw2:yaw", 0x00000002, true, 8, Nanos(5ms), Nanos(0), "gateway gw2"});
+  theirs.frames.push_back(CanBackgroundFrame{"gw2:steer", 0x00000001, true, 8, Nanos(5ms), Nanos(0), "gateway gw2", std::nullopt});
+  theirs.frames.push_back(CanBackgroundFrame{"gw2:yaw", 0x00000002, true, 8, Nanos(5ms), Nanos(0), "gateway gw2", std::nullopt});
   kb.set_peer_reservations({{"can:body", theirs}});
   const ChannelReport refused = kb.probe(brake);
   EXPECT_EQ(refused.verdict, Verdict::rejected);
   EXPECT_TRUE(has_reason(refused, "gw2:steer")) << reasons_text(refused);
   EXPECT_GT(kb.loads()[0].peers, 0.1);
   // The etag bits of the peer's extended frame (16383, the first this gateway would hand out) are not.
-  const CanBackgroundFrame top{"gw2:log", 0x1F000000 | 16383, true, 8, Nanos(100ms), Nanos(0), "gateway gw2"};
+  const CanBackgroundFrame top{"gw2:log", 0x1F000000 | 16383, true, 8, Nanos(100ms), Nanos(0), "gateway gw2", std::nullopt};
   kb.set_peer_reservations({{"can:body", PeerReservations{0, {top}, {}}}});
   ChannelSpec slow = channel("slow", 0x200, ChannelClass::nrt, {"lan"}, {"body"}, 8, Nanos(100ms));
   ASSERT_TRUE(kb.bind(slow).bound());
@@ -258,6 +258,38 @@ TEST(FederationAdmission, OtherGatewaysFramesDelayCanChannelsAndKeepTheirEtags) 
       << reasons_text(*report.find("early"));
 }
 
+TEST(FederationAdmission, ABindThatWouldBreakAnotherGatewaysHrtFrameIsRejected) {
+  SegmentSpec body = can_segment("body", 500'000);
+  body.network = "body";
+  KnowledgeBase kb(gateway(100us), {body, dds_segment("lan", 100us)});
+  // gw1's HRT frame (priority 0, TxNode 1, etag 16383) every 1 ms, released with 200 us of jitter:
+  // R = 0.2 + 0.32 = 0.52 ms alone; its channel there allows up to 0.8 ms.
+  const CanBackgroundFrame steer{"gw1:steer", (1u << 14) | 16383, true, 8, Nanos(1ms), Nanos(200us), "gateway gw1 (0000000000000001)",
+                                 Nanos(800us)};
+  kb.set_peer_reservations({{"can:body", PeerReservations{0, {steer}, {}}}});
+  // An NRT frame of 8 bytes loses arbitration to it but may hold the bus when it is queued:
+  // R = 0.2 + 0.32 + 0.32 = 0.84 ms > 0.8 ms.
+  const ChannelReport refused = kb.probe(channel("logbook", 0x600, ChannelClass::nrt, {"lan"}, {"body"}, 8, Nanos(10ms)));
+  EXPECT_EQ(refused.verdict, Verdict::rejected);
+  EXPECT_TRUE(has_reason(refused, "would break the hrt frame gw1:steer of gateway gw1 (0000000000000001): R = 840 us > 800 us"))
+      << reasons_text(refused);
+  // One byte blocks for 0.18 ms: R = 0.70 ms, within.
+  const BindOutcome tiny = kb.bind(channel("tiny", 0x601, ChannelClass::nrt, {"lan"}, {"body"}, 1, Nanos(10ms)));
+  EXPECT_TRUE(tiny.bound()) << reasons_text(tiny.report);
+}
+
+TEST(FederationAnnouncement, AnHrtFrameCarriesTheMostResponseTimeItsChannelAllows) {
+  SegmentSpec body = can_segment("body", 500'000);
+  body.network = "body";
+  KnowledgeBase kb(gateway(100us), {body, dds_segment("lan", 100us)});
+  ASSERT_TRUE(kb.bind(channel("steer", 0x500, ChannelClass::hrt, {"lan"}, {"body"}, 8, Nanos(1ms), Nanos(800us))).bound());
+  const Announcement a = announcement_of(GatewayIdentity{0x42, "gw1"}, kb, 1);
+  ASSERT_EQ(a.segments[0].frames.size(), 1u);
+  // R = 0.2 (released after 0.1 on lan + 0.1 residence) + 0.32 = 0.52 ms, end to end 0.52 ms: 0.28 ms to spare.
+  EXPECT_EQ(a.segments[0].frames[0].jitter, Nanos(200us));
+  EXPECT_EQ(a.segments[0].frames[0].deadline, std::optional<Nanos>(Nanos(800us)));
+}
+
 TEST(FederationAnnouncement, SaysWhatThisGatewayReservesWhere) {
   SegmentSpec body = can_segment("body");
   body.network = "body";
@@ -277,6 +309,7 @@ TEST(FederationAnnouncement, SaysWhatThisGatewayReservesWhere) {
   EXPECT_EQ(a.segments[1].network, "dds:domain=0");
   EXPECT_NEAR(a.segments[1].load, alone, 1e-9) << "other gateways' load is not announced as this one's";
   EXPECT_NEAR(a.segments[1].reserved_bps, alone * 1e6, 1e-3);
+  EXPECT_FALSE(a.segments[0].frames[0].deadline) << "an SRT channel's frame has no deadline to keep";
   ASSERT_EQ(a.channels.size(), 1u);
   EXPECT_EQ(a.channels[0].hops.size(), 2u);
   EXPECT_TRUE(decode_announcement(encode(a)).announcement) << decode_announcement(encode(a)).error;

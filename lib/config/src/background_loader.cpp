@@ -181,7 +181,7 @@ class BackgroundParser {
 
   void take_message(const DbcMessage& m, const std::string& file, const std::string& path) {
     const std::string origin = file + ":" + std::to_string(m.line) + ":" + std::to_string(m.column);
-    CanBackgroundFrame frame{m.name, m.can_id, m.extended, m.length, Nanos(0), Nanos(0), origin};
+    CanBackgroundFrame frame{m.name, m.can_id, m.extended, m.length, Nanos(0), Nanos(0), origin, std::nullopt};
     const auto declared = periods_.find(m.name);
     if (declared != periods_.end()) {
       frame.period = declared->second.first;

@@ -364,7 +364,10 @@ AdmissionSet::Trial AdmissionSet::trial(const ChannelSpec& channel, std::uint16_
     if (load == t.loads.end()) load = t.loads.insert(t.loads.end(), {p.segment, segments_[p.segment].load});
     load->second += hop_load(segment_specs_[p.segment], channel);
   }
-  if (touches_can) t.can = analyse_can(&t, false);
+  if (touches_can) {
+    t.can = analyse_can(&t, false);
+    t.broken_frames = frames_broken_by(*t.can);
+  }
   t.report = report_of(t.spec, t.data, &t);
   for (const std::size_t c : affected_by(t)) {
     if (specs_[c].cls != ChannelClass::hrt) continue;
@@ -372,6 +375,40 @@ AdmissionSet::Trial AdmissionSet::trial(const ChannelSpec& channel, std::uint16_
     if (existing.verdict == Verdict::rejected) t.broken_hrt.push_back(std::move(existing));
   }
   return t;
+}
+
+// Background frames with a deadline on the buses `side` planned afresh (those the newcomer joins)
+// that met it before and miss it in `side`'s analysis. A frame already late before is not the
+// newcomer's doing.
+std::vector<AdmissionSet::Trial::BrokenFrame> AdmissionSet::frames_broken_by(const CanSide& side) const {
+  std::vector<Trial::BrokenFrame> out;
+  for (std::size_t s = 0; s < segments_.size(); ++s) {
+    const std::vector<CanBackgroundFrame>& frames = segment_specs_[s].can.background;
+    const bool any = std::any_of(frames.begin(), frames.end(), [](const auto& f) { return f.deadline.has_value(); });
+    if (!any || !side.replanned[s] || side.runs[s].empty()) continue;
+    const auto& after = side.runs[s].back().results();
+    // Before: the committed analysis, or the background alone on a bus without channels yet.
+    std::vector<std::optional<Nanos>> alone;
+    const std::vector<std::optional<Nanos>>* before = nullptr;
+    std::size_t before_first = segments_[s].plans.size();
+    if (!segments_[s].runs.empty()) {
+      before = &segments_[s].runs.back().results();
+    } else {
+      alone = response_times(segments_[s].background, bus_timing(segment_specs_[s].can));
+      before = &alone;
+      before_first = 0;
+    }
+    const std::size_t after_first = side.plans[s].size();
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+      if (!frames[k].deadline) continue;
+      const std::optional<Nanos>& r = after.at(after_first + k);
+      if (r && *r <= *frames[k].deadline) continue;
+      const std::optional<Nanos>& b = before->at(before_first + k);
+      if (!b || *b > *frames[k].deadline) continue;
+      out.push_back({frames[k].name, frames[k].origin, r, *frames[k].deadline});
+    }
+  }
+  return out;
 }
 
 // Bound channels whose report the trial can change: those on a segment it pushes over its

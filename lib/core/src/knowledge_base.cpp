@@ -120,6 +120,12 @@ KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel, std::o
   a.trial = set_.trial(channel, a.etag.value_or(0));
   a.report = a.trial->report;
   add_upstream(channel, a.report);
+  for (const AdmissionSet::Trial::BrokenFrame& frame : a.trial->broken_frames) {
+    a.report.verdict = Verdict::rejected;
+    a.report.reasons.push_back("would break the hrt frame " + frame.name + " of " + frame.origin + ": R = " +
+                               (frame.response ? format_duration(*frame.response) : std::string("unbounded")) + " > " +
+                               format_duration(frame.deadline) + ", the most its channel there allows");
+  }
   for (const ChannelReport& existing : a.trial->broken_hrt) {
     a.report.verdict = Verdict::rejected;
     for (const auto& reason : existing.reasons) {

@@ -9,7 +9,17 @@ namespace {
 
 // The frames a bound channel's CAN hop puts on the bus: one stream per hop, an event of n
 // fragments counted as n frames per period (the same load; the spacing is the sender's).
-std::optional<AnnouncedFrame> frame_of(const ChannelSpec& spec, const HopReport& hop) {
+// How much longer the hop's response time may grow with the HRT channel still admitted: the room
+// under its own check (R <= reaction_time) and under the end-to-end ones. Nullopt: none to give.
+std::optional<Nanos> slack_of(const ChannelSpec& spec, const HopReport& hop, const EndToEnd& e2e) {
+  if (spec.cls != ChannelClass::hrt || !spec.reaction_time || !hop.latency || !e2e.latency) return std::nullopt;
+  Nanos slack = std::min(*spec.reaction_time - *hop.latency, *spec.reaction_time - *e2e.latency);
+  if (spec.temp_validity) slack = std::min(slack, *spec.temp_validity - *e2e.latency - Nanos(1));
+  if (slack < Nanos(0)) return std::nullopt;
+  return slack;
+}
+
+std::optional<AnnouncedFrame> frame_of(const ChannelSpec& spec, const HopReport& hop, const EndToEnd& e2e) {
   if (!hop.can || !spec.period || spec.period->count() <= 0) return std::nullopt;
   const auto frames = std::max<std::uint32_t>(1, hop.can->frames_per_event);
   AnnouncedFrame f;
@@ -19,6 +29,7 @@ std::optional<AnnouncedFrame> frame_of(const ChannelSpec& spec, const HopReport&
   f.length = hop.can->frame_bytes;
   f.period = std::max(Nanos(1000), *spec.period / frames);
   f.jitter = hop.can->jitter;
+  if (const auto slack = slack_of(spec, hop, e2e)) f.deadline = *hop.latency + *slack;
   return f;
 }
 
@@ -67,7 +78,7 @@ Announcement announcement_of(const GatewayIdentity& self, const KnowledgeBase& k
     // Past the bound a peer accepts, channels are left out of the list; their load and frames stay.
     if (a.channels.size() < kMaxAnnouncedChannels) a.channels.push_back(channel_of(channel, *spec));
     for (const HopReport& hop : channel.hops) {
-      const auto frame = frame_of(*spec, hop);
+      const auto frame = frame_of(*spec, hop, channel.end_to_end);
       if (!frame) continue;
       for (AnnouncedSegment& s : a.segments) {
         if (s.name == hop.segment && s.frames.size() < kMaxAnnouncedFrames) s.frames.push_back(*frame);

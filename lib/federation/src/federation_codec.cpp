@@ -28,7 +28,7 @@ Json nanos_or_null(const std::optional<Nanos>& value) { return value ? Json(valu
 
 Json frame_json(const AnnouncedFrame& f) {
   return {{"channel", f.channel}, {"can_id", f.can_id}, {"extended", f.extended}, {"length", f.length},
-          {"period_ns", f.period.count()}, {"jitter_ns", f.jitter.count()}};
+          {"period_ns", f.period.count()}, {"jitter_ns", f.jitter.count()}, {"deadline_ns", nanos_or_null(f.deadline)}};
 }
 
 Json segment_json(const AnnouncedSegment& s) {
@@ -131,6 +131,7 @@ AnnouncedFrame read_frame(const Reader& r, const Json& j, const std::string& whe
   f.jitter = r.nanos(j, "jitter_ns", where);
   // A release jitter beyond a second is no CAN frame's: it would only make every analysis diverge.
   if (f.jitter > Nanos(1'000'000'000)) throw Refusal{where + ".jitter_ns is above 1 s"};
+  f.deadline = r.nanos_or_unbounded(j, "deadline_ns", where);
   return f;
 }
 

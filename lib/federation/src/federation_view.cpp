@@ -17,6 +17,7 @@ void merge_heaviest(CanBackgroundFrame& kept, const CanBackgroundFrame& other) {
   kept.period = std::min(kept.period, other.period);
   kept.length = std::max(kept.length, other.length);
   kept.jitter = std::max(kept.jitter, other.jitter);
+  if (other.deadline && (!kept.deadline || *other.deadline < *kept.deadline)) kept.deadline = other.deadline;
 }
 
 // The path `channel` gives its events before `hop` (one of its subscriber hops): its upstream,
@@ -182,7 +183,7 @@ PeerNetworks FederationView::reservations() const {
       r.bits_per_second += theirs.reserved_bps;
       for (const AnnouncedFrame& f : theirs.frames) {
         CanBackgroundFrame frame{peer.announcement.name + ":" + f.channel, f.can_id, f.extended, f.length, f.period, f.jitter,
-                                 "gateway " + peer.announcement.name + " (" + gateway_id_text(id) + ")"};
+                                 "gateway " + peer.announcement.name + " (" + gateway_id_text(id) + ")", f.deadline};
         const auto [kept, fresh] = frames[theirs.network].emplace(std::make_pair(f.can_id, f.extended), frame);
         if (!fresh) merge_heaviest(kept->second, frame);
       }

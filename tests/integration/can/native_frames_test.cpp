@@ -16,7 +16,7 @@ TEST(NativeFrames, IdentifiersMatchExactlyByFormatAndNeverAsRemoteRequests) {
   ASSERT_TRUE(table.add_publisher(NativeCanFrame{0x123, true}, can_native::RxChannel{8, 0x43, 8}));
   EXPECT_FALSE(table.add_publisher(NativeCanFrame{0x123, false}, can_native::RxChannel{9, 0x44, 4}));  // one sender
   table.add_subscriber(NativeCanFrame{0x7FF, false});
-  table.add_background(CanBackgroundFrame{"Engine", 0x0C0, false, 8, Nanos(10ms), Nanos(0), "test"});
+  table.add_background(CanBackgroundFrame{"Engine", 0x0C0, false, 8, Nanos(10ms), Nanos(0), "test", std::nullopt});
   ASSERT_NE(table.find(0x123), nullptr);
   EXPECT_EQ(table.find(0x123)->id, 7u);
   EXPECT_EQ(table.find(0x123 | CAN_EFF_FLAG)->id, 8u);

@@ -221,6 +221,14 @@ class AdmissionSet {
   struct Trial {
     ChannelReport report;                  // the newcomer in the new set
     std::vector<ChannelReport> broken_hrt;  // bound HRT channels the newcomer would reject, bind order
+    // Background frames with a deadline (other gateways' HRT frames) that met it and would not.
+    struct BrokenFrame {
+      std::string name;    // e.g. "gw1:steer"
+      std::string origin;  // e.g. "gateway gw1 (00000000000010ab)"
+      std::optional<Nanos> response;  // nullopt: unbounded
+      Nanos deadline{0};
+    };
+    std::vector<BrokenFrame> broken_frames;
    private:
     friend class AdmissionSet;
     ChannelSpec spec;
@@ -256,6 +264,7 @@ class AdmissionSet {
   CanSide analyse_can(const Trial* newcomer, bool replan_all) const;
   ChannelReport report_of(const ChannelSpec& spec, const ChannelData& data, const Trial* change) const;
   std::vector<std::size_t> affected_by(const Trial& t) const;
+  std::vector<Trial::BrokenFrame> frames_broken_by(const CanSide& side) const;
   struct Member {
     const ChannelSpec* spec;
     const ChannelData* data;

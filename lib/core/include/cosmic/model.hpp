@@ -45,6 +45,9 @@ struct CanBackgroundFrame {
   Nanos period{0};            // minimum inter-arrival time (> 0)
   Nanos jitter{0};            // queuing jitter
   std::string origin;         // where it was declared: "body.dbc:12:1" or "robot.yaml:20:9"
+  // Another gateway's frame of an HRT channel (federation): the longest response time it may have
+  // with that channel still admitted there. A bind here that would push it beyond is rejected.
+  std::optional<Nanos> deadline;
   friend bool operator==(const CanBackgroundFrame&, const CanBackgroundFrame&) = default;
 };
 

@@ -43,6 +43,9 @@ struct AnnouncedFrame {
   std::uint32_t length = 8;  // data bytes of one frame
   Nanos period{0};           // minimum inter-arrival time of the frame (> 0)
   Nanos jitter{0};
+  // HRT channels: the longest response time the frame may have with its channel still admitted
+  // (its response time plus the channel's slack); other gateways' binds must keep it within.
+  std::optional<Nanos> deadline;
   friend bool operator==(const AnnouncedFrame&, const AnnouncedFrame&) = default;
 };
 
