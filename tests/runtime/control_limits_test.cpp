@@ -13,8 +13,10 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -93,6 +95,44 @@ TEST_F(ControlTest, StatusIsAnsweredWhileALongAdmissionRunsAndASecondBindIsBusy)
   EXPECT_EQ(other.call({{"command", "channels"}})["channels"].size(), 41u);
   // Once it is done, binding works again.
   EXPECT_EQ(other.call({{"command", "bind"}, {"yaml", many_channels(1, 5000)}})["ok"], true);
+}
+
+// The federation's claim window (BindGate): the commit waits, other changes are busy meanwhile, and
+// the bind is admitted again against what changed (here another gateway's share of the lan).
+TEST_F(ControlTest, AGatedBindWaitsAndIsAdmittedAgainAgainstWhatChangedMeanwhile) {
+  Setup setup;
+  setup.admission = Admission::server_worker;
+  serve_with(setup);
+  std::mutex mutex;
+  std::condition_variable held;
+  std::function<void()> commit;
+  protocol->set_bind_gate([&](const BindPlan& plan, std::function<void()> later) {
+    EXPECT_TRUE(plan.admitted);
+    std::lock_guard lock(mutex);
+    commit = std::move(later);
+    held.notify_all();
+  });
+  Client binder(socket_path);
+  const std::string heavy = "- {name: heavy, subject: 7000, class: srt, period: 1ms, reaction_time: 50ms, omission_degree: 1, "
+                            "payload: 1000B, publishers: [viz], subscribers: [lan]}\n";
+  binder.send_raw(Json{{"command", "bind"}, {"yaml", heavy}}.dump() + "\n");
+  {
+    std::unique_lock lock(mutex);
+    ASSERT_TRUE(held.wait_for(lock, std::chrono::seconds(10), [&] { return commit != nullptr; }));
+  }
+  Client other(socket_path);
+  const Json busy = other.call({{"command", "unbind"}, {"name", "speed"}});
+  EXPECT_EQ(busy["error"]["code"], "busy");
+  EXPECT_NE(busy["error"]["message"].get<std::string>().find("claiming"), std::string::npos) << busy.dump();
+  // Another gateway now reserves 80 of the lan's 100 Mbit/s; then the window ends (control thread).
+  server->post([&] {
+    gateway.set_peer_reservations({{"dds:domain=0", PeerReservations{80e6, {}, {}}}});
+    commit();
+  });
+  const Json answer = Json::parse(binder.read_line(), nullptr, false);
+  ASSERT_EQ(answer["channels"].size(), 1u) << answer.dump();
+  EXPECT_EQ(answer["channels"][0]["verdict"], "degraded") << answer.dump();
+  EXPECT_NE(answer["channels"][0].dump().find("other gateways 80.0%"), std::string::npos) << answer.dump();
 }
 
 TEST_F(ControlTest, AdmissionOnTheServersWorkerAnswersInOrder) {
