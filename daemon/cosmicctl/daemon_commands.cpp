@@ -208,6 +208,17 @@ void print_channel(const Json& r) {
   print_channels(Json{{"channels", Json::array({c})}});
   print_runtime(c);
   std::cout << "\nadmission:\n";
+  // A channel whose events come through other gateways (federation): their hops first.
+  if (c["admission"].contains("upstream")) {
+    const Json& e2e = c["admission"]["end_to_end"];
+    std::cout << "  path over gateways: "
+              << (e2e["upstream_s"].is_null() ? std::string("unbounded") : micros(e2e["upstream_s"].get<double>())) << " before this one, "
+              << (e2e["local_s"].is_null() ? std::string("unbounded") : micros(e2e["local_s"].get<double>())) << " here\n";
+    for (const auto& hop : c["admission"]["upstream"]) {
+      std::cout << "  " << text(hop["role"]) << " " << text(hop["segment"]) << " on gateway " << text(hop["gateway"]) << "  "
+                << (hop["latency_s"].is_null() ? std::string("unbounded") : micros(hop["latency_s"].get<double>())) << "\n";
+    }
+  }
   for (const auto& hop : c["admission"]["hops"]) {
     std::cout << "  " << text(hop["role"]) << " " << text(hop["segment"]);
     if (hop.contains("can")) {
