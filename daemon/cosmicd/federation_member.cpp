@@ -165,7 +165,8 @@ void FederationMember::gate(const cosmic::BindPlan& plan, std::function<void()> 
     return;
   }
   const auto now = std::chrono::duration_cast<cosmic::Nanos>(std::chrono::steady_clock::now().time_since_epoch());
-  claim_ = Claim{now + spec_.claim_window, std::move(commit), cosmic::announcement_of(gateway_.identity(), *plan.kb, 0).segments};
+  std::vector<cosmic::AnnouncedSegment> claimed = cosmic::announcement_of(gateway_.identity(), *plan.kb, 0).segments;
+  claim_ = Claim{now + spec_.claim_window, std::move(commit), std::move(claimed)};
   peers_changed_ = true;  // announce() publishes the claim now, not at the next change
   announce();
 }

@@ -133,6 +133,8 @@ TEST_F(ControlTest, AGatedBindWaitsAndIsAdmittedAgainAgainstWhatChangedMeanwhile
   ASSERT_EQ(answer["channels"].size(), 1u) << answer.dump();
   EXPECT_EQ(answer["channels"][0]["verdict"], "degraded") << answer.dump();
   EXPECT_NE(answer["channels"][0].dump().find("other gateways 80.0%"), std::string::npos) << answer.dump();
+  // The claim is over: changes are accepted again.
+  EXPECT_EQ(other.call({{"command", "unbind"}, {"name", "heavy"}})["ok"], true);
 }
 
 TEST_F(ControlTest, AdmissionOnTheServersWorkerAnswersInOrder) {

@@ -34,7 +34,7 @@ Announcement sample_announcement() {
   steer.reaction_time = Nanos(20ms);
   steer.temp_validity = Nanos(50ms);
   steer.payload = 8;
-  steer.upstream = {PathHop{"gw1", "front-can", HopRole::publisher, Nanos(1ms)}};
+  steer.upstream = {PathHop{"gw1", "front-can", HopRole::publisher, Nanos(1ms), 0x77}};
   steer.upstream_age = Nanos(2ms);
   AnnouncedChannel log;
   log.name = "log";
@@ -100,6 +100,7 @@ TEST(FederationCodec, RefusesMalformedAndOutOfRangeAnnouncements) {
       {"claim not a list", [](Json& j) { j["claim"] = 3; }, "claim is not a list"},
       {"claim with a bad load", [](Json& j) { j["claim"][0]["load"] = 2; }, "claim[0].load is outside"},
       {"negative residence", [](Json& j) { j["residence_ns"] = -1; }, "residence_ns"},
+      {"upstream hop with id 0", [](Json& j) { j["channels"][0]["upstream"][0]["gateway_id"] = "0000000000000000"; }, "gateway_id is 0"},
       {"upstream hop without gateway", [](Json& j) { j["channels"][0]["upstream"][0].erase("gateway"); }, "gateway is missing"},
       {"fractional payload", [](Json& j) { j["channels"][0]["payload"] = 1.5; }, "payload"},
       {"too many channels", [](Json& j) { j["channels"] = Json(std::vector<int>(kMaxAnnouncedChannels + 1, 0)); }, "more than 4096"},

@@ -278,6 +278,22 @@ TEST(FederationAdmission, ABindThatWouldBreakAnotherGatewaysHrtFrameIsRejected) 
   EXPECT_TRUE(tiny.bound()) << reasons_text(tiny.report);
 }
 
+TEST(FederationAdmission, TheDeadlineIsCheckedAgainstWhatIsAlreadyBoundHere) {
+  SegmentSpec body = can_segment("body", 500'000);
+  body.network = "body";
+  KnowledgeBase kb(gateway(100us), {body, dds_segment("lan", 100us)});
+  // A local 1-byte NRT channel first: the bus has a committed analysis when the peer's frame comes.
+  ASSERT_TRUE(kb.bind(channel("tiny", 0x601, ChannelClass::nrt, {"lan"}, {"body"}, 1, Nanos(10ms))).bound());
+  const CanBackgroundFrame steer{"gw1:steer", (1u << 14) | 16383, true, 8, Nanos(1ms), Nanos(200us), "gateway gw1 (0000000000000001)",
+                                 Nanos(800us)};
+  kb.set_peer_reservations({{"can:body", PeerReservations{0, {steer}, {}}}});
+  // tiny blocks steer by 0.18 ms (R = 0.70 ms); an 8-byte NRT frame would by 0.32 ms (R = 0.84 ms).
+  const ChannelReport refused = kb.probe(channel("logbook", 0x600, ChannelClass::nrt, {"lan"}, {"body"}, 8, Nanos(10ms)));
+  EXPECT_TRUE(has_reason(refused, "would break the hrt frame gw1:steer")) << reasons_text(refused);
+  // A channel on the lan only does not touch the bus's analysis.
+  EXPECT_EQ(kb.probe(channel("chat", 0x602, ChannelClass::nrt, {"lan"}, {"lan"}, 8, Nanos(10ms))).verdict, Verdict::bound);
+}
+
 TEST(FederationAnnouncement, AnHrtFrameCarriesTheMostResponseTimeItsChannelAllows) {
   SegmentSpec body = can_segment("body", 500'000);
   body.network = "body";
@@ -387,6 +403,21 @@ TEST(FederationEndToEnd, ConflictingDefinitionsOfOneSubjectAreMismatchesWithReas
   // Another subject on the same network is not on that path.
   steer.subject = 0x78;
   EXPECT_TRUE(kb.probe(steer).upstream.empty());
+}
+
+TEST(FederationView, APathThroughThisGatewayIsNoUpstream) {
+  // gw2 sends `steer` onto the backbone, having received it from gw1 (this gateway) before: a ring.
+  FederationView view(0x11);
+  Announcement a = upstream_gateway(Nanos(1ms));
+  a.channels[0].upstream = {PathHop{"gw-self", "rear", HopRole::publisher, Nanos(1ms), 0x11}};
+  ASSERT_TRUE(view.apply(said(a, "w1"), Nanos(1s)));
+  EXPECT_TRUE(view.reservations().at("dds:domain=0").senders.empty());
+  // Without this gateway on it, the same path is an upstream.
+  a.channels[0].upstream[0].gateway_id = 0x99;
+  a.revision = 2;
+  ASSERT_TRUE(view.apply(said(a, "w1"), Nanos(2s)));
+  ASSERT_EQ(view.reservations().at("dds:domain=0").senders.size(), 1u);
+  EXPECT_EQ(view.reservations().at("dds:domain=0").senders[0].hops.size(), 2u);
 }
 
 TEST(FederationAnnouncement, NetworkIdentities) {

@@ -9,8 +9,10 @@ namespace {
 // than an hour keeps a dead gateway's reservations far too long.
 constexpr Nanos kMinLease{100'000'000};
 constexpr Nanos kMaxLease{3'600'000'000'000};
-// Shorter than a DDS round trip on a loaded host decides nothing; longer keeps binds waiting.
-constexpr Nanos kMinClaimWindow{10'000'000};
+// Two racing binds are decided when the window covers two control-loop ticks (100 ms each), the
+// claim's delivery and the winner's committed announcement's (docs/federation.md): below 300 ms
+// that cannot hold even on loopback. Longer than 10 s keeps binds waiting for nothing.
+constexpr Nanos kMinClaimWindow{300'000'000};
 constexpr Nanos kMaxClaimWindow{10'000'000'000};
 
 std::string key(const std::string& path, const char* name) { return path + "." + name; }
@@ -37,7 +39,7 @@ void parse_federation(YamlReader& reader, const YAML::Node& node, const std::str
   if (has(node, "claim_window")) {
     if (auto v = reader.duration(node["claim_window"], key(path, "claim_window"), false)) {
       if (*v < kMinClaimWindow || *v > kMaxClaimWindow) {
-        reader.error_at(node["claim_window"], key(path, "claim_window"), "claim_window out of range", "from 10ms to 10s, e.g. 300ms");
+        reader.error_at(node["claim_window"], key(path, "claim_window"), "claim_window out of range", "from 300ms to 10s, e.g. 500ms");
       } else {
         out.claim_window = *v;
       }

@@ -423,7 +423,8 @@ ControlProtocol::Answer ControlProtocol::bind(const Json& request, bool replace,
       [this, plan, request, command, gated, what, later]() -> Answer {
         if (!gated || !plan->admitted) return commit_planned(std::move(*plan), request, command, false);
         running_ = what + " (claiming the federation's shared networks)";
-        gate_(*plan, [this, plan, request, command, later] {
+        try {
+          gate_(*plan, [this, plan, request, command, later] {
           running_.clear();
           Json answer;
           try {
@@ -432,7 +433,11 @@ ControlProtocol::Answer ControlProtocol::bind(const Json& request, bool replace,
             answer = failure("internal_error", e.what());
           }
           later(render(answer));
-        });
+          });
+        } catch (const std::exception& e) {
+          running_.clear();  // never left busy by a gate that failed
+          return failure("internal_error", std::string("claiming the networks failed: ") + e.what());
+        }
         return std::nullopt;
       },
       later);
@@ -441,7 +446,8 @@ ControlProtocol::Answer ControlProtocol::bind(const Json& request, bool replace,
 Json ControlProtocol::commit_planned(BindPlan plan, const Json& request, const std::string& command, bool replan) {
   if (replan && plan.generation != gateway_.generation()) {
     // Other gateways' reservations (or claims) changed while the bind waited: admit it again, here
-    // on the control thread (milliseconds), against what is known now.
+    // on the control thread, against what is known now (an incremental admission: milliseconds for
+    // hundreds of channels; status answers wait that long).
     BindPlan fresh = plan.replacing ? gateway_.replace_plan_input(plan.channels) : gateway_.bind_plan_input(plan.channels);
     replace_or_bind(fresh);
     plan = std::move(fresh);

@@ -377,15 +377,15 @@ AdmissionSet::Trial AdmissionSet::trial(const ChannelSpec& channel, std::uint16_
   return t;
 }
 
-// Background frames with a deadline on the buses `side` planned afresh (those the newcomer joins)
-// that met it before and miss it in `side`'s analysis. A frame already late before is not the
-// newcomer's doing.
+// Background frames with a deadline (on any bus: a newcomer elsewhere can change the release jitter
+// of a channel's downstream CAN hop) that met it in the committed analysis and miss it in `side`'s.
+// A frame already late before is not the newcomer's doing.
 std::vector<AdmissionSet::Trial::BrokenFrame> AdmissionSet::frames_broken_by(const CanSide& side) const {
   std::vector<Trial::BrokenFrame> out;
   for (std::size_t s = 0; s < segments_.size(); ++s) {
     const std::vector<CanBackgroundFrame>& frames = segment_specs_[s].can.background;
     const bool any = std::any_of(frames.begin(), frames.end(), [](const auto& f) { return f.deadline.has_value(); });
-    if (!any || !side.replanned[s] || side.runs[s].empty()) continue;
+    if (!any || side.runs[s].empty()) continue;
     const auto& after = side.runs[s].back().results();
     // Before: the committed analysis, or the background alone on a bus without channels yet.
     std::vector<std::optional<Nanos>> alone;

@@ -7,19 +7,22 @@
 namespace cosmic {
 namespace {
 
-// The frames a bound channel's CAN hop puts on the bus: one stream per hop, an event of n
-// fragments counted as n frames per period (the same load; the spacing is the sender's).
 // How much longer the hop's response time may grow with the HRT channel still admitted: the room
-// under its own check (R <= reaction_time) and under the end-to-end ones. Nullopt: none to give.
-std::optional<Nanos> slack_of(const ChannelSpec& spec, const HopReport& hop, const EndToEnd& e2e) {
+// under its own check (R <= reaction_time), and its share of the room under the end-to-end ones,
+// split evenly between the channel's `can_hops` (each may be on a bus other gateways share, and
+// their binds there must not spend the same room twice). Nullopt: none to give.
+std::optional<Nanos> slack_of(const ChannelSpec& spec, const HopReport& hop, const EndToEnd& e2e, std::size_t can_hops) {
   if (spec.cls != ChannelClass::hrt || !spec.reaction_time || !hop.latency || !e2e.latency) return std::nullopt;
-  Nanos slack = std::min(*spec.reaction_time - *hop.latency, *spec.reaction_time - *e2e.latency);
-  if (spec.temp_validity) slack = std::min(slack, *spec.temp_validity - *e2e.latency - Nanos(1));
+  Nanos end_to_end = *spec.reaction_time - *e2e.latency;
+  if (spec.temp_validity) end_to_end = std::min(end_to_end, *spec.temp_validity - *e2e.latency - Nanos(1));
+  const Nanos slack = std::min(*spec.reaction_time - *hop.latency, end_to_end / static_cast<std::int64_t>(std::max<std::size_t>(1, can_hops)));
   if (slack < Nanos(0)) return std::nullopt;
   return slack;
 }
 
-std::optional<AnnouncedFrame> frame_of(const ChannelSpec& spec, const HopReport& hop, const EndToEnd& e2e) {
+// The frames a bound channel's CAN hop puts on the bus: one stream per hop, an event of n
+// fragments counted as n frames per period (the same load; the spacing is the sender's).
+std::optional<AnnouncedFrame> frame_of(const ChannelSpec& spec, const HopReport& hop, const EndToEnd& e2e, std::size_t can_hops) {
   if (!hop.can || !spec.period || spec.period->count() <= 0) return std::nullopt;
   const auto frames = std::max<std::uint32_t>(1, hop.can->frames_per_event);
   AnnouncedFrame f;
@@ -29,7 +32,7 @@ std::optional<AnnouncedFrame> frame_of(const ChannelSpec& spec, const HopReport&
   f.length = hop.can->frame_bytes;
   f.period = std::max(Nanos(1000), *spec.period / frames);
   f.jitter = hop.can->jitter;
-  if (const auto slack = slack_of(spec, hop, e2e)) f.deadline = *hop.latency + *slack;
+  if (const auto slack = slack_of(spec, hop, e2e, can_hops)) f.deadline = *hop.latency + *slack;
   return f;
 }
 
@@ -47,6 +50,18 @@ AnnouncedChannel channel_of(const ChannelReport& report, const ChannelSpec& spec
   c.payload = spec.payload;
   c.upstream = report.upstream;
   c.upstream_age = report.end_to_end.upstream;
+  // What no peer would decode: an over-long path or an age beyond the codec's bounds is announced
+  // as unbounded (the conservative reading), not refused with the whole announcement.
+  auto bounded = [](std::optional<Nanos>& value) {
+    if (value && (*value < Nanos(0) || *value > kMaxAnnouncedDuration)) value.reset();
+  };
+  if (c.upstream.size() > kMaxAnnouncedHops) {
+    c.upstream.clear();
+    c.upstream_age.reset();
+    c.end_to_end.reset();
+  }
+  bounded(c.upstream_age);
+  bounded(c.end_to_end);
   return c;
 }
 
@@ -77,8 +92,9 @@ Announcement announcement_of(const GatewayIdentity& self, const KnowledgeBase& k
     if (!spec) continue;
     // Past the bound a peer accepts, channels are left out of the list; their load and frames stay.
     if (a.channels.size() < kMaxAnnouncedChannels) a.channels.push_back(channel_of(channel, *spec));
+    const auto can_hops = static_cast<std::size_t>(std::count_if(channel.hops.begin(), channel.hops.end(), [](const HopReport& h) { return h.can.has_value(); }));
     for (const HopReport& hop : channel.hops) {
-      const auto frame = frame_of(*spec, hop, channel.end_to_end);
+      const auto frame = frame_of(*spec, hop, channel.end_to_end, can_hops);
       if (!frame) continue;
       for (AnnouncedSegment& s : a.segments) {
         if (s.name == hop.segment && s.frames.size() < kMaxAnnouncedFrames) s.frames.push_back(*frame);

@@ -17,7 +17,7 @@ using Json = nlohmann::json;
 // Deepest nesting of a valid announcement: object > segments > segment > frames > frame.
 constexpr int kMaxNesting = 6;
 // Longest period or latency an announcement may state (a day): beyond it a number is a mistake.
-constexpr std::int64_t kMaxAnnouncedNanos = 86'400'000'000'000;
+constexpr std::int64_t kMaxAnnouncedNanos = kMaxAnnouncedDuration.count();
 
 // 1 -> "1", 1e12 -> "1e+12": a bound as a refusal quotes it.
 std::string format_number(double value) { return Json(value).dump(); }
@@ -43,7 +43,8 @@ Json channel_json(const AnnouncedChannel& c) {
   for (const auto& h : c.hops) hops.push_back({{"segment", h.segment}, {"role", role_text(h.role)}, {"latency_ns", nanos_or_null(h.latency)}});
   Json upstream = Json::array();
   for (const auto& h : c.upstream) {
-    upstream.push_back({{"gateway", h.gateway}, {"segment", h.segment}, {"role", role_text(h.role)}, {"latency_ns", nanos_or_null(h.latency)}});
+    upstream.push_back({{"gateway", h.gateway}, {"gateway_id", gateway_id_text(h.gateway_id)}, {"segment", h.segment},
+                        {"role", role_text(h.role)}, {"latency_ns", nanos_or_null(h.latency)}});
   }
   return {{"name", c.name}, {"subject", c.subject}, {"class", to_string(c.cls)}, {"verdict", to_string(c.verdict)},
           {"hops", hops}, {"end_to_end_ns", nanos_or_null(c.end_to_end)}, {"period_ns", nanos_or_null(c.period)},
@@ -149,6 +150,21 @@ AnnouncedSegment read_segment(const Reader& r, const Json& j, const std::string&
   return s;
 }
 
+// A gateway id: 16 lower-case hexadecimal digits, not 0.
+std::uint64_t read_id(const Reader& r, const Json& j, const char* key, const std::string& where) {
+  const std::string text = r.text(j, key, where, false);
+  const std::string at = where + "." + key;
+  std::uint64_t id = 0;
+  if (text.size() != 16) throw Refusal{at + " is not 16 hexadecimal digits"};
+  for (const char c : text) {
+    const int digit = (c >= '0' && c <= '9') ? c - '0' : (c >= 'a' && c <= 'f') ? c - 'a' + 10 : -1;
+    if (digit < 0) throw Refusal{at + " is not 16 lower-case hexadecimal digits"};
+    id = (id << 4) | static_cast<std::uint64_t>(digit);
+  }
+  if (id == 0) throw Refusal{at + " is 0"};
+  return id;
+}
+
 HopRole read_role(const Reader& r, const Json& j, const std::string& where) {
   return r.choice<HopRole>(j, "role", where, {{"publisher", HopRole::publisher}, {"subscriber", HopRole::subscriber}});
 }
@@ -178,6 +194,7 @@ AnnouncedChannel read_channel(const Reader& r, const Json& j, const std::string&
     const std::string at = where + ".upstream[" + std::to_string(i) + "]";
     PathHop h;
     h.gateway = r.text(upstream[i], "gateway", at, false);
+    h.gateway_id = read_id(r, upstream[i], "gateway_id", at);
     h.segment = r.text(upstream[i], "segment", at, false);
     h.role = read_role(r, upstream[i], at);
     h.latency = r.nanos_or_unbounded(upstream[i], "latency_ns", at);
@@ -187,18 +204,6 @@ AnnouncedChannel read_channel(const Reader& r, const Json& j, const std::string&
   return c;
 }
 
-std::uint64_t read_gateway_id(const Reader& r, const Json& j) {
-  const std::string text = r.text(j, "gateway", "announcement", false);
-  std::uint64_t id = 0;
-  if (text.size() != 16) throw Refusal{"announcement.gateway is not 16 hexadecimal digits"};
-  for (const char c : text) {
-    const int digit = (c >= '0' && c <= '9') ? c - '0' : (c >= 'a' && c <= 'f') ? c - 'a' + 10 : -1;
-    if (digit < 0) throw Refusal{"announcement.gateway is not 16 lower-case hexadecimal digits"};
-    id = (id << 4) | static_cast<std::uint64_t>(digit);
-  }
-  if (id == 0) throw Refusal{"announcement.gateway is 0"};
-  return id;
-}
 
 Announcement read_announcement(const Json& j) {
   const Reader r;
@@ -206,7 +211,7 @@ Announcement read_announcement(const Json& j) {
     throw Refusal{"announcement.format is not " + std::string(kFederationFormat)};
   }
   Announcement a;
-  a.gateway = read_gateway_id(r, j);
+  a.gateway = read_id(r, j, "gateway", "announcement");
   a.name = r.text(j, "name", "announcement", false);
   a.revision = r.whole(j, "revision", "announcement", UINT64_MAX);
   a.residence = r.nanos(j, "residence_ns", "announcement");

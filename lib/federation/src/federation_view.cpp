@@ -1,6 +1,8 @@
 #include "cosmic/federation_view.hpp"
 
 #include <algorithm>
+#include <optional>
+#include <set>
 
 namespace cosmic {
 namespace {
@@ -20,21 +22,38 @@ void merge_heaviest(CanBackgroundFrame& kept, const CanBackgroundFrame& other) {
   if (other.deadline && (!kept.deadline || *other.deadline < *kept.deadline)) kept.deadline = other.deadline;
 }
 
-// The path `channel` gives its events before `hop` (one of its subscriber hops): its upstream,
-// its own publisher hops, and the age its events leave it with.
+// The path `channel` gives its events before the networks it sends them onto: its upstream, its
+// own publisher hops, and the age its events leave it with.
 UpstreamPath path_before(const Announcement& peer, const AnnouncedChannel& channel) {
   UpstreamPath path{peer.name, channel.name, channel.subject, channel.cls, channel.period, channel.reaction_time,
                     channel.temp_validity, channel.payload, channel.upstream, channel.upstream_age};
   Nanos slowest{0};
   for (const AnnouncedHop& hop : channel.hops) {
     if (hop.role != HopRole::publisher) continue;
-    path.hops.push_back(PathHop{peer.name, hop.segment, hop.role, hop.latency});
+    path.hops.push_back(PathHop{peer.name, hop.segment, hop.role, hop.latency, peer.gateway});
     if (!hop.latency) path.age.reset();
     if (hop.latency) slowest = std::max(slowest, *hop.latency);
   }
   if (path.age) path.age = *path.age + slowest + peer.residence;
   return path;
 }
+
+// A path that passes `self` (the channel goes round a ring of gateways back to this one) or any
+// gateway twice is no upstream: following it would grow the path with every announcement.
+bool loops(const UpstreamPath& path, std::uint64_t self) {
+  std::set<std::uint64_t> seen;
+  std::optional<std::uint64_t> current;  // a gateway's hops come together
+  for (const PathHop& hop : path.hops) {
+    if (hop.gateway_id == self) return true;
+    if (hop.gateway_id == current) continue;
+    if (!seen.insert(hop.gateway_id).second) return true;
+    current = hop.gateway_id;
+  }
+  return false;
+}
+
+// Of two gateways sending one subject onto one network, the slower path counts.
+bool slower(const UpstreamPath& a, const UpstreamPath& b) { return !a.age || (b.age && *a.age > *b.age); }
 
 const std::string* network_of(const Announcement& peer, const std::string& segment) {
   for (const AnnouncedSegment& s : peer.segments) {
@@ -78,7 +97,11 @@ std::string FederationView::cheap_refusal(const FederationMessage& message) {
   }
   const auto it = peers_.find(message.key);
   if (it != peers_.end() && it->second.source != message.source && it->second.state == PeerState::alive) {
-    pending_[message.key] = message;  // taken over once that writer is gone
+    // Kept to take over once that writer is gone: one per writer, and never in place of another
+    // writer's (a spoofer cannot displace a rejoined gateway's waiting announcement).
+    std::erase_if(pending_, [&](const auto& p) { return p.second.source == message.source && p.first != message.key; });
+    const auto waiting = pending_.find(message.key);
+    if (waiting == pending_.end() || waiting->second.source == message.source) pending_[message.key] = message;
     return "gateway " + gateway_id_text(message.key) + " (" + it->second.announcement.name + ") is announced by another writer";
   }
   if (it == peers_.end() && peers_.size() >= max_peers_) return "more than " + std::to_string(max_peers_) + " gateways in the federation";
@@ -167,12 +190,18 @@ bool FederationView::shared(const std::string& network) const {
 PeerNetworks FederationView::reservations() const {
   PeerNetworks out;
   std::map<std::string, std::map<std::pair<std::uint32_t, bool>, CanBackgroundFrame>> frames;  // by network, by identifier
+  std::map<std::string, std::map<std::uint64_t, UpstreamPath>> senders;                         // by network, by subject
   for (const auto& [id, peer] : peers_) {
     if (peer.state != PeerState::alive) continue;
     for (const AnnouncedChannel& channel : peer.announcement.channels) {
+      std::optional<UpstreamPath> path;  // built once per channel, when it sends onto a shared network
       for (const AnnouncedHop& hop : channel.hops) {
         const std::string* network = hop.role == HopRole::subscriber ? network_of(peer.announcement, hop.segment) : nullptr;
-        if (network) out[*network].senders.push_back(path_before(peer.announcement, channel));
+        if (!network) continue;
+        if (!path) path = path_before(peer.announcement, channel);
+        if (loops(*path, self_)) break;
+        auto [kept, fresh] = senders[*network].emplace(channel.subject, *path);
+        if (!fresh && slower(*path, kept->second)) kept->second = *path;
       }
     }
     // A bind in its claim window on a gateway with a lower id goes first: count it already.
@@ -188,6 +217,9 @@ PeerNetworks FederationView::reservations() const {
         if (!fresh) merge_heaviest(kept->second, frame);
       }
     }
+  }
+  for (auto& [network, by_subject] : senders) {
+    for (auto& [subject, path] : by_subject) out[network].senders.push_back(std::move(path));
   }
   counters_.frames_over_cap = 0;
   for (auto& [network, by_id] : frames) {

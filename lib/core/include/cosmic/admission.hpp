@@ -90,6 +90,7 @@ struct PathHop {
   std::string segment;  // its name for the segment
   HopRole role = HopRole::publisher;
   std::optional<Nanos> latency;  // nullopt: unbounded
+  std::uint64_t gateway_id = 0;  // its GatewayIdentity::id: a path through the reader itself is a ring
   friend bool operator==(const PathHop&, const PathHop&) = default;
 };
 

@@ -181,7 +181,7 @@ struct FederationSpec {
   Nanos lease{Nanos(3'000'000'000)};  // a peer silent (its participant's lease) this long is lost
   // A bind that adds load to a network other gateways share first claims it for this long, so a
   // concurrent bind on another gateway sees it (lower gateway id goes first).
-  Nanos claim_window{Nanos(300'000'000)};
+  Nanos claim_window{Nanos(500'000'000)};
   bool enabled() const { return !segment.empty(); }
   friend bool operator==(const FederationSpec&, const FederationSpec&) = default;
 };

@@ -27,6 +27,7 @@ class KnowledgeBase;
 
 // Bounds of an announcement the codec accepts (each refusal names the one exceeded).
 inline constexpr double kMaxAnnouncedBitsPerSecond = 1e12;
+inline constexpr Nanos kMaxAnnouncedDuration{86'400'000'000'000};  // a day
 inline constexpr std::size_t kMaxAnnouncementBytes = 1u << 20;
 inline constexpr std::size_t kMaxAnnouncedSegments = 64;
 inline constexpr std::size_t kMaxAnnouncedChannels = 4096;

@@ -82,8 +82,9 @@ class FederationView {
   // A CAN identifier announced by several peers counts once, as the heaviest of them (shortest
   // period, longest frame, largest jitter), so no peer can hide another's frame; at most
   // kMaxPeerFramesPerNetwork identifiers per network (the lowest, which delay the most), the rest
-  // counted in counters().frames_over_cap. `senders`: every channel a peer sends onto the network,
-  // with the path before it. A peer with a lower gateway id than this one's that is claiming (a
+  // counted in counters().frames_over_cap. `senders`: the channels peers send onto the network,
+  // with the path before it, one per subject (the slowest path when several peers send it); a path
+  // through this gateway or through any gateway twice (a ring) is left out. A peer with a lower gateway id than this one's that is claiming (a
   // bind in its claim window) counts with what it claims.
   static constexpr std::size_t kMaxPeerFramesPerNetwork = 4096;
   PeerNetworks reservations() const;
