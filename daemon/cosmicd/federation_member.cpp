@@ -111,22 +111,21 @@ void FederationMember::hear(cosmic::Nanos now) {
 }
 
 void FederationMember::announce() {
-  if (gateway_.generation() == announced_generation_ && !peers_changed_) return;
-  cosmic::Announcement now = cosmic::announcement_of(gateway_.identity(), gateway_.knowledge_base(), 0);
+  std::set<std::string> violated = gateway_.violated_channel_names();
+  if (gateway_.generation() == announced_generation_ && !peers_changed_ && violated == announced_violated_) return;
+  cosmic::Announcement now = cosmic::announcement_of(gateway_.identity(), gateway_.knowledge_base(), 0, violated);
   if (claim_) now.claim = claim_->segments;
-  if (announced_ && *announced_ == now) {
-    announced_generation_ = gateway_.generation();
-    peers_changed_ = false;
-    return;
+  if (!announced_ || *announced_ != now) {
+    cosmic::Announcement numbered = now;
+    numbered.revision = ++revision_;
+    if (!link_->publish(numbered.gateway, cosmic::encode(numbered))) {
+      log_.log(cosmic::LogLevel::warning, "federation: cannot publish this gateway's announcement; trying again");
+      return;  // nothing marked announced: the next tick tries again
+    }
+    announced_ = std::move(now);
   }
-  cosmic::Announcement numbered = now;
-  numbered.revision = ++revision_;
-  if (!link_->publish(numbered.gateway, cosmic::encode(numbered))) {
-    log_.log(cosmic::LogLevel::warning, "federation: cannot publish this gateway's announcement; trying again");
-    return;
-  }
-  announced_ = std::move(now);
   announced_generation_ = gateway_.generation();
+  announced_violated_ = std::move(violated);
   peers_changed_ = false;
 }
 

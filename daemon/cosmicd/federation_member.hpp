@@ -9,6 +9,7 @@
 
 #include <functional>
 #include <memory>
+#include <set>
 #include <nlohmann/json.hpp>
 
 #include "cosmic/federation_link.hpp"
@@ -78,6 +79,7 @@ class FederationMember {
   std::optional<cosmic::Announcement> announced_;  // with revision 0, to compare
   std::uint64_t announced_generation_ = UINT64_MAX;
   bool peers_changed_ = false;
+  std::set<std::string> announced_violated_;  // channels announced violated at run time
   struct Claim {
     cosmic::Nanos deadline{0};
     std::function<void()> commit;

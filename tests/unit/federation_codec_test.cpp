@@ -36,6 +36,7 @@ Announcement sample_announcement() {
   steer.payload = 8;
   steer.upstream = {PathHop{"gw1", "front-can", HopRole::publisher, Nanos(1ms), 0x77}};
   steer.upstream_age = Nanos(2ms);
+  steer.violated = true;
   AnnouncedChannel log;
   log.name = "log";
   log.subject = 7;

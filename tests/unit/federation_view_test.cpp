@@ -389,6 +389,21 @@ TEST(FederationEndToEnd, AChannelCrossingTwoGatewaysIsAdmittedOverTheWholePath) 
   EXPECT_TRUE(has_reason(refused, "through gateway gw1")) << reasons_text(refused);
 }
 
+TEST(FederationEndToEnd, AnUpstreamViolatedAtRunTimeDegradesTheChannelHere) {
+  FederationView view(kSelf);
+  Announcement a = upstream_gateway(Nanos(1ms));
+  a.channels[0].violated = true;
+  ASSERT_TRUE(view.apply(said(a, "w1"), Nanos(1s)));
+  KnowledgeBase kb(gateway(500us), {dds_segment("backbone", 1ms, false), lcm_segment("rear", 2ms)});
+  ASSERT_TRUE(kb.bind(channel("steer", 0x77, ChannelClass::srt, {"backbone"}, {"rear"}, 8, Nanos(10ms), Nanos(20ms))).bound());
+  EXPECT_EQ(kb.report().find("steer")->verdict, Verdict::bound);
+  kb.set_peer_reservations(view.reservations());
+  const AdmissionReport report = kb.report();
+  EXPECT_EQ(report.find("steer")->verdict, Verdict::degraded);
+  EXPECT_TRUE(has_reason(*report.find("steer"), "gateway gw1 reports channel steer-front violated at run time"))
+      << reasons_text(*report.find("steer"));
+}
+
 TEST(FederationEndToEnd, ConflictingDefinitionsOfOneSubjectAreMismatchesWithReasons) {
   FederationView view(kSelf);
   // gw1 sends it every 5 ms; this gateway admitted one every 10 ms.

@@ -56,6 +56,10 @@ void apply_upstream(const ChannelSpec& channel, const UpstreamPath& upstream, Ch
     worsen(consequence_of("validity", channel.cls),
            path + " >= temp_validity " + format_duration(*channel.temp_validity) + ": events would arrive stale");
   }
+  if (upstream.violated) {
+    worsen(consequence_of("latency", channel.cls), "gateway " + upstream.gateway + " reports channel " + upstream.channel +
+                                                       " violated at run time: the path's bound does not hold now");
+  }
   for (auto& [verdict, reason] : definition_differences(channel, upstream)) worsen(verdict, std::move(reason));
 }
 

@@ -67,7 +67,8 @@ AnnouncedChannel channel_of(const ChannelReport& report, const ChannelSpec& spec
 
 }  // namespace
 
-Announcement announcement_of(const GatewayIdentity& self, const KnowledgeBase& kb, std::uint64_t revision) {
+Announcement announcement_of(const GatewayIdentity& self, const KnowledgeBase& kb, std::uint64_t revision,
+                             const std::set<std::string>& violated) {
   Announcement a;
   a.gateway = self.id;
   a.name = self.name;
@@ -91,7 +92,10 @@ Announcement announcement_of(const GatewayIdentity& self, const KnowledgeBase& k
     const ChannelSpec* spec = kb.find_bound(channel.name);
     if (!spec) continue;
     // Past the bound a peer accepts, channels are left out of the list; their load and frames stay.
-    if (a.channels.size() < kMaxAnnouncedChannels) a.channels.push_back(channel_of(channel, *spec));
+    if (a.channels.size() < kMaxAnnouncedChannels) {
+      a.channels.push_back(channel_of(channel, *spec));
+      a.channels.back().violated = violated.count(channel.name) > 0;
+    }
     const auto can_hops = static_cast<std::size_t>(std::count_if(channel.hops.begin(), channel.hops.end(), [](const HopReport& h) { return h.can.has_value(); }));
     for (const HopReport& hop : channel.hops) {
       const auto frame = frame_of(*spec, hop, channel.end_to_end, can_hops);

@@ -49,7 +49,7 @@ Json channel_json(const AnnouncedChannel& c) {
   return {{"name", c.name}, {"subject", c.subject}, {"class", to_string(c.cls)}, {"verdict", to_string(c.verdict)},
           {"hops", hops}, {"end_to_end_ns", nanos_or_null(c.end_to_end)}, {"period_ns", nanos_or_null(c.period)},
           {"reaction_time_ns", nanos_or_null(c.reaction_time)}, {"temp_validity_ns", nanos_or_null(c.temp_validity)},
-          {"payload", c.payload}, {"upstream", upstream}, {"upstream_ns", nanos_or_null(c.upstream_age)}};
+          {"payload", c.payload}, {"upstream", upstream}, {"upstream_ns", nanos_or_null(c.upstream_age)}, {"violated", c.violated}};
 }
 
 // Reads one announcement; the first problem throws Refusal (caught by decode_announcement only).
@@ -201,6 +201,7 @@ AnnouncedChannel read_channel(const Reader& r, const Json& j, const std::string&
     c.upstream.push_back(std::move(h));
   }
   c.upstream_age = r.nanos_or_unbounded(j, "upstream_ns", where);
+  c.violated = r.flag(j, "violated", where);
   return c;
 }
 

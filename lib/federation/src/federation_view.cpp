@@ -26,7 +26,7 @@ void merge_heaviest(CanBackgroundFrame& kept, const CanBackgroundFrame& other) {
 // own publisher hops, and the age its events leave it with.
 UpstreamPath path_before(const Announcement& peer, const AnnouncedChannel& channel) {
   UpstreamPath path{peer.name, channel.name, channel.subject, channel.cls, channel.period, channel.reaction_time,
-                    channel.temp_validity, channel.payload, channel.upstream, channel.upstream_age};
+                    channel.temp_validity, channel.payload, channel.upstream, channel.upstream_age, channel.violated};
   Nanos slowest{0};
   for (const AnnouncedHop& hop : channel.hops) {
     if (hop.role != HopRole::publisher) continue;

@@ -537,6 +537,14 @@ std::size_t Gateway::violated_channels() const {
                                                 [](const auto& t) { return t.second.state == RuntimeState::violated; }));
 }
 
+std::set<std::string> Gateway::violated_channel_names() const {
+  std::set<std::string> names;
+  for (const auto& [name, track] : runtime_) {
+    if (track.state == RuntimeState::violated) names.insert(name);
+  }
+  return names;
+}
+
 std::vector<std::string> Gateway::take_thread_problems() { return router_ ? router_->take_thread_problems() : std::vector<std::string>{}; }
 
 std::optional<std::size_t> Gateway::matched_peers(const std::string& segment, const std::string& channel) const {

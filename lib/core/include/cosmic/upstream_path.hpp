@@ -27,6 +27,7 @@ struct UpstreamPath {
   std::uint64_t payload = 0;
   std::vector<PathHop> hops;  // every hop before the shared network, on that gateway and before it
   std::optional<Nanos> age;   // worst-case age of its events when sent onto the network; nullopt: unbounded
+  bool violated = false;      // that gateway reports the channel `violated` at run time now
   friend bool operator==(const UpstreamPath&, const UpstreamPath&) = default;
 };
 
@@ -34,7 +35,8 @@ struct UpstreamPath {
 // gateway's, the whole path's latency against reaction_time and temp_validity, and a reason for
 // every way the upstream gateway's definition differs from this one. An upstream that sends events
 // more often or larger than `channel` admits fails the channel like a check does (rejected for
-// HRT); other differences (class, reaction_time, temp_validity) degrade it.
+// HRT); other differences (class, reaction_time, temp_validity) degrade it. An upstream that
+// reports the channel violated at run time fails it like a missed end-to-end bound.
 void apply_upstream(const ChannelSpec& channel, const UpstreamPath& upstream, ChannelReport& report);
 
 }  // namespace cosmic

@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -86,6 +87,8 @@ struct AnnouncedChannel {
   // events arrive with (0: they start here; nullopt: unbounded).
   std::vector<PathHop> upstream;
   std::optional<Nanos> upstream_age{Nanos(0)};
+  // Its bounds do not hold at run time now (the gateway's runtime state `violated`).
+  bool violated = false;
   friend bool operator==(const AnnouncedChannel&, const AnnouncedChannel&) = default;
 };
 
@@ -104,8 +107,10 @@ struct Announcement {
 };
 
 // What this gateway announces: its segments' networks and reservations and its bound channels'
-// hops, from the knowledge base. `revision` is the caller's counter.
-Announcement announcement_of(const GatewayIdentity& self, const KnowledgeBase& kb, std::uint64_t revision);
+// hops, from the knowledge base; `violated` names the channels whose bounds do not hold at run
+// time now. `revision` is the caller's counter.
+Announcement announcement_of(const GatewayIdentity& self, const KnowledgeBase& kb, std::uint64_t revision,
+                             const std::set<std::string>& violated = {});
 
 std::string encode(const Announcement& announcement);
 

@@ -165,6 +165,8 @@ class Gateway {
   // Updates the runtime state of every channel from the lanes' miss counters (call periodically).
   void refresh_runtime(Nanos now);
   std::size_t violated_channels() const;
+  // Their names (the federation announces them to gateways downstream).
+  std::set<std::string> violated_channel_names() const;
   // What the forwarding threads could not get of gateway.realtime since the last call.
   std::vector<std::string> take_thread_problems();
 
