@@ -17,6 +17,7 @@
 #include "cosmic/config_loader.hpp"
 #include "cosmic/control_server.hpp"
 #include "cosmic/dds_federation_link.hpp"
+#include "cosmic/thread_policy.hpp"
 #include "daemon_logger.hpp"
 #include "federation_member.hpp"
 #include "metrics_server.hpp"
@@ -151,6 +152,10 @@ class Daemon {
     std::erase_if(config.channels, [&](const cosmic::ChannelSpec& c) {
       return std::find(state_.unbound.begin(), state_.unbound.end(), c.name) != state_.unbound.end();
     });
+    // Before the gateway starts its threads: they start from this one and inherit the placement
+    // of `other` unless their own kind has CPUs.
+    for (const auto& problem : cosmic::place_process_threads(config.gateway.realtime.cpus.other))
+      log_.log(cosmic::LogLevel::warning, "realtime: " + problem);
     const auto started = gateway_.start(config);
     if (!started.applied) {
       log_.log(cosmic::LogLevel::error, started.error);
@@ -180,6 +185,17 @@ class Daemon {
     log_.log(cosmic::LogLevel::info, "realtime: SCHED_FIFO priorities hrt " + std::to_string(realtime.hrt_priority) + ", srt " +
                                          std::to_string(realtime.srt_priority) + ", nrt " + std::to_string(realtime.nrt_priority) +
                                          ", receive " + std::to_string(realtime.receive_priority));
+    if (realtime.cpus.any()) {
+      const auto list = [](const std::vector<int>& cpus) {
+        if (cpus.empty()) return std::string("any");
+        std::string text;
+        for (const int cpu : cpus) text += (text.empty() ? "" : ",") + std::to_string(cpu);
+        return text;
+      };
+      const cosmic::CpuPlacement& c = realtime.cpus;
+      log_.log(cosmic::LogLevel::info, "realtime: CPUs hrt " + list(c.hrt) + ", srt " + list(c.srt) + ", nrt " + list(c.nrt) +
+                                           ", receive " + list(c.receive) + ", other " + list(c.other));
+    }
   }
 
   // An entry that cannot be bound now (a segment down at boot, a changed configuration) stays

@@ -251,7 +251,7 @@ int dds_pub(const DdsOptions& o) {
       r = writer->write(sample, fdds::HANDLE_NIL);
     }
     return r == ReturnCode_t::RETCODE_OK;
-  });
+  }, o.max_rate);
   if (!g_stalled) writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0));
   if (retries > 0) err_line("write retries: " + std::to_string(retries));
   return rc;

@@ -16,6 +16,7 @@ struct DdsOptions {
   std::uint64_t count = 0;
   std::uint64_t size = 64;
   double rate = 0;
+  double max_rate = 0;  // 0: catch up after a stall at full speed
   std::uint64_t warmup = 200;
   int keep_last = 0;  // 0: KEEP_ALL
   bool wait_go = false;

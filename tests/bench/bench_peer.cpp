@@ -2,12 +2,12 @@
 // each side in its own process. The same code measures the native paths (LCM -> LCM,
 // DDS -> DDS) and the paths through cosmicd, so the only difference between them is the gateway.
 //
-//   cosmic-bench-peer lcm-pub --url U --channel C --count N --size B [--rate HZ] [--warmup W]
+//   cosmic-bench-peer lcm-pub --url U --channel C --count N --size B [--rate HZ] [--warmup W] [--max-rate HZ]
 //                             [--envelope]
 //   cosmic-bench-peer lcm-sub --url U --channel C --count N [--timeout S] [--idle S] [--envelope]
 //                             [--dump FILE]
 //   cosmic-bench-peer dds-pub --domain D --topic T --count N --size B [--rate HZ] [--warmup W]
-//                             [--keep-last DEPTH] [--wait-go] [--match-timeout S] [--stall S]
+//                             [--max-rate HZ] [--keep-last DEPTH] [--wait-go] [--match-timeout S] [--stall S]
 //                             [--native TYPE]
 //   cosmic-bench-peer dds-sub --domain D --topic T --count N [--timeout S] [--idle S] [--dump FILE]
 //                             [--native TYPE]
@@ -26,7 +26,8 @@
 //
 // Publishers first send W warm-up events (default 200, paced at min(rate, 5000)/s; they let
 // discovery settle and warm caches and are ignored by the receiver), pause 200 ms, then the N
-// measured events at --rate (0: as fast as possible). dds-pub waits until a reader matched
+// measured events at --rate (0: as fast as possible); with --max-rate (the channel's contract) a
+// publisher the machine held up catches up no faster than that rate. dds-pub waits until a reader matched
 // (exit 2 after --match-timeout), and with --wait-go prints WAITING on stderr and reads one line
 // on stdin before sending (the caller first checks the far side has matched us too).
 //
@@ -37,6 +38,7 @@
 // Each program ends with one line on stdout: "RESULT key=value ...".
 //   pub: sent failed seconds rate (measured events only) stalled (dds-pub: 1 when the reader side
 //        stopped accepting events for --stall seconds, default 5; the run then ends, exit 5)
+//        late_max_us late_over_1ms (how late against its schedule the publisher got to send)
 //   sub: expected received lost duplicates malformed p50_us p90_us p99_us p999_us max_us mean_us
 //        span_s rate (measured events per second between the first and the last arrival)
 //        warmup_received
@@ -206,6 +208,7 @@ struct LcmOptions {
   std::uint64_t count = 0;
   std::uint64_t size = 64;
   double rate = 0;
+  double max_rate = 0;
   std::uint64_t warmup = 200;
   bool envelope = false;
   double timeout = 60;
@@ -232,7 +235,7 @@ int lcm_pub(const LcmOptions& o) {
     buffer.resize(static_cast<std::size_t>(e.getEncodedSize()));
     e.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
     return lcm_publish(lcm, o.channel.c_str(), buffer.data(), static_cast<unsigned>(buffer.size())) == 0;
-  });
+  }, o.max_rate);
   lcm_destroy(lcm);
   return rc;
 }
@@ -328,6 +331,7 @@ int main(int argc, char** argv) {
   lcm_common(lp);
   lp->add_option("--size", lo.size, "payload bytes (>= 16)");
   lp->add_option("--rate", lo.rate, "events/s (0: as fast as possible)");
+  lp->add_option("--max-rate", lo.max_rate, "the channel's max_rate: catch up after a stall no faster than this");
   lp->add_option("--warmup", lo.warmup, "warm-up events");
   CLI::App* ls = app.add_subcommand("lcm-sub", "receive on LCM");
   lcm_common(ls);
@@ -338,6 +342,7 @@ int main(int argc, char** argv) {
   dds_common(dp);
   dp->add_option("--size", dd.size, "payload bytes (>= 16)");
   dp->add_option("--rate", dd.rate, "events/s (0: as fast as possible)");
+  dp->add_option("--max-rate", dd.max_rate, "the channel's max_rate: catch up after a stall no faster than this");
   dp->add_option("--warmup", dd.warmup, "warm-up events");
   dp->add_option("--keep-last", dd.keep_last, "KEEP_LAST depth (default KEEP_ALL)");
   dp->add_flag("--wait-go", dd.wait_go, "after matching, wait for a line on stdin");

@@ -34,13 +34,24 @@ void stamp(std::vector<std::uint8_t>& payload);
 void err_line(const std::string& text);
 
 // Drives a publisher: warm-up, pause, measured events. send(payload) returns false on failure.
+// Measured event k is due at start + (k - 1) / rate. With max_rate > 0 the publisher keeps a
+// channel contract of that rate as a real component would: after a stall (this process not
+// scheduled) it catches up no faster than max_rate instead of sending the missed events back to
+// back, which would exceed its contract. How late events went out against their schedule is
+// reported (late_max_us, late_over_1ms): that is the machine delaying the publisher, not the
+// network after it.
 template <typename Send>
-int publish_all(std::uint64_t count, std::uint64_t size, double rate, std::uint64_t warmup, Send&& send) {
+int publish_all(std::uint64_t count, std::uint64_t size, double rate, std::uint64_t warmup, Send&& send,
+                double max_rate = 0) {
   std::vector<std::uint8_t> payload(std::max<std::uint64_t>(size, kMinSize));
   const double warm_rate = rate > 0 ? std::min(rate, 5000.0) : 5000.0;
+  const std::int64_t min_gap = max_rate > 0 ? static_cast<std::int64_t>(1e9 / max_rate) : 0;
+  std::int64_t last_send = 0;
   std::int64_t start = mono_ns();
   for (std::uint64_t k = 1; k <= warmup && !g_stop && !g_stalled; ++k) {
-    sleep_until_ns(start + static_cast<std::int64_t>(static_cast<double>(k - 1) * 1e9 / warm_rate));
+    const std::int64_t scheduled = start + static_cast<std::int64_t>(static_cast<double>(k - 1) * 1e9 / warm_rate);
+    sleep_until_ns(k > 1 ? std::max(scheduled, last_send + min_gap) : scheduled);
+    last_send = mono_ns();
     fill(payload, kWarmupBit | static_cast<std::uint32_t>(k));
     stamp(payload);
     send(payload);
@@ -48,9 +59,17 @@ int publish_all(std::uint64_t count, std::uint64_t size, double rate, std::uint6
   if (warmup > 0) sleep_until_ns(mono_ns() + 200'000'000);
   std::uint64_t sent = 0;
   std::uint64_t failed = 0;
+  std::int64_t late_max = 0;
+  std::uint64_t late_over_1ms = 0;
   start = mono_ns();
   for (std::uint64_t k = 1; k <= count && !g_stop && !g_stalled; ++k) {
-    if (rate > 0) sleep_until_ns(start + static_cast<std::int64_t>(static_cast<double>(k - 1) * 1e9 / rate));
+    if (rate > 0) {
+      const std::int64_t scheduled = start + static_cast<std::int64_t>(static_cast<double>(k - 1) * 1e9 / rate);
+      sleep_until_ns(k > 1 ? std::max(scheduled, last_send + min_gap) : scheduled);
+      last_send = mono_ns();
+      late_max = std::max(late_max, last_send - scheduled);
+      if (last_send - scheduled > 1'000'000) ++late_over_1ms;
+    }
     fill(payload, static_cast<std::uint32_t>(k));
     stamp(payload);
     if (send(payload)) {
@@ -60,8 +79,10 @@ int publish_all(std::uint64_t count, std::uint64_t size, double rate, std::uint6
     }
   }
   const double seconds = static_cast<double>(mono_ns() - start) / 1e9;
-  std::printf("RESULT sent=%" PRIu64 " failed=%" PRIu64 " seconds=%.6f rate=%.0f stalled=%d\n", sent, failed,
-              seconds, seconds > 0 ? static_cast<double>(sent) / seconds : 0.0, g_stalled ? 1 : 0);
+  std::printf("RESULT sent=%" PRIu64 " failed=%" PRIu64 " seconds=%.6f rate=%.0f stalled=%d late_max_us=%.1f"
+              " late_over_1ms=%" PRIu64 "\n",
+              sent, failed, seconds, seconds > 0 ? static_cast<double>(sent) / seconds : 0.0, g_stalled ? 1 : 0,
+              static_cast<double>(late_max) / 1e3, late_over_1ms);
   std::fflush(stdout);
   if (g_stalled) return 5;
   return failed == 0 && !g_stop ? 0 : 4;

@@ -36,7 +36,8 @@
 //   {"event":"publication"|"subscription","topic":T,"participant":P,"reliability":"reliable"|"best_effort",
 //    "durability":..,"deadline_ns":..,"lifespan_ns":..,"latency_budget_ns":..}
 //      a remote writer (sub mode) or reader (pub mode) of the topic was discovered, with the QoS
-//      it announced (durations null when infinite) and its participant's GUID prefix P (hex)
+//      it announced (durations null when infinite), its participant's GUID prefix P (hex) and
+//      "transports": the kinds of the unicast locators it is reached at ("udpv4", "shm", ...)
 //   {"event":"done",...}
 // Fast DDS's own log goes to stderr too.
 #include <signal.h>
@@ -48,6 +49,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <iostream>
+#include <set>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -141,10 +143,26 @@ std::string prefix_hex(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) {
   return out;
 }
 
+// The kinds of the locators an endpoint announced, each once: what transports reach it.
+json locator_kinds(const eprosima::fastrtps::rtps::RemoteLocatorList& locators) {
+  std::set<std::string> kinds;
+  for (const auto& locator : locators.unicast) {
+    switch (locator.kind) {
+      case LOCATOR_KIND_UDPv4: kinds.insert("udpv4"); break;
+      case LOCATOR_KIND_UDPv6: kinds.insert("udpv6"); break;
+      case LOCATOR_KIND_SHM: kinds.insert("shm"); break;
+      default: kinds.insert("kind " + std::to_string(locator.kind)); break;
+    }
+  }
+  return json(std::vector<std::string>(kinds.begin(), kinds.end()));
+}
+
 template <typename Qos>
 json qos_json(const char* kind, const std::string& topic, const Qos& qos,
-              const eprosima::fastrtps::rtps::GuidPrefix_t& participant) {
+              const eprosima::fastrtps::rtps::GuidPrefix_t& participant,
+              const eprosima::fastrtps::rtps::RemoteLocatorList& locators) {
   return json{{"event", kind},
+              {"transports", locator_kinds(locators)},
               {"topic", topic},
               {"participant", prefix_hex(participant)},
               {"reliability", qos.m_reliability.kind == fdds::RELIABLE_RELIABILITY_QOS
@@ -169,7 +187,7 @@ class Listener : public fdds::DomainParticipantListener {
     if (info.info.guid().guidPrefix == participant->guid().guidPrefix) return;  // our own
     if (info.status == eprosima::fastrtps::rtps::WriterDiscoveryInfo::DISCOVERED_WRITER &&
         info.info.topicName().to_string() == topic_) {
-      diag(qos_json("publication", topic_, info.info.m_qos, info.info.guid().guidPrefix));
+      diag(qos_json("publication", topic_, info.info.m_qos, info.info.guid().guidPrefix, info.info.remote_locators()));
     }
   }
   void on_subscriber_discovery(fdds::DomainParticipant* participant,
@@ -177,7 +195,7 @@ class Listener : public fdds::DomainParticipantListener {
     if (info.info.guid().guidPrefix == participant->guid().guidPrefix) return;  // our own
     if (info.status == eprosima::fastrtps::rtps::ReaderDiscoveryInfo::DISCOVERED_READER &&
         info.info.topicName().to_string() == topic_) {
-      diag(qos_json("subscription", topic_, info.info.m_qos, info.info.guid().guidPrefix));
+      diag(qos_json("subscription", topic_, info.info.m_qos, info.info.guid().guidPrefix, info.info.remote_locators()));
     }
   }
   void on_publication_matched(fdds::DataWriter*,

@@ -251,7 +251,7 @@ class ConfigParser {
     if (!type) {
       reader_.check_map(node, path, {"name", "type", "interface", "profile", "bitrate", "fd", "data_bitrate", "errors", "max_utilization",
                                      "background", "domain", "latency_bound", "bandwidth", "reliability", "realtime", "max_message_size",
-                                     "interfaces", "discovery_server", "url", "network"});
+                                     "interfaces", "discovery_server", "shared_memory", "url", "network"});
       return std::nullopt;
     }
     s.type = static_cast<SegmentType>(*type);
@@ -352,7 +352,8 @@ class ConfigParser {
 
   void parse_dds(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
     reader_.check_map(node, path, {"name", "type", "domain", "latency_bound", "bandwidth", "reliability", "realtime",
-                                   "max_message_size", "interfaces", "discovery_server", "max_utilization", "network"});
+                                   "max_message_size", "interfaces", "discovery_server", "shared_memory", "max_utilization",
+                                   "network"});
     parse_ip_common(node, path, s);
     if (has(node, "domain")) {
       if (auto v = reader_.unsigned_int(node["domain"], key(path, "domain"), 0, 232)) s.dds.domain = static_cast<std::uint32_t>(*v);
@@ -374,6 +375,16 @@ class ConfigParser {
         }
         s.dds.discovery_server = *v;
       }
+    }
+    if (has(node, "shared_memory")) parse_shared_memory(node["shared_memory"], key(path, "shared_memory"), s);
+  }
+
+  // `shared_memory: [srt, nrt]`: the classes whose participant also uses Fast DDS's shared memory.
+  void parse_shared_memory(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
+    if (!reader_.is_list(node, path)) return;
+    s.dds.shared_memory = {false, false, false};
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      if (auto v = reader_.choice(node[i], indexed(path, i), {"hrt", "srt", "nrt"})) s.dds.shared_memory[*v] = true;
     }
   }
 

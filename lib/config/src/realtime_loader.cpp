@@ -25,7 +25,7 @@ void parse_priorities(YamlReader& reader, const YAML::Node& node, const std::str
   }
 }
 
-void parse_cpus(YamlReader& reader, const YAML::Node& node, const std::string& path, RealtimeSpec& out) {
+void parse_cpu_list(YamlReader& reader, const YAML::Node& node, const std::string& path, std::vector<int>& out) {
   if (!reader.is_list(node, path)) return;
   const unsigned available = std::max(1u, std::thread::hardware_concurrency());
   for (std::size_t i = 0; i < node.size(); ++i) {
@@ -36,8 +36,30 @@ void parse_cpus(YamlReader& reader, const YAML::Node& node, const std::string& p
                         "a CPU number below " + std::to_string(available));
         continue;
       }
-      out.cpus.push_back(static_cast<int>(*v));
+      out.push_back(static_cast<int>(*v));
     }
+  }
+}
+
+// `cpus: [..]` places every thread on those CPUs; `cpus: {hrt: [..], srt, nrt, receive, other}`
+// places each kind on its own (a kind not named may run anywhere).
+void parse_cpus(YamlReader& reader, const YAML::Node& node, const std::string& path, CpuPlacement& out) {
+  if (node.IsSequence()) {
+    std::vector<int> all;
+    parse_cpu_list(reader, node, path, all);
+    out = CpuPlacement{all, all, all, all, all};
+    return;
+  }
+  if (!node.IsMap()) {
+    reader.error_at(node, path, "expected a list of CPUs or a map of them by thread kind",
+                    "cpus: [1] or cpus: {hrt: [1], srt: [1], nrt: [0], receive: [0], other: [0]}");
+    return;
+  }
+  if (!reader.check_map(node, path, {"hrt", "srt", "nrt", "receive", "other"})) return;
+  const std::pair<const char*, std::vector<int>*> kinds[] = {
+      {"hrt", &out.hrt}, {"srt", &out.srt}, {"nrt", &out.nrt}, {"receive", &out.receive}, {"other", &out.other}};
+  for (const auto& [name, target] : kinds) {
+    if (present(node, name)) parse_cpu_list(reader, node[name], path + "." + name, *target);
   }
 }
 
@@ -46,7 +68,7 @@ void parse_cpus(YamlReader& reader, const YAML::Node& node, const std::string& p
 void parse_realtime(YamlReader& reader, const YAML::Node& node, const std::string& path, RealtimeSpec& out) {
   if (!reader.check_map(node, path, {"priorities", "cpus", "lock_memory"})) return;
   if (present(node, "priorities")) parse_priorities(reader, node["priorities"], path + ".priorities", out);
-  if (present(node, "cpus")) parse_cpus(reader, node["cpus"], path + ".cpus", out);
+  if (present(node, "cpus")) parse_cpus(reader, node["cpus"], path + ".cpus", out.cpus);
   if (present(node, "lock_memory")) {
     if (auto v = reader.boolean(node["lock_memory"], path + ".lock_memory")) out.lock_memory = *v;
   }

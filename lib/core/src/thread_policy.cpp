@@ -6,10 +6,23 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
+#include <dirent.h>
+
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 
 namespace cosmic {
+namespace {
+cpu_set_t cpu_set_of(const std::vector<int>& cpus) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  for (const int cpu : cpus) {
+    if (cpu >= 0 && cpu < CPU_SETSIZE) CPU_SET(cpu, &set);
+  }
+  return set;
+}
+}  // namespace
 
 std::vector<std::string> apply_thread_policy(const ThreadPolicy& policy) {
   std::vector<std::string> problems;
@@ -19,11 +32,7 @@ std::vector<std::string> apply_thread_policy(const ThreadPolicy& policy) {
       problems.push_back("name " + name + ": " + std::strerror(rc));
   }
   if (!policy.cpus.empty()) {
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    for (const int cpu : policy.cpus) {
-      if (cpu >= 0 && cpu < CPU_SETSIZE) CPU_SET(cpu, &set);
-    }
+    const cpu_set_t set = cpu_set_of(policy.cpus);
     if (const int rc = pthread_setaffinity_np(pthread_self(), sizeof set, &set); rc != 0)
       problems.push_back("CPU affinity: " + std::string(std::strerror(rc)));
   }
@@ -38,6 +47,27 @@ std::vector<std::string> apply_thread_policy(const ThreadPolicy& policy) {
     if (::setpriority(PRIO_PROCESS, tid, policy.nice) != 0)
       problems.push_back("nice " + std::to_string(policy.nice) + ": " + std::strerror(errno));
   }
+  return problems;
+}
+
+}  // namespace cosmic
+
+namespace cosmic {
+
+std::vector<std::string> place_process_threads(const std::vector<int>& cpus) {
+  std::vector<std::string> problems;
+  if (cpus.empty()) return problems;
+  const cpu_set_t set = cpu_set_of(cpus);
+  DIR* tasks = ::opendir("/proc/self/task");
+  if (tasks == nullptr) return {std::string("CPU affinity: /proc/self/task: ") + std::strerror(errno)};
+  while (const dirent* entry = ::readdir(tasks)) {
+    if (entry->d_name[0] == '.') continue;
+    const auto tid = static_cast<pid_t>(std::strtol(entry->d_name, nullptr, 10));
+    // A thread that ended since the directory was read is no problem.
+    if (::sched_setaffinity(tid, sizeof set, &set) != 0 && errno != ESRCH)
+      problems.push_back("CPU affinity of thread " + std::to_string(tid) + ": " + std::strerror(errno));
+  }
+  ::closedir(tasks);
   return problems;
 }
 

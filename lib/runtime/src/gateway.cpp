@@ -57,7 +57,7 @@ RouterLimits router_limits(const GatewaySpec& gateway) {
   const int priority[3] = {rt.hrt_priority, rt.srt_priority, rt.nrt_priority};
   for (std::size_t c = 0; c < 3; ++c) {
     limits.lane_threads[c].fifo_priority = priority[c];
-    limits.lane_threads[c].cpus = rt.cpus;
+    limits.lane_threads[c].cpus = rt.cpus.of(static_cast<ChannelClass>(c));
   }
   return limits;
 }
@@ -66,7 +66,7 @@ BindResult Gateway::start(const Config& config) {
   identity_.name = config.gateway.name;
   const RouterLimits limits = router_limits(config.gateway);
   router_ = std::make_unique<Router>(identity_, kMaxSegments, limits);
-  const ThreadPolicy receive{"rx", config.gateway.realtime.receive_priority, 0, config.gateway.realtime.cpus};
+  const ThreadPolicy receive{"rx", config.gateway.realtime.receive_priority, 0, config.gateway.realtime.cpus.receive};
   for (std::size_t i = 0; i < kMaxSegments; ++i) {
     EventSink& inbox = router_->inbox(i);
     inbox.set_receive_thread_policy(receive);

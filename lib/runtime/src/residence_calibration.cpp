@@ -98,7 +98,7 @@ CalibrationPhase run_phase(const GatewaySpec& gateway, const CalibrationOptions&
   // The HRT producer plays an adapter's receive thread, so it runs as gateway.realtime says.
   std::thread producer([&] {
     const RealtimeSpec& rt = gateway.realtime;
-    for (auto& p : apply_thread_policy(ThreadPolicy{"calib-rx", rt.receive_priority, 0, rt.cpus}))
+    for (auto& p : apply_thread_policy(ThreadPolicy{"calib-rx", rt.receive_priority, 0, rt.cpus.receive}))
       problems.push_back("receive thread: " + p);
     phase.hrt_events = offer_hrt(router, options);
   });

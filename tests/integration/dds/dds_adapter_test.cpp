@@ -128,6 +128,46 @@ TEST(DdsAdapter, EachClassHasAParticipantOfItsOwn) {
   EXPECT_EQ(sub.out_lines().size(), 3u);
 }
 
+// The HRT participant speaks UDP alone by default, to peers on this host too: under an NRT flood
+// Fast DDS's shared-memory path held HRT samples back for up to 10 ms and let them go in a bunch
+// (scripts/bench, HRT under flood), UDP did not. The other classes keep shared memory, and
+// `shared_memory` gives it back to HRT. What a native subscriber discovers is what it would use.
+TEST(DdsAdapter, HrtParticipantSpeaksUdpAloneUnlessSharedMemoryIsAsked) {
+  for (const bool hrt_shared : {false, true}) {
+    SCOPED_TRACE(hrt_shared ? "shared_memory: [hrt, srt, nrt]" : "default");
+    const std::uint32_t domain = hrt_shared ? 68 : 67;
+    SegmentSpec spec = dds_segment(domain);
+    if (hrt_shared) spec.dds.shared_memory = {true, true, true};
+    Fixture f(spec);
+    ASSERT_TRUE(f.adapter->start(f.sink).ok);
+    ChannelBinding hrt = binding(1, "ctl.hrt", HopRole::subscriber);
+    hrt.spec.cls = ChannelClass::hrt;
+    ChannelBinding nrt = binding(2, "log.nrt", HopRole::subscriber);
+    const ChannelBinding all[] = {hrt, nrt};
+    ASSERT_TRUE(f.adapter->configure(all).ok);
+    auto transports_of = [&](const std::string& topic) {
+      Child sub(peer({"sub", "--domain", std::to_string(domain), "--topic", topic, "--count", "1", "--timeout", "30"}));
+      json kinds;
+      EXPECT_TRUE(sub.wait_err(
+          [&](const std::string& line) {
+            const json j = parse(line);
+            if (!j.is_object() || j.value("event", "") != "publication") return false;
+            kinds = j.value("transports", json::array());
+            return true;
+          },
+          kWait))
+          << sub.describe();
+      return kinds;
+    };
+    const json hrt_kinds = transports_of("cosmic/ctl_hrt");
+    const json nrt_kinds = transports_of("cosmic/log_nrt");
+    auto has = [](const json& kinds, const char* kind) { return std::find(kinds.begin(), kinds.end(), kind) != kinds.end(); };
+    EXPECT_TRUE(has(hrt_kinds, "udpv4")) << hrt_kinds.dump();
+    EXPECT_EQ(has(hrt_kinds, "shm"), hrt_shared) << hrt_kinds.dump();
+    EXPECT_TRUE(has(nrt_kinds, "shm")) << nrt_kinds.dump();
+  }
+}
+
 // ---- adapter -> native subscriber -------------------------------------------------------------
 
 TEST(DdsAdapter, SendsEnvelopesToNativeSubscriber) {

@@ -190,7 +190,7 @@ Status DdsAdapter::open_participant(ChannelClass cls, const ThreadPolicy& thread
   std::string name = gateway + "/" + segment_.name;
   if (cls != ChannelClass::nrt) name += std::string("/") + kClassName[static_cast<std::size_t>(cls)];
   dds::DomainParticipantQos qos;
-  if (Status st = participant_qos(segment_, name, qos); !st.ok) {
+  if (Status st = participant_qos(segment_, name, segment_.dds.shared_memory[static_cast<std::size_t>(cls)], qos); !st.ok) {
     return st;
   }
   ThreadPolicy policy = threads;

@@ -62,7 +62,8 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
 
   std::string start() override {
     dds::DomainParticipantQos qos;
-    if (Status st = dds_detail::participant_qos(segment_, (self_.name.empty() ? "cosmicd" : self_.name) + "/federation", qos); !st.ok) {
+    if (Status st = dds_detail::participant_qos(segment_, (self_.name.empty() ? "cosmicd" : self_.name) + "/federation",
+                                              segment_.dds.shared_memory[static_cast<std::size_t>(ChannelClass::nrt)], qos); !st.ok) {
       return st.error;
     }
     // The participant's lease is what the others judge this gateway by: each reader drops a remote

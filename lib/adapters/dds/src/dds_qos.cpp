@@ -162,7 +162,35 @@ dds::DataReaderQos reader_qos(const SegmentSpec& segment, const ChannelSpec& cha
   return qos;
 }
 
-Status participant_qos(const SegmentSpec& segment, const std::string& participant_name,
+namespace {
+// Puts the segment's interface allow-list (IPv4 addresses or interface names) on `udp`.
+Status allow_interfaces(const std::vector<std::string>& interfaces, eprosima::fastdds::rtps::UDPv4TransportDescriptor& udp) {
+  if (interfaces.empty()) return Status::success();
+  const LocalAddresses local = local_ipv4_addresses();
+  for (const std::string& entry : interfaces) {
+    if (is_ipv4(entry)) {
+      if (local.all.count(entry) == 0) {
+        return Status::failure("DDS interface " + entry + " is not an address of this host");
+      }
+      udp.interfaceWhiteList.push_back(entry);
+      continue;
+    }
+    bool found = false;
+    for (const auto& [name, address] : local.by_name) {
+      if (name == entry) {
+        udp.interfaceWhiteList.push_back(address);
+        found = true;
+      }
+    }
+    if (!found) {
+      return Status::failure("DDS interface " + entry + " is neither an IPv4 address nor an interface with one");
+    }
+  }
+  return Status::success();
+}
+}  // namespace
+
+Status participant_qos(const SegmentSpec& segment, const std::string& participant_name, bool shared_memory,
                        dds::DomainParticipantQos& qos) {
   qos = dds::PARTICIPANT_QOS_DEFAULT;
   qos.name(participant_name);
@@ -170,34 +198,15 @@ Status participant_qos(const SegmentSpec& segment, const std::string& participan
   // the property and the adapter filters by GUID prefix on reception.
   qos.properties().properties().emplace_back("fastdds.ignore_local_endpoints", "true");
 
-  if (!segment.dds.interfaces.empty()) {
-    const LocalAddresses local = local_ipv4_addresses();
+  if (!segment.dds.interfaces.empty() || !shared_memory) {
     auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
-    for (const std::string& entry : segment.dds.interfaces) {
-      if (is_ipv4(entry)) {
-        if (local.all.count(entry) == 0) {
-          return Status::failure("DDS interface " + entry + " is not an address of this host");
-        }
-        udp->interfaceWhiteList.push_back(entry);
-        continue;
-      }
-      bool found = false;
-      for (const auto& [name, address] : local.by_name) {
-        if (name == entry) {
-          udp->interfaceWhiteList.push_back(address);
-          found = true;
-        }
-      }
-      if (!found) {
-        return Status::failure("DDS interface " + entry +
-                               " is neither an IPv4 address nor an interface with one");
-      }
-    }
+    if (Status st = allow_interfaces(segment.dds.interfaces, *udp); !st.ok) return st;
     qos.transport().use_builtin_transports = false;
     qos.transport().user_transports.push_back(udp);
-    // Shared memory stays: it only reaches participants on this host.
-    qos.transport().user_transports.push_back(
-        std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+    // Shared memory only reaches participants on this host, so an allow-list leaves it on.
+    if (shared_memory) {
+      qos.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+    }
   }
 
   if (!segment.dds.discovery_server.empty()) {

@@ -56,9 +56,11 @@ eprosima::fastdds::dds::DataWriterQos writer_qos(const SegmentSpec& segment,
 eprosima::fastdds::dds::DataReaderQos reader_qos(const SegmentSpec& segment,
                                                  const ChannelSpec& channel);
 
-// Transports (interface allow-list) and discovery (simple or discovery-server client) of the
-// segment's participant. Fails for an unknown interface or a malformed "IP:PORT".
-Status participant_qos(const SegmentSpec& segment, const std::string& participant_name,
+// Transports (interface allow-list; shared memory or UDP alone) and discovery (simple or
+// discovery-server client) of one of the segment's participants. Without `shared_memory` the
+// participant speaks UDPv4 only, to peers on this host too. Fails for an unknown interface or a
+// malformed "IP:PORT".
+Status participant_qos(const SegmentSpec& segment, const std::string& participant_name, bool shared_memory,
                        eprosima::fastdds::dds::DomainParticipantQos& qos);
 
 // Largest DDS domain id whose RTPS ports fit in 16 bits with the default port parameters.

@@ -4,6 +4,8 @@
 // the Config; no I/O.
 #pragma once
 
+#include <array>
+
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -66,6 +68,10 @@ struct DdsSegmentProperties {
   std::uint32_t domain = 0;
   std::vector<std::string> interfaces;  // allow-list of IPv4 addresses or interface names
   std::string discovery_server;         // "IP:PORT", empty for simple discovery
+  // By class (hrt, srt, nrt): whether that class's participant also uses Fast DDS's shared-memory
+  // transport to peers on this host (segment key `shared_memory`). Off for HRT by default: under
+  // load the shared-memory path held HRT samples back for milliseconds, UDP did not (docs/yaml-reference.md).
+  std::array<bool, 3> shared_memory{false, true, true};
   friend bool operator==(const DdsSegmentProperties&, const DdsSegmentProperties&) = default;
 };
 
@@ -161,6 +167,24 @@ struct MetricsSpec {
   friend bool operator==(const MetricsSpec&, const MetricsSpec&) = default;
 };
 
+// gateway.realtime.cpus: where each kind of cosmicd thread may run; an empty list: any CPU. A
+// deployment with a hard real-time path gives the HRT lanes (and the HRT DDS participants' threads,
+// which inherit it) CPUs of their own and keeps every other thread off them: a time-shared thread
+// in a long system call on an HRT CPU delays an HRT thread woken there until it leaves the kernel
+// (docs/operations.md, "A CPU for the hard real-time path").
+struct CpuPlacement {
+  std::vector<int> hrt;      // the HRT egress lanes and the HRT DDS participants' threads
+  std::vector<int> srt;      // the SRT egress lanes and the SRT DDS participants' threads
+  std::vector<int> nrt;      // the NRT egress lanes
+  std::vector<int> receive;  // the receive threads: CAN, LCM and the NRT DDS participants'
+  std::vector<int> other;    // every other thread (control, metrics, logging, discovery)
+  bool any() const { return !hrt.empty() || !srt.empty() || !nrt.empty() || !receive.empty() || !other.empty(); }
+  const std::vector<int>& of(ChannelClass cls) const {
+    return cls == ChannelClass::hrt ? hrt : cls == ChannelClass::srt ? srt : nrt;
+  }
+  friend bool operator==(const CpuPlacement&, const CpuPlacement&) = default;
+};
+
 // gateway.realtime: how the forwarding threads run. Priorities are SCHED_FIFO (1..99, 0 = the
 // normal time-sharing class); without the privilege cosmicd runs on and says what it could not get.
 struct RealtimeSpec {
@@ -168,9 +192,9 @@ struct RealtimeSpec {
   int srt_priority = 0;      // the SRT egress lanes
   int nrt_priority = 0;      // the NRT egress lanes (0: time sharing at nice 10)
   int receive_priority = 0;  // the adapters' receive threads that cosmicd owns (CAN, LCM)
-  std::vector<int> cpus;     // CPU affinity of those threads; empty: any CPU
+  CpuPlacement cpus;         // CPU affinity of those threads and of the rest
   bool lock_memory = false;  // mlockall(MCL_CURRENT | MCL_FUTURE) at start
-  bool requested() const { return hrt_priority || srt_priority || nrt_priority || receive_priority || !cpus.empty() || lock_memory; }
+  bool requested() const { return hrt_priority || srt_priority || nrt_priority || receive_priority || cpus.any() || lock_memory; }
   friend bool operator==(const RealtimeSpec&, const RealtimeSpec&) = default;
 };
 

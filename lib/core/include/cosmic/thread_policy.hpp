@@ -18,4 +18,9 @@ struct ThreadPolicy {
 // Operation not permitted"); the thread runs on with what it got.
 std::vector<std::string> apply_thread_policy(const ThreadPolicy& policy);
 
+// Restricts every thread this process has now to `cpus` (threads they start later inherit it;
+// a thread that applies a policy of its own with CPUs moves on to those). Called once at start,
+// before the forwarding threads exist. Returns what could not be applied.
+std::vector<std::string> place_process_threads(const std::vector<int>& cpus);
+
 }  // namespace cosmic

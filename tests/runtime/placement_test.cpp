@@ -1,0 +1,119 @@
+// gateway.realtime.cpus by kind of thread: the lanes of each class run on their class's CPUs, and
+// place_process_threads() moves every thread of the process (cosmicd's `other`).
+#include <gtest/gtest.h>
+#include <sched.h>
+
+#include <condition_variable>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "cosmic/config_loader.hpp"
+#include "cosmic/gateway.hpp"
+#include "cosmic/memory_adapter.hpp"
+#include "cosmic/thread_policy.hpp"
+
+namespace cosmic {
+namespace {
+
+class SilentLogger final : public Logger {
+ public:
+  void log(LogLevel, std::string_view) override {}
+};
+
+std::vector<int> cpus_of(pid_t tid) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  EXPECT_EQ(sched_getaffinity(tid, sizeof set, &set), 0) << "thread " << tid;
+  std::vector<int> out;
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu)
+    if (CPU_ISSET(cpu, &set)) out.push_back(cpu);
+  return out;
+}
+
+// The CPUs of every thread of this process, by thread name.
+std::multimap<std::string, std::vector<int>> threads_by_name() {
+  std::multimap<std::string, std::vector<int>> out;
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::string comm;
+    std::getline(std::ifstream(task.path() / "comm"), comm);
+    out.emplace(comm, cpus_of(static_cast<pid_t>(std::stol(task.path().filename().string()))));
+  }
+  return out;
+}
+
+int last_cpu() { return static_cast<int>(std::thread::hardware_concurrency()) - 1; }
+
+TEST(PlacementTest, EachClassOfLanesRunsOnItsOwnCpus) {
+  if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "needs two CPUs";
+  const std::vector<int> everywhere = cpus_of(0);
+  const std::string last = std::to_string(last_cpu());
+  const std::string yaml = "gateway: {name: gw, realtime: {cpus: {hrt: [" + last + "], nrt: [0]}}}\n" +
+                           R"(segments:
+  - {name: lan, type: dds, latency_bound: 1ms, realtime: true}
+  - {name: rt, type: dds, domain: 1, latency_bound: 1ms, realtime: true}
+channels:
+  - {name: distance, subject: 7, class: hrt, period: 10ms, reaction_time: 50ms, payload: 4B, publishers: [lan], subscribers: [rt]}
+  - {name: camera, subject: 8, class: srt, period: 10ms, reaction_time: 50ms, payload: 4B, publishers: [lan], subscribers: [rt]}
+  - {name: log, subject: 9, class: nrt, payload: 4B, publishers: [lan], subscribers: [rt]}
+)";
+  SilentLogger log;
+  Gateway gateway([&](const SegmentSpec& spec, const GatewayIdentity&, Logger&) -> std::unique_ptr<SegmentAdapter> {
+    return std::make_unique<MemoryAdapter>(spec.name);
+  }, log, 0x42);
+  const auto parsed = parse_config(yaml, "placement.yaml");
+  ASSERT_TRUE(parsed.ok()) << parsed.errors[0].to_string();
+  ASSERT_TRUE(gateway.start(parsed.config).applied);
+  // A lane thread applies its policy as it starts: wait until each class has one that did.
+  const auto placed = [&](const std::string& name, const std::vector<int>& want) {
+    for (auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10); std::chrono::steady_clock::now() < deadline;) {
+      const auto threads = threads_by_name();
+      const auto [first, end] = threads.equal_range(name);
+      if (first != end && std::all_of(first, end, [&](const auto& t) { return t.second == want; })) return true;
+      std::this_thread::yield();
+    }
+    return false;
+  };
+  EXPECT_TRUE(placed("hrt:rt", {last_cpu()})) << "the HRT lane on the HRT CPU";
+  EXPECT_TRUE(placed("nrt:rt", {0})) << "the NRT lane off it";
+  EXPECT_TRUE(placed("srt:rt", everywhere)) << "a class without CPUs runs anywhere";
+  gateway.stop();
+}
+
+TEST(PlacementTest, PlaceProcessThreadsMovesEveryThreadThatExists) {
+  if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "needs two CPUs";
+  const std::vector<int> everywhere = cpus_of(0);
+  std::mutex mutex;
+  std::condition_variable changed;
+  bool placed = false;
+  pid_t other_tid = 0;
+  std::vector<int> seen_by_other;
+  std::thread other([&] {
+    std::unique_lock lock(mutex);
+    other_tid = gettid();
+    changed.notify_all();
+    changed.wait(lock, [&] { return placed; });
+    seen_by_other = cpus_of(0);
+  });
+  {
+    std::unique_lock lock(mutex);
+    changed.wait(lock, [&] { return other_tid != 0; });
+  }
+  EXPECT_TRUE(place_process_threads({last_cpu()}).empty());
+  EXPECT_EQ(cpus_of(0), std::vector<int>{last_cpu()});
+  {
+    std::lock_guard lock(mutex);
+    placed = true;
+    changed.notify_all();
+  }
+  other.join();
+  EXPECT_EQ(seen_by_other, std::vector<int>{last_cpu()}) << "a thread that already ran is moved too";
+  EXPECT_TRUE(place_process_threads({}).empty()) << "no CPUs: nothing to do";
+  EXPECT_EQ(cpus_of(0), std::vector<int>{last_cpu()});
+  EXPECT_TRUE(place_process_threads(everywhere).empty());  // as before, for the tests after this one
+}
+
+}  // namespace
+}  // namespace cosmic
