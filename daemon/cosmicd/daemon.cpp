@@ -189,7 +189,10 @@ class Daemon {
       const auto list = [](const std::vector<int>& cpus) {
         if (cpus.empty()) return std::string("any");
         std::string text;
-        for (const int cpu : cpus) text += (text.empty() ? "" : ",") + std::to_string(cpu);
+        for (const int cpu : cpus) {
+          if (!text.empty()) text.push_back(',');
+          text.append(std::to_string(cpu));
+        }
         return text;
       };
       const cosmic::CpuPlacement& c = realtime.cpus;

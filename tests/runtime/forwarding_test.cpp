@@ -8,6 +8,7 @@
 #include <mutex>
 #include <thread>
 
+#include "cosmic/can_buffering.hpp"
 #include "cosmic/config_loader.hpp"
 #include "cosmic/gateway.hpp"
 #include "cosmic/memory_adapter.hpp"
@@ -181,6 +182,59 @@ TEST(ForwardingTest, ResidenceAndDeadlineMissesAreCountedPerHop) {
   EXPECT_GT(hop.egress->residence_max.count(), 0);
   EXPECT_EQ(snap[0].residence_miss, 2u);
   EXPECT_EQ(snap[0].deadline_miss, 1u);
+}
+
+// A CAN segment's egress lanes hold what its bus carries in kCanHold (egress_lane_floor: 5,320
+// frames at 1 Mbit/s, beyond the NRT class depth of 1,024): a burst forwarded to it while the
+// lane's send is stuck is queued whole, and only what passes that is queue_full.
+TEST(ForwardingTest, ACanSegmentsLanesHoldWhatItsBusCarriesInTheHold) {
+  RecordingLogger log;
+  std::map<std::string, MemoryAdapter*> adapters;
+  StuckNrtAdapter* stuck = nullptr;
+  Gateway gateway(
+      [&](const SegmentSpec& spec, const GatewayIdentity&, Logger&) -> std::unique_ptr<SegmentAdapter> {
+        if (spec.type == SegmentType::can) {
+          auto adapter = std::make_unique<StuckNrtAdapter>(std::map<ChannelId, ChannelClass>{{1, ChannelClass::nrt}});
+          stuck = adapter.get();
+          return adapter;
+        }
+        auto adapter = std::make_unique<MemoryAdapter>(spec.name);
+        adapters[spec.name] = adapter.get();
+        return adapter;
+      },
+      log, 0x42);
+  const auto parsed = parse_config(R"(
+gateway: {name: gw}
+segments:
+  - {name: lan, type: dds}
+  - {name: body, type: can, interface: can9, bitrate: 1Mbit/s}
+channels:
+  - {name: bulk, subject: 7, class: nrt, payload: 4B, publishers: [lan], subscribers: [body]}
+)", "can.yaml");
+  ASSERT_TRUE(parsed.ok()) << parsed.errors[0].to_string();
+  ASSERT_TRUE(gateway.start(parsed.config).applied);
+  ASSERT_NE(stuck, nullptr);
+  const SegmentSpec& body = parsed.config.segments[1];
+  const std::size_t floor = egress_lane_floor(body);
+  ASSERT_GT(floor, RouterLimits{}.nrt_queue);
+  ASSERT_TRUE(adapters["lan"]->inject("bulk", {0, 0, 0, 0}));
+  ASSERT_TRUE(stuck->wait_nrt_stuck(5000ms));  // the lane holds the first event in its send
+  for (std::size_t i = 1; i <= floor + 10; ++i) {
+    const auto n = static_cast<std::uint32_t>(i);
+    ASSERT_TRUE(adapters["lan"]->inject("bulk", {static_cast<std::uint8_t>(n), static_cast<std::uint8_t>(n >> 8), 0, 0}));
+  }
+  auto stats = gateway.channel_stats();
+  ASSERT_EQ(stats.size(), 1u);
+  const auto queue_full = [&] {
+    for (const auto& seg : gateway.router().snapshot().at(0).segments)
+      if (seg.segment == "body") return seg.dropped[static_cast<std::size_t>(DropReason::queue_full)];
+    return std::uint64_t{0};
+  };
+  EXPECT_EQ(queue_full(), 10u) << "the lane held " << floor << " behind the one in its send";
+  stuck->release();
+  EXPECT_TRUE(stuck->wait_for(1, floor + 1, 10000ms));
+  EXPECT_EQ(stuck->sent(1), floor + 1);
+  gateway.stop();
 }
 
 constexpr const char* kHrtConfig = R"(

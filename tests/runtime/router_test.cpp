@@ -4,6 +4,7 @@
 
 #include <map>
 
+#include "cosmic/can_buffering.hpp"
 #include "cosmic/memory_adapter.hpp"
 #include "cosmic/router.hpp"
 #include "cosmic/router_policy.hpp"
@@ -264,6 +265,37 @@ TEST_F(RouterTest, QueuesAreBoundedAndOverflowIsCounted) {
   EXPECT_EQ(out.sent().size(), 5u);
   // A full lane is the egress segment's congestion: counted there.
   EXPECT_EQ(counters("bulk", "out").dropped[static_cast<std::size_t>(DropReason::queue_full)], 6u);
+}
+
+// A segment set with a lane depth floor (a CAN bus: what it carries in kCanHold) holds that many
+// events in each lane, whatever the class depth; set again without it, the class depth again.
+TEST_F(RouterTest, ALaneDepthFloorHoldsABurstTheClassDepthWouldDrop) {
+  router.set_segment(1, "out", &out, 12);
+  bind({channel("bulk", ChannelClass::nrt)});
+  for (int i = 0; i < 13; ++i) in.inject("bulk", {static_cast<std::uint8_t>(i)});
+  EXPECT_EQ(router.queued(), 12u);
+  EXPECT_EQ(counters("bulk", "out").dropped[static_cast<std::size_t>(DropReason::queue_full)], 1u);
+  router.run_once(100);
+  const auto sent = out.sent();
+  ASSERT_EQ(sent.size(), 12u);
+  for (std::uint8_t k = 0; k < 12; ++k) EXPECT_EQ(sent[k].payload, (std::vector<std::uint8_t>{k})) << "in order";
+  router.set_segment(1, "out", &out);
+  for (int i = 0; i < 6; ++i) in.inject("bulk", {static_cast<std::uint8_t>(i)});
+  EXPECT_EQ(router.queued(), 4u) << "the class depth (nrt_queue 4)";
+}
+
+// egress_lane_floor(): a CAN segment's lanes hold what its bus carries in kCanHold at its
+// shortest frame; other segments keep the class depths.
+TEST(EgressLaneFloor, CanLanesHoldWhatTheBusCarriesInTheHold) {
+  SegmentSpec can;
+  can.type = SegmentType::can;
+  can.can.bitrate = BitRate{1'000'000};
+  EXPECT_EQ(egress_lane_floor(can), 5320u);  // 1e6 / 47 frames/s for 250 ms, rounded up
+  can.can.bitrate = BitRate{125'000};
+  EXPECT_EQ(egress_lane_floor(can), 665u);
+  SegmentSpec dds;
+  dds.type = SegmentType::dds;
+  EXPECT_EQ(egress_lane_floor(dds), 0u);
 }
 
 TEST_F(RouterTest, RawChannelsDropTheSamePayloadSeenAgainWithinTheLoopWindow) {

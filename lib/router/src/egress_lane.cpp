@@ -7,8 +7,8 @@
 
 namespace cosmic {
 
-EgressLane::EgressLane(LaneContext& context, std::size_t segment, std::size_t depth, std::size_t byte_budget)
-    : context_(context), segment_(segment), depth_(std::max<std::size_t>(1, depth)), byte_budget_(byte_budget) {}
+EgressLane::EgressLane(LaneContext& context, std::size_t segment, std::size_t byte_budget)
+    : context_(context), segment_(segment), byte_budget_(byte_budget) {}
 
 EgressLane::~EgressLane() { deactivate(); }
 
@@ -58,11 +58,16 @@ void EgressLane::hand_over(std::span<LaneItem> items) noexcept {
   in_hand_.store(0, std::memory_order_relaxed);
 }
 
-void EgressLane::activate(SegmentAdapter* adapter, const ThreadPolicy& policy, bool threaded) {
+void EgressLane::activate(SegmentAdapter* adapter, const ThreadPolicy& policy, bool threaded, std::size_t depth) {
   deactivate();
   {
     PiLock lock(mutex_);
-    if (ring_.empty()) ring_.resize(depth_);
+    // deactivate() emptied the ring and head_ may point anywhere in it: a new depth starts afresh.
+    const std::size_t want = std::max<std::size_t>(1, depth);
+    if (ring_.size() != want) {
+      std::vector<LaneItem>(want).swap(ring_);
+      head_ = 0;
+    }
     active_ = true;
     current_generation_.store(generation_, std::memory_order_release);
   }

@@ -47,15 +47,16 @@ struct LaneContext {
 
 class EgressLane {
  public:
-  EgressLane(LaneContext& context, std::size_t segment, std::size_t depth, std::size_t byte_budget);
+  EgressLane(LaneContext& context, std::size_t segment, std::size_t byte_budget);
   ~EgressLane();
   EgressLane(const EgressLane&) = delete;
   EgressLane& operator=(const EgressLane&) = delete;
 
   // False when the lane is full (by count or bytes) or not active: the caller counts queue_full.
   bool push(LaneItem&& item) noexcept COSMIC_EXCLUDES(mutex_);
-  // Starts sending to `adapter`; with `threaded`, on a new thread run under `policy`.
-  void activate(SegmentAdapter* adapter, const ThreadPolicy& policy, bool threaded) COSMIC_EXCLUDES(mutex_);
+  // Starts sending to `adapter`; with `threaded`, on a new thread run under `policy`. The lane
+  // holds up to `depth` events (at least 1) from now on.
+  void activate(SegmentAdapter* adapter, const ThreadPolicy& policy, bool threaded, std::size_t depth) COSMIC_EXCLUDES(mutex_);
   // Stops sending: joins the thread (after its send in progress) and drops what is queued.
   void deactivate() COSMIC_EXCLUDES(mutex_);
   // Without a thread: handles up to `budget` queued events now; returns how many.
@@ -84,11 +85,10 @@ class EgressLane {
 
   LaneContext& context_;
   const std::size_t segment_;
-  const std::size_t depth_;
   const std::size_t byte_budget_;
 
   mutable PiMutex mutex_;  // the ring; held for moves only, never across send()
-  std::vector<LaneItem> ring_ COSMIC_GUARDED_BY(mutex_);  // allocated at the first activation
+  std::vector<LaneItem> ring_ COSMIC_GUARDED_BY(mutex_);  // its size is the depth; sized at activation
   std::size_t head_ COSMIC_GUARDED_BY(mutex_) = 0;
   std::size_t count_ COSMIC_GUARDED_BY(mutex_) = 0;
   std::size_t bytes_ COSMIC_GUARDED_BY(mutex_) = 0;

@@ -20,6 +20,17 @@ PayloadBuffer* PayloadPool::pop_free() noexcept {
   return fresh;
 }
 
+void PayloadPool::raise_limit(std::size_t max_buffers) noexcept {
+  PiLock lock(mutex_);
+  if (max_buffers <= max_buffers_) return;
+  try {
+    all_.reserve(max_buffers);  // pop_free() relies on the capacity: emplace_back never throws
+    max_buffers_ = max_buffers;
+  } catch (...) {
+    // Memory is short: the pool keeps its limit, and a lane that outgrows it counts queue_full.
+  }
+}
+
 void PayloadPool::push_free(PayloadBuffer* buffer) noexcept {
   PiLock lock(mutex_);
   buffer->next_free_ = free_;

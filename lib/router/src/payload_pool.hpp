@@ -34,6 +34,9 @@ class PayloadPool {
   // At most `max_buffers` buffers exist at once; a released buffer larger than `retained_bytes`
   // gives its memory back (one burst of big NRT events must not pin it).
   PayloadPool(std::size_t max_buffers, std::size_t retained_bytes);
+  // Lets up to `max_buffers` exist (never fewer than now allowed); control thread, when a lane
+  // deeper than the pool was sized for is activated.
+  void raise_limit(std::size_t max_buffers) noexcept COSMIC_EXCLUDES(mutex_);
   PayloadPool(const PayloadPool&) = delete;
   PayloadPool& operator=(const PayloadPool&) = delete;
 
@@ -47,7 +50,7 @@ class PayloadPool {
   PayloadBuffer* pop_free() noexcept COSMIC_EXCLUDES(mutex_);
   void push_free(PayloadBuffer* buffer) noexcept COSMIC_EXCLUDES(mutex_);
 
-  const std::size_t max_buffers_;
+  std::size_t max_buffers_ COSMIC_GUARDED_BY(mutex_);
   const std::size_t retained_bytes_;
   PiMutex mutex_;
   PayloadBuffer* free_ COSMIC_GUARDED_BY(mutex_) = nullptr;

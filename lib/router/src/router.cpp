@@ -57,11 +57,10 @@ Router::Router(GatewayIdentity self, std::size_t segment_capacity, RouterLimits 
         LockGuard lock(problems_mutex_);
         thread_problems_.insert(thread_problems_.end(), problems.begin(), problems.end());
       }});
-  const std::size_t depth[kClassCount] = {limits_.hrt_queue, limits_.srt_queue, limits_.nrt_queue};
   for (std::size_t i = 0; i < segment_names_.size(); ++i) {
     inboxes_.push_back(std::make_unique<SegmentInbox>(*this, i));
     for (std::size_t c = 0; c < kClassCount; ++c)
-      lanes_.push_back(std::make_unique<EgressLane>(*lane_context_, i, depth[c], limits_.queue_bytes));
+      lanes_.push_back(std::make_unique<EgressLane>(*lane_context_, i, limits_.queue_bytes));
   }
 }
 
@@ -73,7 +72,8 @@ EgressLane& Router::lane(std::size_t segment, ChannelClass cls) {
   return *lanes_[segment * kClassCount + class_index(cls)];
 }
 
-void Router::set_segment(std::size_t index, std::string name, SegmentAdapter* adapter) {
+void Router::set_segment(std::size_t index, std::string name, SegmentAdapter* adapter, std::size_t lane_depth_floor) {
+  const std::size_t depth[kClassCount] = {limits_.hrt_queue, limits_.srt_queue, limits_.nrt_queue};
   for (std::size_t c = 0; c < kClassCount; ++c) {
     EgressLane& l = *lanes_.at(index * kClassCount + c);
     if (adapter == nullptr) {
@@ -82,7 +82,14 @@ void Router::set_segment(std::size_t index, std::string name, SegmentAdapter* ad
     }
     ThreadPolicy policy = limits_.lane_threads[c];
     policy.name = kClassPrefix[c] + name;
-    l.activate(adapter, policy, limits_.threaded);
+    const std::size_t lane_depth = std::max(depth[c], lane_depth_floor);
+    // The pool was sized for four times every lane at its class depth; a deeper lane brings
+    // buffers of its own.
+    if (lane_depth > depth[c]) {
+      extra_buffers_ += lane_depth - depth[c];
+      pool_->raise_limit(4 * (limits_.hrt_queue + limits_.srt_queue + limits_.nrt_queue) + extra_buffers_);
+    }
+    l.activate(adapter, policy, limits_.threaded, lane_depth);
   }
   segment_names_.at(index) = std::move(name);
 }

@@ -1,5 +1,6 @@
 #include "cosmic/gateway.hpp"
 
+#include "cosmic/can_buffering.hpp"
 #include "cosmic/can_interference.hpp"
 #include "cosmic/channel_changes.hpp"
 
@@ -84,7 +85,7 @@ BindResult Gateway::start(const Config& config) {
       stop();
       return result;
     }
-    router_->set_segment(slot.index, spec.name, slot.adapter.get());
+    router_->set_segment(slot.index, spec.name, slot.adapter.get(), egress_lane_floor(spec));
     const Status started = slot.adapter->start(router_->inbox(slot.index));
     if (!started.ok) log_.log(LogLevel::error, "segment " + spec.name + " did not start: " + started.error);
     slots_.emplace(spec.name, std::move(slot));
@@ -385,7 +386,7 @@ BindResult Gateway::commit_reload(ReloadPlan plan) {
       result.error = "cannot create the adapter of segment " + spec.name + "; running configuration kept";
       return result;
     }
-    router_->set_segment(slot.index, spec.name, slot.adapter.get());
+    router_->set_segment(slot.index, spec.name, slot.adapter.get(), egress_lane_floor(spec));
     const Status started = slot.adapter->start(router_->inbox(slot.index));
     if (!started.ok) log_.log(LogLevel::error, "segment " + spec.name + " did not start: " + started.error);
     fresh.emplace(spec.name, std::move(slot));

@@ -30,6 +30,8 @@
 #                   traffic still flows
 #   overflow        frames sent while cosmicd is stopped (SIGSTOP): kernel drops shown as overflow
 #                   drops, received + dropped = sent
+#   burst           2,500 frames on vcan1 while cosmicd is stopped -> every one on vcan0 (CAN -> CAN,
+#                   counted by vcan0's tx_packets): no lane or socket drop
 #   error_frames    controller error frames (injected with cansend): bus-off -> down + degraded,
 #                   restarted -> up; error-passive/warning -> degraded, error-active -> up;
 #                   controller overflow counted; traffic flows afterwards

@@ -5,36 +5,31 @@
 // memory per queued CAN frame (measured: an skb per frame, classic or FD, kernel 6.1), a socket
 // holds 277 frames: a burst on a 1 Mbit/s bus fills that in 13 ms, less than a time-shared
 // receive thread may wait for a CPU on a busy machine, while the kernel's cangw, which forwards
-// in the kernel's receive path, loses nothing. So the buffer is sized for the bus itself: every
-// frame the bus can carry during kReceiveHold (at its shortest frame), whatever is bound now,
-// so that a rebinding never needs a new socket.
+// in the kernel's receive path, loses nothing. So the buffer is sized for the bus itself
+// (cosmic/can_buffering.hpp): every frame the bus can carry during kCanHold, whatever is bound
+// now, so that a rebinding never needs a new socket.
 #pragma once
 
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
 
+#include "cosmic/can_buffering.hpp"
 #include "cosmic/model.hpp"
 #include "cosmic/units.hpp"
 
 namespace cosmic {
 
 // How long the receive thread may be held off its CPU without losing a frame.
-inline constexpr Nanos kReceiveHold = std::chrono::milliseconds(250);
+inline constexpr Nanos kReceiveHold = kCanHold;
 // Kernel memory one queued frame costs (skb truesize, measured on Debian's 6.1 kernel).
 inline constexpr std::size_t kKernelBytesPerFrame = 768;
-// The shortest frame on the wire: a classic data frame with an 11-bit identifier and no data,
-// without stuff bits, plus the interframe space (44 + 3 bits). A CAN FD frame spends at least as
-// many bits at the nominal rate before its data phase, so this bounds the frame rate of both.
-inline constexpr std::uint32_t kShortestFrameBits = 47;
 // Never less than Linux's default buffer holds.
 inline constexpr std::size_t kMinReceiveFrames = 256;
 
 // Frames the receive socket must hold: the bus's frame rate at its shortest frame times kReceiveHold.
 inline std::size_t receive_buffer_frames(const CanSegmentProperties& can) {
-  const double frames_per_second = static_cast<double>(can.bitrate.bits_per_second) / kShortestFrameBits;
-  const double held = frames_per_second * static_cast<double>(kReceiveHold.count()) / 1e9;
-  return std::max(kMinReceiveFrames, static_cast<std::size_t>(held + 0.999));
+  return std::max(kMinReceiveFrames, can_frames_within(can, kReceiveHold));
 }
 
 // The value to hand SO_RCVBUF(FORCE): the kernel doubles it for its bookkeeping and counts each
