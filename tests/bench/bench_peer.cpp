@@ -77,6 +77,9 @@ std::int64_t mono_ns() {
 }
 
 void sleep_until_ns(std::int64_t t) {
+  // Already due: no system call (clock_nanosleep with a past deadline still costs about 15 us on
+  // a virtual machine, which alone kept a 20 kHz publisher at 14k events/s).
+  if (t <= mono_ns()) return;
   timespec ts{};
   ts.tv_sec = t / 1'000'000'000;
   ts.tv_nsec = t % 1'000'000'000;

@@ -82,6 +82,20 @@ channels:
   gateway.stop();
 }
 
+// Time-shared NRT lanes yield (nice 10) while an HRT or SRT lane is time-shared too; once both
+// run SCHED_FIFO, NRT lanes run at nice 0 like the receive threads that feed them.
+TEST(PlacementTest, NrtLanesYieldOnlyWhileAHigherClassIsTimeShared) {
+  const auto nrt_nice = [](int hrt, int srt) {
+    GatewaySpec gateway;
+    gateway.realtime.hrt_priority = hrt;
+    gateway.realtime.srt_priority = srt;
+    return router_limits(gateway).lane_threads[static_cast<std::size_t>(ChannelClass::nrt)].nice;
+  };
+  EXPECT_EQ(nrt_nice(0, 0), 10);
+  EXPECT_EQ(nrt_nice(80, 0), 10) << "SRT lanes are time-shared: NRT yields to them";
+  EXPECT_EQ(nrt_nice(80, 60), 0);
+}
+
 TEST(PlacementTest, PlaceProcessThreadsMovesEveryThreadThatExists) {
   if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "needs two CPUs";
   const std::vector<int> everywhere = cpus_of(0);
