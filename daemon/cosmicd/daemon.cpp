@@ -186,8 +186,9 @@ class Daemon {
                                          std::to_string(realtime.srt_priority) + ", nrt " + std::to_string(realtime.nrt_priority) +
                                          ", receive " + std::to_string(realtime.receive_priority));
     if (realtime.cpus.any()) {
-      const auto list = [](const std::vector<int>& cpus) {
-        if (cpus.empty()) return std::string("any");
+      const cosmic::CpuPlacement& c = realtime.cpus;
+      const auto list = [&c](const std::vector<int>& cpus) {
+        if (cpus.empty()) return std::string(c.other.empty() ? "any" : "as other");
         std::string text;
         for (const int cpu : cpus) {
           if (!text.empty()) text.push_back(',');
@@ -195,7 +196,6 @@ class Daemon {
         }
         return text;
       };
-      const cosmic::CpuPlacement& c = realtime.cpus;
       log_.log(cosmic::LogLevel::info, "realtime: CPUs hrt " + list(c.hrt) + ", srt " + list(c.srt) + ", nrt " + list(c.nrt) +
                                            ", receive " + list(c.receive) + ", other " + list(c.other));
     }

@@ -282,6 +282,27 @@ TEST_F(RouterTest, ALaneDepthFloorHoldsABurstTheClassDepthWouldDrop) {
   router.set_segment(1, "out", &out);
   for (int i = 0; i < 6; ++i) in.inject("bulk", {static_cast<std::uint8_t>(i)});
   EXPECT_EQ(router.queued(), 4u) << "the class depth (nrt_queue 4)";
+  router.run_once(100);
+}
+
+// A floor beyond what the payload pool was sized for (4 x the class depths: 5,136 here) raises the
+// pool's limit, so the lane really holds it; HRT lanes keep their class depth (256).
+TEST_F(RouterTest, ADeepLaneRaisesThePoolAndHrtLanesKeepTheirDepth) {
+  const std::size_t floor = 6000;
+  router.set_segment(1, "out", &out, floor);
+  bind({channel("bulk", ChannelClass::nrt), channel("brake", ChannelClass::hrt)});
+  for (std::size_t i = 0; i < floor; ++i) ASSERT_TRUE(in.inject("bulk", {static_cast<std::uint8_t>(i)}));
+  EXPECT_EQ(router.queued(), floor);
+  EXPECT_EQ(counters("bulk", "out").dropped[static_cast<std::size_t>(DropReason::queue_full)], 0u);
+  for (int i = 0; i < 300; ++i) ASSERT_TRUE(in.inject("brake", {1}));
+  EXPECT_EQ(router.queued(), floor + 256);
+  EXPECT_EQ(counters("brake", "out").dropped[static_cast<std::size_t>(DropReason::queue_full)], 44u);
+  // Set again (a reload): the pool is not raised twice, and the lanes still hold the floor.
+  router.run_once(floor + 256);
+  router.set_segment(1, "out", &out, floor);
+  for (std::size_t i = 0; i < floor; ++i) ASSERT_TRUE(in.inject("bulk", {static_cast<std::uint8_t>(i)}));
+  EXPECT_EQ(router.queued(), floor);
+  router.run_once(floor);
 }
 
 // egress_lane_floor(): a CAN segment's lanes hold what its bus carries in kCanHold at its

@@ -49,7 +49,7 @@ TEST(RealtimeConfig, CpusByKindOfThread) {
   ASSERT_TRUE(r.ok()) << errors_of(r);
   const CpuPlacement& c = r.config.gateway.realtime.cpus;
   EXPECT_EQ(c.hrt, std::vector<int>{last});
-  EXPECT_TRUE(c.srt.empty()) << "a kind not named may run anywhere";
+  EXPECT_TRUE(c.srt.empty()) << "a kind not named is left to other";
   EXPECT_EQ(c.of(ChannelClass::nrt), std::vector<int>{0});
   EXPECT_EQ(c.of(ChannelClass::hrt), std::vector<int>{last});
   EXPECT_EQ(c.receive, std::vector<int>{0});

@@ -42,7 +42,7 @@ void parse_cpu_list(YamlReader& reader, const YAML::Node& node, const std::strin
 }
 
 // `cpus: [..]` places every thread on those CPUs; `cpus: {hrt: [..], srt, nrt, receive, other}`
-// places each kind on its own (a kind not named may run anywhere).
+// places each kind on its own (a kind not named runs where `other` says, anywhere without it).
 void parse_cpus(YamlReader& reader, const YAML::Node& node, const std::string& path, CpuPlacement& out) {
   if (node.IsSequence()) {
     std::vector<int> all;

@@ -11,6 +11,7 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <thread>
 
 namespace cosmic {
 namespace {
@@ -54,18 +55,35 @@ std::vector<std::string> apply_thread_policy(const ThreadPolicy& policy) {
 
 namespace cosmic {
 
+bool sched_fifo_permitted(int priority) {
+  if (priority <= 0) return false;
+  bool permitted = false;
+  std::thread probe([&] {
+    sched_param param{};
+    param.sched_priority = priority;
+    permitted = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
+  });
+  probe.join();
+  return permitted;
+}
+
 std::vector<std::string> place_process_threads(const std::vector<int>& cpus) {
   std::vector<std::string> problems;
   if (cpus.empty()) return problems;
   const cpu_set_t set = cpu_set_of(cpus);
   DIR* tasks = ::opendir("/proc/self/task");
-  if (tasks == nullptr) return {std::string("CPU affinity: /proc/self/task: ") + std::strerror(errno)};
+  if (tasks == nullptr) {
+    const int error = errno;
+    return {std::string("CPU affinity: /proc/self/task: ") + std::strerror(error)};
+  }
   while (const dirent* entry = ::readdir(tasks)) {
     if (entry->d_name[0] == '.') continue;
     const auto tid = static_cast<pid_t>(std::strtol(entry->d_name, nullptr, 10));
     // A thread that ended since the directory was read is no problem.
-    if (::sched_setaffinity(tid, sizeof set, &set) != 0 && errno != ESRCH)
-      problems.push_back("CPU affinity of thread " + std::to_string(tid) + ": " + std::strerror(errno));
+    if (::sched_setaffinity(tid, sizeof set, &set) != 0) {
+      const int error = errno;  // before any allocation below can change it
+      if (error != ESRCH) problems.push_back("CPU affinity of thread " + std::to_string(tid) + ": " + std::strerror(error));
+    }
   }
   ::closedir(tasks);
   return problems;

@@ -60,12 +60,22 @@ void EgressLane::hand_over(std::span<LaneItem> items) noexcept {
 
 void EgressLane::activate(SegmentAdapter* adapter, const ThreadPolicy& policy, bool threaded, std::size_t depth) {
   deactivate();
+  // A ring of a new depth is allocated before the lock and the old one freed after it: pushers
+  // (refused while inactive) never wait for the allocator.
+  // Only the control thread resizes the ring, so its size cannot change between the two locks.
+  const std::size_t want = std::max<std::size_t>(1, depth);
+  std::size_t current = 0;
+  {
+    PiLock lock(mutex_);
+    current = ring_.size();
+  }
+  std::vector<LaneItem> ring;
+  if (current != want) ring.resize(want);
   {
     PiLock lock(mutex_);
     // deactivate() emptied the ring and head_ may point anywhere in it: a new depth starts afresh.
-    const std::size_t want = std::max<std::size_t>(1, depth);
-    if (ring_.size() != want) {
-      std::vector<LaneItem>(want).swap(ring_);
+    if (current != want) {
+      ring_.swap(ring);
       head_ = 0;
     }
     active_ = true;

@@ -1,34 +1,31 @@
 #include "payload_pool.hpp"
 
+#include <algorithm>
 #include <new>
 #include <utility>
 
 namespace cosmic {
 
 PayloadPool::PayloadPool(std::size_t max_buffers, std::size_t retained_bytes)
-    : max_buffers_(max_buffers), retained_bytes_(retained_bytes) {
-  all_.reserve(max_buffers_);
-}
+    : max_buffers_(max_buffers), retained_bytes_(retained_bytes) {}
 
 PayloadBuffer* PayloadPool::pop_free() noexcept {
   PiLock lock(mutex_);
   if (free_ != nullptr) return std::exchange(free_, free_->next_free_);
   if (all_.size() >= max_buffers_) return nullptr;
-  auto* fresh = new (std::nothrow) PayloadBuffer();
+  std::unique_ptr<PayloadBuffer> fresh(new (std::nothrow) PayloadBuffer());
   if (fresh == nullptr) return nullptr;
-  all_.emplace_back(fresh);  // cannot throw: capacity reserved up front
-  return fresh;
+  try {
+    all_.push_back(std::move(fresh));  // the deque may need a block: memory short is an exhausted pool
+  } catch (...) {
+    return nullptr;
+  }
+  return all_.back().get();
 }
 
 void PayloadPool::raise_limit(std::size_t max_buffers) noexcept {
   PiLock lock(mutex_);
-  if (max_buffers <= max_buffers_) return;
-  try {
-    all_.reserve(max_buffers);  // pop_free() relies on the capacity: emplace_back never throws
-    max_buffers_ = max_buffers;
-  } catch (...) {
-    // Memory is short: the pool keeps its limit, and a lane that outgrows it counts queue_full.
-  }
+  max_buffers_ = std::max(max_buffers_, max_buffers);
 }
 
 void PayloadPool::push_free(PayloadBuffer* buffer) noexcept {

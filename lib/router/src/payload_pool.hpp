@@ -8,6 +8,7 @@
 #pragma once
 
 #include <atomic>
+#include <deque>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -35,7 +36,7 @@ class PayloadPool {
   // gives its memory back (one burst of big NRT events must not pin it).
   PayloadPool(std::size_t max_buffers, std::size_t retained_bytes);
   // Lets up to `max_buffers` exist (never fewer than now allowed); control thread, when a lane
-  // deeper than the pool was sized for is activated.
+  // deeper than the pool was sized for is activated. Allocates nothing.
   void raise_limit(std::size_t max_buffers) noexcept COSMIC_EXCLUDES(mutex_);
   PayloadPool(const PayloadPool&) = delete;
   PayloadPool& operator=(const PayloadPool&) = delete;
@@ -54,7 +55,9 @@ class PayloadPool {
   const std::size_t retained_bytes_;
   PiMutex mutex_;
   PayloadBuffer* free_ COSMIC_GUARDED_BY(mutex_) = nullptr;
-  std::vector<std::unique_ptr<PayloadBuffer>> all_ COSMIC_GUARDED_BY(mutex_);  // ownership; grows up to max_buffers_
+  // Ownership; grows up to max_buffers_. A deque never moves what it holds, so a raised limit
+  // needs no reallocation under the lock the ingress threads take.
+  std::deque<std::unique_ptr<PayloadBuffer>> all_ COSMIC_GUARDED_BY(mutex_);
 };
 
 }  // namespace cosmic

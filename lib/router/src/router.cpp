@@ -50,6 +50,7 @@ Router::Router(GatewayIdentity self, std::size_t segment_capacity, RouterLimits 
       clock_(clock),
       unrouted_(new std::atomic<std::uint64_t>[segment_names_.size()]()),
       table_(std::make_shared<const Table>()),
+      lane_extra_(segment_capacity, 0),
       pool_(std::make_unique<PayloadPool>(4 * (limits_.hrt_queue + limits_.srt_queue + limits_.nrt_queue),
                                           kRetainedPayloadBytes)) {
   lane_context_.reset(new LaneContext{
@@ -74,6 +75,7 @@ EgressLane& Router::lane(std::size_t segment, ChannelClass cls) {
 
 void Router::set_segment(std::size_t index, std::string name, SegmentAdapter* adapter, std::size_t lane_depth_floor) {
   const std::size_t depth[kClassCount] = {limits_.hrt_queue, limits_.srt_queue, limits_.nrt_queue};
+  std::size_t extra = 0;
   for (std::size_t c = 0; c < kClassCount; ++c) {
     EgressLane& l = *lanes_.at(index * kClassCount + c);
     if (adapter == nullptr) {
@@ -82,15 +84,20 @@ void Router::set_segment(std::size_t index, std::string name, SegmentAdapter* ad
     }
     ThreadPolicy policy = limits_.lane_threads[c];
     policy.name = kClassPrefix[c] + name;
-    const std::size_t lane_depth = std::max(depth[c], lane_depth_floor);
-    // The pool was sized for four times every lane at its class depth; a deeper lane brings
-    // buffers of its own.
-    if (lane_depth > depth[c]) {
-      extra_buffers_ += lane_depth - depth[c];
-      pool_->raise_limit(4 * (limits_.hrt_queue + limits_.srt_queue + limits_.nrt_queue) + extra_buffers_);
-    }
+    // HRT lanes keep their depth: HRT traffic is policed to its admitted rate, and an HRT event
+    // that waited out a bus's burst would have missed its bound anyway.
+    const bool deepened = static_cast<ChannelClass>(c) != ChannelClass::hrt;
+    const std::size_t lane_depth = deepened ? std::max(depth[c], lane_depth_floor) : depth[c];
+    extra += lane_depth - depth[c];
     l.activate(adapter, policy, limits_.threaded, lane_depth);
   }
+  // The pool holds four times one set of class depths for every lane of every segment together;
+  // lanes deeper than their class bring their excess, counted per segment so that setting a
+  // segment again (a reload) does not add it twice.
+  lane_extra_.at(index) = extra;
+  std::size_t all_extra = 0;
+  for (const std::size_t e : lane_extra_) all_extra += e;
+  pool_->raise_limit(4 * (limits_.hrt_queue + limits_.srt_queue + limits_.nrt_queue) + all_extra);
   segment_names_.at(index) = std::move(name);
 }
 

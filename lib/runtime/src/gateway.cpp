@@ -65,7 +65,9 @@ RouterLimits router_limits(const GatewaySpec& gateway) {
   // against the receive threads that feed them (nice 0): under an overload those took nearly all
   // the CPU to receive events that then found their lane full (scripts/bench at saturation:
   // LCM -> cosmicd -> DDS forwarded 27k events/s with the NRT lane at nice 10, 86k at nice 0).
-  if (rt.hrt_priority > 0 && rt.srt_priority > 0) limits.lane_threads[static_cast<std::size_t>(ChannelClass::nrt)].nice = 0;
+  // Configured is not granted: without the privilege HRT and SRT lanes stay time-shared.
+  if (rt.hrt_priority > 0 && rt.srt_priority > 0 && sched_fifo_permitted(std::max(rt.hrt_priority, rt.srt_priority)))
+    limits.lane_threads[static_cast<std::size_t>(ChannelClass::nrt)].nice = 0;
   return limits;
 }
 

@@ -5,7 +5,7 @@
 // frames wherever its buffers are smaller than what the bus delivers while one of its threads is
 // held off its CPU. So cosmicd sizes its buffers for the bus, not for what is bound now: every
 // frame the bus can carry (at its shortest frame) during kCanHold, in the receive socket
-// (receive_buffer.hpp of the CAN adapter) and in each egress lane to a CAN segment.
+// (receive_buffer.hpp of the CAN adapter) and in each SRT and NRT egress lane to a CAN segment.
 #pragma once
 
 #include <algorithm>
@@ -31,7 +31,8 @@ inline std::size_t can_frames_within(const CanSegmentProperties& can, Nanos span
   return static_cast<std::size_t>(frames_per_second * static_cast<double>(span.count()) / 1e9 + 0.999);
 }
 
-// The least depth of each egress lane to `segment`: on CAN, the frames its bus carries in kCanHold
+// The least depth of each SRT and NRT egress lane to `segment` (Router::set_segment; HRT lanes
+// keep their class depth): on CAN, the frames its bus carries in kCanHold
 // (a burst forwarded from an equally fast bus fits while the lane thread is held); elsewhere 0
 // (the configured class depth stands).
 inline std::size_t egress_lane_floor(const SegmentSpec& segment) {

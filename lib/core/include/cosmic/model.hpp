@@ -167,7 +167,8 @@ struct MetricsSpec {
   friend bool operator==(const MetricsSpec&, const MetricsSpec&) = default;
 };
 
-// gateway.realtime.cpus: where each kind of cosmicd thread may run; an empty list: any CPU. A
+// gateway.realtime.cpus: where each kind of cosmicd thread may run; an empty list: where `other`
+// says (every thread is placed there first), any CPU when `other` is empty too. A
 // deployment with a hard real-time path gives the HRT lanes (and the HRT DDS participants' threads,
 // which inherit it) CPUs of their own and keeps every other thread off them: a time-shared thread
 // in a long system call on an HRT CPU delays an HRT thread woken there until it leaves the kernel
@@ -190,7 +191,7 @@ struct CpuPlacement {
 struct RealtimeSpec {
   int hrt_priority = 0;      // the HRT egress lanes
   int srt_priority = 0;      // the SRT egress lanes
-  int nrt_priority = 0;      // the NRT egress lanes (0: time sharing at nice 10)
+  int nrt_priority = 0;      // the NRT egress lanes (0: time sharing; nice 10 unless HRT and SRT run SCHED_FIFO)
   int receive_priority = 0;  // the adapters' receive threads that cosmicd owns (CAN, LCM)
   CpuPlacement cpus;         // CPU affinity of those threads and of the rest
   bool lock_memory = false;  // mlockall(MCL_CURRENT | MCL_FUTURE) at start

@@ -18,6 +18,10 @@ struct ThreadPolicy {
 // Operation not permitted"); the thread runs on with what it got.
 std::vector<std::string> apply_thread_policy(const ThreadPolicy& policy);
 
+// Whether a thread of this process may run SCHED_FIFO at `priority` (tried on a short-lived
+// thread of its own: privilege, RLIMIT_RTPRIO and the container all decide). Control thread.
+bool sched_fifo_permitted(int priority);
+
 // Restricts every thread this process has now to `cpus` (threads they start later inherit it;
 // a thread that applies a policy of its own with CPUs moves on to those). Called once at start,
 // before the forwarding threads exist. Returns what could not be applied.

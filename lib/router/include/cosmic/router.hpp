@@ -81,8 +81,8 @@ class Router {
   // Sink to give the adapter of segment `index`.
   EventSink& inbox(std::size_t index);
   // Names slot `index` and sets the adapter that sends there; starts that segment's lane threads.
-  // Each lane holds its class's queue depth (RouterLimits), or `lane_depth_floor` events where
-  // that is more (a CAN bus's burst: egress_lane_floor()). Null: stops them (after the send in
+  // Each lane holds its class's queue depth (RouterLimits); SRT and NRT lanes hold
+  // `lane_depth_floor` events where that is more (a CAN bus's burst: egress_lane_floor()). Null: stops them (after the send in
   // progress) and drops what they had queued. Control thread.
   void set_segment(std::size_t index, std::string name, SegmentAdapter* adapter, std::size_t lane_depth_floor = 0);
   std::size_t segment_capacity() const { return segment_names_.size(); }
@@ -140,8 +140,8 @@ class Router {
   Mutex apply_mutex_;  // serialises apply() (control thread) against itself
 
   std::atomic<std::uint64_t> progress_{0};
+  std::vector<std::size_t> lane_extra_;  // per segment: its lanes' depth beyond their class depths (control thread)
   std::unique_ptr<PayloadPool> pool_;
-  std::size_t extra_buffers_ = 0;  // lane depth beyond the class depths, ever activated (control thread)
   std::unique_ptr<LaneContext> lane_context_;
   std::vector<std::unique_ptr<EgressLane>> lanes_;  // segment * 3 + class
 

@@ -697,6 +697,7 @@ def scenario_burst(s):
                        % (count, IF_FD, int(read_text(tx_packets)) - tx0, IF, hop["tx"] - hop0["tx"],
                           {k: v for k, v in hop["dropped"].items() if v}))
     expect_eq("frames on %s (tx_packets)" % IF, int(read_text(tx_packets)) - tx0, count)
+    expect_eq("relay's frames sent on bus", hop["tx"] - hop0["tx"], count)
     expect_eq("relay's queue_full drops on bus", hop["dropped"]["queue_full"] - hop0["dropped"]["queue_full"], 0)
     expect_eq("overflow drops on bus_fd", gw.segments()["bus_fd"]["adapter"]["overflow_drops"] - overflow0, 0)
     check(gw.alive(), "cosmicd is alive")
