@@ -226,7 +226,8 @@ channels:
   auto stats = gateway.channel_stats();
   ASSERT_EQ(stats.size(), 1u);
   const auto queue_full = [&] {
-    for (const auto& seg : gateway.router().snapshot().at(0).segments)
+    const auto snapshot = gateway.router().snapshot();  // the segments below live in it
+    for (const auto& seg : snapshot.at(0).segments)
       if (seg.segment == "body") return seg.dropped[static_cast<std::size_t>(DropReason::queue_full)];
     return std::uint64_t{0};
   };
