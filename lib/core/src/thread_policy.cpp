@@ -51,10 +51,6 @@ std::vector<std::string> apply_thread_policy(const ThreadPolicy& policy) {
   return problems;
 }
 
-}  // namespace cosmic
-
-namespace cosmic {
-
 bool sched_fifo_permitted(int priority) {
   if (priority <= 0) return false;
   bool permitted = false;
