@@ -46,6 +46,9 @@ std::multimap<std::string, std::vector<int>> threads_by_name() {
 
 int last_cpu() { return static_cast<int>(std::thread::hardware_concurrency()) - 1; }
 
+// The placement tests skip on a machine with one CPU: there, "the HRT CPU" and "the others" are
+// the same CPU and no placement can be told from another. The project's machines and CI have two.
+
 TEST(PlacementTest, EachClassOfLanesRunsOnItsOwnCpus) {
   if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "needs two CPUs";
   const std::vector<int> everywhere = cpus_of(0);

@@ -10,6 +10,7 @@
 
 #include "cosmic/admission.hpp"
 #include "cosmic/can_background.hpp"
+#include "config_test_support.hpp"
 #include "cosmic/config_loader.hpp"
 #include "cosmic/report.hpp"
 #include "test_support.hpp"
@@ -88,26 +89,20 @@ ConfigResult load(const TempDir& dir, const std::string& background) {
   return load_config_file(dir.write("gw.yaml", config_with(background)));
 }
 
-std::string errors_text(const ConfigResult& r) {
-  std::string out;
-  for (const auto& e : r.errors) out += e.to_string() + "\n";
-  return out;
-}
-
 Evaluation admit(const Config& c) { return evaluate(c.gateway, c.segments, c.channels, {}); }
 
 TEST(CanBackgroundConfig, YamlFramesAndTheDbcGiveIdenticalNumbers) {
   TempDir dir;
   dir.write("body.dbc", kBodyDbc);
   const ConfigResult from_dbc = load(dir, "    background: {dbc: body.dbc, periods: {DoorEvent: 50ms}}\n");
-  ASSERT_TRUE(from_dbc.ok()) << errors_text(from_dbc);
+  ASSERT_TRUE(from_dbc.ok()) << test::errors_text(from_dbc);
   const ConfigResult from_yaml = load(dir, R"(    background:
       frames:
         - {name: EngineData, can_id: 0x0C0, dlc: 8, period: 10ms}
         - {name: BodyStatus, can_id: 0x18EFFF01, extended: true, dlc: 4, period: 100ms}
         - {name: DoorEvent, can_id: 0x320, length: 2B, period: 50ms}
 )");
-  ASSERT_TRUE(from_yaml.ok()) << errors_text(from_yaml);
+  ASSERT_TRUE(from_yaml.ok()) << test::errors_text(from_yaml);
   const auto& dbc_frames = from_dbc.config.segments[0].can.background;
   ASSERT_EQ(dbc_frames.size(), 3u);
   EXPECT_EQ(dbc_frames[1].can_id, 0x18EFFF01u);
@@ -134,7 +129,7 @@ TEST(CanBackgroundConfig, AReloadReadsTheDbcAgain) {
   faster.replace(faster.find("BO_ 192 10;"), 11, "BO_ 192 5;");
   dir.write("body.dbc", faster);
   const ConfigResult again = loader.load(yaml);
-  ASSERT_TRUE(again.ok()) << errors_text(again);
+  ASSERT_TRUE(again.ok()) << test::errors_text(again);
   EXPECT_FALSE(loader.last_was_unchanged());
   EXPECT_EQ(again.config.segments[0].can.background[0].period, Nanos(5ms));
 }
@@ -144,28 +139,28 @@ TEST(CanBackgroundConfig, ErrorsAreLocatedAndNameTheMessage) {
   dir.write("body.dbc", kBodyDbc);
   // DoorEvent has no cycle time: the error points into the DBC and says what to write.
   ConfigResult r = load(dir, "    background: {dbc: body.dbc}\n");
-  ASSERT_EQ(r.errors.size(), 1u) << errors_text(r);
+  ASSERT_EQ(r.errors.size(), 1u) << test::errors_text(r);
   EXPECT_NE(r.errors[0].file.find("body.dbc"), std::string::npos);
   EXPECT_EQ(r.errors[0].line, 20);  // BO_ 800 DoorEvent
-  EXPECT_NE(r.errors[0].message.find("DoorEvent (0x320) has no GenMsgCycleTime"), std::string::npos) << errors_text(r);
+  EXPECT_NE(r.errors[0].message.find("DoorEvent (0x320) has no GenMsgCycleTime"), std::string::npos) << test::errors_text(r);
   EXPECT_NE(r.errors[0].valid.find("periods: {DoorEvent: 50ms}"), std::string::npos);
   // ignore: leaves it out.
   r = load(dir, "    background: {dbc: body.dbc, ignore: [DoorEvent]}\n");
-  ASSERT_TRUE(r.ok()) << errors_text(r);
+  ASSERT_TRUE(r.ok()) << test::errors_text(r);
   EXPECT_EQ(r.config.segments[0].can.background.size(), 2u);
   // Names the DBC does not have, a missing file, periods without a DBC.
   r = load(dir, "    background: {dbc: body.dbc, periods: {DoorEvent: 50ms, Wiper: 1s}, ignore: [Horn]}\n");
-  EXPECT_EQ(r.errors.size(), 2u) << errors_text(r);
-  EXPECT_NE(errors_text(r).find("segments[0].background.periods.Wiper: the DBC file"), std::string::npos) << errors_text(r);
-  EXPECT_NE(errors_text(r).find("no message named Horn"), std::string::npos) << errors_text(r);
+  EXPECT_EQ(r.errors.size(), 2u) << test::errors_text(r);
+  EXPECT_NE(test::errors_text(r).find("segments[0].background.periods.Wiper: the DBC file"), std::string::npos) << test::errors_text(r);
+  EXPECT_NE(test::errors_text(r).find("no message named Horn"), std::string::npos) << test::errors_text(r);
   r = load(dir, "    background: {dbc: missing.dbc}\n");
   ASSERT_EQ(r.errors.size(), 1u);
   EXPECT_EQ(r.errors[0].line, 8);  // the background line of the YAML
-  EXPECT_NE(r.errors[0].message.find("cannot read DBC file"), std::string::npos) << errors_text(r);
+  EXPECT_NE(r.errors[0].message.find("cannot read DBC file"), std::string::npos) << test::errors_text(r);
   r = load(dir, "    background: {dbc: /dev/zero}\n");  // never read from a device or a FIFO
-  EXPECT_NE(errors_text(r).find("not a regular file"), std::string::npos) << errors_text(r);
+  EXPECT_NE(test::errors_text(r).find("not a regular file"), std::string::npos) << test::errors_text(r);
   r = load(dir, "    background: {periods: {DoorEvent: 50ms}}\n");
-  EXPECT_NE(errors_text(r).find("periods applies to a DBC's messages"), std::string::npos) << errors_text(r);
+  EXPECT_NE(test::errors_text(r).find("periods applies to a DBC's messages"), std::string::npos) << test::errors_text(r);
 }
 
 TEST(CanBackgroundConfig, FrameValuesAreChecked) {
@@ -181,7 +176,7 @@ TEST(CanBackgroundConfig, FrameValuesAreChecked) {
         - {can_id: 0x104, dlc: 1, period: 10ms}
         - {can_id: 0x104, dlc: 2, period: 20ms}
 )");
-  const std::string text = errors_text(r);
+  const std::string text = test::errors_text(r);
   EXPECT_EQ(r.errors.size(), 7u) << text;
   EXPECT_NE(text.find("frames[0].can_id: '0x800' is out of range"), std::string::npos) << text;
   EXPECT_NE(text.find("frames[1].can_id: '0x20000000' is out of range"), std::string::npos) << text;

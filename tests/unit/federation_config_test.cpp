@@ -2,6 +2,7 @@
 // and every mistake with its location and key path.
 #include <gtest/gtest.h>
 
+#include "config_test_support.hpp"
 #include "cosmic/config_loader.hpp"
 
 namespace cosmic {
@@ -17,22 +18,16 @@ std::string document(const std::string& federation, const std::string& extra_seg
          extra_segment + "channels: []\n";
 }
 
-std::string errors_of(const ConfigResult& r) {
-  std::string out;
-  for (const auto& e : r.errors) out += e.to_string() + "\n";
-  return out;
-}
-
 TEST(FederationConfig, ReadsTheSegmentTheLeaseAndNetworkNames) {
   const ConfigResult r = parse_config(document("  federation: {segment: lan, lease: 2s}\n"), "g.yaml");
-  ASSERT_TRUE(r.ok()) << errors_of(r);
+  ASSERT_TRUE(r.ok()) << test::errors_text(r);
   EXPECT_TRUE(r.config.gateway.federation.enabled());
   EXPECT_EQ(r.config.gateway.federation.segment, "lan");
   EXPECT_EQ(r.config.gateway.federation.lease, Nanos(2s));
   EXPECT_EQ(r.config.segments[0].network, "backbone");
   EXPECT_EQ(r.config.segments[1].network, "body-bus");
   const ConfigResult off = parse_config(document(""), "g.yaml");
-  ASSERT_TRUE(off.ok()) << errors_of(off);
+  ASSERT_TRUE(off.ok()) << test::errors_text(off);
   EXPECT_FALSE(off.config.gateway.federation.enabled());
   EXPECT_EQ(off.config.gateway.federation.lease, Nanos(3s));
 }
@@ -56,8 +51,7 @@ TEST(FederationConfig, EveryMistakeIsReportedWithItsPlace) {
   };
   for (const Case& c : cases) {
     const ConfigResult r = parse_config(document(c.federation, c.extra), "g.yaml");
-    EXPECT_FALSE(r.ok()) << c.expected;
-    EXPECT_NE(errors_of(r).find(c.expected), std::string::npos) << "want: " << c.expected << "\ngot:\n" << errors_of(r);
+    test::expect_refused_with(r, c.expected);
   }
 }
 

@@ -4,6 +4,7 @@
 
 #include <thread>
 
+#include "config_test_support.hpp"
 #include "cosmic/config_loader.hpp"
 
 namespace cosmic {
@@ -16,18 +17,12 @@ std::string document(const std::string& realtime, const std::string& dds_extra =
          "channels: []\n";
 }
 
-std::string errors_of(const ConfigResult& r) {
-  std::string out;
-  for (const auto& e : r.errors) out += e.to_string() + "\n";
-  return out;
-}
-
 const unsigned kCpus = std::max(1u, std::thread::hardware_concurrency());
 
 TEST(RealtimeConfig, PrioritiesAndOneListOfCpusForEveryThread) {
   const ConfigResult r =
       parse_config(document("  realtime: {priorities: {hrt: 80, srt: 60, receive: 10}, cpus: [0], lock_memory: true}\n"), "g.yaml");
-  ASSERT_TRUE(r.ok()) << errors_of(r);
+  ASSERT_TRUE(r.ok()) << test::errors_text(r);
   const RealtimeSpec& rt = r.config.gateway.realtime;
   EXPECT_EQ(rt.hrt_priority, 80);
   EXPECT_EQ(rt.srt_priority, 60);
@@ -37,7 +32,7 @@ TEST(RealtimeConfig, PrioritiesAndOneListOfCpusForEveryThread) {
   const std::vector<int> zero{0};
   EXPECT_EQ(rt.cpus, (CpuPlacement{zero, zero, zero, zero, zero}));
   const ConfigResult none = parse_config(document(""), "g.yaml");
-  ASSERT_TRUE(none.ok()) << errors_of(none);
+  ASSERT_TRUE(none.ok()) << test::errors_text(none);
   EXPECT_FALSE(none.config.gateway.realtime.requested());
   EXPECT_FALSE(none.config.gateway.realtime.cpus.any());
 }
@@ -46,7 +41,7 @@ TEST(RealtimeConfig, CpusByKindOfThread) {
   const int last = static_cast<int>(kCpus) - 1;
   const std::string text = "  realtime: {cpus: {hrt: [" + std::to_string(last) + "], nrt: [0], receive: [0], other: [0]}}\n";
   const ConfigResult r = parse_config(document(text), "g.yaml");
-  ASSERT_TRUE(r.ok()) << errors_of(r);
+  ASSERT_TRUE(r.ok()) << test::errors_text(r);
   const CpuPlacement& c = r.config.gateway.realtime.cpus;
   EXPECT_EQ(c.hrt, std::vector<int>{last});
   EXPECT_TRUE(c.srt.empty()) << "a kind not named is left to other";
@@ -59,14 +54,14 @@ TEST(RealtimeConfig, CpusByKindOfThread) {
 
 TEST(RealtimeConfig, SharedMemoryByClass) {
   const ConfigResult defaults = parse_config(document(""), "g.yaml");
-  ASSERT_TRUE(defaults.ok()) << errors_of(defaults);
+  ASSERT_TRUE(defaults.ok()) << test::errors_text(defaults);
   EXPECT_EQ(defaults.config.segments[0].dds.shared_memory, (std::array<bool, 3>{false, true, true}))
       << "HRT over UDP alone, the others with shared memory";
   const ConfigResult all = parse_config(document("", ", shared_memory: [hrt, srt, nrt]"), "g.yaml");
-  ASSERT_TRUE(all.ok()) << errors_of(all);
+  ASSERT_TRUE(all.ok()) << test::errors_text(all);
   EXPECT_EQ(all.config.segments[0].dds.shared_memory, (std::array<bool, 3>{true, true, true}));
   const ConfigResult none = parse_config(document("", ", shared_memory: []"), "g.yaml");
-  ASSERT_TRUE(none.ok()) << errors_of(none);
+  ASSERT_TRUE(none.ok()) << test::errors_text(none);
   EXPECT_EQ(none.config.segments[0].dds.shared_memory, (std::array<bool, 3>{false, false, false}));
 }
 
@@ -89,8 +84,7 @@ TEST(RealtimeConfig, EveryMistakeIsReportedWithItsPlace) {
   };
   for (const Case& c : cases) {
     const ConfigResult r = parse_config(document(c.realtime, c.dds_extra), "g.yaml");
-    EXPECT_FALSE(r.ok()) << c.expected;
-    EXPECT_NE(errors_of(r).find(c.expected), std::string::npos) << "want: " << c.expected << "\ngot:\n" << errors_of(r);
+    test::expect_refused_with(r, c.expected);
   }
 }
 
