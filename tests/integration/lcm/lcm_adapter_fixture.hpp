@@ -129,6 +129,17 @@ class Child {
     return true;
   }
 
+  // Waits until stdout holds `n` complete lines.
+  bool wait_stdout_lines(std::size_t n, Clock::duration timeout = kWait) {
+    const auto deadline = Clock::now() + timeout;
+    while (static_cast<std::size_t>(std::count(out_.begin(), out_.end(), '\n')) < n) {
+      if (Clock::now() >= deadline || exit_status_) return false;
+      pump(50ms);
+      reap();
+    }
+    return true;
+  }
+
   // Waits for the process to exit; its exit code, or nullopt on timeout / signal.
   std::optional<int> wait_exit(Clock::duration timeout = kWait) {
     const auto deadline = Clock::now() + timeout;

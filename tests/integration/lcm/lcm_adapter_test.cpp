@@ -38,7 +38,7 @@ TEST_F(LcmAdapterTest, HealthAndBadUrl) {
   EXPECT_FALSE(st.ok);
   EXPECT_NE(st.error.find("nosuchprovider://x"), std::string::npos) << st.error;
   EXPECT_EQ(bad->health().state, SegmentHealth::down);
-  EXPECT_NE(bad->health().detail.find("lcm_create failed"), std::string::npos);
+  EXPECT_NE(bad->health().detail.find("bad LCM URL"), std::string::npos) << bad->health().detail;
   EXPECT_EQ(bad->send(outbound(1, Bytes{1, 2})), SendStatus::failed);
   bad->stop();
   bad->stop();

@@ -1,12 +1,12 @@
 // Issue 20, item 2: no shared lock across I/O between classes. An NRT send stalled inside the
-// kernel (liblcm's sendmsg blocks, as it does on a full socket buffer) must not delay an HRT send
-// on the same segment. Before, every class published through one lcm_t under one encode mutex,
-// so the HRT send waited for the stalled NRT one.
+// kernel (a blocking sendmsg, as on a full socket buffer) must not delay an HRT send on the same
+// segment. Before, every class published through one lcm_t under one encode mutex, so the HRT
+// send waited for the stalled NRT one; now each class has its own transmit socket.
 //
-// The stall is real blocking inside liblcm: this executable defines sendmsg(), which the dynamic
-// linker resolves liblcm's calls to (an executable's symbols come first); it passes every call to
-// libc's sendmsg except, while armed, a message of the channel named kStalledChannel, which it
-// holds until released.
+// The stall is real blocking inside the adapter's sendmsg: this executable defines sendmsg(),
+// which the dynamic linker resolves the adapter's calls to (an executable's symbols come first);
+// it passes every call to libc's sendmsg except, while armed, a message of the channel named
+// kStalledChannel, which it holds until released.
 #include <dlfcn.h>
 #include <sys/socket.h>
 

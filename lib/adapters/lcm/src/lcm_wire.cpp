@@ -11,7 +11,29 @@ std::uint64_t read_be(const std::uint8_t* p, std::size_t bytes) {
   return v;
 }
 
+void write_be(std::uint8_t* p, std::uint64_t v, std::size_t bytes) {
+  for (std::size_t i = bytes; i-- > 0;) {
+    p[i] = static_cast<std::uint8_t>(v);
+    v >>= 8;
+  }
+}
+
 }  // namespace
+
+std::array<std::uint8_t, kLcmEnvelopeHeaderSize> encode_lcm_envelope_header(const EventHeader& header,
+                                                                           std::uint32_t payload_size) {
+  std::array<std::uint8_t, kLcmEnvelopeHeaderSize> out{};
+  std::uint8_t* p = out.data();
+  write_be(p, kLcmEnvelopeHash, 8);
+  write_be(p + 8, header.subject, 8);
+  write_be(p + 16, header.origin, 8);
+  write_be(p + 24, header.sequence, 4);
+  p[28] = header.hop_count;
+  write_be(p + 29, static_cast<std::uint64_t>(header.created_ns), 8);
+  write_be(p + 37, static_cast<std::uint64_t>(header.age_ns), 8);
+  write_be(p + kLcmEnvelopePayloadSizeOffset, payload_size, 4);
+  return out;
+}
 
 std::optional<LcmEnvelope> decode_lcm_envelope(std::span<const std::uint8_t> bytes, std::uint64_t max_payload) {
   // LCM hands over at most an int's worth of bytes; anything longer is not ours to read.

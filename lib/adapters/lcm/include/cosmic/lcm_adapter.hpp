@@ -1,4 +1,7 @@
-// LCM segment adapter: one lcm_t per segment (SegmentSpec::lcm.url) with its own receive thread.
+// LCM segment adapter: LCM's UDP multicast protocol (SegmentSpec::lcm.url) spoken by the gateway
+// itself, one receive socket and thread per segment and one transmit socket per channel class;
+// messages beyond one datagram go in LCM's fragments both ways (up to the segment's
+// max_message_size). A memq:// segment has no socket: what it sends reaches no one.
 //
 // LCM channel name = COSMIC channel name, or the one a native binding names
 // (ChannelSpec::native: `{channel: NAME}`, always raw). Per channel (ChannelSpec::lcm_encoding):

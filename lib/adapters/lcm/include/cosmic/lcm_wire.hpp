@@ -11,6 +11,7 @@
 // 0 <= payload_size <= the segment's max_message_size, and no byte is missing or left over.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -34,5 +35,11 @@ struct LcmEnvelope {
 // One whole LCM message as an envelope; nullopt when it is not exactly one well-formed envelope
 // with a payload of at most `max_payload` bytes.
 std::optional<LcmEnvelope> decode_lcm_envelope(std::span<const std::uint8_t> bytes, std::uint64_t max_payload);
+
+// The envelope's bytes before its payload, for an event of `payload_size` bytes (at most
+// INT32_MAX; the adapter refuses larger ones before): the header and that payload, back to back,
+// are one envelope exactly as lcm-gen encodes it.
+std::array<std::uint8_t, kLcmEnvelopeHeaderSize> encode_lcm_envelope_header(const EventHeader& header,
+                                                                           std::uint32_t payload_size);
 
 }  // namespace cosmic

@@ -1,0 +1,282 @@
+#include "lcm_sockets.hpp"
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/uio.h>
+#include <unistd.h>
+
+#include <array>
+#include <cerrno>
+#include <climits>
+#include <cstring>
+
+#include "cosmic/lcm_udpm.hpp"
+
+namespace cosmic::lcm_detail {
+namespace {
+
+std::string errno_text(const char* what) {
+  return std::string(what) + ": " + std::strerror(errno);
+}
+
+// The group and port as a socket address; nullopt when the group is not an IPv4 address.
+std::optional<sockaddr_in> group_address(const LcmUrl& url) {
+  sockaddr_in out{};
+  out.sin_family = AF_INET;
+  out.sin_port = htons(url.port);
+  if (::inet_pton(AF_INET, url.group.c_str(), &out.sin_addr) != 1) return std::nullopt;
+  return out;
+}
+
+int set_int(int fd, int level, int name, int value) {
+  return ::setsockopt(fd, level, name, &value, sizeof value);
+}
+
+// The socket's receive buffer as close to `bytes` as this process may make it; a warning when
+// it falls short.
+void size_receive_buffer(int fd, std::size_t bytes, OpenedSocket& out) {
+  const int request = bytes > static_cast<std::size_t>(INT_MAX / 2) ? INT_MAX / 2 : static_cast<int>(bytes);
+  if (set_int(fd, SOL_SOCKET, SO_RCVBUFFORCE, request) != 0) set_int(fd, SOL_SOCKET, SO_RCVBUF, request);
+  int granted = 0;
+  socklen_t length = sizeof granted;
+  if (::getsockopt(fd, SOL_SOCKET, SO_RCVBUF, &granted, &length) != 0) return;
+  // Linux reports twice what was set (the other half is its bookkeeping).
+  if (static_cast<std::size_t>(granted) / 2 >= static_cast<std::size_t>(request)) return;
+  out.warnings.push_back("the receive buffer holds " + std::to_string(granted / 2) + " bytes, not the " +
+                         std::to_string(request) + " asked for: a burst beyond it is lost (counted as overflow "
+                         "drops). Set net.core.rmem_max to at least " + std::to_string(request) +
+                         " or give cosmicd CAP_NET_ADMIN");
+}
+
+OpenedSocket failed(OpenedSocket out, int fd, std::string why) {
+  if (fd >= 0) ::close(fd);
+  out.fd = -1;
+  out.error = std::move(why);
+  return out;
+}
+
+}  // namespace
+
+OpenedSocket open_receive_socket(const LcmUrl& url, std::size_t buffer_bytes) {
+  OpenedSocket out;
+  const auto group = group_address(url);
+  if (!group) return failed(std::move(out), -1, "not an IPv4 multicast group: " + url.group);
+  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  if (fd < 0) return failed(std::move(out), fd, errno_text("socket"));
+  if (set_int(fd, SOL_SOCKET, SO_REUSEADDR, 1) != 0) return failed(std::move(out), fd, errno_text("SO_REUSEADDR"));
+  sockaddr_in bind_to{};
+  bind_to.sin_family = AF_INET;
+  bind_to.sin_port = htons(url.port);
+  bind_to.sin_addr.s_addr = htonl(INADDR_ANY);
+  if (::bind(fd, reinterpret_cast<const sockaddr*>(&bind_to), sizeof bind_to) != 0)
+    return failed(std::move(out), fd, errno_text(("bind to port " + std::to_string(url.port)).c_str()));
+  ip_mreq membership{};
+  membership.imr_multiaddr = group->sin_addr;
+  membership.imr_interface.s_addr = htonl(INADDR_ANY);
+  if (::setsockopt(fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &membership, sizeof membership) != 0)
+    return failed(std::move(out), fd, errno_text(("joining " + url.group + " (check the multicast route)").c_str()));
+  // Without this, Linux hands the socket every group any socket of the host joined on this port.
+  if (set_int(fd, IPPROTO_IP, IP_MULTICAST_ALL, 0) != 0) out.warnings.push_back(errno_text("IP_MULTICAST_ALL"));
+  if (set_int(fd, SOL_SOCKET, SO_TIMESTAMPNS, 1) != 0)
+    out.warnings.push_back(errno_text("SO_TIMESTAMPNS (residence then starts when the datagram is read)"));
+  if (set_int(fd, SOL_SOCKET, SO_RXQ_OVFL, 1) != 0) out.warnings.push_back(errno_text("SO_RXQ_OVFL (drops not counted)"));
+  size_receive_buffer(fd, url.recv_buf_size ? *url.recv_buf_size : buffer_bytes, out);
+  out.fd = fd;
+  return out;
+}
+
+OpenedSocket open_send_socket(const LcmUrl& url) {
+  OpenedSocket out;
+  const auto group = group_address(url);
+  if (!group) return failed(std::move(out), -1, "not an IPv4 multicast group: " + url.group);
+  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return failed(std::move(out), fd, errno_text("socket"));
+  const int ttl = static_cast<int>(url.ttl.value_or(0));
+  if (set_int(fd, IPPROTO_IP, IP_MULTICAST_TTL, ttl) != 0) return failed(std::move(out), fd, errno_text("IP_MULTICAST_TTL"));
+  if (set_int(fd, IPPROTO_IP, IP_MULTICAST_LOOP, 1) != 0) return failed(std::move(out), fd, errno_text("IP_MULTICAST_LOOP"));
+  if (::connect(fd, reinterpret_cast<const sockaddr*>(&*group), sizeof *group) != 0)
+    return failed(std::move(out), fd, errno_text(("no route to " + url.group + " (check the multicast route)").c_str()));
+  sockaddr_in local{};
+  socklen_t length = sizeof local;
+  if (::getsockname(fd, reinterpret_cast<sockaddr*>(&local), &length) != 0)
+    return failed(std::move(out), fd, errno_text("getsockname"));
+  out.local = Endpoint{ntohl(local.sin_addr.s_addr), ntohs(local.sin_port)};
+  out.fd = fd;
+  return out;
+}
+
+ReceiveBatch::ReceiveBatch(std::size_t slots) : slots_(slots), iovecs_(slots), headers_(slots) {
+  for (std::size_t i = 0; i < slots; ++i) {
+    // One byte beyond the largest LCM datagram: a longer one shows as truncated.
+    slots_[i].bytes.resize(kLcmMaxDatagram + 1);
+    iovecs_[i] = iovec{slots_[i].bytes.data(), slots_[i].bytes.size()};
+  }
+}
+
+int ReceiveBatch::receive(int fd) {
+  for (std::size_t i = 0; i < headers_.size(); ++i) {
+    msghdr& h = headers_[i].msg_hdr;
+    h = msghdr{};
+    h.msg_name = &slots_[i].from;
+    h.msg_namelen = sizeof slots_[i].from;
+    h.msg_iov = &iovecs_[i];
+    h.msg_iovlen = 1;
+    h.msg_control = slots_[i].control;
+    h.msg_controllen = sizeof slots_[i].control;
+    headers_[i].msg_len = 0;
+  }
+  const int n = ::recvmmsg(fd, headers_.data(), static_cast<unsigned>(headers_.size()), MSG_DONTWAIT, nullptr);
+  if (n < 0) return (errno == EAGAIN || errno == EWOULDBLOCK) ? 0 : -1;
+  for (int i = 0; i < n; ++i) {
+    Slot& slot = slots_[static_cast<std::size_t>(i)];
+    slot.arrival_ns = 0;
+    msghdr& h = headers_[static_cast<std::size_t>(i)].msg_hdr;
+    for (cmsghdr* c = CMSG_FIRSTHDR(&h); c != nullptr; c = CMSG_NXTHDR(&h, c)) {
+      if (c->cmsg_level != SOL_SOCKET) continue;
+      if (c->cmsg_type == SCM_TIMESTAMPNS) {
+        timespec ts{};
+        std::memcpy(&ts, CMSG_DATA(c), sizeof ts);
+        slot.arrival_ns = static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+      } else if (c->cmsg_type == SO_RXQ_OVFL) {
+        std::uint32_t drops = 0;
+        std::memcpy(&drops, CMSG_DATA(c), sizeof drops);
+        kernel_drops_ = drops;
+      }
+    }
+  }
+  return n;
+}
+
+std::span<const std::uint8_t> ReceiveBatch::datagram(std::size_t i) const {
+  return std::span<const std::uint8_t>(slots_[i].bytes.data(), std::min<std::size_t>(headers_[i].msg_len, kLcmMaxDatagram));
+}
+
+bool ReceiveBatch::truncated(std::size_t i) const {
+  return (headers_[i].msg_hdr.msg_flags & MSG_TRUNC) != 0 || headers_[i].msg_len > kLcmMaxDatagram;
+}
+
+Endpoint ReceiveBatch::sender(std::size_t i) const {
+  const auto& from = slots_[i].from;
+  if (from.ss_family != AF_INET) return Endpoint{};
+  sockaddr_in in{};
+  std::memcpy(&in, &from, sizeof in);
+  return Endpoint{ntohl(in.sin_addr.s_addr), ntohs(in.sin_port)};
+}
+
+std::int64_t ReceiveBatch::arrival_realtime_ns(std::size_t i) const { return slots_[i].arrival_ns; }
+
+namespace {
+
+// The iovecs of payload bytes [offset, offset + length) of the concatenated `parts`, appended.
+void append_slice(std::span<const std::span<const std::uint8_t>> parts, std::size_t offset, std::size_t length,
+                  std::vector<iovec>& out) {
+  for (const auto& part : parts) {
+    if (length == 0) return;
+    if (offset >= part.size()) {
+      offset -= part.size();
+      continue;
+    }
+    const std::size_t take = std::min(length, part.size() - offset);
+    out.push_back(iovec{const_cast<std::uint8_t*>(part.data() + offset), take});
+    length -= take;
+    offset = 0;
+  }
+}
+
+std::optional<std::string> send_datagram(int fd, std::vector<iovec>& iov) {
+  std::size_t expected = 0;
+  for (const iovec& v : iov) expected += v.iov_len;
+  msghdr msg{};
+  msg.msg_iov = iov.data();
+  msg.msg_iovlen = iov.size();
+  const ssize_t n = ::sendmsg(fd, &msg, MSG_NOSIGNAL);
+  if (n < 0) return errno_text("sendmsg");
+  if (static_cast<std::size_t>(n) != expected) return std::string("sendmsg sent part of a datagram");
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<std::string> send_lcm_message(int fd, std::uint32_t sequence, std::string_view channel,
+                                            std::span<const std::span<const std::uint8_t>> parts) {
+  std::size_t payload_size = 0;
+  for (const auto& part : parts) payload_size += part.size();
+  const auto plan = plan_lcm_message(channel.size(), payload_size);
+  if (!plan) return std::string("message too large for LCM (or channel name not 1-63 bytes)");
+  // The channel with its NUL: string_view does not promise one, so it is sent from here.
+  std::array<char, kLcmMaxChannelBytes + 1> name{};
+  std::memcpy(name.data(), channel.data(), channel.size());
+  std::vector<iovec> iov;
+  iov.reserve(parts.size() + 2);
+  if (plan->fragment_count == 0) {
+    auto header = lcm_short_header(sequence);
+    iov.push_back(iovec{header.data(), header.size()});
+    iov.push_back(iovec{name.data(), channel.size() + 1});
+    append_slice(parts, 0, payload_size, iov);
+    return send_datagram(fd, iov);
+  }
+  std::size_t offset = 0;
+  for (std::uint16_t no = 0; no < plan->fragment_count; ++no) {
+    const std::size_t slice = std::min(payload_size - offset, no == 0 ? plan->first_slice : kLcmFragmentMaxData);
+    auto header = lcm_fragment_header(sequence, static_cast<std::uint32_t>(payload_size),
+                                      static_cast<std::uint32_t>(offset), no, plan->fragment_count);
+    iov.clear();
+    iov.push_back(iovec{header.data(), header.size()});
+    if (no == 0) iov.push_back(iovec{name.data(), channel.size() + 1});
+    append_slice(parts, offset, slice, iov);
+    if (auto why = send_datagram(fd, iov)) return why;
+    offset += slice;
+  }
+  return std::nullopt;
+}
+
+bool SendBatch::add(std::uint32_t sequence, std::string_view channel,
+                    std::span<const std::span<const std::uint8_t>> parts) {
+  if (count_ == kCapacity || parts.size() > kMaxParts) return false;
+  std::size_t payload_size = 0;
+  for (const auto& part : parts) payload_size += part.size();
+  const auto plan = plan_lcm_message(channel.size(), payload_size);
+  if (!plan || plan->fragment_count != 0) return false;
+  Slot& slot = slots_[count_];
+  slot.header = lcm_short_header(sequence);
+  std::memcpy(slot.channel.data(), channel.data(), channel.size());
+  slot.channel[channel.size()] = '\0';
+  std::size_t n = 0;
+  slot.iov[n++] = iovec{slot.header.data(), slot.header.size()};
+  slot.iov[n++] = iovec{slot.channel.data(), channel.size() + 1};
+  for (const auto& part : parts)
+    if (!part.empty()) slot.iov[n++] = iovec{const_cast<std::uint8_t*>(part.data()), part.size()};
+  slot.bytes = kLcmShortHeaderSize + channel.size() + 1 + payload_size;
+  mmsghdr& h = headers_[count_];
+  h = mmsghdr{};
+  h.msg_hdr.msg_iov = slot.iov.data();
+  h.msg_hdr.msg_iovlen = n;
+  failed_[count_] = false;
+  ++count_;
+  return true;
+}
+
+std::optional<std::string> SendBatch::send(int fd) {
+  std::optional<std::string> first_error;
+  std::size_t done = 0;
+  while (done < count_) {
+    const int n = ::sendmmsg(fd, headers_.data() + done, static_cast<unsigned>(count_ - done), MSG_NOSIGNAL);
+    if (n <= 0) {
+      // The first message of the rest failed (errno): count it and go on with the others.
+      if (!first_error) first_error = errno_text("sendmmsg");
+      failed_[done++] = true;
+      continue;
+    }
+    for (std::size_t i = done; i < done + static_cast<std::size_t>(n); ++i) {
+      if (headers_[i].msg_len != slots_[i].bytes) {
+        failed_[i] = true;
+        if (!first_error) first_error = "sendmmsg sent part of a datagram";
+      }
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  count_ = 0;
+  return first_error;
+}
+
+}  // namespace cosmic::lcm_detail

@@ -1,0 +1,148 @@
+// The LCM adapter's own transport (lib/adapters/lcm/src/lcm_sockets.cpp) against liblcm in
+// another process (cosmic-lcm-peer): messages too large for one datagram cross in LCM's fragments
+// both ways, the kernel's drops on a full receive buffer are counted, memq:// runs with no socket.
+#include <condition_variable>
+#include <mutex>
+
+#include <nlohmann/json.hpp>
+
+#include "lcm_adapter_fixture.hpp"
+
+namespace cosmic::lcm_test {
+namespace {
+
+// 200,000 bytes: four fragments of liblcm's 65,487 bytes.
+constexpr std::size_t kLarge = 200'000;
+
+TEST_F(LcmAdapterTest, MessagesBeyondOneDatagramCrossInFragmentsBothWays) {
+  const int port = 7720;
+  segment_.max_message_size = 1u << 20;
+  auto adapter = make(port);
+  const std::vector<ChannelBinding> bindings{binding(1, "BIG_IN", HopRole::publisher, LcmEncoding::raw, 3),
+                                             binding(2, "BIG_OUT", HopRole::subscriber)};
+  ASSERT_TRUE(adapter->configure(bindings).ok);
+  ASSERT_TRUE(adapter->start(sink_).ok);
+
+  // liblcm fragments, we reassemble.
+  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "BIG_IN", "--raw", "--count", "3", "--size",
+             std::to_string(kLarge), "--rate", "50"});
+  ASSERT_EQ(pub.wait_exit(), std::optional<int>(0)) << pub.stderr_text();
+  ASSERT_TRUE(sink_.wait_events(1, 3)) << sink_.count(1) << " of 3 large messages";
+  const auto in = sink_.events(1);
+  for (std::size_t i = 0; i < in.size(); ++i) EXPECT_EQ(in[i].payload, peer_pattern(i + 1, kLarge)) << "message " << i + 1;
+
+  // We fragment, liblcm reassembles.
+  Child sub({peer(), "sub", "--url", url_for(port), "--channel", "BIG_OUT", "--count", "3", "--timeout", "10"});
+  ASSERT_TRUE(sub.wait_stderr("READY")) << sub.stderr_text();
+  // One at a time: the subscriber's default socket buffer holds about one such message.
+  for (std::uint32_t k = 1; k <= 3; ++k) {
+    ASSERT_EQ(adapter->send(outbound(2, own_pattern(k, kLarge + k), k, 0xB16, self_.id)), SendStatus::sent);
+    ASSERT_TRUE(sub.wait_stdout_lines(k)) << sub.stderr_text();
+  }
+  ASSERT_EQ(sub.wait_exit(), std::optional<int>(0)) << sub.stderr_text();
+  const auto lines = sub.stdout_lines();
+  ASSERT_EQ(lines.size(), 3u);
+  for (std::uint32_t k = 1; k <= 3; ++k) {
+    const auto j = nlohmann::json::parse(lines[k - 1]);
+    EXPECT_EQ(j["sequence"].get<std::uint32_t>(), k);
+    EXPECT_EQ(j["subject"].get<std::uint64_t>(), 0xB16u);
+    EXPECT_EQ(j["payload"].get<std::string>(), hex(own_pattern(k, kLarge + k)));
+  }
+  EXPECT_EQ(adapter->statistics().receive_errors, 0u);
+  adapter->stop();
+}
+
+TEST_F(LcmAdapterTest, AMessageBeyondTheSegmentsLimitIsNotReassembled) {
+  const int port = 7721;
+  segment_.max_message_size = 100'000;
+  auto adapter = make(port);
+  ASSERT_TRUE(adapter->configure(std::vector{binding(1, "BIG_IN", HopRole::publisher, LcmEncoding::raw, 3)}).ok);
+  ASSERT_TRUE(adapter->start(sink_).ok);
+  Child big({peer(), "pub", "--url", url_for(port), "--channel", "BIG_IN", "--raw", "--count", "2", "--size",
+             std::to_string(kLarge)});
+  ASSERT_EQ(big.wait_exit(), std::optional<int>(0)) << big.stderr_text();
+  // A small one after them arrives alone: the large ones were refused, not delivered late.
+  Child small({peer(), "pub", "--url", url_for(port), "--channel", "BIG_IN", "--raw", "--count", "1", "--size", "8"});
+  ASSERT_EQ(small.wait_exit(), std::optional<int>(0)) << small.stderr_text();
+  ASSERT_TRUE(sink_.wait_events(1, 1));
+  const auto in = sink_.events(1);
+  ASSERT_EQ(in.size(), 1u);
+  EXPECT_EQ(in[0].payload, peer_pattern(1, 8));
+  adapter->stop();
+}
+
+// Holds the receive thread inside on_event until released, so the socket's buffer fills.
+class BlockingSink final : public EventSink {
+ public:
+  void on_event(const InboundEvent&) override {
+    std::unique_lock lock(mutex_);
+    ++events_;
+    changed_.notify_all();
+    changed_.wait(lock, [&] { return released_; });
+  }
+  void on_problem(ChannelId, InboundProblem) override {}
+  bool wait_events(std::size_t n) {
+    std::unique_lock lock(mutex_);
+    return changed_.wait_for(lock, kWait, [&] { return events_ >= n; });
+  }
+  void release() {
+    std::lock_guard lock(mutex_);
+    released_ = true;
+    changed_.notify_all();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::size_t events_ = 0;
+  bool released_ = false;
+};
+
+TEST_F(LcmAdapterTest, DatagramsTheKernelDropsForAFullBufferAreCounted) {
+  const int port = 7722;
+  segment_.name = "lcm0";
+  segment_.type = SegmentType::lcm;
+  // The smallest buffer Linux grants: a few datagrams.
+  segment_.lcm.url = url_for(port) + "&recv_buf_size=2048";
+  auto adapter = make_lcm_adapter(segment_, self_, logger_);
+  BlockingSink sink;
+  ASSERT_TRUE(adapter->configure(std::vector{binding(1, "FLOOD", HopRole::publisher, LcmEncoding::raw, 3)}).ok);
+  ASSERT_TRUE(adapter->start(sink).ok);
+  Child first({peer(), "pub", "--url", url_for(port), "--channel", "FLOOD", "--raw", "--count", "1", "--size", "64"});
+  ASSERT_EQ(first.wait_exit(), std::optional<int>(0)) << first.stderr_text();
+  ASSERT_TRUE(sink.wait_events(1));  // the receive thread is held now
+  Child flood({peer(), "pub", "--url", url_for(port), "--channel", "FLOOD", "--raw", "--count", "500", "--size", "64"});
+  ASSERT_EQ(flood.wait_exit(), std::optional<int>(0)) << flood.stderr_text();
+  sink.release();
+  // A datagram queued after the drops carries their count (SO_RXQ_OVFL).
+  std::uint64_t drops = 0;
+  ASSERT_TRUE(poll_until([&] {
+    Child marker({peer(), "pub", "--url", url_for(port), "--channel", "FLOOD", "--raw", "--count", "1", "--size", "64"});
+    marker.wait_exit();
+    drops = adapter->statistics().overflow_drops;
+    return drops > 0;
+  })) << "no drop counted; received " << adapter->statistics().received;
+  const auto stats = adapter->statistics();
+  EXPECT_LE(stats.received + stats.overflow_drops, 1u + 500u + 200u) << "more accounted for than were sent";
+  EXPECT_GT(stats.received, 1u);
+  adapter->stop();
+}
+
+TEST_F(LcmAdapterTest, AMemqSegmentRunsWithNoSocketAndReceivesNothing) {
+  segment_.name = "viz";
+  segment_.type = SegmentType::lcm;
+  segment_.lcm.url = "memq://";
+  auto adapter = make_lcm_adapter(segment_, self_, logger_);
+  ASSERT_TRUE(adapter->configure(std::vector{binding(1, "VIZ", HopRole::subscriber)}).ok);
+  ASSERT_TRUE(adapter->start(sink_).ok);
+  EXPECT_EQ(adapter->health().state, SegmentHealth::up);
+  EXPECT_EQ(adapter->send(outbound(1, Bytes{1, 2, 3})), SendStatus::sent);
+  EXPECT_EQ(adapter->send(outbound(9, Bytes{1})), SendStatus::failed);  // not bound
+  EXPECT_EQ(adapter->statistics().sent, 1u);
+  adapter->stop();
+  EXPECT_EQ(adapter->health().state, SegmentHealth::down);
+  EXPECT_EQ(adapter->send(outbound(1, Bytes{1})), SendStatus::failed);  // stopped
+}
+
+}  // namespace
+}  // namespace cosmic::lcm_test
