@@ -234,11 +234,10 @@ TEST_F(LcmAdapterTest, OwnEnvelopesAreNotReceivedBack) {
   ASSERT_TRUE(adapter->configure(bindings).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
 
+  // Ours go out (a native subscriber hears them: EnvelopeToNativeSubscriber) and loop back to our
+  // own socket, whose filter drops them in the kernel: the peer's, sent after, arrive alone.
   for (std::uint32_t k = 1; k <= 10; ++k)
     ASSERT_EQ(adapter->send(outbound(5, own_pattern(k, 16), k, 0, self_.id)), SendStatus::sent);
-  ASSERT_TRUE(sink_.wait_problems(5, InboundProblem::own_echo, 10))
-      << sink_.problems(5, InboundProblem::own_echo) << " echoes, " << sink_.count(5) << " events, "
-      << adapter->statistics().received << " received";
 
   Child pub({peer(), "pub", "--url", url_for(port), "--channel", "LOOPED", "--count", "5", "--size",
              "16", "--origin", "5", "--subject", "9"});
@@ -253,7 +252,8 @@ TEST_F(LcmAdapterTest, OwnEnvelopesAreNotReceivedBack) {
     EXPECT_EQ(events[i].header.sequence, i + 1);
     EXPECT_EQ(events[i].payload, peer_pattern(i + 1, 16));
   }
-  EXPECT_EQ(sink_.problems(5, InboundProblem::own_echo), 10u);
+  EXPECT_EQ(sink_.problems(5, InboundProblem::own_echo), 0u) << "our datagrams reached the receive thread";
+  EXPECT_EQ(adapter->statistics().received, 5u);
 
   // Envelopes carrying this gateway's origin that it did not just publish (a loop through another
   // gateway, or a spoof) are delivered, for the router's ingress check to drop and count.
@@ -262,7 +262,7 @@ TEST_F(LcmAdapterTest, OwnEnvelopesAreNotReceivedBack) {
   ASSERT_EQ(spoof.wait_exit(), std::optional<int>(0)) << spoof.stderr_text();
   ASSERT_TRUE(sink_.wait_events(5, 8));
   for (std::size_t i = 5; i < 8; ++i) EXPECT_EQ(sink_.events(5).at(i).header.origin, self_.id);
-  EXPECT_EQ(sink_.problems(5, InboundProblem::own_echo), 10u);
+  EXPECT_EQ(sink_.problems(5, InboundProblem::own_echo), 0u);
   adapter->stop();
 }
 
@@ -275,11 +275,9 @@ TEST_F(LcmAdapterTest, OwnRawMessagesAreNotReceivedBack) {
   ASSERT_TRUE(adapter->configure(bindings).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
 
+  // Raw messages carry no origin: only their source tells ours from a native program's.
   for (std::uint32_t k = 1; k <= 10; ++k)
     ASSERT_EQ(adapter->send(outbound(6, own_pattern(k, 24))), SendStatus::sent);
-  ASSERT_TRUE(sink_.wait_problems(6, InboundProblem::own_echo, 10))
-      << sink_.problems(6, InboundProblem::own_echo) << " echoes, " << sink_.count(6) << " events, "
-      << adapter->statistics().received << " received";
 
   Child pub({peer(), "pub", "--url", url_for(port), "--channel", "LOOPED_RAW", "--raw", "--count",
              "5", "--size", "24"});
@@ -292,7 +290,7 @@ TEST_F(LcmAdapterTest, OwnRawMessagesAreNotReceivedBack) {
     EXPECT_EQ(events[i].payload, peer_pattern(i + 1, 24));
     EXPECT_EQ(events[i].header.subject, 11u);
   }
-  EXPECT_EQ(sink_.problems(6, InboundProblem::own_echo), 10u);
+  EXPECT_EQ(sink_.problems(6, InboundProblem::own_echo), 0u) << "our datagrams reached the receive thread";
   adapter->stop();
 }
 

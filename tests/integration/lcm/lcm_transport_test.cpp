@@ -71,6 +71,61 @@ TEST_F(LcmAdapterTest, AMessageBeyondTheSegmentsLimitIsNotReassembled) {
   adapter->stop();
 }
 
+TEST_F(LcmAdapterTest, ABatchGoesOutInOrderWithEachEventsOwnStatus) {
+  const int port = 7723;
+  segment_.max_message_size = 1u << 20;
+  auto adapter = make(port);
+  const std::vector<ChannelBinding> bindings{binding(1, "BATCH_ENV", HopRole::subscriber),
+                                             binding(2, "BATCH_RAW", HopRole::subscriber, LcmEncoding::raw, 4)};
+  ASSERT_TRUE(adapter->configure(bindings).ok);
+  ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->batches_sends());
+  Child env({peer(), "sub", "--url", url_for(port), "--channel", "BATCH_ENV", "--count", "41", "--timeout", "10"});
+  Child raw({peer(), "sub", "--url", url_for(port), "--channel", "BATCH_RAW", "--raw", "--count", "4", "--timeout", "10"});
+  ASSERT_TRUE(env.wait_stderr("READY")) << env.stderr_text();
+  ASSERT_TRUE(raw.wait_stderr("READY")) << raw.stderr_text();
+
+  // More events than one sendmmsg takes (32), two channels, one event of a channel not bound
+  // here, and one envelope that needs fragments (it goes alone, in its place).
+  std::vector<Bytes> payloads;
+  std::vector<OutboundEvent> events;
+  payloads.reserve(46);
+  for (std::uint32_t k = 1; k <= 41; ++k) {
+    payloads.push_back(own_pattern(k, k == 20 ? 70'000 : 8 + k));
+    events.push_back(outbound(1, payloads.back(), k, 0xBA7, self_.id));
+    if (k % 10 == 5) {
+      payloads.push_back(own_pattern(100 + k, 12));
+      events.push_back(outbound(2, payloads.back()));
+    }
+    if (k == 33) {
+      payloads.push_back(Bytes{9});
+      events.push_back(outbound(9, payloads.back()));
+    }
+  }
+  ASSERT_EQ(events.size(), 46u);
+  std::vector<SendStatus> results(events.size(), SendStatus::failed);
+  adapter->send_batch(events, results);
+  for (std::size_t i = 0; i < events.size(); ++i)
+    EXPECT_EQ(results[i], events[i].channel == 9 ? SendStatus::failed : SendStatus::sent) << "event " << i;
+
+  ASSERT_EQ(env.wait_exit(), std::optional<int>(0)) << env.stderr_text();
+  const auto lines = env.stdout_lines();
+  ASSERT_EQ(lines.size(), 41u);
+  for (std::uint32_t k = 1; k <= 41; ++k) {
+    const auto j = nlohmann::json::parse(lines[k - 1]);
+    EXPECT_EQ(j["sequence"].get<std::uint32_t>(), k);
+    EXPECT_EQ(j["payload"].get<std::string>(), hex(own_pattern(k, k == 20 ? 70'000 : 8 + k)));
+  }
+  ASSERT_EQ(raw.wait_exit(), std::optional<int>(0)) << raw.stderr_text();
+  const auto raw_lines = raw.stdout_lines();
+  ASSERT_EQ(raw_lines.size(), 4u);
+  for (std::size_t i = 0; i < raw_lines.size(); ++i)
+    EXPECT_EQ(nlohmann::json::parse(raw_lines[i])["payload"].get<std::string>(), hex(own_pattern(100 + 5 + 10 * i, 12)));
+  EXPECT_EQ(adapter->statistics().sent, 45u);
+  EXPECT_EQ(adapter->statistics().send_errors, 1u);
+  adapter->stop();
+}
+
 // Holds the receive thread inside on_event until released, so the socket's buffer fills.
 class BlockingSink final : public EventSink {
  public:

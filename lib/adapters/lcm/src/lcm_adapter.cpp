@@ -16,8 +16,9 @@
 //                   channel class, each under its own mutex held across sendmsg: an NRT send
 //                   stalled in the kernel never holds what an HRT send needs (issue 20, item 2).
 // Our own datagrams loop back to the receive socket (multicast loopback stays on so programs on
-// this host hear the gateway); the receive thread knows them exactly by their source, the address
-// and port of one of our connected transmit sockets, and reports them as own_echo.
+// this host hear the gateway). A socket filter drops them in the kernel by their source, the
+// address and port of one of our connected transmit sockets; where it cannot be attached the
+// receive thread tells them by that source itself and reports them as own_echo.
 // The EventSink is called with table_mutex_ held shared: it must hand the event on (the router
 // queues it) and not call back into this adapter.
 #include "cosmic/lcm_adapter.hpp"
@@ -117,6 +118,8 @@ class LcmAdapter final : public SegmentAdapter {
       close_senders();
       return fail_start("receive socket on " + segment_.lcm.url + ": " + rx.error);
     }
+    if (const auto why = lcm_detail::drop_own_datagrams(rx.fd, own_sources_))
+      rx.warnings.push_back("own datagrams are read back and dropped here (" + *why + ")");
     for (const auto& warning : rx.warnings) log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + warning);
     stop_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
     if (stop_fd_ < 0) {

@@ -1,6 +1,7 @@
 #include "lcm_sockets.hpp"
 
 #include <arpa/inet.h>
+#include <linux/filter.h>
 #include <netinet/in.h>
 #include <sys/uio.h>
 #include <unistd.h>
@@ -103,6 +104,29 @@ OpenedSocket open_send_socket(const LcmUrl& url) {
   out.local = Endpoint{ntohl(local.sin_addr.s_addr), ntohs(local.sin_port)};
   out.fd = fd;
   return out;
+}
+
+// Classic BPF over a UDP socket's datagram: the filter runs with the UDP header at offset 0 and
+// the IP header at SKF_NET_OFF. Per own endpoint: source address, then source port; a match
+// drops the datagram (returns 0), anything else is accepted whole.
+std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> own) {
+  constexpr std::uint32_t kSourceAddress = static_cast<std::uint32_t>(SKF_NET_OFF) + 12;
+  constexpr std::uint32_t kSourcePort = 0;
+  if (own.empty() || own.size() > 16) return std::string("no endpoints to filter");
+  std::vector<sock_filter> program;
+  const std::size_t drop_at = own.size() * 4 + 1;  // after every check and the accept
+  for (const Endpoint& e : own) {
+    program.push_back(BPF_STMT(BPF_LD | BPF_W | BPF_ABS, kSourceAddress));
+    program.push_back(BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, e.address, 0, 2));
+    program.push_back(BPF_STMT(BPF_LD | BPF_H | BPF_ABS, kSourcePort));
+    const std::size_t here = program.size();
+    program.push_back(BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, e.port, static_cast<std::uint8_t>(drop_at - here - 1), 0));
+  }
+  program.push_back(BPF_STMT(BPF_RET | BPF_K, 0xFFFFFFFFu));  // accept
+  program.push_back(BPF_STMT(BPF_RET | BPF_K, 0));            // drop
+  const sock_fprog fprog{static_cast<unsigned short>(program.size()), program.data()};
+  if (::setsockopt(fd, SOL_SOCKET, SO_ATTACH_FILTER, &fprog, sizeof fprog) != 0) return errno_text("SO_ATTACH_FILTER");
+  return std::nullopt;
 }
 
 ReceiveBatch::ReceiveBatch(std::size_t slots) : slots_(slots), iovecs_(slots), headers_(slots) {

@@ -54,6 +54,12 @@ OpenedSocket open_receive_socket(const LcmUrl& url, std::size_t buffer_bytes);
 // programs on this host receive what it sends.
 OpenedSocket open_send_socket(const LcmUrl& url);
 
+// Attaches a socket filter to receive socket `fd` that drops, in the kernel, every datagram sent
+// from one of `own` (our transmit sockets: multicast loopback hands our own datagrams back to
+// every socket of the group, ours included). nullopt when attached; otherwise why not (the
+// receive thread then tells them by their source itself).
+std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> own);
+
 // One recvmmsg's worth of datagrams, reused from call to call.
 class ReceiveBatch {
  public:
