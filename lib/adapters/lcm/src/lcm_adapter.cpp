@@ -228,18 +228,17 @@ class LcmAdapter final : public SegmentAdapter {
         if (channel->cls != first->cls || !stage(sender, *channel, events[i])) break;
         staged[count++] = i;
       }
-      if (count == 0) {  // the message at i needs fragments
+      if (count == 0) {  // the message at i needs fragments, or there is no socket (memq, stopped)
         results[i] = send_one(sender, *first, events[i]);
         ++i;
         continue;
       }
-      const auto why = memq_.load(std::memory_order_relaxed) ? std::nullopt : sender.batch.send(sender.fd);
+      const auto why = sender.batch.send(sender.fd);
       for (std::size_t k = 0; k < count; ++k) {
-        const bool failed = !memq_.load(std::memory_order_relaxed) && sender.batch.failed(k);
-        results[staged[k]] = failed ? send_failed(*transmitting(events[staged[k]].channel), why ? why->c_str() : "sendmmsg")
-                                    : sent();
+        results[staged[k]] = sender.batch.failed(k)
+                                 ? send_failed(*transmitting(events[staged[k]].channel), why ? why->c_str() : "sendmmsg")
+                                 : sent();
       }
-      if (memq_.load(std::memory_order_relaxed)) sender.batch = lcm_detail::SendBatch{};
     }
   }
 
