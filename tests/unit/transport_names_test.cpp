@@ -85,5 +85,24 @@ channels: []
   EXPECT_EQ(text.find("int x;"), std::string::npos) << "the value itself is never echoed with its control characters: " << text;
 }
 
+TEST(LcmChannelNames, ANulOrControlCharacterIsRefusedBeforeItReachesTheWire) {
+  EXPECT_EQ(transport_name_problem(SegmentType::lcm, "WHEEL_SPEED"), std::nullopt);
+  EXPECT_EQ(transport_name_problem(SegmentType::lcm, "odometry/pose 2"), std::nullopt);  // LCM allows these
+  EXPECT_TRUE(transport_name_problem(SegmentType::lcm, std::string("A\0B", 3)));
+  EXPECT_TRUE(transport_name_problem(SegmentType::lcm, "A\nB"));
+  EXPECT_TRUE(transport_name_problem(SegmentType::lcm, "A\x7f"));
+  EXPECT_EQ(transport_name_problem(SegmentType::dds, std::string("A\0B", 3)), std::nullopt);  // DDS names are checked elsewhere
+  // In a native binding of the configuration, at its place.
+  const ConfigResult r = parse_config(std::string(kHead) + R"(  - {name: lan, type: dds}
+  - {name: viz, type: lcm}
+channels:
+  - {name: wheel, subject: 1, class: nrt, publishers: [lan], subscribers: [viz], native: {viz: {channel: "WHEEL\u0000SPEED"}}}
+)",
+                                      "gw.yaml");
+  const std::string text = errors_text(r.errors);
+  EXPECT_NE(text.find("gw.yaml:6:"), std::string::npos) << text;
+  EXPECT_NE(text.find("LCM channel names hold no control characters; this one has 0x00"), std::string::npos) << text;
+}
+
 }  // namespace
 }  // namespace cosmic

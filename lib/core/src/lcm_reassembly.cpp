@@ -59,11 +59,24 @@ LcmReassembler::Partial* LcmReassembler::start(std::uint64_t sender, const LcmDa
   return &partials_.back();
 }
 
+void LcmReassembler::skip(std::uint64_t sender, std::uint32_t sequence) {
+  if (Partial* p = find_sender(sender); p != nullptr && p->sequence == sequence)
+    drop(static_cast<std::size_t>(p - partials_.data()));
+  remember_finished(sender, sequence);
+}
+
+void LcmReassembler::remember_finished(std::uint64_t sender, std::uint32_t sequence) {
+  finished_[next_finished_] = {sender, sequence};
+  next_finished_ = (next_finished_ + 1) % finished_.size();
+  finished_count_ = std::min(finished_count_ + 1, finished_.size());
+}
+
 LcmReassembler::Outcome LcmReassembler::add(std::uint64_t sender, const LcmDatagram& fragment) {
   if (!fragment.fragment || fragment.fragment_no >= fragment.fragment_count) return Outcome::refused;
   // A fragment of a message already delivered (a duplicate arriving late) starts nothing.
-  if (std::find(finished_.begin(), finished_.end(), std::pair{sender, fragment.sequence}) != finished_.end())
-    return Outcome::refused;
+  const auto finished_end = finished_.begin() + static_cast<std::ptrdiff_t>(finished_count_);
+  if (std::find(finished_.begin(), finished_end, std::pair{sender, fragment.sequence}) != finished_end)
+    return Outcome::ignored;
   Partial* p = find_sender(sender);
   if (p != nullptr && p->sequence != fragment.sequence) {
     // The sender moved on: what it left unfinished is lost.
@@ -98,8 +111,7 @@ LcmReassembler::Outcome LcmReassembler::add(std::uint64_t sender, const LcmDatag
   bytes_held_ -= p->data.size();
   completed_ = std::move(p->data);
   p->data.clear();  // moved from: drop() accounts nothing more for it
-  finished_[next_finished_] = {sender, fragment.sequence};
-  next_finished_ = (next_finished_ + 1) % finished_.size();
+  remember_finished(sender, fragment.sequence);
   drop(static_cast<std::size_t>(p - partials_.data()));
   if (!whole) {
     ++abandoned_;

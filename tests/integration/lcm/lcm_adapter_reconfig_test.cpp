@@ -257,6 +257,30 @@ TEST(LcmWire, DecodesWhatLcmGenEncodesWithoutCopying) {
   EXPECT_TRUE(decode_lcm_envelope(no_payload, 0)->payload.empty());
 }
 
+TEST(LcmWire, EncodesTheHeaderAsLcmGenDoes) {
+  ::cosmic::envelope e{};
+  e.subject = -2;
+  e.origin = INT64_MIN + 7;
+  e.sequence = -3;
+  e.hop_count = -1;
+  e.created_ns = 1'700'000'000'123'456'789;
+  e.age_ns = -5;
+  e.payload = {1, 2, 3, 4};
+  e.payload_size = 4;
+  const Bytes reference = encoded(e);
+  EventHeader header;
+  header.subject = 0xFFFFFFFFFFFFFFFEull;
+  header.origin = 0x8000000000000007ull;
+  header.sequence = 0xFFFFFFFDu;
+  header.hop_count = 255;
+  header.created_ns = 1'700'000'000'123'456'789;
+  header.age_ns = -5;
+  const auto ours = encode_lcm_envelope_header(header, 4);
+  Bytes whole(ours.begin(), ours.end());
+  whole.insert(whole.end(), e.payload.begin(), e.payload.end());
+  EXPECT_EQ(whole, reference);
+}
+
 TEST(LcmWire, RefusesAnythingButExactlyOneEnvelopeWithinTheLimit) {
   ::cosmic::envelope e{};
   e.payload = Bytes(10, 0x5a);

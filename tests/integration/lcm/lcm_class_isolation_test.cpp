@@ -26,7 +26,9 @@ struct SendStall {
   std::mutex mutex;
   std::condition_variable changed;
   bool armed = false;
-  bool holding = false;  // a sendmsg of kStalledChannel is held
+  bool holding = false;  // a sendmsg or sendmmsg of kStalledChannel is held
+  unsigned batches = 0;  // sendmmsg calls so far
+  unsigned batched = 0;  // messages they carried
 };
 
 SendStall& stall() {
@@ -42,21 +44,37 @@ bool carries_stalled_channel(const msghdr* msg) {
   return false;
 }
 
+// Holds the calling thread while armed (the caller carries kStalledChannel).
+void hold_while_armed() {
+  SendStall& s = stall();
+  std::unique_lock lock(s.mutex);
+  if (!s.armed) return;
+  s.holding = true;
+  s.changed.notify_all();
+  s.changed.wait(lock, [&] { return !s.armed; });
+  s.holding = false;
+}
+
 }  // namespace
+
+extern "C" int sendmmsg(int fd, mmsghdr* msgs, unsigned int count, int flags) {
+  using Real = int (*)(int, mmsghdr*, unsigned int, int);
+  static const auto real = reinterpret_cast<Real>(dlsym(RTLD_NEXT, "sendmmsg"));
+  bool stalled = false;
+  for (unsigned i = 0; i < count; ++i) stalled = stalled || carries_stalled_channel(&msgs[i].msg_hdr);
+  {
+    std::lock_guard lock(stall().mutex);
+    ++stall().batches;
+    stall().batched += count;
+  }
+  if (stalled) hold_while_armed();
+  return real(fd, msgs, count, flags);
+}
 
 extern "C" ssize_t sendmsg(int fd, const msghdr* msg, int flags) {
   using Real = ssize_t (*)(int, const msghdr*, int);
   static const auto real = reinterpret_cast<Real>(dlsym(RTLD_NEXT, "sendmsg"));
-  SendStall& s = stall();
-  if (carries_stalled_channel(msg)) {
-    std::unique_lock lock(s.mutex);
-    if (s.armed) {
-      s.holding = true;
-      s.changed.notify_all();
-      s.changed.wait(lock, [&] { return !s.armed; });
-      s.holding = false;
-    }
-  }
+  if (carries_stalled_channel(msg)) hold_while_armed();
   return real(fd, msg, flags);
 }
 
@@ -99,6 +117,65 @@ TEST_F(LcmAdapterTest, AnNrtSendStalledInTheKernelDoesNotDelayAnHrtSend) {
   EXPECT_EQ(nrt.get(), SendStatus::sent);
   // Within one class, sends still take turns: the other NRT channel goes once the stall ends.
   EXPECT_EQ(adapter->send(outbound(3, payload, 1, 0, self_.id)), SendStatus::sent);
+  adapter->stop();
+}
+
+// The same through the egress lanes' batched path: an NRT batch stalled inside sendmmsg.
+TEST_F(LcmAdapterTest, AnNrtBatchStalledInTheKernelDoesNotDelayAnHrtBatch) {
+  auto adapter = make(7713);
+  ASSERT_TRUE(adapter->start(sink_).ok);
+  const std::vector<ChannelBinding> bindings{class_binding(1, std::string(kStalledChannel), ChannelClass::nrt),
+                                             class_binding(2, "HRT_FAST", ChannelClass::hrt)};
+  ASSERT_TRUE(adapter->configure(bindings).ok);
+  {
+    std::lock_guard lock(stall().mutex);
+    stall().armed = true;
+  }
+  const Bytes payload(64, 0x5A);
+  const std::vector<OutboundEvent> nrt_events(4, outbound(1, payload, 1, 0, self_.id));
+  const std::vector<OutboundEvent> hrt_events(4, outbound(2, payload, 1, 0, self_.id));
+  std::vector<SendStatus> nrt_results(4, SendStatus::failed);
+  std::vector<SendStatus> hrt_results(4, SendStatus::failed);
+  auto nrt = std::async(std::launch::async, [&] { adapter->send_batch(nrt_events, nrt_results); });
+  {
+    std::unique_lock lock(stall().mutex);
+    ASSERT_TRUE(stall().changed.wait_for(lock, kWait, [] { return stall().holding; })) << "the NRT batch never reached sendmmsg";
+  }
+  auto hrt = std::async(std::launch::async, [&] { adapter->send_batch(hrt_events, hrt_results); });
+  const bool hrt_done = hrt.wait_for(kWait) == std::future_status::ready;
+  {
+    std::lock_guard lock(stall().mutex);
+    stall().armed = false;
+    stall().changed.notify_all();
+  }
+  ASSERT_TRUE(hrt_done) << "the HRT batch waited for the stalled NRT batch";
+  nrt.get();
+  for (const SendStatus s : hrt_results) EXPECT_EQ(s, SendStatus::sent);
+  for (const SendStatus s : nrt_results) EXPECT_EQ(s, SendStatus::sent);
+  adapter->stop();
+}
+
+TEST_F(LcmAdapterTest, ABatchOfShortMessagesLeavesInOneSendmmsg) {
+  auto adapter = make(7714);
+  ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(std::vector{class_binding(1, "NRT_MANY", ChannelClass::nrt)}).ok);
+  const Bytes payload(64, 0x33);
+  const std::vector<OutboundEvent> events(10, outbound(1, payload, 1, 0, self_.id));
+  std::vector<SendStatus> results(10, SendStatus::failed);
+  unsigned batches_before = 0;
+  unsigned batched_before = 0;
+  {
+    std::lock_guard lock(stall().mutex);
+    batches_before = stall().batches;
+    batched_before = stall().batched;
+  }
+  adapter->send_batch(events, results);
+  for (const SendStatus s : results) EXPECT_EQ(s, SendStatus::sent);
+  {
+    std::lock_guard lock(stall().mutex);
+    EXPECT_EQ(stall().batches - batches_before, 1u);
+    EXPECT_EQ(stall().batched - batched_before, 10u);
+  }
   adapter->stop();
 }
 

@@ -68,6 +68,29 @@ TEST_F(LcmAdapterTest, AMessageBeyondTheSegmentsLimitIsNotReassembled) {
   const auto in = sink_.events(1);
   ASSERT_EQ(in.size(), 1u);
   EXPECT_EQ(in[0].payload, peer_pattern(1, 8));
+  // Each of their four fragments was refused and counted (none held: they never fit).
+  EXPECT_EQ(adapter->statistics().receive_errors, 8u);
+  adapter->stop();
+}
+
+TEST_F(LcmAdapterTest, FragmentsOfAChannelNotReceivedHereAreSkippedWhole) {
+  const int port = 7724;
+  segment_.max_message_size = 1u << 20;
+  auto adapter = make(port);
+  ASSERT_TRUE(adapter->configure(std::vector{binding(1, "BIG_IN", HopRole::publisher, LcmEncoding::raw, 3)}).ok);
+  ASSERT_TRUE(adapter->start(sink_).ok);
+  // Another program's large messages on a channel this segment does not carry: fragment 0 names
+  // it, the three after it carry no name and must not be held (nor counted lost).
+  Child other({peer(), "pub", "--url", url_for(port), "--channel", "NOT_OURS", "--raw", "--count", "3", "--size",
+               std::to_string(kLarge), "--rate", "50"});
+  ASSERT_EQ(other.wait_exit(), std::optional<int>(0)) << other.stderr_text();
+  Child ours({peer(), "pub", "--url", url_for(port), "--channel", "BIG_IN", "--raw", "--count", "1", "--size",
+              std::to_string(kLarge)});
+  ASSERT_EQ(ours.wait_exit(), std::optional<int>(0)) << ours.stderr_text();
+  ASSERT_TRUE(sink_.wait_events(1, 1));
+  EXPECT_EQ(sink_.events(1).at(0).payload, peer_pattern(1, kLarge));
+  EXPECT_EQ(adapter->statistics().receive_errors, 0u);
+  EXPECT_EQ(adapter->statistics().received, 1u);
   adapter->stop();
 }
 

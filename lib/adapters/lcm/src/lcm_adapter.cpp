@@ -9,16 +9,14 @@
 //   control_mutex_  serialises start/configure/stop (control thread) and guards the receive
 //                   socket and thread.
 //   table_mutex_    shared_mutex over the channel table and the sink. send() (lane threads) takes
-//                   it shared for one event, the receive thread for one batch of datagrams;
-//                   configure() and stop() take it exclusively only to swap the table or the sink,
-//                   never around I/O.
-//   senders_[class] one transmit socket, its LCM sequence number and the envelope header per
-//                   channel class, each under its own mutex held across sendmsg: an NRT send
-//                   stalled in the kernel never holds what an HRT send needs (issue 20, item 2).
+//                   it shared for one event or batch, the receive thread for one batch of
+//                   datagrams; configure() and stop() take it exclusively only to swap the table
+//                   or the sink, never around I/O.
+//   transmit_       the per-class transmit sockets, each under its own mutex (lcm_transmit.hpp).
 // Our own datagrams loop back to the receive socket (multicast loopback stays on so programs on
-// this host hear the gateway). A socket filter drops them in the kernel by their source, the
-// address and port of one of our connected transmit sockets; where it cannot be attached the
-// receive thread tells them by that source itself and reports them as own_echo.
+// this host hear the gateway). A socket filter cuts them down to nothing in the kernel, by their
+// source, the address and port of one of our connected transmit sockets, and the receive thread
+// skips them by that source.
 // The EventSink is called with table_mutex_ held shared: it must hand the event on (the router
 // queues it) and not call back into this adapter.
 #include "cosmic/lcm_adapter.hpp"
@@ -55,7 +53,9 @@
 #include "cosmic/thread_annotations.hpp"
 #include "cosmic/thread_policy.hpp"
 #include "cosmic/transport_limits.hpp"
+#include "lcm_channel.hpp"
 #include "lcm_sockets.hpp"
+#include "lcm_transmit.hpp"
 
 namespace cosmic {
 namespace {
@@ -73,24 +73,18 @@ struct StringHash {
   std::size_t operator()(std::string_view s) const noexcept { return std::hash<std::string_view>{}(s); }
 };
 
-// One channel bound on this segment. rx: the gateway receives it here (HopRole::publisher);
-// tx: the gateway sends it here (HopRole::subscriber). Both may be set.
-struct Channel {
-  ChannelId id = kNoChannel;
-  std::string name;
-  std::uint64_t subject = 0;
-  LcmEncoding encoding = LcmEncoding::envelope;
-  ChannelClass cls = ChannelClass::nrt;  // which transmit socket sends it
-  bool rx = false;
-  bool tx = false;
-};
+using lcm_detail::Channel;
 
 class LcmAdapter final : public SegmentAdapter {
  public:
   // An envelope's origin is not compared with ours here: our own datagrams are known by their
   // source, and the router's ingress check counts any other envelope carrying our origin.
   LcmAdapter(const SegmentSpec& segment, Logger& log)
-      : segment_(segment), log_(log), reassembler_(segment.max_message_size) {}
+      : segment_(segment),
+        log_(log),
+        transmit_(segment.name, log, counters_, health_, receive_failing_),
+        // An envelope's payload may be max_message_size bytes: the message is its header longer.
+        reassembler_(segment.max_message_size + kLcmEnvelopeHeaderSize) {}
 
   ~LcmAdapter() override { stop(); }
 
@@ -112,23 +106,25 @@ class LcmAdapter final : public SegmentAdapter {
       set_health(SegmentHealth::up, "");
       return Status{};
     }
-    if (const auto why = open_senders(url)) return fail_start(*why);
+    if (const auto why = transmit_.open(url)) return fail_start(*why);
     lcm_detail::OpenedSocket rx = lcm_detail::open_receive_socket(url, kDefaultReceiveBuffer);
     if (rx.fd < 0) {
-      close_senders();
+      transmit_.close();
       return fail_start("receive socket on " + segment_.lcm.url + ": " + rx.error);
     }
-    if (const auto why = lcm_detail::drop_own_datagrams(rx.fd, own_sources_))
-      rx.warnings.push_back("own datagrams are read back and dropped here (" + *why + ")");
+    if (const auto why = transmit_.follow_with_filter(rx.fd))
+      rx.warnings.push_back("own datagrams are read back in full and skipped here (" + *why + ")");
     for (const auto& warning : rx.warnings) log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + warning);
     stop_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
     if (stop_fd_ < 0) {
       const std::string why = std::string("eventfd for the receive loop: ") + std::strerror(errno);
+      transmit_.close();
       ::close(rx.fd);
-      close_senders();
       return fail_start(why);
     }
     rx_fd_ = rx.fd;
+    receive_failing_.store(false, std::memory_order_relaxed);
+    kernel_drops_seen_ = 0;  // a new socket counts from 0; its thread starts below
     attach_sink(&sink);
     running_.store(true, std::memory_order_release);
     try {
@@ -138,9 +134,9 @@ class LcmAdapter final : public SegmentAdapter {
     } catch (const std::exception& e) {
       running_.store(false);
       attach_sink(nullptr);
+      transmit_.close();
       ::close(std::exchange(stop_fd_, -1));
       ::close(std::exchange(rx_fd_, -1));
-      close_senders();
       return fail_start(std::string("cannot start the LCM receive thread: ") + e.what());
     }
     started_ = true;
@@ -197,48 +193,26 @@ class LcmAdapter final : public SegmentAdapter {
   SendStatus send(const OutboundEvent& event) override {
     SharedLock table(table_mutex_);
     const Channel* channel = transmitting(event.channel);
-    if (channel == nullptr) return unbound();
-    ClassSender& sender = senders_.at(static_cast<std::size_t>(channel->cls));
-    LockGuard transmit(sender.mutex);
-    return send_one(sender, *channel, event);
+    if (channel == nullptr) return transmit_.unbound();
+    if (memq_.load(std::memory_order_relaxed)) return memq_sent();
+    return transmit_.send(*channel, event);
   }
 
   // An egress lane's batch: each run of events of one class that fit one datagram goes out in
   // one sendmmsg, in order; a message that needs fragments goes alone.
   void send_batch(std::span<const OutboundEvent> events, std::span<SendStatus> results) override {
+    constexpr std::size_t kChunk = lcm_detail::SendBatch::kCapacity;
     const std::size_t n = std::min(events.size(), results.size());
     SharedLock table(table_mutex_);
-    std::size_t i = 0;
-    while (i < n) {
-      const Channel* first = transmitting(events[i].channel);
-      if (first == nullptr) {
-        results[i++] = unbound();
+    for (std::size_t from = 0; from < n; from += kChunk) {
+      const std::size_t count = std::min(kChunk, n - from);
+      std::array<const Channel*, kChunk> channels{};
+      for (std::size_t i = 0; i < count; ++i) channels[i] = transmitting(events[from + i].channel);
+      if (memq_.load(std::memory_order_relaxed)) {
+        for (std::size_t i = 0; i < count; ++i) results[from + i] = channels[i] ? memq_sent() : transmit_.unbound();
         continue;
       }
-      ClassSender& sender = senders_.at(static_cast<std::size_t>(first->cls));
-      LockGuard transmit(sender.mutex);
-      std::array<std::size_t, lcm_detail::SendBatch::kCapacity> staged{};  // indices into events
-      std::size_t count = 0;
-      for (; i < n; ++i) {
-        const Channel* channel = transmitting(events[i].channel);
-        if (channel == nullptr) {
-          results[i] = unbound();
-          continue;
-        }
-        if (channel->cls != first->cls || !stage(sender, *channel, events[i])) break;
-        staged[count++] = i;
-      }
-      if (count == 0) {  // the message at i needs fragments, or there is no socket (memq, stopped)
-        results[i] = send_one(sender, *first, events[i]);
-        ++i;
-        continue;
-      }
-      const auto why = sender.batch.send(sender.fd);
-      for (std::size_t k = 0; k < count; ++k) {
-        results[staged[k]] = sender.batch.failed(k)
-                                 ? send_failed(*transmitting(events[staged[k]].channel), why ? why->c_str() : "sendmmsg")
-                                 : sent();
-      }
+      transmit_.send_batch(events.subspan(from, count), std::span(channels.data(), count), results.subspan(from, count));
     }
   }
 
@@ -254,6 +228,7 @@ class LcmAdapter final : public SegmentAdapter {
     LockGuard control(control_mutex_);
     if (!started_) return;
     started_ = false;
+    attach_sink(nullptr);  // waits for sends in flight; no send starts after it
     if (thread_.joinable()) {
       running_.store(false, std::memory_order_release);
       const std::uint64_t one = 1;
@@ -262,74 +237,17 @@ class LcmAdapter final : public SegmentAdapter {
       ::close(std::exchange(stop_fd_, -1));
       ::close(std::exchange(rx_fd_, -1));
     }
-    attach_sink(nullptr);  // waits for sends in flight
-    close_senders();
+    transmit_.close();
     memq_.store(false, std::memory_order_relaxed);
     set_health(SegmentHealth::down, "stopped");
     log_.log(LogLevel::info, "LCM segment " + segment_.name + " stopped");
   }
 
  private:
-  // What one channel class sends with (see the top of this file).
-  struct ClassSender {
-    Mutex mutex;
-    int fd COSMIC_GUARDED_BY(mutex) = -1;  // connected to the group; closed by close_senders()
-    std::uint32_t sequence COSMIC_GUARDED_BY(mutex) = 0;  // LCM's per-sender message number
-    // Envelope headers of the messages in flight, one per batch slot.
-    std::array<std::array<std::uint8_t, kLcmEnvelopeHeaderSize>, lcm_detail::SendBatch::kCapacity>
-        envelope_headers COSMIC_GUARDED_BY(mutex){};
-    lcm_detail::SendBatch batch COSMIC_GUARDED_BY(mutex);
-  };
-
   const Channel* transmitting(ChannelId id) const COSMIC_REQUIRES_SHARED(table_mutex_) {
     const auto it = channels_.find(id);
     if (sink_ == nullptr || it == channels_.end() || !it->second.tx) return nullptr;
     return &it->second;
-  }
-
-  SendStatus unbound() {
-    counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
-    return SendStatus::failed;
-  }
-
-  // The parts of `event` as LCM carries it on `channel`: its payload, after the envelope's
-  // header (written to `header`) on an envelope channel. nullopt when it is too large for one.
-  static std::optional<std::size_t> message_parts(const Channel& channel, const OutboundEvent& event,
-                                                  std::array<std::uint8_t, kLcmEnvelopeHeaderSize>& header,
-                                                  std::array<std::span<const std::uint8_t>, 2>& parts) {
-    std::size_t count = 0;
-    if (channel.encoding == LcmEncoding::envelope) {
-      if (event.payload.size() > static_cast<std::size_t>(INT32_MAX) - kLcmEnvelopeHeaderSize) return std::nullopt;
-      // The header goes out as given, as on DDS: the router stamps what this gateway originates
-      // with its id, a component (libcosmic-client) stamps its own.
-      header = encode_lcm_envelope_header(event.header, static_cast<std::uint32_t>(event.payload.size()));
-      parts[count++] = header;
-    }
-    parts[count++] = event.payload;
-    return count;
-  }
-
-  SendStatus send_one(ClassSender& sender, const Channel& channel, const OutboundEvent& event)
-      COSMIC_REQUIRES(sender.mutex) {
-    if (memq_.load(std::memory_order_relaxed)) return sent();
-    if (sender.fd < 0) return send_failed(channel, "not started");
-    std::array<std::span<const std::uint8_t>, 2> parts{};
-    const auto count = message_parts(channel, event, sender.envelope_headers[0], parts);
-    if (!count) return send_failed(channel, "payload too large");
-    const auto why = lcm_detail::send_lcm_message(sender.fd, sender.sequence++, channel.name, std::span(parts.data(), *count));
-    return why ? send_failed(channel, why->c_str()) : sent();
-  }
-
-  // Adds `event` to the sender's batch; false when it does not fit one datagram or the batch.
-  bool stage(ClassSender& sender, const Channel& channel, const OutboundEvent& event) COSMIC_REQUIRES(sender.mutex) {
-    const std::size_t slot = sender.batch.size();
-    if (slot >= lcm_detail::SendBatch::kCapacity || sender.fd < 0) return false;
-    std::array<std::span<const std::uint8_t>, 2> parts{};
-    const auto count = message_parts(channel, event, sender.envelope_headers[slot], parts);
-    if (!count) return false;
-    if (!sender.batch.add(sender.sequence, channel.name, std::span(parts.data(), *count))) return false;
-    ++sender.sequence;
-    return true;
   }
 
   Status fail_start(const std::string& why) {
@@ -359,78 +277,67 @@ class LcmAdapter final : public SegmentAdapter {
     return std::nullopt;
   }
 
-  // One connected transmit socket per class (start(), control thread), their sources noted for
-  // the receive thread; the reason when one fails.
-  std::optional<std::string> open_senders(const LcmUrl& url) COSMIC_REQUIRES(control_mutex_) {
-    for (std::size_t i = 0; i < senders_.size(); ++i) {
-      lcm_detail::OpenedSocket tx = lcm_detail::open_send_socket(url);
-      if (tx.fd < 0) {
-        close_senders();
-        return "transmit socket on " + segment_.lcm.url + ": " + tx.error;
-      }
-      LockGuard lock(senders_[i].mutex);
-      senders_[i].fd = tx.fd;
-      own_sources_[i] = tx.local;
-    }
-    return std::nullopt;
-  }
-
-  void close_senders() {
-    for (ClassSender& sender : senders_) {
-      LockGuard lock(sender.mutex);  // waits for a send in flight
-      if (sender.fd >= 0) ::close(std::exchange(sender.fd, -1));
-    }
-  }
-
   // The segment's receive thread: waits for datagrams or stop(), then reads all that are queued
   // in batches and hands each batch's events on under one shared table lock.
   void receive_loop(int fd, int stop_fd, const ThreadPolicy& policy) {
     for (const auto& problem : apply_thread_policy(policy))
       log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": receive thread: " + problem);
     lcm_detail::ReceiveBatch batch(kReceiveBatch);
-    bool failing = false;
     while (running_.load(std::memory_order_acquire)) {
-      pollfd fds[2] = {{fd, POLLIN, 0}, {stop_fd, POLLIN, 0}};
-      // A failing read is retried after a pause rather than in a spin; stop_fd still ends it.
+      // After a failed read, a pause (stop_fd still ends it) rather than a spin on a socket that
+      // keeps reporting data it cannot hand over.
+      const bool failing = receive_failing_.load(std::memory_order_relaxed);
+      pollfd fds[2] = {{failing ? -1 : fd, POLLIN, 0}, {stop_fd, POLLIN, 0}};
       const int ready = ::poll(fds, 2, failing ? kRetryAfterFailureMs : -1);
       if (ready < 0 && errno != EINTR) {
-        note_receive_failure(failing, "poll: " + std::string(std::strerror(errno)));
+        note_receive_failure("poll", errno);
         continue;
       }
       if (fds[1].revents != 0) break;
-      if (ready <= 0 || (fds[0].revents & POLLIN) == 0) continue;
-      for (;;) {
-        const int n = batch.receive(fd);
-        if (n < 0) {
-          note_receive_failure(failing, "recvmmsg: " + std::string(std::strerror(errno)));
-          break;
-        }
-        if (n == 0) break;
-        handle_batch(batch, static_cast<std::size_t>(n));
-        if (failing) {
-          failing = false;
-          set_health(SegmentHealth::up, "");
-          log_.log(LogLevel::notice, "LCM segment " + segment_.name + " receiving again");
-        }
-        if (static_cast<std::size_t>(n) < batch.slots()) break;  // the queue is empty now
-      }
+      if (!failing && (ready <= 0 || (fds[0].revents & POLLIN) == 0)) continue;
+      drain(fd, batch);
     }
   }
 
-  void note_receive_failure(bool& failing, const std::string& what) {
-    if (failing) return;
-    failing = true;
+  // Reads what is queued in batches until a batch comes back short, stop() is asked for, or a
+  // read fails.
+  void drain(int fd, lcm_detail::ReceiveBatch& batch) {
+    while (running_.load(std::memory_order_relaxed)) {
+      const int n = batch.receive(fd);
+      if (n < 0) {
+        note_receive_failure("recvmmsg", errno);
+        return;
+      }
+      if (receive_failing_.exchange(false, std::memory_order_relaxed)) {
+        set_health(SegmentHealth::up, "");
+        log_.log(LogLevel::notice, "LCM segment " + segment_.name + " receiving again");
+      }
+      if (n == 0) return;
+      handle_batch(batch, static_cast<std::size_t>(n));
+      if (static_cast<std::size_t>(n) < batch.slots()) return;  // the queue is empty now
+    }
+  }
+
+  void note_receive_failure(const char* call, int error) {
+    if (receive_failing_.exchange(true, std::memory_order_relaxed)) return;
+    const std::string what = std::string(call) + ": " + std::strerror(error);
     set_health(SegmentHealth::degraded, what + " on " + segment_.lcm.url);
     log_.log(LogLevel::error, "LCM segment " + segment_.name + ": " + what);
   }
 
-  bool own_source(Endpoint from) const {
-    return std::find(own_sources_.begin(), own_sources_.end(), from) != own_sources_.end();
+  // The socket's drop count is cumulative and starts again with every socket: the segment's
+  // counter adds what it rose by.
+  void note_kernel_drops(const lcm_detail::ReceiveBatch& batch) {
+    const auto drops = batch.kernel_drops();
+    if (!drops) return;
+    const std::uint32_t rise = *drops - kernel_drops_seen_;  // modulo 2^32, as the kernel counts
+    kernel_drops_seen_ = *drops;
+    if (rise != 0) counters_.overflow_drops.fetch_add(rise, std::memory_order_relaxed);
   }
 
   // Receive thread only.
   void handle_batch(const lcm_detail::ReceiveBatch& batch, std::size_t count) {
-    if (const auto drops = batch.kernel_drops()) counters_.overflow_drops.store(*drops, std::memory_order_relaxed);
+    note_kernel_drops(batch);
     // One reading of both clocks for the batch: arrival times are converted with it.
     const std::int64_t steady_now = std::chrono::duration_cast<Nanos>(std::chrono::steady_clock::now().time_since_epoch()).count();
     const std::int64_t realtime_now =
@@ -438,6 +345,8 @@ class LcmAdapter final : public SegmentAdapter {
     SharedLock table(table_mutex_);
     if (sink_ == nullptr) return;
     for (std::size_t i = 0; i < count; ++i) {
+      const Endpoint from = batch.sender(i);
+      if (transmit_.is_own(from)) continue;  // ours, looped back (emptied by the socket filter)
       const auto parsed = batch.truncated(i) ? std::nullopt : parse_lcm_datagram(batch.datagram(i));
       if (!parsed) {
         counters_.receive_errors.fetch_add(1, std::memory_order_relaxed);  // not LCM's, or damaged
@@ -446,32 +355,38 @@ class LcmAdapter final : public SegmentAdapter {
       std::int64_t arrival = batch.arrival_realtime_ns(i);
       if (arrival == 0) arrival = realtime_now;
       const Nanos received_at = steady_arrival(arrival, Nanos(steady_now), realtime_now);
-      const Endpoint from = batch.sender(i);
-      if (own_source(from)) {
-        // Ours, looped back: one report per message (at its only or first datagram).
-        if (!parsed->channel.empty()) report_echo(parsed->channel);
-        continue;
-      }
       if (!parsed->fragment) {
         deliver(parsed->channel, parsed->data, received_at, arrival);
         continue;
       }
-      // Only a channel bound here is worth reassembling; fragments after the first carry no name.
-      if (!parsed->channel.empty() && !receives(parsed->channel)) continue;
-      const auto outcome = reassembler_.add(from.key(), *parsed);
-      if (outcome == LcmReassembler::Outcome::complete)
-        deliver(reassembler_.channel(), reassembler_.payload(), received_at, arrival);
+      reassemble(from, *parsed, received_at, arrival);
     }
+  }
+
+  // One fragment. Messages of channels not received here are skipped whole (fragment 0 names the
+  // channel; the fragments after it do not); what the reassembler refuses or gives up is a
+  // receive error, as a malformed datagram is.
+  void reassemble(Endpoint from, const LcmDatagram& fragment, Nanos received_at, std::int64_t arrival)
+      COSMIC_REQUIRES_SHARED(table_mutex_) {
+    if (!fragment.channel.empty() && !receives(fragment.channel)) {
+      reassembler_.skip(from.key(), fragment.sequence);
+      return;
+    }
+    const std::uint64_t abandoned_before = reassembler_.abandoned();
+    LcmReassembler::Outcome outcome = LcmReassembler::Outcome::refused;
+    try {
+      outcome = reassembler_.add(from.key(), fragment);
+    } catch (const std::bad_alloc&) {
+      outcome = LcmReassembler::Outcome::refused;  // no memory for the message: it is lost
+    }
+    const std::uint64_t lost = reassembler_.abandoned() - abandoned_before + (outcome == LcmReassembler::Outcome::refused);
+    if (lost != 0) counters_.receive_errors.fetch_add(lost, std::memory_order_relaxed);
+    if (outcome == LcmReassembler::Outcome::complete) deliver(reassembler_.channel(), reassembler_.payload(), received_at, arrival);
   }
 
   bool receives(std::string_view name) const COSMIC_REQUIRES_SHARED(table_mutex_) {
     const auto it = by_name_.find(name);
     return it != by_name_.end() && it->second->rx;
-  }
-
-  void report_echo(std::string_view name) COSMIC_REQUIRES_SHARED(table_mutex_) {
-    const auto it = by_name_.find(name);
-    if (it != by_name_.end() && it->second->rx) sink_->on_problem(it->second->id, InboundProblem::own_echo);
   }
 
   // One whole message of LCM channel `name`; table_mutex_ held shared by the caller.
@@ -485,6 +400,11 @@ class LcmAdapter final : public SegmentAdapter {
     event.channel = channel.id;
     event.received_at = received_at;
     if (channel.encoding == LcmEncoding::raw) {
+      if (bytes.size() > segment_.max_message_size) {
+        counters_.receive_errors.fetch_add(1, std::memory_order_relaxed);
+        sink_->on_problem(channel.id, InboundProblem::decode_error);
+        return;
+      }
       event.header.subject = channel.subject;
       event.header.created_ns = arrival_realtime_ns;  // wall clock, informational
       event.payload = bytes;
@@ -506,24 +426,19 @@ class LcmAdapter final : public SegmentAdapter {
     sink_->on_event(event);
   }
 
-  SendStatus sent() {
+  // memq://: nothing to send on, and nothing lost by it.
+  SendStatus memq_sent() {
     counters_.sent.fetch_add(1, std::memory_order_relaxed);
-    send_failing_.store(false, std::memory_order_relaxed);
     return SendStatus::sent;
-  }
-
-  SendStatus send_failed(const Channel& channel, const char* why) {
-    counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
-    // Log the first failure of a run of failures, not every event.
-    if (!send_failing_.exchange(true, std::memory_order_relaxed))
-      log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": send on channel " + channel.name + ": " + why);
-    return SendStatus::failed;
   }
 
   void set_health(SegmentHealth state, std::string detail) { health_.set(state, std::move(detail)); }
 
   const SegmentSpec segment_;
   Logger& log_;
+  AdapterCounters counters_;
+  HealthCell health_;
+  std::atomic<bool> receive_failing_{false};  // a read failed; cleared by the next that works
 
   Mutex control_mutex_;
   bool started_ COSMIC_GUARDED_BY(control_mutex_) = false;
@@ -531,8 +446,6 @@ class LcmAdapter final : public SegmentAdapter {
   int rx_fd_ COSMIC_GUARDED_BY(control_mutex_) = -1;
   int stop_fd_ COSMIC_GUARDED_BY(control_mutex_) = -1;  // eventfd: stop() wakes the receive loop
   std::atomic<bool> running_{false};
-  // Written by start() before the receive thread exists, read by that thread only.
-  std::array<Endpoint, 3> own_sources_{};
   // memq://: set by start() before the sink is attached, cleared by stop() after it is detached.
   std::atomic<bool> memq_{false};
 
@@ -541,12 +454,10 @@ class LcmAdapter final : public SegmentAdapter {
   std::unordered_map<ChannelId, Channel> channels_ COSMIC_GUARDED_BY(table_mutex_);
   std::unordered_map<std::string, Channel*, StringHash, std::equal_to<>> by_name_ COSMIC_GUARDED_BY(table_mutex_);
 
-  std::array<ClassSender, 3> senders_;  // indexed by ChannelClass
-  LcmReassembler reassembler_;          // receive thread only
-
-  AdapterCounters counters_;
-  HealthCell health_;
-  std::atomic<bool> send_failing_{false};
+  lcm_detail::LcmTransmitter transmit_;
+  // Receive thread only.
+  LcmReassembler reassembler_;
+  std::uint32_t kernel_drops_seen_ = 0;  // the socket's drop count at its last report
 };
 
 }  // namespace

@@ -68,7 +68,9 @@ OpenedSocket open_receive_socket(const LcmUrl& url, std::size_t buffer_bytes) {
   sockaddr_in bind_to{};
   bind_to.sin_family = AF_INET;
   bind_to.sin_port = htons(url.port);
-  bind_to.sin_addr.s_addr = htonl(INADDR_ANY);
+  // The group's address, not every address: a unicast datagram to this host's port is no
+  // message of the group (as liblcm binds on Linux).
+  bind_to.sin_addr = group->sin_addr;
   if (::bind(fd, reinterpret_cast<const sockaddr*>(&bind_to), sizeof bind_to) != 0)
     return failed(std::move(out), fd, errno_text(("bind to port " + std::to_string(url.port)).c_str()));
   ip_mreq membership{};
@@ -107,14 +109,16 @@ OpenedSocket open_send_socket(const LcmUrl& url) {
 }
 
 // Classic BPF over a UDP socket's datagram: the filter runs with the UDP header at offset 0 and
-// the IP header at SKF_NET_OFF. Per own endpoint: source address, then source port; a match
-// drops the datagram (returns 0), anything else is accepted whole.
+// the IP header at SKF_NET_OFF. Per own endpoint: source address, then source port; a match keeps
+// the UDP header alone (the kernel trims to at least that), anything else is accepted whole.
+// Trimmed, not dropped: a dropped datagram counts in the socket's drops (SO_RXQ_OVFL, which the
+// segment reports as overflow) and in the host's UDP InErrors.
 std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> own) {
   constexpr std::uint32_t kSourceAddress = static_cast<std::uint32_t>(SKF_NET_OFF) + 12;
   constexpr std::uint32_t kSourcePort = 0;
   if (own.empty() || own.size() > 16) return std::string("no endpoints to filter");
   std::vector<sock_filter> program;
-  const std::size_t drop_at = own.size() * 4 + 1;  // after every check and the accept
+  const std::size_t drop_at = own.size() * 4 + 1;  // the trim: after every check and the accept
   for (const Endpoint& e : own) {
     program.push_back(BPF_STMT(BPF_LD | BPF_W | BPF_ABS, kSourceAddress));
     program.push_back(BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, e.address, 0, 2));
@@ -123,7 +127,7 @@ std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> 
     program.push_back(BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, e.port, static_cast<std::uint8_t>(drop_at - here - 1), 0));
   }
   program.push_back(BPF_STMT(BPF_RET | BPF_K, 0xFFFFFFFFu));  // accept
-  program.push_back(BPF_STMT(BPF_RET | BPF_K, 0));            // drop
+  program.push_back(BPF_STMT(BPF_RET | BPF_K, 1));            // trim to the UDP header
   const sock_fprog fprog{static_cast<unsigned short>(program.size()), program.data()};
   if (::setsockopt(fd, SOL_SOCKET, SO_ATTACH_FILTER, &fprog, sizeof fprog) != 0) return errno_text("SO_ATTACH_FILTER");
   return std::nullopt;
@@ -191,67 +195,73 @@ std::int64_t ReceiveBatch::arrival_realtime_ns(std::size_t i) const { return slo
 
 namespace {
 
-// The iovecs of payload bytes [offset, offset + length) of the concatenated `parts`, appended.
-void append_slice(std::span<const std::span<const std::uint8_t>> parts, std::size_t offset, std::size_t length,
-                  std::vector<iovec>& out) {
+constexpr std::size_t kMaxIov = 2 + SendBatch::kMaxParts;  // header, channel, the payload's parts
+
+// The iovecs of payload bytes [offset, offset + length) of the concatenated `parts`, appended
+// after the `count` already in `iov`; the new count.
+std::size_t append_slice(std::span<const std::span<const std::uint8_t>> parts, std::size_t offset, std::size_t length,
+                         std::array<iovec, kMaxIov>& iov, std::size_t count) {
   for (const auto& part : parts) {
-    if (length == 0) return;
+    if (length == 0) break;
     if (offset >= part.size()) {
       offset -= part.size();
       continue;
     }
     const std::size_t take = std::min(length, part.size() - offset);
-    out.push_back(iovec{const_cast<std::uint8_t*>(part.data() + offset), take});
+    iov[count++] = iovec{const_cast<std::uint8_t*>(part.data() + offset), take};  // the kernel only reads it
     length -= take;
     offset = 0;
   }
+  return count;
 }
 
-std::optional<std::string> send_datagram(int fd, std::vector<iovec>& iov) {
+SendFailure send_datagram(int fd, std::array<iovec, kMaxIov>& iov, std::size_t count) {
   std::size_t expected = 0;
-  for (const iovec& v : iov) expected += v.iov_len;
+  for (std::size_t i = 0; i < count; ++i) expected += iov[i].iov_len;
   msghdr msg{};
   msg.msg_iov = iov.data();
-  msg.msg_iovlen = iov.size();
-  const ssize_t n = ::sendmsg(fd, &msg, MSG_NOSIGNAL);
-  if (n < 0) return errno_text("sendmsg");
-  if (static_cast<std::size_t>(n) != expected) return std::string("sendmsg sent part of a datagram");
-  return std::nullopt;
+  msg.msg_iovlen = count;
+  ssize_t n = -1;
+  do {
+    n = ::sendmsg(fd, &msg, MSG_NOSIGNAL);
+  } while (n < 0 && errno == EINTR);
+  if (n < 0) return SendFailure{errno, "sendmsg"};
+  if (static_cast<std::size_t>(n) != expected) return SendFailure{0, "sendmsg sent part of a datagram"};
+  return SendFailure{};
 }
 
 }  // namespace
 
-std::optional<std::string> send_lcm_message(int fd, std::uint32_t sequence, std::string_view channel,
-                                            std::span<const std::span<const std::uint8_t>> parts) {
+SendFailure send_lcm_message(int fd, std::uint32_t sequence, std::string_view channel,
+                             std::span<const std::span<const std::uint8_t>> parts) {
+  if (parts.size() > SendBatch::kMaxParts) return SendFailure{0, "too many parts"};
   std::size_t payload_size = 0;
   for (const auto& part : parts) payload_size += part.size();
   const auto plan = plan_lcm_message(channel.size(), payload_size);
-  if (!plan) return std::string("message too large for LCM (or channel name not 1-63 bytes)");
+  if (!plan) return SendFailure{0, "message too large for LCM (more than 65,535 fragments)"};
   // The channel with its NUL: string_view does not promise one, so it is sent from here.
   std::array<char, kLcmMaxChannelBytes + 1> name{};
   std::memcpy(name.data(), channel.data(), channel.size());
-  std::vector<iovec> iov;
-  iov.reserve(parts.size() + 2);
+  std::array<iovec, kMaxIov> iov{};
   if (plan->fragment_count == 0) {
     auto header = lcm_short_header(sequence);
-    iov.push_back(iovec{header.data(), header.size()});
-    iov.push_back(iovec{name.data(), channel.size() + 1});
-    append_slice(parts, 0, payload_size, iov);
-    return send_datagram(fd, iov);
+    iov[0] = iovec{header.data(), header.size()};
+    iov[1] = iovec{name.data(), channel.size() + 1};
+    return send_datagram(fd, iov, append_slice(parts, 0, payload_size, iov, 2));
   }
   std::size_t offset = 0;
   for (std::uint16_t no = 0; no < plan->fragment_count; ++no) {
     const std::size_t slice = std::min(payload_size - offset, no == 0 ? plan->first_slice : kLcmFragmentMaxData);
     auto header = lcm_fragment_header(sequence, static_cast<std::uint32_t>(payload_size),
                                       static_cast<std::uint32_t>(offset), no, plan->fragment_count);
-    iov.clear();
-    iov.push_back(iovec{header.data(), header.size()});
-    if (no == 0) iov.push_back(iovec{name.data(), channel.size() + 1});
-    append_slice(parts, offset, slice, iov);
-    if (auto why = send_datagram(fd, iov)) return why;
+    std::size_t count = 0;
+    iov[count++] = iovec{header.data(), header.size()};
+    if (no == 0) iov[count++] = iovec{name.data(), channel.size() + 1};
+    count = append_slice(parts, offset, slice, iov, count);
+    if (const SendFailure failure = send_datagram(fd, iov, count); failure.failed()) return failure;
     offset += slice;
   }
-  return std::nullopt;
+  return SendFailure{};
 }
 
 bool SendBatch::add(std::uint32_t sequence, std::string_view channel,
@@ -280,27 +290,28 @@ bool SendBatch::add(std::uint32_t sequence, std::string_view channel,
   return true;
 }
 
-std::optional<std::string> SendBatch::send(int fd) {
-  std::optional<std::string> first_error;
+SendFailure SendBatch::send(int fd) {
+  SendFailure first;
   std::size_t done = 0;
   while (done < count_) {
     const int n = ::sendmmsg(fd, headers_.data() + done, static_cast<unsigned>(count_ - done), MSG_NOSIGNAL);
+    if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
-      // The first message of the rest failed (errno): count it and go on with the others.
-      if (!first_error) first_error = errno_text("sendmmsg");
+      // The first message of the rest failed (errno): mark it and go on with the others.
+      if (!first.failed()) first = SendFailure{n < 0 ? errno : 0, "sendmmsg"};
       failed_[done++] = true;
       continue;
     }
     for (std::size_t i = done; i < done + static_cast<std::size_t>(n); ++i) {
       if (headers_[i].msg_len != slots_[i].bytes) {
         failed_[i] = true;
-        if (!first_error) first_error = "sendmmsg sent part of a datagram";
+        if (!first.failed()) first = SendFailure{0, "sendmmsg sent part of a datagram"};
       }
     }
     done += static_cast<std::size_t>(n);
   }
   count_ = 0;
-  return first_error;
+  return first;
 }
 
 }  // namespace cosmic::lcm_detail

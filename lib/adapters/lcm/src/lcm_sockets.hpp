@@ -42,9 +42,9 @@ struct OpenedSocket {
   std::vector<std::string> warnings;
 };
 
-// Bound to the group's port on every address (shared with other LCM programs on this host,
+// Bound to the group's address and port (shared with other LCM programs on this host,
 // SO_REUSEADDR), a member of the group on the default interface, receiving that group only
-// (IP_MULTICAST_ALL off), non-blocking, with kernel arrival times (SO_TIMESTAMPNS) and drop counts
+// (IP_MULTICAST_ALL off as well), non-blocking, with kernel arrival times (SO_TIMESTAMPNS) and drop counts
 // (SO_RXQ_OVFL), and a receive buffer of `buffer_bytes` (SO_RCVBUFFORCE where privileged, else
 // SO_RCVBUF up to net.core.rmem_max, with a warning when it falls short).
 OpenedSocket open_receive_socket(const LcmUrl& url, std::size_t buffer_bytes);
@@ -54,10 +54,11 @@ OpenedSocket open_receive_socket(const LcmUrl& url, std::size_t buffer_bytes);
 // programs on this host receive what it sends.
 OpenedSocket open_send_socket(const LcmUrl& url);
 
-// Attaches a socket filter to receive socket `fd` that drops, in the kernel, every datagram sent
+// Attaches a socket filter to receive socket `fd` that cuts, in the kernel, every datagram sent
 // from one of `own` (our transmit sockets: multicast loopback hands our own datagrams back to
-// every socket of the group, ours included). nullopt when attached; otherwise why not (the
-// receive thread then tells them by their source itself).
+// every socket of the group, ours included) down to an empty one, so none of their bytes is
+// copied. Replaces a filter attached before. nullopt when attached; otherwise why not. Either
+// way the receive thread still tells them by their source.
 std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> own);
 
 // One recvmmsg's worth of datagrams, reused from call to call.
@@ -91,11 +92,19 @@ class ReceiveBatch {
   std::optional<std::uint32_t> kernel_drops_;
 };
 
-// Sends one LCM message whose payload is the concatenation of `parts` on connected socket `fd`:
-// one short datagram, or its fragments back to back (cosmic/lcm_udpm.hpp). nullopt when every
-// datagram went out whole; otherwise why not (a message cut after some fragments is lost).
-std::optional<std::string> send_lcm_message(int fd, std::uint32_t sequence, std::string_view channel,
-                                            std::span<const std::span<const std::uint8_t>> parts);
+// Why a send failed, without allocating (sends run on the egress lanes): the errno (0 when the
+// kernel gave none) and what failed; `what` null when nothing did.
+struct SendFailure {
+  int error = 0;
+  const char* what = nullptr;
+  bool failed() const { return what != nullptr; }
+};
+
+// Sends one LCM message whose payload is the concatenation of `parts` (at most
+// SendBatch::kMaxParts) on connected socket `fd`: one short datagram, or its fragments back to
+// back (cosmic/lcm_udpm.hpp). A message cut after some fragments is lost. Never allocates.
+SendFailure send_lcm_message(int fd, std::uint32_t sequence, std::string_view channel,
+                             std::span<const std::span<const std::uint8_t>> parts);
 
 // Short messages (one datagram each) gathered for one sendmmsg on a connected socket: the system
 // call and its entry cost once for a batch an egress lane hands over. Owned by one thread at a
@@ -110,8 +119,8 @@ class SendBatch {
   bool add(std::uint32_t sequence, std::string_view channel, std::span<const std::span<const std::uint8_t>> parts);
   std::size_t size() const { return count_; }
   // Sends every message added, in order, and empties the batch; `failed(i)` says whether the
-  // i-th message did not go out whole. nullopt when all went; otherwise the first reason.
-  std::optional<std::string> send(int fd);
+  // i-th message did not go out whole, the result the first failure. Never allocates.
+  SendFailure send(int fd);
   bool failed(std::size_t i) const { return failed_[i]; }
 
  private:

@@ -37,11 +37,17 @@ class LcmReassembler {
     pending,    // kept; the message is not complete yet
     complete,   // the message is whole: see channel() and payload()
     refused,    // this fragment was not taken (too large, inconsistent, duplicate)
+    ignored,    // a fragment of a message completed or skipped lately: nothing wrong, nothing kept
   };
 
   // One fragment (LcmDatagram::fragment set) from `sender`. After `complete`, channel() and
   // payload() show the message until the next call.
   Outcome add(std::uint64_t sender, const LcmDatagram& fragment);
+
+  // The message `sequence` of `sender` is not wanted (its fragment 0 names a channel the caller
+  // does not receive): what is held of it goes, and its further fragments are refused without
+  // being held (nor counted as abandoned).
+  void skip(std::uint64_t sender, std::uint32_t sequence);
 
   std::string_view channel() const { return completed_channel_; }
   std::span<const std::uint8_t> payload() const { return completed_; }
@@ -69,6 +75,7 @@ class LcmReassembler {
   Partial* find_sender(std::uint64_t sender);
   Partial* start(std::uint64_t sender, const LcmDatagram& fragment);
   bool make_room(std::size_t bytes);
+  void remember_finished(std::uint64_t sender, std::uint32_t sequence);
   void drop(std::size_t index);
 
   const std::size_t max_message_size_;
@@ -79,6 +86,7 @@ class LcmReassembler {
   // The messages completed last (sender, sequence): a late duplicate of theirs is refused.
   std::array<std::pair<std::uint64_t, std::uint32_t>, kMaxSenders> finished_{};
   std::size_t next_finished_ = 0;
+  std::size_t finished_count_ = 0;  // entries of finished_ in use
   std::uint64_t clock_ = 0;
   std::uint64_t abandoned_ = 0;
   std::string completed_channel_;

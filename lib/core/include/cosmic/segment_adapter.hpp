@@ -154,10 +154,10 @@ class SegmentAdapter {
   virtual void send_batch(std::span<const OutboundEvent> events, std::span<SendStatus> results) {
     for (std::size_t i = 0; i < events.size() && i < results.size(); ++i) results[i] = send(events[i]);
   }
-  // True where send_batch() costs less than send() one by one (CAN: one sendmmsg). Lanes hand
-  // only such an adapter several events at once. The others (DDS, LCM: no batched write) get
-  // one event at a time, so each event's residence is taken right after its own send, not
-  // after the sends of a whole batch.
+  // True where send_batch() costs less than send() one by one (CAN, LCM: one sendmmsg). Lanes
+  // hand only such an adapter several events at once, and only what queued up behind a send in
+  // progress; an event's residence is then taken after its batch's send. The others (DDS: no
+  // batched write) get one event at a time, each event's residence taken right after its send.
   virtual bool batches_sends() const { return false; }
   virtual HealthReport health() const = 0;
   virtual AdapterStatistics statistics() const = 0;

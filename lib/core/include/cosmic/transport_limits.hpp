@@ -22,7 +22,17 @@ inline constexpr std::size_t kMaxInterfaceName = 15;
 
 // Why a segment of type `type` cannot carry a channel named `channel`, if it cannot.
 inline std::optional<std::string> transport_name_problem(SegmentType type, std::string_view channel) {
-  if (type == SegmentType::lcm && channel.size() > kLcmMaxChannelName) {
+  if (type != SegmentType::lcm) return std::nullopt;
+  // A NUL ends the name on the wire (what follows would become payload for other subscribers);
+  // control characters would be written into logs. The name itself is not echoed here.
+  for (const char c : channel) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      char shown[8];
+      std::snprintf(shown, sizeof shown, "0x%02X", static_cast<unsigned char>(c));
+      return std::string("LCM channel names hold no control characters; this one has ") + shown;
+    }
+  }
+  if (channel.size() > kLcmMaxChannelName) {
     return "LCM channel names have at most " + std::to_string(kLcmMaxChannelName) + " characters, '" +
            std::string(channel.substr(0, 16)) + "...' has " + std::to_string(channel.size());
   }

@@ -1,0 +1,221 @@
+#include "lcm_transmit.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <climits>
+#include <cstring>
+#include <exception>
+#include <utility>
+
+namespace cosmic::lcm_detail {
+namespace {
+
+constexpr auto kReopenPause = std::chrono::seconds(1);
+
+Endpoint endpoint_of(std::uint64_t key) {
+  return Endpoint{static_cast<std::uint32_t>(key >> 16), static_cast<std::uint16_t>(key & 0xffff)};
+}
+
+// The failures a renumbered or vanished interface leaves a connected socket with.
+bool source_gone(int error) {
+  return error == EADDRNOTAVAIL || error == EINVAL || error == ENETUNREACH || error == ENODEV;
+}
+
+const char* class_name(std::size_t index) {
+  static constexpr const char* kNames[] = {"hrt", "srt", "nrt"};
+  return index < 3 ? kNames[index] : "?";
+}
+
+// The parts of `event` as LCM carries it on `channel`: its payload, after the envelope's header
+// (written to `header`) on an envelope channel; their count, 0 when too large for an envelope.
+std::size_t message_parts(const Channel& channel, const OutboundEvent& event,
+                          std::array<std::uint8_t, kLcmEnvelopeHeaderSize>& header,
+                          std::array<std::span<const std::uint8_t>, SendBatch::kMaxParts>& parts) {
+  std::size_t count = 0;
+  if (channel.encoding == LcmEncoding::envelope) {
+    if (event.payload.size() > static_cast<std::size_t>(INT32_MAX) - kLcmEnvelopeHeaderSize) return 0;
+    // The header goes out as given, as on DDS: the router stamps what this gateway originates
+    // with its id, a component (libcosmic-client) stamps its own.
+    header = encode_lcm_envelope_header(event.header, static_cast<std::uint32_t>(event.payload.size()));
+    parts[count++] = header;
+  }
+  parts[count++] = event.payload;
+  return count;
+}
+
+}  // namespace
+
+LcmTransmitter::LcmTransmitter(std::string segment_name, Logger& log, AdapterCounters& counters, HealthCell& health,
+                               const std::atomic<bool>& receive_failing)
+    : segment_name_(std::move(segment_name)),
+      log_(log),
+      counters_(counters),
+      health_(health),
+      receive_failing_(receive_failing) {}
+
+std::optional<std::string> LcmTransmitter::open(const LcmUrl& url) {
+  url_ = url;
+  for (std::size_t i = 0; i < senders_.size(); ++i) {
+    OpenedSocket tx = open_send_socket(url);
+    if (tx.fd < 0) {
+      close();
+      return "transmit socket on udpm://" + url.group + ":" + std::to_string(url.port) + ": " + tx.error;
+    }
+    LockGuard lock(senders_[i].mutex);
+    senders_[i].fd = tx.fd;
+    senders_[i].failing.store(false, std::memory_order_relaxed);
+    own_keys_[i].store(tx.local.key(), std::memory_order_relaxed);
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> LcmTransmitter::follow_with_filter(int receive_fd) {
+  {
+    LockGuard lock(filter_mutex_);
+    receive_fd_ = receive_fd;
+  }
+  return attach_filter();
+}
+
+std::optional<std::string> LcmTransmitter::attach_filter() {
+  LockGuard lock(filter_mutex_);
+  if (receive_fd_ < 0) return std::nullopt;
+  std::array<Endpoint, 3> own{};
+  std::size_t count = 0;
+  for (const auto& key : own_keys_)
+    if (const std::uint64_t k = key.load(std::memory_order_relaxed); k != 0) own[count++] = endpoint_of(k);
+  if (count == 0) return std::nullopt;
+  return drop_own_datagrams(receive_fd_, std::span(own.data(), count));
+}
+
+void LcmTransmitter::close() {
+  {
+    LockGuard lock(filter_mutex_);
+    receive_fd_ = -1;
+  }
+  for (std::size_t i = 0; i < senders_.size(); ++i) {
+    LockGuard lock(senders_[i].mutex);  // waits for a send in flight
+    if (senders_[i].fd >= 0) ::close(std::exchange(senders_[i].fd, -1));
+    own_keys_[i].store(0, std::memory_order_relaxed);
+  }
+  url_.reset();
+}
+
+bool LcmTransmitter::is_own(Endpoint from) const {
+  const std::uint64_t key = from.key();
+  for (const auto& own : own_keys_)
+    if (own.load(std::memory_order_relaxed) == key) return true;
+  return false;
+}
+
+SendStatus LcmTransmitter::unbound() {
+  counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
+  return SendStatus::failed;
+}
+
+SendStatus LcmTransmitter::send(const Channel& channel, const OutboundEvent& event) {
+  ClassSender& sender = senders_.at(static_cast<std::size_t>(channel.cls));
+  LockGuard transmit(sender.mutex);
+  return send_one(sender, channel, event);
+}
+
+void LcmTransmitter::send_batch(std::span<const OutboundEvent> events, std::span<const Channel* const> channels,
+                                std::span<SendStatus> results) {
+  const std::size_t n = std::min({events.size(), channels.size(), results.size()});
+  std::size_t i = 0;
+  while (i < n) {
+    const Channel* first = channels[i];
+    if (first == nullptr) {
+      results[i++] = unbound();
+      continue;
+    }
+    ClassSender& sender = senders_.at(static_cast<std::size_t>(first->cls));
+    LockGuard transmit(sender.mutex);
+    std::array<std::size_t, SendBatch::kCapacity> staged{};  // indices into events
+    std::size_t count = 0;
+    for (; i < n; ++i) {
+      if (channels[i] == nullptr) {
+        results[i] = unbound();
+        continue;
+      }
+      if (channels[i]->cls != first->cls || !stage(sender, *channels[i], events[i])) break;
+      staged[count++] = i;
+    }
+    if (count == 0) {  // the message at i needs fragments, or there is no socket (memq, stopped)
+      results[i] = send_one(sender, *first, events[i]);
+      ++i;
+      continue;
+    }
+    const SendFailure why = sender.batch.send(sender.fd);
+    for (std::size_t k = 0; k < count; ++k)
+      results[staged[k]] = sender.batch.failed(k) ? failed(sender, *channels[staged[k]], why) : sent(sender);
+  }
+}
+
+SendStatus LcmTransmitter::send_one(ClassSender& sender, const Channel& channel, const OutboundEvent& event) {
+  if (sender.fd < 0) return failed(sender, channel, SendFailure{0, "no transmit socket"});
+  std::array<std::span<const std::uint8_t>, SendBatch::kMaxParts> parts{};
+  const std::size_t count = message_parts(channel, event, sender.envelope_headers[0], parts);
+  if (count == 0) return failed(sender, channel, SendFailure{0, "payload too large"});
+  const SendFailure why = send_lcm_message(sender.fd, sender.sequence++, channel.name, std::span(parts.data(), count));
+  return why.failed() ? failed(sender, channel, why) : sent(sender);
+}
+
+bool LcmTransmitter::stage(ClassSender& sender, const Channel& channel, const OutboundEvent& event) {
+  const std::size_t slot = sender.batch.size();
+  if (slot >= SendBatch::kCapacity || sender.fd < 0) return false;
+  std::array<std::span<const std::uint8_t>, SendBatch::kMaxParts> parts{};
+  const std::size_t count = message_parts(channel, event, sender.envelope_headers[slot], parts);
+  if (count == 0 || !sender.batch.add(sender.sequence, channel.name, std::span(parts.data(), count))) return false;
+  ++sender.sequence;
+  return true;
+}
+
+SendStatus LcmTransmitter::sent(ClassSender& sender) {
+  counters_.sent.fetch_add(1, std::memory_order_relaxed);
+  if (sender.failing.exchange(false, std::memory_order_relaxed) && !receive_failing_.load(std::memory_order_relaxed))
+    health_.set(SegmentHealth::up, "");
+  return SendStatus::sent;
+}
+
+// Counts the failure; logs the first of a run (per class, so NRT trouble never hides HRT's);
+// reopens a socket whose source went away. Never throws: the log line is the one allocation.
+SendStatus LcmTransmitter::failed(ClassSender& sender, const Channel& channel, SendFailure why) {
+  counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
+  const auto index = static_cast<std::size_t>(&sender - senders_.data());
+  const bool first = !sender.failing.exchange(true, std::memory_order_relaxed);
+  try {
+    if (first) {
+      log_.log(LogLevel::warning, "LCM segment " + segment_name_ + ": send on channel " + channel.name + " (" +
+                                      class_name(index) + "): " + why.what +
+                                      (why.error != 0 ? std::string(": ") + std::strerror(why.error) : std::string()));
+    }
+    if (source_gone(why.error)) reopen(sender, index);
+  } catch (const std::exception&) {
+    // Out of memory for a log line: the failure is counted all the same.
+  }
+  return SendStatus::failed;
+}
+
+void LcmTransmitter::reopen(ClassSender& sender, std::size_t index) {
+  const auto now = std::chrono::steady_clock::now();
+  if (!url_ || now - sender.last_reopen < kReopenPause) return;
+  sender.last_reopen = now;
+  OpenedSocket tx = open_send_socket(*url_);
+  if (tx.fd < 0) {
+    health_.set(SegmentHealth::degraded, std::string("the ") + class_name(index) + " transmit socket cannot reopen: " + tx.error);
+    log_.log(LogLevel::error, "LCM segment " + segment_name_ + ": " + class_name(index) +
+                                  " transmit socket cannot reopen: " + tx.error);
+    return;
+  }
+  if (sender.fd >= 0) ::close(sender.fd);
+  sender.fd = tx.fd;
+  own_keys_[index].store(tx.local.key(), std::memory_order_relaxed);
+  log_.log(LogLevel::notice, "LCM segment " + segment_name_ + ": " + class_name(index) + " transmit socket reopened");
+  if (const auto why = attach_filter())
+    log_.log(LogLevel::warning, "LCM segment " + segment_name_ + ": own datagrams read back in full (" + *why + ")");
+}
+
+}  // namespace cosmic::lcm_detail

@@ -1,0 +1,94 @@
+// The LCM adapter's transmit side: one connected socket per channel class, each with its own LCM
+// sequence number, envelope headers and batch, under its own mutex held across sendmsg/sendmmsg,
+// so an NRT send stalled in the kernel never holds what an HRT send needs (issue 20, item 2).
+//
+// Threads: open()/close() on the control thread (close() waits for sends in flight); send() and
+// send_batch() on the egress lanes; is_own() on the receive thread. A socket whose source
+// address went away (the interface renumbered: EADDRNOTAVAIL, EINVAL, ENETUNREACH, ENODEV) is
+// reopened by the lane that meets the failure, at most once a second per class, and the receive
+// socket's filter follows the new source. While a class cannot send, the segment is degraded.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+
+#include "cosmic/adapter_counters.hpp"
+#include "cosmic/health_cell.hpp"
+#include "cosmic/lcm_url.hpp"
+#include "cosmic/lcm_wire.hpp"
+#include "cosmic/log.hpp"
+#include "cosmic/mutex.hpp"
+#include "cosmic/segment_adapter.hpp"
+#include "cosmic/thread_annotations.hpp"
+#include "lcm_channel.hpp"
+#include "lcm_sockets.hpp"
+
+namespace cosmic::lcm_detail {
+
+class LcmTransmitter {
+ public:
+  // `receive_failing` is the receive side's own trouble: a transmit recovery does not clear it.
+  LcmTransmitter(std::string segment_name, Logger& log, AdapterCounters& counters, HealthCell& health,
+                 const std::atomic<bool>& receive_failing);
+
+  // Opens the three sockets; the reason when one fails (none is left open then).
+  std::optional<std::string> open(const LcmUrl& url);
+  // The receive socket whose filter follows our sources (-1: none); attaches it now. The reason
+  // when the filter cannot be attached.
+  std::optional<std::string> follow_with_filter(int receive_fd);
+  void close();
+
+  // True when `from` is one of our transmit sockets (looped back to us).
+  bool is_own(Endpoint from) const;
+
+  // One event of `channel` (bound for sending).
+  SendStatus send(const Channel& channel, const OutboundEvent& event);
+  // events[i] of channels[i] (each bound for sending, or null: refused as failed), in order: a run
+  // of one class that fits single datagrams leaves in one sendmmsg.
+  void send_batch(std::span<const OutboundEvent> events, std::span<const Channel* const> channels,
+                  std::span<SendStatus> results);
+
+  SendStatus unbound();
+
+ private:
+  struct ClassSender {
+    Mutex mutex;
+    int fd COSMIC_GUARDED_BY(mutex) = -1;
+    std::uint32_t sequence COSMIC_GUARDED_BY(mutex) = 0;  // LCM's per-sender message number
+    // Envelope headers of the messages in flight, one per batch slot.
+    std::array<std::array<std::uint8_t, kLcmEnvelopeHeaderSize>, SendBatch::kCapacity> envelope_headers
+        COSMIC_GUARDED_BY(mutex){};
+    SendBatch batch COSMIC_GUARDED_BY(mutex);
+    std::chrono::steady_clock::time_point last_reopen COSMIC_GUARDED_BY(mutex){};
+    std::atomic<bool> failing{false};  // a run of failures is logged once
+  };
+
+  SendStatus send_one(ClassSender& sender, const Channel& channel, const OutboundEvent& event)
+      COSMIC_REQUIRES(sender.mutex);
+  bool stage(ClassSender& sender, const Channel& channel, const OutboundEvent& event) COSMIC_REQUIRES(sender.mutex);
+  SendStatus sent(ClassSender& sender);
+  SendStatus failed(ClassSender& sender, const Channel& channel, SendFailure why) COSMIC_REQUIRES(sender.mutex);
+  void reopen(ClassSender& sender, std::size_t index) COSMIC_REQUIRES(sender.mutex);
+  std::optional<std::string> attach_filter();
+
+  const std::string segment_name_;
+  Logger& log_;
+  AdapterCounters& counters_;
+  HealthCell& health_;
+  const std::atomic<bool>& receive_failing_;
+
+  std::optional<LcmUrl> url_;  // set by open() before any send, cleared by close() after them
+  std::array<ClassSender, 3> senders_;  // indexed by ChannelClass
+  // Each sender's source (Endpoint::key()), 0 when closed: written under its sender's mutex,
+  // read by the receive thread.
+  std::array<std::atomic<std::uint64_t>, 3> own_keys_{};
+  Mutex filter_mutex_;  // one filter (re)attachment at a time
+  int receive_fd_ COSMIC_GUARDED_BY(filter_mutex_) = -1;
+};
+
+}  // namespace cosmic::lcm_detail
