@@ -64,6 +64,8 @@ using lcm_detail::Endpoint;
 
 constexpr int kRetryAfterFailureMs = 100;  // pause before reading again after a failing read
 constexpr std::size_t kReceiveBatch = 32;  // datagrams per recvmmsg
+// How long start() waits for its own LCM_SELF_TEST message to come back (liblcm's check).
+constexpr std::chrono::milliseconds kSelfTestTimeout{2000};
 // The receive socket's buffer unless the URL names one (recv_buf_size): about 5,000 small
 // datagrams or 60 of 64 KiB, what liblcm's queues held before (4,096 messages).
 constexpr std::size_t kDefaultReceiveBuffer = 4u << 20;
@@ -111,6 +113,12 @@ class LcmAdapter final : public SegmentAdapter {
     if (rx.fd < 0) {
       transmit_.close();
       return fail_start("receive socket on " + segment_.lcm.url + ": " + rx.error);
+    }
+    // Before the filter: the probe comes from a socket of its own, and this is where liblcm checked.
+    if (const auto why = lcm_detail::self_test(url, rx.fd, kSelfTestTimeout)) {
+      transmit_.close();
+      ::close(rx.fd);
+      return fail_start(*why);
     }
     if (const auto why = transmit_.follow_with_filter(rx.fd))
       rx.warnings.push_back("own datagrams are read back in full and skipped here (" + *why + ")");

@@ -3,9 +3,11 @@
 #include <arpa/inet.h>
 #include <linux/filter.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <sys/uio.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <climits>
@@ -131,6 +133,39 @@ std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> 
   const sock_fprog fprog{static_cast<unsigned short>(program.size()), program.data()};
   if (::setsockopt(fd, SOL_SOCKET, SO_ATTACH_FILTER, &fprog, sizeof fprog) != 0) return errno_text("SO_ATTACH_FILTER");
   return std::nullopt;
+}
+
+std::optional<std::string> self_test(const LcmUrl& url, int fd, std::chrono::milliseconds timeout) {
+  static constexpr std::string_view kChannel = "LCM_SELF_TEST";
+  OpenedSocket probe = open_send_socket(url);
+  if (probe.fd < 0) return "self test: " + probe.error;
+  // A payload no other sender's message carries: our probe socket's own source.
+  std::array<std::uint8_t, 6> token{};
+  const std::uint64_t key = probe.local.key();
+  for (std::size_t i = 0; i < token.size(); ++i) token[i] = static_cast<std::uint8_t>(key >> (8 * i));
+  const std::array<std::span<const std::uint8_t>, 1> parts{std::span<const std::uint8_t>(token)};
+  const SendFailure sent = send_lcm_message(probe.fd, 0, kChannel, parts);
+  ::close(probe.fd);
+  if (sent.failed()) return std::string("self test: ") + sent.what + (sent.error ? std::string(": ") + std::strerror(sent.error) : "");
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  ReceiveBatch batch(8);
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) break;
+    pollfd p{fd, POLLIN, 0};
+    if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) continue;
+    const int n = batch.receive(fd);
+    if (n < 0) return errno_text("self test: recvmmsg");
+    for (int i = 0; i < n; ++i) {
+      const auto d = parse_lcm_datagram(batch.datagram(static_cast<std::size_t>(i)));
+      if (d && !d->fragment && d->channel == kChannel && batch.sender(static_cast<std::size_t>(i)) == probe.local &&
+          std::equal(d->data.begin(), d->data.end(), token.begin(), token.end()))
+        return std::nullopt;
+    }
+  }
+  return "self test: our own message on " + url.group + ":" + std::to_string(url.port) +
+         " did not come back within " + std::to_string(timeout.count()) +
+         " ms (check the multicast route, multicast loopback and the firewall)";
 }
 
 ReceiveBatch::ReceiveBatch(std::size_t slots) : slots_(slots), iovecs_(slots), headers_(slots) {

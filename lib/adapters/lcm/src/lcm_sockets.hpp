@@ -13,6 +13,7 @@
 #include <time.h>
 
 #include <array>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -60,6 +61,12 @@ OpenedSocket open_send_socket(const LcmUrl& url);
 // copied. Replaces a filter attached before. nullopt when attached; otherwise why not. Either
 // way the receive thread still tells them by their source.
 std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> own);
+
+// liblcm's start-up check, as it makes it: a message on LCM_SELF_TEST sent from a socket of its
+// own must come back to receive socket `fd` within `timeout`. Whatever else arrives meanwhile is
+// read and dropped (nothing is delivered before the segment is up). nullopt when it came back;
+// otherwise why not (no multicast loopback, a firewall, a route on another interface).
+std::optional<std::string> self_test(const LcmUrl& url, int fd, std::chrono::milliseconds timeout);
 
 // One recvmmsg's worth of datagrams, reused from call to call.
 class ReceiveBatch {
