@@ -21,6 +21,7 @@
 #include "daemon_logger.hpp"
 #include "federation_member.hpp"
 #include "metrics_server.hpp"
+#include "realtime_watchdog.hpp"
 #include "service_notifier.hpp"
 
 namespace cosmicd {
@@ -303,9 +304,14 @@ class Daemon {
 
   void loop(cosmic::ControlServer& server) {
     auto last_health = std::chrono::steady_clock::now() - std::chrono::seconds(1);
+    auto last_watchdog = std::chrono::steady_clock::now();
     while (running_) {
       server.run_for(std::chrono::milliseconds(100));
       federation_.tick(steady_now());
+      if (std::chrono::steady_clock::now() - last_watchdog >= std::chrono::seconds(1)) {
+        for (const auto& line : watchdog_.check(steady_now())) log_.log(cosmic::LogLevel::error, "realtime: " + line);
+        last_watchdog = std::chrono::steady_clock::now();
+      }
       if (std::chrono::steady_clock::now() - last_health >= std::chrono::milliseconds(250)) {
         gateway_.refresh_health();
         gateway_.refresh_runtime(steady_now());
@@ -324,6 +330,7 @@ class Daemon {
   cosmic::Gateway gateway_;
   FederationMember federation_;  // after gateway_: it uses the gateway until it is destroyed
   ServiceNotifier notifier_;
+  RealtimeWatchdog watchdog_;  // a busy real-time thread is made time-shared
   BindingState state_;
   cosmic::Config file_config_;  // the configuration file as last loaded
   // Start and then the admission worker, one reload at a time: an unchanged file is not parsed again.
