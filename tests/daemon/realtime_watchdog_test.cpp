@@ -64,6 +64,8 @@ TEST(BusyThreadJudge, AThreadThatLeftRealtimeIsForgotten) {
 // The watchdog's eyes and hands on real threads. (Not a real SCHED_FIFO busy loop: on this
 // 2-CPU VM one stalled the whole machine for minutes, kernel threads of its CPU included.)
 TEST(RealtimeWatchdog, SeesRealtimeThreadsAndTheirCpuTimeAndMakesOneTimeShared) {
+  // Only a process that may use SCHED_FIFO can make a real-time thread to look at; scripts/test and
+  // CI run as root, where it runs. A developer's unprivileged run skips it and says why.
   if (!cosmic::sched_fifo_permitted(10))
     GTEST_SKIP() << "SCHED_FIFO is not permitted to this process (no CAP_SYS_NICE, RLIMIT_RTPRIO 0)";
   std::atomic<bool> run{true};
