@@ -3,7 +3,7 @@
 // was seen spinning forever right after a participant started, inheriting the HRT participant's
 // SCHED_FIFO priority and reserved CPU) keeps every thread of lower or equal priority off that CPU
 // for good: discovery, the lanes, the HRT path itself. Such a thread is made time-shared (nice 19)
-// once, and the reason is logged; the rest of the gateway runs on. The kernel's own real-time
+// on the control thread's CPUs once, and the reason is logged; the rest of the gateway runs on. The kernel's own real-time
 // throttling leaves only time-shared threads their 5% and does nothing for the other real-time ones.
 //
 // Control thread only (cosmicd's loop calls check() every second).
@@ -57,7 +57,8 @@ class BusyThreadJudge {
 // that ends while it is read is left out.
 std::vector<ThreadSample> sample_process_threads();
 
-// Makes thread `tid` of this process time-shared at nice 19; the reason when it cannot.
+// Makes thread `tid` of this process time-shared at nice 19, on the CPUs of the calling thread;
+// the reason when it cannot.
 std::optional<std::string> make_time_shared(pid_t tid);
 
 // The judge over this process's threads, demoting and describing what it found.

@@ -6,6 +6,7 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
@@ -71,7 +72,19 @@ TEST(RealtimeWatchdog, SeesRealtimeThreadsAndTheirCpuTimeAndMakesOneTimeShared) 
   std::atomic<bool> run{true};
   std::atomic<pid_t> fifo_tid{0};
   std::atomic<pid_t> busy_tid{0};
+  // The real-time thread sits on the last CPU, the test's own thread on the others (as cosmicd's
+  // HRT threads and its control thread in the reserved placement), when there are two.
+  const int cpu_count = static_cast<int>(std::thread::hardware_concurrency());
+  cpu_set_t control_cpus, saved_cpus;
+  ASSERT_EQ(sched_getaffinity(0, sizeof saved_cpus, &saved_cpus), 0);
+  CPU_ZERO(&control_cpus);
+  for (int cpu = 0; cpu < std::max(1, cpu_count - 1); ++cpu) CPU_SET(cpu, &control_cpus);
+  ASSERT_EQ(sched_setaffinity(0, sizeof control_cpus, &control_cpus), 0);
   std::thread fifo([&] {  // real-time, asleep
+    cpu_set_t last;
+    CPU_ZERO(&last);
+    CPU_SET(std::max(0, cpu_count - 1), &last);
+    pthread_setaffinity_np(pthread_self(), sizeof last, &last);
     sched_param param{};
     param.sched_priority = 10;
     pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
@@ -112,6 +125,10 @@ TEST(RealtimeWatchdog, SeesRealtimeThreadsAndTheirCpuTimeAndMakesOneTimeShared) 
   EXPECT_EQ(sched_getscheduler(fifo_tid.load()), SCHED_OTHER);
   errno = 0;
   EXPECT_EQ(getpriority(PRIO_PROCESS, static_cast<id_t>(fifo_tid.load())), 19);
+  cpu_set_t now_on;
+  ASSERT_EQ(sched_getaffinity(fifo_tid.load(), sizeof now_on, &now_on), 0);
+  EXPECT_TRUE(CPU_EQUAL(&now_on, &control_cpus));  // moved next to the control thread
+  sched_setaffinity(0, sizeof saved_cpus, &saved_cpus);
   run.store(false);
   fifo.join();
   busy.join();
