@@ -1,4 +1,5 @@
 #include "can_adapter_impl.hpp"
+#include "cosmic/receive_buffer_size.hpp"
 
 namespace cosmic::can_detail {
 
@@ -96,13 +97,7 @@ bool CanAdapter::open_socket(int ifindex) {
 void CanAdapter::size_receive_buffer(int s) {
   const std::size_t wanted = receive_buffer_frames(segment_.can);
   const int request = receive_buffer_request(wanted);
-  if (::setsockopt(s, SOL_SOCKET, SO_RCVBUFFORCE, &request, sizeof request) != 0) {
-    ::setsockopt(s, SOL_SOCKET, SO_RCVBUF, &request, sizeof request);  // an error leaves the default
-  }
-  int granted = 0;
-  socklen_t length = sizeof granted;
-  if (::getsockopt(s, SOL_SOCKET, SO_RCVBUF, &granted, &length) != 0) granted = 0;
-  const std::size_t held = frames_held(granted);
+  const std::size_t held = frames_held(cosmic::size_receive_buffer(s, request).reported);
   if (held >= wanted || receive_buffer_warned_) return;
   receive_buffer_warned_ = true;
   log_.log(LogLevel::warning,

@@ -29,7 +29,6 @@
 #include <array>
 #include <atomic>
 #include <cerrno>
-#include <climits>
 #include <cstring>
 #include <exception>
 #include <optional>

@@ -14,6 +14,7 @@
 #include <cstring>
 
 #include "cosmic/lcm_udpm.hpp"
+#include "cosmic/receive_buffer_size.hpp"
 
 namespace cosmic::lcm_detail {
 namespace {
@@ -37,17 +38,12 @@ int set_int(int fd, int level, int name, int value) {
 
 // The socket's receive buffer as close to `bytes` as this process may make it; a warning when
 // it falls short.
-void size_receive_buffer(int fd, std::size_t bytes, OpenedSocket& out) {
-  const int request = bytes > static_cast<std::size_t>(INT_MAX / 2) ? INT_MAX / 2 : static_cast<int>(bytes);
-  if (set_int(fd, SOL_SOCKET, SO_RCVBUFFORCE, request) != 0) set_int(fd, SOL_SOCKET, SO_RCVBUF, request);
-  int granted = 0;
-  socklen_t length = sizeof granted;
-  if (::getsockopt(fd, SOL_SOCKET, SO_RCVBUF, &granted, &length) != 0) return;
-  // Linux reports twice what was set (the other half is its bookkeeping).
-  if (static_cast<std::size_t>(granted) / 2 >= static_cast<std::size_t>(request)) return;
-  out.warnings.push_back("the receive buffer holds " + std::to_string(granted / 2) + " bytes, not the " +
-                         std::to_string(request) + " asked for: a burst beyond it is lost (counted as overflow "
-                         "drops). Set net.core.rmem_max to at least " + std::to_string(request) +
+void warn_if_short(int fd, std::size_t bytes, OpenedSocket& out) {
+  const ReceiveBufferSize size = size_receive_buffer(fd, static_cast<long long>(std::min<std::size_t>(bytes, INT_MAX)));
+  if (size.reported == 0 || !size.short_of_request()) return;
+  out.warnings.push_back("the receive buffer holds " + std::to_string(size.usable()) + " bytes, not the " +
+                         std::to_string(size.requested) + " asked for: a burst beyond it is lost (counted as overflow "
+                         "drops). Set net.core.rmem_max to at least " + std::to_string(size.requested) +
                          " or give cosmicd CAP_NET_ADMIN");
 }
 
@@ -85,7 +81,7 @@ OpenedSocket open_receive_socket(const LcmUrl& url, std::size_t buffer_bytes) {
   if (set_int(fd, SOL_SOCKET, SO_TIMESTAMPNS, 1) != 0)
     out.warnings.push_back(errno_text("SO_TIMESTAMPNS (residence then starts when the datagram is read)"));
   if (set_int(fd, SOL_SOCKET, SO_RXQ_OVFL, 1) != 0) out.warnings.push_back(errno_text("SO_RXQ_OVFL (drops not counted)"));
-  size_receive_buffer(fd, url.recv_buf_size ? *url.recv_buf_size : buffer_bytes, out);
+  warn_if_short(fd, url.recv_buf_size ? *url.recv_buf_size : buffer_bytes, out);
   out.fd = fd;
   return out;
 }
