@@ -34,7 +34,9 @@ TEST(ReceiveBufferSize, AsksTheKernelAndReportsWhatItGranted) {
   EXPECT_EQ(size.usable(), size.reported / 2);
   EXPECT_EQ(size.short_of_request(), size.usable() < size.requested);
   // Root (scripts/test, CI) has CAP_NET_ADMIN: the whole request, whatever rmem_max says.
-  if (::geteuid() == 0) EXPECT_FALSE(size.short_of_request()) << size.usable() << " of " << size.requested;
+  if (::geteuid() == 0) {
+    EXPECT_FALSE(size.short_of_request()) << size.usable() << " of " << size.requested;
+  }
 }
 
 TEST(ReceiveBufferSize, ClampsWhatNoIntCanHold) {
