@@ -1,0 +1,97 @@
+// The LCM receive socket's filter (lcm_sockets.hpp, drop_own_datagrams) over real sockets: it cuts
+// the datagrams of cosmicd's own transmit sockets and nothing else. The own-echo tests of the
+// adapter see it cut; here a stranger that shares the port but not the address, and one that
+// shares the address but not the port, must both get through whole.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <map>
+#include <string>
+#include <variant>
+
+#include "lcm_sockets.hpp"
+
+namespace cosmic::lcm_detail {
+namespace {
+
+constexpr std::uint32_t kLoopback = 0x7f000001;   // 127.0.0.1
+constexpr std::uint32_t kLoopback2 = 0x7f000002;  // 127.0.0.2, also this host's (127/8 is lo)
+
+struct Udp {
+  int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  ~Udp() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+// Binds `s` to address:port (port 0: any), multicast out of lo; the endpoint it got.
+Endpoint bind_sender(const Udp& s, std::uint32_t address, std::uint16_t port) {
+  sockaddr_in at{};
+  at.sin_family = AF_INET;
+  at.sin_addr.s_addr = htonl(address);
+  at.sin_port = htons(port);
+  if (::bind(s.fd, reinterpret_cast<const sockaddr*>(&at), sizeof at) != 0) return {};
+  in_addr lo{};
+  lo.s_addr = htonl(kLoopback);
+  ::setsockopt(s.fd, IPPROTO_IP, IP_MULTICAST_IF, &lo, sizeof lo);
+  sockaddr_in local{};
+  socklen_t length = sizeof local;
+  ::getsockname(s.fd, reinterpret_cast<sockaddr*>(&local), &length);
+  return Endpoint{ntohl(local.sin_addr.s_addr), ntohs(local.sin_port)};
+}
+
+bool send_to_group(const Udp& s, const LcmUrl& url, std::size_t bytes) {
+  sockaddr_in group{};
+  group.sin_family = AF_INET;
+  group.sin_port = htons(url.port);
+  ::inet_pton(AF_INET, url.group.c_str(), &group.sin_addr);
+  const std::string payload(bytes, 'x');
+  return ::sendto(s.fd, payload.data(), payload.size(), 0, reinterpret_cast<const sockaddr*>(&group), sizeof group) ==
+         static_cast<ssize_t>(bytes);
+}
+
+TEST(LcmSocketFilter, CutsOnlyTheExactSourceOfOwnTransmitSockets) {
+  const auto parsed = parse_lcm_url("udpm://239.255.76.91:7691?ttl=0");
+  ASSERT_TRUE(std::holds_alternative<LcmUrl>(parsed));
+  const LcmUrl url = std::get<LcmUrl>(parsed);
+  const OpenedSocket rx = open_receive_socket(url, 1 << 20);
+  ASSERT_GE(rx.fd, 0) << rx.error;
+
+  Udp own, same_port, same_address;
+  const Endpoint own_at = bind_sender(own, kLoopback, 0);
+  ASSERT_NE(own_at.port, 0);
+  const Endpoint same_port_at = bind_sender(same_port, kLoopback2, own_at.port);
+  ASSERT_EQ(same_port_at.port, own_at.port) << "127.0.0.2 with the own port";
+  const Endpoint same_address_at = bind_sender(same_address, kLoopback, 0);
+  ASSERT_NE(same_address_at.port, own_at.port);
+
+  const Endpoint filtered[] = {own_at};
+  ASSERT_EQ(drop_own_datagrams(rx.fd, filtered), std::nullopt);
+  ASSERT_TRUE(send_to_group(own, url, 10));
+  ASSERT_TRUE(send_to_group(same_port, url, 20));
+  ASSERT_TRUE(send_to_group(same_address, url, 30));
+
+  std::map<std::uint64_t, std::size_t> size_by_sender;
+  ReceiveBatch batch(8);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (size_by_sender.size() < 3 && std::chrono::steady_clock::now() < deadline) {
+    pollfd p{rx.fd, POLLIN, 0};
+    if (::poll(&p, 1, 100) <= 0) continue;
+    const int n = batch.receive(rx.fd);
+    for (int i = 0; i < n; ++i) size_by_sender[batch.sender(static_cast<std::size_t>(i)).key()] = batch.datagram(static_cast<std::size_t>(i)).size();
+  }
+  ::close(rx.fd);
+  ASSERT_EQ(size_by_sender.size(), 3u);
+  EXPECT_EQ(size_by_sender[own_at.key()], 0u);            // cut to its UDP header
+  EXPECT_EQ(size_by_sender[same_port_at.key()], 20u);     // another address: whole
+  EXPECT_EQ(size_by_sender[same_address_at.key()], 30u);  // another port: whole
+}
+
+}  // namespace
+}  // namespace cosmic::lcm_detail
