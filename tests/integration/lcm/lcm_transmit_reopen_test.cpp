@@ -1,0 +1,136 @@
+// The LCM transmit side (lcm_transmit.hpp) when the address its sockets send from goes away: the
+// interface is renumbered under it, the next send fails, the socket is reopened on the new
+// address and the datagrams carry that source from then on, which the receive filter follows.
+// The network is a veth pair in this test's own namespace (scripts/netns-run); the kernel here
+// has no dummy device.
+#include <arpa/inet.h>
+#include <net/if.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <variant>
+#include <vector>
+
+#include "lcm_transmit.hpp"
+
+namespace cosmic::lcm_detail {
+namespace {
+
+constexpr std::uint32_t kFirstAddress = 0x0a4d0001;   // 10.77.0.1
+constexpr std::uint32_t kSecondAddress = 0x0a4d0002;  // 10.77.0.2
+
+class LinesLogger final : public Logger {
+ public:
+  void log(LogLevel, std::string_view message) override {
+    std::lock_guard lock(mutex_);
+    lines_.emplace_back(message);
+  }
+  bool has(const std::string& part) {
+    std::lock_guard lock(mutex_);
+    for (const auto& line : lines_)
+      if (line.find(part) != std::string::npos) return true;
+    return false;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::string> lines_;
+};
+
+int shell(const std::string& command) { return std::system((command + " 2>&1").c_str()); }
+
+// A member of the group on `interface` (by index, which renumbering keeps), bound to its port.
+int group_member(const LcmUrl& url, const char* interface) {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
+  const int on = 1;
+  ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);
+  sockaddr_in at{};
+  at.sin_family = AF_INET;
+  at.sin_port = htons(url.port);
+  ::inet_pton(AF_INET, url.group.c_str(), &at.sin_addr);
+  if (::bind(fd, reinterpret_cast<const sockaddr*>(&at), sizeof at) != 0) return -1;
+  ip_mreqn join{};
+  join.imr_multiaddr = at.sin_addr;
+  join.imr_ifindex = static_cast<int>(::if_nametoindex(interface));
+  if (::setsockopt(fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &join, sizeof join) != 0) return -1;
+  return fd;
+}
+
+// The source of the next datagram on `fd` within `wait`.
+std::optional<Endpoint> next_source(int fd, std::chrono::milliseconds wait) {
+  pollfd p{fd, POLLIN, 0};
+  if (::poll(&p, 1, static_cast<int>(wait.count())) <= 0) return std::nullopt;
+  char bytes[65536];
+  sockaddr_in from{};
+  socklen_t length = sizeof from;
+  if (::recvfrom(fd, bytes, sizeof bytes, 0, reinterpret_cast<sockaddr*>(&from), &length) < 0) return std::nullopt;
+  return Endpoint{ntohl(from.sin_addr.s_addr), ntohs(from.sin_port)};
+}
+
+TEST(LcmTransmitReopen, ASocketWhoseAddressWentAwayIsReopenedOnTheNewOne) {
+  ASSERT_EQ(shell("ip link add cosmic0 type veth peer name cosmic1 && ip link set cosmic1 up && "
+                  "ip link set cosmic0 multicast on up && ip addr add 10.77.0.1/24 dev cosmic0 && "
+                  "ip route add 239.255.77.0/24 dev cosmic0"),
+            0);
+  const auto parsed = parse_lcm_url("udpm://239.255.77.1:7701?ttl=0");
+  ASSERT_TRUE(std::holds_alternative<LcmUrl>(parsed));
+  const LcmUrl url = std::get<LcmUrl>(parsed);
+  const int member = group_member(url, "cosmic0");
+  ASSERT_GE(member, 0);
+
+  LinesLogger log;
+  AdapterCounters counters;
+  HealthCell health;
+  std::atomic<bool> receive_failing{false};
+  LcmTransmitter transmitter("renumbered", log, counters, health, receive_failing);
+  ASSERT_EQ(transmitter.open(url), std::nullopt);
+  Channel channel;
+  channel.id = 1;
+  channel.name = "RENUMBERED";
+  channel.encoding = LcmEncoding::raw;
+  channel.tx = true;
+  const std::vector<std::uint8_t> payload(16, 0x5a);
+  OutboundEvent event;
+  event.channel = 1;
+  event.payload = payload;
+
+  ASSERT_EQ(transmitter.send(channel, event), SendStatus::sent);
+  const auto first = next_source(member, std::chrono::milliseconds(5000));
+  ASSERT_TRUE(first.has_value());
+  EXPECT_EQ(first->address, kFirstAddress);
+  EXPECT_TRUE(transmitter.is_own(*first));
+
+  // Renumbered: the old address goes, a new one comes (and the group's route with it).
+  ASSERT_EQ(shell("ip addr del 10.77.0.1/24 dev cosmic0 && ip addr add 10.77.0.2/24 dev cosmic0 && "
+                  "ip route replace 239.255.77.0/24 dev cosmic0"),
+            0);
+  // Sends fail until the socket is reopened (at once for the first failure, then at most once a
+  // second); then they leave from the new address.
+  std::optional<Endpoint> after;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(15);
+  while (!after && std::chrono::steady_clock::now() < deadline) {
+    if (transmitter.send(channel, event) == SendStatus::sent) after = next_source(member, std::chrono::milliseconds(1000));
+    if (!after) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_TRUE(after.has_value()) << "no datagram from a reopened socket";
+  EXPECT_EQ(after->address, kSecondAddress);
+  EXPECT_TRUE(transmitter.is_own(*after));     // the receive side knows the new source as ours
+  EXPECT_FALSE(transmitter.is_own(*first));    // and the old one no longer
+  EXPECT_GE(counters.send_errors.load(), 1u);  // the send that met the missing address
+  EXPECT_TRUE(log.has("transmit socket reopened"));
+  transmitter.close();
+  ::close(member);
+}
+
+}  // namespace
+}  // namespace cosmic::lcm_detail
