@@ -1,7 +1,8 @@
-// The LCM receive socket's filter (lcm_sockets.hpp, drop_own_datagrams) over real sockets: it cuts
-// the datagrams of cosmicd's own transmit sockets and nothing else. The own-echo tests of the
-// adapter see it cut; here a stranger that shares the port but not the address, and one that
-// shares the address but not the port, must both get through whole.
+// The LCM transport's socket layer (lcm_sockets.hpp) over real sockets, where the adapter's tests
+// cannot reach: the receive filter cuts the datagrams of cosmicd's own transmit sockets and
+// nothing else (a stranger that shares the port but not the address, and one that shares the
+// address but not the port, get through whole), and the start-up self test says why when our
+// own message does not come back.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -91,6 +92,33 @@ TEST(LcmSocketFilter, CutsOnlyTheExactSourceOfOwnTransmitSockets) {
   EXPECT_EQ(size_by_sender[own_at.key()], 0u);            // cut to its UDP header
   EXPECT_EQ(size_by_sender[same_port_at.key()], 20u);     // another address: whole
   EXPECT_EQ(size_by_sender[same_address_at.key()], 30u);  // another port: whole
+}
+
+LcmUrl url_of(const char* text) {
+  const auto parsed = parse_lcm_url(text);
+  return std::get<LcmUrl>(parsed);
+}
+
+TEST(LcmSelfTest, PassesWhenOurMessageComesBackToTheReceiveSocket) {
+  const LcmUrl url = url_of("udpm://239.255.76.92:7692?ttl=0");
+  const OpenedSocket rx = open_receive_socket(url, 1 << 20);
+  ASSERT_GE(rx.fd, 0) << rx.error;
+  EXPECT_EQ(self_test(url, rx.fd, std::chrono::milliseconds(5000)), std::nullopt);
+  ::close(rx.fd);
+}
+
+// The receive socket listens to another group's port, as one that the route, the loopback or a
+// firewall keeps our message from: the self test waits its time and names the group and the
+// likely causes.
+TEST(LcmSelfTest, SaysWhyWhenOurMessageDoesNotComeBack) {
+  const LcmUrl url = url_of("udpm://239.255.76.93:7693?ttl=0");
+  const OpenedSocket elsewhere = open_receive_socket(url_of("udpm://239.255.76.93:7694?ttl=0"), 1 << 20);
+  ASSERT_GE(elsewhere.fd, 0) << elsewhere.error;
+  const auto why = self_test(url, elsewhere.fd, std::chrono::milliseconds(300));
+  ASSERT_TRUE(why.has_value());
+  EXPECT_NE(why->find("239.255.76.93:7693 did not come back within 300 ms"), std::string::npos) << *why;
+  EXPECT_NE(why->find("multicast route"), std::string::npos) << *why;
+  ::close(elsewhere.fd);
 }
 
 }  // namespace
