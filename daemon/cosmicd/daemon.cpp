@@ -157,6 +157,9 @@ class Daemon {
     // of `other` unless their own kind has CPUs.
     for (const auto& problem : cosmic::place_process_threads(config.gateway.realtime.cpus.other))
       log_.log(cosmic::LogLevel::warning, "realtime: " + problem);
+    std::vector<int> lanes_cpus = config.gateway.realtime.cpus.hrt;
+    lanes_cpus.insert(lanes_cpus.end(), config.gateway.realtime.cpus.srt.begin(), config.gateway.realtime.cpus.srt.end());
+    watchdog_.keep_off(std::move(lanes_cpus));
     const auto started = gateway_.start(config);
     if (!started.applied) {
       log_.log(cosmic::LogLevel::error, started.error);

@@ -78,20 +78,31 @@ std::vector<ThreadSample> sample_process_threads() {
   return out;
 }
 
-std::optional<std::string> make_time_shared(pid_t tid) {
+cpu_set_t demoted_thread_cpus(const std::vector<int>& keep_off) {
+  cpu_set_t control;
+  CPU_ZERO(&control);
+  if (::sched_getaffinity(0, sizeof control, &control) != 0) {
+    for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) CPU_SET(cpu, &control);  // unknown: any CPU
+  }
+  cpu_set_t out = control;
+  for (const int cpu : keep_off) {
+    if (cpu >= 0 && cpu < CPU_SETSIZE) CPU_CLR(cpu, &out);
+  }
+  return CPU_COUNT(&out) > 0 ? out : control;
+}
+
+std::optional<std::string> make_time_shared(pid_t tid, const cpu_set_t& cpus) {
   sched_param param{};
   param.sched_priority = 0;
   if (::sched_setscheduler(tid, SCHED_OTHER, &param) != 0) return std::string("sched_setscheduler: ") + std::strerror(errno);
   // setpriority(PRIO_PROCESS, tid) sets the nice value of this one thread on Linux.
   if (::setpriority(PRIO_PROCESS, static_cast<id_t>(tid), 19) != 0) return std::string("nice 19: ") + std::strerror(errno);
-  // Onto the calling (control) thread's CPUs. Time-shared but alone on a reserved CPU, a loop
-  // that retakes a mutex as soon as it lets it go still shuts out a waiter on another CPU, which
-  // wakes too late every time (Fast DDS 2.9's flow controller does that to the thread removing a
-  // matched reader); sharing the waiter's CPUs, the kernel preempts it for the waiter.
-  cpu_set_t cpus;
-  CPU_ZERO(&cpus);
-  if (::sched_getaffinity(0, sizeof cpus, &cpus) != 0) return std::string("sched_getaffinity: ") + std::strerror(errno);
-  if (::sched_setaffinity(tid, sizeof cpus, &cpus) != 0) return std::string("CPU affinity: ") + std::strerror(errno);
+  // Onto the control thread's CPUs. Time-shared but alone on a reserved CPU, a loop that retakes
+  // a mutex as soon as it lets it go still shuts out a waiter on another CPU, which wakes too
+  // late every time (Fast DDS 2.9's flow controller does that to the thread removing a matched
+  // reader); sharing the waiter's CPUs, the kernel preempts it for the waiter.
+  if (::sched_setaffinity(tid, sizeof cpus, &cpus) != 0)
+    return std::string("time-shared, but its CPU affinity: ") + std::strerror(errno);
   return std::nullopt;
 }
 
@@ -103,8 +114,8 @@ std::vector<std::string> RealtimeWatchdog::check(std::chrono::nanoseconds now) {
     std::string line = "thread " + v.thread.name + " (" + std::to_string(v.thread.tid) + ") ran real-time for " + share +
                        " of the last " + std::to_string(v.window.count() / 1'000'000) +
                        " ms, a busy loop that starves every thread below it on its CPU: ";
-    if (const auto why = make_time_shared(v.thread.tid)) {
-      line += "it could not be made time-shared (" + *why + ")";
+    if (const auto why = make_time_shared(v.thread.tid, demoted_thread_cpus(keep_off_))) {
+      line += "it could not be made time-shared on the control thread's CPUs (" + *why + ")";
     } else {
       line += "it runs time-shared (nice 19), on the control thread's CPUs, from now on";
     }

@@ -3,12 +3,14 @@
 // was seen spinning forever right after a participant started, inheriting the HRT participant's
 // SCHED_FIFO priority and reserved CPU) keeps every thread of lower or equal priority off that CPU
 // for good: discovery, the lanes, the HRT path itself. Such a thread is made time-shared (nice 19)
-// on the control thread's CPUs once, and the reason is logged; the rest of the gateway runs on. The kernel's own real-time
+// on the control thread's CPUs, off those reserved for real-time lanes, once, and the reason is
+// logged; the rest of the gateway runs on. The kernel's own real-time
 // throttling leaves only time-shared threads their 5% and does nothing for the other real-time ones.
 //
 // Control thread only (cosmicd's loop calls check() every second).
 #pragma once
 
+#include <sched.h>
 #include <sys/types.h>
 
 #include <chrono>
@@ -57,18 +59,26 @@ class BusyThreadJudge {
 // that ends while it is read is left out.
 std::vector<ThreadSample> sample_process_threads();
 
-// Makes thread `tid` of this process time-shared at nice 19, on the CPUs of the calling thread;
-// the reason when it cannot.
-std::optional<std::string> make_time_shared(pid_t tid);
+// The CPUs a demoted thread goes to: those of the calling (control) thread, without `keep_off`
+// (the CPUs reserved for the real-time lanes); all of the calling thread's when that leaves none.
+cpu_set_t demoted_thread_cpus(const std::vector<int>& keep_off);
+
+// Makes thread `tid` of this process time-shared at nice 19, on `cpus`; the reason when it
+// cannot, naming the step that failed.
+std::optional<std::string> make_time_shared(pid_t tid, const cpu_set_t& cpus);
 
 // The judge over this process's threads, demoting and describing what it found.
 class RealtimeWatchdog {
  public:
+  // The CPUs reserved for real-time lanes (gateway.realtime.cpus hrt and srt): a demoted thread
+  // is kept off them. Set before the first check().
+  void keep_off(std::vector<int> cpus) { keep_off_ = std::move(cpus); }
   // One line per thread demoted (or that could not be), for the log.
   std::vector<std::string> check(std::chrono::nanoseconds now);
 
  private:
   BusyThreadJudge judge_;
+  std::vector<int> keep_off_;
 };
 
 }  // namespace cosmicd

@@ -21,6 +21,8 @@
 #include <thread>
 #include <vector>
 
+extern "C" long thread_id_probe_gettid();  // thread_id_probe.cpp, a shared library
+
 namespace {
 
 // The calling thread's id as the kernel names it in /proc, without any system call number.
@@ -54,6 +56,13 @@ TEST(ThreadIdCache, EachThreadGetsItsOwnId) {
     EXPECT_EQ(cached[i], from_proc[i]) << "thread " << i;
     EXPECT_NE(cached[i], ::syscall(SYS_gettid)) << "thread " << i;
   }
+  // A thread on a stack (and thread-local storage) glibc reuses from one that ended.
+  long reused = 0, reused_from_proc = -1;
+  std::thread([&] {
+    reused = ::syscall(SYS_gettid);
+    reused_from_proc = thread_id_from_proc();
+  }).join();
+  EXPECT_EQ(reused, reused_from_proc);
 }
 
 TEST(ThreadIdCache, OtherSystemCallsPassThroughWithTheirArgumentsAndErrors) {
@@ -95,6 +104,7 @@ int child_after_forbidding_gettid() {
   if (::prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) != 0) return 11;
   if (::prctl(PR_SET_SECCOMP, SECCOMP_MODE_FILTER, &filter) != 0) return 12;
   if (::syscall(SYS_gettid) != ::getpid()) return 13;  // cached: no system call made
+  if (thread_id_probe_gettid() != ::getpid()) return 15;  // a library's versioned call: the same
   long fresh = 0;
   std::thread other([&] { fresh = ::syscall(SYS_gettid); });
   other.join();
@@ -111,7 +121,23 @@ TEST(ThreadIdCache, AnswersWithoutAskingTheKernelAgainAndIsClearedInAForkedChild
   ASSERT_EQ(::waitpid(child, &status, 0), child);
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 0) << "10: fork kept the parent's id, 11/12: no seccomp here, "
-                                       "13: asked the kernel again, 14: the filter refused nothing";
+                                       "13: asked the kernel again, 14: the filter refused nothing, "
+                                       "15: a shared library's syscall() is not this one";
 }
+
+#ifdef SYS_fork
+// A fork made through syscall() itself, as a library could, skips pthread_atfork: the wrapper
+// clears the cache in the child. The child makes system calls only, then _exit.
+TEST(ThreadIdCache, IsClearedInTheChildOfAForkMadeThroughSyscall) {
+  ASSERT_GT(::syscall(SYS_gettid), 0);
+  const long child = ::syscall(SYS_fork);
+  ASSERT_GE(child, 0);
+  if (child == 0) ::_exit(::syscall(SYS_gettid) == ::syscall(SYS_getpid) ? 0 : 1);
+  int status = 0;
+  ASSERT_EQ(::waitpid(static_cast<pid_t>(child), &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "the child answered with its parent's thread id";
+}
+#endif
 
 }  // namespace

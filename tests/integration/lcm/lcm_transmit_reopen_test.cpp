@@ -78,6 +78,9 @@ std::optional<Endpoint> next_source(int fd, std::chrono::milliseconds wait) {
 }
 
 TEST(LcmTransmitReopen, ASocketWhoseAddressWentAwayIsReopenedOnTheNewOne) {
+  // It changes the network: only in a namespace of its own (the suite runs under scripts/netns-run).
+  const char* in_netns = std::getenv("COSMIC_IN_NETNS");
+  ASSERT_TRUE(in_netns != nullptr && std::string(in_netns) == "1") << "run it under scripts/netns-run";
   ASSERT_EQ(shell("ip link add cosmic0 type veth peer name cosmic1 && ip link set cosmic1 up && "
                   "ip link set cosmic0 multicast on up && ip addr add 10.77.0.1/24 dev cosmic0 && "
                   "ip route add 239.255.77.0/24 dev cosmic0"),
@@ -87,6 +90,9 @@ TEST(LcmTransmitReopen, ASocketWhoseAddressWentAwayIsReopenedOnTheNewOne) {
   const LcmUrl url = std::get<LcmUrl>(parsed);
   const int member = group_member(url, "cosmic0");
   ASSERT_GE(member, 0);
+  // A receive socket as the adapter's, which the transmitter's filter follows.
+  const OpenedSocket rx = open_receive_socket(url, 1 << 20);
+  ASSERT_GE(rx.fd, 0) << rx.error;
 
   LinesLogger log;
   AdapterCounters counters;
@@ -94,6 +100,7 @@ TEST(LcmTransmitReopen, ASocketWhoseAddressWentAwayIsReopenedOnTheNewOne) {
   std::atomic<bool> receive_failing{false};
   LcmTransmitter transmitter("renumbered", log, counters, health, receive_failing);
   ASSERT_EQ(transmitter.open(url), std::nullopt);
+  ASSERT_EQ(transmitter.follow_with_filter(rx.fd), std::nullopt);
   Channel channel;
   channel.id = 1;
   channel.name = "RENUMBERED";
@@ -128,8 +135,25 @@ TEST(LcmTransmitReopen, ASocketWhoseAddressWentAwayIsReopenedOnTheNewOne) {
   EXPECT_FALSE(transmitter.is_own(*first));    // and the old one no longer
   EXPECT_GE(counters.send_errors.load(), 1u);  // the send that met the missing address
   EXPECT_TRUE(log.has("transmit socket reopened"));
+  // The receive socket's filter now cuts what the new source sends: its datagrams arrive empty.
+  ASSERT_EQ(transmitter.send(channel, event), SendStatus::sent);
+  std::optional<std::size_t> echo_size;
+  ReceiveBatch batch(8);
+  const auto echo_deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!echo_size && std::chrono::steady_clock::now() < echo_deadline) {
+    pollfd p{rx.fd, POLLIN, 0};
+    if (::poll(&p, 1, 100) <= 0) continue;
+    const int n = batch.receive(rx.fd);
+    for (int i = 0; i < n; ++i) {
+      if (batch.sender(static_cast<std::size_t>(i)) == *after) echo_size = batch.datagram(static_cast<std::size_t>(i)).size();
+    }
+  }
+  ASSERT_TRUE(echo_size.has_value()) << "no echo of the new source on the receive socket";
+  EXPECT_EQ(*echo_size, 0u);
   transmitter.close();
   ::close(member);
+  ::close(rx.fd);
+  EXPECT_EQ(shell("ip link del cosmic0"), 0);
 }
 
 }  // namespace
