@@ -65,6 +65,7 @@ const std::vector<BadConfig> kBadConfigs = {
   {"interface_too_long.yaml", {{4, 16, "segments[0].interface", "interface name 'can-interface-name0' is too long (at most 15 characters)"}}},
   {"bad_class.yaml", {{9, 12, "channels[0].class", "'firm' is not allowed here (one of: hrt, srt, nrt)"}}},
   {"unknown_segment_type.yaml", {{3, 11, "segments[0].type", "'zenoh' is not allowed here (one of: can, dds, lcm)"}}},
+  {"bad_own_datagrams.yaml", {{6, 20, "segments[1].own_datagrams", "'discard' is not allowed here (one of: cut, drop)"}}},
   {"bad_reliability.yaml", {{4, 18, "segments[0].reliability", "'sometimes' is not allowed here (one of: reliable, best_effort)"}}},
   {"invalid_name.yaml", {{7, 11, "channels[0].name", "invalid name 'my channel'"}}},
   {"bad_lcm_url.yaml", {{6, 10, "segments[1].url", "unsupported LCM URL 'http://239.255.76.67:7667'"}}},

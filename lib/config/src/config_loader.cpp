@@ -251,7 +251,7 @@ class ConfigParser {
     if (!type) {
       reader_.check_map(node, path, {"name", "type", "interface", "profile", "bitrate", "fd", "data_bitrate", "errors", "max_utilization",
                                      "background", "domain", "latency_bound", "bandwidth", "reliability", "realtime", "max_message_size",
-                                     "interfaces", "discovery_server", "shared_memory", "url", "network"});
+                                     "interfaces", "discovery_server", "shared_memory", "url", "network", "own_datagrams"});
       return std::nullopt;
     }
     s.type = static_cast<SegmentType>(*type);
@@ -390,7 +390,7 @@ class ConfigParser {
 
   void parse_lcm(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
     reader_.check_map(node, path, {"name", "type", "url", "latency_bound", "bandwidth", "realtime", "max_message_size",
-                                   "max_utilization", "network"});
+                                   "max_utilization", "network", "own_datagrams"});
     s.reliability = Reliability::best_effort;
     parse_ip_common(node, path, s);
     if (has(node, "url")) {
@@ -402,6 +402,10 @@ class ConfigParser {
         }
         s.lcm.url = *v;
       }
+    }
+    if (has(node, "own_datagrams")) {
+      s.lcm.own_datagrams = static_cast<LcmOwnDatagrams>(
+          reader_.choice(node["own_datagrams"], key(path, "own_datagrams"), {"cut", "drop"}).value_or(0));
     }
   }
 

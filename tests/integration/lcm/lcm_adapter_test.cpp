@@ -17,6 +17,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+
 #include "cosmic/lcm_adapter.hpp"
 #include "lcm_adapter_fixture.hpp"
 
@@ -266,6 +271,54 @@ TEST_F(LcmAdapterTest, OwnEnvelopesAreNotReceivedBack) {
   ASSERT_TRUE(sink_.wait_events(5, 8));
   for (std::size_t i = 5; i < 8; ++i) EXPECT_EQ(sink_.events(5).at(i).header.origin, self_.id);
   EXPECT_EQ(sink_.problems(5, InboundProblem::own_echo), 0u);
+  adapter->stop();
+}
+
+// The drops the kernel counted for the UDP socket bound to `port` (the last column of
+// /proc/net/udp); 0 when there is none.
+std::uint64_t udp_socket_drops(int port) {
+  std::ifstream table("/proc/net/udp");
+  std::string line;
+  std::getline(table, line);  // the header
+  char wanted[8];
+  std::snprintf(wanted, sizeof wanted, ":%04X ", port);
+  while (std::getline(table, line)) {
+    std::istringstream fields(line);
+    std::string slot, local, last, field;
+    fields >> slot >> local;
+    if ((local + " ").find(wanted) == std::string::npos) continue;
+    while (fields >> field) last = field;
+    return std::stoull(last);
+  }
+  return 0;
+}
+
+// own_datagrams: drop. Ours never reach the receive socket's queue; the kernel counts each as a
+// drop of that socket, and the segment's overflow count leaves them out: a burst of ours, short
+// and in fragments, then the peer's, and overflow_drops stays 0.
+TEST_F(LcmAdapterTest, DroppedOwnDatagramsAreNoOverflow) {
+  const int port = 7708;
+  segment_.lcm.own_datagrams = LcmOwnDatagrams::drop;
+  auto adapter = make(port);
+  const std::vector<ChannelBinding> bindings{binding(7, "LOOPED_DROP", HopRole::publisher, LcmEncoding::raw, 12),
+                                             binding(7, "LOOPED_DROP", HopRole::subscriber, LcmEncoding::raw, 12)};
+  ASSERT_TRUE(adapter->configure(bindings).ok);
+  ASSERT_TRUE(adapter->start(sink_).ok);
+  for (std::uint32_t k = 1; k <= 50; ++k)
+    ASSERT_EQ(adapter->send(outbound(7, own_pattern(k, 24))), SendStatus::sent);
+  ASSERT_EQ(adapter->send(outbound(7, own_pattern(51, 150000))), SendStatus::sent);  // 3 fragments
+
+  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "LOOPED_DROP", "--raw", "--count", "5", "--size", "24"});
+  ASSERT_EQ(pub.wait_exit(), std::optional<int>(0)) << pub.stderr_text();
+  ASSERT_TRUE(sink_.wait_events(7, 5));
+  const auto events = sink_.events(7);
+  ASSERT_EQ(events.size(), 5u);
+  for (std::size_t i = 0; i < events.size(); ++i) EXPECT_EQ(events[i].payload, peer_pattern(i + 1, 24));
+  EXPECT_EQ(adapter->statistics().received, 5u);
+  EXPECT_EQ(adapter->statistics().overflow_drops, 0u);
+  EXPECT_EQ(adapter->statistics().receive_errors, 0u);
+  // The kernel did drop them: the receive socket's drop count (/proc/net/udp) is our 53 datagrams.
+  EXPECT_EQ(udp_socket_drops(port), 53u);
   adapter->stop();
 }
 

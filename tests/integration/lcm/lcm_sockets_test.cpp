@@ -13,6 +13,7 @@
 
 #include <chrono>
 #include <map>
+#include <optional>
 #include <string>
 #include <variant>
 
@@ -57,10 +58,13 @@ bool send_to_group(const Udp& s, const LcmUrl& url, std::size_t bytes) {
          static_cast<ssize_t>(bytes);
 }
 
+LcmUrl url_of(const char* text) {
+  const auto parsed = parse_lcm_url(text);
+  return std::get<LcmUrl>(parsed);
+}
+
 TEST(LcmSocketFilter, CutsOnlyTheExactSourceOfOwnTransmitSockets) {
-  const auto parsed = parse_lcm_url("udpm://239.255.76.91:7691?ttl=0");
-  ASSERT_TRUE(std::holds_alternative<LcmUrl>(parsed));
-  const LcmUrl url = std::get<LcmUrl>(parsed);
+  const LcmUrl url = url_of("udpm://239.255.76.91:7691?ttl=0");
   const OpenedSocket rx = open_receive_socket(url, 1 << 20);
   ASSERT_GE(rx.fd, 0) << rx.error;
 
@@ -94,9 +98,37 @@ TEST(LcmSocketFilter, CutsOnlyTheExactSourceOfOwnTransmitSockets) {
   EXPECT_EQ(size_by_sender[same_address_at.key()], 30u);  // another port: whole
 }
 
-LcmUrl url_of(const char* text) {
-  const auto parsed = parse_lcm_url(text);
-  return std::get<LcmUrl>(parsed);
+// With the drop filter, the own datagram never reaches the queue: the others arrive whole, and
+// the socket's drop count (SO_RXQ_OVFL, carried by the next datagram read) shows the one drop.
+TEST(LcmSocketFilter, DropModeNeverQueuesOwnDatagramsAndTheKernelCountsThem) {
+  const LcmUrl url = url_of("udpm://239.255.76.94:7695?ttl=0");
+  const OpenedSocket rx = open_receive_socket(url, 1 << 20);
+  ASSERT_GE(rx.fd, 0) << rx.error;
+  Udp own, stranger;
+  const Endpoint own_at = bind_sender(own, kLoopback, 0);
+  const Endpoint stranger_at = bind_sender(stranger, kLoopback, 0);
+  ASSERT_NE(own_at.port, 0);
+  const Endpoint filtered[] = {own_at};
+  ASSERT_EQ(drop_own_datagrams(rx.fd, filtered, LcmOwnDatagrams::drop), std::nullopt);
+  ASSERT_TRUE(send_to_group(own, url, 10));
+  ASSERT_TRUE(send_to_group(stranger, url, 30));
+
+  std::map<std::uint64_t, std::size_t> size_by_sender;
+  std::optional<std::uint32_t> drops;
+  ReceiveBatch batch(8);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (size_by_sender.empty() && std::chrono::steady_clock::now() < deadline) {
+    pollfd p{rx.fd, POLLIN, 0};
+    if (::poll(&p, 1, 100) <= 0) continue;
+    const int n = batch.receive(rx.fd);
+    for (int i = 0; i < n; ++i) size_by_sender[batch.sender(static_cast<std::size_t>(i)).key()] = batch.datagram(static_cast<std::size_t>(i)).size();
+    drops = batch.kernel_drops();
+  }
+  ::close(rx.fd);
+  ASSERT_EQ(size_by_sender.size(), 1u);  // the stranger's, sent after ours: ours never arrived
+  EXPECT_EQ(size_by_sender[stranger_at.key()], 30u);
+  ASSERT_TRUE(drops.has_value());
+  EXPECT_EQ(*drops, 1u);
 }
 
 TEST(LcmSelfTest, PassesWhenOurMessageComesBackToTheReceiveSocket) {

@@ -119,8 +119,11 @@ class LcmAdapter final : public SegmentAdapter {
       ::close(rx.fd);
       return fail_start(*why);
     }
-    if (const auto why = transmit_.follow_with_filter(rx.fd))
+    own_dropped_ = segment_.lcm.own_datagrams == LcmOwnDatagrams::drop;
+    if (const auto why = transmit_.follow_with_filter(rx.fd, segment_.lcm.own_datagrams)) {
       rx.warnings.push_back("own datagrams are read back in full and skipped here (" + *why + ")");
+      own_dropped_ = false;
+    }
     for (const auto& warning : rx.warnings) log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + warning);
     stop_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
     if (stop_fd_ < 0) {
@@ -132,6 +135,8 @@ class LcmAdapter final : public SegmentAdapter {
     rx_fd_ = rx.fd;
     receive_failing_.store(false, std::memory_order_relaxed);
     kernel_drops_seen_ = 0;  // a new socket counts from 0; its thread starts below
+    kernel_drops_total_ = 0;
+    overflow_reported_ = 0;
     attach_sink(&sink);
     running_.store(true, std::memory_order_release);
     try {
@@ -333,13 +338,20 @@ class LcmAdapter final : public SegmentAdapter {
   }
 
   // The socket's drop count is cumulative and starts again with every socket: the segment's
-  // counter adds what it rose by.
+  // counter adds what it rose by. With the drop filter, every datagram we sent that looped back
+  // is one of those drops and no overflow: they are taken out by the count of datagrams sent,
+  // which was raised before each send and is read after the drop count, so the difference never
+  // exceeds the true overflow; the counter only rises to it.
   void note_kernel_drops(const lcm_detail::ReceiveBatch& batch) {
     const auto drops = batch.kernel_drops();
     if (!drops) return;
-    const std::uint32_t rise = *drops - kernel_drops_seen_;  // modulo 2^32, as the kernel counts
+    kernel_drops_total_ += static_cast<std::uint32_t>(*drops - kernel_drops_seen_);  // modulo 2^32, as the kernel counts
     kernel_drops_seen_ = *drops;
-    if (rise != 0) counters_.overflow_drops.fetch_add(rise, std::memory_order_relaxed);
+    const std::uint64_t own = own_dropped_ ? transmit_.datagrams_sent() : 0;
+    const std::uint64_t overflow = kernel_drops_total_ > own ? kernel_drops_total_ - own : 0;
+    if (overflow <= overflow_reported_) return;
+    counters_.overflow_drops.fetch_add(overflow - overflow_reported_, std::memory_order_relaxed);
+    overflow_reported_ = overflow;
   }
 
   // Receive thread only.
@@ -465,6 +477,9 @@ class LcmAdapter final : public SegmentAdapter {
   // Receive thread only.
   LcmReassembler reassembler_;
   std::uint32_t kernel_drops_seen_ = 0;  // the socket's drop count at its last report
+  std::uint64_t kernel_drops_total_ = 0;  // ... summed without wrapping (receive thread)
+  std::uint64_t overflow_reported_ = 0;   // what overflow_drops got from this socket so far
+  bool own_dropped_ = false;  // the filter drops our own datagrams (set by start(), before the thread)
 };
 
 }  // namespace

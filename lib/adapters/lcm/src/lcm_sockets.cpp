@@ -108,10 +108,11 @@ OpenedSocket open_send_socket(const LcmUrl& url) {
 
 // Classic BPF over a UDP socket's datagram: the filter runs with the UDP header at offset 0 and
 // the IP header at SKF_NET_OFF. Per own endpoint: source address, then source port; a match keeps
-// the UDP header alone (the kernel trims to at least that), anything else is accepted whole.
-// Trimmed, not dropped: a dropped datagram counts in the socket's drops (SO_RXQ_OVFL, which the
-// segment reports as overflow) and in the host's UDP InErrors.
-std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> own) {
+// the UDP header alone (the kernel trims to at least that), or nothing (dropped); anything else
+// is accepted whole. A dropped datagram counts in the socket's drops (SO_RXQ_OVFL) and in the
+// host's UDP InErrors, which is why cutting is the default; dropping spares the receive thread a
+// wake-up and a read per datagram sent.
+std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> own, LcmOwnDatagrams mode) {
   constexpr std::uint32_t kSourceAddress = static_cast<std::uint32_t>(SKF_NET_OFF) + 12;
   constexpr std::uint32_t kSourcePort = 0;
   if (own.empty() || own.size() > 16) return std::string("no endpoints to filter");
@@ -125,7 +126,8 @@ std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> 
     program.push_back(BPF_JUMP(BPF_JMP | BPF_JEQ | BPF_K, e.port, static_cast<std::uint8_t>(drop_at - here - 1), 0));
   }
   program.push_back(BPF_STMT(BPF_RET | BPF_K, 0xFFFFFFFFu));  // accept
-  program.push_back(BPF_STMT(BPF_RET | BPF_K, 1));            // trim to the UDP header
+  // Cut: trim to the UDP header (queued, read, skipped). Drop: 0, never queued.
+  program.push_back(BPF_STMT(BPF_RET | BPF_K, mode == LcmOwnDatagrams::drop ? 0u : 1u));
   const sock_fprog fprog{static_cast<unsigned short>(program.size()), program.data()};
   if (::setsockopt(fd, SOL_SOCKET, SO_ATTACH_FILTER, &fprog, sizeof fprog) != 0) return errno_text("SO_ATTACH_FILTER");
   return std::nullopt;

@@ -24,6 +24,7 @@
 
 #include "cosmic/lcm_udpm.hpp"
 #include "cosmic/lcm_url.hpp"
+#include "cosmic/model.hpp"
 
 namespace cosmic::lcm_detail {
 
@@ -55,12 +56,14 @@ OpenedSocket open_receive_socket(const LcmUrl& url, std::size_t buffer_bytes);
 // programs on this host receive what it sends.
 OpenedSocket open_send_socket(const LcmUrl& url);
 
-// Attaches a socket filter to receive socket `fd` that cuts, in the kernel, every datagram sent
+// Attaches a socket filter to receive socket `fd` that, in the kernel, cuts every datagram sent
 // from one of `own` (our transmit sockets: multicast loopback hands our own datagrams back to
 // every socket of the group, ours included) down to an empty one, so none of their bytes is
-// copied. Replaces a filter attached before. nullopt when attached; otherwise why not. Either
-// way the receive thread still tells them by their source.
-std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> own);
+// copied, or with `mode` drop drops it before it is queued. Replaces a filter attached before.
+// nullopt when attached; otherwise why not. Either way the receive thread still tells them by
+// their source.
+std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> own,
+                                              LcmOwnDatagrams mode = LcmOwnDatagrams::cut);
 
 // liblcm's start-up check, as it makes it: a message on LCM_SELF_TEST sent from a socket of its
 // own must come back to receive socket `fd` within `timeout`. Whatever else arrives meanwhile is

@@ -57,6 +57,7 @@ LcmTransmitter::LcmTransmitter(std::string segment_name, Logger& log, AdapterCou
 
 std::optional<std::string> LcmTransmitter::open(const LcmUrl& url) {
   url_ = url;
+  datagrams_sent_.store(0, std::memory_order_release);
   for (std::size_t i = 0; i < senders_.size(); ++i) {
     OpenedSocket tx = open_send_socket(url);
     if (tx.fd < 0) {
@@ -71,10 +72,11 @@ std::optional<std::string> LcmTransmitter::open(const LcmUrl& url) {
   return std::nullopt;
 }
 
-std::optional<std::string> LcmTransmitter::follow_with_filter(int receive_fd) {
+std::optional<std::string> LcmTransmitter::follow_with_filter(int receive_fd, LcmOwnDatagrams mode) {
   {
     LockGuard lock(filter_mutex_);
     receive_fd_ = receive_fd;
+    filter_mode_ = mode;
   }
   return attach_filter();
 }
@@ -87,7 +89,7 @@ std::optional<std::string> LcmTransmitter::attach_filter() {
   for (const auto& key : own_keys_)
     if (const std::uint64_t k = key.load(std::memory_order_relaxed); k != 0) own[count++] = endpoint_of(k);
   if (count == 0) return std::nullopt;
-  return drop_own_datagrams(receive_fd_, std::span(own.data(), count));
+  return drop_own_datagrams(receive_fd_, std::span(own.data(), count), filter_mode_);
 }
 
 void LcmTransmitter::close() {
@@ -148,6 +150,7 @@ void LcmTransmitter::send_batch(std::span<const OutboundEvent> events, std::span
       ++i;
       continue;
     }
+    datagrams_sent_.fetch_add(count, std::memory_order_release);  // one datagram each (stage())
     const SendFailure why = sender.batch.send(sender.fd);
     for (std::size_t k = 0; k < count; ++k)
       results[staged[k]] = sender.batch.failed(k) ? failed(sender, *channels[staged[k]], why) : sent(sender);
@@ -159,6 +162,10 @@ SendStatus LcmTransmitter::send_one(ClassSender& sender, const Channel& channel,
   std::array<std::span<const std::uint8_t>, SendBatch::kMaxParts> parts{};
   const std::size_t count = message_parts(channel, event, sender.envelope_headers[0], parts);
   if (count == 0) return failed(sender, channel, SendFailure{0, "payload too large"});
+  std::size_t payload_size = 0;
+  for (std::size_t k = 0; k < count; ++k) payload_size += parts[k].size();
+  if (const auto plan = plan_lcm_message(channel.name.size(), payload_size))
+    datagrams_sent_.fetch_add(std::max<std::size_t>(1, plan->fragment_count), std::memory_order_release);
   const SendFailure why = send_lcm_message(sender.fd, sender.sequence++, channel.name, std::span(parts.data(), count));
   return why.failed() ? failed(sender, channel, why) : sent(sender);
 }

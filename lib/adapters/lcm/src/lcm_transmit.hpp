@@ -38,9 +38,14 @@ class LcmTransmitter {
 
   // Opens the three sockets; the reason when one fails (none is left open then).
   std::optional<std::string> open(const LcmUrl& url);
-  // The receive socket whose filter follows our sources (-1: none); attaches it now. The reason
-  // when the filter cannot be attached.
-  std::optional<std::string> follow_with_filter(int receive_fd);
+  // The receive socket whose filter follows our sources (-1: none), cutting or dropping what
+  // they send (`mode`); attaches it now. The reason when the filter cannot be attached.
+  std::optional<std::string> follow_with_filter(int receive_fd, LcmOwnDatagrams mode = LcmOwnDatagrams::cut);
+  // Datagrams our transmit sockets handed the kernel since open(), counted before each send (so
+  // never fewer than have looped back; a failed send's stay counted). With the drop filter each
+  // one that loops back is a drop of the receive socket's: the segment's overflow count leaves
+  // them out. Any thread.
+  std::uint64_t datagrams_sent() const { return datagrams_sent_.load(std::memory_order_acquire); }
   void close();
 
   // True when `from` is one of our transmit sockets (looped back to us).
@@ -89,6 +94,8 @@ class LcmTransmitter {
   std::array<std::atomic<std::uint64_t>, 3> own_keys_{};
   Mutex filter_mutex_;  // one filter (re)attachment at a time
   int receive_fd_ COSMIC_GUARDED_BY(filter_mutex_) = -1;
+  LcmOwnDatagrams filter_mode_ COSMIC_GUARDED_BY(filter_mutex_) = LcmOwnDatagrams::cut;
+  std::atomic<std::uint64_t> datagrams_sent_{0};
 };
 
 }  // namespace cosmic::lcm_detail

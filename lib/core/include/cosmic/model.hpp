@@ -75,8 +75,15 @@ struct DdsSegmentProperties {
   friend bool operator==(const DdsSegmentProperties&, const DdsSegmentProperties&) = default;
 };
 
+// What the receive socket's filter does with the datagrams cosmicd itself sent, which multicast
+// loopback hands back to it (docs/lcm-mapping.md): cut them to nothing (queued and read, no
+// counter touched), or drop them in the kernel (never queued nor read: cheaper, but each counts
+// in the host's UDP InErrors; cosmicd's own overflow count leaves them out).
+enum class LcmOwnDatagrams { cut, drop };
+
 struct LcmSegmentProperties {
   std::string url = "udpm://239.255.76.67:7667?ttl=0";
+  LcmOwnDatagrams own_datagrams = LcmOwnDatagrams::cut;
   friend bool operator==(const LcmSegmentProperties&, const LcmSegmentProperties&) = default;
 };
 
