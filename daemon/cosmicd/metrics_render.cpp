@@ -129,6 +129,11 @@ void render_segment_counters(Exposition& out, const MetricsSnapshot& s) {
       out.sample(labels, f.frames);
     }
   }
+  out.family("cosmic_segment_own_datagrams_dropped", MetricType::counter,
+             "LCM datagrams the gateway sent whose looped-back copy its receive filter dropped (own_datagrams: drop); "
+             "each is one in the host's UDP InErrors.");
+  for (const auto& seg : s.segments)
+    if (seg.adapter.own_datagrams_dropped) out.sample(segment_labels(seg), *seg.adapter.own_datagrams_dropped);
 }
 
 void render_channel_state(Exposition& out, const MetricsSnapshot& s) {

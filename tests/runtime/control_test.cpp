@@ -87,6 +87,7 @@ class NegotiatingAdapter final : public SegmentAdapter {
   AdapterStatistics statistics() const override {
     AdapterStatistics s = inner_.statistics();
     s.binding_requests_over_limit = incompatible_.load() * 10;
+    s.own_datagrams_dropped = incompatible_.load() * 100;
     return s;
   }
   std::optional<std::size_t> matched_peers(ChannelId) const override { return 0; }
@@ -136,10 +137,13 @@ TEST(ControlAnswers, IncompatiblePeersAndBindingRequestsOverTheLimit) {
   const Json segments = call({{"command", "segments"}})["segments"];
   for (const auto& s : segments) {
     const Json& over = s["adapter"]["binding_requests_over_limit"];
+    const Json& own = s["adapter"]["own_datagrams_dropped"];
     if (s["name"] == "lan") {
       EXPECT_EQ(over, 20);
+      EXPECT_EQ(own, 200);
     } else {
       EXPECT_TRUE(over.is_null()) << s;  // no binding protocol
+      EXPECT_TRUE(own.is_null()) << s;   // no filter that drops
     }
   }
   gateway.stop();

@@ -146,7 +146,7 @@ channels:
   EXPECT_EQ(viz.reliability, Reliability::best_effort);  // LCM has no retransmission
   EXPECT_FALSE(viz.realtime);
   EXPECT_EQ(viz.lcm.url, "udpm://239.255.76.67:7667?ttl=0");
-  EXPECT_EQ(viz.lcm.own_datagrams, LcmOwnDatagrams::cut);  // the default
+  EXPECT_EQ(viz.lcm.own_datagrams, LcmOwnDatagrams::drop);  // the default
   EXPECT_EQ(viz.latency_bound, Nanos(10ms));
 
   const ChannelSpec& c = config.channels[0];
@@ -182,7 +182,7 @@ segments:
     max_message_size: 1KiB
     interfaces: [eth0, lo]
     discovery_server: 127.0.0.1:11811
-  - {name: viz, type: lcm, url: "memq://", latency_bound: 2ms, bandwidth: 10Mbit/s, own_datagrams: drop}
+  - {name: viz, type: lcm, url: "memq://", latency_bound: 2ms, bandwidth: 10Mbit/s, own_datagrams: cut}
 channels:
   - name: c
     subject: 18446744073709551615
@@ -218,7 +218,7 @@ channels:
   EXPECT_EQ(lan.dds.interfaces, (std::vector<std::string>{"eth0", "lo"}));
   EXPECT_EQ(lan.dds.discovery_server, "127.0.0.1:11811");
   EXPECT_EQ(config.segments[2].lcm.url, "memq://");
-  EXPECT_EQ(config.segments[2].lcm.own_datagrams, LcmOwnDatagrams::drop);
+  EXPECT_EQ(config.segments[2].lcm.own_datagrams, LcmOwnDatagrams::cut);
   EXPECT_EQ(config.segments[2].bandwidth, BitRate{10'000'000});
   const ChannelSpec& c = config.channels[0];
   EXPECT_EQ(c.subject, UINT64_MAX);

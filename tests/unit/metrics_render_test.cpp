@@ -142,6 +142,19 @@ TEST(MetricsRender, SegmentsHealthLoadAndAdapterCounters) {
   EXPECT_LINE(m, "cosmic_segment_send_backlog_messages{segment=\"lan\",type=\"dds\"} 5");
 }
 
+// Only a segment whose filter drops the gateway's own datagrams (LCM, own_datagrams: drop) has
+// the counter; the others have no sample rather than a 0 that would claim a filter.
+TEST(MetricsRender, OwnDatagramsDroppedOnlyWhereTheFilterDropsThem) {
+  MetricsSnapshot s = robot();
+  cosmic::SegmentInfo viz = segment("viz", cosmic::SegmentType::lcm, cosmic::SegmentHealth::up);
+  viz.adapter.own_datagrams_dropped = 1234;
+  s.segments.push_back(viz);
+  const std::string m = render_metrics(s, ExpositionFormat::prometheus_text);
+  EXPECT_LINE(m, "cosmic_segment_own_datagrams_dropped_total{segment=\"viz\",type=\"lcm\"} 1234");
+  EXPECT_EQ(m.find("cosmic_segment_own_datagrams_dropped_total{segment=\"lan\""), std::string::npos);
+  EXPECT_EQ(m.find("cosmic_segment_own_datagrams_dropped_total{segment=\"body-can\""), std::string::npos);
+}
+
 TEST(MetricsRender, PerHopCountersAndEveryDropReason) {
   const std::string m = text();
   const std::string in = "channel=\"distance\",class=\"hrt\",segment=\"body-can\",role=\"publisher\"";

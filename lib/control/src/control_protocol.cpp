@@ -252,7 +252,9 @@ Json ControlProtocol::segments() const {
                  {"backlog", s.adapter.backlog},
                  {"binding_requests_over_limit", s.adapter.binding_requests_over_limit
                                                      ? Json(*s.adapter.binding_requests_over_limit)
-                                                     : Json(nullptr)}}}};
+                                                     : Json(nullptr)},
+                 {"own_datagrams_dropped",
+                  s.adapter.own_datagrams_dropped ? Json(*s.adapter.own_datagrams_dropped) : Json(nullptr)}}}};
     if (s.spec.type == SegmentType::can) {
       entry["interface"] = s.spec.can.interface;
       entry["bitrate"] = s.spec.can.bitrate.bits_per_second;

@@ -230,50 +230,6 @@ TEST_F(LcmAdapterTest, RawSendIsRecordedByLcmLogger) {
   adapter->stop();
 }
 
-TEST_F(LcmAdapterTest, OwnEnvelopesAreNotReceivedBack) {
-  const int port = 7705;
-  auto adapter = make(port);
-  // The same channel received and sent on this segment: LCM loops our publications back.
-  const std::vector<ChannelBinding> bindings{binding(5, "LOOPED", HopRole::publisher),
-                                             binding(5, "LOOPED", HopRole::subscriber)};
-  ASSERT_TRUE(adapter->configure(bindings).ok);
-  ASSERT_TRUE(adapter->start(sink_).ok);
-
-  // Ours go out (a native subscriber hears them: EnvelopeToNativeSubscriber) and loop back to our
-  // own socket, whose filter drops them in the kernel: the peer's, sent after, arrive alone.
-  for (std::uint32_t k = 1; k <= 10; ++k)
-    ASSERT_EQ(adapter->send(outbound(5, own_pattern(k, 16), k, 0, self_.id)), SendStatus::sent);
-
-  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "LOOPED", "--count", "5", "--size",
-             "16", "--origin", "5", "--subject", "9"});
-  ASSERT_EQ(pub.wait_exit(), std::optional<int>(0)) << pub.stderr_text();
-  ASSERT_TRUE(sink_.wait_events(5, 5));
-
-  const auto events = sink_.events(5);
-  ASSERT_EQ(events.size(), 5u);
-  for (std::size_t i = 0; i < events.size(); ++i) {
-    EXPECT_EQ(events[i].header.origin, 5u);
-    EXPECT_EQ(events[i].header.subject, 9u);
-    EXPECT_EQ(events[i].header.sequence, i + 1);
-    EXPECT_EQ(events[i].payload, peer_pattern(i + 1, 16));
-  }
-  EXPECT_EQ(sink_.problems(5, InboundProblem::own_echo), 0u);
-  EXPECT_EQ(adapter->statistics().received, 5u);
-  // Emptied by the filter, not dropped: a drop would count as overflow (SO_RXQ_OVFL).
-  EXPECT_EQ(adapter->statistics().overflow_drops, 0u);
-  EXPECT_EQ(adapter->statistics().receive_errors, 0u);
-
-  // Envelopes carrying this gateway's origin that it did not just publish (a loop through another
-  // gateway, or a spoof) are delivered, for the router's ingress check to drop and count.
-  Child spoof({peer(), "pub", "--url", url_for(port), "--channel", "LOOPED", "--count", "3", "--size",
-               "16", "--origin", std::to_string(self_.id), "--subject", "9"});
-  ASSERT_EQ(spoof.wait_exit(), std::optional<int>(0)) << spoof.stderr_text();
-  ASSERT_TRUE(sink_.wait_events(5, 8));
-  for (std::size_t i = 5; i < 8; ++i) EXPECT_EQ(sink_.events(5).at(i).header.origin, self_.id);
-  EXPECT_EQ(sink_.problems(5, InboundProblem::own_echo), 0u);
-  adapter->stop();
-}
-
 // The drops the kernel counted for the UDP socket bound to `port` (the last column of
 // /proc/net/udp); 0 when there is none.
 std::uint64_t udp_socket_drops(int port) {
@@ -293,12 +249,61 @@ std::uint64_t udp_socket_drops(int port) {
   return 0;
 }
 
-// own_datagrams: drop. Ours never reach the receive socket's queue; the kernel counts each as a
-// drop of that socket, and the segment's overflow count leaves them out: a burst of ours, short
-// and in fragments, then the peer's, and overflow_drops stays 0.
+TEST_F(LcmAdapterTest, OwnEnvelopesAreNotReceivedBack) {
+  const int port = 7705;
+  segment_.lcm.own_datagrams = LcmOwnDatagrams::cut;
+  auto adapter = make(port);
+  // The same channel received and sent on this segment: LCM loops our publications back.
+  const std::vector<ChannelBinding> bindings{binding(5, "LOOPED", HopRole::publisher),
+                                             binding(5, "LOOPED", HopRole::subscriber)};
+  ASSERT_TRUE(adapter->configure(bindings).ok);
+  ASSERT_TRUE(adapter->start(sink_).ok);
+
+  // Ours go out (a native subscriber hears them: EnvelopeToNativeSubscriber) and loop back to our
+  // own socket, whose filter (own_datagrams: cut) empties them in the kernel and the receive
+  // thread skips them: the peer's, sent after, arrive alone.
+  for (std::uint32_t k = 1; k <= 10; ++k)
+    ASSERT_EQ(adapter->send(outbound(5, own_pattern(k, 16), k, 0, self_.id)), SendStatus::sent);
+
+  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "LOOPED", "--count", "5", "--size",
+             "16", "--origin", "5", "--subject", "9"});
+  ASSERT_EQ(pub.wait_exit(), std::optional<int>(0)) << pub.stderr_text();
+  ASSERT_TRUE(sink_.wait_events(5, 5));
+
+  const auto events = sink_.events(5);
+  ASSERT_EQ(events.size(), 5u);
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    EXPECT_EQ(events[i].header.origin, 5u);
+    EXPECT_EQ(events[i].header.subject, 9u);
+    EXPECT_EQ(events[i].header.sequence, i + 1);
+    EXPECT_EQ(events[i].payload, peer_pattern(i + 1, 16));
+  }
+  EXPECT_EQ(sink_.problems(5, InboundProblem::own_echo), 0u);
+  EXPECT_EQ(adapter->statistics().received, 5u);
+  // Emptied by the filter, not dropped: the kernel counted no drop, and there is none to report.
+  EXPECT_EQ(adapter->statistics().overflow_drops, 0u);
+  EXPECT_EQ(adapter->statistics().receive_errors, 0u);
+  EXPECT_EQ(udp_socket_drops(port), 0u);
+  EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::nullopt);
+
+  // Envelopes carrying this gateway's origin that it did not just publish (a loop through another
+  // gateway, or a spoof) are delivered, for the router's ingress check to drop and count.
+  Child spoof({peer(), "pub", "--url", url_for(port), "--channel", "LOOPED", "--count", "3", "--size",
+               "16", "--origin", std::to_string(self_.id), "--subject", "9"});
+  ASSERT_EQ(spoof.wait_exit(), std::optional<int>(0)) << spoof.stderr_text();
+  ASSERT_TRUE(sink_.wait_events(5, 8));
+  for (std::size_t i = 5; i < 8; ++i) EXPECT_EQ(sink_.events(5).at(i).header.origin, self_.id);
+  EXPECT_EQ(sink_.problems(5, InboundProblem::own_echo), 0u);
+  adapter->stop();
+}
+
+// own_datagrams: drop, the default. Ours never reach the receive socket's queue; the kernel
+// counts each as a drop of that socket, and the segment's overflow count leaves them out: a burst
+// of ours, short and in fragments, then the peer's, and overflow_drops stays 0, while
+// own_datagrams_dropped names them, across a restart too.
 TEST_F(LcmAdapterTest, DroppedOwnDatagramsAreNoOverflow) {
   const int port = 7708;
-  segment_.lcm.own_datagrams = LcmOwnDatagrams::drop;
+  ASSERT_EQ(segment_.lcm.own_datagrams, LcmOwnDatagrams::drop);
   auto adapter = make(port);
   const std::vector<ChannelBinding> bindings{binding(7, "LOOPED_DROP", HopRole::publisher, LcmEncoding::raw, 12),
                                              binding(7, "LOOPED_DROP", HopRole::subscriber, LcmEncoding::raw, 12)};
@@ -319,11 +324,26 @@ TEST_F(LcmAdapterTest, DroppedOwnDatagramsAreNoOverflow) {
   EXPECT_EQ(adapter->statistics().receive_errors, 0u);
   // The kernel did drop them: the receive socket's drop count (/proc/net/udp) is our 53 datagrams.
   EXPECT_EQ(udp_socket_drops(port), 53u);
+  EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::optional<std::uint64_t>(53));
+  adapter->stop();
+  EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::optional<std::uint64_t>(53));
+
+  // A new socket counts from 0 in the kernel and in the transmitter; the segment's figure goes on.
+  ASSERT_TRUE(adapter->start(sink_).ok);
+  for (std::uint32_t k = 52; k <= 53; ++k)
+    ASSERT_EQ(adapter->send(outbound(7, own_pattern(k, 24))), SendStatus::sent);
+  EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::optional<std::uint64_t>(55));
+  Child more({peer(), "pub", "--url", url_for(port), "--channel", "LOOPED_DROP", "--raw", "--count", "1", "--size", "24"});
+  ASSERT_EQ(more.wait_exit(), std::optional<int>(0)) << more.stderr_text();
+  ASSERT_TRUE(sink_.wait_events(7, 6));
+  EXPECT_EQ(udp_socket_drops(port), 2u);
+  EXPECT_EQ(adapter->statistics().overflow_drops, 0u);
   adapter->stop();
 }
 
 TEST_F(LcmAdapterTest, OwnRawMessagesAreNotReceivedBack) {
   const int port = 7706;
+  segment_.lcm.own_datagrams = LcmOwnDatagrams::cut;
   auto adapter = make(port);
   const std::vector<ChannelBinding> bindings{
       binding(6, "LOOPED_RAW", HopRole::publisher, LcmEncoding::raw, 11),

@@ -14,9 +14,9 @@
 //                   or the sink, never around I/O.
 //   transmit_       the per-class transmit sockets, each under its own mutex (lcm_transmit.hpp).
 // Our own datagrams loop back to the receive socket (multicast loopback stays on so programs on
-// this host hear the gateway). A socket filter cuts them down to nothing in the kernel, by their
-// source, the address and port of one of our connected transmit sockets, and the receive thread
-// skips them by that source.
+// this host hear the gateway). A socket filter picks them out in the kernel by their source, the
+// address and port of one of our connected transmit sockets, and drops them (own_datagrams: drop,
+// the default) or cuts them down to nothing, which the receive thread then skips by that source.
 // The EventSink is called with table_mutex_ held shared: it must hand the event on (the router
 // queues it) and not call back into this adapter.
 #include "cosmic/lcm_adapter.hpp"
@@ -124,6 +124,7 @@ class LcmAdapter final : public SegmentAdapter {
       rx.warnings.push_back("own datagrams are read back in full and skipped here (" + *why + ")");
       own_dropped_ = false;
     }
+    count_own_drops(own_dropped_);
     for (const auto& warning : rx.warnings) log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + warning);
     stop_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
     if (stop_fd_ < 0) {
@@ -234,7 +235,13 @@ class LcmAdapter final : public SegmentAdapter {
 
   std::optional<std::size_t> matched_peers(ChannelId) const override { return std::nullopt; }  // multicast: unknowable
 
-  AdapterStatistics statistics() const override { return counters_.snapshot(); }
+  AdapterStatistics statistics() const override {
+    AdapterStatistics s = counters_.snapshot();
+    LockGuard lock(own_count_mutex_);
+    if (own_counting_ || own_dropped_before_ > 0)
+      s.own_datagrams_dropped = own_dropped_before_ + (own_counting_ ? transmit_.datagrams_sent() : 0);
+    return s;
+  }
 
   void stop() override {
     LockGuard control(control_mutex_);
@@ -249,6 +256,7 @@ class LcmAdapter final : public SegmentAdapter {
       ::close(std::exchange(stop_fd_, -1));
       ::close(std::exchange(rx_fd_, -1));
     }
+    count_own_drops(false);  // after the last send (attach_sink above), before the next start resets the count
     transmit_.close();
     memq_.store(false, std::memory_order_relaxed);
     set_health(SegmentHealth::down, "stopped");
@@ -256,6 +264,19 @@ class LcmAdapter final : public SegmentAdapter {
   }
 
  private:
+  // own_datagrams_dropped: the datagrams sent while the filter drops our own copies. The
+  // transmitter counts from 0 again with every start; what earlier sockets sent is kept here.
+  void count_own_drops(bool from_now_on) {
+    LockGuard lock(own_count_mutex_);
+    if (own_counting_) own_dropped_before_ += transmit_.datagrams_sent();
+    own_counting_ = from_now_on;
+    if (from_now_on)
+      log_.log(LogLevel::notice, "LCM segment " + segment_.name +
+                                     ": the datagrams it sends loop back and are dropped by its receive filter "
+                                     "(own_datagrams: drop); each counts once in the host's UDP InErrors and none in "
+                                     "RcvbufErrors; cosmicctl segments --json reports them as own_datagrams_dropped");
+  }
+
   const Channel* transmitting(ChannelId id) const COSMIC_REQUIRES_SHARED(table_mutex_) {
     const auto it = channels_.find(id);
     if (sink_ == nullptr || it == channels_.end() || !it->second.tx) return nullptr;
@@ -480,6 +501,10 @@ class LcmAdapter final : public SegmentAdapter {
   std::uint64_t kernel_drops_total_ = 0;  // ... summed without wrapping (receive thread)
   std::uint64_t overflow_reported_ = 0;   // what overflow_drops got from this socket so far
   bool own_dropped_ = false;  // the filter drops our own datagrams (set by start(), before the thread)
+
+  mutable Mutex own_count_mutex_;  // statistics() from any thread; start()/stop() write
+  bool own_counting_ COSMIC_GUARDED_BY(own_count_mutex_) = false;
+  std::uint64_t own_dropped_before_ COSMIC_GUARDED_BY(own_count_mutex_) = 0;
 };
 
 }  // namespace

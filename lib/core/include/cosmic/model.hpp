@@ -76,14 +76,15 @@ struct DdsSegmentProperties {
 };
 
 // What the receive socket's filter does with the datagrams cosmicd itself sent, which multicast
-// loopback hands back to it (docs/lcm-mapping.md): cut them to nothing (queued and read, no
-// counter touched), or drop them in the kernel (never queued nor read: cheaper, but each counts
-// in the host's UDP InErrors; cosmicd's own overflow count leaves them out).
+// loopback hands back to it (docs/lcm-mapping.md): drop them in the kernel (never queued nor
+// read, no wake-up; each counts in the host's UDP InErrors, cosmicd's own overflow count leaves
+// them out and reports them as own_datagrams_dropped), or cut them to nothing (queued and read,
+// no counter touched, at the price of a read and a wake-up of the receive thread per datagram sent).
 enum class LcmOwnDatagrams { cut, drop };
 
 struct LcmSegmentProperties {
   std::string url = "udpm://239.255.76.67:7667?ttl=0";
-  LcmOwnDatagrams own_datagrams = LcmOwnDatagrams::cut;
+  LcmOwnDatagrams own_datagrams = LcmOwnDatagrams::drop;
   friend bool operator==(const LcmSegmentProperties&, const LcmSegmentProperties&) = default;
 };
 

@@ -114,6 +114,11 @@ struct AdapterStatistics {
   // Requests of the transport's binding protocol over its rate limit (CAN: GET_ETAG, answered
   // later or not at all; also counted in receive_errors); nullopt where there is no such protocol.
   std::optional<std::uint64_t> binding_requests_over_limit;
+  // LCM with own_datagrams: drop: the datagrams the gateway sent whose looped-back copy its own
+  // receive filter dropped in the kernel, one per datagram sent; each is also one in the host's
+  // UDP InErrors and in the socket's drops (/proc/net/udp), and none in overflow_drops. Nullopt
+  // where the filter does not drop them.
+  std::optional<std::uint64_t> own_datagrams_dropped;
   // CAN: the unexplained identifiers (at most 64, lowest identifier first) and the frames of any
   // further ones; empty where the transport cannot see foreign traffic.
   std::vector<UnexplainedFrames> unexplained;
