@@ -341,6 +341,44 @@ TEST_F(LcmAdapterTest, DroppedOwnDatagramsAreNoOverflow) {
   adapter->stop();
 }
 
+// A segment that receives no channel leaves the group: what it sends still reaches the group's
+// other members but no longer loops back to its own receive socket (no drop of that socket,
+// nothing in the host's InErrors, no own_datagrams_dropped). Binding a received channel joins it
+// again before the channel is used; unbinding the last one leaves it again.
+TEST_F(LcmAdapterTest, ASegmentThatOnlySendsLeavesTheGroupUntilAChannelIsReceived) {
+  const int port = 7712;
+  auto adapter = make(port);
+  const ChannelBinding out = binding(8, "ONLY_OUT", HopRole::subscriber, LcmEncoding::raw, 13);
+  const ChannelBinding in = binding(9, "NOW_IN", HopRole::publisher, LcmEncoding::raw, 14);
+  ASSERT_TRUE(adapter->configure(std::vector{out}).ok);
+  ASSERT_TRUE(adapter->start(sink_).ok);
+
+  Child sub({peer(), "sub", "--url", url_for(port), "--channel", "ONLY_OUT", "--raw", "--count", "10", "--timeout", "10"});
+  ASSERT_TRUE(sub.wait_stderr("READY")) << sub.stderr_text();
+  for (std::uint32_t k = 1; k <= 10; ++k) ASSERT_EQ(adapter->send(outbound(8, own_pattern(k, 24))), SendStatus::sent);
+  ASSERT_EQ(sub.wait_exit(), std::optional<int>(0)) << sub.stderr_text();
+  EXPECT_EQ(sub.stdout_lines().size(), 10u);
+  EXPECT_EQ(udp_socket_drops(port), 0u);
+  EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::optional<std::uint64_t>(0));
+
+  ASSERT_TRUE(adapter->configure(std::vector{out, in}).ok);
+  for (std::uint32_t k = 11; k <= 15; ++k) ASSERT_EQ(adapter->send(outbound(8, own_pattern(k, 24))), SendStatus::sent);
+  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "NOW_IN", "--raw", "--count", "3", "--size", "24"});
+  ASSERT_EQ(pub.wait_exit(), std::optional<int>(0)) << pub.stderr_text();
+  ASSERT_TRUE(sink_.wait_events(9, 3));
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(sink_.events(9).at(i).payload, peer_pattern(i + 1, 24));
+  EXPECT_EQ(udp_socket_drops(port), 5u);  // a member again: ours loop back and are dropped
+  EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::optional<std::uint64_t>(5));
+
+  ASSERT_TRUE(adapter->configure(std::vector{out}).ok);
+  for (std::uint32_t k = 16; k <= 19; ++k) ASSERT_EQ(adapter->send(outbound(8, own_pattern(k, 24))), SendStatus::sent);
+  EXPECT_EQ(adapter->statistics().sent, 19u);
+  EXPECT_EQ(udp_socket_drops(port), 5u);
+  EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::optional<std::uint64_t>(5));
+  EXPECT_EQ(adapter->statistics().overflow_drops, 0u);
+  adapter->stop();
+}
+
 TEST_F(LcmAdapterTest, OwnRawMessagesAreNotReceivedBack) {
   const int port = 7706;
   segment_.lcm.own_datagrams = LcmOwnDatagrams::cut;

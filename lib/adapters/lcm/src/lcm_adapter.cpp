@@ -17,6 +17,8 @@
 // this host hear the gateway). A socket filter picks them out in the kernel by their source, the
 // address and port of one of our connected transmit sockets, and drops them (own_datagrams: drop,
 // the default) or cuts them down to nothing, which the receive thread then skips by that source.
+// The receive socket is a member of the group only while a channel is received here (join_group,
+// leave_group), so a segment that only sends gets none of them back.
 // The EventSink is called with table_mutex_ held shared: it must hand the event on (the router
 // queues it) and not call back into this adapter.
 #include "cosmic/lcm_adapter.hpp"
@@ -124,7 +126,6 @@ class LcmAdapter final : public SegmentAdapter {
       rx.warnings.push_back("own datagrams are read back in full and skipped here (" + *why + ")");
       own_dropped_ = false;
     }
-    count_own_drops(own_dropped_);
     for (const auto& warning : rx.warnings) log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + warning);
     stop_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
     if (stop_fd_ < 0) {
@@ -134,6 +135,14 @@ class LcmAdapter final : public SegmentAdapter {
       return fail_start(why);
     }
     rx_fd_ = rx.fd;
+    rx_url_ = url;
+    member_ = true;  // open_receive_socket() joined the group
+    bool receives = false;
+    {
+      SharedLock table(table_mutex_);
+      receives = receives_any();
+    }
+    if (!receives) leave_group();
     receive_failing_.store(false, std::memory_order_relaxed);
     kernel_drops_seen_ = 0;  // a new socket counts from 0; its thread starts below
     kernel_drops_total_ = 0;
@@ -152,6 +161,7 @@ class LcmAdapter final : public SegmentAdapter {
       ::close(std::exchange(rx_fd_, -1));
       return fail_start(std::string("cannot start the LCM receive thread: ") + e.what());
     }
+    count_own_drops(own_dropped_);
     started_ = true;
     set_health(SegmentHealth::up, "");
     log_.log(LogLevel::info, "LCM segment " + segment_.name + " up on " + segment_.lcm.url);
@@ -190,15 +200,31 @@ class LcmAdapter final : public SegmentAdapter {
       if (b.role == HopRole::publisher) c.rx = true;
       if (b.role == HopRole::subscriber) c.tx = true;
     }
+    // The receive socket rejoins the group before a channel is received here again.
+    const bool receives = std::any_of(wanted.begin(), wanted.end(), [](const auto& c) { return c.second.rx; });
+    if (receives && started_ && rx_fd_ >= 0) {
+      if (const auto why = join_group()) {
+        for (const auto& [id, channel] : wanted)
+          if (channel.rx) {
+            refuse(id, channel.name, "cannot receive on this segment: " + *why);
+            refused_ids.insert(id);
+          }
+      }
+    }
     // A channel refused in one role is not carried in the other either.
     for (const ChannelId id : refused_ids) wanted.erase(id);
-    // Swap the table (brief exclusive lock; channels kept keep flowing through it). Every
-    // datagram reaches the receive socket anyway: reception is a lookup by name, no subscription.
+    // Swap the table (brief exclusive lock; channels kept keep flowing through it). Reception is a
+    // lookup by name, no subscription: every datagram of the group reaches the receive socket
+    // while it is a member.
     std::unordered_map<std::string, Channel*, StringHash, std::equal_to<>> by_name;
-    LockGuard table(table_mutex_);
-    channels_ = std::move(wanted);
-    for (auto& [id, channel] : channels_) by_name.emplace(channel.name, &channel);
-    by_name_ = std::move(by_name);
+    const bool still_receives = std::any_of(wanted.begin(), wanted.end(), [](const auto& c) { return c.second.rx; });
+    {
+      LockGuard table(table_mutex_);
+      channels_ = std::move(wanted);
+      for (auto& [id, channel] : channels_) by_name.emplace(channel.name, &channel);
+      by_name_ = std::move(by_name);
+    }
+    if (started_ && rx_fd_ >= 0 && !still_receives) leave_group();
     if (!status.ok) log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + status.error);
     return status;
   }
@@ -239,7 +265,7 @@ class LcmAdapter final : public SegmentAdapter {
     AdapterStatistics s = counters_.snapshot();
     LockGuard lock(own_count_mutex_);
     if (own_counting_ || own_dropped_before_ > 0)
-      s.own_datagrams_dropped = own_dropped_before_ + (own_counting_ ? transmit_.datagrams_sent() : 0);
+      s.own_datagrams_dropped = own_dropped_before_ + (own_counting_ ? transmit_.datagrams_looped_back() : 0);
     return s;
   }
 
@@ -255,6 +281,7 @@ class LcmAdapter final : public SegmentAdapter {
       thread_.join();
       ::close(std::exchange(stop_fd_, -1));
       ::close(std::exchange(rx_fd_, -1));
+      member_ = false;
     }
     count_own_drops(false);  // after the last send (attach_sink above), before the next start resets the count
     transmit_.close();
@@ -264,15 +291,46 @@ class LcmAdapter final : public SegmentAdapter {
   }
 
  private:
+  bool receives_any() const COSMIC_REQUIRES_SHARED(table_mutex_) {
+    return std::any_of(channels_.begin(), channels_.end(), [](const auto& c) { return c.second.rx; });
+  }
+
+  // The receive socket is a member of the group only while a channel is received here. A segment
+  // that only sends leaves it: what it sends no longer loops back to it (nothing to drop or cut,
+  // nothing in the host's InErrors) and the group's other traffic never wakes its receive thread.
+  std::optional<std::string> join_group() COSMIC_REQUIRES(control_mutex_) {
+    if (member_) return std::nullopt;
+    transmit_.count_looped_back(true);  // before the join: the count never falls short
+    if (auto why = lcm_detail::set_group_membership(rx_fd_, *rx_url_, true)) {
+      transmit_.count_looped_back(false);
+      return why;
+    }
+    member_ = true;
+    log_.log(LogLevel::info, "LCM segment " + segment_.name + ": a channel is received here: joined " + rx_url_->group);
+    return std::nullopt;
+  }
+
+  void leave_group() COSMIC_REQUIRES(control_mutex_) {
+    if (!member_) return;
+    if (const auto why = lcm_detail::set_group_membership(rx_fd_, *rx_url_, false)) {
+      log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": stays a member of the group (" + *why + ")");
+      return;
+    }
+    transmit_.count_looped_back(false);  // after the leave: the count never falls short
+    member_ = false;
+    log_.log(LogLevel::info, "LCM segment " + segment_.name + ": no channel is received here: left " + rx_url_->group +
+                                 " (joins it again when one is bound)");
+  }
+
   // own_datagrams_dropped: the datagrams sent while the filter drops our own copies. The
   // transmitter counts from 0 again with every start; what earlier sockets sent is kept here.
   void count_own_drops(bool from_now_on) {
     LockGuard lock(own_count_mutex_);
-    if (own_counting_) own_dropped_before_ += transmit_.datagrams_sent();
+    if (own_counting_) own_dropped_before_ += transmit_.datagrams_looped_back();
     own_counting_ = from_now_on;
     if (from_now_on)
       log_.log(LogLevel::notice, "LCM segment " + segment_.name +
-                                     ": the datagrams it sends loop back and are dropped by its receive filter "
+                                     ": its own datagrams that loop back are dropped by its receive filter "
                                      "(own_datagrams: drop); each counts once in the host's UDP InErrors and none in "
                                      "RcvbufErrors; cosmicctl segments --json reports them as own_datagrams_dropped");
   }
@@ -368,7 +426,7 @@ class LcmAdapter final : public SegmentAdapter {
     if (!drops) return;
     kernel_drops_total_ += static_cast<std::uint32_t>(*drops - kernel_drops_seen_);  // modulo 2^32, as the kernel counts
     kernel_drops_seen_ = *drops;
-    const std::uint64_t own = own_dropped_ ? transmit_.datagrams_sent() : 0;
+    const std::uint64_t own = own_dropped_ ? transmit_.datagrams_looped_back() : 0;
     const std::uint64_t overflow = kernel_drops_total_ > own ? kernel_drops_total_ - own : 0;
     if (overflow <= overflow_reported_) return;
     counters_.overflow_drops.fetch_add(overflow - overflow_reported_, std::memory_order_relaxed);
@@ -485,6 +543,8 @@ class LcmAdapter final : public SegmentAdapter {
   std::thread thread_ COSMIC_GUARDED_BY(control_mutex_);
   int rx_fd_ COSMIC_GUARDED_BY(control_mutex_) = -1;
   int stop_fd_ COSMIC_GUARDED_BY(control_mutex_) = -1;  // eventfd: stop() wakes the receive loop
+  std::optional<LcmUrl> rx_url_ COSMIC_GUARDED_BY(control_mutex_);
+  bool member_ COSMIC_GUARDED_BY(control_mutex_) = false;  // rx_fd_ is a member of the group
   std::atomic<bool> running_{false};
   // memq://: set by start() before the sink is attached, cleared by stop() after it is detached.
   std::atomic<bool> memq_{false};

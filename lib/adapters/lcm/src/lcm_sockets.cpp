@@ -71,11 +71,7 @@ OpenedSocket open_receive_socket(const LcmUrl& url, std::size_t buffer_bytes) {
   bind_to.sin_addr = group->sin_addr;
   if (::bind(fd, reinterpret_cast<const sockaddr*>(&bind_to), sizeof bind_to) != 0)
     return failed(std::move(out), fd, errno_text(("bind to port " + std::to_string(url.port)).c_str()));
-  ip_mreq membership{};
-  membership.imr_multiaddr = group->sin_addr;
-  membership.imr_interface.s_addr = htonl(INADDR_ANY);
-  if (::setsockopt(fd, IPPROTO_IP, IP_ADD_MEMBERSHIP, &membership, sizeof membership) != 0)
-    return failed(std::move(out), fd, errno_text(("joining " + url.group + " (check the multicast route)").c_str()));
+  if (auto why = set_group_membership(fd, url, true)) return failed(std::move(out), fd, std::move(*why));
   // Without this, Linux hands the socket every group any socket of the host joined on this port.
   if (set_int(fd, IPPROTO_IP, IP_MULTICAST_ALL, 0) != 0) out.warnings.push_back(errno_text("IP_MULTICAST_ALL"));
   if (set_int(fd, SOL_SOCKET, SO_TIMESTAMPNS, 1) != 0)
@@ -84,6 +80,18 @@ OpenedSocket open_receive_socket(const LcmUrl& url, std::size_t buffer_bytes) {
   warn_if_short(fd, url.recv_buf_size ? *url.recv_buf_size : buffer_bytes, out);
   out.fd = fd;
   return out;
+}
+
+std::optional<std::string> set_group_membership(int fd, const LcmUrl& url, bool member) {
+  const auto group = group_address(url);
+  if (!group) return "not an IPv4 multicast group: " + url.group;
+  ip_mreq membership{};
+  membership.imr_multiaddr = group->sin_addr;
+  membership.imr_interface.s_addr = htonl(INADDR_ANY);
+  if (::setsockopt(fd, IPPROTO_IP, member ? IP_ADD_MEMBERSHIP : IP_DROP_MEMBERSHIP, &membership, sizeof membership) == 0)
+    return std::nullopt;
+  return member ? errno_text(("joining " + url.group + " (check the multicast route)").c_str())
+                : errno_text(("leaving " + url.group).c_str());
 }
 
 OpenedSocket open_send_socket(const LcmUrl& url) {

@@ -56,6 +56,12 @@ OpenedSocket open_receive_socket(const LcmUrl& url, std::size_t buffer_bytes);
 // programs on this host receive what it sends.
 OpenedSocket open_send_socket(const LcmUrl& url);
 
+// Joins (`member`) or leaves the URL's group on receive socket `fd`, on the interface the kernel
+// picks for it, as open_receive_socket() joined it. With IP_MULTICAST_ALL off, a socket that left
+// receives nothing of the group, even while other sockets of the host stay members. nullopt when
+// done; otherwise why not (joining and leaving twice fail).
+std::optional<std::string> set_group_membership(int fd, const LcmUrl& url, bool member);
+
 // Attaches a socket filter to receive socket `fd` that, in the kernel, cuts every datagram sent
 // from one of `own` (our transmit sockets: multicast loopback hands our own datagrams back to
 // every socket of the group, ours included) down to an empty one, so none of their bytes is

@@ -57,7 +57,8 @@ LcmTransmitter::LcmTransmitter(std::string segment_name, Logger& log, AdapterCou
 
 std::optional<std::string> LcmTransmitter::open(const LcmUrl& url) {
   url_ = url;
-  datagrams_sent_.store(0, std::memory_order_release);
+  looped_back_.store(0, std::memory_order_release);
+  counting_looped_back_.store(true, std::memory_order_release);
   for (std::size_t i = 0; i < senders_.size(); ++i) {
     OpenedSocket tx = open_send_socket(url);
     if (tx.fd < 0) {
@@ -150,11 +151,15 @@ void LcmTransmitter::send_batch(std::span<const OutboundEvent> events, std::span
       ++i;
       continue;
     }
-    datagrams_sent_.fetch_add(count, std::memory_order_release);  // one datagram each (stage())
+    note_sending(count);  // one datagram each (stage())
     const SendFailure why = sender.batch.send(sender.fd);
     for (std::size_t k = 0; k < count; ++k)
       results[staged[k]] = sender.batch.failed(k) ? failed(sender, *channels[staged[k]], why) : sent(sender);
   }
+}
+
+void LcmTransmitter::note_sending(std::size_t datagrams) {
+  if (counting_looped_back_.load(std::memory_order_acquire)) looped_back_.fetch_add(datagrams, std::memory_order_release);
 }
 
 SendStatus LcmTransmitter::send_one(ClassSender& sender, const Channel& channel, const OutboundEvent& event) {
@@ -165,7 +170,7 @@ SendStatus LcmTransmitter::send_one(ClassSender& sender, const Channel& channel,
   std::size_t payload_size = 0;
   for (std::size_t k = 0; k < count; ++k) payload_size += parts[k].size();
   if (const auto plan = plan_lcm_message(channel.name.size(), payload_size))
-    datagrams_sent_.fetch_add(std::max<std::size_t>(1, plan->fragment_count), std::memory_order_release);
+    note_sending(std::max<std::size_t>(1, plan->fragment_count));
   const SendFailure why = send_lcm_message(sender.fd, sender.sequence++, channel.name, std::span(parts.data(), count));
   return why.failed() ? failed(sender, channel, why) : sent(sender);
 }

@@ -41,11 +41,15 @@ class LcmTransmitter {
   // The receive socket whose filter follows our sources (-1: none), cutting or dropping what
   // they send (`mode`); attaches it now. The reason when the filter cannot be attached.
   std::optional<std::string> follow_with_filter(int receive_fd, LcmOwnDatagrams mode = LcmOwnDatagrams::cut);
-  // Datagrams our transmit sockets handed the kernel since open(), counted before each send (so
-  // never fewer than have looped back; a failed send's stay counted). With the drop filter each
-  // one that loops back is a drop of the receive socket's: the segment's overflow count leaves
-  // them out. Any thread.
-  std::uint64_t datagrams_sent() const { return datagrams_sent_.load(std::memory_order_acquire); }
+  // Datagrams our transmit sockets handed the kernel since open() while the receive socket was a
+  // member of the group, so each looped back to it: counted before each send (never fewer than
+  // have looped back; a failed send's stay counted). With the drop filter each one is a drop of
+  // the receive socket's: the segment's overflow count leaves them out. Any thread.
+  std::uint64_t datagrams_looped_back() const { return looped_back_.load(std::memory_order_acquire); }
+  // Whether what is sent from now on loops back to the receive socket (it is a member of the
+  // group; open() starts counting). The control thread calls it before joining and after leaving,
+  // so the count never falls short of what looped back.
+  void count_looped_back(bool counting) { counting_looped_back_.store(counting, std::memory_order_release); }
   void close();
 
   // True when `from` is one of our transmit sockets (looped back to us).
@@ -80,6 +84,8 @@ class LcmTransmitter {
   SendStatus failed(ClassSender& sender, const Channel& channel, SendFailure why) COSMIC_REQUIRES(sender.mutex);
   void reopen(ClassSender& sender, std::size_t index) COSMIC_REQUIRES(sender.mutex);
   std::optional<std::string> attach_filter();
+  // Before `datagrams` leave: counted as looping back while the receive socket is a member.
+  void note_sending(std::size_t datagrams);
 
   const std::string segment_name_;
   Logger& log_;
@@ -95,7 +101,8 @@ class LcmTransmitter {
   Mutex filter_mutex_;  // one filter (re)attachment at a time
   int receive_fd_ COSMIC_GUARDED_BY(filter_mutex_) = -1;
   LcmOwnDatagrams filter_mode_ COSMIC_GUARDED_BY(filter_mutex_) = LcmOwnDatagrams::cut;
-  std::atomic<std::uint64_t> datagrams_sent_{0};
+  std::atomic<std::uint64_t> looped_back_{0};
+  std::atomic<bool> counting_looped_back_{true};
 };
 
 }  // namespace cosmic::lcm_detail
