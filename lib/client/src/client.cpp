@@ -109,6 +109,9 @@ std::unique_ptr<Transport> transport_for(const std::string& segment, std::string
     spec.type = cosmic::SegmentType::lcm;
     spec.reliability = cosmic::Reliability::best_effort;
     spec.lcm.url = rest;
+    // A component sends at its own modest rate: its own looped-back messages are cut and skipped
+    // rather than dropped, which would count each in the host's UDP InErrors (docs/components.md).
+    spec.lcm.own_datagrams = cosmic::LcmOwnDatagrams::cut;
     return cosmic::client_detail::make_ip_transport(spec);
   }
   if (kind == "can" && !target.empty() && options.rfind("node=", 0) == 0) {

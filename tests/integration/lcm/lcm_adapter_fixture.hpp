@@ -303,6 +303,25 @@ inline OutboundEvent outbound(ChannelId channel, const Bytes& payload, std::uint
 
 inline std::string peer() { return COSMIC_LCM_PEER; }
 
+// The drops the kernel counted for the UDP socket bound to `port` (the last column of
+// /proc/net/udp); 0 when there is none.
+inline std::uint64_t udp_socket_drops(int port) {
+  std::ifstream table("/proc/net/udp");
+  std::string line;
+  std::getline(table, line);  // the header
+  char wanted[8];
+  std::snprintf(wanted, sizeof wanted, ":%04X ", port);
+  while (std::getline(table, line)) {
+    std::istringstream fields(line);
+    std::string slot, local, last, field;
+    fields >> slot >> local;
+    if ((local + " ").find(wanted) == std::string::npos) continue;
+    while (fields >> field) last = field;
+    return std::stoull(last);
+  }
+  return 0;
+}
+
 class LcmAdapterTest : public ::testing::Test {
  protected:
   void SetUp() override {

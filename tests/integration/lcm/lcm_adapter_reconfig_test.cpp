@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -302,6 +303,35 @@ TEST(LcmWire, RefusesAnythingButExactlyOneEnvelopeWithinTheLimit) {
                            with_payload_size(9), with_payload_size(0x7fffffff), with_payload_size(0xffffffff)}) {
     EXPECT_FALSE(decode_lcm_envelope(bad, UINT64_MAX).has_value()) << bad.size();
   }
+}
+
+// A segment that only sends has left the group; binding a received channel joins it again, and
+// when that join fails (here: the namespace's multicast route is gone) the channel is refused
+// with the kernel's reason, the sending one stays bound, and a later configure() joins once the
+// route is back.
+TEST_F(LcmAdapterTest, AChannelTheSegmentCannotJoinForIsRefusedWithTheReason) {
+  const int port = 7713;
+  auto adapter = make(port);
+  const ChannelBinding out = binding(1, "STAYS_OUT", HopRole::subscriber, LcmEncoding::raw, 5);
+  const ChannelBinding in = binding(2, "WANTS_IN", HopRole::publisher, LcmEncoding::raw, 6);
+  ASSERT_TRUE(adapter->configure(std::vector{out}).ok);
+  ASSERT_TRUE(adapter->start(sink_).ok);
+
+  ASSERT_EQ(std::system("ip route del 224.0.0.0/4 dev lo"), 0);
+  const Status refused = adapter->configure(std::vector{out, in});
+  ASSERT_EQ(std::system("ip route add 224.0.0.0/4 dev lo"), 0);
+  EXPECT_FALSE(refused.ok);
+  ASSERT_EQ(refused.refused.size(), 1u) << refused.error;
+  EXPECT_EQ(refused.refused[0].channel, 2u);
+  EXPECT_NE(refused.refused[0].reason.find("cannot receive on this segment: joining 239.255.76.67"), std::string::npos)
+      << refused.refused[0].reason;
+  EXPECT_EQ(adapter->send(outbound(1, own_pattern(1, 16))), SendStatus::sent);  // the sending channel stays
+
+  ASSERT_TRUE(adapter->configure(std::vector{out, in}).ok);
+  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "WANTS_IN", "--raw", "--count", "2", "--size", "16"});
+  ASSERT_EQ(pub.wait_exit(), std::optional<int>(0)) << pub.stderr_text();
+  ASSERT_TRUE(sink_.wait_events(2, 2));
+  adapter->stop();
 }
 
 }  // namespace

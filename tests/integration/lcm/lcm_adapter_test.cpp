@@ -230,25 +230,6 @@ TEST_F(LcmAdapterTest, RawSendIsRecordedByLcmLogger) {
   adapter->stop();
 }
 
-// The drops the kernel counted for the UDP socket bound to `port` (the last column of
-// /proc/net/udp); 0 when there is none.
-std::uint64_t udp_socket_drops(int port) {
-  std::ifstream table("/proc/net/udp");
-  std::string line;
-  std::getline(table, line);  // the header
-  char wanted[8];
-  std::snprintf(wanted, sizeof wanted, ":%04X ", port);
-  while (std::getline(table, line)) {
-    std::istringstream fields(line);
-    std::string slot, local, last, field;
-    fields >> slot >> local;
-    if ((local + " ").find(wanted) == std::string::npos) continue;
-    while (fields >> field) last = field;
-    return std::stoull(last);
-  }
-  return 0;
-}
-
 TEST_F(LcmAdapterTest, OwnEnvelopesAreNotReceivedBack) {
   const int port = 7705;
   segment_.lcm.own_datagrams = LcmOwnDatagrams::cut;

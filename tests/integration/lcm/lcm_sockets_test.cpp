@@ -77,7 +77,7 @@ TEST(LcmSocketFilter, CutsOnlyTheExactSourceOfOwnTransmitSockets) {
   ASSERT_NE(same_address_at.port, own_at.port);
 
   const Endpoint filtered[] = {own_at};
-  ASSERT_EQ(drop_own_datagrams(rx.fd, filtered), std::nullopt);
+  ASSERT_EQ(drop_own_datagrams(rx.fd, filtered, LcmOwnDatagrams::cut), std::nullopt);
   ASSERT_TRUE(send_to_group(own, url, 10));
   ASSERT_TRUE(send_to_group(same_port, url, 20));
   ASSERT_TRUE(send_to_group(same_address, url, 30));

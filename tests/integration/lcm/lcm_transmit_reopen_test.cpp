@@ -100,7 +100,7 @@ TEST(LcmTransmitReopen, ASocketWhoseAddressWentAwayIsReopenedOnTheNewOne) {
   std::atomic<bool> receive_failing{false};
   LcmTransmitter transmitter("renumbered", log, counters, health, receive_failing);
   ASSERT_EQ(transmitter.open(url), std::nullopt);
-  ASSERT_EQ(transmitter.follow_with_filter(rx.fd), std::nullopt);
+  ASSERT_EQ(transmitter.follow_with_filter(rx.fd, LcmOwnDatagrams::cut), std::nullopt);
   Channel channel;
   channel.id = 1;
   channel.name = "RENUMBERED";

@@ -206,6 +206,42 @@ TEST_F(LcmAdapterTest, DatagramsTheKernelDropsForAFullBufferAreCounted) {
   adapter->stop();
 }
 
+// own_datagrams: drop with a real overflow at the same time: while the receive thread is held,
+// the segment sends 300 datagrams of its own (dropped by its filter) and a peer floods a buffer of
+// a few datagrams. The socket's drops are both; overflow_drops is exactly the flood's share, and
+// own_datagrams_dropped the 300.
+TEST_F(LcmAdapterTest, OwnDropsAndAFullBufferAreToldApart) {
+  const int port = 7725;
+  segment_.name = "lcm0";
+  segment_.type = SegmentType::lcm;
+  segment_.lcm.url = url_for(port) + "&recv_buf_size=2048";
+  ASSERT_EQ(segment_.lcm.own_datagrams, LcmOwnDatagrams::drop);
+  auto adapter = make_lcm_adapter(segment_, self_, logger_);
+  BlockingSink sink;
+  ASSERT_TRUE(adapter->configure(std::vector{binding(1, "FLOOD", HopRole::publisher, LcmEncoding::raw, 3),
+                                             binding(2, "MINE", HopRole::subscriber, LcmEncoding::raw, 4)})
+                  .ok);
+  ASSERT_TRUE(adapter->start(sink).ok);
+  Child first({peer(), "pub", "--url", url_for(port), "--channel", "FLOOD", "--raw", "--count", "1", "--size", "64"});
+  ASSERT_EQ(first.wait_exit(), std::optional<int>(0)) << first.stderr_text();
+  ASSERT_TRUE(sink.wait_events(1));  // the receive thread is held now
+  for (std::uint32_t k = 1; k <= 300; ++k) ASSERT_EQ(adapter->send(outbound(2, own_pattern(k, 32))), SendStatus::sent);
+  Child flood({peer(), "pub", "--url", url_for(port), "--channel", "FLOOD", "--raw", "--count", "500", "--size", "64"});
+  ASSERT_EQ(flood.wait_exit(), std::optional<int>(0)) << flood.stderr_text();
+  sink.release();
+  // A datagram queued after the drops carries their count: once one has been read, the segment's
+  // figure is the socket's drops less our 300.
+  std::uint64_t socket_drops = 0;
+  ASSERT_TRUE(poll_until([&] {
+    Child marker({peer(), "pub", "--url", url_for(port), "--channel", "FLOOD", "--raw", "--count", "1", "--size", "64"});
+    marker.wait_exit();
+    socket_drops = udp_socket_drops(port);
+    return socket_drops > 300 && adapter->statistics().overflow_drops == socket_drops - 300;
+  })) << "socket drops " << socket_drops << ", overflow_drops " << adapter->statistics().overflow_drops;
+  EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::optional<std::uint64_t>(300));
+  adapter->stop();
+}
+
 TEST_F(LcmAdapterTest, AMemqSegmentRunsWithNoSocketAndReceivesNothing) {
   segment_.name = "viz";
   segment_.type = SegmentType::lcm;

@@ -13,6 +13,8 @@
 //                   datagrams; configure() and stop() take it exclusively only to swap the table
 //                   or the sink, never around I/O.
 //   transmit_       the per-class transmit sockets, each under its own mutex (lcm_transmit.hpp).
+//   own_count_mutex_ the own_datagrams_dropped bookkeeping: statistics() from any thread, start()
+//                   and stop() write it; never taken on the forwarding path.
 // Our own datagrams loop back to the receive socket (multicast loopback stays on so programs on
 // this host hear the gateway). A socket filter picks them out in the kernel by their source, the
 // address and port of one of our connected transmit sockets, and drops them (own_datagrams: drop,
@@ -121,10 +123,10 @@ class LcmAdapter final : public SegmentAdapter {
       ::close(rx.fd);
       return fail_start(*why);
     }
-    own_dropped_ = segment_.lcm.own_datagrams == LcmOwnDatagrams::drop;
+    bool own_dropped = segment_.lcm.own_datagrams == LcmOwnDatagrams::drop;
     if (const auto why = transmit_.follow_with_filter(rx.fd, segment_.lcm.own_datagrams)) {
       rx.warnings.push_back("own datagrams are read back in full and skipped here (" + *why + ")");
-      own_dropped_ = false;
+      own_dropped = false;
     }
     for (const auto& warning : rx.warnings) log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + warning);
     stop_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
@@ -137,6 +139,7 @@ class LcmAdapter final : public SegmentAdapter {
     rx_fd_ = rx.fd;
     rx_url_ = url;
     member_ = true;  // open_receive_socket() joined the group
+    may_leave_ = rx.sees_own_groups_only;
     bool receives = false;
     {
       SharedLock table(table_mutex_);
@@ -144,8 +147,8 @@ class LcmAdapter final : public SegmentAdapter {
     }
     if (!receives) leave_group();
     receive_failing_.store(false, std::memory_order_relaxed);
-    kernel_drops_seen_ = 0;  // a new socket counts from 0; its thread starts below
-    kernel_drops_total_ = 0;
+    overflow_seen_ = 0;  // a new socket and transmitter count from 0; its thread starts below
+    overflow_total_ = 0;
     overflow_reported_ = 0;
     attach_sink(&sink);
     running_.store(true, std::memory_order_release);
@@ -161,7 +164,7 @@ class LcmAdapter final : public SegmentAdapter {
       ::close(std::exchange(rx_fd_, -1));
       return fail_start(std::string("cannot start the LCM receive thread: ") + e.what());
     }
-    count_own_drops(own_dropped_);
+    count_own_drops(own_dropped);
     started_ = true;
     set_health(SegmentHealth::up, "");
     log_.log(LogLevel::info, "LCM segment " + segment_.name + " up on " + segment_.lcm.url);
@@ -265,7 +268,7 @@ class LcmAdapter final : public SegmentAdapter {
     AdapterStatistics s = counters_.snapshot();
     LockGuard lock(own_count_mutex_);
     if (own_counting_ || own_dropped_before_ > 0)
-      s.own_datagrams_dropped = own_dropped_before_ + (own_counting_ ? transmit_.datagrams_looped_back() : 0);
+      s.own_datagrams_dropped = own_dropped_before_ + (own_counting_ ? transmit_.own_drops() : 0);
     return s;
   }
 
@@ -311,7 +314,9 @@ class LcmAdapter final : public SegmentAdapter {
   }
 
   void leave_group() COSMIC_REQUIRES(control_mutex_) {
-    if (!member_) return;
+    // A socket that receives every group of the host (IP_MULTICAST_ALL could not be turned off)
+    // would go on receiving ours while any other program is a member: it stays a member.
+    if (!member_ || !may_leave_) return;
     if (const auto why = lcm_detail::set_group_membership(rx_fd_, *rx_url_, false)) {
       log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": stays a member of the group (" + *why + ")");
       return;
@@ -326,13 +331,13 @@ class LcmAdapter final : public SegmentAdapter {
   // transmitter counts from 0 again with every start; what earlier sockets sent is kept here.
   void count_own_drops(bool from_now_on) {
     LockGuard lock(own_count_mutex_);
-    if (own_counting_) own_dropped_before_ += transmit_.datagrams_looped_back();
+    if (own_counting_) own_dropped_before_ += transmit_.own_drops();
     own_counting_ = from_now_on;
     if (from_now_on)
       log_.log(LogLevel::notice, "LCM segment " + segment_.name +
-                                     ": its own datagrams that loop back are dropped by its receive filter "
-                                     "(own_datagrams: drop); each counts once in the host's UDP InErrors and none in "
-                                     "RcvbufErrors; cosmicctl segments --json reports them as own_datagrams_dropped");
+                                     ": while a channel is received here, its own datagrams loop back and its receive filter "
+                                     "drops them (own_datagrams: drop); each counts once in the host's UDP InErrors and "
+                                     "none in RcvbufErrors; cosmicctl segments --json reports them as own_datagrams_dropped");
   }
 
   const Channel* transmitting(ChannelId id) const COSMIC_REQUIRES_SHARED(table_mutex_) {
@@ -416,21 +421,23 @@ class LcmAdapter final : public SegmentAdapter {
     log_.log(LogLevel::error, "LCM segment " + segment_.name + ": " + what);
   }
 
-  // The socket's drop count is cumulative and starts again with every socket: the segment's
-  // counter adds what it rose by. With the drop filter, every datagram we sent that looped back
-  // is one of those drops and no overflow: they are taken out by the count of datagrams sent,
-  // which was raised before each send and is read after the drop count, so the difference never
-  // exceeds the true overflow; the counter only rises to it.
+  // The socket's drop count is cumulative, 32 bits wide, and starts again with every socket; so
+  // does the transmitter's count of our own datagrams the filter drops (own_drops(), raised before
+  // each send and read after the drop count, so never short of the own drops in it). Their
+  // difference modulo 2^32 is the overflow as far as this datagram knows, never more than the true
+  // one; it is followed step by step (each step signed, far below 2^31 between two datagrams), so
+  // neither counter's wrap is lost however many of our own were dropped meanwhile. The segment's
+  // counter only rises to it.
   void note_kernel_drops(const lcm_detail::ReceiveBatch& batch) {
     const auto drops = batch.kernel_drops();
     if (!drops) return;
-    kernel_drops_total_ += static_cast<std::uint32_t>(*drops - kernel_drops_seen_);  // modulo 2^32, as the kernel counts
-    kernel_drops_seen_ = *drops;
-    const std::uint64_t own = own_dropped_ ? transmit_.datagrams_looped_back() : 0;
-    const std::uint64_t overflow = kernel_drops_total_ > own ? kernel_drops_total_ - own : 0;
-    if (overflow <= overflow_reported_) return;
-    counters_.overflow_drops.fetch_add(overflow - overflow_reported_, std::memory_order_relaxed);
-    overflow_reported_ = overflow;
+    const auto overflow_now = static_cast<std::uint32_t>(*drops - static_cast<std::uint32_t>(transmit_.own_drops()));
+    overflow_total_ += static_cast<std::int32_t>(overflow_now - overflow_seen_);
+    overflow_seen_ = overflow_now;
+    if (overflow_total_ <= overflow_reported_) return;
+    counters_.overflow_drops.fetch_add(static_cast<std::uint64_t>(overflow_total_ - overflow_reported_),
+                                       std::memory_order_relaxed);
+    overflow_reported_ = overflow_total_;
   }
 
   // Receive thread only.
@@ -444,7 +451,7 @@ class LcmAdapter final : public SegmentAdapter {
     if (sink_ == nullptr) return;
     for (std::size_t i = 0; i < count; ++i) {
       const Endpoint from = batch.sender(i);
-      if (transmit_.is_own(from)) continue;  // ours, looped back (emptied by the socket filter)
+      if (transmit_.is_own(from)) continue;  // ours, looped back (emptied by a cutting filter, or none attached)
       const auto parsed = batch.truncated(i) ? std::nullopt : parse_lcm_datagram(batch.datagram(i));
       if (!parsed) {
         counters_.receive_errors.fetch_add(1, std::memory_order_relaxed);  // not LCM's, or damaged
@@ -545,6 +552,7 @@ class LcmAdapter final : public SegmentAdapter {
   int stop_fd_ COSMIC_GUARDED_BY(control_mutex_) = -1;  // eventfd: stop() wakes the receive loop
   std::optional<LcmUrl> rx_url_ COSMIC_GUARDED_BY(control_mutex_);
   bool member_ COSMIC_GUARDED_BY(control_mutex_) = false;  // rx_fd_ is a member of the group
+  bool may_leave_ COSMIC_GUARDED_BY(control_mutex_) = false;  // leaving stops all of the group's datagrams
   std::atomic<bool> running_{false};
   // memq://: set by start() before the sink is attached, cleared by stop() after it is detached.
   std::atomic<bool> memq_{false};
@@ -557,10 +565,9 @@ class LcmAdapter final : public SegmentAdapter {
   lcm_detail::LcmTransmitter transmit_;
   // Receive thread only.
   LcmReassembler reassembler_;
-  std::uint32_t kernel_drops_seen_ = 0;  // the socket's drop count at its last report
-  std::uint64_t kernel_drops_total_ = 0;  // ... summed without wrapping (receive thread)
-  std::uint64_t overflow_reported_ = 0;   // what overflow_drops got from this socket so far
-  bool own_dropped_ = false;  // the filter drops our own datagrams (set by start(), before the thread)
+  std::uint32_t overflow_seen_ = 0;    // drops less own drops, modulo 2^32, at the last report
+  std::int64_t overflow_total_ = 0;    // ... followed without wrapping
+  std::int64_t overflow_reported_ = 0;  // what overflow_drops got from this socket so far
 
   mutable Mutex own_count_mutex_;  // statistics() from any thread; start()/stop() write
   bool own_counting_ COSMIC_GUARDED_BY(own_count_mutex_) = false;

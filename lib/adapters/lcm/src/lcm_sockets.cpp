@@ -73,7 +73,10 @@ OpenedSocket open_receive_socket(const LcmUrl& url, std::size_t buffer_bytes) {
     return failed(std::move(out), fd, errno_text(("bind to port " + std::to_string(url.port)).c_str()));
   if (auto why = set_group_membership(fd, url, true)) return failed(std::move(out), fd, std::move(*why));
   // Without this, Linux hands the socket every group any socket of the host joined on this port.
-  if (set_int(fd, IPPROTO_IP, IP_MULTICAST_ALL, 0) != 0) out.warnings.push_back(errno_text("IP_MULTICAST_ALL"));
+  if (set_int(fd, IPPROTO_IP, IP_MULTICAST_ALL, 0) != 0)
+    out.warnings.push_back(errno_text("IP_MULTICAST_ALL"));
+  else
+    out.sees_own_groups_only = true;
   if (set_int(fd, SOL_SOCKET, SO_TIMESTAMPNS, 1) != 0)
     out.warnings.push_back(errno_text("SO_TIMESTAMPNS (residence then starts when the datagram is read)"));
   if (set_int(fd, SOL_SOCKET, SO_RXQ_OVFL, 1) != 0) out.warnings.push_back(errno_text("SO_RXQ_OVFL (drops not counted)"));
@@ -117,9 +120,9 @@ OpenedSocket open_send_socket(const LcmUrl& url) {
 // Classic BPF over a UDP socket's datagram: the filter runs with the UDP header at offset 0 and
 // the IP header at SKF_NET_OFF. Per own endpoint: source address, then source port; a match keeps
 // the UDP header alone (the kernel trims to at least that), or nothing (dropped); anything else
-// is accepted whole. A dropped datagram counts in the socket's drops (SO_RXQ_OVFL) and in the
-// host's UDP InErrors, which is why cutting is the default; dropping spares the receive thread a
-// wake-up and a read per datagram sent.
+// is accepted whole. Dropping (the default) spares the receive thread a wake-up and a read per
+// datagram sent; a dropped datagram counts in the socket's drops (SO_RXQ_OVFL) and in the host's
+// UDP InErrors, which cutting leaves alone.
 std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> own, LcmOwnDatagrams mode) {
   constexpr std::uint32_t kSourceAddress = static_cast<std::uint32_t>(SKF_NET_OFF) + 12;
   constexpr std::uint32_t kSourcePort = 0;

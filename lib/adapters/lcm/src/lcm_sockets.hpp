@@ -42,6 +42,8 @@ struct OpenedSocket {
   Endpoint local;  // transmit sockets: the source every datagram of theirs carries
   std::string error;
   std::vector<std::string> warnings;
+  // Receive sockets: IP_MULTICAST_ALL is off, so the socket gets only the groups it joined itself.
+  bool sees_own_groups_only = false;
 };
 
 // Bound to the group's address and port (shared with other LCM programs on this host,
@@ -68,8 +70,7 @@ std::optional<std::string> set_group_membership(int fd, const LcmUrl& url, bool 
 // copied, or with `mode` drop drops it before it is queued. Replaces a filter attached before.
 // nullopt when attached; otherwise why not. Either way the receive thread still tells them by
 // their source.
-std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> own,
-                                              LcmOwnDatagrams mode = LcmOwnDatagrams::cut);
+std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> own, LcmOwnDatagrams mode);
 
 // liblcm's start-up check, as it makes it: a message on LCM_SELF_TEST sent from a socket of its
 // own must come back to receive socket `fd` within `timeout`. Whatever else arrives meanwhile is

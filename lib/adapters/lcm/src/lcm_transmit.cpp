@@ -57,7 +57,7 @@ LcmTransmitter::LcmTransmitter(std::string segment_name, Logger& log, AdapterCou
 
 std::optional<std::string> LcmTransmitter::open(const LcmUrl& url) {
   url_ = url;
-  looped_back_.store(0, std::memory_order_release);
+  own_drops_.store(0, std::memory_order_release);
   counting_looped_back_.store(true, std::memory_order_release);
   for (std::size_t i = 0; i < senders_.size(); ++i) {
     OpenedSocket tx = open_send_socket(url);
@@ -90,13 +90,25 @@ std::optional<std::string> LcmTransmitter::attach_filter() {
   for (const auto& key : own_keys_)
     if (const std::uint64_t k = key.load(std::memory_order_relaxed); k != 0) own[count++] = endpoint_of(k);
   if (count == 0) return std::nullopt;
-  return drop_own_datagrams(receive_fd_, std::span(own.data(), count), filter_mode_);
+  auto why = drop_own_datagrams(receive_fd_, std::span(own.data(), count), filter_mode_);
+  // A filter that could not follow leaves the new source's datagrams to be read and skipped.
+  filter_drops_.store(!why && filter_mode_ == LcmOwnDatagrams::drop, std::memory_order_release);
+  return why;
+}
+
+void LcmTransmitter::count_looped_back(bool counting) {
+  counting_looped_back_.store(counting, std::memory_order_release);
+  if (!counting) return;
+  // A lane that read the flag before it was set may still be inside its send: wait for it (each
+  // send holds its sender's mutex), so nothing it sends after the join goes uncounted.
+  for (auto& sender : senders_) LockGuard wait_for_send(sender.mutex);
 }
 
 void LcmTransmitter::close() {
   {
     LockGuard lock(filter_mutex_);
     receive_fd_ = -1;
+    filter_drops_.store(false, std::memory_order_release);
   }
   for (std::size_t i = 0; i < senders_.size(); ++i) {
     LockGuard lock(senders_[i].mutex);  // waits for a send in flight
@@ -159,7 +171,8 @@ void LcmTransmitter::send_batch(std::span<const OutboundEvent> events, std::span
 }
 
 void LcmTransmitter::note_sending(std::size_t datagrams) {
-  if (counting_looped_back_.load(std::memory_order_acquire)) looped_back_.fetch_add(datagrams, std::memory_order_release);
+  if (counting_looped_back_.load(std::memory_order_acquire) && filter_drops_.load(std::memory_order_acquire))
+    own_drops_.fetch_add(datagrams, std::memory_order_release);
 }
 
 SendStatus LcmTransmitter::send_one(ClassSender& sender, const Channel& channel, const OutboundEvent& event) {

@@ -40,16 +40,17 @@ class LcmTransmitter {
   std::optional<std::string> open(const LcmUrl& url);
   // The receive socket whose filter follows our sources (-1: none), cutting or dropping what
   // they send (`mode`); attaches it now. The reason when the filter cannot be attached.
-  std::optional<std::string> follow_with_filter(int receive_fd, LcmOwnDatagrams mode = LcmOwnDatagrams::cut);
+  std::optional<std::string> follow_with_filter(int receive_fd, LcmOwnDatagrams mode);
   // Datagrams our transmit sockets handed the kernel since open() while the receive socket was a
-  // member of the group, so each looped back to it: counted before each send (never fewer than
-  // have looped back; a failed send's stay counted). With the drop filter each one is a drop of
-  // the receive socket's: the segment's overflow count leaves them out. Any thread.
-  std::uint64_t datagrams_looped_back() const { return looped_back_.load(std::memory_order_acquire); }
+  // member of the group and its filter dropped our own: each is one drop of that socket's (the
+  // segment's own_datagrams_dropped; its overflow count leaves them out). Counted before each
+  // send, so never fewer than the kernel dropped (a failed send's stay counted). Any thread.
+  std::uint64_t own_drops() const { return own_drops_.load(std::memory_order_acquire); }
   // Whether what is sent from now on loops back to the receive socket (it is a member of the
-  // group; open() starts counting). The control thread calls it before joining and after leaving,
-  // so the count never falls short of what looped back.
-  void count_looped_back(bool counting) { counting_looped_back_.store(counting, std::memory_order_release); }
+  // group; open() starts counting). The control thread calls it before joining, and it returns
+  // once no send that missed it is still in flight, and after leaving, so the count never falls
+  // short of what the kernel dropped.
+  void count_looped_back(bool counting);
   void close();
 
   // True when `from` is one of our transmit sockets (looped back to us).
@@ -84,7 +85,7 @@ class LcmTransmitter {
   SendStatus failed(ClassSender& sender, const Channel& channel, SendFailure why) COSMIC_REQUIRES(sender.mutex);
   void reopen(ClassSender& sender, std::size_t index) COSMIC_REQUIRES(sender.mutex);
   std::optional<std::string> attach_filter();
-  // Before `datagrams` leave: counted as looping back while the receive socket is a member.
+  // Before `datagrams` leave: counted while they loop back to a filter that drops them.
   void note_sending(std::size_t datagrams);
 
   const std::string segment_name_;
@@ -100,9 +101,10 @@ class LcmTransmitter {
   std::array<std::atomic<std::uint64_t>, 3> own_keys_{};
   Mutex filter_mutex_;  // one filter (re)attachment at a time
   int receive_fd_ COSMIC_GUARDED_BY(filter_mutex_) = -1;
-  LcmOwnDatagrams filter_mode_ COSMIC_GUARDED_BY(filter_mutex_) = LcmOwnDatagrams::cut;
-  std::atomic<std::uint64_t> looped_back_{0};
+  LcmOwnDatagrams filter_mode_ COSMIC_GUARDED_BY(filter_mutex_) = LcmOwnDatagrams::drop;
+  std::atomic<std::uint64_t> own_drops_{0};
   std::atomic<bool> counting_looped_back_{true};
+  std::atomic<bool> filter_drops_{false};  // the attached filter drops our own (attach_filter)
 };
 
 }  // namespace cosmic::lcm_detail
