@@ -176,6 +176,12 @@ class BlockingSink final : public EventSink {
   bool released_ = false;
 };
 
+// `count` raw 64-byte messages on FLOOD from a peer; its exit status once it is done.
+std::optional<int> publish_flood(int port, int count) {
+  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "FLOOD", "--raw", "--count", std::to_string(count), "--size", "64"});
+  return pub.wait_exit();
+}
+
 TEST_F(LcmAdapterTest, DatagramsTheKernelDropsForAFullBufferAreCounted) {
   const int port = 7722;
   segment_.name = "lcm0";
@@ -186,17 +192,14 @@ TEST_F(LcmAdapterTest, DatagramsTheKernelDropsForAFullBufferAreCounted) {
   BlockingSink sink;
   ASSERT_TRUE(adapter->configure(std::vector{binding(1, "FLOOD", HopRole::publisher, LcmEncoding::raw, 3)}).ok);
   ASSERT_TRUE(adapter->start(sink).ok);
-  Child first({peer(), "pub", "--url", url_for(port), "--channel", "FLOOD", "--raw", "--count", "1", "--size", "64"});
-  ASSERT_EQ(first.wait_exit(), std::optional<int>(0)) << first.stderr_text();
+  ASSERT_EQ(publish_flood(port, 1), std::optional<int>(0));
   ASSERT_TRUE(sink.wait_events(1));  // the receive thread is held now
-  Child flood({peer(), "pub", "--url", url_for(port), "--channel", "FLOOD", "--raw", "--count", "500", "--size", "64"});
-  ASSERT_EQ(flood.wait_exit(), std::optional<int>(0)) << flood.stderr_text();
+  ASSERT_EQ(publish_flood(port, 500), std::optional<int>(0));
   sink.release();
   // A datagram queued after the drops carries their count (SO_RXQ_OVFL).
   std::uint64_t drops = 0;
   ASSERT_TRUE(poll_until([&] {
-    Child marker({peer(), "pub", "--url", url_for(port), "--channel", "FLOOD", "--raw", "--count", "1", "--size", "64"});
-    marker.wait_exit();
+    publish_flood(port, 1);
     drops = adapter->statistics().overflow_drops;
     return drops > 0;
   })) << "no drop counted; received " << adapter->statistics().received;
@@ -222,19 +225,16 @@ TEST_F(LcmAdapterTest, OwnDropsAndAFullBufferAreToldApart) {
                                              binding(2, "MINE", HopRole::subscriber, LcmEncoding::raw, 4)})
                   .ok);
   ASSERT_TRUE(adapter->start(sink).ok);
-  Child first({peer(), "pub", "--url", url_for(port), "--channel", "FLOOD", "--raw", "--count", "1", "--size", "64"});
-  ASSERT_EQ(first.wait_exit(), std::optional<int>(0)) << first.stderr_text();
+  ASSERT_EQ(publish_flood(port, 1), std::optional<int>(0));
   ASSERT_TRUE(sink.wait_events(1));  // the receive thread is held now
   for (std::uint32_t k = 1; k <= 300; ++k) ASSERT_EQ(adapter->send(outbound(2, own_pattern(k, 32))), SendStatus::sent);
-  Child flood({peer(), "pub", "--url", url_for(port), "--channel", "FLOOD", "--raw", "--count", "500", "--size", "64"});
-  ASSERT_EQ(flood.wait_exit(), std::optional<int>(0)) << flood.stderr_text();
+  ASSERT_EQ(publish_flood(port, 500), std::optional<int>(0));
   sink.release();
   // A datagram queued after the drops carries their count: once one has been read, the segment's
   // figure is the socket's drops less our 300.
   std::uint64_t socket_drops = 0;
   ASSERT_TRUE(poll_until([&] {
-    Child marker({peer(), "pub", "--url", url_for(port), "--channel", "FLOOD", "--raw", "--count", "1", "--size", "64"});
-    marker.wait_exit();
+    publish_flood(port, 1);
     socket_drops = udp_socket_drops(port);
     return socket_drops > 300 && adapter->statistics().overflow_drops == socket_drops - 300;
   })) << "socket drops " << socket_drops << ", overflow_drops " << adapter->statistics().overflow_drops;
