@@ -1,6 +1,7 @@
 // The LCM transmit side (lcm_transmit.hpp) when the address its sockets send from goes away: the
 // interface is renumbered under it, the next send fails, the socket is reopened on the new
 // address and the datagrams carry that source from then on, which the receive filter follows.
+// And its count of our own datagrams the receive filter drops.
 // The network is a veth pair in this test's own namespace (scripts/netns-run); the kernel here
 // has no dummy device.
 #include <arpa/inet.h>
@@ -154,6 +155,56 @@ TEST(LcmTransmitReopen, ASocketWhoseAddressWentAwayIsReopenedOnTheNewOne) {
   ::close(member);
   ::close(rx.fd);
   EXPECT_EQ(shell("ip link del cosmic0"), 0);
+}
+
+// own_drops() counts what the receive socket's filter drops of ours: nothing while no filter
+// could be attached or it only cuts, nothing while the receive socket is no member of the group.
+TEST(LcmTransmitOwnDrops, CountedOnlyWhileAFilterDropsThemAndTheSocketIsAMember) {
+  const auto parsed = parse_lcm_url("udpm://239.255.76.67:7714?ttl=0");
+  ASSERT_TRUE(std::holds_alternative<LcmUrl>(parsed));
+  const LcmUrl url = std::get<LcmUrl>(parsed);
+  const OpenedSocket rx = open_receive_socket(url, 1 << 20);
+  ASSERT_GE(rx.fd, 0) << rx.error;
+  LinesLogger log;
+  AdapterCounters counters;
+  HealthCell health;
+  std::atomic<bool> receive_failing{false};
+  LcmTransmitter transmitter("own", log, counters, health, receive_failing);
+  ASSERT_EQ(transmitter.open(url), std::nullopt);
+  Channel channel;
+  channel.id = 1;
+  channel.name = "OWN";
+  channel.encoding = LcmEncoding::raw;
+  channel.tx = true;
+  const std::vector<std::uint8_t> payload(16, 0x5a);
+  OutboundEvent event;
+  event.channel = 1;
+  event.payload = payload;
+  auto send = [&](int n) {
+    for (int i = 0; i < n; ++i) ASSERT_EQ(transmitter.send(channel, event), SendStatus::sent);
+  };
+
+  int pipe_fds[2];
+  ASSERT_EQ(::pipe(pipe_fds), 0);
+  EXPECT_TRUE(transmitter.follow_with_filter(pipe_fds[0], LcmOwnDatagrams::drop).has_value());  // no socket
+  send(2);
+  EXPECT_EQ(transmitter.own_drops(), 0u);
+  ASSERT_EQ(transmitter.follow_with_filter(rx.fd, LcmOwnDatagrams::drop), std::nullopt);
+  send(3);
+  EXPECT_EQ(transmitter.own_drops(), 3u);
+  transmitter.count_looped_back(false);  // the receive socket left the group
+  send(2);
+  EXPECT_EQ(transmitter.own_drops(), 3u);
+  transmitter.count_looped_back(true);
+  send(1);
+  EXPECT_EQ(transmitter.own_drops(), 4u);
+  ASSERT_EQ(transmitter.follow_with_filter(rx.fd, LcmOwnDatagrams::cut), std::nullopt);
+  send(1);
+  EXPECT_EQ(transmitter.own_drops(), 4u);
+  transmitter.close();
+  ::close(pipe_fds[0]);
+  ::close(pipe_fds[1]);
+  ::close(rx.fd);
 }
 
 }  // namespace
