@@ -50,6 +50,28 @@ class LinesLogger final : public Logger {
 
 int shell(const std::string& command) { return std::system((command + " 2>&1").c_str()); }
 
+// A transmitter with what it reports to, and one raw 16-byte event of channel 1 (`name`) to send.
+struct TransmitRig {
+  explicit TransmitRig(const std::string& name) : transmitter(name, log, counters, health, receive_failing) {
+    channel.id = 1;
+    channel.name = name;
+    channel.encoding = LcmEncoding::raw;
+    channel.tx = true;
+    event.channel = 1;
+    event.payload = payload;
+  }
+  SendStatus send() { return transmitter.send(channel, event); }
+
+  LinesLogger log;
+  AdapterCounters counters;
+  HealthCell health;
+  std::atomic<bool> receive_failing{false};
+  LcmTransmitter transmitter;
+  Channel channel;
+  const std::vector<std::uint8_t> payload = std::vector<std::uint8_t>(16, 0x5a);
+  OutboundEvent event;
+};
+
 // A member of the group on `interface` (by index, which renumbering keeps), bound to its port.
 int group_member(const LcmUrl& url, const char* interface) {
   const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
@@ -95,24 +117,12 @@ TEST(LcmTransmitReopen, ASocketWhoseAddressWentAwayIsReopenedOnTheNewOne) {
   const OpenedSocket rx = open_receive_socket(url, 1 << 20);
   ASSERT_GE(rx.fd, 0) << rx.error;
 
-  LinesLogger log;
-  AdapterCounters counters;
-  HealthCell health;
-  std::atomic<bool> receive_failing{false};
-  LcmTransmitter transmitter("renumbered", log, counters, health, receive_failing);
+  TransmitRig rig("RENUMBERED");
+  LcmTransmitter& transmitter = rig.transmitter;
   ASSERT_EQ(transmitter.open(url), std::nullopt);
   ASSERT_EQ(transmitter.follow_with_filter(rx.fd, LcmOwnDatagrams::cut), std::nullopt);
-  Channel channel;
-  channel.id = 1;
-  channel.name = "RENUMBERED";
-  channel.encoding = LcmEncoding::raw;
-  channel.tx = true;
-  const std::vector<std::uint8_t> payload(16, 0x5a);
-  OutboundEvent event;
-  event.channel = 1;
-  event.payload = payload;
 
-  ASSERT_EQ(transmitter.send(channel, event), SendStatus::sent);
+  ASSERT_EQ(rig.send(), SendStatus::sent);
   const auto first = next_source(member, std::chrono::milliseconds(5000));
   ASSERT_TRUE(first.has_value());
   EXPECT_EQ(first->address, kFirstAddress);
@@ -127,17 +137,17 @@ TEST(LcmTransmitReopen, ASocketWhoseAddressWentAwayIsReopenedOnTheNewOne) {
   std::optional<Endpoint> after;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(15);
   while (!after && std::chrono::steady_clock::now() < deadline) {
-    if (transmitter.send(channel, event) == SendStatus::sent) after = next_source(member, std::chrono::milliseconds(1000));
+    if (rig.send() == SendStatus::sent) after = next_source(member, std::chrono::milliseconds(1000));
     if (!after) std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   ASSERT_TRUE(after.has_value()) << "no datagram from a reopened socket";
   EXPECT_EQ(after->address, kSecondAddress);
   EXPECT_TRUE(transmitter.is_own(*after));     // the receive side knows the new source as ours
   EXPECT_FALSE(transmitter.is_own(*first));    // and the old one no longer
-  EXPECT_GE(counters.send_errors.load(), 1u);  // the send that met the missing address
-  EXPECT_TRUE(log.has("transmit socket reopened"));
+  EXPECT_GE(rig.counters.send_errors.load(), 1u);  // the send that met the missing address
+  EXPECT_TRUE(rig.log.has("transmit socket reopened"));
   // The receive socket's filter now cuts what the new source sends: its datagrams arrive empty.
-  ASSERT_EQ(transmitter.send(channel, event), SendStatus::sent);
+  ASSERT_EQ(rig.send(), SendStatus::sent);
   std::optional<std::size_t> echo_size;
   ReceiveBatch batch(8);
   const auto echo_deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
@@ -165,23 +175,11 @@ TEST(LcmTransmitOwnDrops, CountedOnlyWhileAFilterDropsThemAndTheSocketIsAMember)
   const LcmUrl url = std::get<LcmUrl>(parsed);
   const OpenedSocket rx = open_receive_socket(url, 1 << 20);
   ASSERT_GE(rx.fd, 0) << rx.error;
-  LinesLogger log;
-  AdapterCounters counters;
-  HealthCell health;
-  std::atomic<bool> receive_failing{false};
-  LcmTransmitter transmitter("own", log, counters, health, receive_failing);
+  TransmitRig rig("OWN");
+  LcmTransmitter& transmitter = rig.transmitter;
   ASSERT_EQ(transmitter.open(url), std::nullopt);
-  Channel channel;
-  channel.id = 1;
-  channel.name = "OWN";
-  channel.encoding = LcmEncoding::raw;
-  channel.tx = true;
-  const std::vector<std::uint8_t> payload(16, 0x5a);
-  OutboundEvent event;
-  event.channel = 1;
-  event.payload = payload;
   auto send = [&](int n) {
-    for (int i = 0; i < n; ++i) ASSERT_EQ(transmitter.send(channel, event), SendStatus::sent);
+    for (int i = 0; i < n; ++i) ASSERT_EQ(rig.send(), SendStatus::sent);
   };
 
   int pipe_fds[2];
