@@ -115,6 +115,16 @@ void print_segments(const Json& r) {
     }
     if (s.value("unexplained_others", 0) > 0) std::cout << "  (and " << text(s["unexplained_others"]) << " frames of further identifiers)\n";
   }
+  // LCM own_datagrams: drop: what the host's UDP InErrors counts of cosmicd's own sends.
+  bool first_note = true;
+  for (const auto& s : r["segments"]) {
+    const Json& own = s["adapter"].value("own_datagrams_dropped", Json());
+    if (!own.is_number_unsigned() || own.get<std::uint64_t>() == 0) continue;
+    if (std::exchange(first_note, false)) std::cout << "\n";
+    std::cout << text(s["name"]) << ": " << text(own)
+              << " own datagrams dropped by its receive filter (each also counted in the host's UDP InErrors; "
+                 "own_datagrams: cut avoids it)\n";
+  }
 }
 
 // Seconds as a short age: "0.4s ago", "12s ago".

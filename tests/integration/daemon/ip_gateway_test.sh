@@ -208,6 +208,28 @@ YAML
   passed
 }
 
+# own_datagrams: drop (the default): gw-a's lcm-a receives a channel, so it is a member of the
+# group and its filter drops what it sends looped back, one per message, which cosmicctl reports;
+# gw-b's lcm-b only sends, so it left the group and gets none of its own back.
+test_own_datagrams_are_counted() {
+  scenario "own LCM datagrams dropped by the filter are counted, none on a segment that only sends"
+  local before
+  before=$(segment_adapter_field a lcm-a sent)
+  publish_dds_to_a steady --count 200 --size 32 --rate 1000 || return
+  wait_until 10 "200 more sent on lcm-a" segment_field_at_least a lcm-a sent $((before + 200)) || return
+  local sent own
+  sent=$(segment_adapter_field a lcm-a sent)
+  own=$(segment_adapter_field a lcm-a own_datagrams_dropped)
+  [ "$own" = "$sent" ] || fail "gw-a lcm-a: own_datagrams_dropped $own, sent $sent"
+  ctl a segments | grep -q "^lcm-a: $own own datagrams dropped by its receive filter" ||
+    fail "cosmicctl segments (text) does not name them: $(ctl a segments)"
+  [ "$(segment_adapter_field b lcm-b sent)" -gt 0 ] || fail "gw-b sent nothing on lcm-b"
+  own=$(segment_adapter_field b lcm-b own_datagrams_dropped)
+  [ "$own" = 0 ] || fail "gw-b lcm-b, which only sends, had $own of its own back"
+  ctl b segments | grep -q "own datagrams dropped" && fail "gw-b's text names own drops it does not have"
+  passed
+}
+
 test_reload_of_broken_file_keeps_running_configuration() {
   scenario "reload of a broken file keeps the running configuration"
   cp "$WORK/a.yaml" "$WORK/a.good"
@@ -293,7 +315,7 @@ start_daemon b "$WORK/b.yaml" || exit 1
 
 scenarios=("$@")
 [ ${#scenarios[@]} -gt 0 ] || scenarios=(raw_lcm_across_dds cross_connected_gateways three_gateways_in_a_ring expired_events_are_dropped
-  rate_limit_holds bind_unbind_while_traffic_flows hrt_bind_over_lcm_is_rejected
+  rate_limit_holds bind_unbind_while_traffic_flows own_datagrams_are_counted hrt_bind_over_lcm_is_rejected
   incompatible_peer_is_a_visible_mismatch reload_of_broken_file_keeps_running_configuration)
 for s in "${scenarios[@]}"; do
   "test_$s"

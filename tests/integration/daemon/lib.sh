@@ -66,6 +66,16 @@ print(-1)' "$2" "$3" "$4"
 }
 
 # field_at_least NAME CHANNEL SEGMENT FIELD MIN
+# segment_adapter_field GW SEGMENT FIELD: an adapter counter of a segment (cosmicctl segments --json).
+segment_adapter_field() {
+  ctl "$1" --json segments | python3 -c '
+import json, sys
+for s in json.load(sys.stdin)["segments"]:
+    if s["name"] == sys.argv[1]:
+        print(s["adapter"][sys.argv[2]])' "$2" "$3"
+}
+segment_field_at_least() { [ "$(segment_adapter_field "$1" "$2" "$3")" -ge "$4" ]; }
+
 field_at_least() { [ "$(channel_field "$1" "$2" "$3" "$4")" -ge "$5" ]; }
 # field_equals NAME CHANNEL SEGMENT FIELD VALUE
 field_equals() { [ "$(channel_field "$1" "$2" "$3" "$4")" -eq "$5" ]; }
