@@ -398,11 +398,35 @@ TEST(LatencyHistogramTest, QuantilesBracketTheRecordedValues) {
   LatencyHistogram h;
   for (int i = 1; i <= 100; ++i) h.record(Nanos(i * 1000));
   EXPECT_EQ(h.count(), 100u);
-  // Buckets are 4 per power of two: at most 25 % above the true value.
+  // Buckets are 8 per power of two: at most 12.5 % above the true value.
   EXPECT_GE(h.quantile(0.5).count(), 50'000);
-  EXPECT_LE(h.quantile(0.5).count(), 62'500);
+  EXPECT_LE(h.quantile(0.5).count(), 56'250);
   EXPECT_GE(h.quantile(0.99).count(), 99'000);
   EXPECT_EQ(h.max().count(), 100'000);
+}
+
+// Every value lands in the one bucket whose bounds hold it, the buckets tile the range without a
+// gap, and a bucket is at most 1/8 of its lower bound wide.
+TEST(LatencyHistogramTest, BucketsTileTheRangeEightPerPowerOfTwo) {
+  std::uint64_t previous_upper = 0;
+  for (std::size_t b = 1; b + 1 < LatencyHistogram::kBuckets; ++b) {
+    const std::uint64_t upper = LatencyHistogram::upper_bound_of(b);
+    ASSERT_GT(upper, previous_upper) << "bucket " << b;
+    const std::uint64_t lower = previous_upper + 1;
+    EXPECT_LE(upper - lower + 1, std::max<std::uint64_t>(1, lower / 8)) << "bucket " << b;
+    LatencyHistogram h;
+    h.record(Nanos(static_cast<std::int64_t>(lower)));
+    h.record(Nanos(static_cast<std::int64_t>(upper)));
+    EXPECT_EQ(h.bucket_count(b), 2u) << "bucket " << b << " [" << lower << ", " << upper << "]";
+    previous_upper = upper;
+    if (upper > (std::uint64_t{1} << 40)) break;  // far beyond any residence
+  }
+  // 20.5 us and 23 us: one bucket at four per power of two, two at eight.
+  LatencyHistogram near_20us;
+  near_20us.record(Nanos(20'500));
+  near_20us.record(Nanos(23'000));
+  EXPECT_EQ(near_20us.quantile(0.0).count(), 22'527);
+  EXPECT_EQ(near_20us.quantile(1.0).count(), 23'000);
 }
 
 

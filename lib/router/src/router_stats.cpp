@@ -21,19 +21,21 @@ const char* to_string(DropReason reason) {
 
 const char* to_string(RuntimeState state) { return state == RuntimeState::violated ? "violated" : "bound"; }
 
+// Values below kSubBuckets have a bucket each; above, a power of two 2^e (e >= kSubBucketBits)
+// is split into kSubBuckets equal buckets by the kSubBucketBits bits after its leading one.
 std::size_t LatencyHistogram::bucket_of(std::uint64_t ns) {
-  if (ns < 4) return static_cast<std::size_t>(ns);
-  const unsigned exponent = 63u - static_cast<unsigned>(std::countl_zero(ns));  // >= 2
-  const std::uint64_t mantissa = (ns >> (exponent - 2)) & 0x3;
-  const std::size_t bucket = 4 * (exponent - 1) + mantissa;
+  if (ns < kSubBuckets) return static_cast<std::size_t>(ns);
+  const unsigned exponent = 63u - static_cast<unsigned>(std::countl_zero(ns));  // >= kSubBucketBits
+  const std::uint64_t mantissa = (ns >> (exponent - kSubBucketBits)) & (kSubBuckets - 1);
+  const std::size_t bucket = kSubBuckets * (exponent - kSubBucketBits + 1) + mantissa;
   return bucket < kBuckets ? bucket : kBuckets - 1;
 }
 
 std::uint64_t LatencyHistogram::upper_bound_of(std::size_t bucket) {
-  if (bucket < 4) return bucket;
-  const std::size_t exponent = bucket / 4 + 1;
-  const std::uint64_t mantissa = bucket % 4;
-  return ((4 + mantissa + 1) << (exponent - 2)) - 1;
+  if (bucket < kSubBuckets) return bucket;
+  const std::size_t exponent = bucket / kSubBuckets + kSubBucketBits - 1;
+  const std::uint64_t mantissa = bucket % kSubBuckets;
+  return ((kSubBuckets + mantissa + 1) << (exponent - kSubBucketBits)) - 1;
 }
 
 void LatencyHistogram::record(Nanos value) {
