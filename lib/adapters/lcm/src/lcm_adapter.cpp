@@ -203,31 +203,32 @@ class LcmAdapter final : public SegmentAdapter {
       if (b.role == HopRole::publisher) c.rx = true;
       if (b.role == HopRole::subscriber) c.tx = true;
     }
-    // The receive socket rejoins the group before a channel is received here again.
-    const bool receives = std::any_of(wanted.begin(), wanted.end(), [](const auto& c) { return c.second.rx; });
-    if (receives && started_ && rx_fd_ >= 0) {
-      if (const auto why = join_group()) {
-        for (const auto& [id, channel] : wanted)
-          if (channel.rx) {
-            refuse(id, channel.name, "cannot receive on this segment: " + *why);
-            refused_ids.insert(id);
-          }
-      }
-    }
     // A channel refused in one role is not carried in the other either.
     for (const ChannelId id : refused_ids) wanted.erase(id);
+    // The receive socket rejoins the group before a channel is received here again; if it cannot,
+    // every received channel is refused (and, by the rule above, not sent either).
+    bool receives = std::any_of(wanted.begin(), wanted.end(), [](const auto& c) { return c.second.rx; });
+    if (receives && started_ && rx_fd_ >= 0) {
+      if (const auto why = join_group()) {
+        std::erase_if(wanted, [&](const auto& entry) {
+          if (!entry.second.rx) return false;
+          refuse(entry.first, entry.second.name, "cannot receive on this segment: " + *why);
+          return true;
+        });
+        receives = false;
+      }
+    }
     // Swap the table (brief exclusive lock; channels kept keep flowing through it). Reception is a
     // lookup by name, no subscription: every datagram of the group reaches the receive socket
     // while it is a member.
     std::unordered_map<std::string, Channel*, StringHash, std::equal_to<>> by_name;
-    const bool still_receives = std::any_of(wanted.begin(), wanted.end(), [](const auto& c) { return c.second.rx; });
     {
       LockGuard table(table_mutex_);
       channels_ = std::move(wanted);
       for (auto& [id, channel] : channels_) by_name.emplace(channel.name, &channel);
       by_name_ = std::move(by_name);
     }
-    if (started_ && rx_fd_ >= 0 && !still_receives) leave_group();
+    if (started_ && rx_fd_ >= 0 && !receives) leave_group();
     if (!status.ok) log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + status.error);
     return status;
   }
