@@ -12,7 +12,7 @@ _cosmicctl_global_options="--help --json --socket --version"
 # The options of one command (besides the global ones, which may follow it too).
 _cosmicctl_command_options() {
   case $1 in
-    bind) echo "--replace" ;;
+    bind) echo "--replace --match-timeout" ;;
     calibrate) echo "--seconds --rate" ;;
     diagram) echo "--format --detail" ;;
     gen) echo "--component --output" ;;
@@ -34,7 +34,7 @@ _cosmicctl() {
     word=${COMP_WORDS[i]}
     case $word in
       --socket) socket=(--socket "${COMP_WORDS[i + 1]}"); ((i++)) ;;
-      --format | --component | --output | --interval | --iterations | --seconds | --rate) ((i++)) ;;
+      --format | --component | --output | --interval | --iterations | --seconds | --rate | --match-timeout) ((i++)) ;;
       -*) ;;
       *)
         if [ -z "$command" ]; then

@@ -1,4 +1,5 @@
 // cosmicctl commands that talk to a running cosmicd over its control socket.
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -81,6 +82,26 @@ void print_replaced(const Json& replaced) {
     if (c["changes"].empty()) std::cout << "    (the same definition)\n";
     std::cout << "    hops kept: " << hops(c["hops"]["kept"]) << "; added: " << hops(c["hops"]["added"])
               << "; removed: " << hops(c["hops"]["removed"]) << "\n";
+  }
+}
+
+// How a replacement switched over (made before break): the wait and each new publisher's matches.
+void print_switch_over(const Json& s) {
+  char waited[64];
+  std::snprintf(waited, sizeof waited, "%.0f ms", s["waited_s"].get<double>() * 1e3);
+  std::cout << "switched over after " << waited;
+  if (s["publishers"].empty()) std::cout << " (no new publisher to wait for)";
+  std::cout << "\n";
+  for (const auto& p : s["publishers"]) {
+    std::cout << "    new publisher " << text(p["segment"]) << " of " << text(p["channel"]) << ": ";
+    if (p["matched"].is_null()) {
+      std::cout << "no discovery on this transport (receiving since the switch)\n";
+    } else if (p["matched"].get<std::size_t>() == 0) {
+      std::cout << "NO writer matched within the match timeout (" << s["match_timeout_s"].get<double>()
+                << " s): events published there before discovery completes are lost\n";
+    } else {
+      std::cout << p["matched"].get<std::size_t>() << " writer(s) matched before the switch\n";
+    }
   }
 }
 
@@ -312,11 +333,17 @@ std::vector<CommandRunner> add_daemon_commands(CLI::App& app, const GlobalOption
   auto* bind = app.add_subcommand("bind", "Bind channel definitions from a YAML file (admission decides)");
   auto bind_file = std::make_shared<std::string>();
   auto replace = std::make_shared<bool>(false);
+  auto match_timeout = std::make_shared<std::string>();
   bind->add_option("FILE", *bind_file, "YAML with channel definitions")->required();
-  bind->add_flag("--replace", *replace,
+  auto* replace_flag = bind->add_flag("--replace", *replace,
                  "Replace the definitions of bound channels of the same names in one step (admission on the new whole "
-                 "set; rejected: nothing changes; subscribers that stay keep receiving)");
-  runners.push_back(add_request_command(app, options, bind, [bind_file, replace](Json& req) {
+                 "set; rejected: nothing changes; subscribers that stay keep receiving). Made before break: new "
+                 "publishers are opened first and the old ones feed the channel until they have matched");
+  bind->add_option("--match-timeout", *match_timeout,
+                   "With --replace: how long the switch waits for new publishers to match a writer (DDS) before it "
+                   "switches anyway, e.g. 500ms, 10s (default 5s, at most 60s)")
+      ->needs(replace_flag);
+  runners.push_back(add_request_command(app, options, bind, [bind_file, replace, match_timeout](Json& req) {
     std::ifstream in(*bind_file);
     if (!in) {
       std::cerr << "cosmicctl: cannot read " << *bind_file << "\n";
@@ -327,10 +354,20 @@ std::vector<CommandRunner> add_daemon_commands(CLI::App& app, const GlobalOption
     if (!is_utf8("file name " + *bind_file, *bind_file)) return kExitUsage;
     if (!is_utf8(*bind_file, content.str())) return kExitConfigError;
     req = {{"command", *replace ? "replace" : "bind"}, {"yaml", content.str()}, {"file", *bind_file}};
+    if (!match_timeout->empty()) {
+      const auto timeout = cosmic::parse_duration(*match_timeout);
+      if (!timeout.value || *timeout.value > std::chrono::seconds(60)) {
+        std::cerr << "cosmicctl: --match-timeout: '" << *match_timeout
+                  << "' is not a duration from 0 to 60s (e.g. 500ms, 10s)\n";
+        return kExitUsage;
+      }
+      req["match_timeout_s"] = std::chrono::duration<double>(*timeout.value).count();
+    }
     return kExitOk;
   }, [](const Json& r) {
     print_verdicts(r["channels"]);
     if (r.contains("replaced")) print_replaced(r["replaced"]);
+    if (r.contains("switch_over")) print_switch_over(r["switch_over"]);
   }));
   return runners;
 }

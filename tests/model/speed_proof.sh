@@ -130,7 +130,7 @@ grep -q "forwarded" "$WORK/live.svg" || fail "the live diagram has no counters"
 
 # 4. Measured against promised: actual_speed's end-to-end bound + one controller period + speed's.
 python3 - "$WORK/check.json" "$(tail -1 "$WORK/probe.out")" <<'PY'
-import json, sys
+import json, os, sys
 report = {c["name"]: c for c in json.load(open(sys.argv[1]))["channels"]}
 measured = json.loads(sys.argv[2])
 e2e = lambda n: report[n]["end_to_end"]["latency_s"] * 1e6
@@ -141,6 +141,14 @@ print(f"{'measured sensor -> drive (us)':34} {measured['p50_us']:9.0f} {measured
 print(f"{'promised (us)':34} {'':>9} {'':>9} {promised:9.0f}   = actual_speed {e2e('actual_speed'):.0f} + period {period} + speed {e2e('speed'):.0f}")
 print(f"obstacle: speed 0 sent to the drive {measured['stop_ms']:.0f} ms after the first obstacle event"
       if measured["obstacle_stop"] else "obstacle: no stop")
+# The verdict on the worst case (a figure, not a pass/fail test: the proof checks that the chain
+# carries every step; timing in the emulated CAN VM is not a host's).
+if measured["max_us"] <= promised:
+    print(f"{'verdict':34} met: max {measured['max_us']:.0f} us <= promised {promised:.0f} us")
+else:
+    why = (" (inside the emulated CAN VM, whose software CPU is tens of times slower than a host)"
+           if os.environ.get("CAN_VM") == "1" else "")
+    print(f"{'verdict':34} MISSED: max {measured['max_us']:.0f} us > promised {promised:.0f} us{why}")
 PY
 
 # 5. The controller and cosmicd stop on SIGTERM and exit 0. In a sanitizer build a report in either

@@ -8,7 +8,8 @@ number, so the subscriber on `out` (DDS) sees which numbers crossed each switch 
 The gateway promises, and the test asserts, that a subscriber that stays loses nothing of a
 publisher that stays: its DDS writer and the `steady` subscription are kept, events already queued
 go out. For the switched source it prints what was lost or delivered twice and how long the stream
-paused; the figures are in docs/control-protocol.md (`replace`).
+paused, and asserts that the switch to the DDS publisher was made before break (it waited for the
+match, so the pause is not DDS discovery); the figures are in docs/control-protocol.md (`replace`).
 """
 from __future__ import annotations
 
@@ -176,6 +177,8 @@ def test_a_replacement_under_traffic_keeps_the_subscriber_that_stays(own_gateway
             switched_to_sim = time.monotonic()
             assert "publishers: [steady, wire] -> [steady, sim]" in to_sim.stdout
             assert "hops kept: steady (P), out (S); added: sim (P); removed: wire (P)" in to_sim.stdout, to_sim.stdout
+            # Made before break: the switch waited for sim's writer to match the gateway's new reader.
+            assert "new publisher sim of feed: 1 writer(s) matched before the switch" in to_sim.stdout, to_sim.stdout
             wait_until(lambda: any(e[3] > switched_to_sim for e in received.of("d")), 15, "events from sim after the switch")
             time.sleep(0.5)
 
@@ -205,6 +208,9 @@ def test_a_replacement_under_traffic_keeps_the_subscriber_that_stays(own_gateway
         # rejected replacement and two switches (figures["first"] is before all three).
         assert figures["lost"] == 0 and figures["twice"] == 0, figures
         assert figures["last"] > to_wire_figures["first_after"]
+        # The switched source's pause is what was in flight on the hop removed, not DDS discovery
+        # (seconds on a loaded machine before the switch was made before break, issue 40).
+        assert to_sim_figures["pause_ms"] < 1000, to_sim_figures
 
     # Persisted like bind: after a restart the channel has the last replacement's definition.
     assert g.replace(feed_yaml("steady", "sim"), "to-sim-again.yaml")[0].returncode == 0

@@ -87,7 +87,7 @@ class Client {
 
 class ControlTest : public ::testing::Test {
  protected:
-  ControlTest()
+  explicit ControlTest(const char* config = kConfig)
       : dir(std::filesystem::temp_directory_path() / ("cosmic-control-" + std::to_string(::getpid()))),
         gateway([this](const SegmentSpec& spec, const GatewayIdentity&, Logger&) {
                   auto adapter = std::make_unique<MemoryAdapter>(spec.name);
@@ -97,7 +97,7 @@ class ControlTest : public ::testing::Test {
                 log, 0x42) {
     std::filesystem::remove_all(dir);
     socket_path = (dir / "run" / "control.sock").string();
-    gateway.start(parse_config(kConfig, "test.yaml").config);
+    gateway.start(parse_config(config, "test.yaml").config);
   }
   ~ControlTest() override {
     open_gate();

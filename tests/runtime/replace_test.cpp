@@ -5,7 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <functional>
+#include <future>
 #include <map>
+#include <optional>
+#include <thread>
 #include <string>
 
 #include "control_fixture.hpp"
@@ -248,6 +252,94 @@ TEST_F(ReplaceTest, ARefusingTransportUndoesTheReplacement) {
   EXPECT_EQ(state(), before);
 }
 
+// --- made before break (issue 40): the new publisher hop opens first, the old source feeds the
+// channel until it has matched a writer (or the match timeout passes), then the switch.
+
+bool eventually(const std::function<bool()>& condition, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!condition()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(1ms);
+  }
+  return true;
+}
+
+TEST_F(ReplaceTest, MadeBeforeBreakTheOldSourceFeedsUntilTheNewOneHasMatched) {
+  adapters["sim"]->simulate_discovery();
+  auto replacing = std::async(std::launch::async, [&] { return gateway.replace(channels(kRangeFromSim), 20s); });
+  // The simulator's hop is open beside the CAN sensor's before the switch.
+  ASSERT_TRUE(eventually([&] { return carried_id("sim", "range", HopRole::publisher) != kNoChannel; }, 5000ms));
+  EXPECT_NE(carried_id("body", "range", HopRole::publisher), kNoChannel);
+  // Until it matches, the CAN sensor feeds the channel; what the simulator sends goes nowhere.
+  ASSERT_TRUE(adapters["body"]->inject("range", {1, 1, 1, 1}));
+  EXPECT_EQ(adapters["lan"]->wait_sent(1, 5s), 1u);
+  ASSERT_TRUE(adapters["sim"]->inject("range", {2, 2, 2, 2}));
+  EXPECT_EQ(replacing.wait_for(100ms), std::future_status::timeout) << "switched before the new publisher matched";
+
+  adapters["sim"]->set_matched("range", 1);
+  ASSERT_EQ(replacing.wait_for(10s), std::future_status::ready);
+  const BindResult result = replacing.get();
+  ASSERT_TRUE(result.applied) << result.error;
+  EXPECT_FALSE(result.match_timed_out);
+  ASSERT_EQ(result.new_publishers.size(), 1u);
+  EXPECT_EQ(result.new_publishers[0].channel, "range");
+  EXPECT_EQ(result.new_publishers[0].segment, "sim");
+  EXPECT_EQ(result.new_publishers[0].matched, std::optional<std::size_t>(1));
+  EXPECT_GE(result.switch_wait, std::chrono::milliseconds(100));
+  EXPECT_EQ(carried_id("body", "range", HopRole::publisher), kNoChannel);
+  EXPECT_FALSE(adapters["body"]->inject("range", {9, 9, 9, 9}));
+  ASSERT_TRUE(adapters["sim"]->inject("range", {3, 3, 3, 3}));
+  ASSERT_EQ(adapters["lan"]->wait_sent(2, 5s), 2u);
+  const auto sent = adapters["lan"]->sent();
+  EXPECT_EQ(sent[0].payload, (std::vector<std::uint8_t>{1, 1, 1, 1}));
+  EXPECT_EQ(sent[1].payload, (std::vector<std::uint8_t>{3, 3, 3, 3}));
+}
+
+TEST_F(ReplaceTest, AtTheMatchTimeoutItSwitchesAndSaysNoWriterMatched) {
+  adapters["sim"]->simulate_discovery();
+  const BindResult result = gateway.replace(channels(kRangeFromSim), 60ms);
+  ASSERT_TRUE(result.applied) << result.error;
+  EXPECT_TRUE(result.match_timed_out);
+  ASSERT_EQ(result.new_publishers.size(), 1u);
+  EXPECT_EQ(result.new_publishers[0].matched, std::optional<std::size_t>(0));
+  EXPECT_GE(result.switch_wait, std::chrono::milliseconds(60));
+  EXPECT_EQ(carried_id("body", "range", HopRole::publisher), kNoChannel);
+  EXPECT_NE(carried_id("sim", "range", HopRole::publisher), kNoChannel);
+}
+
+TEST_F(ReplaceTest, WithoutDiscoveryTheSwitchDoesNotWait) {
+  const BindResult result = gateway.replace(channels(kRangeFromSim), 20s);
+  ASSERT_TRUE(result.applied) << result.error;
+  EXPECT_FALSE(result.match_timed_out);
+  ASSERT_EQ(result.new_publishers.size(), 1u);
+  EXPECT_EQ(result.new_publishers[0].matched, std::nullopt);  // nothing to wait for: LCM, CAN
+  EXPECT_LT(result.switch_wait, 5s);
+}
+
+TEST_F(ReplaceTest, ANewHopTheTransportRefusesIsClosedAgainWithoutWaiting) {
+  const std::string before = state();
+  adapters["sim"]->simulate_discovery();
+  adapters["sim"]->refuse_channel("range", "no such topic");
+  auto replacing = std::async(std::launch::async, [&] { return gateway.replace(channels(kRangeFromSim), 60s); });
+  ASSERT_EQ(replacing.wait_for(30s), std::future_status::ready) << "waited for a hop that was refused";
+  const BindResult result = replacing.get();
+  EXPECT_FALSE(result.applied);
+  EXPECT_NE(result.error.find("segment sim does not carry channel range: no such topic"), std::string::npos) << result.error;
+  EXPECT_EQ(state(), before);
+}
+
+// A rejected replacement opens nothing: no hop appears anywhere, however long it could wait.
+TEST_F(ReplaceTest, ARejectedReplacementOpensNoHop) {
+  adapters["sim"]->simulate_discovery();
+  const std::string before = state();
+  const BindResult result = gateway.replace(channels(
+      "{name: range, subject: 0x10, class: srt, period: 10ms, reaction_time: 20ms, omission_degree: 1, payload: 4KiB, "
+      "publishers: [sim], subscribers: [lan, body]}"), 60s);
+  EXPECT_FALSE(result.applied);
+  EXPECT_EQ(state(), before);
+  EXPECT_EQ(carried_id("sim", "range", HopRole::publisher), kNoChannel);
+}
+
 }  // namespace
 
 // The control protocol's `replace`: the answer says what changed per channel and which hops stay.
@@ -274,6 +366,75 @@ TEST_F(ControlTest, ReplaceAnswersWhatChangedAndWhichHopsStay) {
                                           "publishers: [viz], subscribers: [lan]}"}});
   ASSERT_EQ(same["ok"], true) << same.dump();
   EXPECT_EQ(same["replaced"][0]["hops"]["kept"].size(), 2u);
+}
+
+// Made before break over the socket: the answer comes once the new publisher matched (the wait
+// runs on the server's worker, the control thread answers meanwhile) or at the match timeout.
+// kConfig with a simulator's DDS domain: `speed` does not use it yet.
+constexpr const char* kWithSim = R"(
+gateway: {name: gw}
+segments:
+  - {name: lan, type: dds, latency_bound: 1ms}
+  - {name: viz, type: lcm, latency_bound: 2ms}
+  - {name: sim, type: dds, domain: 1, latency_bound: 1ms}
+channels:
+  - {name: speed, subject: 1, class: srt, period: 10ms, reaction_time: 20ms, omission_degree: 1, publishers: [lan], subscribers: [viz]}
+)";
+
+class SwitchOverTest : public ControlTest {
+ protected:
+  SwitchOverTest() : ControlTest(kWithSim) {}
+};
+
+TEST_F(SwitchOverTest, ReplaceWaitsForTheNewPublisherToMatchThenSaysSo) {
+  Setup setup;
+  setup.admission = Admission::server_worker;
+  serve_with(setup);
+  Client client(socket_path);
+  adapters["sim"]->simulate_discovery();
+  const std::string from_sim =
+      "{name: speed, subject: 1, class: srt, period: 10ms, reaction_time: 20ms, omission_degree: 1, publishers: [sim], subscribers: [viz]}";
+  const std::string from_lan =
+      "{name: speed, subject: 1, class: srt, period: 10ms, reaction_time: 20ms, omission_degree: 1, publishers: [lan], subscribers: [viz]}";
+  const Json timed_out = client.call({{"command", "replace"}, {"yaml", from_sim}, {"match_timeout_s", 0.05}});
+  ASSERT_EQ(timed_out["ok"], true) << timed_out.dump();
+  const Json& switched = timed_out["switch_over"];
+  EXPECT_EQ(switched["timed_out"], true);
+  EXPECT_GE(switched["waited_s"].get<double>(), 0.05);
+  EXPECT_DOUBLE_EQ(switched["match_timeout_s"].get<double>(), 0.05);
+  EXPECT_EQ(switched["publishers"], Json::array({{{"channel", "speed"}, {"segment", "sim"}, {"matched", 0}}}));
+
+  // Back to lan, then to sim again once a writer there has matched: no timeout.
+  ASSERT_EQ(client.call({{"command", "replace"}, {"yaml", from_lan}})["ok"], true);
+  client.send_raw(Json{{"command", "replace"}, {"yaml", from_sim}, {"match_timeout_s", 30}}.dump() + "\n");
+  // While the switch waits, the control thread answers reads; changes are busy.
+  Client other(socket_path);
+  ASSERT_TRUE(eventually([&] {
+    const Json busy = other.call({{"command", "unbind"}, {"name", "speed"}});
+    return busy["error"]["code"] == "busy" &&
+           busy["error"]["message"].get<std::string>().find("waiting up to 30 s for its new publishers to match") != std::string::npos;
+  }, 5000ms));
+  EXPECT_EQ(other.call({{"command", "status"}})["ok"], true);
+  EXPECT_EQ(gateway.knowledge_base().find_bound("speed")->publishers, std::vector<std::string>{"lan"});
+  adapters["sim"]->set_matched("speed", 2);
+  const Json matched = Json::parse(client.read_line(), nullptr, false);
+  ASSERT_EQ(matched["ok"], true) << matched.dump();
+  EXPECT_EQ(matched["switch_over"]["timed_out"], false);
+  EXPECT_EQ(matched["switch_over"]["publishers"][0]["matched"], 2);
+  EXPECT_LT(matched["switch_over"]["waited_s"].get<double>(), 30.0);
+}
+
+TEST_F(ControlTest, ReplaceWithABadMatchTimeoutIsRefusedAndChangesNothing) {
+  serve();
+  Client client(socket_path);
+  const std::string yaml = "{name: speed, subject: 1, class: srt, period: 10ms, reaction_time: 20ms, omission_degree: 1, publishers: [viz], subscribers: [lan]}";
+  for (const Json& bad : {Json(-1), Json(61), Json("5s"), Json(nullptr)}) {
+    const Json answer = client.call({{"command", "replace"}, {"yaml", yaml}, {"match_timeout_s", bad}});
+    EXPECT_EQ(answer["ok"], false) << bad.dump();
+    EXPECT_EQ(answer["error"]["code"], "bad_request") << bad.dump();
+    EXPECT_NE(answer["error"]["message"].get<std::string>().find("match_timeout_s"), std::string::npos);
+  }
+  EXPECT_EQ(gateway.knowledge_base().find_bound("speed")->publishers, std::vector<std::string>{"lan"});
 }
 
 TEST_F(ControlTest, ReplaceOfAChannelThatIsNotBoundIsNotFoundAndChangesNothing) {

@@ -7,17 +7,12 @@
 #include "cosmic/json_nesting.hpp"
 #include "cosmic/report.hpp"
 
+#include "bind_answer.hpp"
+
 namespace cosmic {
 namespace {
 
 using Json = nlohmann::json;
-
-Json failure(const std::string& code, const std::string& message) {
-  return Json{{"ok", false}, {"error", {{"code", code}, {"message", message}}}};
-}
-
-// Texts quoted from files or interfaces may hold invalid UTF-8: replace it, never throw.
-std::string render(const Json& response) { return response.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n"; }
 
 // A client-chosen text fit for one log line: printable ASCII, at most kMaxLoggedText characters.
 std::string printable(std::string_view text) {
@@ -45,44 +40,6 @@ void replace_or_bind(BindPlan& plan) {
   } else {
     Gateway::plan_bind(plan);
   }
-}
-
-// A replacement's answer says per channel what changed and which hops stay (their endpoints and
-// the subscribers behind them keep running), which are new and which are gone.
-Json replaced_answer(const BindResult& result) {
-  Json out = Json::array();
-  for (const ReplacedChannel& replaced : result.replaced) {
-    const ChannelSpec& before = replaced.before;
-    const auto now = std::find_if(result.channels.begin(), result.channels.end(),
-                                  [&](const ChannelReport& c) { return c.name == before.name; });
-    Json hops{{"kept", Json::array()}, {"added", Json::array()}, {"removed", Json::array()}};
-    std::vector<std::pair<std::string, HopRole>> old_hops;
-    for (const auto& p : before.publishers) old_hops.emplace_back(p, HopRole::publisher);
-    for (const auto& s : before.subscribers) old_hops.emplace_back(s, HopRole::subscriber);
-    std::vector<std::pair<std::string, HopRole>> new_hops;
-    if (now != result.channels.end()) {
-      for (const auto& hop : now->hops) new_hops.emplace_back(hop.segment, hop.role);
-    }
-    auto hop_json = [](const std::pair<std::string, HopRole>& h) { return Json{{"segment", h.first}, {"role", to_string(h.second)}}; };
-    for (const auto& h : old_hops) {
-      const bool kept = std::find(new_hops.begin(), new_hops.end(), h) != new_hops.end();
-      hops[kept ? "kept" : "removed"].push_back(hop_json(h));
-    }
-    for (const auto& h : new_hops) {
-      if (std::find(old_hops.begin(), old_hops.end(), h) == old_hops.end()) hops["added"].push_back(hop_json(h));
-    }
-    out.push_back({{"name", before.name}, {"changes", replaced.changes}, {"hops", std::move(hops)}});
-  }
-  return out;
-}
-
-Json bind_answer(const BindResult& result) {
-  Json out{{"ok", result.applied}, {"applied", result.applied}, {"channels", Json::array()}};
-  for (const auto& c : result.channels) out["channels"].push_back(to_json(c));
-  const bool rejected = std::any_of(result.channels.begin(), result.channels.end(),
-                                    [](const ChannelReport& c) { return c.verdict == Verdict::rejected; });
-  if (!result.applied) out["error"] = {{"code", rejected ? "rejected" : "bind_failed"}, {"message", result.error}};
-  return out;
 }
 
 }  // namespace
@@ -403,6 +360,13 @@ ControlProtocol::Answer ControlProtocol::bind(const Json& request, bool replace,
     out["errors"] = to_json(parsed.errors);
     return out;
   }
+  if (replace && request.contains("match_timeout_s")) {
+    const Json& timeout = request["match_timeout_s"];
+    if (!timeout.is_number() || !(timeout.get<double>() >= 0 && timeout.get<double>() <= kMaxMatchTimeoutS)) {
+      return failure("bad_request", "\"match_timeout_s\" must be a number of seconds from 0 to " +
+                                        std::to_string(static_cast<int>(kMaxMatchTimeoutS)) + "; nothing changed");
+    }
+  }
   if (replace) {
     // A replacement of something not bound is most likely a wrong name: binding it would leave
     // the channel meant to be replaced running as it was.
@@ -423,18 +387,18 @@ ControlProtocol::Answer ControlProtocol::bind(const Json& request, bool replace,
   return run_admission(
       what, [plan] { replace_or_bind(*plan); },
       [this, plan, request, command, gated, what, later]() -> Answer {
-        if (!gated || !plan->admitted) return commit_planned(std::move(*plan), request, command, false);
+        if (!gated || !plan->admitted) return conclude(plan, request, command, false, later);
         running_ = what + " (claiming the federation's shared networks)";
         try {
           gate_(*plan, [this, plan, request, command, later] {
           running_.clear();
-          Json answer;
+          Answer answer;
           try {
-            answer = commit_planned(std::move(*plan), request, command, true);
+            answer = conclude(plan, request, command, true, later);
           } catch (const std::exception& e) {
             answer = failure("internal_error", e.what());
           }
-          later(render(answer));
+          if (answer) later(render(*answer));
           });
         } catch (const std::exception& e) {
           running_.clear();  // never left busy by a gate that failed
@@ -443,6 +407,12 @@ ControlProtocol::Answer ControlProtocol::bind(const Json& request, bool replace,
         return std::nullopt;
       },
       later);
+}
+
+ControlProtocol::Answer ControlProtocol::conclude(std::shared_ptr<BindPlan> plan, const Json& request,
+                                                  const std::string& command, bool replan, const Reply& later) {
+  if (plan->replacing) return switch_planned(std::move(plan), request, command, replan, later);
+  return commit_planned(std::move(*plan), request, command, replan);
 }
 
 Json ControlProtocol::commit_planned(BindPlan plan, const Json& request, const std::string& command, bool replan) {

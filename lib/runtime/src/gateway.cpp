@@ -9,6 +9,7 @@
 #include <set>
 #include <string_view>
 #include <unordered_map>
+#include <utility>
 
 namespace cosmic {
 
@@ -96,7 +97,7 @@ BindResult Gateway::start(const Config& config) {
   return result;
 }
 
-Gateway::Refusals Gateway::configure_adapters() {
+Gateway::Refusals Gateway::configure_adapters(const std::multimap<std::string, ChannelBinding>& extra) {
   const AdmissionReport report = kb_->report();
   std::unordered_map<std::string_view, const ChannelReport*> verdicts;
   verdicts.reserve(report.channels.size());
@@ -111,6 +112,7 @@ Gateway::Refusals Gateway::configure_adapters() {
         if (hop.segment == name) bindings.push_back(ChannelBinding{id_for(channel), channel, hop.role, hop.can});
       }
     }
+    for (auto [it, end] = extra.equal_range(name); it != end; ++it) bindings.push_back(it->second);
     const Status status = slot.adapter->configure(bindings);
     std::set<std::pair<ChannelId, HopRole>> given;
     for (const auto& b : bindings) given.emplace(b.id, b.role);
@@ -229,6 +231,14 @@ void Gateway::plan_bind(BindPlan& plan) {
 }
 
 BindResult Gateway::commit_bind(BindPlan plan) {
+  // A replacement's hops opened by prepare_replace() close again unless this commit keeps them.
+  const bool prepared = std::exchange(prepared_, false);
+  BindResult result = commit_plan(std::move(plan));
+  if (prepared && !result.applied) configure_adapters();
+  return result;
+}
+
+BindResult Gateway::commit_plan(BindPlan plan) {
   BindResult result;
   result.channels = std::move(plan.reports);
   const auto& channels = plan.channels;

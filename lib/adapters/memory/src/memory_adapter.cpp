@@ -162,4 +162,23 @@ std::vector<ChannelBinding> MemoryAdapter::bindings() const {
   return bindings_;
 }
 
+std::optional<std::size_t> MemoryAdapter::matched_peers(ChannelId channel) const {
+  LockGuard lock(mutex_);
+  if (!discovery_) return std::nullopt;
+  const auto bound = std::find_if(bindings_.begin(), bindings_.end(), [&](const ChannelBinding& b) { return b.id == channel; });
+  if (bound == bindings_.end()) return std::nullopt;
+  const auto peers = matched_.find(bound->spec.name);
+  return peers == matched_.end() ? 0 : peers->second;
+}
+
+void MemoryAdapter::simulate_discovery() {
+  LockGuard lock(mutex_);
+  discovery_ = true;
+}
+
+void MemoryAdapter::set_matched(const std::string& channel, std::size_t peers) {
+  LockGuard lock(mutex_);
+  matched_[channel] = peers;
+}
+
 }  // namespace cosmic

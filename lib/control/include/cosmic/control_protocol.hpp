@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -50,6 +51,9 @@ using BindGate = std::function<void(const BindPlan& plan, std::function<void()> 
 
 // Bounds of a request the parser accepts (no recursion over attacker-chosen nesting).
 inline constexpr int kMaxRequestNesting = 16;
+// A replacement's wait for its new publishers to match (request field match_timeout_s).
+inline constexpr double kDefaultMatchTimeoutS = 5.0;
+inline constexpr double kMaxMatchTimeoutS = 60.0;
 // Characters of a client-chosen text (command, channel name) quoted in a log line.
 inline constexpr std::size_t kMaxLoggedText = 64;
 
@@ -87,6 +91,18 @@ class ControlProtocol {
   // Commits a bind plan and answers. `replan`: admit it again first if the bindings changed since
   // it was made (after a claim window); otherwise such a commit is refused ("try again").
   Json commit_planned(BindPlan plan, const Json& request, const std::string& command, bool replan);
+  // A planned bind's last step: commit_planned(), or for a replacement switch_planned().
+  Answer conclude(std::shared_ptr<BindPlan> plan, const Json& request, const std::string& command, bool replan,
+                  const Reply& later);
+  // A replacement made before break (control_switch_over.cpp): admitted again when `replan` and the
+  // bindings changed, its new hops opened, then the switch once every new publisher has matched or
+  // the request's match timeout passed. The wait polls through offload_ (the control thread stays
+  // free; other changes are `busy` meanwhile); without offload_ it polls here.
+  struct SwitchWait;
+  Answer switch_planned(std::shared_ptr<BindPlan> plan, const Json& request, const std::string& command, bool replan,
+                        const Reply& later);
+  void await_match(std::shared_ptr<SwitchWait> wait);
+  Json switched(SwitchWait& wait, bool timed_out);
   std::string next_log_tag(const char* kind, const PeerCredentials& peer);
   Json status() const;
   Json segments() const;

@@ -17,6 +17,7 @@
 // configuration, e.g. a reload, tries again) and the rest runs.
 #pragma once
 
+#include <chrono>
 #include <functional>
 #include <map>
 #include <memory>
@@ -42,12 +43,26 @@ struct ReplacedChannel {
   std::vector<std::string> changes;  // one line per field the new definition changes (channel_changes.hpp)
 };
 
+// A publisher hop a replacement adds, opened before the switch (make before break).
+struct NewPublisher {
+  std::string channel;
+  std::string segment;
+  // Remote writers its endpoint had matched at the switch; nullopt where the transport has no
+  // discovery (LCM, CAN: whatever is sent there is received as soon as the hop exists).
+  std::optional<std::size_t> matched;
+};
+
 struct BindResult {
   bool applied = false;                 // false: nothing changed
   std::vector<ChannelReport> channels;  // verdict of each requested channel
   std::string error;                    // why nothing changed, when not a rejection
   // A replacement: the channels it concerns that were bound, in the order of `channels`.
   std::vector<ReplacedChannel> replaced;
+  // A replacement, made before break: its new publisher hops as they were at the switch, how long
+  // the switch waited for them to match after they were opened, and whether it gave up waiting.
+  std::vector<NewPublisher> new_publishers;
+  Nanos switch_wait{0};
+  bool match_timed_out = false;
 };
 
 struct SegmentInfo {
@@ -117,7 +132,11 @@ class Gateway {
   // not bound) nothing changes. A replaced channel keeps its channel id, so adapters keep the
   // endpoints of its hops whose segment, role and transport QoS stay, and its etag where it still
   // needs one; events already queued for subscriber segments that stay are still sent.
-  BindResult replace(const std::vector<ChannelSpec>& channels);
+  // Made before break: the new hops are opened first, beside the running ones, and the switch
+  // waits (polling, at most `match_timeout`) until every new publisher hop on a transport with
+  // discovery has matched a remote writer; the old publishers feed the channel until then.
+  BindResult replace(const std::vector<ChannelSpec>& channels, Nanos match_timeout = kDefaultMatchTimeout);
+  static constexpr Nanos kDefaultMatchTimeout{5'000'000'000};
   // False when no such channel is bound.
   bool unbind(const std::string& name);
   // Validated configuration in, running one swapped: unchanged segments and channels keep
@@ -134,6 +153,19 @@ class Gateway {
   // replace() in the same steps; commit_bind() commits either kind of plan.
   BindPlan replace_plan_input(std::vector<ChannelSpec> channels) const;
   static void plan_replace(BindPlan& plan);
+  // Make before break, control thread. prepare_replace() opens an admitted replacement's hops on
+  // segments the channel does not use yet, beside the running ones; routes stay as they are (the
+  // old publishers keep feeding the channel; what reaches a new publisher hop before the switch
+  // counts as no_route). False when there is nothing to wait for: not admitted, bindings changed
+  // since the plan, no such hop, or a segment refused one (then closed again: the commit reports
+  // it). switch_over() then commits (commit_bind), closing the opened hops when the commit refuses,
+  // and says how long the switch waited and what the new publishers had matched.
+  bool prepare_replace(const BindPlan& plan);
+  BindResult switch_over(BindPlan plan, std::chrono::steady_clock::time_point prepared_at, bool timed_out);
+  // The new publisher hops of a replacement with the remote writers each has matched now.
+  std::vector<NewPublisher> new_publishers(const BindPlan& plan) const;
+  // True when every new publisher hop on a transport with discovery has matched a writer.
+  static bool all_matched(const std::vector<NewPublisher>& publishers);
   // reload() in steps: the plan on any thread (no I/O), the commit on the control thread.
   // With `base` (reload_base(), taken on the control thread) a configuration with the base's
   // gateway, segments and reserved etags whose channels begin with the base's, in order, starts
@@ -215,8 +247,13 @@ class Gateway {
     std::uint64_t violations = 0;
   };
 
-  // Configures every adapter with the bound set; returns (and keeps in refused_) what they refused.
-  Refusals configure_adapters();
+  // Configures every adapter with the bound set plus `extra` (segment name -> a binding of a
+  // replacement being prepared); returns (and keeps in refused_) what they refused.
+  Refusals configure_adapters(const std::multimap<std::string, ChannelBinding>& extra = {});
+  // commit_bind() without closing what prepare_replace() opened when it refuses.
+  BindResult commit_plan(BindPlan plan);
+  // The hops of `plan`'s new definitions that the running bindings do not have, by segment.
+  std::multimap<std::string, ChannelBinding> added_hops(const BindPlan& plan) const;
   // Makes `report` say `failed`, with the reasons, when a segment refused its channel.
   void mark_refused(ChannelReport& report) const;
   // `foreign`: why the channel's analysis does not hold now (undeclared frames beat it), or null.
@@ -246,6 +283,7 @@ class Gateway {
   std::map<std::string, std::pair<ChannelSpec, ChannelId>> channel_ids_;
   ChannelId next_channel_id_ = 1;
   std::uint64_t generation_ = 0;
+  bool prepared_ = false;  // adapters carry a replacement's added hops (prepare_replace)
   std::shared_ptr<const ReloadBase> base_;  // valid while generation_ == base_generation_
   std::uint64_t base_generation_ = 0;
 };

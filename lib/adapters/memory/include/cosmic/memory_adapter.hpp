@@ -33,7 +33,8 @@ class MemoryAdapter final : public SegmentAdapter {
   bool batches_sends() const override { return true; }  // so router tests see the lanes' batches
   HealthReport health() const override;
   AdapterStatistics statistics() const override;
-  std::optional<std::size_t> matched_peers(ChannelId) const override { return std::nullopt; }
+  // nullopt (no discovery, as LCM and CAN) unless simulate_discovery() was called.
+  std::optional<std::size_t> matched_peers(ChannelId channel) const override;
   void stop() override;
 
   // Delivers an event on `channel` as if received from the network. False when the channel is
@@ -55,6 +56,10 @@ class MemoryAdapter final : public SegmentAdapter {
   // Makes configure() refuse channel `name` with `reason` (named in Status::refused, as a
   // transport that cannot carry that channel) and take the other bindings; "" accepts it again.
   void refuse_channel(const std::string& name, std::string reason);
+  // From now on the segment has discovery, as DDS: matched_peers() of a channel carried here is
+  // what set_matched() said of it (0 until then), nullopt for a channel not carried.
+  void simulate_discovery();
+  void set_matched(const std::string& channel, std::size_t peers);
   // Makes configure() fail as a whole with `reason`, naming no channel and keeping the bindings it
   // had (as a transport that rolls back); "" lets configure() succeed again.
   void fail_configure(std::string reason);
@@ -72,6 +77,8 @@ class MemoryAdapter final : public SegmentAdapter {
   AdapterStatistics stats_ COSMIC_GUARDED_BY(mutex_);
   std::map<std::string, std::string> refuse_ COSMIC_GUARDED_BY(mutex_);  // channel name -> reason
   std::string fail_configure_ COSMIC_GUARDED_BY(mutex_);
+  bool discovery_ COSMIC_GUARDED_BY(mutex_) = false;
+  std::map<std::string, std::size_t> matched_ COSMIC_GUARDED_BY(mutex_);  // channel name -> peers
   bool congested_ COSMIC_GUARDED_BY(mutex_) = false;
   bool held_ COSMIC_GUARDED_BY(mutex_) = false;
   mutable std::condition_variable released_;
