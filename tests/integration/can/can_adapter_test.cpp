@@ -7,11 +7,15 @@
 
 #include <algorithm>
 #include <fstream>
+#include <functional>
+#include <memory>
+#include <optional>
 #include <thread>
 
 #include "can_test_support.hpp"
 #include "cosmic/can_fragment.hpp"
 #include "cosmic/can_wire.hpp"
+#include "famouso_afp.hpp"
 #include "receive_buffer.hpp"
 
 namespace cosmic::test {
@@ -201,6 +205,113 @@ TEST_F(CanAdapterTest, CanFdFramesBothWays) {
   ASSERT_TRUE(sink_.wait_events(3, kWait));
   EXPECT_EQ(sink_.events()[2].payload, big);
   EXPECT_EQ(sink_.problem_count(), 0u);
+}
+
+// Gateway -> device (issue 40): fragmented events of every size class (empty, one fragment full,
+// one byte more, several fragments, a padded last one on FD, the channel's largest) arrive whole
+// at a raw CAN socket (candump), and `sent` counts exactly the frames that arrived. `reassemble`
+// is the device's receiver (COSMIC fragments or FAMOUSO's AFP): one frame's data in, the complete
+// event out when it is one (std::nullopt while partial; a dropped event fails the test).
+using DeviceReassembly = std::function<std::optional<std::vector<std::uint8_t>>(const CanLine& line)>;
+
+void expect_fragmented_events_arrive(SegmentAdapter& adapter, ChannelId channel, const std::string& interface,
+                                     const std::vector<std::size_t>& sizes, std::size_t frames,
+                                     const std::function<bool(const CanLine&)>& ours, const DeviceReassembly& reassemble) {
+  Candump dump(interface, interface, static_cast<int>(frames));
+  std::vector<std::vector<std::uint8_t>> sent;
+  for (std::size_t i = 0; i < sizes.size(); ++i) {
+    sent.push_back(bytes(sizes[i], static_cast<std::uint8_t>(i + 1)));
+    ASSERT_EQ(adapter.send(OutboundEvent{channel, {}, sent.back()}), SendStatus::sent) << sizes[i] << " B";
+  }
+  const auto lines = dump.wait(milliseconds(10000));
+  ASSERT_EQ(lines.size(), frames) << "frames on " << interface;
+  std::vector<std::vector<std::uint8_t>> arrived;
+  for (const CanLine& line : lines) {
+    ASSERT_TRUE(ours(line)) << hex_id(line.id);
+    std::optional<std::vector<std::uint8_t>> event;
+    ASSERT_NO_FATAL_FAILURE(event = reassemble(line));
+    if (event) arrived.push_back(std::move(*event));
+  }
+  ASSERT_EQ(arrived.size(), sizes.size());
+  for (std::size_t i = 0; i < sizes.size(); ++i) {
+    ASSERT_GE(arrived[i].size(), sizes[i]) << "event " << i;
+    EXPECT_EQ(std::vector<std::uint8_t>(arrived[i].begin(), arrived[i].begin() + static_cast<long>(sizes[i])), sent[i])
+        << sizes[i] << " B";
+    // Whatever follows the event is its last FD frame's padding: zeros, less than one FD length step.
+    EXPECT_LT(arrived[i].size() - sizes[i], 16u);
+    EXPECT_TRUE(std::all_of(arrived[i].begin() + static_cast<long>(sizes[i]), arrived[i].end(), [](auto b) { return b == 0; }));
+  }
+  EXPECT_EQ(adapter.statistics().sent, frames);
+  EXPECT_EQ(adapter.statistics().send_errors, 0u);
+}
+
+DeviceReassembly cosmic_device(std::size_t largest) {
+  ReassemblyLimits limits;
+  limits.padding_slack = 15;  // an FD last fragment is padded to the next FD length (docs/can-wire-format.md 6)
+  auto reassembler = std::make_shared<Reassembler>(limits);
+  return [reassembler, largest](const CanLine& line) -> std::optional<std::vector<std::uint8_t>> {
+    const auto r = reassembler->accept(1, line.data, largest, Nanos(0));
+    EXPECT_TRUE(r.outcome == FragmentOutcome::partial || r.outcome == FragmentOutcome::complete)
+        << "fragment " << hex(line.data) << " (" << line.data.size() << " B)";
+    EXPECT_FALSE(r.dropped_event);
+    if (r.outcome != FragmentOutcome::complete) return std::nullopt;
+    return std::vector<std::uint8_t>(r.event.begin(), r.event.end());
+  };
+}
+
+TEST_F(CanAdapterTest, FdFragmentedEventsArriveWholeAndSentCountsTheirFrames) {
+  ASSERT_EQ(shell("ip link set vcan1 down && ip link set vcan1 mtu 72 && ip link set vcan1 up"), 0);
+  const auto seg = can_segment("vcan1", true);
+  constexpr std::size_t kLargest = 1000;  // the channel's payload
+  ASSERT_NO_FATAL_FAILURE(open(seg, {can_binding(51, "map", 0x51, kLargest, HopRole::subscriber, 0xF2, 520, seg)}));
+  const std::uint32_t id = encode_can_id(CanIdentifier{0xF2, kGatewayNode, 520});
+  const std::vector<std::size_t> sizes{0, 62, 63, 64, 200, 300, kLargest, 1};
+  std::size_t frames = 0;
+  for (const std::size_t size : sizes) frames += fragment_count(size, 64);
+  ASSERT_EQ(frames, 1u + 1 + 2 + 2 + 4 + 5 + 17 + 1);
+  expect_fragmented_events_arrive(*adapter_, 51, "vcan1", sizes, frames,
+                                  [&](const CanLine& l) { return l.id == id && l.fd; }, cosmic_device(kLargest));
+}
+
+TEST_F(CanAdapterTest, ClassicFragmentedEventsArriveWholeAndSentCountsTheirFrames) {
+  const auto seg = can_segment("vcan0");
+  constexpr std::size_t kLargest = 1500;
+  ASSERT_NO_FATAL_FAILURE(open(seg, {can_binding(52, "log", 0x52, kLargest, HopRole::subscriber, 0xF3, 521, seg)}));
+  const std::uint32_t id = encode_can_id(CanIdentifier{0xF3, kGatewayNode, 521});
+  const std::vector<std::size_t> sizes{0, 6, 7, 8, 62, 63, 64, 200, 300, kLargest, 1};
+  std::size_t frames = 0;
+  for (const std::size_t size : sizes) frames += fragment_count(size, 8);
+  ASSERT_EQ(frames, 1u + 1 + 2 + 2 + 11 + 11 + 11 + 34 + 50 + 250 + 1);
+  expect_fragmented_events_arrive(*adapter_, 52, "vcan0", sizes, frames,
+                                  [&](const CanLine& l) { return l.id == id && !l.fd; }, cosmic_device(kLargest));
+}
+
+// FAMOUSO's AFP: events over 8 bytes leave as AFP fragments with the identifier's fragment flag;
+// up to 8 bytes as one plain frame.
+TEST_F(CanAdapterTest, AfpFragmentedEventsArriveWholeAndSentCountsTheirFrames) {
+  auto seg = can_segment("vcan0");
+  seg.can.profile = CanProfile::famouso;
+  constexpr std::size_t kLargest = 1000;
+  ChannelBinding binding = can_binding(53, "log", 0x53, kLargest, HopRole::subscriber, 0x78, 522, seg);
+  binding.can->profile = CanProfile::famouso;
+  binding.can->can_id = encode_famouso_id(FamousoIdentifier{0x78, true, kGatewayNode, 522});
+  ASSERT_NO_FATAL_FAILURE(open(seg, {binding}));
+  const std::uint32_t plain = encode_famouso_id(FamousoIdentifier{0x78, false, kGatewayNode, 522});
+  const std::vector<std::size_t> sizes{0, 8, 9, 62, 63, 64, 200, 224, 225, 300, kLargest, 1};
+  std::size_t frames = 0;
+  for (const std::size_t size : sizes) frames += size <= famouso::kAfpMtu ? 1 : famouso::afp_fragment_count(size);
+  auto afp = std::make_shared<famouso::AfpReassembler>();
+  auto device = [afp, plain, kLargest](const CanLine& line) -> std::optional<std::vector<std::uint8_t>> {
+    if (line.id == plain) return line.data;  // a plain frame is the event
+    const auto r = afp->accept(1, line.data, kLargest, Nanos(0));
+    EXPECT_NE(r.outcome, famouso::AfpOutcome::rejected);
+    EXPECT_FALSE(r.dropped_event);
+    if (r.outcome != famouso::AfpOutcome::complete) return std::nullopt;
+    return std::vector<std::uint8_t>(r.event.begin(), r.event.end());
+  };
+  expect_fragmented_events_arrive(*adapter_, 53, "vcan0", sizes, frames,
+                                  [&](const CanLine& l) { return (l.id == plain || l.id == (plain | kFamousoFragmentFlag)) && !l.fd; },
+                                  device);
 }
 
 // A 1 KiB NRT event leaves as 171 classic frames in order and reassembles to the event.

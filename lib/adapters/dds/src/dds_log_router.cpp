@@ -1,9 +1,11 @@
 #include "dds_log_router.hpp"
 
+#include <atomic>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <string_view>
 
 #include <fastdds/dds/log/Log.hpp>
 
@@ -52,9 +54,18 @@ class LogRouter {
     }
   };
   void forward(const dds::Log::Entry& entry) {
-    const LogLevel level = entry.kind == dds::Log::Error     ? LogLevel::error
-                           : entry.kind == dds::Log::Warning ? LogLevel::warning
-                                                             : LogLevel::debug;
+    LogLevel level = entry.kind == dds::Log::Error     ? LogLevel::error
+                     : entry.kind == dds::Log::Warning ? LogLevel::warning
+                                                       : LogLevel::debug;
+    std::string note;
+    if (is_peer_key_only_dispose(entry)) {
+      // Not a fault of ours or the peer's: explained once, then kept at debug.
+      level = LogLevel::debug;
+      if (!key_only_explained_.exchange(true)) {
+        level = LogLevel::info;
+        note = kKeyOnlyNote;
+      }
+    }
     std::string text = "fastdds";
     if (entry.context.category != nullptr) {
       text += " [";
@@ -63,11 +74,28 @@ class LogRouter {
     }
     text += ": ";
     text += entry.message;
+    text += note;
     std::lock_guard lock(mutex_);
     for (auto& [log, count] : loggers_) {
       log->log(level, text);
     }
   }
+  // A DDS peer that leaves (or deletes an endpoint) announces it with a key-only DATA whose key
+  // is serialized in the payload, as DDSI-RTPS allows and Cyclone DDS does (28 bytes: a GUID
+  // parameter list). Fast DDS 2.9 reads only a key of at most 16 bytes there: it warns, ignores
+  // the announcement and forgets the peer when its lease ends instead (docs/operations.md).
+  static bool is_peer_key_only_dispose(const dds::Log::Entry& entry) {
+    const std::string_view category = entry.context.category ? entry.context.category : "";
+    const std::string_view message = entry.message;
+    return (category == "RTPS_MSG_IN" && message.find("Ignoring Serialized Payload for too large key-only data") != std::string_view::npos) ||
+           (category == "RTPS_PDP" && message.find("Problem getting the key of the change, removing") != std::string_view::npos) ||
+           (category == "RTPS_EDP" && message.find("Received change with no Key") != std::string_view::npos);
+  }
+  static constexpr const char* kKeyOnlyNote =
+      " (a DDS peer, e.g. Cyclone DDS, announced that a participant or endpoint left with its key serialized in "
+      "the message; Fast DDS 2.9 cannot read that form and forgets the peer when its lease ends instead: "
+      "harmless, see docs/operations.md \"Fast DDS messages about key-only data\"; logged at debug from now on)";
+  std::atomic<bool> key_only_explained_{false};
   std::once_flag installed_;  // the consumer is installed once per process
   std::mutex mutex_;          // guards loggers_; never held while calling into dds::Log
   std::map<Logger*, int> loggers_;

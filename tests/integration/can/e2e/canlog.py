@@ -13,6 +13,7 @@ import re
 import sys
 
 CLASSIC_FRAGMENT_DATA = 6  # event bytes per classic fragment (8 - 2 header bytes)
+FD_FRAGMENT_DATA = 62      # event bytes per CAN FD fragment (64 - 2 header bytes)
 # One frame of a candump -L log; fd_flags is None for a classic frame, else the FD flags nibble
 # (BRS = 1, ESI = 2, FDF = 4 on newer kernels).
 Frame = collections.namedtuple("Frame", "id eff rtr fd_flags data")
@@ -80,11 +81,12 @@ def read_frames(path):
     return frames
 
 
-def reassemble(datas, first_seq):
-    """Events carried by consecutive classic fragments (the data of each frame, in order), checked
-    against the sender rules of section 6: sequences first_seq, first_seq + 1, ... (mod 16),
-    indexes 0, 1, ... with the last bit on the final one, all but the last fragment full.
-    Raises ValueError naming the first violation."""
+def reassemble(datas, first_seq, fragment_data=CLASSIC_FRAGMENT_DATA):
+    """Events carried by consecutive fragments (the data of each frame, in order; classic, or CAN FD
+    with fragment_data=FD_FRAGMENT_DATA), checked against the sender rules of section 6: sequences
+    first_seq, first_seq + 1, ... (mod 16), indexes 0, 1, ... with the last bit on the final one,
+    all but the last fragment full. On CAN FD the last fragment's padding stays on the event (the
+    receiver cuts it at the channel's payload). Raises ValueError naming the first violation."""
     seq, expect_index, event, events = first_seq & 0xF, 0, bytearray(), []
     for n, data in enumerate(datas):
         where = "fragment %d (%s)" % (n, data.hex().upper())
@@ -96,9 +98,9 @@ def reassemble(datas, first_seq):
             raise ValueError(where + ": sequence %d, expected %d" % (f_seq, seq))
         if index != expect_index:
             raise ValueError(where + ": index %d, expected %d" % (index, expect_index))
-        if not last and len(body) != CLASSIC_FRAGMENT_DATA:
+        if not last and len(body) != fragment_data:
             raise ValueError(where + ": a fragment before the last carries %d bytes, not %d"
-                             % (len(body), CLASSIC_FRAGMENT_DATA))
+                             % (len(body), fragment_data))
         event += body
         if last:
             events.append(bytes(event))

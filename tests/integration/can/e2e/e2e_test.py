@@ -33,12 +33,13 @@ GW_NODE = 9                      # gateway.can_node_id
 DEV = 5                          # TxNode of the device this test plays on the bus
 SUBJ = {"sensor": 0x1000000A1, "command": 0x1000000B2, "bulk_up": 0x1000000C3, "bulk_down": 0x1000000C4,
         "fd_down": 0x1000000D5, "fd_up": 0x1000000D6, "wheel": 0x1000000E1, "lamp": 0x1000000E2,
-        "brake": 0x1000000E3, "relay": 0x1000000D7}
+        "brake": 0x1000000E3, "relay": 0x1000000D7, "fd_bulk_down": 0x1000000D8}
 ETAG = {"sensor": 16383,         # dynamic: the first etag handed out (section 3)
-        "command": 300, "bulk_up": 201, "bulk_down": 202, "fd_down": 501, "fd_up": 502, "relay": 503}
+        "command": 300, "bulk_up": 201, "bulk_down": 202, "fd_down": 501, "fd_up": 502, "relay": 503,
+        "fd_bulk_down": 504}
 CHANNELS = ("sensor", "command", "bulk_up", "bulk_down")  # those on segment bus (vcan0) with etags
 NATIVE_CHANNELS = ("wheel", "brake", "lamp")              # native identifiers on segment bus
-FD_CHANNELS = ("fd_down", "fd_up")                        # those on segment bus_fd (vcan1) alone
+FD_CHANNELS = ("fd_down", "fd_up", "fd_bulk_down")        # those on segment bus_fd (vcan1) alone
 BRIDGED_CHANNELS = ("relay",)                             # bus_fd -> bus
 SEGMENTS = 4
 PRIO_COMMAND = 0x10              # the only SRT channel on the bus: first SRT level (section 2)
@@ -637,6 +638,45 @@ def scenario_can_fd(s):
     s.notes.append("identifier %08X, flags BRS, 21 -> 24 and 9 -> 12 bytes" % ident)
 
 
+def scenario_fd_fragments_down(s):
+    """Issue 40: LCM events of 0, 62, 63, 64, 200, 300 bytes, the channel's largest (1000) and 1
+    byte -> cosmicd -> fragments on the CAN FD bus: every frame arrives (FD, bit-rate switch), by
+    the sender rules with 62 event bytes a fragment, and each event reassembles to what was
+    published (the last fragment padded to an FD length with zeros). cosmicd counts as sent on
+    bus_fd exactly the events and frames that arrived, and no send error."""
+    gw = s.t.gw
+    prio = gw.can_hop("fd_bulk_down")["priority"]
+    check(0xF0 <= prio <= 0xFF, "fd_bulk_down has an NRT priority (0xF0-0xFF), got %r" % prio)
+    ident = canlog.can_id(prio, GW_NODE, ETAG["fd_bulk_down"])
+    tx0 = gw.hop("fd_bulk_down", "bus_fd")["tx"]
+    adapter0 = gw.segments()["bus_fd"]["adapter"]
+    s.candump("dump", "%08X:C0003FFF" % ETAG["fd_bulk_down"], iface=IF_FD)
+    sizes = [0, 62, 63, 64, 200, 300, 1000, 1]
+    frames_expected = sum(max(1, -(-n // canlog.FD_FRAGMENT_DATA)) for n in sizes)
+    for n in sizes:  # one at a time: each publisher's message 1, in this order
+        s.lcm_pub("fd_bulk_down", n)
+    wait_until("%d fragments on vcan1" % frames_expected, 30, lambda: len(s.frames("dump")) >= frames_expected)
+    frames = s.frames("dump")
+    expect_eq("fragments on vcan1", len(frames), frames_expected)
+    check(all(f.id == ident and f.fd_flags is not None and f.fd_flags & 1 for f in frames),
+          "every fragment is an FD frame with the bit-rate switch on identifier %08X" % ident)
+    try:
+        events = canlog.reassemble([f.data for f in frames], 0, canlog.FD_FRAGMENT_DATA)
+    except ValueError as e:
+        raise Fail("FD fragments break the sender rules: %s" % e)
+    expect_eq("events reassembled", len(events), len(sizes))
+    for n, event in zip(sizes, events):
+        expect_eq("event of %d bytes" % n, event[:n].hex(), canlog.payload("lcm", n, 1).hex())
+        check(len(event) - n < 16 and not any(event[n:]), "event of %d bytes: only zero padding after it (%d bytes)"
+              % (n, len(event) - n))
+    wait_until("cosmicd's counters", 10, lambda: gw.hop("fd_bulk_down", "bus_fd")["tx"] - tx0 >= len(sizes))
+    expect_eq("events counted as sent on bus_fd", gw.hop("fd_bulk_down", "bus_fd", cli=True)["tx"] - tx0, len(sizes))
+    adapter = gw.segments(cli=True)["bus_fd"]["adapter"]
+    expect_eq("frames counted as sent on bus_fd", adapter["sent"] - adapter0["sent"], frames_expected)
+    expect_eq("send errors on bus_fd", adapter["send_errors"] - adapter0["send_errors"], 0)
+    s.notes.append("identifier %08X, %d fragments for %d events, tx %d" % (ident, frames_expected, len(sizes), len(sizes)))
+
+
 def scenario_overflow(s):
     """Frames the kernel drops while cosmicd does not read (SIGSTOP) show up as overflow drops;
     with what it received they add up to what was sent."""
@@ -808,7 +848,7 @@ def scenario_link_down_up(s):
 
 
 SCENARIOS = [scenario_etags, scenario_get_etag, scenario_can_to_ip, scenario_ip_to_can, scenario_fragments_up,
-             scenario_fragments_down, scenario_can_fd, scenario_native, scenario_unexplained, scenario_garbage, scenario_overflow, scenario_burst, scenario_error_frames,
+             scenario_fragments_down, scenario_can_fd, scenario_fd_fragments_down, scenario_native, scenario_unexplained, scenario_garbage, scenario_overflow, scenario_burst, scenario_error_frames,
              scenario_link_down_up]
 
 
