@@ -237,6 +237,12 @@ class Scene:
                 to_sim = self.replace(distance, "sim", "distance-sim.yaml")
                 if to_sim.returncode != 0:
                     raise SceneFailed("the replacement onto sim failed")
+                # The simulator's side of the same match (cosmic_wait_ready): the gateway switched
+                # once its reader had matched, so this returns at once.
+                began = time.monotonic()
+                simulator.wait_ready(5.0)
+                print(f"  simulator: ready (the gateway's reader has matched its writer), "
+                      f"checked in {(time.monotonic() - began) * 1e3:.1f} ms")
                 results.append((f"Python simulator (sim, DDS domain {SIM_DOMAIN})", self.episodes("sim"), self.promise_ms(),
                                 switch_note(to_sim)))
 

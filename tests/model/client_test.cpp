@@ -1,5 +1,6 @@
 // libcosmic-client through its C API: two components on one DDS domain (run in a private network
-// namespace), polling with cosmic_get_event, the refusals of bad input, and the control query.
+// namespace), polling with cosmic_get_event, waiting until a channel is carried (cosmic_wait_ready),
+// the refusals of bad input, and the control query.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -256,6 +257,105 @@ TEST(Client, ANewHandlerReplacesTheOldAndTheOldSubscriptionNoLongerStopsIt) {
   sub.close();  // stops every handler: the subscription outlives its client harmlessly
   EXPECT_FALSE(now.active());
   EXPECT_THROW(sub.announce(kSpeed, 0), std::runtime_error);
+}
+
+// Issue 40: a component waits until its channel is carried. A channel of its own name, so that no
+// endpoint of another test can match it.
+constexpr cosmic_channel_desc kProbe{"ready_probe", 0x4001, COSMIC_NRT, 0, 0, 0, 3, 4, COSMIC_PUBLISH};
+
+std::chrono::milliseconds since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - start);
+}
+
+TEST(Client, WaitReadyTimesOutWithoutAPeerAndReturnsOnceOneMatched) {
+  Client pub("dds:0");
+  ASSERT_NE(pub.handle, nullptr) << pub.error;
+  cosmic_channel* out = cosmic_announce(pub.handle, &kProbe, 1000);
+  ASSERT_NE(out, nullptr) << cosmic_last_error(pub.handle);
+
+  // No reader anywhere: the timeout, with a reason naming the channel, segment, role and time.
+  auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(cosmic_wait_ready(out, 200), COSMIC_E_TIMEOUT);
+  EXPECT_GE(since(start), std::chrono::milliseconds(200)) << "returned before its timeout";
+  const std::string why = cosmic_last_error(pub.handle);
+  EXPECT_NE(why.find("channel 'ready_probe'"), std::string::npos) << why;
+  EXPECT_NE(why.find("'dds:0'"), std::string::npos) << why;
+  EXPECT_NE(why.find("publish (no reader"), std::string::npos) << why;
+  EXPECT_EQ(why.find("subscribe"), std::string::npos) << why;
+  const auto waited = why.find("after waiting ");
+  ASSERT_NE(waited, std::string::npos) << why;
+  EXPECT_GE(std::stoi(why.substr(waited + 14)), 200) << why;
+  EXPECT_EQ(cosmic_wait_ready(out, 0), COSMIC_E_TIMEOUT);  // 0: a check without waiting
+
+  // A second component subscribes: both sides become ready, well within the generous bound.
+  Client sub("dds:0");
+  ASSERT_NE(sub.handle, nullptr) << sub.error;
+  const auto in_desc = with_roles(kProbe, COSMIC_SUBSCRIBE);
+  cosmic_channel* in = cosmic_announce(sub.handle, &in_desc, 1000);
+  ASSERT_NE(in, nullptr) << cosmic_last_error(sub.handle);
+  start = std::chrono::steady_clock::now();
+  ASSERT_EQ(cosmic_wait_ready(out, 10'000), COSMIC_OK) << cosmic_last_error(pub.handle);
+  EXPECT_LT(since(start), std::chrono::milliseconds(10'000));
+  ASSERT_EQ(cosmic_wait_ready(in, 10'000), COSMIC_OK) << cosmic_last_error(sub.handle);
+  EXPECT_EQ(cosmic_wait_ready(out, 0), COSMIC_OK);  // stays ready while the peer is there
+
+  // Once both ends are ready, the channel carries: the very first event arrives (no retries).
+  const std::int32_t value = 7;
+  ASSERT_EQ(cosmic_publish(out, &value, sizeof value), COSMIC_OK);
+  cosmic_event_info info{};
+  std::int32_t got = 0;
+  EXPECT_TRUE(wait_for([&] { return cosmic_get_event(in, &info, &got, sizeof got) == COSMIC_OK; }, std::chrono::seconds(10)));
+  EXPECT_EQ(got, 7);
+}
+
+TEST(Client, WaitReadyWithBothRolesNeedsAPeerNotItsOwnEndpoints) {
+  Client both("dds:0");
+  ASSERT_NE(both.handle, nullptr) << both.error;
+  const auto desc = with_roles(kProbe, COSMIC_PUBLISH | COSMIC_SUBSCRIBE);
+  cosmic_channel* ch = cosmic_announce(both.handle, &desc, 1000);
+  ASSERT_NE(ch, nullptr) << cosmic_last_error(both.handle);
+  // Its own reader matching its own writer carries nothing to or from the gateway.
+  EXPECT_EQ(cosmic_wait_ready(ch, 300), COSMIC_E_TIMEOUT);
+  const std::string why = cosmic_last_error(both.handle);
+  EXPECT_NE(why.find("publish (no reader"), std::string::npos) << why;
+  EXPECT_NE(why.find("subscribe (no writer"), std::string::npos) << why;
+
+  Client peer("dds:0");  // publishes and subscribes too: matches both roles
+  ASSERT_NE(peer.handle, nullptr) << peer.error;
+  cosmic_channel* other = cosmic_announce(peer.handle, &desc, 1000);
+  ASSERT_NE(other, nullptr) << cosmic_last_error(peer.handle);
+  EXPECT_EQ(cosmic_wait_ready(ch, 10'000), COSMIC_OK) << cosmic_last_error(both.handle);
+  EXPECT_EQ(cosmic_wait_ready(other, 10'000), COSMIC_OK) << cosmic_last_error(peer.handle);
+}
+
+TEST(Client, WaitReadyOnLcmReturnsAtOnceAndRefusesBadArguments) {
+  Client lcm("lcm:udpm://239.255.76.67:7941?ttl=0");
+  ASSERT_NE(lcm.handle, nullptr) << lcm.error;
+  cosmic_channel* out = cosmic_announce(lcm.handle, &kProbe, 1000);
+  ASSERT_NE(out, nullptr) << cosmic_last_error(lcm.handle);
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(cosmic_wait_ready(out, 10'000), COSMIC_OK);  // no discovery: nothing to wait for
+  EXPECT_LT(since(start), std::chrono::milliseconds(1000));
+  EXPECT_EQ(cosmic_wait_ready(nullptr, 100), COSMIC_E_INVALID);
+  EXPECT_EQ(cosmic_wait_ready(out, -1), COSMIC_E_INVALID);
+  EXPECT_NE(std::string(cosmic_last_error(lcm.handle)).find("negative"), std::string::npos);
+}
+
+// The C++ wrapper: TimeoutError with the reason, then a return once a peer matched.
+TEST(Client, WrapperWaitReadyThrowsTimeoutErrorUntilAPeerMatches) {
+  cosmic::client::Client sub("dds:0");
+  auto& in = sub.announce(with_roles(kProbe, COSMIC_SUBSCRIBE), 1000);
+  try {
+    in.wait_ready(std::chrono::milliseconds(100));
+    ADD_FAILURE() << "ready without a writer";
+  } catch (const cosmic::client::TimeoutError& e) {
+    EXPECT_NE(std::string(e.what()).find("subscribe (no writer"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(in.wait_ready(std::chrono::milliseconds(-1)), std::invalid_argument);
+  cosmic::client::Client pub("dds:0");
+  auto& out = pub.announce(kProbe, 1000);
+  EXPECT_NO_THROW(in.wait_ready(std::chrono::seconds(10)));
+  EXPECT_NO_THROW(out.wait_ready(std::chrono::seconds(10)));
 }
 
 TEST(Client, CheckChannelWithoutAGateway) {

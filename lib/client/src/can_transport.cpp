@@ -98,6 +98,10 @@ class CanTransport final : public Transport {
     return COSMIC_OK;
   }
 
+  // No discovery to ask, and nothing left to wait for: announce() succeeded only once a gateway's
+  // SUPPLY_ETAG answered, and a gateway answers only for a channel it binds on this bus.
+  std::optional<std::size_t> matched(std::size_t, int) const override { return std::nullopt; }
+
  private:
   int write_frame(std::uint32_t id, std::span<const std::uint8_t> data, std::string& error) {
     can_frame frame{};

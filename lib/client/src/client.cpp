@@ -1,6 +1,7 @@
 // The C API of libcosmic-client over one Transport per client.
 #include "cosmic/client.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -8,6 +9,7 @@
 #include <cstring>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -53,6 +55,7 @@ struct cosmic_channel {
 };
 
 struct cosmic_client final : Delivery {
+  std::string segment;  // as cosmic_open() was given it; set before the client is shared
   cosmic::Mutex mutex;  // guards channels and error
   std::vector<std::unique_ptr<cosmic_channel>> channels COSMIC_GUARDED_BY(mutex);
   std::string error COSMIC_GUARDED_BY(mutex);
@@ -135,6 +138,22 @@ cosmic::ChannelSpec spec_of(const cosmic_channel_desc& d) {
   return s;
 }
 
+// The roles of `roles` whose endpoint nothing matched yet, for cosmic_wait_ready's error; empty
+// when each has a match, or when the transport has no discovery (nothing to wait for).
+std::string unmatched_roles(const Transport& transport, std::size_t index, int roles) {
+  std::string missing;
+  for (const int role : {COSMIC_PUBLISH, COSMIC_SUBSCRIBE}) {
+    if (!(roles & role)) continue;
+    const std::optional<std::size_t> peers = transport.matched(index, role);
+    if (!peers) return "";
+    if (*peers > 0) continue;
+    missing += missing.empty() ? "" : " and ";
+    missing += role == COSMIC_PUBLISH ? "publish (no reader has matched this component's writer)"
+                                      : "subscribe (no writer has matched this component's reader)";
+  }
+  return missing;
+}
+
 std::int64_t wall_clock_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
@@ -146,6 +165,7 @@ extern "C" {
 cosmic_client* cosmic_open(const char* segment, char* error, size_t error_size) {
   std::string why;
   auto client = std::make_unique<cosmic_client>();
+  client->segment = segment ? segment : "";
   client->transport = transport_for(segment ? segment : "", why);
   if (client->transport && client->transport->start(*client, why) == COSMIC_OK) return client.release();
   copy_text(why, error, error_size);
@@ -186,6 +206,32 @@ cosmic_channel* cosmic_announce(cosmic_client* client, const cosmic_channel_desc
     return nullptr;
   }
   return handle;
+}
+
+int cosmic_wait_ready(cosmic_channel* channel, int timeout_ms) {
+  using Clock = std::chrono::steady_clock;
+  if (!channel) return COSMIC_E_INVALID;
+  cosmic_client* client = channel->client;
+  if (timeout_ms < 0) {
+    return client->fail(COSMIC_E_INVALID, "cosmic_wait_ready: timeout_ms " + std::to_string(timeout_ms) + " is negative");
+  }
+  // The transports offer no match notification through SegmentAdapter: the counts are polled
+  // (shared locks and a status copy, microseconds) every millisecond until the deadline.
+  constexpr auto kPoll = std::chrono::milliseconds(1);
+  const auto start = Clock::now();
+  const auto deadline = start + std::chrono::milliseconds(timeout_ms);
+  while (true) {
+    const std::string missing = unmatched_roles(*client->transport, channel->index, channel->roles);
+    if (missing.empty()) return COSMIC_OK;
+    const auto now = Clock::now();
+    if (now >= deadline) {
+      const auto waited = std::chrono::duration_cast<std::chrono::milliseconds>(now - start).count();
+      return client->fail(COSMIC_E_TIMEOUT, "channel '" + channel->spec.name + "' on segment '" + client->segment +
+                                                "' is not ready after waiting " + std::to_string(waited) +
+                                                " ms; unmatched: " + missing);
+    }
+    std::this_thread::sleep_until(std::min(deadline, now + kPoll));
+  }
 }
 
 int cosmic_publish(cosmic_channel* channel, const void* data, size_t size) {

@@ -1,5 +1,7 @@
 // DDS and LCM for a component: the gateway's adapters with the roles mirrored, so topics, envelope
 // and QoS are exactly what cosmicd expects (one implementation of the mapping, not two).
+#include <fastrtps/config.h>
+
 #include <random>
 #include <vector>
 
@@ -37,6 +39,21 @@ class QuietLogger : public Logger {
 ChannelId binding_id(std::size_t index) { return static_cast<ChannelId>(index + 1); }
 std::size_t index_of(ChannelId id) { return static_cast<std::size_t>(id - 1); }
 
+// Fast DDS before 2.10 matches a participant's reader with its own writer of the same topic (the
+// adapter sets fastdds.ignore_local_endpoints, which takes effect from 2.10 on): a channel announced
+// with both roles is matched once by itself in each role, and that match carries nothing between
+// the component and the gateway. tests/model/client_test.cpp checks that such a channel without a
+// peer is not ready.
+#if FASTRTPS_VERSION_MAJOR < 2 || (FASTRTPS_VERSION_MAJOR == 2 && FASTRTPS_VERSION_MINOR < 10)
+constexpr std::size_t kOwnMatchesWithBothRoles = 1;
+#else
+constexpr std::size_t kOwnMatchesWithBothRoles = 0;
+#endif
+
+// The adapter's role for the component's endpoint of `role`: the component's publication is the
+// adapter's sending side (HopRole::subscriber, a writer), its subscription the receiving one.
+HopRole hop_role_of(int role) { return role == COSMIC_PUBLISH ? HopRole::subscriber : HopRole::publisher; }
+
 class IpTransport final : public Transport, private EventSink {
  public:
   explicit IpTransport(const SegmentSpec& segment) : segment_(segment) {
@@ -50,8 +67,13 @@ class IpTransport final : public Transport, private EventSink {
 
   int start(Delivery& delivery, std::string& error) override {
     delivery_ = &delivery;
-    adapter_ = segment_.type == SegmentType::dds ? std::unique_ptr<SegmentAdapter>(make_dds_adapter(segment_, self_, log_))
-                                                  : make_lcm_adapter(segment_, self_, log_);
+    if (segment_.type == SegmentType::dds) {
+      auto dds = make_dds_segment_adapter(segment_, self_, log_);
+      dds_ = dds.get();
+      adapter_ = std::move(dds);
+    } else {
+      adapter_ = make_lcm_adapter(segment_, self_, log_);
+    }
     const Status s = adapter_->start(*this);
     if (!s.ok) error = s.error;
     return s.ok ? COSMIC_OK : COSMIC_E_TRANSPORT;
@@ -60,8 +82,8 @@ class IpTransport final : public Transport, private EventSink {
   int announce(std::size_t index, const ChannelSpec& spec, int roles, int, std::string& error) override {
     LockGuard lock(mutex_);
     auto next = bindings_;
-    if (roles & COSMIC_PUBLISH) next.push_back(ChannelBinding{binding_id(index), spec, HopRole::subscriber, std::nullopt});
-    if (roles & COSMIC_SUBSCRIBE) next.push_back(ChannelBinding{binding_id(index), spec, HopRole::publisher, std::nullopt});
+    if (roles & COSMIC_PUBLISH) next.push_back(ChannelBinding{binding_id(index), spec, hop_role_of(COSMIC_PUBLISH), std::nullopt});
+    if (roles & COSMIC_SUBSCRIBE) next.push_back(ChannelBinding{binding_id(index), spec, hop_role_of(COSMIC_SUBSCRIBE), std::nullopt});
     const Status s = adapter_->configure(next);
     if (!s.ok) {
       error = s.error;
@@ -85,6 +107,23 @@ class IpTransport final : public Transport, private EventSink {
     return COSMIC_E_TRANSPORT;
   }
 
+  // DDS: the matches of the component's writer or reader, without its own; LCM has no discovery.
+  std::optional<std::size_t> matched(std::size_t index, int role) const override {
+    if (!dds_) return std::nullopt;
+    const ChannelId id = binding_id(index);
+    int roles = 0;
+    {
+      LockGuard lock(mutex_);
+      for (const ChannelBinding& b : bindings_) {
+        if (b.id == id) roles |= b.role == HopRole::subscriber ? COSMIC_PUBLISH : COSMIC_SUBSCRIBE;
+      }
+    }
+    if (!(roles & role)) return 0;
+    const std::size_t all = dds_->matched_endpoints(id, hop_role_of(role));
+    const std::size_t own = roles == (COSMIC_PUBLISH | COSMIC_SUBSCRIBE) ? kOwnMatchesWithBothRoles : 0;
+    return all > own ? all - own : 0;
+  }
+
  private:
   void on_event(const InboundEvent& event) override {
     // Only channels announced to subscribe are bound for receiving.
@@ -97,7 +136,8 @@ class IpTransport final : public Transport, private EventSink {
   QuietLogger log_;
   Delivery* delivery_ = nullptr;
   std::unique_ptr<SegmentAdapter> adapter_;
-  Mutex mutex_;
+  DdsSegmentAdapter* dds_ = nullptr;  // adapter_ on a DDS segment, for its per-role matches
+  mutable Mutex mutex_;
   std::vector<ChannelBinding> bindings_ COSMIC_GUARDED_BY(mutex_);
 };
 

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -30,6 +31,11 @@ class Transport {
   virtual int announce(std::size_t index, const ChannelSpec& spec, int roles, int timeout_ms, std::string& error) = 0;
   // One event of channel `index`, announced with COSMIC_PUBLISH. Never throws.
   virtual int send(std::size_t index, const EventHeader& header, std::span<const std::uint8_t> payload, std::string& error) = 0;
+  // Remote endpoints matched with the component's endpoint of `role` on channel `index`
+  // (COSMIC_PUBLISH: readers of its writer; COSMIC_SUBSCRIBE: writers of its reader), never
+  // counting the component's own; nullopt where the transport has no discovery to ask (LCM, CAN).
+  // Any thread; cheap enough to poll every millisecond.
+  virtual std::optional<std::size_t> matched(std::size_t index, int role) const = 0;
 };
 
 // "dds:..." and "lcm:..." through the gateway's own segment adapters, roles mirrored: the

@@ -5,7 +5,8 @@ address; cosmicd forwards its events like any other publisher's::
 
     import cosmic, numpy as np
     with cosmic.Client("dds:0") as lan:
-        distance = lan.announce_from("config/robot.yaml", "distance", roles=cosmic.PUBLISH)
+        # ready=5.0: returns once the gateway's reader matched (cosmic.NotReadyError after 5 s)
+        distance = lan.announce_from("config/robot.yaml", "distance", roles=cosmic.PUBLISH, ready=5.0)
         distance.publish(np.array([1.25], dtype="<f4"))     # the array's memory, no copy
         obstacle = lan.announce("obstacle", 0x100000050, cls="hrt", payload=1, roles="subscribe")
         event = obstacle.get_event(timeout=0.1)              # None after 100 ms without one
@@ -24,6 +25,7 @@ from . import _native
 from ._errors import (
     E_AGAIN,
     E_INVALID,
+    E_TIMEOUT,
     E_TOO_LARGE,
     E_TRANSPORT,
     E_UNAVAILABLE,
@@ -32,6 +34,7 @@ from ._errors import (
     ClosedError,
     Error,
     InvalidError,
+    NotReadyError,
     TooLargeError,
     TransportError,
     UnavailableError,
@@ -40,10 +43,10 @@ from ._errors import (
 from ._native import Channel, Event, check_channel, parse_duration_ns
 
 __all__ = [
-    "Channel", "ChannelDesc", "Client", "ClosedError", "Error", "Event", "InvalidError", "PUBLISH", "Role",
-    "SUBSCRIBE", "TooLargeError", "TransportError", "UnavailableError", "UnboundError", "check_channel",
+    "Channel", "ChannelDesc", "Client", "ClosedError", "Error", "Event", "InvalidError", "NotReadyError", "PUBLISH",
+    "Role", "SUBSCRIBE", "TooLargeError", "TransportError", "UnavailableError", "UnboundError", "check_channel",
     "load_channel", "parse_duration_ns", "OK", "E_INVALID", "E_TRANSPORT", "E_AGAIN", "E_TOO_LARGE",
-    "E_UNBOUND", "E_UNAVAILABLE",
+    "E_UNBOUND", "E_UNAVAILABLE", "E_TIMEOUT",
 ]
 
 
@@ -152,14 +155,18 @@ class Client(_native.Client):
     def announce(self, channel: Union[str, ChannelDesc], subject: Optional[int] = None, *, roles: Roles,
                  cls: Optional[Union[str, int]] = None, period: Duration = None, reaction_time: Duration = None,
                  temp_validity: Duration = None, omission_degree: Optional[int] = None, payload: Optional[int] = None,
-                 timeout: Duration = 5.0) -> Channel:
+                 timeout: Duration = 5.0, ready: Duration = None) -> Channel:
         """Sets up a channel for ``roles`` (cosmic_announce) and returns it.
 
         ``channel`` is the channel's name with ``subject`` and its model as keywords (defaults: nrt,
         no period, omission_degree 0, payload 8 bytes), or a ChannelDesc (from load_channel), whose
         fields the keywords given override. ``roles``: cosmic.PUBLISH, cosmic.SUBSCRIBE, both or'ed,
         or "publish", "subscribe", "publish,subscribe". ``timeout`` bounds a CAN announce's wait for
-        the gateway's etag. Raises cosmic.InvalidError, cosmic.TransportError, cosmic.UnboundError.
+        the gateway's etag. ``ready`` (seconds, or None: do not wait): then wait_ready(ready) too, so
+        that the channel is returned once it is carried (on DDS every role has a matched peer, e.g.
+        the gateway's reader; at once on LCM and CAN); cosmic.NotReadyError when that time passed
+        (the channel stays announced on the client). Raises cosmic.InvalidError,
+        cosmic.TransportError, cosmic.UnboundError, cosmic.NotReadyError.
         """
         given = {k: v for k, v in dict(subject=subject, cls=cls, period=period, reaction_time=reaction_time,
                                         temp_validity=temp_validity, omission_degree=omission_degree,
@@ -170,14 +177,20 @@ class Client(_native.Client):
             raise InvalidError(E_INVALID, f"announce({channel!r}): a subject is needed (or a ChannelDesc)")
         else:
             desc = ChannelDesc(name=channel, **given)
-        return self._announce(
+        ready_ns = None if ready is None else _ns(ready, "ready")
+        announced = self._announce(
             desc.name, desc.subject, _class(desc.cls), _ns(desc.period, "period"),
             _ns(desc.reaction_time, "reaction_time"), _ns(desc.temp_validity, "temp_validity"),
             desc.omission_degree, desc.payload, _roles(roles), min(_ns(timeout, "timeout") // 1_000_000, 2**31 - 1))
+        if ready_ns is not None:
+            announced.wait_ready(ready_ns / 1e9)
+        return announced
 
-    def announce_from(self, yaml_file: str, name: str, *, roles: Roles, timeout: Duration = 5.0) -> Channel:
-        """announce() of channel ``name`` as the gateway configuration ``yaml_file`` describes it."""
-        return self.announce(load_channel(yaml_file, name), roles=roles, timeout=timeout)
+    def announce_from(self, yaml_file: str, name: str, *, roles: Roles, timeout: Duration = 5.0,
+                      ready: Duration = None) -> Channel:
+        """announce() of channel ``name`` as the gateway configuration ``yaml_file`` describes it
+        (``ready``: see announce())."""
+        return self.announce(load_channel(yaml_file, name), roles=roles, timeout=timeout, ready=ready)
 
 
 # No receive thread may still want the GIL once the interpreter finalizes.

@@ -11,6 +11,7 @@ E_AGAIN = -3
 E_TOO_LARGE = -4
 E_UNBOUND = -5
 E_UNAVAILABLE = -6
+E_TIMEOUT = -7
 
 CODE_NAMES = {
     E_INVALID: "COSMIC_E_INVALID",
@@ -19,6 +20,7 @@ CODE_NAMES = {
     E_TOO_LARGE: "COSMIC_E_TOO_LARGE",
     E_UNBOUND: "COSMIC_E_UNBOUND",
     E_UNAVAILABLE: "COSMIC_E_UNAVAILABLE",
+    E_TIMEOUT: "COSMIC_E_TIMEOUT",
 }
 
 
@@ -54,6 +56,12 @@ class UnavailableError(Error):
     """COSMIC_E_UNAVAILABLE: the gateway's control socket cannot be reached or answers nonsense."""
 
 
+class NotReadyError(Error, TimeoutError):
+    """COSMIC_E_TIMEOUT: no peer matched the channel within wait_ready()'s (or announce(ready=...)'s)
+    timeout; the message names the channel, the segment, the role(s) still unmatched and the time
+    waited. The channel stays announced and usable. Also a built-in TimeoutError."""
+
+
 class ClosedError(Error):
     """A call on a client (or one of its channels) after close(); code COSMIC_E_INVALID."""
 
@@ -64,6 +72,7 @@ _BY_CODE = {
     E_TOO_LARGE: TooLargeError,
     E_UNBOUND: UnboundError,
     E_UNAVAILABLE: UnavailableError,
+    E_TIMEOUT: NotReadyError,
 }
 
 

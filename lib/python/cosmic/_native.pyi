@@ -11,6 +11,7 @@ E_AGAIN: int
 E_TOO_LARGE: int
 E_UNBOUND: int
 E_UNAVAILABLE: int
+E_TIMEOUT: int
 PUBLISH: int
 SUBSCRIBE: int
 
@@ -43,6 +44,10 @@ class Channel:
     def subscribe(self, callback: Callable[[Event], Any]) -> None: ...
     def unsubscribe(self) -> None: ...
     def get_event(self, timeout: Optional[float] = 0.0) -> Optional[Event]: ...
+    def wait_ready(self, timeout: float) -> None:
+        """Waits up to `timeout` s until every announced role has a matched remote endpoint (DDS;
+        at once on LCM and CAN); raises cosmic.NotReadyError (a TimeoutError) when it passed."""
+        ...
 
 class Client:
     def __init__(self, segment: str) -> None: ...

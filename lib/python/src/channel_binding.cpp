@@ -3,6 +3,8 @@
 #include <pybind11/stl.h>
 
 #include <chrono>
+#include <climits>
+#include <cmath>
 #include <optional>
 #include <utility>
 
@@ -97,6 +99,26 @@ void unsubscribe(const ChannelRef& self) {
   }
   py::gil_scoped_release nogil;
   cosmic_subscribe(self.channel->handle, deliver_to_queue, self.channel);
+}
+
+// cosmic_wait_ready with the GIL released: the wait is bounded by `timeout`, after which Ctrl-C and
+// a close() from another thread take effect. Never inside a callback (the C API's rule: it would
+// hold up the receive thread for up to `timeout`).
+void wait_ready(const ChannelRef& self, double timeout) {
+  if (!(timeout >= 0)) raise_error(COSMIC_E_INVALID, "wait_ready(): timeout must be >= 0 seconds");
+  if (running_callback().channel) {
+    raise_error(COSMIC_E_INVALID, "wait_ready() of channel '" + self.channel->name + "' from inside the callback of channel '" +
+                                      running_callback().channel->name + "' (it would hold up the receive thread)");
+  }
+  ClientState::Use use(*self.client, "wait_ready()");
+  const double ms = std::round(timeout * 1e3);
+  const int timeout_ms = ms >= static_cast<double>(INT_MAX) ? INT_MAX : static_cast<int>(ms);
+  int rc = COSMIC_OK;
+  {
+    py::gil_scoped_release nogil;
+    rc = cosmic_wait_ready(self.channel->handle, timeout_ms);
+  }
+  if (rc != COSMIC_OK) raise_error(rc, "wait_ready(): " + self.client->last_error());
 }
 
 std::optional<QueuedEvent> pop(ChannelState& channel) {
@@ -211,6 +233,15 @@ sys.unraisablehook; the receive thread carries on. Keep callbacks short: they de
       .def("unsubscribe", &unsubscribe, R"doc(
 Stops the callback: when this returns it is not running (unless called from inside it) and is
 never called again; later events are queued for get_event().)doc")
+      .def("wait_ready", &wait_ready, "timeout"_a, R"doc(
+Waits up to `timeout` seconds (rounded to whole milliseconds) until the channel is carried: on
+DDS, until every announced role has a matched remote endpoint (publish: a reader, the gateway's or
+another component's, matched this component's writer; subscribe: a writer matched its reader).
+Events published before a reader matched are lost to it. Returns at once on LCM (no discovery)
+and on CAN (announce already got the gateway's etag). Raises cosmic.NotReadyError (a TimeoutError)
+naming the channel, the segment, the unmatched role(s) and the time waited; the channel stays
+usable; cosmic.InvalidError for a negative timeout or a call from inside a callback. The GIL is
+released meanwhile; Ctrl-C and close() from another thread take effect when it returns.)doc")
       .def("get_event", &get_event, "timeout"_a = 0.0, R"doc(
 The oldest queued event, or None when none arrived within `timeout` seconds (0: do not wait, the
 polling of a fixed-step loop; None: wait until one arrives). Events are queued while no callback

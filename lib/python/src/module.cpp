@@ -36,6 +36,7 @@ PYBIND11_MODULE(_native, m) {
   m.attr("E_TOO_LARGE") = py::int_(static_cast<int>(COSMIC_E_TOO_LARGE));
   m.attr("E_UNBOUND") = py::int_(static_cast<int>(COSMIC_E_UNBOUND));
   m.attr("E_UNAVAILABLE") = py::int_(static_cast<int>(COSMIC_E_UNAVAILABLE));
+  m.attr("E_TIMEOUT") = py::int_(static_cast<int>(COSMIC_E_TIMEOUT));
   m.attr("PUBLISH") = py::int_(static_cast<int>(COSMIC_PUBLISH));
   m.attr("SUBSCRIBE") = py::int_(static_cast<int>(COSMIC_SUBSCRIBE));
   cosmic::python::bind_client(m);

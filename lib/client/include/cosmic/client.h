@@ -50,7 +50,8 @@ enum {
   COSMIC_E_AGAIN = -3,       /* cosmic_get_event: no event waiting; publish: try again */
   COSMIC_E_TOO_LARGE = -4,   /* event larger than the channel's payload or the caller's buffer */
   COSMIC_E_UNBOUND = -5,     /* CAN: no gateway answered GET_ETAG for the subject */
-  COSMIC_E_UNAVAILABLE = -6  /* cosmic_check_channel: the gateway cannot be reached */
+  COSMIC_E_UNAVAILABLE = -6, /* cosmic_check_channel: the gateway cannot be reached */
+  COSMIC_E_TIMEOUT = -7      /* cosmic_wait_ready: no peer matched within the timeout */
 };
 
 /* A channel as the model (the YAML) describes it. Durations in nanoseconds, 0 = not given. */
@@ -87,8 +88,34 @@ void cosmic_close(cosmic_client* client);
 const char* cosmic_last_error(const cosmic_client* client);
 
 /* Sets up the channel for the roles in desc->roles (creates the DDS writer/reader, binds the CAN
- * etag: up to timeout_ms waiting for the gateway's SUPPLY_ETAG). NULL on failure. */
+ * etag: up to timeout_ms waiting for the gateway's SUPPLY_ETAG). NULL on failure. On DDS it
+ * returns before any peer has matched: cosmic_wait_ready() waits until the channel is carried. */
 cosmic_channel* cosmic_announce(cosmic_client* client, const cosmic_channel_desc* desc, int timeout_ms);
+/* Waits up to timeout_ms until the channel is carried: every role announced on it has at least one
+ * matched remote endpoint. COSMIC_PUBLISH: a reader (the gateway's, or another component's) has
+ * matched this component's writer; COSMIC_SUBSCRIBE: a writer has matched its reader. Call it after
+ * cosmic_announce() (which never waits for this) and before the first event that must not be lost:
+ * events published before a reader matched are lost to it, and DDS discovery takes from
+ * milliseconds to seconds (e.g. after `cosmicctl bind --replace` moved the channel's publisher to
+ * this segment, the gateway's new reader appears there).
+ * Returns COSMIC_OK once ready, at once when it already is (timeout_ms 0: a check without waiting);
+ * COSMIC_E_TIMEOUT when timeout_ms passed first, with cosmic_last_error() naming the channel, the
+ * segment, the role(s) still unmatched and the time waited; COSMIC_E_INVALID for a NULL channel
+ * or a negative timeout_ms.
+ * Per transport:
+ *   DDS  waits for the matches (polled every millisecond). They are what this side of DDS sees;
+ *        the remote end matches on its own side at about the same time. COSMIC_PUBLISH: the
+ *        writer keeps its latest omission_degree + 1 events for a reader it matched until that
+ *        reader has them, so a reliable reader (the gateway's on a reliable segment) gets what is
+ *        published after COSMIC_OK even if its own side matches a little later. COSMIC_SUBSCRIBE:
+ *        the remote writer may match this reader a little after this reader matched it, and what
+ *        it sends before that does not reach this reader;
+ *   LCM  COSMIC_OK at once: multicast has no discovery, a subscriber cannot be seen;
+ *   CAN  COSMIC_OK at once: cosmic_announce() already waited for the gateway's SUPPLY_ETAG answer to
+ *        GET_ETAG, which a gateway gives only for a channel it binds on that bus.
+ * The channel stays announced and usable whatever this returns. From any thread, for any number of
+ * channels at once; never from inside a callback (it would hold up the receive thread). */
+int cosmic_wait_ready(cosmic_channel* channel, int timeout_ms);
 /* One event of `size` bytes (at most desc->payload). */
 int cosmic_publish(cosmic_channel* channel, const void* data, size_t size);
 /* Events of the channel go to `fn` on the receive thread; fn NULL: they are queued for

@@ -1,8 +1,11 @@
 // C++ wrapper of libcosmic-client (cosmic/client.h has the contract: formats, threads, ownership).
-// Setup (open, announce) throws std::runtime_error with the reason; the hot path (publish,
-// poll) returns COSMIC_* codes and never throws.
+// Setup (open, announce, wait_ready) throws std::runtime_error (or TimeoutError, derived from it)
+// with the reason; the hot path (publish, poll) returns COSMIC_* codes and never throws.
 #pragma once
 
+#include <algorithm>
+#include <chrono>
+#include <climits>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -20,6 +23,13 @@ namespace cosmic::client {
 struct Event {
   cosmic_event_info info{};
   std::vector<std::uint8_t> data;
+};
+
+// Channel::wait_ready() ran out of time (COSMIC_E_TIMEOUT): what() names the channel, the
+// segment, the role(s) still unmatched and the time waited.
+class TimeoutError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
 };
 
 using Handler = std::function<void(const cosmic_event_info&, std::span<const std::uint8_t>)>;
@@ -62,14 +72,27 @@ class [[nodiscard]] Subscription {
 };
 
 // One announced channel; owned by its Client (valid while the Client lives and is not closed).
-// publish() and poll() from any thread; on_event(), stop_events() and the Subscriptions of one
-// channel from one thread at a time (the handler's thread counts as one).
+// publish(), poll() and wait_ready() from any thread; on_event(), stop_events() and the
+// Subscriptions of one channel from one thread at a time (the handler's thread counts as one).
 class Channel : public std::enable_shared_from_this<Channel> {
  public:
-  explicit Channel(cosmic_channel* handle) : handle_(handle) {}
+  explicit Channel(cosmic_channel* handle, cosmic_client* client = nullptr) : handle_(handle), client_(client) {}
   Channel(const Channel&) = delete;
   Channel& operator=(const Channel&) = delete;
 
+  // Waits until the channel is carried (cosmic_wait_ready): every announced role has a matched
+  // remote endpoint on DDS; at once on LCM and CAN. Call it after announce and before the first
+  // event that must not be lost. Throws TimeoutError when `timeout` passed first (the channel stays
+  // usable), std::invalid_argument for a negative timeout. Timeouts beyond INT_MAX ms are cut to it.
+  void wait_ready(std::chrono::milliseconds timeout) {
+    if (timeout.count() < 0) throw std::invalid_argument("wait_ready: the timeout is negative");
+    const auto ms = std::min<std::chrono::milliseconds::rep>(timeout.count(), INT_MAX);
+    const int rc = cosmic_wait_ready(handle_, static_cast<int>(ms));
+    if (rc == COSMIC_OK) return;
+    const std::string why = std::string("cosmic_wait_ready: ") + (client_ ? cosmic_last_error(client_) : "failed");
+    if (rc == COSMIC_E_TIMEOUT) throw TimeoutError(why);
+    throw std::runtime_error(why);
+  }
   int publish(std::span<const std::uint8_t> data) { return cosmic_publish(handle_, data.data(), data.size()); }
   // Any trivially copyable value, as its bytes.
   template <typename T>
@@ -132,6 +155,7 @@ class Channel : public std::enable_shared_from_this<Channel> {
     retired_.clear();
   }
   cosmic_channel* handle_;
+  cosmic_client* client_;  // for cosmic_last_error(); null: the reasons are not known
   std::unique_ptr<Installed> installed_;
   std::vector<std::unique_ptr<Installed>> retired_;
   std::uint64_t generation_ = 0;  // counts installs and stops; a Subscription stops only its own
@@ -162,7 +186,7 @@ class Client {
     if (!client_) throw std::runtime_error(std::string("cosmic_announce(") + desc.name + "): the client is closed");
     cosmic_channel* handle = cosmic_announce(client_, &desc, timeout_ms);
     if (!handle) throw std::runtime_error(std::string("cosmic_announce(") + desc.name + "): " + cosmic_last_error(client_));
-    channels_.push_back(std::make_shared<Channel>(handle));
+    channels_.push_back(std::make_shared<Channel>(handle, client_));
     return *channels_.back();
   }
   // Stops the receive threads (waiting for a handler in progress), then frees the channels: no
