@@ -127,4 +127,15 @@ sed -i 's/BA_DEF_DEF_ "GenMsgCycleTime" 5;/BA_DEF_DEF_ "GenMsgCycleTime" 0;/' "$
 run busy_no_cycle 2 check "$WORK/busy.yaml"
 contains busy_no_cycle err "$WORK/busy.dbc:9:1: segments[0].background.dbc: message F0 (0x010) has no GenMsgCycleTime"
 
+# bind --match-timeout (issue 40): only with --replace, a duration from 0 to 60 s; refused before
+# anything is sent (no gateway needed: the socket does not exist).
+echo "{name: x, subject: 1, class: nrt, publishers: [a], subscribers: [b]}" >"$WORK/x.yaml"
+run match_no_replace 64 --socket "$WORK/none.sock" bind --match-timeout 5s "$WORK/x.yaml"
+contains match_no_replace err "--match-timeout requires --replace"
+run match_too_long 64 --socket "$WORK/none.sock" bind --replace --match-timeout 61s "$WORK/x.yaml"
+contains match_too_long err "--match-timeout: '61s' is not a duration from 0 to 60s"
+run match_garbage 64 --socket "$WORK/none.sock" bind --replace --match-timeout soon "$WORK/x.yaml"
+contains match_garbage err "--match-timeout: 'soon' is not a duration from 0 to 60s"
+run match_fine_no_gateway 69 --socket "$WORK/none.sock" bind --replace --match-timeout 500ms "$WORK/x.yaml"
+
 finish "cosmicctl check"
