@@ -17,7 +17,7 @@ const Json& member(const Json& object, const char* key) {
   return object.is_object() && object.contains(key) ? object[key] : empty;
 }
 
-std::string text(const Json& value) { return value.is_string() ? value.get<std::string>() : value.dump(); }
+std::string json_text(const Json& value) { return value.is_string() ? value.get<std::string>() : value.dump(); }
 
 std::uint64_t count_at(const Json& object, const char* key) {
   return object.is_object() && object.contains(key) && object[key].is_number_unsigned() ? object[key].get<std::uint64_t>() : 0;
@@ -36,7 +36,7 @@ std::string rate_text(std::optional<double> rate) {
   return with_unit(*rate, "%.1f");
 }
 
-std::string micros(double seconds) { return with_unit(seconds * 1e6, "%.0fus"); }
+std::string column_micros(double seconds) { return with_unit(seconds * 1e6, "%.0fus"); }
 
 // A counter's value in the previous sample, when there was one.
 struct Prior {
@@ -109,12 +109,12 @@ TopLine header(const TopSample& current, const Rates& rates) {
   const std::uint64_t progress = count_at(router, "progress");
   const std::uint64_t violated = count_at(s["channels"], "violated");
   const std::uint64_t failed = count_at(s["channels"], "failed");
-  std::string line = "cosmicd " + text(g["name"]) + " (id " + text(g["id"]) + "), up " +
-                     std::to_string(static_cast<long>(g.value("uptime_s", 0.0))) + " s   segments " + text(s["segments"]["up"]) +
-                     "/" + text(s["segments"]["total"]) + " up   channels " + text(s["channels"]["bound"]) + " bound, " +
-                     text(s["channels"]["degraded"]) + " degraded, " + std::to_string(failed) + " failed, " +
+  std::string line = "cosmicd " + json_text(g["name"]) + " (id " + json_text(g["id"]) + "), up " +
+                     std::to_string(static_cast<long>(g.value("uptime_s", 0.0))) + " s   segments " + json_text(s["segments"]["up"]) +
+                     "/" + json_text(s["segments"]["total"]) + " up   channels " + json_text(s["channels"]["bound"]) + " bound, " +
+                     json_text(s["channels"]["degraded"]) + " degraded, " + std::to_string(failed) + " failed, " +
                      std::to_string(violated) + " violated   router " +
-                     text(router["queued"]) + " queued, " + rate_text(rates.of(progress, rates.previous_progress())) + " ev/s";
+                     json_text(router["queued"]) + " queued, " + rate_text(rates.of(progress, rates.previous_progress())) + " ev/s";
   return {line, violated > 0 || failed > 0 || count_at(s["segments"], "up") < count_at(s["segments"], "total")};
 }
 
@@ -128,12 +128,12 @@ void segment_rows(std::vector<TopLine>& out, const TopSample& current, const Rat
     const auto errors = count_at(a, "receive_errors") + count_at(a, "send_errors");
     const Prior old_errors =
         old_adapter ? Prior{true, count_at(*old_adapter, "receive_errors") + count_at(*old_adapter, "send_errors")} : Prior{};
-    const std::string health = text(s["health"]);
-    out.push_back({pad_column(text(s["name"]), 14) + pad_column(text(s["type"]), 5) + pad_column(health, 9) +
+    const std::string health = json_text(s["health"]);
+    out.push_back({pad_column(json_text(s["name"]), 14) + pad_column(json_text(s["type"]), 5) + pad_column(health, 9) +
                        pad_column(cosmic::format_percent(s.value("utilization", 0.0)), 7) +
                        pad_column(rate_text(rates.of(count_at(a, "received"), before(old_adapter, "received"))), 9) +
                        pad_column(rate_text(rates.of(count_at(a, "sent"), before(old_adapter, "sent"))), 9) +
-                       pad_column(rate_text(rates.of(errors, old_errors)), 7) + pad_column(text(a["overflow_drops"]), 9) +
+                       pad_column(rate_text(rates.of(errors, old_errors)), 7) + pad_column(json_text(a["overflow_drops"]), 9) +
                        s.value("detail", ""),
                    health != "up"});
   }
@@ -141,7 +141,7 @@ void segment_rows(std::vector<TopLine>& out, const TopSample& current, const Rat
 
 std::string residence_of(const Json& hop) {
   if (!hop.contains("runtime")) return "-";
-  return micros(hop["runtime"].value("residence_p50_s", 0.0)) + "/" + micros(hop["runtime"].value("residence_p99_s", 0.0));
+  return column_micros(hop["runtime"].value("residence_p50_s", 0.0)) + "/" + column_micros(hop["runtime"].value("residence_p99_s", 0.0));
 }
 
 std::string misses_of(const Json& hop) {
@@ -162,8 +162,8 @@ void channel_rows(std::vector<TopLine>& out, const TopSample& current, const Rat
       const Json* old = rates.previous_hop(name, hop.value("segment", ""));
       const bool publisher = hop.value("role", "") == "publisher";
       const Prior old_drops = old ? Prior{true, drops_of(*old)} : Prior{};
-      out.push_back({pad_column(first ? name : "", 16) + pad_column(first ? text(c["class"]) : "", 6) +
-                         pad_column(text(hop["segment"]), 12) + pad_column(publisher ? "P" : "S", 5) +
+      out.push_back({pad_column(first ? name : "", 16) + pad_column(first ? json_text(c["class"]) : "", 6) +
+                         pad_column(json_text(hop["segment"]), 12) + pad_column(publisher ? "P" : "S", 5) +
                          pad_column(publisher ? rate_text(rates.of(count_at(hop, "rx"), before(old, "rx"))) : "-", 9) +
                          pad_column(publisher ? "-" : rate_text(rates.of(count_at(hop, "tx"), before(old, "tx"))), 9) +
                          pad_column(rate_text(rates.of(drops_of(hop), old_drops)), 8) + pad_column(residence_of(hop), 16) +

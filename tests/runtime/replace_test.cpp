@@ -24,7 +24,7 @@ using namespace std::chrono_literals;
 
 // Two sources of `range` (a real sensor on `body`, a simulator on `sim`), a subscriber on `lan`
 // and a monitor on `viz`; `tilt` shares nothing with it but the gateway.
-constexpr const char* kConfig = R"(
+constexpr const char* kReplaceConfig = R"(
 gateway: {name: gw, can_node_id: 1}
 segments:
   - {name: body, type: can, interface: can0, bitrate: 500kbit/s}
@@ -55,7 +55,7 @@ class ReplaceTest : public ::testing::Test {
           adapters[spec.name] = adapter.get();
           return adapter;
         }, log, 0x77) {
-    const auto config = parse_config(kConfig, "test.yaml");
+    const auto config = parse_config(kReplaceConfig, "test.yaml");
     EXPECT_TRUE(config.ok()) << (config.errors.empty() ? "" : config.errors[0].to_string());
     EXPECT_TRUE(gateway.start(config.config).applied);
   }
@@ -370,7 +370,7 @@ TEST_F(ControlTest, ReplaceAnswersWhatChangedAndWhichHopsStay) {
 
 // Made before break over the socket: the answer comes once the new publisher matched (the wait
 // runs on the server's worker, the control thread answers meanwhile) or at the match timeout.
-// kConfig with a simulator's DDS domain: `speed` does not use it yet.
+// The control tests' configuration with a simulator's DDS domain: `speed` does not use it yet.
 constexpr const char* kWithSim = R"(
 gateway: {name: gw}
 segments:

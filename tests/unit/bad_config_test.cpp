@@ -26,7 +26,7 @@ struct BadConfig {
 
 std::string bad_config_path(const std::string& name) { return std::string(COSMIC_BAD_CONFIG_DIR) + "/" + name; }
 
-std::string describe(const std::vector<ConfigError>& errors) {
+std::string describe_errors(const std::vector<ConfigError>& errors) {
   std::string out;
   for (const auto& e : errors) out += "  " + e.to_string() + "\n";
   return out;
@@ -134,7 +134,7 @@ TEST_P(BadConfigTest, ReportsEveryErrorWithLocation) {
   ASSERT_TRUE(std::filesystem::exists(path)) << path;
   const ConfigResult result = load_config_file(path);
   EXPECT_FALSE(result.ok());
-  ASSERT_EQ(result.errors.size(), bad.errors.size()) << describe(result.errors);
+  ASSERT_EQ(result.errors.size(), bad.errors.size()) << describe_errors(result.errors);
   for (std::size_t i = 0; i < bad.errors.size(); ++i) {
     const Expected& want = bad.errors[i];
     const ConfigError& got = result.errors[i];
@@ -186,7 +186,7 @@ TEST(BadConfigs, UnreadableFile) {
 
 TEST(BadConfigs, FileNameOnlyLabelsErrors) {
   const ConfigResult result = parse_config("segments: []\nchannels: []\nextra: 1\n", "label.yaml");
-  ASSERT_EQ(result.errors.size(), 1u) << describe(result.errors);
+  ASSERT_EQ(result.errors.size(), 1u) << describe_errors(result.errors);
   EXPECT_EQ(result.errors[0].to_string(),
             "label.yaml:3:1: extra: unknown key 'extra' (valid keys here: gateway, segments, channels, components)");
 }

@@ -19,13 +19,13 @@ namespace {
 
 using namespace cosmic::test;
 
-std::string errors_text(const std::vector<ConfigError>& errors) {
+std::string native_errors_text(const std::vector<ConfigError>& errors) {
   std::string out;
   for (const auto& e : errors) out += e.to_string() + "\n";
   return out;
 }
 
-constexpr const char* kSegments = R"(gateway: {name: gw, can_node_id: 1}
+constexpr const char* kNativeSegments = R"(gateway: {name: gw, can_node_id: 1}
 segments:
   - {name: lan, type: dds, domain: 3, latency_bound: 1ms, realtime: true}
   - {name: robot, type: dds, domain: 4, latency_bound: 1ms}
@@ -33,26 +33,26 @@ segments:
 channels:
 )";
 
-ConfigResult parse(const std::string& channels) { return parse_config(std::string(kSegments) + channels, "gw.yaml"); }
+ConfigResult parse_native(const std::string& channels) { return parse_config(std::string(kNativeSegments) + channels, "gw.yaml"); }
 
 constexpr const char* kTwist = "geometry_msgs::msg::dds_::Twist_";
 
 TEST(NativeDdsConfig, TopicTypeAndRepresentationAreReadAndPersisted) {
-  const ConfigResult r = parse(R"(  - {name: cmd_vel, subject: 0x20, class: srt, period: 10ms, reaction_time: 50ms, payload: 52B, publishers: [robot], subscribers: [lan, viz],
+  const ConfigResult r = parse_native(R"(  - {name: cmd_vel, subject: 0x20, class: srt, period: 10ms, reaction_time: 50ms, payload: 52B, publishers: [robot], subscribers: [lan, viz],
      native: {robot: {topic: rt/cmd_vel, type: "geometry_msgs::msg::dds_::Twist_"}, lan: {topic: rt/ns1/cmd_vel, type: "geometry_msgs::msg::dds_::Twist_", representation: xcdr2, keyed: false}}}
 )");
-  ASSERT_TRUE(r.ok()) << errors_text(r.errors);
+  ASSERT_TRUE(r.ok()) << native_errors_text(r.errors);
   const ChannelSpec& c = r.config.channels.at(0);
   EXPECT_EQ(c.native_dds("robot"), (NativeDdsTopic{"rt/cmd_vel", kTwist, DdsRepresentation::xcdr1}));
   EXPECT_EQ(c.native_dds("lan"), (NativeDdsTopic{"rt/ns1/cmd_vel", kTwist, DdsRepresentation::xcdr2}));
   EXPECT_FALSE(c.native_dds("viz"));
   const ChannelsResult back = parse_channels(channel_to_yaml(c), "state", r.config);
-  ASSERT_TRUE(back.errors.empty()) << errors_text(back.errors) << channel_to_yaml(c);
+  ASSERT_TRUE(back.errors.empty()) << native_errors_text(back.errors) << channel_to_yaml(c);
   EXPECT_EQ(back.channels.at(0), c) << channel_to_yaml(c);
 }
 
 TEST(NativeDdsConfig, EveryProblemIsLocatedAtOnce) {
-  const ConfigResult r = parse(R"(  - {name: a, subject: 0x10, class: nrt, payload: 52B, publishers: [robot], subscribers: [lan], native: {robot: {topic: "rt/cmd vel", type: T}}}
+  const ConfigResult r = parse_native(R"(  - {name: a, subject: 0x10, class: nrt, payload: 52B, publishers: [robot], subscribers: [lan], native: {robot: {topic: "rt/cmd vel", type: T}}}
   - {name: b, subject: 0x11, class: nrt, payload: 52B, publishers: [robot], subscribers: [lan], native: {robot: {topic: cosmic/b, type: T}}}
   - {name: c, subject: 0x12, class: nrt, payload: 52B, publishers: [robot], subscribers: [lan], native: {robot: {topic: rt/c, type: "pkg::::T"}}}
   - {name: d, subject: 0x13, class: nrt, payload: 52B, publishers: [robot], subscribers: [lan], native: {robot: {topic: rt/d, type: "cosmic::Envelope"}}}
@@ -64,7 +64,7 @@ TEST(NativeDdsConfig, EveryProblemIsLocatedAtOnce) {
   - {name: j, subject: 0x19, class: nrt, payload: 52B, publishers: [robot], subscribers: [lan], native: {robot: {topic: "rt//j", type: T}}}
   - {name: k, subject: 0x1A, class: nrt, payload: 52B, publishers: [robot], subscribers: [lan], native: {robot: {topic: "rt/k\"\n", type: T}}}
 )");
-  const std::string text = errors_text(r.errors);
+  const std::string text = native_errors_text(r.errors);
   EXPECT_NE(text.find("gw.yaml:7:121: channels[0].native.robot.topic: topic name 'rt/cmd vel' has 0x20 at position 7"), std::string::npos)
       << text;
   EXPECT_NE(text.find("channels[1].native.robot.topic: topic name 'cosmic/b' is under cosmic/"), std::string::npos) << text;

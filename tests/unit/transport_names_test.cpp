@@ -14,7 +14,7 @@
 namespace cosmic {
 namespace {
 
-std::string errors_text(const std::vector<ConfigError>& errors) {
+std::string names_errors_text(const std::vector<ConfigError>& errors) {
   std::string out;
   for (const auto& e : errors) out += e.to_string() + "\n";
   return out;
@@ -56,7 +56,7 @@ TEST(LcmUrl, TwoSegmentsOnOnePortAreFoundWhateverTheSpellingAndBadUrlsAreLocated
 channels: []
 )",
                                       "gw.yaml");
-  const std::string text = errors_text(r.errors);
+  const std::string text = names_errors_text(r.errors);
   EXPECT_NE(text.find("segments[1].url"), std::string::npos) << text;  // default port 7667 = a's port
   EXPECT_NE(text.find("UDP port 7667"), std::string::npos) << text;
   EXPECT_NE(text.find("gw.yaml:5:31: segments[2].url: unsupported LCM URL 'udpm://239.255.76.67:7667/': the port must be a decimal"),
@@ -77,7 +77,7 @@ TEST(InterfaceNames, QuotesAndControlCharactersAreRefusedWhereTheyAreWritten) {
 channels: []
 )",
                                       "gw.yaml");
-  const std::string text = errors_text(r.errors);
+  const std::string text = names_errors_text(r.errors);
   EXPECT_NE(text.find("gw.yaml:3:39: segments[0].interface: interface names hold letters, digits, '_', '.', '@' and '-' only; this one has '\"'"),
             std::string::npos)
       << text;
@@ -99,7 +99,7 @@ channels:
   - {name: wheel, subject: 1, class: nrt, publishers: [lan], subscribers: [viz], native: {viz: {channel: "WHEEL\u0000SPEED"}}}
 )",
                                       "gw.yaml");
-  const std::string text = errors_text(r.errors);
+  const std::string text = names_errors_text(r.errors);
   EXPECT_NE(text.find("gw.yaml:6:"), std::string::npos) << text;
   EXPECT_NE(text.find("LCM channel names hold no control characters; this one has 0x00"), std::string::npos) << text;
 }

@@ -5,14 +5,14 @@
 namespace cosmic::config_detail {
 namespace {
 
-bool present(const YAML::Node& map, const char* name) { return map[name] && !map[name].IsNull(); }
+bool key_given(const YAML::Node& map, const char* name) { return map[name] && !map[name].IsNull(); }
 
 void parse_priorities(YamlReader& reader, const YAML::Node& node, const std::string& path, RealtimeSpec& out) {
   if (!reader.check_map(node, path, {"hrt", "srt", "nrt", "receive"})) return;
   const std::pair<const char*, int*> fields[] = {
       {"hrt", &out.hrt_priority}, {"srt", &out.srt_priority}, {"nrt", &out.nrt_priority}, {"receive", &out.receive_priority}};
   for (const auto& [name, target] : fields) {
-    if (!present(node, name)) continue;
+    if (!key_given(node, name)) continue;
     if (auto v = reader.unsigned_int(node[name], path + "." + name, 0, 99)) *target = static_cast<int>(*v);
   }
   // HRT must preempt SRT and NRT on the same CPU, so it may not be configured below them.
@@ -59,7 +59,7 @@ void parse_cpus(YamlReader& reader, const YAML::Node& node, const std::string& p
   const std::pair<const char*, std::vector<int>*> kinds[] = {
       {"hrt", &out.hrt}, {"srt", &out.srt}, {"nrt", &out.nrt}, {"receive", &out.receive}, {"other", &out.other}};
   for (const auto& [name, target] : kinds) {
-    if (present(node, name)) parse_cpu_list(reader, node[name], path + "." + name, *target);
+    if (key_given(node, name)) parse_cpu_list(reader, node[name], path + "." + name, *target);
   }
 }
 
@@ -67,9 +67,9 @@ void parse_cpus(YamlReader& reader, const YAML::Node& node, const std::string& p
 
 void parse_realtime(YamlReader& reader, const YAML::Node& node, const std::string& path, RealtimeSpec& out) {
   if (!reader.check_map(node, path, {"priorities", "cpus", "lock_memory"})) return;
-  if (present(node, "priorities")) parse_priorities(reader, node["priorities"], path + ".priorities", out);
-  if (present(node, "cpus")) parse_cpus(reader, node["cpus"], path + ".cpus", out.cpus);
-  if (present(node, "lock_memory")) {
+  if (key_given(node, "priorities")) parse_priorities(reader, node["priorities"], path + ".priorities", out);
+  if (key_given(node, "cpus")) parse_cpus(reader, node["cpus"], path + ".cpus", out.cpus);
+  if (key_given(node, "lock_memory")) {
     if (auto v = reader.boolean(node["lock_memory"], path + ".lock_memory")) out.lock_memory = *v;
   }
 }

@@ -4,14 +4,6 @@
 #include <cstdio>
 
 namespace cosmic {
-namespace {
-
-std::int64_t ceil_div(std::int64_t numerator, std::int64_t denominator) {
-  return numerator <= 0 ? 0 : (numerator + denominator - 1) / denominator;
-}
-
-}  // namespace
-
 CanIdFormat id_format(const CanBackgroundFrame& frame) {
   return frame.extended ? CanIdFormat::extended29 : CanIdFormat::standard11;
 }

@@ -17,10 +17,6 @@ constexpr std::uint32_t kFdTrailerBits = 12;
 // Analysis gives up (unbounded) past this horizon: no CAN deadline is anywhere near it.
 constexpr std::int64_t kHorizonNs = 100'000'000'000;
 
-std::int64_t ceil_div(std::int64_t numerator, std::int64_t denominator) {
-  return numerator <= 0 ? 0 : (numerator + denominator - 1) / denominator;
-}
-
 std::int64_t error_overhead(std::int64_t interval, const CanBusTiming& timing, std::int64_t largest_hep_frame) {
   if (timing.errors.max_per_window == 0 || timing.errors.window.count() <= 0) return 0;
   const std::int64_t windows = ceil_div(interval, timing.errors.window.count());

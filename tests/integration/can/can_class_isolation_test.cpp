@@ -64,7 +64,7 @@ extern "C" ssize_t write(int fd, const void* buffer, std::size_t count) {
 namespace cosmic::test {
 namespace {
 
-constexpr milliseconds kWait{5000};
+constexpr milliseconds kIsolationWait{5000};
 
 // Releases a held write however the test ends, so no sender stays blocked past it.
 struct ReleaseOnExit {
@@ -87,7 +87,7 @@ TEST(CanClassIsolation, AnNrtSendHeldInsideItsWriteDoesNotDelayAnHrtSend) {
   ChannelBinding hrt = can_binding(202, "hrt-brake", 0x202, 8, HopRole::subscriber, 0x00, 331, seg);
   hrt.spec.cls = ChannelClass::hrt;
   ASSERT_TRUE(adapter->configure(std::vector{nrt, hrt}).ok);
-  ASSERT_TRUE(wait_until([&] { return adapter->health().state == SegmentHealth::up; }, kWait));
+  ASSERT_TRUE(wait_until([&] { return adapter->health().state == SegmentHealth::up; }, kIsolationWait));
   const std::uint32_t nrt_id = encode_can_id(CanIdentifier{0xF0, kGatewayNode, 330});
   const std::uint32_t hrt_id = encode_can_id(CanIdentifier{0x00, kGatewayNode, 331});
   Candump dump("vcan0", "vcan0," + hex_id(hrt_id) + ":1FFFFFFF," + hex_id(nrt_id) + ":1FFFFFFF", 2);
@@ -107,13 +107,13 @@ TEST(CanClassIsolation, AnNrtSendHeldInsideItsWriteDoesNotDelayAnHrtSend) {
   bool held = false;  // asserted outside the lock: gtest's own output must not meet the interposer holding it
   {
     std::unique_lock lock(stall().mutex);
-    held = stall().changed.wait_for(lock, kWait, [] { return stall().holding; });
+    held = stall().changed.wait_for(lock, kIsolationWait, [] { return stall().holding; });
   }
   ASSERT_TRUE(held) << "the NRT frame never reached write()";
   hrt_send = std::async(std::launch::async, [&] { return adapter->send(OutboundEvent{202, {}, brake}); });
-  ASSERT_EQ(hrt_send.wait_for(kWait), std::future_status::ready) << "the HRT send waited for the held NRT write";
+  ASSERT_EQ(hrt_send.wait_for(kIsolationWait), std::future_status::ready) << "the HRT send waited for the held NRT write";
   EXPECT_EQ(hrt_send.get(), SendStatus::sent);
-  EXPECT_TRUE(wait_until([&] { return !dump.lines().empty(); }, kWait));
+  EXPECT_TRUE(wait_until([&] { return !dump.lines().empty(); }, kIsolationWait));
   bool still_held = false;
   {
     std::lock_guard lock(stall().mutex);
@@ -123,7 +123,7 @@ TEST(CanClassIsolation, AnNrtSendHeldInsideItsWriteDoesNotDelayAnHrtSend) {
   }
   EXPECT_TRUE(still_held) << "the NRT write must still be held while the HRT frame goes out";
   EXPECT_EQ(nrt_send.get(), SendStatus::sent);
-  const auto lines = dump.wait(kWait);
+  const auto lines = dump.wait(kIsolationWait);
   ASSERT_EQ(lines.size(), 2u);
   EXPECT_EQ(lines[0].id, hrt_id);  // on the bus first, though sent second
   EXPECT_EQ(lines[1].id, nrt_id);

@@ -19,6 +19,12 @@ namespace cosmic {
 enum class CanIdFormat { standard11, extended29 };
 
 // Largest identifier of each format.
+// ceil(numerator / denominator) for denominator > 0; 0 for numerator <= 0 (releases of a
+// periodic frame within an interval, windows of the fault hypothesis).
+constexpr std::int64_t ceil_div(std::int64_t numerator, std::int64_t denominator) {
+  return numerator <= 0 ? 0 : (numerator + denominator - 1) / denominator;
+}
+
 inline constexpr std::uint32_t kStandardIdMax = 0x7FF;
 inline constexpr std::uint32_t kExtendedIdMax = 0x1FFFFFFF;
 
