@@ -420,13 +420,12 @@ Json ControlProtocol::commit_planned(BindPlan plan, const Json& request, const s
     // Other gateways' reservations (or claims) changed while the bind waited: admit it again, here
     // on the control thread, against what is known now (an incremental admission: milliseconds for
     // hundreds of channels; status answers wait that long).
-    BindPlan fresh = plan.replacing ? gateway_.replace_plan_input(plan.channels) : gateway_.bind_plan_input(plan.channels);
-    replace_or_bind(fresh);
+    BindPlan fresh = gateway_.bind_plan_input(plan.channels);
+    Gateway::plan_bind(fresh);
     plan = std::move(fresh);
   }
   const BindResult result = gateway_.commit_bind(std::move(plan));
   Json answer = bind_answer(result);
-  if (result.replaced.size() > 0) answer["replaced"] = replaced_answer(result);
   return finish(command, request, std::move(answer));
 }
 

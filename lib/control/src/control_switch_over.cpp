@@ -41,14 +41,7 @@ ControlProtocol::Answer ControlProtocol::switch_planned(std::shared_ptr<BindPlan
   auto wait = std::make_shared<SwitchWait>(SwitchWait{plan, request, command, later, Steady::now(),
                                                       std::chrono::duration_cast<Nanos>(std::chrono::duration<double>(seconds))});
   if (!gateway_.prepare_replace(*plan)) return switched(*wait, false);
-  if (!offload_ || !later) {
-    bool matched = Gateway::all_matched(gateway_.new_publishers(*plan));
-    while (!matched && Steady::now() - wait->prepared_at < wait->timeout) {
-      std::this_thread::sleep_for(kMatchPoll);
-      matched = Gateway::all_matched(gateway_.new_publishers(*plan));
-    }
-    return switched(*wait, !matched);
-  }
+  if (!offload_ || !later) return switched(*wait, !gateway_.await_new_publishers(*plan, wait->prepared_at, wait->timeout));
   char limit[32];
   std::snprintf(limit, sizeof limit, "%g", seconds);
   running_ = command + " of " + (plan->channels.empty() ? std::string() : plan->channels.front().name) +

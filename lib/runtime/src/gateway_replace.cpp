@@ -72,19 +72,19 @@ BindResult Gateway::replace(const std::vector<ChannelSpec>& channels, Nanos matc
   BindPlan plan = replace_plan_input(channels);
   plan_replace(plan);
   const auto prepared_at = std::chrono::steady_clock::now();
-  bool timed_out = false;
-  if (prepare_replace(plan)) {
-    // No event loop here: poll the adapters' match counts (the control protocol polls from its
-    // worker instead, leaving the control thread free).
-    while (!all_matched(new_publishers(plan))) {
-      if (std::chrono::steady_clock::now() - prepared_at >= match_timeout) {
-        timed_out = true;
-        break;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    }
-  }
+  const bool timed_out = prepare_replace(plan) && !await_new_publishers(plan, prepared_at, match_timeout);
   return switch_over(std::move(plan), prepared_at, timed_out);
+}
+
+// No event loop here: polls the adapters' match counts (the control protocol polls from its
+// worker instead when it has one, leaving the control thread free).
+bool Gateway::await_new_publishers(const BindPlan& plan, std::chrono::steady_clock::time_point prepared_at,
+                                   Nanos match_timeout) const {
+  while (!all_matched(new_publishers(plan))) {
+    if (std::chrono::steady_clock::now() - prepared_at >= match_timeout) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return true;
 }
 
 // Only segments where the channel has no hop at all: a hop that changes role on a segment the

@@ -91,7 +91,7 @@ class ControlProtocol {
   // Commits a bind plan and answers. `replan`: admit it again first if the bindings changed since
   // it was made (after a claim window); otherwise such a commit is refused ("try again").
   Json commit_planned(BindPlan plan, const Json& request, const std::string& command, bool replan);
-  // A planned bind's last step: commit_planned(), or for a replacement switch_planned().
+  // A planned bind's last step: commit_planned() (a bind), or switch_planned() (a replacement).
   Answer conclude(std::shared_ptr<BindPlan> plan, const Json& request, const std::string& command, bool replan,
                   const Reply& later);
   // A replacement made before break (control_switch_over.cpp): admitted again when `replan` and the

@@ -164,6 +164,9 @@ class Gateway {
   BindResult switch_over(BindPlan plan, std::chrono::steady_clock::time_point prepared_at, bool timed_out);
   // The new publisher hops of a replacement with the remote writers each has matched now.
   std::vector<NewPublisher> new_publishers(const BindPlan& plan) const;
+  // Blocks, polling, until all_matched() or `match_timeout` after `prepared_at`; false at the timeout.
+  bool await_new_publishers(const BindPlan& plan, std::chrono::steady_clock::time_point prepared_at,
+                            Nanos match_timeout) const;
   // True when every new publisher hop on a transport with discovery has matched a writer.
   static bool all_matched(const std::vector<NewPublisher>& publishers);
   // reload() in steps: the plan on any thread (no I/O), the commit on the control thread.
