@@ -138,6 +138,8 @@ TEST(ForwardingTest, BlockedSegmentDelaysOnlyItsOwnLanes) {
   ChannelSpec both = spec_of("speed", 33, ChannelClass::hrt);
   router.apply({Route{1, both, {0}, {1, 2}}});
   ChannelBinding binding{1, both, HopRole::subscriber, std::nullopt};
+  slow.start(router.inbox(1));
+  fast.start(router.inbox(2));
   slow.configure({&binding, 1});
   fast.configure({&binding, 1});
   slow.hold_sends(true);  // a stuck driver on one segment
@@ -161,6 +163,7 @@ TEST(ForwardingTest, ResidenceAndDeadlineMissesAreCountedPerHop) {
   spec.reaction_time = Nanos(5'000'000);
   router.apply({Route{1, spec, {0}, {1}}});
   ChannelBinding binding{1, spec, HopRole::subscriber, std::nullopt};
+  out.start(router.inbox(1));
   out.configure({&binding, 1});
   EventHeader fresh;
   fresh.subject = 44;
@@ -367,6 +370,7 @@ TEST(ForwardingTest, RouteChurnWhileProducersAndLanesRun) {
     routes.push_back(Route{id, spec, {0}, {1}});
     bindings.push_back(ChannelBinding{id, spec, HopRole::subscriber, std::nullopt});
   }
+  out.start(router.inbox(1));
   out.configure(bindings);
   router.apply(routes);
   std::atomic<bool> done{false};

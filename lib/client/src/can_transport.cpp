@@ -14,10 +14,12 @@
 #include <map>
 #include <thread>
 
+#include "cosmic/thread_policy.hpp"
 #include "cosmic/can_fragment.hpp"
 #include "cosmic/can_wire.hpp"
 #include "cosmic/client.h"
 #include "cosmic/mutex.hpp"
+#include "cosmic/steady_clock.hpp"
 #include "cosmic/thread_annotations.hpp"
 #include "transport.hpp"
 
@@ -33,8 +35,6 @@ struct CanChannel {
   std::uint16_t etag = 0;  // 0 until SUPPLY_ETAG arrived
   std::uint8_t fragment_sequence = 0;
 };
-
-Nanos steady_now() { return std::chrono::duration_cast<Nanos>(std::chrono::steady_clock::now().time_since_epoch()); }
 
 class CanTransport final : public Transport {
  public:
@@ -122,6 +122,7 @@ class CanTransport final : public Transport {
   }
 
   void read_loop() {
+    apply_thread_policy(ThreadPolicy{"cosmic-can-rx", 0, 0, {}});  // a name only: the component sets its own policy
     can_frame frame{};
     while (running_) {
       if (::read(fd_, &frame, sizeof frame) != static_cast<ssize_t>(sizeof frame)) continue;

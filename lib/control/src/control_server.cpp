@@ -1,3 +1,4 @@
+#include "cosmic/thread_policy.hpp"
 #include "cosmic/control_server.hpp"
 
 #include <fcntl.h>
@@ -127,6 +128,7 @@ Offload ControlServer::offload() {
 }
 
 void ControlServer::work_loop() {
+  apply_thread_policy(ThreadPolicy{"ctl-worker", 0, 0, {}});  // a name only; runs as cosmicd's control thread
   while (true) {
     std::pair<std::function<void()>, std::function<void()>> job;
     {

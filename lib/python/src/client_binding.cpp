@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <thread>
 
+#include "cosmic/thread_policy.hpp"
 #include "binding.hpp"
 #include "channel_ref.hpp"
 
@@ -91,6 +92,7 @@ void ClientState::close_from_callback_thread() {
   auto& clients = open_clients();
   clients.erase(std::remove(clients.begin(), clients.end(), this), clients.end());
   std::thread([handle = handle_, channels = std::move(channels_)]() mutable {
+    apply_thread_policy(cosmic::ThreadPolicy{"cosmic-py-close", 0, 0, {}});
     cosmic_close(handle);
     channels.clear();
   }).detach();

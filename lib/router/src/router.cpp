@@ -11,10 +11,6 @@
 
 namespace cosmic {
 
-Nanos steady_now() {
-  return std::chrono::duration_cast<Nanos>(std::chrono::steady_clock::now().time_since_epoch());
-}
-
 namespace {
 std::int64_t wall_clock_ns() {
   return std::chrono::duration_cast<Nanos>(std::chrono::system_clock::now().time_since_epoch()).count();

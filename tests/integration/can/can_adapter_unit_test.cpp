@@ -184,7 +184,9 @@ TEST(CanAdapterWithoutBus, StartsAndReportsAMissingInterface) {
 // adapter cannot carry is named in Status::refused with its reason, and only those.
 TEST(CanAdapterWithoutBus, RejectsBindingsItCannotCarry) {
   NullLogger log;
+  NullSink sink;
   auto adapter = make_can_adapter(can_segment("nosuchcan7"), GatewayIdentity{1, "gw"}, log);
+  ASSERT_TRUE(adapter->start(sink).ok);  // a segment that is not started refuses every binding
   ChannelBinding reserved;
   reserved.id = 1;
   reserved.spec.name = "reserved";
@@ -219,7 +221,9 @@ TEST(CanAdapterWithoutBus, RefusesAPlanInAnotherLayout) {
   NullLogger log;
   SegmentSpec famouso = can_segment("nosuchcan7");
   famouso.can.profile = CanProfile::famouso;
+  NullSink sink;
   auto adapter = make_can_adapter(famouso, GatewayIdentity{1, "gw"}, log);
+  ASSERT_TRUE(adapter->start(sink).ok);
   ChannelBinding binding;
   binding.id = 5;
   binding.spec.name = "c";

@@ -35,8 +35,8 @@ TEST_F(LcmAdapterTest, ConfigureWhileFlowingLosesNothingOnOtherChannels) {
   const ChannelBinding b = binding(3, "EXTRA_IN", HopRole::publisher, LcmEncoding::raw);
   const ChannelBinding c = binding(4, "EXTRA_OUT", HopRole::subscriber);
   const std::vector<std::vector<ChannelBinding>> configs{{a, t}, {a, t, b}, {t, a, c}, {a, t, b, c}};
-  ASSERT_TRUE(adapter->configure(configs[0]).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(configs[0]).ok);
 
   Child sub({peer(), "sub", "--url", url, "--channel", "FLOW_OUT", "--count",
              std::to_string(kCount), "--timeout", "20"});
@@ -103,8 +103,8 @@ TEST_F(LcmAdapterTest, MalformedEnvelopesCountDecodeErrors) {
   const std::string url = url_for(port);
   auto adapter = make(port);
   const std::vector<ChannelBinding> bindings{binding(8, "ENV_IN", HopRole::publisher)};
-  ASSERT_TRUE(adapter->configure(bindings).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(bindings).ok);
 
   // A valid envelope, then damaged copies of it.
   ::cosmic::envelope e{};
@@ -174,13 +174,13 @@ TEST_F(LcmAdapterTest, ANameBeyondTheTransportLimitIsRefusedForItsChannelAlone) 
   const std::vector<ChannelBinding> bindings{binding(1, longest, HopRole::subscriber),
                                              binding(2, too_long, HopRole::subscriber),
                                              binding(3, "FINE", HopRole::subscriber)};
+  ASSERT_TRUE(adapter->start(sink_).ok);
   const Status status = adapter->configure(bindings);
   EXPECT_FALSE(status.ok);
   ASSERT_EQ(status.refused.size(), 1u) << status.error;
   EXPECT_EQ(status.refused[0].channel, 2u);
   EXPECT_EQ(status.refused[0].reason, *transport_name_problem(SegmentType::lcm, too_long));
   EXPECT_NE(status.error.find("at most 63 characters"), std::string::npos) << status.error;
-  ASSERT_TRUE(adapter->start(sink_).ok);
   EXPECT_EQ(adapter->send(outbound(1, Bytes{1})), SendStatus::sent);
   EXPECT_EQ(adapter->send(outbound(3, Bytes{1})), SendStatus::sent);
   EXPECT_EQ(adapter->send(outbound(2, Bytes{1})), SendStatus::failed);
@@ -208,7 +208,7 @@ TEST_F(LcmAdapterTest, EveryRefusedBindingIsNamedAndTheRestIsCarried) {
   ASSERT_EQ(refused.size(), 3u) << status.error;
   EXPECT_NE(refused[2].find("already bound by channel id 1"), std::string::npos) << refused[2];
   EXPECT_NE(refused[3].find("already bound as LCM channel 'NEW'"), std::string::npos) << refused[3];
-  EXPECT_EQ(refused[4], "no channel id or name");
+  EXPECT_EQ(refused[4], "the binding has no channel id or name");  // the words of every adapter (BindingPlan)
   EXPECT_EQ(adapter->send(outbound(1, Bytes{1})), SendStatus::sent) << "the channel bound before keeps flowing";
   // A refused channel is not carried in any role: id 3's first (valid) binding is not either.
   EXPECT_EQ(adapter->send(outbound(3, Bytes{1})), SendStatus::failed);
@@ -314,8 +314,8 @@ TEST_F(LcmAdapterTest, AChannelTheSegmentCannotJoinForIsRefusedWithTheReason) {
   auto adapter = make(port);
   const ChannelBinding out = binding(1, "STAYS_OUT", HopRole::subscriber, LcmEncoding::raw, 5);
   const ChannelBinding in = binding(2, "WANTS_IN", HopRole::publisher, LcmEncoding::raw, 6);
-  ASSERT_TRUE(adapter->configure(std::vector{out}).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(std::vector{out}).ok);
 
   ASSERT_EQ(std::system("ip route del 224.0.0.0/4 dev lo"), 0);
   const Status refused = adapter->configure(std::vector{out, in});

@@ -38,12 +38,17 @@ TEST_F(LcmAdapterTest, HealthAndBadUrl) {
   segment_.lcm.url = "nosuchprovider://x";
   auto bad = make_lcm_adapter(segment_, self_, logger_);
   const std::vector<ChannelBinding> bindings{binding(1, "CH", HopRole::publisher)};
-  EXPECT_TRUE(bad->configure(bindings).ok);
   const Status st = bad->start(sink_);
   EXPECT_FALSE(st.ok);
   EXPECT_NE(st.error.find("nosuchprovider://x"), std::string::npos) << st.error;
   EXPECT_EQ(bad->health().state, SegmentHealth::down);
   EXPECT_NE(bad->health().detail.find("bad LCM URL"), std::string::npos) << bad->health().detail;
+  // A segment that did not start carries nothing (SegmentAdapter's lifecycle): the whole segment
+  // fails to configure, naming no channel.
+  const Status unstarted = bad->configure(bindings);
+  EXPECT_FALSE(unstarted.ok);
+  EXPECT_TRUE(unstarted.refused.empty());
+  EXPECT_NE(unstarted.error.find("not started"), std::string::npos) << unstarted.error;
   EXPECT_EQ(bad->send(outbound(1, Bytes{1, 2})), SendStatus::failed);
   bad->stop();
   bad->stop();
@@ -70,8 +75,8 @@ TEST_F(LcmAdapterTest, EnvelopeToNativeSubscriber) {
   constexpr int kCount = 40;
   auto adapter = make(port);
   const std::vector<ChannelBinding> bindings{binding(7, "COSMIC_ENV", HopRole::subscriber)};
-  ASSERT_TRUE(adapter->configure(bindings).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(bindings).ok);
 
   Child sub({peer(), "sub", "--url", url_for(port), "--channel", "COSMIC_ENV", "--count",
              std::to_string(kCount), "--timeout", "10"});
@@ -113,8 +118,8 @@ TEST_F(LcmAdapterTest, RawFromNativePublisherKeepsBytes) {
   auto adapter = make(port);
   const std::vector<ChannelBinding> bindings{
       binding(3, "NATIVE_POSE", HopRole::publisher, LcmEncoding::raw, 4242)};
+  ASSERT_TRUE(adapter->start(sink_).ok);
   ASSERT_TRUE(adapter->configure(bindings).ok);
-  ASSERT_TRUE(adapter->start(sink_).ok);  // subscribed (group joined) when start returns
 
   Child pub({peer(), "pub", "--url", url_for(port), "--channel", "NATIVE_POSE", "--raw", "--count",
              std::to_string(kCount), "--size", std::to_string(kSize), "--rate", "2000"});
@@ -144,8 +149,8 @@ TEST_F(LcmAdapterTest, ANativeBindingNamesTheLcmChannelAndCarriesTheContentsRaw)
   auto adapter = make(port);
   ChannelBinding wheel = binding(9, "wheel", HopRole::publisher, LcmEncoding::envelope, 0x90);
   wheel.spec.native.push_back(NativeBinding{"lcm0", std::nullopt, "WHEEL_SPEED", std::nullopt});
-  ASSERT_TRUE(adapter->configure(std::vector<ChannelBinding>{wheel}).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(std::vector<ChannelBinding>{wheel}).ok);
   Child pub({peer(), "pub", "--url", url_for(port), "--channel", "WHEEL_SPEED", "--raw", "--count", "5", "--size", "8", "--rate", "1000"});
   ASSERT_EQ(pub.wait_exit(), std::optional<int>(0)) << pub.stderr_text();
   ASSERT_TRUE(sink_.wait_events(9, 5)) << sink_.count(9);
@@ -170,10 +175,11 @@ TEST_F(LcmAdapterTest, RestartResubscribes) {
   auto adapter = make(port);
   const std::vector<ChannelBinding> bindings{
       binding(4, "AGAIN", HopRole::publisher, LcmEncoding::raw, 1)};
-  ASSERT_TRUE(adapter->start(sink_).ok);  // configured after start
+  ASSERT_TRUE(adapter->start(sink_).ok);
   ASSERT_TRUE(adapter->configure(bindings).ok);
   adapter->stop();
-  ASSERT_TRUE(adapter->start(sink_).ok);  // the channel table survives stop()
+  ASSERT_TRUE(adapter->start(sink_).ok);  // stop() forgot the channels: a new start carries none
+  ASSERT_TRUE(adapter->configure(bindings).ok);  // until configured again, which joins the group
   Child pub({peer(), "pub", "--url", url_for(port), "--channel", "AGAIN", "--raw", "--count", "3",
              "--size", "4"});
   ASSERT_EQ(pub.wait_exit(), std::optional<int>(0)) << pub.stderr_text();
@@ -189,8 +195,8 @@ TEST_F(LcmAdapterTest, RawSendIsRecordedByLcmLogger) {
   const std::vector<ChannelBinding> bindings{
       binding(1, "RAW_SCAN", HopRole::subscriber, LcmEncoding::raw),
       binding(2, "COSMIC_PROBE", HopRole::subscriber, LcmEncoding::raw)};
-  ASSERT_TRUE(adapter->configure(bindings).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(bindings).ok);
 
   char dir_template[] = "/tmp/cosmic-lcm-log-XXXXXX";
   ASSERT_NE(mkdtemp(dir_template), nullptr);
@@ -237,8 +243,8 @@ TEST_F(LcmAdapterTest, OwnEnvelopesAreNotReceivedBack) {
   // The same channel received and sent on this segment: LCM loops our publications back.
   const std::vector<ChannelBinding> bindings{binding(5, "LOOPED", HopRole::publisher),
                                              binding(5, "LOOPED", HopRole::subscriber)};
-  ASSERT_TRUE(adapter->configure(bindings).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(bindings).ok);
 
   // Ours go out (a native subscriber hears them: EnvelopeToNativeSubscriber) and loop back to our
   // own socket, whose filter (own_datagrams: cut) empties them in the kernel and the receive
@@ -288,8 +294,8 @@ TEST_F(LcmAdapterTest, DroppedOwnDatagramsAreNoOverflow) {
   auto adapter = make(port);
   const std::vector<ChannelBinding> bindings{binding(7, "LOOPED_DROP", HopRole::publisher, LcmEncoding::raw, 12),
                                              binding(7, "LOOPED_DROP", HopRole::subscriber, LcmEncoding::raw, 12)};
-  ASSERT_TRUE(adapter->configure(bindings).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(bindings).ok);
   for (std::uint32_t k = 1; k <= 50; ++k)
     ASSERT_EQ(adapter->send(outbound(7, own_pattern(k, 24))), SendStatus::sent);
   ASSERT_EQ(adapter->send(outbound(7, own_pattern(51, 150000))), SendStatus::sent);  // 3 fragments
@@ -311,6 +317,7 @@ TEST_F(LcmAdapterTest, DroppedOwnDatagramsAreNoOverflow) {
 
   // A new socket counts from 0 in the kernel and in the transmitter; the segment's figure goes on.
   ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(bindings).ok);  // stop() forgot the channels
   for (std::uint32_t k = 52; k <= 53; ++k)
     ASSERT_EQ(adapter->send(outbound(7, own_pattern(k, 24))), SendStatus::sent);
   EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::optional<std::uint64_t>(55));
@@ -331,8 +338,8 @@ TEST_F(LcmAdapterTest, ASegmentThatOnlySendsLeavesTheGroupUntilAChannelIsReceive
   auto adapter = make(port);
   const ChannelBinding out = binding(8, "ONLY_OUT", HopRole::subscriber, LcmEncoding::raw, 13);
   const ChannelBinding in = binding(9, "NOW_IN", HopRole::publisher, LcmEncoding::raw, 14);
-  ASSERT_TRUE(adapter->configure(std::vector{out}).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(std::vector{out}).ok);
 
   Child sub({peer(), "sub", "--url", url_for(port), "--channel", "ONLY_OUT", "--raw", "--count", "10", "--timeout", "10"});
   ASSERT_TRUE(sub.wait_stderr("READY")) << sub.stderr_text();
@@ -367,8 +374,8 @@ TEST_F(LcmAdapterTest, OwnRawMessagesAreNotReceivedBack) {
   const std::vector<ChannelBinding> bindings{
       binding(6, "LOOPED_RAW", HopRole::publisher, LcmEncoding::raw, 11),
       binding(6, "LOOPED_RAW", HopRole::subscriber, LcmEncoding::raw, 11)};
-  ASSERT_TRUE(adapter->configure(bindings).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(bindings).ok);
 
   // Raw messages carry no origin: only their source tells ours from a native program's.
   for (std::uint32_t k = 1; k <= 10; ++k)

@@ -20,8 +20,8 @@ TEST_F(LcmAdapterTest, MessagesBeyondOneDatagramCrossInFragmentsBothWays) {
   auto adapter = make(port);
   const std::vector<ChannelBinding> bindings{binding(1, "BIG_IN", HopRole::publisher, LcmEncoding::raw, 3),
                                              binding(2, "BIG_OUT", HopRole::subscriber)};
-  ASSERT_TRUE(adapter->configure(bindings).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(bindings).ok);
 
   // liblcm fragments, we reassemble.
   Child pub({peer(), "pub", "--url", url_for(port), "--channel", "BIG_IN", "--raw", "--count", "3", "--size",
@@ -56,8 +56,8 @@ TEST_F(LcmAdapterTest, AMessageBeyondTheSegmentsLimitIsNotReassembled) {
   const int port = 7721;
   segment_.max_message_size = 100'000;
   auto adapter = make(port);
-  ASSERT_TRUE(adapter->configure(std::vector{binding(1, "BIG_IN", HopRole::publisher, LcmEncoding::raw, 3)}).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(std::vector{binding(1, "BIG_IN", HopRole::publisher, LcmEncoding::raw, 3)}).ok);
   Child big({peer(), "pub", "--url", url_for(port), "--channel", "BIG_IN", "--raw", "--count", "2", "--size",
              std::to_string(kLarge)});
   ASSERT_EQ(big.wait_exit(), std::optional<int>(0)) << big.stderr_text();
@@ -77,8 +77,8 @@ TEST_F(LcmAdapterTest, FragmentsOfAChannelNotReceivedHereAreSkippedWhole) {
   const int port = 7724;
   segment_.max_message_size = 1u << 20;
   auto adapter = make(port);
-  ASSERT_TRUE(adapter->configure(std::vector{binding(1, "BIG_IN", HopRole::publisher, LcmEncoding::raw, 3)}).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(std::vector{binding(1, "BIG_IN", HopRole::publisher, LcmEncoding::raw, 3)}).ok);
   // Another program's large messages on a channel this segment does not carry: fragment 0 names
   // it, the three after it carry no name and must not be held (nor counted lost).
   Child other({peer(), "pub", "--url", url_for(port), "--channel", "NOT_OURS", "--raw", "--count", "3", "--size",
@@ -100,8 +100,8 @@ TEST_F(LcmAdapterTest, ABatchGoesOutInOrderWithEachEventsOwnStatus) {
   auto adapter = make(port);
   const std::vector<ChannelBinding> bindings{binding(1, "BATCH_ENV", HopRole::subscriber),
                                              binding(2, "BATCH_RAW", HopRole::subscriber, LcmEncoding::raw, 4)};
-  ASSERT_TRUE(adapter->configure(bindings).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(bindings).ok);
   ASSERT_TRUE(adapter->batches_sends());
   Child env({peer(), "sub", "--url", url_for(port), "--channel", "BATCH_ENV", "--count", "41", "--timeout", "10"});
   Child raw({peer(), "sub", "--url", url_for(port), "--channel", "BATCH_RAW", "--raw", "--count", "4", "--timeout", "10"});
@@ -190,8 +190,8 @@ TEST_F(LcmAdapterTest, DatagramsTheKernelDropsForAFullBufferAreCounted) {
   segment_.lcm.url = url_for(port) + "&recv_buf_size=2048";
   auto adapter = make_lcm_adapter(segment_, self_, logger_);
   BlockingSink sink;
-  ASSERT_TRUE(adapter->configure(std::vector{binding(1, "FLOOD", HopRole::publisher, LcmEncoding::raw, 3)}).ok);
   ASSERT_TRUE(adapter->start(sink).ok);
+  ASSERT_TRUE(adapter->configure(std::vector{binding(1, "FLOOD", HopRole::publisher, LcmEncoding::raw, 3)}).ok);
   ASSERT_EQ(publish_flood(port, 1), std::optional<int>(0));
   ASSERT_TRUE(sink.wait_events(1));  // the receive thread is held now
   ASSERT_EQ(publish_flood(port, 500), std::optional<int>(0));
@@ -221,10 +221,10 @@ TEST_F(LcmAdapterTest, OwnDropsAndAFullBufferAreToldApart) {
   ASSERT_EQ(segment_.lcm.own_datagrams, LcmOwnDatagrams::drop);
   auto adapter = make_lcm_adapter(segment_, self_, logger_);
   BlockingSink sink;
+  ASSERT_TRUE(adapter->start(sink).ok);
   ASSERT_TRUE(adapter->configure(std::vector{binding(1, "FLOOD", HopRole::publisher, LcmEncoding::raw, 3),
                                              binding(2, "MINE", HopRole::subscriber, LcmEncoding::raw, 4)})
                   .ok);
-  ASSERT_TRUE(adapter->start(sink).ok);
   ASSERT_EQ(publish_flood(port, 1), std::optional<int>(0));
   ASSERT_TRUE(sink.wait_events(1));  // the receive thread is held now
   for (std::uint32_t k = 1; k <= 300; ++k) ASSERT_EQ(adapter->send(outbound(2, own_pattern(k, 32))), SendStatus::sent);
@@ -247,8 +247,8 @@ TEST_F(LcmAdapterTest, AMemqSegmentRunsWithNoSocketAndReceivesNothing) {
   segment_.type = SegmentType::lcm;
   segment_.lcm.url = "memq://";
   auto adapter = make_lcm_adapter(segment_, self_, logger_);
-  ASSERT_TRUE(adapter->configure(std::vector{binding(1, "VIZ", HopRole::subscriber)}).ok);
   ASSERT_TRUE(adapter->start(sink_).ok);
+  ASSERT_TRUE(adapter->configure(std::vector{binding(1, "VIZ", HopRole::subscriber)}).ok);
   EXPECT_EQ(adapter->health().state, SegmentHealth::up);
   EXPECT_EQ(adapter->send(outbound(1, Bytes{1, 2, 3})), SendStatus::sent);
   EXPECT_EQ(adapter->send(outbound(9, Bytes{1})), SendStatus::failed);  // not bound

@@ -5,50 +5,37 @@ namespace cosmic::can_detail {
 // ------------------------------------------------------------------------------ lifecycle
 
 Status CanAdapter::start(EventSink& sink) {
-  if (started_) return Status::failure("already started");
+  if (started_) return Status::failure("segment " + segment_.name + " already started");
   if (segment_.can.interface.empty() || segment_.can.interface.size() >= IFNAMSIZ) {
     return Status::failure("invalid CAN interface name '" + segment_.can.interface + "'");
   }
-  wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-  if (wake_fd_ < 0) return Status::failure("eventfd: " + errno_text(errno));
-  ctl_fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-  if (ctl_fd_ < 0) {
-    const int err = errno;
-    ::close(wake_fd_);
-    wake_fd_ = -1;
-    return Status::failure("socket(AF_UNIX): " + errno_text(err));
-  }
+  auto ctl = posix_call("socket(AF_UNIX)", [] { return ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0); });
+  if (!ctl) return Status::failure(ctl.error().text);
+  ctl_fd_ = ctl.value();
   sink_ = &sink;
-  stopping_ = false;
   started_ = true;
   check_link();  // opens the socket now when the interface is there: health is right at once
-  try {
-    ThreadPolicy policy = sink.receive_thread_policy();
-    policy.name = "rx:" + segment_.name;
-    thread_ = std::thread([this, policy] {
-      for (const auto& problem : apply_thread_policy(policy))
-        log_.log(LogLevel::warning, "segment " + segment_.name + ": receive thread: " + problem);
-      run();
-    });
-  } catch (const std::exception& e) {
+  ThreadPolicy policy = sink.receive_thread_policy();
+  policy.name = "rx:" + segment_.name;
+  if (auto running = receiver_.start(policy, log_, "segment " + segment_.name + ": ", [this] { run(); }); !running) {
     close_socket();
     ::close(ctl_fd_);
-    ::close(wake_fd_);
-    ctl_fd_ = wake_fd_ = -1;
+    ctl_fd_ = -1;
+    sink_ = nullptr;
     started_ = false;
-    return Status::failure(std::string("cannot start the receive thread: ") + e.what());
+    return Status::failure(running.error().text);
   }
   return Status::success();
 }
 
 void CanAdapter::stop() {
   if (!started_) return;
-  stopping_ = true;
-  wake();
-  if (thread_.joinable()) thread_.join();
+  receiver_.stop();
   close_socket();
   {
     PiLock lock(io_mutex_);
+    table_ = std::make_shared<Table>();  // stop() forgets the bindings (SegmentAdapter's lifecycle)
+    generation_.fetch_add(1, std::memory_order_release);
     backlog_.clear();
     answers_.clear();
     pending_requests_.clear();
@@ -58,8 +45,7 @@ void CanAdapter::stop() {
     retry_at_.reset();
   }
   ::close(ctl_fd_);
-  ::close(wake_fd_);
-  ctl_fd_ = wake_fd_ = -1;
+  ctl_fd_ = -1;
   sink_ = nullptr;
   started_ = false;
   link_up_ = false;
@@ -70,24 +56,58 @@ void CanAdapter::stop() {
   health_ = {SegmentHealth::down, "stopped"};
 }
 
-void CanAdapter::wake() {
-  if (wake_fd_ < 0) return;
-  const std::uint64_t one = 1;
-  [[maybe_unused]] const ssize_t n = ::write(wake_fd_, &one, sizeof one);
-}
+void CanAdapter::wake() { receiver_.wake(); }
 
 // ------------------------------------------------------------------------------ configure
 
 Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
+  if (!started_) return not_started(segment_.name);
+  BindingPlan plan(bindings);
+  std::shared_ptr<Table> table = plan_table(plan);
+  Status status = plan.status();
+
+  PiLock lock(io_mutex_);
+  if (sock_ >= 0 && ::setsockopt(sock_, SOL_CAN_RAW, CAN_RAW_FILTER, table->filters.data(),
+                                 static_cast<socklen_t>(table->filters.size() * sizeof(can_filter))) != 0) {
+    // The kernel keeps the old filters, so the old table stays: the whole segment failed.
+    const std::string error = "CAN_RAW_FILTER: " + errno_text(errno) + "; the previous channels stay";
+    log_.log(LogLevel::error, "segment " + segment_.name + ": " + error);
+    return Status::failure(error);
+  }
+  backlog_.set_capacity(table->backlog_frames);
+  for (auto it = tx_sequence_.begin(); it != tx_sequence_.end();) {
+    const bool bound =
+        std::any_of(table->tx.begin(), table->tx.end(), [&](const auto& t) { return t.second.etag == it->first; });
+    it = bound ? std::next(it) : tx_sequence_.erase(it);
+  }
+  // FAMOUSO nodes ask once and wait: requests for subjects bound only now are answered now.
+  std::erase_if(pending_requests_, [&](const can_binding::GetEtagRequest& r) COSMIC_REQUIRES(io_mutex_) {
+    const auto found = table->etag_of.find(r.subject);
+    if (found == table->etag_of.end()) return false;
+    queue_supply_etag(r.requester, found->second, r.subject, *table);
+    return true;
+  });
+  table_ = std::move(table);
+  generation_.fetch_add(1, std::memory_order_release);
+  if (!answers_.empty()) wake();
+  if (!status.ok) log_.log(LogLevel::error, "segment " + segment_.name + ": " + status.error);
+  return status;
+}
+
+std::shared_ptr<CanAdapter::Table> CanAdapter::plan_table(BindingPlan& plan) const {
+  std::shared_ptr<Table> table = build_table(plan);
+  // A channel refused in one role may have entered the table in another: build it again without.
+  // Fewer bindings only take reasons to refuse away, so the second build refuses nothing more.
+  if (plan.any_refused()) table = build_table(plan);
+  return table;
+}
+
+std::shared_ptr<CanAdapter::Table> CanAdapter::build_table(BindingPlan& plan) const {
   auto table = std::make_shared<Table>();
-  Status status;
-  auto refuse = [&](const ChannelBinding& b, const std::string& why) {
-    status.ok = false;
-    status.error += (status.error.empty() ? "" : "; ") + ("channel " + b.spec.name + ": " + why);
-    status.refused.push_back(ChannelRefusal{b.id, why});
-  };
+  auto refuse = [&](const ChannelBinding& b, const std::string& why) { plan.refuse(b, why); };
   for (const CanBackgroundFrame& frame : segment_.can.background) table->native.add_background(frame);
-  for (const auto& b : bindings) {
+  for (const ChannelBinding* binding : plan.accepted()) {
+    const ChannelBinding& b = *binding;
     if (!b.can) {
       refuse(b, "no CAN plan");
       continue;
@@ -149,32 +169,7 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
     table->filters.assign(1, can_filter{0, 0});  // too many: every frame, filtered in user space
   }
 
-  PiLock lock(io_mutex_);
-  if (sock_ >= 0 && ::setsockopt(sock_, SOL_CAN_RAW, CAN_RAW_FILTER, table->filters.data(),
-                                 static_cast<socklen_t>(table->filters.size() * sizeof(can_filter))) != 0) {
-    // The kernel keeps the old filters, so the old table stays: the whole segment failed.
-    const std::string error = "CAN_RAW_FILTER: " + errno_text(errno) + "; the previous channels stay";
-    log_.log(LogLevel::error, "segment " + segment_.name + ": " + error);
-    return Status::failure(error);
-  }
-  backlog_.set_capacity(table->backlog_frames);
-  for (auto it = tx_sequence_.begin(); it != tx_sequence_.end();) {
-    const bool bound =
-        std::any_of(table->tx.begin(), table->tx.end(), [&](const auto& t) { return t.second.etag == it->first; });
-    it = bound ? std::next(it) : tx_sequence_.erase(it);
-  }
-  // FAMOUSO nodes ask once and wait: requests for subjects bound only now are answered now.
-  std::erase_if(pending_requests_, [&](const can_binding::GetEtagRequest& r) COSMIC_REQUIRES(io_mutex_) {
-    const auto found = table->etag_of.find(r.subject);
-    if (found == table->etag_of.end()) return false;
-    queue_supply_etag(r.requester, found->second, r.subject, *table);
-    return true;
-  });
-  table_ = std::move(table);
-  generation_.fetch_add(1, std::memory_order_release);
-  if (!answers_.empty()) wake();
-  if (!status.ok) log_.log(LogLevel::error, "segment " + segment_.name + ": " + status.error);
-  return status;
+  return table;
 }
 
 std::optional<std::string> CanAdapter::bind_native(const ChannelBinding& b, Table& table) const {

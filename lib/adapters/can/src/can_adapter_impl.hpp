@@ -35,6 +35,10 @@
 #include "binding_guard.hpp"
 #include "can_binding.hpp"
 #include "cosmic/arrival_clock.hpp"
+#include "cosmic/binding_plan.hpp"
+#include "cosmic/posix_call.hpp"
+#include "cosmic/receive_thread.hpp"
+#include "cosmic/steady_clock.hpp"
 #include "cosmic/mutex.hpp"
 #include "cosmic/pi_mutex.hpp"
 #include "cosmic/thread_annotations.hpp"
@@ -70,10 +74,6 @@ constexpr Nanos kDeferredRequestRetry = std::chrono::milliseconds(20);  // well 
 constexpr std::size_t kMaxPendingRequests = 64;     // FAMOUSO: unanswered GET_ETAGs kept for a later bind
 constexpr std::size_t kMaxAnnouncedSubscriptions = 256;  // FAMOUSO: subscriptions logged once each
 constexpr canid_t kEtagFilterMask = 0x3FFF | CAN_EFF_FLAG;
-
-inline Nanos steady_now() { return std::chrono::duration_cast<Nanos>(std::chrono::steady_clock::now().time_since_epoch()); }
-
-inline std::string errno_text(int err) { return std::strerror(err); }
 
 inline std::uint32_t source_key(const CanIdentifier& id) { return (static_cast<std::uint32_t>(id.tx_node) << 14) | id.etag; }
 
@@ -204,6 +204,10 @@ class CanAdapter final : public SegmentAdapter {
   void problem(ChannelId channel, InboundProblem what);
   void drain_backlog() COSMIC_EXCLUDES(io_mutex_);
   void refresh_rx_table() COSMIC_EXCLUDES(io_mutex_);  // the receive thread's snapshot of the bindings (rx_table_)
+  // configure(): the tables of the bindings `plan` accepts, refusing in it what cannot be carried
+  // (a refused channel is carried in no role).
+  std::shared_ptr<Table> plan_table(BindingPlan& plan) const;
+  std::shared_ptr<Table> build_table(BindingPlan& plan) const;
   // configure(): a native channel's binding into `table`; the reason when it cannot be carried.
   std::optional<std::string> bind_native(const ChannelBinding& b, Table& table) const;
 
@@ -250,10 +254,8 @@ class CanAdapter final : public SegmentAdapter {
   const bool famouso_;  // FAMOUSO profile: its identifier layout, CCP, etag-4 answers, AFP
 
   EventSink* sink_ = nullptr;
-  std::thread thread_;
-  std::atomic<bool> stopping_{false};
+  ReceiveThread receiver_;  // runs run(); woken by senders that queued frames or answers
   std::atomic<bool> started_{false};
-  int wake_fd_ = -1;
   int ctl_fd_ = -1;  // for interface ioctls (AF_UNIX: works without AF_CAN)
 
   // Receive-thread state.

@@ -185,7 +185,7 @@ void CanAdapter::check_link() {
 
 void CanAdapter::run() {
   next_link_check_ = steady_now() + (link_up_ ? kLinkCheckWhileUp : kLinkCheckWhileDown);
-  while (!stopping_) {
+  while (!receiver_.stopping()) {
     Nanos now = steady_now();
     if (now >= next_link_check_) {
       check_link();
@@ -197,7 +197,7 @@ void CanAdapter::run() {
     handle_protocol_timeouts(now);
     serve_deferred_requests(now);
 
-    pollfd fds[3] = {{wake_fd_, POLLIN, 0}, {-1, 0, 0}, {census_sock_, POLLIN, 0}};
+    pollfd fds[3] = {{receiver_.wake_fd(), POLLIN, 0}, {-1, 0, 0}, {census_sock_, POLLIN, 0}};
     Nanos deadline = next_link_check_;
     if (const auto d = reassembler_.next_deadline()) deadline = std::min(deadline, *d + Nanos(1));
     if (const auto d = afp_.next_deadline()) deadline = std::min(deadline, *d + Nanos(1));
@@ -220,11 +220,8 @@ void CanAdapter::run() {
       std::this_thread::sleep_for(milliseconds(10));
       continue;
     }
-    if (stopping_) break;
-    if (fds[0].revents & POLLIN) {
-      std::uint64_t count = 0;
-      [[maybe_unused]] const ssize_t n = ::read(wake_fd_, &count, sizeof count);
-    }
+    if (receiver_.stopping()) break;
+    if (fds[0].revents & POLLIN) receiver_.clear_wakes();
     if (fds[1].fd >= 0 && (fds[1].revents & (POLLIN | POLLERR | POLLHUP))) read_frames();
     drain_backlog();
     drain_answers();

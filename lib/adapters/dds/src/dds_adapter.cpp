@@ -31,6 +31,7 @@
 #include <utility>
 #include <vector>
 
+#include "cosmic/binding_plan.hpp"
 #include "dds_adapter_impl.hpp"
 #include "dds_log_router.hpp"
 
@@ -78,34 +79,18 @@ Status DdsAdapter::start(EventSink& sink) {
 
 Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
   std::lock_guard control(control_mutex_);
-  if (!started()) {
-    return Status::failure("DDS segment " + segment_.name + " is not started");
-  }
+  if (!started()) return not_started(segment_.name);
   // Every other problem concerns one channel, which is refused in both roles (not carried at
   // all); the rest of the segment is configured (SegmentAdapter::configure).
-  Status status;
-  std::set<ChannelId> refused;
-  auto refuse = [&](const ChannelBinding& b, const std::string& why) {
-    if (!refused.insert(b.id).second) return;
-    status.ok = false;
-    status.error += (status.error.empty() ? "" : "; ") + ("channel " + b.spec.name + ": " + why);
-    status.refused.push_back(ChannelRefusal{b.id, why});
-  };
-  // Validate and index the wanted endpoints.
+  BindingPlan plan(bindings);
+  auto refuse = [&](const ChannelBinding& b, const std::string& why) { plan.refuse(b, why); };
+  // Index the wanted endpoints.
   std::map<ChannelId, const ChannelBinding*> want_writers;
   std::map<ChannelId, const ChannelBinding*> want_readers;
   std::vector<const ChannelSpec*> specs;
-  for (const ChannelBinding& b : bindings) {
-    if (b.id == kNoChannel || b.spec.name.empty()) {
-      refuse(b, "the binding has no channel id or name");
-      continue;
-    }
-    auto& table = b.role == HopRole::subscriber ? want_writers : want_readers;
-    if (!table.emplace(b.id, &b).second) {
-      refuse(b, "bound twice in the same role");
-      continue;
-    }
-    specs.push_back(&b.spec);
+  for (const ChannelBinding* b : plan.accepted()) {
+    (b->role == HopRole::subscriber ? want_writers : want_readers).emplace(b->id, b);
+    specs.push_back(&b->spec);
   }
   for (const auto& [channel, why] : dds_topic_collisions(specs, segment_.name)) {
     for (const ChannelBinding& b : bindings) {
@@ -118,7 +103,7 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
   std::vector<std::unique_ptr<WriterEntry>> new_writers;
   std::vector<std::unique_ptr<ReaderEntry>> new_readers;
   for (const auto& [id, b] : want_writers) {
-    if (refused.count(id)) continue;
+    if (plan.refused(id)) continue;
     auto it = writers_.find(id);  // only this (control) thread changes writers_
     if (it != writers_.end() && it->second->shape == shape_of(segment_, b->spec) &&
         it->second->home == &home_of(b->spec.cls)) {
@@ -132,7 +117,7 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
     }
   }
   for (const auto& [id, b] : want_readers) {
-    if (refused.count(id)) continue;
+    if (plan.refused(id)) continue;
     auto it = readers_.find(id);
     if (it != readers_.end()) {
       if (it->second->shape == shape_of(segment_, b->spec) && it->second->home == &home_of(b->spec.cls)) {
@@ -150,20 +135,19 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
     }
   }
   // A channel refused in one role is carried in neither.
-  for (const ChannelId id : refused) {
-    want_writers.erase(id);
-    want_readers.erase(id);
-  }
+  std::erase_if(want_writers, [&](const auto& w) { return plan.refused(w.first); });
+  std::erase_if(want_readers, [&](const auto& r) { return plan.refused(r.first); });
   std::erase_if(new_writers, [&](std::unique_ptr<WriterEntry>& w) {
-    if (!refused.count(w->id)) return false;
+    if (!plan.refused(w->id)) return false;
     destroy_writer(std::move(w));
     return true;
   });
   std::erase_if(new_readers, [&](std::unique_ptr<ReaderEntry>& r) {
-    if (!refused.count(r->id)) return false;
+    if (!plan.refused(r->id)) return false;
     destroy_reader(std::move(r));
     return true;
   });
+  Status status = plan.status();
   if (!status.ok) log_.log(LogLevel::error, prefix() + status.error);
 
   // 2. Swap: the router sees the new writer table at once.

@@ -26,7 +26,6 @@
 #include "cosmic/lcm_adapter.hpp"
 
 #include <poll.h>
-#include <sys/eventfd.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -47,12 +46,16 @@
 
 #include "cosmic/adapter_counters.hpp"
 #include "cosmic/arrival_clock.hpp"
+#include "cosmic/binding_plan.hpp"
 #include "cosmic/health_cell.hpp"
 #include "cosmic/lcm_reassembly.hpp"
 #include "cosmic/lcm_udpm.hpp"
 #include "cosmic/lcm_url.hpp"
+#include "cosmic/receive_thread.hpp"
 #include "cosmic/lcm_wire.hpp"
 #include "cosmic/mutex.hpp"
+#include "cosmic/result.hpp"
+#include "cosmic/steady_clock.hpp"
 #include "cosmic/thread_annotations.hpp"
 #include "cosmic/thread_policy.hpp"
 #include "cosmic/transport_limits.hpp"
@@ -129,13 +132,6 @@ class LcmAdapter final : public SegmentAdapter {
       own_dropped = false;
     }
     for (const auto& warning : rx.warnings) log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + warning);
-    stop_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-    if (stop_fd_ < 0) {
-      const std::string why = std::string("eventfd for the receive loop: ") + std::strerror(errno);
-      transmit_.close();
-      ::close(rx.fd);
-      return fail_start(why);
-    }
     rx_fd_ = rx.fd;
     rx_url_ = url;
     member_ = true;  // open_receive_socket() joined the group
@@ -151,18 +147,15 @@ class LcmAdapter final : public SegmentAdapter {
     overflow_total_ = 0;
     overflow_reported_ = 0;
     attach_sink(&sink);
-    running_.store(true, std::memory_order_release);
-    try {
-      ThreadPolicy policy = sink.receive_thread_policy();
-      policy.name = "rx:" + segment_.name;
-      thread_ = std::thread([this, fd = rx_fd_, stop_fd = stop_fd_, policy] { receive_loop(fd, stop_fd, policy); });
-    } catch (const std::exception& e) {
-      running_.store(false);
+    ThreadPolicy policy = sink.receive_thread_policy();
+    policy.name = "rx:" + segment_.name;
+    auto running = receiver_.start(policy, log_, "LCM segment " + segment_.name + ": ",
+                                   [this, fd = rx_fd_] { receive_loop(fd); });
+    if (!running) {
       attach_sink(nullptr);
       transmit_.close();
-      ::close(std::exchange(stop_fd_, -1));
       ::close(std::exchange(rx_fd_, -1));
-      return fail_start(std::string("cannot start the LCM receive thread: ") + e.what());
+      return fail_start(running.error().text);
     }
     count_own_drops(own_dropped);
     started_ = true;
@@ -173,48 +166,42 @@ class LcmAdapter final : public SegmentAdapter {
 
   Status configure(std::span<const ChannelBinding> bindings) override {
     LockGuard control(control_mutex_);
-    // Every problem here concerns one channel (Status::refused); LCM has no failure of the whole
+    if (!started_) return not_started(segment_.name);
+    // Every problem here concerns one channel (BindingPlan); LCM has no failure of the whole
     // segment once started.
-    Status status;
-    auto refuse = [&status](ChannelId id, const std::string& name, const std::string& why) {
-      status.ok = false;
-      status.error += (status.error.empty() ? "" : "; ") + ("channel " + name + ": " + why);
-      status.refused.push_back(ChannelRefusal{id, why});
-    };
+    BindingPlan plan(bindings);
     std::unordered_map<ChannelId, Channel> wanted;
     std::unordered_map<std::string, ChannelId> names;
-    std::set<ChannelId> refused_ids;
-    for (const ChannelBinding& b : bindings) {
+    for (const ChannelBinding* b : plan.accepted()) {
       // A native binding names the LCM channel and carries the contents raw.
-      const NativeBinding* native = b.spec.native_on(segment_.name);
-      const std::string& name = native && native->lcm_channel ? *native->lcm_channel : b.spec.name;
-      if (const auto problem = binding_problem(b, name, names)) {
-        refuse(b.id, name.empty() ? b.spec.name : name, *problem);
-        refused_ids.insert(b.id);
+      const NativeBinding* native = b->spec.native_on(segment_.name);
+      const std::string& name = native && native->lcm_channel ? *native->lcm_channel : b->spec.name;
+      if (const auto problem = binding_problem(*b, name, names)) {
+        plan.refuse(*b, *problem);
         continue;
       }
-      names.emplace(name, b.id);
-      Channel& c = wanted[b.id];
-      c.id = b.id;
+      names.emplace(name, b->id);
+      Channel& c = wanted[b->id];
+      c.id = b->id;
       c.name = name;
-      c.subject = b.spec.subject;
-      c.encoding = native && native->lcm_channel ? LcmEncoding::raw : b.spec.lcm_encoding;
-      c.cls = b.spec.cls;
-      if (b.role == HopRole::publisher) c.rx = true;
-      if (b.role == HopRole::subscriber) c.tx = true;
+      c.subject = b->spec.subject;
+      c.encoding = native && native->lcm_channel ? LcmEncoding::raw : b->spec.lcm_encoding;
+      c.cls = b->spec.cls;
+      if (b->role == HopRole::publisher) c.rx = true;
+      if (b->role == HopRole::subscriber) c.tx = true;
     }
     // A channel refused in one role is not carried in the other either.
-    for (const ChannelId id : refused_ids) wanted.erase(id);
+    std::erase_if(wanted, [&](const auto& entry) { return plan.refused(entry.first); });
     // The receive socket rejoins the group before a channel is received here again; if it cannot,
     // every received channel is refused (and, by the rule above, not sent either).
     bool receives = std::any_of(wanted.begin(), wanted.end(), [](const auto& c) { return c.second.rx; });
     if (receives && started_ && rx_fd_ >= 0) {
       if (const auto why = join_group()) {
-        std::erase_if(wanted, [&](const auto& entry) {
-          if (!entry.second.rx) return false;
-          refuse(entry.first, entry.second.name, "cannot receive on this segment: " + *why);
-          return true;
-        });
+        for (const ChannelBinding* b : plan.accepted()) {
+          const auto entry = wanted.find(b->id);
+          if (entry != wanted.end() && entry->second.rx) plan.refuse(*b, "cannot receive on this segment: " + *why);
+        }
+        std::erase_if(wanted, [&](const auto& entry) { return plan.refused(entry.first); });
         receives = false;
       }
     }
@@ -229,6 +216,7 @@ class LcmAdapter final : public SegmentAdapter {
       by_name_ = std::move(by_name);
     }
     if (started_ && rx_fd_ >= 0 && !receives) leave_group();
+    Status status = plan.status();
     if (!status.ok) log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + status.error);
     return status;
   }
@@ -278,12 +266,13 @@ class LcmAdapter final : public SegmentAdapter {
     if (!started_) return;
     started_ = false;
     attach_sink(nullptr);  // waits for sends in flight; no send starts after it
-    if (thread_.joinable()) {
-      running_.store(false, std::memory_order_release);
-      const std::uint64_t one = 1;
-      [[maybe_unused]] const ssize_t n = ::write(stop_fd_, &one, sizeof one);
-      thread_.join();
-      ::close(std::exchange(stop_fd_, -1));
+    {
+      LockGuard table(table_mutex_);  // stop() forgets the bindings (SegmentAdapter's lifecycle)
+      channels_.clear();
+      by_name_.clear();
+    }
+    if (receiver_.running()) {
+      receiver_.stop();
       ::close(std::exchange(rx_fd_, -1));
       member_ = false;
     }
@@ -361,7 +350,7 @@ class LcmAdapter final : public SegmentAdapter {
   // Why binding `b` under LCM channel `name` cannot be carried, given the names taken so far.
   std::optional<std::string> binding_problem(const ChannelBinding& b, const std::string& name,
                                              const std::unordered_map<std::string, ChannelId>& names) const {
-    if (b.id == kNoChannel || name.empty()) return std::string("no channel id or name");
+    if (name.empty()) return std::string("the native binding names no LCM channel");
     if (auto problem = transport_name_problem(SegmentType::lcm, name)) return problem;
     const auto taken = names.find(name);
     if (taken != names.end() && taken->second != b.id) {
@@ -376,15 +365,13 @@ class LcmAdapter final : public SegmentAdapter {
 
   // The segment's receive thread: waits for datagrams or stop(), then reads all that are queued
   // in batches and hands each batch's events on under one shared table lock.
-  void receive_loop(int fd, int stop_fd, const ThreadPolicy& policy) {
-    for (const auto& problem : apply_thread_policy(policy))
-      log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": receive thread: " + problem);
+  void receive_loop(int fd) {
     lcm_detail::ReceiveBatch batch(kReceiveBatch);
-    while (running_.load(std::memory_order_acquire)) {
-      // After a failed read, a pause (stop_fd still ends it) rather than a spin on a socket that
+    while (!receiver_.stopping()) {
+      // After a failed read, a pause (stop() still ends it) rather than a spin on a socket that
       // keeps reporting data it cannot hand over.
       const bool failing = receive_failing_.load(std::memory_order_relaxed);
-      pollfd fds[2] = {{failing ? -1 : fd, POLLIN, 0}, {stop_fd, POLLIN, 0}};
+      pollfd fds[2] = {{failing ? -1 : fd, POLLIN, 0}, {receiver_.wake_fd(), POLLIN, 0}};
       const int ready = ::poll(fds, 2, failing ? kRetryAfterFailureMs : -1);
       if (ready < 0 && errno != EINTR) {
         note_receive_failure("poll", errno);
@@ -399,7 +386,7 @@ class LcmAdapter final : public SegmentAdapter {
   // Reads what is queued in batches until a batch comes back short, stop() is asked for, or a
   // read fails.
   void drain(int fd, lcm_detail::ReceiveBatch& batch) {
-    while (running_.load(std::memory_order_relaxed)) {
+    while (!receiver_.stopping()) {
       const int n = batch.receive(fd);
       if (n < 0) {
         note_receive_failure("recvmmsg", errno);
@@ -417,7 +404,7 @@ class LcmAdapter final : public SegmentAdapter {
 
   void note_receive_failure(const char* call, int error) {
     if (receive_failing_.exchange(true, std::memory_order_relaxed)) return;
-    const std::string what = std::string(call) + ": " + std::strerror(error);
+    const std::string what = std::string(call) + ": " + errno_text(error);
     set_health(SegmentHealth::degraded, what + " on " + segment_.lcm.url);
     log_.log(LogLevel::error, "LCM segment " + segment_.name + ": " + what);
   }
@@ -445,7 +432,7 @@ class LcmAdapter final : public SegmentAdapter {
   void handle_batch(const lcm_detail::ReceiveBatch& batch, std::size_t count) {
     note_kernel_drops(batch);
     // One reading of both clocks for the batch: arrival times are converted with it.
-    const std::int64_t steady_now = std::chrono::duration_cast<Nanos>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    const std::int64_t steady = steady_now().count();
     const std::int64_t realtime_now =
         std::chrono::duration_cast<Nanos>(std::chrono::system_clock::now().time_since_epoch()).count();
     SharedLock table(table_mutex_);
@@ -460,7 +447,7 @@ class LcmAdapter final : public SegmentAdapter {
       }
       std::int64_t arrival = batch.arrival_realtime_ns(i);
       if (arrival == 0) arrival = realtime_now;
-      const Nanos received_at = steady_arrival(arrival, Nanos(steady_now), realtime_now);
+      const Nanos received_at = steady_arrival(arrival, Nanos(steady), realtime_now);
       if (!parsed->fragment) {
         deliver(parsed->channel, parsed->data, received_at, arrival);
         continue;
@@ -548,13 +535,11 @@ class LcmAdapter final : public SegmentAdapter {
 
   Mutex control_mutex_;
   bool started_ COSMIC_GUARDED_BY(control_mutex_) = false;
-  std::thread thread_ COSMIC_GUARDED_BY(control_mutex_);
+  ReceiveThread receiver_;  // runs receive_loop(); stop() ends it through its eventfd
   int rx_fd_ COSMIC_GUARDED_BY(control_mutex_) = -1;
-  int stop_fd_ COSMIC_GUARDED_BY(control_mutex_) = -1;  // eventfd: stop() wakes the receive loop
   std::optional<LcmUrl> rx_url_ COSMIC_GUARDED_BY(control_mutex_);
   bool member_ COSMIC_GUARDED_BY(control_mutex_) = false;  // rx_fd_ is a member of the group
   bool may_leave_ COSMIC_GUARDED_BY(control_mutex_) = false;  // leaving stops all of the group's datagrams
-  std::atomic<bool> running_{false};
   // memq://: set by start() before the sink is attached, cleared by stop() after it is detached.
   std::atomic<bool> memq_{false};
 

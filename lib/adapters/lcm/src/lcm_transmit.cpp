@@ -1,5 +1,7 @@
 #include "lcm_transmit.hpp"
 
+#include "cosmic/result.hpp"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -215,7 +217,7 @@ SendStatus LcmTransmitter::failed(ClassSender& sender, const Channel& channel, S
     if (first) {
       log_.log(LogLevel::warning, "LCM segment " + segment_name_ + ": send on channel " + channel.name + " (" +
                                       class_name(index) + "): " + why.what +
-                                      (why.error != 0 ? std::string(": ") + std::strerror(why.error) : std::string()));
+                                      (why.error != 0 ? std::string(": ") + errno_text(why.error) : std::string()));
     }
     if (source_gone(why.error)) reopen(sender, index);
   } catch (const std::exception&) {

@@ -2,32 +2,30 @@
 
 #include <algorithm>
 
-#include "cosmic/router.hpp"
+#include "cosmic/binding_plan.hpp"
+#include "cosmic/steady_clock.hpp"
 
 namespace cosmic {
 
 Status MemoryAdapter::start(EventSink& sink) {
   LockGuard lock(mutex_);
+  if (sink_ != nullptr) return Status::failure("segment " + segment_name_ + " already started");
   sink_ = &sink;
+  health_ = HealthReport{SegmentHealth::up, ""};
   return Status::success();
 }
 
 Status MemoryAdapter::configure(std::span<const ChannelBinding> bindings) {
   LockGuard lock(mutex_);
+  if (sink_ == nullptr) return not_started(segment_name_);
   if (!fail_configure_.empty()) return Status::failure(fail_configure_);
-  Status status;
-  bindings_.clear();
-  for (const auto& b : bindings) {
-    const auto refused = refuse_.find(b.spec.name);
-    if (refused == refuse_.end()) {
-      bindings_.push_back(b);
-      continue;
-    }
-    status.ok = false;
-    status.error += (status.error.empty() ? "" : "; ") + ("channel " + b.spec.name + ": " + refused->second);
-    status.refused.push_back(ChannelRefusal{b.id, refused->second});
+  BindingPlan plan(bindings);
+  for (const ChannelBinding* b : plan.accepted()) {
+    const auto refused = refuse_.find(b->spec.name);
+    if (refused != refuse_.end()) plan.refuse(*b, refused->second);
   }
-  return status;
+  bindings_ = plan.carried();
+  return plan.status();
 }
 
 void MemoryAdapter::refuse_channel(const std::string& name, std::string reason) {
@@ -139,6 +137,8 @@ AdapterStatistics MemoryAdapter::statistics() const {
 void MemoryAdapter::stop() {
   LockGuard lock(mutex_);
   sink_ = nullptr;
+  bindings_.clear();
+  health_ = HealthReport{SegmentHealth::down, "stopped"};
 }
 
 void MemoryAdapter::set_health(SegmentHealth state, std::string detail) {

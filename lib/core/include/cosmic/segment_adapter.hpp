@@ -138,14 +138,24 @@ struct PeerQosConflict {
 class SegmentAdapter {
  public:
   virtual ~SegmentAdapter() = default;
-  // Opens the transport; inbound events flow to `sink` (which must outlive stop()).
+  // The lifecycle, the same for every adapter (tests/contract/adapter_contract.hpp holds each
+  // adapter to it: memory, CAN, DDS, LCM):
+  //  - start() opens the transport; inbound events flow to `sink` (which must outlive stop()). A
+  //    segment starts carrying nothing. start() on a started segment fails and changes nothing.
+  //    A start() that fails leaves the segment not started (health down, with the reason).
+  //  - configure() on a segment that is not started (before start(), after a failed start(),
+  //    after stop()) fails as a whole (cosmic/binding_plan.hpp: not_started) and carries nothing.
+  //  - stop() ends every thread that calls the sink and forgets the bindings: afterwards send()
+  //    answers failed and health() is down ("stopped"); a later start() carries nothing until the
+  //    next configure(). stop() on a segment that is not started does nothing.
   virtual Status start(EventSink& sink) = 0;
-  // Makes the segment carry `bindings`. Channels present before and after keep flowing. One
-  // contract for every adapter (tests/integration/*/ check it per adapter):
+  // Makes the segment carry `bindings`. Channels present before and after keep flowing.
   //  - ok: the segment carries every binding.
-  //  - !ok with Status::refused: the segment carries every binding except exactly those named
-  //    (one entry per refused channel, with the transport's reason; a refused binding is not
-  //    carried at all, whether or not it was before). `error` sums the reasons up.
+  //  - !ok with Status::refused: the segment carries every binding except exactly those named:
+  //    one entry per refused channel, with the transport's reason. A refused channel is carried
+  //    in no role, whether or not it was before. `error` joins the reasons as "channel NAME: why".
+  //    Every transport refuses a binding without channel id or name and a channel bound twice in
+  //    one role (cosmic/binding_plan.hpp plans this for all of them).
   //  - !ok with refused empty: a failure of the whole segment (not started, the kernel refused
   //    its filters, ...); the segment carries exactly what it carried before the call.
   // The gateway shows each refused channel as `failed` with the reason (never bound and silent).

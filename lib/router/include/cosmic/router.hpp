@@ -25,10 +25,12 @@
 #include "cosmic/event.hpp"
 #include "cosmic/log.hpp"
 #include "cosmic/model.hpp"
+#include "cosmic/steady_clock.hpp"
 #include "cosmic/mutex.hpp"
 #include "cosmic/pi_mutex.hpp"
 #include "cosmic/router_stats.hpp"
 #include "cosmic/segment_adapter.hpp"
+#include "cosmic/steady_clock.hpp"
 #include "cosmic/thread_annotations.hpp"
 #include "cosmic/thread_policy.hpp"
 
@@ -62,7 +64,6 @@ struct RouterLimits {
 };
 
 using SteadyClock = Nanos (*)();
-Nanos steady_now();
 
 class EgressLane;
 struct ChannelState;
