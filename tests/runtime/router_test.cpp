@@ -67,7 +67,8 @@ class RouterTest : public ::testing::Test {
   // `raw`: as a format without origin delivers it (raw LCM), marked for the fingerprint loop guard.
   void deliver(ChannelId id, EventHeader header, Nanos at, std::vector<std::uint8_t> payload = {1, 2, 3}, bool raw = false) {
     header.subject = subjects[id];
-    router.inbox(0).on_event(InboundEvent{id, header, payload, at, raw});
+    const FormatIdentity none{false, false, false, true};  // raw LCM's: nothing, and copies echo back
+    router.inbox(0).on_event(InboundEvent{id, header, payload, at, raw ? none : FormatIdentity{}});
   }
 
   const SegmentCountersSnapshot& counters(const std::string& channel, const std::string& segment) {

@@ -83,6 +83,9 @@ void Reassembler::record(Slot* own, std::uint32_t source, SlotState state, std::
   slot->last_activity = now;
 }
 
+// A fragment, in four steps: a record of the source that went stale is forgotten; a fragment of
+// the source's partial event continues it (continue_event); one of an event already finished or
+// given up is ignored (known_fragment); anything else has to begin an event (begin_event).
 FragmentResult Reassembler::accept(std::uint32_t source, std::span<const std::uint8_t> frame,
                                    std::size_t max_event_bytes, Nanos now) {
   FragmentResult result;
@@ -93,92 +96,91 @@ FragmentResult Reassembler::accept(std::uint32_t source, std::span<const std::ui
   }
   const FragmentHeader h = decode_fragment_header(static_cast<std::uint16_t>((frame[0] << 8) | frame[1]));
   const std::span<const std::uint8_t> data = frame.subspan(kFragmentHeaderBytes);
-
   Slot* own = find(source);
-  if (own && stale(*own, now)) {
-    if (own->state == SlotState::partial) {
-      ++counters_.timeouts;
-      result.dropped_event = true;
-    }
+  if (own) forget_if_stale(*own, now, result);
+  if (own && own->state == SlotState::partial) {
+    if (h.sequence == own->sequence) return continue_event(*own, source, h, data, now, result);
+    // The source began a new event before finishing this one: its end was lost.
+    ++counters_.interrupted;
+    result.dropped_event = true;
     own->state = SlotState::empty;
   }
-
-  if (own && own->state == SlotState::partial) {
-    if (h.sequence != own->sequence) {
-      // The source began a new event before finishing this one: its end was lost.
-      ++counters_.interrupted;
-      result.dropped_event = true;
-      own->state = SlotState::empty;
-    } else if (h.index < own->next_index) {
-      ++counters_.duplicates;
-      result.outcome = FragmentOutcome::ignored;
-      return result;
-    } else if (h.index > own->next_index) {
-      ++counters_.gaps;
-      result.dropped_event = true;
-      result.outcome = FragmentOutcome::rejected;
-      record(own, source, SlotState::discarding, h.sequence, h.index, now);
-      return result;
-    } else {
-      const std::size_t limit = own->max_bytes + (h.last ? limits_.padding_slack : 0);
-      if (own->bytes.size() + data.size() > limit || (!h.last && h.index == kMaxFragmentIndex)) {
-        ++counters_.oversize;
-        result.dropped_event = true;
-        result.outcome = FragmentOutcome::rejected;
-        record(own, source, SlotState::discarding, h.sequence, h.index, now);
-        return result;
-      }
-      own->bytes.insert(own->bytes.end(), data.begin(), data.end());
-      ++own->next_index;
-      own->last_activity = now;
-      if (!h.last) {
-        result.outcome = FragmentOutcome::partial;
-        return result;
-      }
-      ++counters_.completed;
-      own->state = SlotState::finished;
-      own->highest_index = h.index;
-      result.outcome = FragmentOutcome::complete;
-      result.event = std::span<const std::uint8_t>(own->bytes.data(), std::min(own->bytes.size(), own->max_bytes));
-      return result;
-    }
+  if (own && known_fragment(*own, h, now)) {
+    result.outcome = FragmentOutcome::ignored;
+    return result;
   }
+  return begin_event(own, source, h, data, max_event_bytes, now, result);
+}
 
-  if (own && own->state == SlotState::finished && h.sequence == own->sequence && h.index <= own->highest_index) {
+void Reassembler::forget_if_stale(Slot& own, Nanos now, FragmentResult& result) {
+  if (!stale(own, now)) return;
+  if (own.state == SlotState::partial) {
+    ++counters_.timeouts;
+    result.dropped_event = true;
+  }
+  own.state = SlotState::empty;
+}
+
+FragmentResult Reassembler::give_up(Slot* own, std::uint32_t source, const FragmentHeader& h, Nanos now,
+                                    std::uint64_t& counter, FragmentResult result) {
+  ++counter;
+  result.dropped_event = true;
+  result.outcome = FragmentOutcome::rejected;
+  record(own, source, SlotState::discarding, h.sequence, h.index, now);
+  return result;
+}
+
+FragmentResult Reassembler::continue_event(Slot& own, std::uint32_t source, const FragmentHeader& h,
+                                           std::span<const std::uint8_t> data, Nanos now, FragmentResult result) {
+  if (h.index < own.next_index) {
     ++counters_.duplicates;
     result.outcome = FragmentOutcome::ignored;
     return result;
   }
-  if (own && own->state == SlotState::discarding && h.sequence == own->sequence && h.index != 0) {
-    if (h.index < own->highest_index) {
-      ++counters_.reordered;
-    } else if (h.index == own->highest_index) {
-      ++counters_.duplicates;
-    } else {
-      ++counters_.stray;
-      own->highest_index = h.index;
-    }
-    own->last_activity = now;
-    result.outcome = FragmentOutcome::ignored;
+  if (h.index > own.next_index) return give_up(&own, source, h, now, counters_.gaps, result);
+  const std::size_t limit = own.max_bytes + (h.last ? limits_.padding_slack : 0);
+  if (own.bytes.size() + data.size() > limit || (!h.last && h.index == kMaxFragmentIndex)) {
+    return give_up(&own, source, h, now, counters_.oversize, result);
+  }
+  own.bytes.insert(own.bytes.end(), data.begin(), data.end());
+  ++own.next_index;
+  own.last_activity = now;
+  if (!h.last) {
+    result.outcome = FragmentOutcome::partial;
     return result;
   }
+  ++counters_.completed;
+  own.state = SlotState::finished;
+  own.highest_index = h.index;
+  result.outcome = FragmentOutcome::complete;
+  result.event = std::span<const std::uint8_t>(own.bytes.data(), std::min(own.bytes.size(), own.max_bytes));
+  return result;
+}
 
-  // This fragment has to begin a new event.
-  if (h.index != 0) {
-    ++counters_.gaps;
-    result.dropped_event = true;
-    result.outcome = FragmentOutcome::rejected;
-    record(own, source, SlotState::discarding, h.sequence, h.index, now);
-    return result;
+bool Reassembler::known_fragment(Slot& own, const FragmentHeader& h, Nanos now) {
+  if (own.state == SlotState::finished && h.sequence == own.sequence && h.index <= own.highest_index) {
+    ++counters_.duplicates;
+    return true;
   }
+  if (own.state != SlotState::discarding || h.sequence != own.sequence || h.index == 0) return false;
+  if (h.index < own.highest_index) {
+    ++counters_.reordered;
+  } else if (h.index == own.highest_index) {
+    ++counters_.duplicates;
+  } else {
+    ++counters_.stray;
+    own.highest_index = h.index;
+  }
+  own.last_activity = now;
+  return true;
+}
+
+FragmentResult Reassembler::begin_event(Slot* own, std::uint32_t source, const FragmentHeader& h,
+                                        std::span<const std::uint8_t> data, std::size_t max_event_bytes, Nanos now,
+                                        FragmentResult result) {
+  if (h.index != 0) return give_up(own, source, h, now, counters_.gaps, result);
   const std::size_t limit = max_event_bytes + (h.last ? limits_.padding_slack : 0);
-  if (data.size() > limit) {
-    ++counters_.oversize;
-    result.dropped_event = true;
-    result.outcome = FragmentOutcome::rejected;
-    record(own, source, SlotState::discarding, h.sequence, h.index, now);
-    return result;
-  }
+  if (data.size() > limit) return give_up(own, source, h, now, counters_.oversize, result);
   if (h.last) {
     ++counters_.completed;
     record(own, source, SlotState::finished, h.sequence, 0, now);
@@ -186,47 +188,44 @@ FragmentResult Reassembler::accept(std::uint32_t source, std::span<const std::ui
     result.event = data.first(std::min(data.size(), max_event_bytes));
     return result;
   }
-
-  Slot* target = own;
-  if (!target) {
-    for (auto& slot : slots_) {
-      if (slot.state == SlotState::partial && stale(slot, now)) {
-        ++counters_.timeouts;
-        result.displaced = slot.source;
-        slot.state = SlotState::empty;
-      }
-      if (slot.state == SlotState::empty) {
-        target = &slot;
-        break;
-      }
-    }
-  }
-  if (!target) {
-    // Records of finished or dropped events give way first (oldest first), then the partial
-    // event idle the longest.
-    for (auto& slot : slots_) {
-      if (slot.state != SlotState::partial && (!target || slot.last_activity < target->last_activity)) target = &slot;
-    }
-  }
-  if (!target) {
-    for (auto& slot : slots_) {
-      if (!target || slot.last_activity < target->last_activity) target = &slot;
-    }
-    ++counters_.evicted;
-    result.displaced = target->source;
-  }
-  target->state = SlotState::partial;
-  target->source = source;
-  target->sequence = h.sequence;
-  target->next_index = 1;
-  target->highest_index = 0;
-  target->max_bytes = max_event_bytes;
-  target->last_activity = now;
-  target->bytes.clear();
-  target->bytes.reserve(max_event_bytes + limits_.padding_slack);
-  target->bytes.insert(target->bytes.end(), data.begin(), data.end());
+  Slot& target = slot_for_new_event(own, now, result);
+  target.state = SlotState::partial;
+  target.source = source;
+  target.sequence = h.sequence;
+  target.next_index = 1;
+  target.highest_index = 0;
+  target.max_bytes = max_event_bytes;
+  target.last_activity = now;
+  target.bytes.clear();
+  target.bytes.reserve(max_event_bytes + limits_.padding_slack);
+  target.bytes.insert(target.bytes.end(), data.begin(), data.end());
   result.outcome = FragmentOutcome::partial;
   return result;
+}
+
+Reassembler::Slot& Reassembler::slot_for_new_event(Slot* own, Nanos now, FragmentResult& result) {
+  if (own) return *own;
+  for (auto& slot : slots_) {
+    if (slot.state == SlotState::partial && stale(slot, now)) {
+      ++counters_.timeouts;
+      result.displaced = slot.source;
+      slot.state = SlotState::empty;
+    }
+    if (slot.state == SlotState::empty) return slot;
+  }
+  // Records of finished or dropped events give way first (oldest first), then the partial event
+  // idle the longest.
+  Slot* target = nullptr;
+  for (auto& slot : slots_) {
+    if (slot.state != SlotState::partial && (!target || slot.last_activity < target->last_activity)) target = &slot;
+  }
+  if (target) return *target;
+  for (auto& slot : slots_) {
+    if (!target || slot.last_activity < target->last_activity) target = &slot;
+  }
+  ++counters_.evicted;
+  result.displaced = target->source;
+  return *target;
 }
 
 std::size_t Reassembler::expire(Nanos now, const std::function<void(std::uint32_t)>& dropped) {

@@ -187,7 +187,7 @@ bool Router::admit(ChannelState& channel, SegmentCounters& counters, const Inbou
   const EventHeader& header = event.header;
   const ChannelSpec& spec = channel.route.spec;
   PiLock lock(channel.policy_mutex);
-  const bool loop_copy = header.origin == 0 && event.guard_loops_by_fingerprint &&
+  const bool loop_copy = header.origin == 0 && event.identity.needs_fingerprint_loop_guard() &&
                          channel.loop_guard.loop_copy(event.payload, event.received_at);
   if (loop_copy || (header.origin != 0 && channel.dedup.seen(header.origin, header.sequence))) {
     counters.drop(DropReason::duplicate);

@@ -207,12 +207,12 @@ class RecordingSink final : public EventSink {
     ChannelId channel;
     EventHeader header;
     Bytes payload;
-    bool fingerprint_guard = false;  // InboundEvent::guard_loops_by_fingerprint
+    bool fingerprint_guard = false;  // InboundEvent::identity.needs_fingerprint_loop_guard()
   };
 
   void on_event(const InboundEvent& event) override {
     std::lock_guard lock(mutex_);
-    events_.push_back({event.channel, event.header, Bytes(event.payload.begin(), event.payload.end()), event.guard_loops_by_fingerprint});
+    events_.push_back({event.channel, event.header, Bytes(event.payload.begin(), event.payload.end()), event.identity.needs_fingerprint_loop_guard()});
     changed_.notify_all();
   }
   void on_problem(ChannelId channel, InboundProblem problem) override {

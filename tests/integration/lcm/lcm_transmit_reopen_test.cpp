@@ -55,7 +55,7 @@ struct TransmitRig {
   explicit TransmitRig(const std::string& name) : transmitter(name, log, counters, health, receive_failing) {
     channel.id = 1;
     channel.name = name;
-    channel.encoding = LcmEncoding::raw;
+    channel.format = make_lcm_message_format(LcmEncoding::raw);
     channel.tx = true;
     event.channel = 1;
     event.payload = payload;

@@ -130,6 +130,9 @@ void CanAdapter::deliver(const RxChannel& channel, std::span<const std::uint8_t>
   event.header.subject = channel.subject;
   event.payload = payload;
   event.received_at = now;
+  // CAN frames carry no origin, sequence or hop count (the TxNode names a node, not an event), and
+  // CAN_RAW never hands a socket its own frames back: no fingerprint guard either.
+  event.identity = FormatIdentity{false, false, false, false};
   if (sink_) sink_->on_event(event);
 }
 

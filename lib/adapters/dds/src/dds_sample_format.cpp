@@ -42,6 +42,7 @@ class EnvelopeFormat final : public DdsSampleFormat {
     event.header.created_ns = env.created_ns();
     event.header.age_ns = env.age_ns();
     event.payload = std::span<const std::uint8_t>(env.payload().data(), env.payload().size());
+    event.identity = FormatIdentity{};  // the whole header travels
     return DecodeResult::event;
   }
   void reserve(std::size_t bytes) override { envelope_.payload().reserve(bytes); }
@@ -74,6 +75,9 @@ class OpaqueFormat final : public DdsSampleFormat {
     event.header.subject = subject_;
     event.header.sequence = writer_sequence(info);
     event.payload = std::span<const std::uint8_t>(sample_.bytes.data(), sample_.bytes.size());
+    // No origin, sequence or hop count of its own; no copy of ours comes back (dropped by GUID
+    // prefix), so no fingerprint guard either.
+    event.identity = FormatIdentity{false, false, false, false};
     return DecodeResult::event;
   }
   void reserve(std::size_t bytes) override { sample_.bytes.reserve(bytes); }

@@ -82,6 +82,8 @@ struct StringHash {
 };
 
 using lcm_detail::Channel;
+using lcm_detail::LcmArrival;
+using lcm_detail::make_lcm_message_format;
 
 class LcmAdapter final : public SegmentAdapter {
  public:
@@ -185,7 +187,7 @@ class LcmAdapter final : public SegmentAdapter {
       c.id = b->id;
       c.name = name;
       c.subject = b->spec.subject;
-      c.encoding = native && native->lcm_channel ? LcmEncoding::raw : b->spec.lcm_encoding;
+      c.format = make_lcm_message_format(native && native->lcm_channel ? LcmEncoding::raw : b->spec.lcm_encoding);
       c.cls = b->spec.cls;
       if (b->role == HopRole::publisher) c.rx = true;
       if (b->role == HopRole::subscriber) c.tx = true;
@@ -492,30 +494,14 @@ class LcmAdapter final : public SegmentAdapter {
     InboundEvent event;
     event.channel = channel.id;
     event.received_at = received_at;
-    if (channel.encoding == LcmEncoding::raw) {
-      if (bytes.size() > segment_.max_message_size) {
-        counters_.receive_errors.fetch_add(1, std::memory_order_relaxed);
-        sink_->on_problem(channel.id, InboundProblem::decode_error);
-        return;
-      }
-      event.header.subject = channel.subject;
-      event.header.created_ns = arrival_realtime_ns;  // wall clock, informational
-      event.payload = bytes;
-      event.guard_loops_by_fingerprint = true;
-      sink_->on_event(event);
-      return;
-    }
-    // Decoded in place (cosmic/lcm_wire.hpp): the payload stays in the receive buffer, no copy.
-    const auto decoded = decode_lcm_envelope(bytes, segment_.max_message_size);
-    if (!decoded) {
+    // An envelope with our origin that is not our own datagram (a loop through another gateway,
+    // or a spoof) goes on to the router, which counts it (ingress check: own origin).
+    const LcmArrival arrival{channel.subject, arrival_realtime_ns};
+    if (!channel.format->decode(bytes, arrival, segment_.max_message_size, event)) {
       counters_.receive_errors.fetch_add(1, std::memory_order_relaxed);
       sink_->on_problem(channel.id, InboundProblem::decode_error);
       return;
     }
-    // An envelope with our origin that is not our own datagram (a loop through another gateway,
-    // or a spoof) goes on to the router, which counts it (ingress check: own origin).
-    event.header = decoded->header;
-    event.payload = decoded->payload;
     sink_->on_event(event);
   }
 

@@ -5,7 +5,10 @@
 #include <cstdint>
 #include <string>
 
+#include <memory>
+
 #include "cosmic/model.hpp"
+#include "lcm_message_format.hpp"
 
 namespace cosmic::lcm_detail {
 
@@ -15,7 +18,7 @@ struct Channel {
   ChannelId id = kNoChannel;
   std::string name;  // the LCM channel name, 1-63 bytes
   std::uint64_t subject = 0;
-  LcmEncoding encoding = LcmEncoding::envelope;
+  std::shared_ptr<const LcmMessageFormat> format;  // envelope or raw: how its messages read and write
   ChannelClass cls = ChannelClass::nrt;  // which transmit socket sends it
   bool rx = false;
   bool tx = false;

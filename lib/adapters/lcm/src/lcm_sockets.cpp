@@ -14,14 +14,14 @@
 #include <cstring>
 
 #include "cosmic/lcm_udpm.hpp"
+#include "cosmic/result.hpp"
 #include "cosmic/receive_buffer_size.hpp"
 
 namespace cosmic::lcm_detail {
 namespace {
 
-std::string errno_text(const char* what) {
-  return std::string(what) + ": " + std::strerror(errno);
-}
+// "WHAT: <errno text>" for the call that just failed.
+std::string failed_call(const char* what) { return Error::from_errno(what, errno).text; }
 
 // The group and port as a socket address; nullopt when the group is not an IPv4 address.
 std::optional<sockaddr_in> group_address(const LcmUrl& url) {
@@ -61,8 +61,8 @@ OpenedSocket open_receive_socket(const LcmUrl& url, std::size_t buffer_bytes) {
   const auto group = group_address(url);
   if (!group) return failed(std::move(out), -1, "not an IPv4 multicast group: " + url.group);
   const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-  if (fd < 0) return failed(std::move(out), fd, errno_text("socket"));
-  if (set_int(fd, SOL_SOCKET, SO_REUSEADDR, 1) != 0) return failed(std::move(out), fd, errno_text("SO_REUSEADDR"));
+  if (fd < 0) return failed(std::move(out), fd, failed_call("socket"));
+  if (set_int(fd, SOL_SOCKET, SO_REUSEADDR, 1) != 0) return failed(std::move(out), fd, failed_call("SO_REUSEADDR"));
   sockaddr_in bind_to{};
   bind_to.sin_family = AF_INET;
   bind_to.sin_port = htons(url.port);
@@ -70,16 +70,16 @@ OpenedSocket open_receive_socket(const LcmUrl& url, std::size_t buffer_bytes) {
   // message of the group (as liblcm binds on Linux).
   bind_to.sin_addr = group->sin_addr;
   if (::bind(fd, reinterpret_cast<const sockaddr*>(&bind_to), sizeof bind_to) != 0)
-    return failed(std::move(out), fd, errno_text(("bind to port " + std::to_string(url.port)).c_str()));
+    return failed(std::move(out), fd, failed_call(("bind to port " + std::to_string(url.port)).c_str()));
   if (auto why = set_group_membership(fd, url, true)) return failed(std::move(out), fd, std::move(*why));
   // Without this, Linux hands the socket every group any socket of the host joined on this port.
   if (set_int(fd, IPPROTO_IP, IP_MULTICAST_ALL, 0) != 0)
-    out.warnings.push_back(errno_text("IP_MULTICAST_ALL"));
+    out.warnings.push_back(failed_call("IP_MULTICAST_ALL"));
   else
     out.sees_own_groups_only = true;
   if (set_int(fd, SOL_SOCKET, SO_TIMESTAMPNS, 1) != 0)
-    out.warnings.push_back(errno_text("SO_TIMESTAMPNS (residence then starts when the datagram is read)"));
-  if (set_int(fd, SOL_SOCKET, SO_RXQ_OVFL, 1) != 0) out.warnings.push_back(errno_text("SO_RXQ_OVFL (drops not counted)"));
+    out.warnings.push_back(failed_call("SO_TIMESTAMPNS (residence then starts when the datagram is read)"));
+  if (set_int(fd, SOL_SOCKET, SO_RXQ_OVFL, 1) != 0) out.warnings.push_back(failed_call("SO_RXQ_OVFL (drops not counted)"));
   warn_if_short(fd, url.recv_buf_size ? *url.recv_buf_size : buffer_bytes, out);
   out.fd = fd;
   return out;
@@ -93,8 +93,8 @@ std::optional<std::string> set_group_membership(int fd, const LcmUrl& url, bool 
   membership.imr_interface.s_addr = htonl(INADDR_ANY);
   if (::setsockopt(fd, IPPROTO_IP, member ? IP_ADD_MEMBERSHIP : IP_DROP_MEMBERSHIP, &membership, sizeof membership) == 0)
     return std::nullopt;
-  return member ? errno_text(("joining " + url.group + " (check the multicast route)").c_str())
-                : errno_text(("leaving " + url.group).c_str());
+  return member ? failed_call(("joining " + url.group + " (check the multicast route)").c_str())
+                : failed_call(("leaving " + url.group).c_str());
 }
 
 OpenedSocket open_send_socket(const LcmUrl& url) {
@@ -102,16 +102,16 @@ OpenedSocket open_send_socket(const LcmUrl& url) {
   const auto group = group_address(url);
   if (!group) return failed(std::move(out), -1, "not an IPv4 multicast group: " + url.group);
   const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-  if (fd < 0) return failed(std::move(out), fd, errno_text("socket"));
+  if (fd < 0) return failed(std::move(out), fd, failed_call("socket"));
   const int ttl = static_cast<int>(url.ttl.value_or(0));
-  if (set_int(fd, IPPROTO_IP, IP_MULTICAST_TTL, ttl) != 0) return failed(std::move(out), fd, errno_text("IP_MULTICAST_TTL"));
-  if (set_int(fd, IPPROTO_IP, IP_MULTICAST_LOOP, 1) != 0) return failed(std::move(out), fd, errno_text("IP_MULTICAST_LOOP"));
+  if (set_int(fd, IPPROTO_IP, IP_MULTICAST_TTL, ttl) != 0) return failed(std::move(out), fd, failed_call("IP_MULTICAST_TTL"));
+  if (set_int(fd, IPPROTO_IP, IP_MULTICAST_LOOP, 1) != 0) return failed(std::move(out), fd, failed_call("IP_MULTICAST_LOOP"));
   if (::connect(fd, reinterpret_cast<const sockaddr*>(&*group), sizeof *group) != 0)
-    return failed(std::move(out), fd, errno_text(("no route to " + url.group + " (check the multicast route)").c_str()));
+    return failed(std::move(out), fd, failed_call(("no route to " + url.group + " (check the multicast route)").c_str()));
   sockaddr_in local{};
   socklen_t length = sizeof local;
   if (::getsockname(fd, reinterpret_cast<sockaddr*>(&local), &length) != 0)
-    return failed(std::move(out), fd, errno_text("getsockname"));
+    return failed(std::move(out), fd, failed_call("getsockname"));
   out.local = Endpoint{ntohl(local.sin_addr.s_addr), ntohs(local.sin_port)};
   out.fd = fd;
   return out;
@@ -140,7 +140,7 @@ std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> 
   // Cut: trim to the UDP header (queued, read, skipped). Drop: 0, never queued.
   program.push_back(BPF_STMT(BPF_RET | BPF_K, mode == LcmOwnDatagrams::drop ? 0u : 1u));
   const sock_fprog fprog{static_cast<unsigned short>(program.size()), program.data()};
-  if (::setsockopt(fd, SOL_SOCKET, SO_ATTACH_FILTER, &fprog, sizeof fprog) != 0) return errno_text("SO_ATTACH_FILTER");
+  if (::setsockopt(fd, SOL_SOCKET, SO_ATTACH_FILTER, &fprog, sizeof fprog) != 0) return failed_call("SO_ATTACH_FILTER");
   return std::nullopt;
 }
 
@@ -164,7 +164,7 @@ std::optional<std::string> self_test(const LcmUrl& url, int fd, std::chrono::mil
     pollfd p{fd, POLLIN, 0};
     if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) continue;
     const int n = batch.receive(fd);
-    if (n < 0) return errno_text("self test: recvmmsg");
+    if (n < 0) return failed_call("self test: recvmmsg");
     for (int i = 0; i < n; ++i) {
       const auto d = parse_lcm_datagram(batch.datagram(static_cast<std::size_t>(i)));
       if (d && !d->fragment && d->channel == kChannel && batch.sender(static_cast<std::size_t>(i)) == probe.local &&

@@ -12,6 +12,9 @@
 #include <utility>
 
 namespace cosmic::lcm_detail {
+
+static_assert(kLcmMessageParts == SendBatch::kMaxParts, "a format's message fits one batch entry");
+
 namespace {
 
 constexpr auto kReopenPause = std::chrono::seconds(1);
@@ -28,23 +31,6 @@ bool source_gone(int error) {
 const char* class_name(std::size_t index) {
   static constexpr const char* kNames[] = {"hrt", "srt", "nrt"};
   return index < 3 ? kNames[index] : "?";
-}
-
-// The parts of `event` as LCM carries it on `channel`: its payload, after the envelope's header
-// (written to `header`) on an envelope channel; their count, 0 when too large for an envelope.
-std::size_t message_parts(const Channel& channel, const OutboundEvent& event,
-                          std::array<std::uint8_t, kLcmEnvelopeHeaderSize>& header,
-                          std::array<std::span<const std::uint8_t>, SendBatch::kMaxParts>& parts) {
-  std::size_t count = 0;
-  if (channel.encoding == LcmEncoding::envelope) {
-    if (event.payload.size() > static_cast<std::size_t>(INT32_MAX) - kLcmEnvelopeHeaderSize) return 0;
-    // The header goes out as given, as on DDS: the router stamps what this gateway originates
-    // with its id, a component (libcosmic-client) stamps its own.
-    header = encode_lcm_envelope_header(event.header, static_cast<std::uint32_t>(event.payload.size()));
-    parts[count++] = header;
-  }
-  parts[count++] = event.payload;
-  return count;
 }
 
 }  // namespace
@@ -179,8 +165,8 @@ void LcmTransmitter::note_sending(std::size_t datagrams) {
 
 SendStatus LcmTransmitter::send_one(ClassSender& sender, const Channel& channel, const OutboundEvent& event) {
   if (sender.fd < 0) return failed(sender, channel, SendFailure{0, "no transmit socket"});
-  std::array<std::span<const std::uint8_t>, SendBatch::kMaxParts> parts{};
-  const std::size_t count = message_parts(channel, event, sender.envelope_headers[0], parts);
+  LcmMessageParts parts{};
+  const std::size_t count = channel.format->encode(event, sender.envelope_headers[0], parts);
   if (count == 0) return failed(sender, channel, SendFailure{0, "payload too large"});
   std::size_t payload_size = 0;
   for (std::size_t k = 0; k < count; ++k) payload_size += parts[k].size();
@@ -193,8 +179,8 @@ SendStatus LcmTransmitter::send_one(ClassSender& sender, const Channel& channel,
 bool LcmTransmitter::stage(ClassSender& sender, const Channel& channel, const OutboundEvent& event) {
   const std::size_t slot = sender.batch.size();
   if (slot >= SendBatch::kCapacity || sender.fd < 0) return false;
-  std::array<std::span<const std::uint8_t>, SendBatch::kMaxParts> parts{};
-  const std::size_t count = message_parts(channel, event, sender.envelope_headers[slot], parts);
+  LcmMessageParts parts{};
+  const std::size_t count = channel.format->encode(event, sender.envelope_headers[slot], parts);
   if (count == 0 || !sender.batch.add(sender.sequence, channel.name, std::span(parts.data(), count))) return false;
   ++sender.sequence;
   return true;

@@ -156,6 +156,20 @@ class Reassembler {
   Slot* record_slot(std::uint32_t source, Slot* own);
   void record(Slot* own, std::uint32_t source, SlotState state, std::uint8_t sequence, std::uint16_t index, Nanos now);
   bool stale(const Slot& slot, Nanos now) const { return now - slot.last_activity > limits_.timeout; }
+  // accept()'s steps (can_fragment.cpp says how they fit together).
+  void forget_if_stale(Slot& own, Nanos now, FragmentResult& result);
+  FragmentResult continue_event(Slot& own, std::uint32_t source, const FragmentHeader& h,
+                                std::span<const std::uint8_t> data, Nanos now, FragmentResult result);
+  // True when `h` belongs to an event of `own` already finished or given up (ignored, counted).
+  bool known_fragment(Slot& own, const FragmentHeader& h, Nanos now);
+  FragmentResult begin_event(Slot* own, std::uint32_t source, const FragmentHeader& h,
+                             std::span<const std::uint8_t> data, std::size_t max_event_bytes, Nanos now,
+                             FragmentResult result);
+  // The slot a new partial event of a source without one goes into; evicts when every slot is busy.
+  Slot& slot_for_new_event(Slot* own, Nanos now, FragmentResult& result);
+  // Counts `counter`, drops the source's event and records the rest of it to be discarded.
+  FragmentResult give_up(Slot* own, std::uint32_t source, const FragmentHeader& h, Nanos now, std::uint64_t& counter,
+                         FragmentResult result);
 
   ReassemblyLimits limits_;
   ReassemblyCounters counters_;

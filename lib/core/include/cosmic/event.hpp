@@ -24,17 +24,30 @@ struct EventHeader {
   std::int64_t age_ns = 0;     // time already spent in transit when it reached this gateway
 };
 
+// What a wire format carries of an event's identity, as the format unit says (envelopes: all of
+// it; raw LCM, native CAN, opaque DDS: none). The router asks it rather than the transport.
+struct FormatIdentity {
+  bool origin = true;     // who made the event (a gateway or a component)
+  bool sequence = true;   // its number from that origin
+  bool hop_count = true;  // how many gateways it crossed
+  // A copy the gateway forwarded can come back to it in this format (raw LCM: two gateways
+  // bridging one group in opposite directions). A native CAN frame cannot: an identifier has one
+  // sender, and CAN_RAW does not return a socket's own frames.
+  bool echoes_back = false;
+  // Without an origin to tell, the router cuts such loops by payload fingerprint (RawLoopGuard).
+  constexpr bool needs_fingerprint_loop_guard() const noexcept { return !origin && echoes_back; }
+  friend bool operator==(const FormatIdentity&, const FormatIdentity&) = default;
+};
+
 // Handed by an adapter to the router (adapter thread).
 struct InboundEvent {
   ChannelId channel = kNoChannel;
   EventHeader header;
   std::span<const std::uint8_t> payload;
   Nanos received_at{0};  // steady clock when the adapter got it
-  // Set by a wire format that carries no origin or sequence on a network that can hand a copy the
-  // gateway forwarded back to it (raw LCM: two gateways bridging one group in opposite directions).
-  // The router then cuts loops by payload fingerprint (RawLoopGuard). A native CAN frame needs
-  // none: an identifier has one sender, and CAN_RAW does not return a socket's own frames.
-  bool guard_loops_by_fingerprint = false;
+  // What the wire format it came in carries of its identity; the router's loop and duplicate
+  // checks ask it (see FormatIdentity).
+  FormatIdentity identity{};
 };
 
 // Handed by the router to an adapter (router thread).
