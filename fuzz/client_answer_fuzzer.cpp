@@ -13,7 +13,8 @@ using cosmic::fuzz::require;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   std::string out;
-  const int rc = cosmic::client_detail::parse_verdict_answer(std::string_view(reinterpret_cast<const char*>(data), size), out);
+  const int rc =
+      cosmic::client_detail::parse_verdict_answer(std::string_view(reinterpret_cast<const char*>(data), size), out);
   require(rc == COSMIC_OK || rc == COSMIC_E_UNAVAILABLE);
   require(!out.empty() || rc == COSMIC_OK);
   return 0;

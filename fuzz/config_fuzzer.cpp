@@ -19,7 +19,9 @@ segments:
   - {name: lan, type: dds, domain: 0}
   - {name: viz, type: lcm, url: "udpm://239.255.76.67:7667?ttl=0"}
 channels: []
-)", "running.yaml").config;
+)",
+                                                            "running.yaml")
+                                           .config;
   return config;
 }
 

@@ -32,7 +32,8 @@ struct Harness {
       : gateway([](const cosmic::SegmentSpec& spec, const cosmic::GatewayIdentity&,
                    cosmic::Logger&) { return std::make_unique<cosmic::MemoryAdapter>(spec.name); },
                 log, 0x42),
-        protocol(gateway, [] { return cosmic::parse_config(kConfig, "reload.yaml"); }, cosmic::AccessPolicy{}, log) {
+        protocol(
+            gateway, [] { return cosmic::parse_config(kConfig, "reload.yaml"); }, cosmic::AccessPolicy{}, log) {
     gateway.start(cosmic::parse_config(kConfig, "fuzz.yaml").config);
   }
   SilentLogger log;

@@ -68,7 +68,9 @@ std::string to_dbc(const cosmic::DbcFile& file) {
   for (const auto& m : file.messages) {
     const std::string id = std::to_string(m.can_id | (m.extended ? kExtendedFlag : 0));
     text += "BO_ " + id + " " + m.name + ": " + std::to_string(m.length) + " X\n";
-    if (m.cycle_time) attributes += "BA_ \"GenMsgCycleTime\" BO_ " + id + " " + std::to_string(m.cycle_time->count() / 1'000'000) + ";\n";
+    if (m.cycle_time)
+      attributes +=
+          "BA_ \"GenMsgCycleTime\" BO_ " + id + " " + std::to_string(m.cycle_time->count() / 1'000'000) + ";\n";
   }
   return text + attributes;
 }

@@ -15,15 +15,18 @@ using cosmic::fuzz::require;
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   const cosmic::DecodedAnnouncement decoded = cosmic::decode_announcement(text);
-  require(decoded.announcement.has_value() != !decoded.error.empty());  // an announcement or a reason, never both or neither
+  require(decoded.announcement.has_value() !=
+          !decoded.error.empty());  // an announcement or a reason, never both or neither
   if (!decoded.announcement) return 0;
   const cosmic::Announcement& a = *decoded.announcement;
   // What decodes encodes to a text that decodes to the same announcement.
   const cosmic::DecodedAnnouncement again = cosmic::decode_announcement(cosmic::encode(a));
   require(again.announcement && *again.announcement == a);  // encode(decode(x)) decodes to the same announcement
-  require(a.gateway != 0 && a.segments.size() <= cosmic::kMaxAnnouncedSegments && a.channels.size() <= cosmic::kMaxAnnouncedChannels);
+  require(a.gateway != 0 && a.segments.size() <= cosmic::kMaxAnnouncedSegments &&
+          a.channels.size() <= cosmic::kMaxAnnouncedChannels);
   cosmic::FederationView view(0x1);
-  view.apply(cosmic::FederationMessage{cosmic::FederationMessage::Kind::announcement, "writer", a.gateway, text}, cosmic::Nanos(1));
+  view.apply(cosmic::FederationMessage{cosmic::FederationMessage::Kind::announcement, "writer", a.gateway, text},
+             cosmic::Nanos(1));
   for (const auto& [network, reservations] : view.reservations()) {
     require(std::isfinite(reservations.bits_per_second) && reservations.bits_per_second >= 0);
     for (const auto& frame : reservations.frames) require(frame.period.count() > 0);
@@ -32,7 +35,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::vector<cosmic::SegmentSpec> segments;
   for (const auto& announced : a.segments) {
     const std::string prefix = std::string(cosmic::to_string(announced.type)) + ":";
-    if (segments.size() == 4 || announced.network.rfind(prefix, 0) != 0 || announced.network.size() == prefix.size()) continue;
+    if (segments.size() == 4 || announced.network.rfind(prefix, 0) != 0 || announced.network.size() == prefix.size())
+      continue;
     cosmic::SegmentSpec s;
     s.name = "s" + std::to_string(segments.size());
     s.type = announced.type;

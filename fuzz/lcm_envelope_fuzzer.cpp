@@ -67,7 +67,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto format = cosmic::lcm_detail::make_lcm_message_format(cosmic::LcmEncoding::envelope);
   cosmic::InboundEvent event;
   require(format->decode(bytes, cosmic::lcm_detail::LcmArrival{}, UINT64_MAX, event));
-  require(event.header.origin == h.origin && event.header.sequence == h.sequence && event.payload.data() == decoded->payload.data());
+  require(event.header.origin == h.origin && event.header.sequence == h.sequence &&
+          event.payload.data() == decoded->payload.data());
   cosmic::lcm_detail::LcmHeaderBuffer header{};
   cosmic::lcm_detail::LcmMessageParts parts{};
   const std::size_t count = format->encode(cosmic::OutboundEvent{0, event.header, event.payload}, header, parts);

@@ -42,8 +42,8 @@ bool valid_channel(std::string_view channel) {
 std::vector<std::uint8_t> serialize(const cosmic::LcmDatagram& d) {
   std::vector<std::uint8_t> out;
   if (d.fragment) {
-    const auto header = cosmic::lcm_fragment_header(d.sequence, d.message_size, d.fragment_offset, d.fragment_no,
-                                                    d.fragment_count);
+    const auto header =
+        cosmic::lcm_fragment_header(d.sequence, d.message_size, d.fragment_offset, d.fragment_no, d.fragment_count);
     out.assign(header.begin(), header.end());
   } else {
     const auto header = cosmic::lcm_short_header(d.sequence);

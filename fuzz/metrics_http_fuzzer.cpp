@@ -103,7 +103,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // Pieces as a connection receives them give the same head.
   RequestHead pieces(kLimit);
   std::size_t taken = 0;
-  for (std::size_t offset = 0; offset < bytes.size(); offset += piece) taken += pieces.feed(bytes.substr(offset, piece));
+  for (std::size_t offset = 0; offset < bytes.size(); offset += piece)
+    taken += pieces.feed(bytes.substr(offset, piece));
   require(pieces.state() == whole.state() && pieces.text() == whole.text() && taken == used);
 
   check_answer(whole, server().answer(bytes));

@@ -32,10 +32,14 @@ void require_clean_cpp(std::string_view text) {
     const char next = i + 1 < text.size() ? text[i + 1] : '\0';
     switch (in) {
       case In::code:
-        if (c == '/' && next == '/') in = In::line_comment, ++i;
-        else if (c == '/' && next == '*') in = In::block_comment, ++i;
-        else if (c == '"') in = In::string;
-        else if (c == '\'') in = In::character;
+        if (c == '/' && next == '/')
+          in = In::line_comment, ++i;
+        else if (c == '/' && next == '*')
+          in = In::block_comment, ++i;
+        else if (c == '"')
+          in = In::string;
+        else if (c == '\'')
+          in = In::character;
         break;
       case In::line_comment:
         require(c != '\\' || next != '\n');  // a backslash would continue the comment
@@ -160,7 +164,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (const auto& component : loaded.config.components) {
     if (cosmicctl::identifier_collision(loaded.config, component)) continue;
     const auto skeleton = cosmicctl::generate_skeleton(loaded.config, component, path, "/usr/lib/cmake/cosmic_client");
-    const auto plain = cosmicctl::generate_skeleton(loaded.config, component, "model.yaml", "/usr/lib/cmake/cosmic_client");
+    const auto plain =
+        cosmicctl::generate_skeleton(loaded.config, component, "model.yaml", "/usr/lib/cmake/cosmic_client");
     for (const auto& [name, content] : skeleton.files) {
       const bool cpp = name.ends_with(".cpp") || name.ends_with(".hpp");
       if (cpp) require_clean_cpp(content);

@@ -31,7 +31,9 @@ segments:
   - {name: lan, type: dds, domain: 0}
   - {name: viz, type: lcm}
 channels: []
-)", "running.yaml").config;
+)",
+                                                            "running.yaml")
+                                           .config;
   return config;
 }
 

@@ -44,8 +44,8 @@ nlohmann::json to_json(const cosmic::CalibrationResult& result) {
 
 void render_text(const cosmic::CalibrationResult& result, std::ostream& out) {
   char line[200];
-  std::snprintf(line, sizeof line, "%-10s %9s %10s %10s %10s %10s %10s\n", "phase", "hrt", "p50", "p99", "p99.9",
-                "max", "miss");
+  std::snprintf(line, sizeof line, "%-10s %9s %10s %10s %10s %10s %10s\n", "phase", "hrt", "p50", "p99", "p99.9", "max",
+                "miss");
   out << line;
   for (const auto& p : result.phases) {
     std::snprintf(line, sizeof line, "%-10s %9llu %10s %10s %10s %10s %10llu\n", p.name.c_str(),

@@ -48,7 +48,8 @@ std::string read_line(int fd, int timeout_ms, std::string& error) {
   std::string answer;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
   while (answer.find('\n') == std::string::npos) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) {
       error = "cosmicd did not answer within " + std::to_string(timeout_ms / 1000) + " s";
       return {};
@@ -70,7 +71,11 @@ std::optional<std::size_t> first_invalid_utf8(std::string_view text) {
   std::size_t i = 0;
   while (i < text.size()) {
     const auto byte = static_cast<unsigned char>(text[i]);
-    const std::size_t length = byte < 0x80 ? 1 : (byte >> 5) == 0x6 ? 2 : (byte >> 4) == 0xE ? 3 : (byte >> 3) == 0x1E ? 4 : 0;
+    const std::size_t length = byte < 0x80           ? 1
+                               : (byte >> 5) == 0x6  ? 2
+                               : (byte >> 4) == 0xE  ? 3
+                               : (byte >> 3) == 0x1E ? 4
+                                                     : 0;
     if (length == 0 || i + length > text.size()) return i;
     for (std::size_t k = 1; k < length; ++k) {
       if ((static_cast<unsigned char>(text[i + k]) & 0xC0) != 0x80) return i;
@@ -79,7 +84,8 @@ std::optional<std::size_t> first_invalid_utf8(std::string_view text) {
     const auto next = static_cast<unsigned char>(length > 1 ? text[i + 1] : 0);
     const bool overlong = (length == 2 && byte < 0xC2) || (length == 3 && byte == 0xE0 && next < 0xA0) ||
                           (length == 4 && byte == 0xF0 && next < 0x90);
-    const bool out_of_range = (length == 3 && byte == 0xED && next >= 0xA0) || (length == 4 && (byte > 0xF4 || (byte == 0xF4 && next >= 0x90)));
+    const bool out_of_range = (length == 3 && byte == 0xED && next >= 0xA0) ||
+                              (length == 4 && (byte > 0xF4 || (byte == 0xF4 && next >= 0x90)));
     if (overlong || out_of_range) return i;
     i += length;
   }

@@ -10,7 +10,7 @@ namespace cosmicctl {
 
 struct ClientResult {
   std::optional<nlohmann::json> response;
-  std::string error;  // why there is no response (daemon unreachable, timeout, garbage)
+  std::string error;               // why there is no response (daemon unreachable, timeout, garbage)
   bool permission_denied = false;  // the socket refused us (file permissions)
 };
 

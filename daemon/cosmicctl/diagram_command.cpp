@@ -80,7 +80,8 @@ int run_diagram(const DiagramOptions& o, const GlobalOptions& global, bool live)
     status = offline_status(loaded.config);
     title += " (admission offline)";
   }
-  const std::string dot = render_dot(loaded.config, status, title, o.detail ? DiagramDetail::tables : DiagramDetail::compact);
+  const std::string dot =
+      render_dot(loaded.config, status, title, o.detail ? DiagramDetail::tables : DiagramDetail::compact);
   if (o.format == "dot") {
     std::cout << dot;
     return kExitOk;
@@ -91,11 +92,15 @@ int run_diagram(const DiagramOptions& o, const GlobalOptions& global, bool live)
 }  // namespace
 
 CommandRunner add_diagram_command(CLI::App& app, const GlobalOptions& options) {
-  auto* command = app.add_subcommand("diagram", "Draw the Event-Channel Diagram of a configuration (SVG or DOT on stdout)");
+  auto* command =
+      app.add_subcommand("diagram", "Draw the Event-Channel Diagram of a configuration (SVG or DOT on stdout)");
   auto o = std::make_shared<DiagramOptions>();
   command->add_option("FILE", o->file, "Configuration file (YAML)")->required();
-  command->add_option("--format", o->format, "svg (needs Graphviz) or dot")->check(CLI::IsMember({"svg", "dot"}))->capture_default_str();
-  command->add_flag("--detail", o->detail, "Every channel as a table (subject, QoS list, verdict, notes) instead of one row");
+  command->add_option("--format", o->format, "svg (needs Graphviz) or dot")
+      ->check(CLI::IsMember({"svg", "dot"}))
+      ->capture_default_str();
+  command->add_flag("--detail", o->detail,
+                    "Every channel as a table (subject, QoS list, verdict, notes) instead of one row");
   return [command, o, &options, &app]() -> int {
     if (!command->parsed()) return -1;
     // --socket given (or COSMIC_SOCKET set): the running gateway's view.

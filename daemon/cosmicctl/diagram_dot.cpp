@@ -18,7 +18,9 @@ const char* role(Side side) { return side == Side::publisher ? "publisher" : "su
 // (issue 22, item 5). The side is part of the prefix because a component that publishes and
 // subscribes is two nodes, one on each side.
 std::string id(const std::string& prefix, const std::string& name) { return "\"" + prefix + name + "\""; }
-std::string component_id(Side side, const std::string& name) { return id(std::string(tag(side)) + "_component_", name); }
+std::string component_id(Side side, const std::string& name) {
+  return id(std::string(tag(side)) + "_component_", name);
+}
 std::string segment_id(Side side, const std::string& name) { return id(std::string(tag(side)) + "_segment_", name); }
 std::string channel_id(const std::string& name) { return id("channel_", name); }
 
@@ -55,7 +57,8 @@ class DotWriter {
     out_ << "digraph event_channels {\n"
          << "  rankdir=LR; newrank=true; nodesep=0.12; ranksep=0.9; fontname=\"Helvetica\"; labelloc=t;\n"
          << "  label=" << title_label(title) << ";\n"
-         << "  node [fontname=\"Helvetica\", fontsize=10]; edge [fontname=\"Helvetica\", fontsize=10, penwidth=1.2, arrowsize=0.7];\n";
+         << "  node [fontname=\"Helvetica\", fontsize=10]; edge [fontname=\"Helvetica\", fontsize=10, penwidth=1.2, "
+            "arrowsize=0.7];\n";
     for (const auto& s : config_.segments) write_cluster(s, Side::publisher);
     for (const auto& c : config_.channels) write_channel(c);
     for (const auto& s : config_.segments) write_cluster(s, Side::subscriber);
@@ -71,8 +74,9 @@ class DotWriter {
  private:
   // The title with the key under it, so the key costs no column of its own.
   static std::string title_label(const std::string& title) {
-    std::string label = "<<TABLE BORDER=\"0\" CELLSPACING=\"3\" CELLPADDING=\"2\"><TR><TD COLSPAN=\"8\"><FONT POINT-SIZE=\"14\">" +
-                        html_text(title) + "</FONT></TD></TR><TR><TD>verdict:</TD>";
+    std::string label =
+        "<<TABLE BORDER=\"0\" CELLSPACING=\"3\" CELLPADDING=\"2\"><TR><TD COLSPAN=\"8\"><FONT POINT-SIZE=\"14\">" +
+        html_text(title) + "</FONT></TD></TR><TR><TD>verdict:</TD>";
     for (const char* v : {"bound", "degraded", "rejected", "failed", "violated", "not bound"}) {
       label += std::string("<TD BORDER=\"1\" BGCOLOR=\"") + verdict_colour(v) + "\">" + v + "</TD>";
     }
@@ -81,9 +85,10 @@ class DotWriter {
 
   // Whether a modelled component on `segment` accounts for the channel's P (or S) tag there.
   bool covered(const cosmic::ChannelSpec& c, const std::string& segment, Side side) const {
-    return std::any_of(config_.components.begin(), config_.components.end(), [&](const cosmic::ComponentSpec& component) {
-      return component.segment == segment && lists(channels_of(component, side), c.name);
-    });
+    return std::any_of(config_.components.begin(), config_.components.end(),
+                       [&](const cosmic::ComponentSpec& component) {
+                         return component.segment == segment && lists(channels_of(component, side), c.name);
+                       });
   }
 
   // The channels with a tag on `segment` that no component accounts for.
@@ -120,15 +125,16 @@ class DotWriter {
     for (const auto* c : components) {
       const std::string node = component_id(side, c->name);
       column.push_back(node);
-      out_ << "    " << node << " [shape=box, style=\"rounded,filled\", fillcolor=\"#fff8e1\", class=\"component " << role(side)
-           << "\", label=\"" << c->name << "\", tooltip=" << dot_string({c->name + " on " + segment + verb + joined(channels_of(*c, side))})
+      out_ << "    " << node << " [shape=box, style=\"rounded,filled\", fillcolor=\"#fff8e1\", class=\"component "
+           << role(side) << "\", label=\"" << c->name
+           << "\", tooltip=" << dot_string({c->name + " on " + segment + verb + joined(channels_of(*c, side))})
            << "];\n";
     }
     if (!uncovered.empty()) {
       const std::string node = segment_id(side, s.name);
       column.push_back(node);
-      out_ << "    " << node << " [shape=cylinder, style=filled, fillcolor=\"#bbdefb\", class=\"segment " << role(side) << "\", label=\""
-           << s.name << "\\n(segment)\", tooltip="
+      out_ << "    " << node << " [shape=cylinder, style=filled, fillcolor=\"#bbdefb\", class=\"segment " << role(side)
+           << "\", label=\"" << s.name << "\\n(segment)\", tooltip="
            << dot_string({"segment " + segment + verb + joined(uncovered) + " (no modelled component)"}) << "];\n";
     }
     out_ << "  }\n";
@@ -139,8 +145,10 @@ class DotWriter {
     const ChannelStatus status = found == status_.end() ? ChannelStatus{} : found->second;
     const std::string node = channel_id(c.name);
     channel_nodes_.push_back(node);
-    out_ << "  " << node << " [shape=plain, class=\"channel " << css_class(status.violated ? "violated" : status.verdict)
-         << "\", tooltip=" << dot_string(channel_tooltip(c, status)) << ", label=" << channel_label(c, status, detail_) << "];\n";
+    out_ << "  " << node << " [shape=plain, class=\"channel "
+         << css_class(status.violated ? "violated" : status.verdict)
+         << "\", tooltip=" << dot_string(channel_tooltip(c, status)) << ", label=" << channel_label(c, status, detail_)
+         << "];\n";
   }
 
   // P tags at the channel's end of the edges that come in, S tags at the channel's end of those
@@ -149,28 +157,32 @@ class DotWriter {
     const std::string node = channel_id(c.name);
     for (const auto& component : config_.components) {
       if (lists(component.publishes, c.name)) {
-        edge(component_id(Side::publisher, component.name), node, Side::publisher, component.name + " publishes " + c.name + " on " + component.segment);
+        edge(component_id(Side::publisher, component.name), node, Side::publisher,
+             component.name + " publishes " + c.name + " on " + component.segment);
       }
     }
     for (const auto& s : c.publishers) {
-      if (!covered(c, s, Side::publisher)) edge(segment_id(Side::publisher, s), node, Side::publisher, c.name + " is published on " + s);
+      if (!covered(c, s, Side::publisher))
+        edge(segment_id(Side::publisher, s), node, Side::publisher, c.name + " is published on " + s);
     }
     for (const auto& component : config_.components) {
       if (lists(component.subscribes, c.name)) {
-        edge(node, component_id(Side::subscriber, component.name), Side::subscriber, component.name + " subscribes " + c.name + " on " + component.segment);
+        edge(node, component_id(Side::subscriber, component.name), Side::subscriber,
+             component.name + " subscribes " + c.name + " on " + component.segment);
       }
     }
     for (const auto& s : c.subscribers) {
-      if (!covered(c, s, Side::subscriber)) edge(node, segment_id(Side::subscriber, s), Side::subscriber, c.name + " is delivered on " + s);
+      if (!covered(c, s, Side::subscriber))
+        edge(node, segment_id(Side::subscriber, s), Side::subscriber, c.name + " is delivered on " + s);
     }
   }
 
   void edge(const std::string& from, const std::string& to, Side side, const std::string& tooltip) {
     const bool publish = side == Side::publisher;
     const char* colour = publish ? "#2e7d32" : "#1565c0";
-    out_ << "  " << from << " -> " << to << " [" << (publish ? "headlabel" : "taillabel") << "=\"" << tag(side) << "\", class=\""
-         << (publish ? "publish" : "subscribe") << "\", color=\"" << colour << "\", fontcolor=\"" << colour
-         << "\", labeldistance=1.4, tooltip=" << dot_string({tooltip}) << "];\n";
+    out_ << "  " << from << " -> " << to << " [" << (publish ? "headlabel" : "taillabel") << "=\"" << tag(side)
+         << "\", class=\"" << (publish ? "publish" : "subscribe") << "\", color=\"" << colour << "\", fontcolor=\""
+         << colour << "\", labeldistance=1.4, tooltip=" << dot_string({tooltip}) << "];\n";
   }
 
   void write_column(const std::vector<std::string>& nodes) {
@@ -191,7 +203,8 @@ class DotWriter {
 
 }  // namespace
 
-std::string render_dot(const cosmic::Config& config, const DiagramStatus& status, const std::string& title, DiagramDetail detail) {
+std::string render_dot(const cosmic::Config& config, const DiagramStatus& status, const std::string& title,
+                       DiagramDetail detail) {
   return DotWriter(config, status, detail).write(title);
 }
 

@@ -47,7 +47,8 @@ std::string hex_subject(std::uint64_t subject) {
 
 std::string upper(const char* text) {
   std::string out(text);
-  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  std::transform(out.begin(), out.end(), out.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
   return out;
 }
 
@@ -103,7 +104,8 @@ std::string verdict_cell(const ChannelStatus& status) {
 // One row: name, class, verdict, the bound (its number only: the tooltip says what it is) and,
 // live, the counters.
 std::string compact_label(const cosmic::ChannelSpec& c, const ChannelStatus& status) {
-  std::string label = "<" + table_open(status) + "<TR>" + name_cell(c) + cell(upper(cosmic::to_string(c.cls))) + verdict_cell(status);
+  std::string label =
+      "<" + table_open(status) + "<TR>" + name_cell(c) + cell(upper(cosmic::to_string(c.cls))) + verdict_cell(status);
   if (status.end_to_end) label += "<TD>&#8804; " + html_text(cosmic::format_duration(*status.end_to_end)) + "</TD>";
   if (!status.counters.empty()) label += cell(joined(status.counters, ", "));
   return label + "</TR></TABLE>>";
@@ -129,11 +131,16 @@ std::string table_label(const cosmic::ChannelSpec& c, const ChannelStatus& statu
 std::string html_text(const std::string& text) {
   std::string out;
   for (const char c : clean_utf8(text)) {
-    if (c == '&') out += "&amp;";
-    else if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '"') out += "&quot;";
-    else out += c;
+    if (c == '&')
+      out += "&amp;";
+    else if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '"')
+      out += "&quot;";
+    else
+      out += c;
   }
   return out;
 }
@@ -166,8 +173,9 @@ std::string channel_label(const cosmic::ChannelSpec& channel, const ChannelStatu
 }
 
 std::vector<std::string> channel_tooltip(const cosmic::ChannelSpec& c, const ChannelStatus& status) {
-  std::vector<std::string> lines{c.name + ": " + upper(cosmic::to_string(c.cls)) + ", subject " + hex_subject(c.subject),
-                                 joined(qos_list(c), ", ")};
+  std::vector<std::string> lines{
+      c.name + ": " + upper(cosmic::to_string(c.cls)) + ", subject " + hex_subject(c.subject),
+      joined(qos_list(c), ", ")};
   std::string verdict = "verdict " + status.verdict;
   if (status.violated) verdict += ", VIOLATED at run time";
   if (const std::string bound = end_to_end_text(status); !bound.empty()) verdict += "; " + bound;

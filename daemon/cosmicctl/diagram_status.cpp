@@ -53,8 +53,10 @@ ChannelStatus live_channel(const Json& c) {
   s.counters.push_back("forwarded " + std::to_string(count(c, "forwarded")));
   if (residence.contains("p99_s") && residence["p99_s"].is_number()) {
     s.counters.push_back("p99 " + spaced_micros(residence["p99_s"].get<double>()));
-    s.notes.push_back("residence p50 " + spaced_micros(residence.value("p50_s", 0.0)) + ", p99 " + spaced_micros(residence["p99_s"].get<double>()) +
-                      ", max " + spaced_micros(residence.value("max_s", 0.0)) + " (bound " + spaced_micros(residence.value("bound_s", 0.0)) + ")");
+    s.notes.push_back("residence p50 " + spaced_micros(residence.value("p50_s", 0.0)) + ", p99 " +
+                      spaced_micros(residence["p99_s"].get<double>()) + ", max " +
+                      spaced_micros(residence.value("max_s", 0.0)) + " (bound " +
+                      spaced_micros(residence.value("bound_s", 0.0)) + ")");
   }
   std::uint64_t dropped = 0;
   for (const auto& seg : c.value("segments", Json::array())) {

@@ -24,8 +24,8 @@ struct ChannelStatus {
   bool violated = false;
   std::optional<cosmic::Nanos> end_to_end;     // the promised worst case, publisher to subscriber
   std::optional<cosmic::Nanos> reaction_time;  // what the channel asked for
-  std::vector<std::string> counters;  // live: short lines drawn on the channel (forwarded, residence, drops)
-  std::vector<std::string> notes;     // the rest: reasons, per-segment counters (tooltip and --detail)
+  std::vector<std::string> counters;           // live: short lines drawn on the channel (forwarded, residence, drops)
+  std::vector<std::string> notes;              // the rest: reasons, per-segment counters (tooltip and --detail)
 };
 using DiagramStatus = std::map<std::string, ChannelStatus>;
 

@@ -67,7 +67,8 @@ int run_gen(const GenOptions& o) {
     if (c.name == o.component) component = &c;
   }
   if (!component) {
-    std::cerr << "cosmicctl: no component '" << o.component << "' in " << o.file << " (one of: " << component_names(loaded.config) << ")\n";
+    std::cerr << "cosmicctl: no component '" << o.component << "' in " << o.file
+              << " (one of: " << component_names(loaded.config) << ")\n";
     return kExitUsage;
   }
   if (const auto collision = identifier_collision(loaded.config, *component)) {
@@ -90,7 +91,8 @@ int run_gen(const GenOptions& o) {
     if (!write_file(path, content)) return kExitUnavailable;
     std::cerr << "wrote " << path.string() << "\n";
   }
-  std::cerr << "build: cmake -S " << o.output << " -B " << o.output << "/build && cmake --build " << o.output << "/build\n";
+  std::cerr << "build: cmake -S " << o.output << " -B " << o.output << "/build && cmake --build " << o.output
+            << "/build\n";
   return kExitOk;
 }
 

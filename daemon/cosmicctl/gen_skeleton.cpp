@@ -65,7 +65,8 @@ std::string literal_text(const std::string& text) {
 std::string fill(std::string text, const std::map<std::string, std::string>& values) {
   for (const auto& [key, value] : values) {
     const std::string mark = "{{" + key + "}}";
-    for (auto at = text.find(mark); at != std::string::npos; at = text.find(mark, at + value.size())) text.replace(at, mark.size(), value);
+    for (auto at = text.find(mark); at != std::string::npos; at = text.find(mark, at + value.size()))
+      text.replace(at, mark.size(), value);
   }
   return text;
 }
@@ -74,9 +75,12 @@ std::string ns(const std::optional<cosmic::Nanos>& d) { return d ? std::to_strin
 
 const char* class_constant(cosmic::ChannelClass c) {
   switch (c) {
-    case cosmic::ChannelClass::hrt: return "COSMIC_HRT";
-    case cosmic::ChannelClass::srt: return "COSMIC_SRT";
-    case cosmic::ChannelClass::nrt: return "COSMIC_NRT";
+    case cosmic::ChannelClass::hrt:
+      return "COSMIC_HRT";
+    case cosmic::ChannelClass::srt:
+      return "COSMIC_SRT";
+    case cosmic::ChannelClass::nrt:
+      return "COSMIC_NRT";
   }
   return "COSMIC_NRT";
 }
@@ -94,10 +98,11 @@ std::string roles(const cosmic::ComponentSpec& c, const std::string& channel) {
 std::string channel_desc(const cosmic::ChannelSpec& c, const cosmic::ComponentSpec& component) {
   char subject[24];
   std::snprintf(subject, sizeof subject, "0x%016llxull", static_cast<unsigned long long>(c.subject));
-  return "// " + c.name + ": " + cosmic::to_string(c.cls) + ", P " + std::to_string(c.publishers.size()) + " segment(s), S " +
-         std::to_string(c.subscribers.size()) + " segment(s)\ninline const cosmic_channel_desc " + identifier(c.name) + "{\"" + c.name +
-         "\", " + subject + ", " + class_constant(c.cls) + ", " + ns(c.period) + ", " + ns(c.reaction_time) + ", " + ns(c.temp_validity) +
-         ", " + std::to_string(c.omission_degree) + ", " + std::to_string(c.payload) + ", " + roles(component, c.name) + "};\n";
+  return "// " + c.name + ": " + cosmic::to_string(c.cls) + ", P " + std::to_string(c.publishers.size()) +
+         " segment(s), S " + std::to_string(c.subscribers.size()) + " segment(s)\ninline const cosmic_channel_desc " +
+         identifier(c.name) + "{\"" + c.name + "\", " + subject + ", " + class_constant(c.cls) + ", " + ns(c.period) +
+         ", " + ns(c.reaction_time) + ", " + ns(c.temp_validity) + ", " + std::to_string(c.omission_degree) + ", " +
+         std::to_string(c.payload) + ", " + roles(component, c.name) + "};\n";
 }
 
 // The channels this component uses, in the model's channel order.
@@ -110,10 +115,12 @@ std::vector<const cosmic::ChannelSpec*> used_channels(const cosmic::Config& conf
 }
 
 struct Pieces {
-  std::string descs, all, members, handler_decls, period_decls, publish_decls, announce, subscribe, periods, logic_handlers, logic_periods;
+  std::string descs, all, members, handler_decls, period_decls, publish_decls, announce, subscribe, periods,
+      logic_handlers, logic_periods;
 };
 
-void add_channel(Pieces& p, const cosmic::ChannelSpec& c, const cosmic::ComponentSpec& component, const std::string& cls) {
+void add_channel(Pieces& p, const cosmic::ChannelSpec& c, const cosmic::ComponentSpec& component,
+                 const std::string& cls) {
   const std::string id = identifier(c.name);
   p.descs += channel_desc(c, component);
   p.all += std::string(p.all.empty() ? "" : ", ") + "&" + id;
@@ -125,11 +132,17 @@ void add_channel(Pieces& p, const cosmic::ChannelSpec& c, const cosmic::Componen
     p.logic_handlers += fill(kLogicHandlerTemplate, {{"CLASS", cls}, {"ID", id}, {"CHANNEL", c.name}});
   }
   if (has(component.publishes, c.name)) {
-    p.publish_decls += "  int publish_" + id + "(std::span<const std::uint8_t> event) { return " + id + "_.publish(event); }\n";
+    p.publish_decls +=
+        "  int publish_" + id + "(std::span<const std::uint8_t> event) { return " + id + "_.publish(event); }\n";
     if (c.period) {
       p.period_decls += "  void " + id + "_period();  // every " + cosmic::format_duration(*c.period) + "\n";
-      p.periods += "      {std::chrono::nanoseconds(" + std::to_string(c.period->count()) + "), &" + cls + "::" + id + "_period},\n";
-      p.logic_periods += fill(kLogicPeriodTemplate, {{"CLASS", cls}, {"COMPONENT", component.name}, {"ID", id}, {"CHANNEL", c.name}, {"PERIOD", cosmic::format_duration(*c.period)}});
+      p.periods += "      {std::chrono::nanoseconds(" + std::to_string(c.period->count()) + "), &" + cls + "::" + id +
+                   "_period},\n";
+      p.logic_periods += fill(kLogicPeriodTemplate, {{"CLASS", cls},
+                                                     {"COMPONENT", component.name},
+                                                     {"ID", id},
+                                                     {"CHANNEL", c.name},
+                                                     {"PERIOD", cosmic::format_duration(*c.period)}});
     }
   }
 }
@@ -151,15 +164,18 @@ std::optional<std::string> identifier_collision(const cosmic::Config& config, co
 std::string client_segment(const cosmic::SegmentSpec& s, unsigned can_node) {
   switch (s.type) {
     case cosmic::SegmentType::dds:
-      return "dds:" + std::to_string(s.dds.domain) + (s.reliability == cosmic::Reliability::best_effort ? "?reliability=best_effort" : "");
-    case cosmic::SegmentType::lcm: return "lcm:" + s.lcm.url;
-    case cosmic::SegmentType::can: return "can:" + s.can.interface + "?node=" + std::to_string(can_node);
+      return "dds:" + std::to_string(s.dds.domain) +
+             (s.reliability == cosmic::Reliability::best_effort ? "?reliability=best_effort" : "");
+    case cosmic::SegmentType::lcm:
+      return "lcm:" + s.lcm.url;
+    case cosmic::SegmentType::can:
+      return "can:" + s.can.interface + "?node=" + std::to_string(can_node);
   }
   return "";
 }
 
-Skeleton generate_skeleton(const cosmic::Config& config, const cosmic::ComponentSpec& component, const std::string& model_file,
-                           const std::string& client_config_dir) {
+Skeleton generate_skeleton(const cosmic::Config& config, const cosmic::ComponentSpec& component,
+                           const std::string& model_file, const std::string& client_config_dir) {
   const std::string cls = camel(component.name);
   const std::string file = identifier(component.name);
   Pieces p;
@@ -168,15 +184,25 @@ Skeleton generate_skeleton(const cosmic::Config& config, const cosmic::Component
   const auto position = static_cast<unsigned>(&component - config.components.data());
   const unsigned node = (config.gateway.can_node_id + 1 + position) % 128;
   const std::map<std::string, std::string> values{
-      {"COMPONENT", component.name}, {"CLASS", cls},          {"FILE", file},
+      {"COMPONENT", component.name},
+      {"CLASS", cls},
+      {"FILE", file},
       // Everything from outside the model's name grammar is escaped for where it lands (issue 22,
       // item 4): the model's path goes into comments, the segment string into a literal.
-      {"MODEL", comment_text(model_file)}, {"SEGMENT", component.segment},
+      {"MODEL", comment_text(model_file)},
+      {"SEGMENT", component.segment},
       {"CLIENT_SEGMENT", literal_text(client_segment(*config.find_segment(component.segment), node))},
       {"CLIENT_CONFIG_DIR", client_config_dir},
-      {"DESCS", p.descs}, {"ALL", p.all},            {"MEMBERS", p.members}, {"HANDLER_DECLS", p.handler_decls},
-      {"PERIOD_DECLS", p.period_decls}, {"PUBLISH_DECLS", p.publish_decls}, {"ANNOUNCE", p.announce},
-      {"SUBSCRIBE", p.subscribe},    {"PERIODS", p.periods}, {"LOGIC_HANDLERS", p.logic_handlers},
+      {"DESCS", p.descs},
+      {"ALL", p.all},
+      {"MEMBERS", p.members},
+      {"HANDLER_DECLS", p.handler_decls},
+      {"PERIOD_DECLS", p.period_decls},
+      {"PUBLISH_DECLS", p.publish_decls},
+      {"ANNOUNCE", p.announce},
+      {"SUBSCRIBE", p.subscribe},
+      {"PERIODS", p.periods},
+      {"LOGIC_HANDLERS", p.logic_handlers},
       {"LOGIC_PERIODS", p.logic_periods}};
   Skeleton out;
   out.files["CMakeLists.txt"] = fill(kCMakeTemplate, values);

@@ -25,8 +25,8 @@ struct Skeleton {
 };
 
 // `client_config_dir`: where cosmic_client-config.cmake lives (a hint; -Dcosmic_client_DIR wins).
-Skeleton generate_skeleton(const cosmic::Config& config, const cosmic::ComponentSpec& component, const std::string& model_file,
-                           const std::string& client_config_dir);
+Skeleton generate_skeleton(const cosmic::Config& config, const cosmic::ComponentSpec& component,
+                           const std::string& model_file, const std::string& client_config_dir);
 
 // Why `component`'s skeleton cannot be generated: two of its channels whose names differ only
 // in '-', '.' or '_' would become one C++ identifier (issue 22, item 5). nullopt when none.

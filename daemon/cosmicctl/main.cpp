@@ -13,7 +13,9 @@ int main(int argc, char** argv) {
   cosmicctl::GlobalOptions options;
   app.add_flag("--json", options.json, "Machine-readable JSON output");
   std::vector<cosmicctl::CommandRunner> commands;
-  app.add_option("--socket", options.socket, "Control socket of the daemon")->capture_default_str()->envname("COSMIC_SOCKET");
+  app.add_option("--socket", options.socket, "Control socket of the daemon")
+      ->capture_default_str()
+      ->envname("COSMIC_SOCKET");
   commands.push_back(cosmicctl::add_check_command(app, options));
   commands.push_back(cosmicctl::add_calibrate_command(app, options));
   commands.push_back(cosmicctl::add_diagram_command(app, options));

@@ -101,10 +101,12 @@ struct Fetched {
 Fetched fetch(const std::string& socket) {
   Fetched out;
   TopSample sample;
-  for (auto [command, slot] : {std::pair{"status", &sample.status}, {"segments", &sample.segments}, {"channels", &sample.channels}}) {
+  for (auto [command, slot] :
+       {std::pair{"status", &sample.status}, {"segments", &sample.segments}, {"channels", &sample.channels}}) {
     ClientResult result = request(socket, Json{{"command", command}}, 5'000);
     if (!result.response || !result.response->value("ok", false)) {
-      if (result.response) result.error = result.response->value("error", Json::object()).value("message", "request failed");
+      if (result.response)
+        result.error = result.response->value("error", Json::object()).value("message", "request failed");
       out.failure = std::move(result);
       return out;
     }
@@ -137,7 +139,8 @@ int run_top(const GlobalOptions& global, const TopOptions& options) {
   if (!first.sample) {  // nothing to show: fail like every other command
     std::cerr << "cosmicctl: " << first.failure.error << "\n";
     if (first.failure.response) {
-      const bool denied = first.failure.response->value("error", Json::object()).value("code", "") == "permission_denied";
+      const bool denied =
+          first.failure.response->value("error", Json::object()).value("code", "") == "permission_denied";
       return denied ? kExitNoPermission : kExitRejected;
     }
     return first.failure.permission_denied ? kExitNoPermission : kExitUnavailable;
@@ -166,10 +169,14 @@ int run_top(const GlobalOptions& global, const TopOptions& options) {
 }  // namespace
 
 CommandRunner add_top_command(CLI::App& app, const GlobalOptions& options) {
-  auto* command = app.add_subcommand("top", "Live view of segments and channels: rates, drops, residence, misses (q quits)");
+  auto* command =
+      app.add_subcommand("top", "Live view of segments and channels: rates, drops, residence, misses (q quits)");
   auto top = std::make_shared<TopOptions>();
-  command->add_option("--interval", top->interval, "Seconds between refreshes")->check(CLI::Range(0.1, 3600.0))->capture_default_str();
-  command->add_option("--iterations", top->iterations, "Draw this many frames, then exit (0: until q)")->check(CLI::NonNegativeNumber);
+  command->add_option("--interval", top->interval, "Seconds between refreshes")
+      ->check(CLI::Range(0.1, 3600.0))
+      ->capture_default_str();
+  command->add_option("--iterations", top->iterations, "Draw this many frames, then exit (0: until q)")
+      ->check(CLI::NonNegativeNumber);
   return [command, &options, top]() -> int {
     if (!command->parsed()) return -1;
     return run_top(options, *top);

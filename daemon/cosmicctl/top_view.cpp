@@ -20,7 +20,9 @@ const Json& member(const Json& object, const char* key) {
 std::string json_text(const Json& value) { return value.is_string() ? value.get<std::string>() : value.dump(); }
 
 std::uint64_t count_at(const Json& object, const char* key) {
-  return object.is_object() && object.contains(key) && object[key].is_number_unsigned() ? object[key].get<std::uint64_t>() : 0;
+  return object.is_object() && object.contains(key) && object[key].is_number_unsigned()
+             ? object[key].get<std::uint64_t>()
+             : 0;
 }
 
 std::string with_unit(double value, const char* format) {
@@ -110,49 +112,54 @@ TopLine header(const TopSample& current, const Rates& rates) {
   const std::uint64_t violated = count_at(s["channels"], "violated");
   const std::uint64_t failed = count_at(s["channels"], "failed");
   std::string line = "cosmicd " + json_text(g["name"]) + " (id " + json_text(g["id"]) + "), up " +
-                     std::to_string(static_cast<long>(g.value("uptime_s", 0.0))) + " s   segments " + json_text(s["segments"]["up"]) +
-                     "/" + json_text(s["segments"]["total"]) + " up   channels " + json_text(s["channels"]["bound"]) + " bound, " +
-                     json_text(s["channels"]["degraded"]) + " degraded, " + std::to_string(failed) + " failed, " +
-                     std::to_string(violated) + " violated   router " +
-                     json_text(router["queued"]) + " queued, " + rate_text(rates.of(progress, rates.previous_progress())) + " ev/s";
+                     std::to_string(static_cast<long>(g.value("uptime_s", 0.0))) + " s   segments " +
+                     json_text(s["segments"]["up"]) + "/" + json_text(s["segments"]["total"]) + " up   channels " +
+                     json_text(s["channels"]["bound"]) + " bound, " + json_text(s["channels"]["degraded"]) +
+                     " degraded, " + std::to_string(failed) + " failed, " + std::to_string(violated) +
+                     " violated   router " + json_text(router["queued"]) + " queued, " +
+                     rate_text(rates.of(progress, rates.previous_progress())) + " ev/s";
   return {line, violated > 0 || failed > 0 || count_at(s["segments"], "up") < count_at(s["segments"], "total")};
 }
 
 void segment_rows(std::vector<TopLine>& out, const TopSample& current, const Rates& rates) {
   out.push_back({pad_column("SEGMENT", 14) + pad_column("TYPE", 5) + pad_column("HEALTH", 9) + pad_column("UTIL", 7) +
-                 pad_column("RX/s", 9) + pad_column("TX/s", 9) + pad_column("ERR/s", 7) + pad_column("OVERFLOW", 9) + "DETAIL"});
+                 pad_column("RX/s", 9) + pad_column("TX/s", 9) + pad_column("ERR/s", 7) + pad_column("OVERFLOW", 9) +
+                 "DETAIL"});
   for (const auto& s : member(current.segments, "segments")) {
     const Json& a = s["adapter"];
     const Json* old = rates.previous_segment(s.value("name", ""));
     const Json* old_adapter = old ? &(*old)["adapter"] : nullptr;
     const auto errors = count_at(a, "receive_errors") + count_at(a, "send_errors");
     const Prior old_errors =
-        old_adapter ? Prior{true, count_at(*old_adapter, "receive_errors") + count_at(*old_adapter, "send_errors")} : Prior{};
+        old_adapter ? Prior{true, count_at(*old_adapter, "receive_errors") + count_at(*old_adapter, "send_errors")}
+                    : Prior{};
     const std::string health = json_text(s["health"]);
     out.push_back({pad_column(json_text(s["name"]), 14) + pad_column(json_text(s["type"]), 5) + pad_column(health, 9) +
                        pad_column(cosmic::format_percent(s.value("utilization", 0.0)), 7) +
                        pad_column(rate_text(rates.of(count_at(a, "received"), before(old_adapter, "received"))), 9) +
                        pad_column(rate_text(rates.of(count_at(a, "sent"), before(old_adapter, "sent"))), 9) +
-                       pad_column(rate_text(rates.of(errors, old_errors)), 7) + pad_column(json_text(a["overflow_drops"]), 9) +
-                       s.value("detail", ""),
+                       pad_column(rate_text(rates.of(errors, old_errors)), 7) +
+                       pad_column(json_text(a["overflow_drops"]), 9) + s.value("detail", ""),
                    health != "up"});
   }
 }
 
 std::string residence_of(const Json& hop) {
   if (!hop.contains("runtime")) return "-";
-  return column_micros(hop["runtime"].value("residence_p50_s", 0.0)) + "/" + column_micros(hop["runtime"].value("residence_p99_s", 0.0));
+  return column_micros(hop["runtime"].value("residence_p50_s", 0.0)) + "/" +
+         column_micros(hop["runtime"].value("residence_p99_s", 0.0));
 }
 
 std::string misses_of(const Json& hop) {
   if (!hop.contains("runtime")) return "-";
-  return std::to_string(count_at(hop["runtime"], "residence_miss")) + "/" + std::to_string(count_at(hop["runtime"], "deadline_miss"));
+  return std::to_string(count_at(hop["runtime"], "residence_miss")) + "/" +
+         std::to_string(count_at(hop["runtime"], "deadline_miss"));
 }
 
 void channel_rows(std::vector<TopLine>& out, const TopSample& current, const Rates& rates) {
-  out.push_back({pad_column("CHANNEL", 16) + pad_column("CLASS", 6) + pad_column("SEGMENT", 12) + pad_column("ROLE", 5) +
-                 pad_column("RX/s", 9) + pad_column("TX/s", 9) + pad_column("DROP/s", 8) + pad_column("RES p50/p99", 16) +
-                 pad_column("MISS res/dl", 12) + pad_column("STATE", 9) + "DROPS"});
+  out.push_back({pad_column("CHANNEL", 16) + pad_column("CLASS", 6) + pad_column("SEGMENT", 12) +
+                 pad_column("ROLE", 5) + pad_column("RX/s", 9) + pad_column("TX/s", 9) + pad_column("DROP/s", 8) +
+                 pad_column("RES p50/p99", 16) + pad_column("MISS res/dl", 12) + pad_column("STATE", 9) + "DROPS"});
   for (const auto& c : member(current.channels, "channels")) {
     const std::string name = c.value("name", "");
     // A channel its transport refused shows that (verdict `failed`) rather than its runtime state.
@@ -166,8 +173,9 @@ void channel_rows(std::vector<TopLine>& out, const TopSample& current, const Rat
                          pad_column(json_text(hop["segment"]), 12) + pad_column(publisher ? "P" : "S", 5) +
                          pad_column(publisher ? rate_text(rates.of(count_at(hop, "rx"), before(old, "rx"))) : "-", 9) +
                          pad_column(publisher ? "-" : rate_text(rates.of(count_at(hop, "tx"), before(old, "tx"))), 9) +
-                         pad_column(rate_text(rates.of(drops_of(hop), old_drops)), 8) + pad_column(residence_of(hop), 16) +
-                         pad_column(misses_of(hop), 12) + pad_column(first ? state : "", 9) + drops_by_reason(hop),
+                         pad_column(rate_text(rates.of(drops_of(hop), old_drops)), 8) +
+                         pad_column(residence_of(hop), 16) + pad_column(misses_of(hop), 12) +
+                         pad_column(first ? state : "", 9) + drops_by_reason(hop),
                      first && state != "bound"});
       first = false;
     }

@@ -32,7 +32,8 @@ cosmic::AccessPolicy make_access_policy(AccessGroups groups) {
     return peer.uid == 0 || in_group(peer.uid, peer.gid, groups.admin_group);
   };
   policy.may_read = [groups](const cosmic::PeerCredentials& peer) {
-    return peer.uid == 0 || in_group(peer.uid, peer.gid, groups.read_group) || in_group(peer.uid, peer.gid, groups.admin_group);
+    return peer.uid == 0 || in_group(peer.uid, peer.gid, groups.read_group) ||
+           in_group(peer.uid, peer.gid, groups.admin_group);
   };
   return policy;
 }

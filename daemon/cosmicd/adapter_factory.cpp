@@ -8,11 +8,13 @@
 
 namespace cosmicd {
 
-std::unique_ptr<cosmic::SegmentAdapter> make_adapter(const cosmic::SegmentSpec& segment, const cosmic::GatewayIdentity& self,
-                                                     cosmic::Logger& log) {
+std::unique_ptr<cosmic::SegmentAdapter> make_adapter(const cosmic::SegmentSpec& segment,
+                                                     const cosmic::GatewayIdentity& self, cosmic::Logger& log) {
   switch (segment.type) {
-    case cosmic::SegmentType::dds: return cosmic::make_dds_adapter(segment, self, log);
-    case cosmic::SegmentType::lcm: return cosmic::make_lcm_adapter(segment, self, log);
+    case cosmic::SegmentType::dds:
+      return cosmic::make_dds_adapter(segment, self, log);
+    case cosmic::SegmentType::lcm:
+      return cosmic::make_lcm_adapter(segment, self, log);
     case cosmic::SegmentType::can:
 #if COSMIC_HAS_CAN
       return cosmic::make_can_adapter(segment, self, log);

@@ -5,7 +5,7 @@
 
 namespace cosmicd {
 
-std::unique_ptr<cosmic::SegmentAdapter> make_adapter(const cosmic::SegmentSpec& segment, const cosmic::GatewayIdentity& self,
-                                                     cosmic::Logger& log);
+std::unique_ptr<cosmic::SegmentAdapter> make_adapter(const cosmic::SegmentSpec& segment,
+                                                     const cosmic::GatewayIdentity& self, cosmic::Logger& log);
 
 }  // namespace cosmicd

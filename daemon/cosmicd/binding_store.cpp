@@ -35,7 +35,8 @@ std::string read_regular_file(int fd, const std::string& path, std::string& out)
   if (::fstat(fd, &info) != 0) return errno_text("cannot stat " + path);
   if (!S_ISREG(info.st_mode)) return path + ": not a regular file; refusing to read it";
   if (static_cast<std::uint64_t>(info.st_size) > kMaxStateFileBytes) {
-    return path + ": " + std::to_string(info.st_size) + " bytes, above the limit of " + std::to_string(kMaxStateFileBytes);
+    return path + ": " + std::to_string(info.st_size) + " bytes, above the limit of " +
+           std::to_string(kMaxStateFileBytes);
   }
   char buffer[65536];
   while (true) {
@@ -44,7 +45,8 @@ std::string read_regular_file(int fd, const std::string& path, std::string& out)
     if (n < 0) return errno_text("cannot read " + path);
     if (n == 0) return {};
     out.append(buffer, static_cast<std::size_t>(n));
-    if (out.size() > kMaxStateFileBytes) return path + ": grew above the limit of " + std::to_string(kMaxStateFileBytes) + " bytes";
+    if (out.size() > kMaxStateFileBytes)
+      return path + ": grew above the limit of " + std::to_string(kMaxStateFileBytes) + " bytes";
   }
 }
 
@@ -64,7 +66,8 @@ int create_temporary(const std::string& path, std::string& temporary) {
   static std::atomic<std::uint64_t> counter{0};
   std::random_device random;
   for (int attempt = 0; attempt < 16; ++attempt) {
-    temporary = path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++) + "." + std::to_string(random());
+    temporary =
+        path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++) + "." + std::to_string(random());
     const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0640);
     if (fd >= 0 || errno != EEXIST) return fd;
   }
@@ -92,7 +95,8 @@ LoadedState load_binding_state(const std::string& path) {
     return out;
   }
   try {
-    for (const auto& b : doc.at("bound")) out.state.bound.push_back({b.at("name").get<std::string>(), b.at("yaml").get<std::string>()});
+    for (const auto& b : doc.at("bound"))
+      out.state.bound.push_back({b.at("name").get<std::string>(), b.at("yaml").get<std::string>()});
     for (const auto& u : doc.at("unbound")) out.state.unbound.push_back(u.get<std::string>());
   } catch (const Json::exception& e) {
     out.state = {};
@@ -129,7 +133,8 @@ std::string save_binding_state(const std::string& path, const BindingState& stat
   std::string temporary;
   const int fd = create_temporary(path, temporary);
   if (fd < 0) return errno_text("create a temporary file beside " + path);
-  const bool written = write_all(fd, doc.dump(2, ' ', false, Json::error_handler_t::replace) + "\n") && ::fsync(fd) == 0;
+  const bool written =
+      write_all(fd, doc.dump(2, ' ', false, Json::error_handler_t::replace) + "\n") && ::fsync(fd) == 0;
   const std::string write_error = written ? std::string() : errno_text("write " + temporary);
   ::close(fd);
   if (!written) {
@@ -141,7 +146,8 @@ std::string save_binding_state(const std::string& path, const BindingState& stat
     ::unlink(temporary.c_str());
     return error;
   }
-  const int dir = ::open(target.parent_path().empty() ? "." : target.parent_path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  const int dir =
+      ::open(target.parent_path().empty() ? "." : target.parent_path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dir >= 0) {
     ::fsync(dir);
     ::close(dir);
@@ -153,7 +159,8 @@ std::string check_binding_entry(const RuntimeBinding& entry, const std::vector<c
   if (channels.size() == 1 && channels.front().name == entry.name) return {};
   std::string defined;
   for (const auto& c : channels) defined += (defined.empty() ? "" : ", ") + c.name;
-  return "entry '" + entry.name + "' defines " + (channels.empty() ? std::string("no channel") : "channel(s) " + defined) +
+  return "entry '" + entry.name + "' defines " +
+         (channels.empty() ? std::string("no channel") : "channel(s) " + defined) +
          " instead of exactly the channel it is named after";
 }
 

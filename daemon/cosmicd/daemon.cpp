@@ -44,13 +44,15 @@ cosmic::LogLevel parse_level(const std::string& text) {
 
 std::string default_state_file() {
   const char* directory = std::getenv("STATE_DIRECTORY");  // set by systemd's StateDirectory=
-  const std::string base = directory ? std::string(directory).substr(0, std::string(directory).find(':')) : "/var/lib/cosmicd";
+  const std::string base =
+      directory ? std::string(directory).substr(0, std::string(directory).find(':')) : "/var/lib/cosmicd";
   return base + "/bindings.json";
 }
 
 void log_verdicts(cosmic::Logger& log, const std::vector<cosmic::ChannelReport>& channels) {
   for (const auto& channel : channels) {
-    std::string line = "channel " + channel.name + " (" + cosmic::to_string(channel.cls) + "): " + cosmic::to_string(channel.verdict);
+    std::string line =
+        "channel " + channel.name + " (" + cosmic::to_string(channel.cls) + "): " + cosmic::to_string(channel.verdict);
     for (const auto& reason : channel.reasons) line += "; " + reason;
     log.log(channel.verdict == cosmic::Verdict::bound ? cosmic::LogLevel::info : cosmic::LogLevel::warning, line);
   }
@@ -106,14 +108,17 @@ class Daemon {
         server.offload());
     protocol_ = &protocol;
     protocol.add_reader("peers", [this] { return federation_.peers_json(steady_now()); });
-    protocol.set_bind_gate([this](const cosmic::BindPlan& plan, std::function<void()> commit) { federation_.gate(plan, std::move(commit)); });
+    protocol.set_bind_gate([this](const cosmic::BindPlan& plan, std::function<void()> commit) {
+      federation_.gate(plan, std::move(commit));
+    });
     server.watch(signal_fd, [&] { on_signals(signal_fd); });
     if (const auto opened = server.open(); !opened.ok) {
       log_.log(cosmic::LogLevel::error, "control socket: " + opened.error);
       gateway_.stop();
       return kExitStartFailure;
     }
-    log_.log(cosmic::LogLevel::notice, "cosmicd " + loaded.config.gateway.name + " running; control socket " + server_options.path);
+    log_.log(cosmic::LogLevel::notice,
+             "cosmicd " + loaded.config.gateway.name + " running; control socket " + server_options.path);
     // /metrics asks for a snapshot only when scraped; it is taken here, on the control thread.
     metrics_.attach([this, &server] {
       server.post([this] {
@@ -141,7 +146,8 @@ class Daemon {
       // Never overwrite what may still hold runtime bindings: move it aside, or stop saving.
       const SetAside aside = set_aside_state_file(state_file_);
       if (aside.error.empty()) {
-        log_.log(cosmic::LogLevel::error, persisted.error + (aside.moved_to.empty() ? "" : "; kept aside as " + aside.moved_to) +
+        log_.log(cosmic::LogLevel::error, persisted.error +
+                                              (aside.moved_to.empty() ? "" : "; kept aside as " + aside.moved_to) +
                                               "; starting from the configuration alone");
       } else {
         state_file_usable_ = false;
@@ -158,7 +164,8 @@ class Daemon {
     for (const auto& problem : cosmic::place_process_threads(config.gateway.realtime.cpus.other))
       log_.log(cosmic::LogLevel::warning, "realtime: " + problem);
     std::vector<int> lanes_cpus = config.gateway.realtime.cpus.hrt;
-    lanes_cpus.insert(lanes_cpus.end(), config.gateway.realtime.cpus.srt.begin(), config.gateway.realtime.cpus.srt.end());
+    lanes_cpus.insert(lanes_cpus.end(), config.gateway.realtime.cpus.srt.begin(),
+                      config.gateway.realtime.cpus.srt.end());
     watchdog_.keep_off(std::move(lanes_cpus));
     const auto started = gateway_.start(config);
     if (!started.applied) {
@@ -175,20 +182,23 @@ class Daemon {
   // applied by each thread as it starts (their problems arrive through take_thread_problems()).
   void report_realtime(const cosmic::RealtimeSpec& realtime) {
     if (!realtime.requested()) {
-      log_.log(cosmic::LogLevel::info, "realtime: not configured; forwarding threads run time-shared (NRT lanes at nice 10)");
+      log_.log(cosmic::LogLevel::info,
+               "realtime: not configured; forwarding threads run time-shared (NRT lanes at nice 10)");
       return;
     }
     if (realtime.lock_memory) {
       if (::mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
         log_.log(cosmic::LogLevel::info, "realtime: memory locked (mlockall)");
       } else {
-        log_.log(cosmic::LogLevel::warning, std::string("realtime: mlockall failed: ") + std::strerror(errno) +
-                                                 "; pages may be swapped out (raise LimitMEMLOCK or grant CAP_IPC_LOCK)");
+        log_.log(cosmic::LogLevel::warning,
+                 std::string("realtime: mlockall failed: ") + std::strerror(errno) +
+                     "; pages may be swapped out (raise LimitMEMLOCK or grant CAP_IPC_LOCK)");
       }
     }
-    log_.log(cosmic::LogLevel::info, "realtime: SCHED_FIFO priorities hrt " + std::to_string(realtime.hrt_priority) + ", srt " +
-                                         std::to_string(realtime.srt_priority) + ", nrt " + std::to_string(realtime.nrt_priority) +
-                                         ", receive " + std::to_string(realtime.receive_priority));
+    log_.log(cosmic::LogLevel::info, "realtime: SCHED_FIFO priorities hrt " + std::to_string(realtime.hrt_priority) +
+                                         ", srt " + std::to_string(realtime.srt_priority) + ", nrt " +
+                                         std::to_string(realtime.nrt_priority) + ", receive " +
+                                         std::to_string(realtime.receive_priority));
     if (realtime.cpus.any()) {
       const cosmic::CpuPlacement& c = realtime.cpus;
       const auto list = [&c](const std::vector<int>& cpus) {
@@ -200,8 +210,8 @@ class Daemon {
         }
         return text;
       };
-      log_.log(cosmic::LogLevel::info, "realtime: CPUs hrt " + list(c.hrt) + ", srt " + list(c.srt) + ", nrt " + list(c.nrt) +
-                                           ", receive " + list(c.receive) + ", other " + list(c.other));
+      log_.log(cosmic::LogLevel::info, "realtime: CPUs hrt " + list(c.hrt) + ", srt " + list(c.srt) + ", nrt " +
+                                           list(c.nrt) + ", receive " + list(c.receive) + ", other " + list(c.other));
     }
   }
 
@@ -221,10 +231,11 @@ class Daemon {
         log_.log(cosmic::LogLevel::notice, "restored runtime binding of channel " + binding.name);
         continue;
       }
-      std::string why = parsed.ok() ? result.error : std::to_string(parsed.errors.size()) + " error(s) in its definition";
+      std::string why =
+          parsed.ok() ? result.error : std::to_string(parsed.errors.size()) + " error(s) in its definition";
       if (!parsed.ok()) why += ": " + parsed.errors.front().to_string();
-      log_.log(cosmic::LogLevel::warning, "runtime binding of channel " + binding.name + " could not be restored (" + why +
-                                              "); kept in the state file for the next start");
+      log_.log(cosmic::LogLevel::warning, "runtime binding of channel " + binding.name + " could not be restored (" +
+                                              why + "); kept in the state file for the next start");
     }
     if (kept.size() != state_.bound.size()) {
       state_.bound = std::move(kept);
@@ -245,14 +256,15 @@ class Daemon {
         std::erase_if(state_.bound, [&](const RuntimeBinding& b) { return b.name == channel.name; });
         std::erase(state_.unbound, channel.name);
         const cosmic::ChannelSpec* in_file = file_config_.find_channel(channel.name);
-        if (in_file && *in_file == channel) continue;  // the file's own definition again
+        if (in_file && *in_file == channel) continue;         // the file's own definition again
         if (in_file) state_.unbound.push_back(channel.name);  // replaces the file's definition
         state_.bound.push_back({channel.name, cosmic::channel_to_yaml(channel)});
       }
     } else if (command == "unbind") {
       const std::string name = request["name"].get<std::string>();
       std::erase_if(state_.bound, [&](const RuntimeBinding& b) { return b.name == name; });
-      if (file_config_.find_channel(name) && std::find(state_.unbound.begin(), state_.unbound.end(), name) == state_.unbound.end()) {
+      if (file_config_.find_channel(name) &&
+          std::find(state_.unbound.begin(), state_.unbound.end(), name) == state_.unbound.end()) {
         state_.unbound.push_back(name);
       }
     }
@@ -260,8 +272,9 @@ class Daemon {
   }
 
   std::string persist() {
-    const std::string error = state_file_usable_ ? save_binding_state(state_file_, state_)
-                                                 : state_file_ + " is unusable and could not be set aside; not overwritten";
+    const std::string error = state_file_usable_
+                                  ? save_binding_state(state_file_, state_)
+                                  : state_file_ + " is unusable and could not be set aside; not overwritten";
     if (!error.empty()) log_.log(cosmic::LogLevel::error, "cannot save runtime bindings: " + error);
     return error;
   }
@@ -294,15 +307,17 @@ class Daemon {
   void log_reload_answer(const nlohmann::json& answer) {
     if (answer.is_discarded()) return;
     for (const auto& c : answer.value("channels", nlohmann::json::array())) {
-      std::string line = "channel " + c.value("name", "") + " (" + c.value("class", "") + "): " + c.value("verdict", "");
+      std::string line =
+          "channel " + c.value("name", "") + " (" + c.value("class", "") + "): " + c.value("verdict", "");
       for (const auto& reason : c.value("reasons", nlohmann::json::array())) line += "; " + reason.get<std::string>();
       log_.log(c.value("verdict", "") == "bound" ? cosmic::LogLevel::info : cosmic::LogLevel::warning, line);
     }
     if (answer.value("ok", false)) return;
-    for (const auto& error : answer.value("errors", nlohmann::json::array())) log_.log(cosmic::LogLevel::error, error.value("text", ""));
+    for (const auto& error : answer.value("errors", nlohmann::json::array()))
+      log_.log(cosmic::LogLevel::error, error.value("text", ""));
     const auto& error = answer["error"];
-    log_.log(cosmic::LogLevel::error, "reload refused (" + error.value("code", "failed") + "): " + error.value("message", "") +
-                                          "; the running configuration is unchanged");
+    log_.log(cosmic::LogLevel::error, "reload refused (" + error.value("code", "failed") + "): " +
+                                          error.value("message", "") + "; the running configuration is unchanged");
   }
 
   void loop(cosmic::ControlServer& server) {
@@ -318,7 +333,8 @@ class Daemon {
       if (std::chrono::steady_clock::now() - last_health >= std::chrono::milliseconds(250)) {
         gateway_.refresh_health();
         gateway_.refresh_runtime(steady_now());
-        for (const auto& problem : gateway_.take_thread_problems()) log_.log(cosmic::LogLevel::warning, "realtime: " + problem);
+        for (const auto& problem : gateway_.take_thread_problems())
+          log_.log(cosmic::LogLevel::warning, "realtime: " + problem);
         notifier_.tick(gateway_);
         metrics_.follow(gateway_.config().gateway.metrics);  // a reload may move or close the endpoint
         last_health = std::chrono::steady_clock::now();

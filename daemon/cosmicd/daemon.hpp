@@ -10,8 +10,8 @@ namespace cosmicd {
 
 struct DaemonOptions {
   std::string config = "/etc/cosmic/cosmicd.yaml";
-  std::string socket;       // overrides gateway.control_socket
-  std::string state_file;   // default: $STATE_DIRECTORY/bindings.json, else /var/lib/cosmicd/bindings.json
+  std::string socket;      // overrides gateway.control_socket
+  std::string state_file;  // default: $STATE_DIRECTORY/bindings.json, else /var/lib/cosmicd/bindings.json
   std::string log_level = "info";
   AccessGroups groups;
 };

@@ -13,22 +13,32 @@ constexpr std::size_t kMaxTrackedMessages = 256;
 // syslog priority of a level, as sd-daemon(3) prefixes expect ("<5>" for notice).
 char syslog_priority(cosmic::LogLevel level) {
   switch (level) {
-    case cosmic::LogLevel::debug: return '7';
-    case cosmic::LogLevel::info: return '6';
-    case cosmic::LogLevel::notice: return '5';
-    case cosmic::LogLevel::warning: return '4';
-    case cosmic::LogLevel::error: return '3';
+    case cosmic::LogLevel::debug:
+      return '7';
+    case cosmic::LogLevel::info:
+      return '6';
+    case cosmic::LogLevel::notice:
+      return '5';
+    case cosmic::LogLevel::warning:
+      return '4';
+    case cosmic::LogLevel::error:
+      return '3';
   }
   return '6';
 }
 
 spdlog::level::level_enum to_spdlog(cosmic::LogLevel level) {
   switch (level) {
-    case cosmic::LogLevel::debug: return spdlog::level::debug;
-    case cosmic::LogLevel::info: return spdlog::level::info;
-    case cosmic::LogLevel::notice: return spdlog::level::info;
-    case cosmic::LogLevel::warning: return spdlog::level::warn;
-    case cosmic::LogLevel::error: return spdlog::level::err;
+    case cosmic::LogLevel::debug:
+      return spdlog::level::debug;
+    case cosmic::LogLevel::info:
+      return spdlog::level::info;
+    case cosmic::LogLevel::notice:
+      return spdlog::level::info;
+    case cosmic::LogLevel::warning:
+      return spdlog::level::warn;
+    case cosmic::LogLevel::error:
+      return spdlog::level::err;
   }
   return spdlog::level::info;
 }

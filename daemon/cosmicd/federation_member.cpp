@@ -6,7 +6,9 @@ namespace {
 // Lost and left peers stay listed this many leases, then are forgotten.
 constexpr int kForgetAfterLeases = 20;
 
-double seconds_between(cosmic::Nanos from, cosmic::Nanos to) { return std::chrono::duration<double>(to - from).count(); }
+double seconds_between(cosmic::Nanos from, cosmic::Nanos to) {
+  return std::chrono::duration<double>(to - from).count();
+}
 
 }  // namespace
 
@@ -52,7 +54,8 @@ void FederationMember::follow_configuration() {
   view_ = std::make_unique<cosmic::FederationView>(gateway_.identity().id);
   announced_generation_ = UINT64_MAX;
   log_.log(cosmic::LogLevel::notice, "federation: joined over segment " + spec.segment + " (DDS domain " +
-                                         std::to_string(segment->dds.domain) + ", lease " + cosmic::format_duration(spec.lease) + ")");
+                                         std::to_string(segment->dds.domain) + ", lease " +
+                                         cosmic::format_duration(spec.lease) + ")");
 }
 
 void FederationMember::log_transitions(const std::map<std::uint64_t, cosmic::PeerState>& before) {
@@ -61,12 +64,14 @@ void FederationMember::log_transitions(const std::map<std::uint64_t, cosmic::Pee
     if (was != before.end() && was->second == peer.state) continue;
     const std::string who = "gateway " + peer.announcement.name + " (" + cosmic::gateway_id_text(id) + ")";
     if (peer.state == cosmic::PeerState::alive) {
-      log_.log(cosmic::LogLevel::notice, "federation: " + who + (was == before.end() ? " joined" : " is back") + " with " +
-                                             std::to_string(peer.announcement.segments.size()) + " segments and " +
-                                             std::to_string(peer.announcement.channels.size()) + " channels");
+      log_.log(cosmic::LogLevel::notice, "federation: " + who + (was == before.end() ? " joined" : " is back") +
+                                             " with " + std::to_string(peer.announcement.segments.size()) +
+                                             " segments and " + std::to_string(peer.announcement.channels.size()) +
+                                             " channels");
     } else {
-      log_.log(cosmic::LogLevel::warning, "federation: " + who + (peer.state == cosmic::PeerState::left ? " left" : " was lost (lease expired)") +
-                                              "; its reservations are released");
+      log_.log(cosmic::LogLevel::warning,
+               "federation: " + who + (peer.state == cosmic::PeerState::left ? " left" : " was lost (lease expired)") +
+                   "; its reservations are released");
     }
   }
 }
@@ -81,7 +86,8 @@ void FederationMember::log_verdict_changes(const cosmic::AdmissionReport& was, c
     }
     std::string line = "federation: channel " + channel.name + " is " + cosmic::to_string(channel.verdict) + " (was " +
                        cosmic::to_string(before->verdict) + ")";
-    line += ", end to end " + (channel.end_to_end.latency ? cosmic::format_duration(*channel.end_to_end.latency) : std::string("unbounded"));
+    line += ", end to end " + (channel.end_to_end.latency ? cosmic::format_duration(*channel.end_to_end.latency)
+                                                          : std::string("unbounded"));
     if (!channel.upstream.empty()) line += " through gateway " + channel.upstream.front().gateway;
     for (const auto& reason : channel.reasons) line += "; " + reason;
     log_.log(channel.verdict == cosmic::Verdict::bound ? cosmic::LogLevel::notice : cosmic::LogLevel::warning, line);
@@ -142,7 +148,7 @@ void FederationMember::end_claim() {
   auto commit = std::move(claim_->commit);
   claim_.reset();
   peers_changed_ = true;  // the claim is over: announce without it, committed or not
-  commit();  // admits again if what the others reserve or claim changed meanwhile
+  commit();               // admits again if what the others reserve or claim changed meanwhile
 }
 
 bool FederationMember::touches_shared_network(const cosmic::BindPlan& plan) const {
@@ -174,28 +180,44 @@ nlohmann::json FederationMember::peers_json(cosmic::Nanos now) const {
   const FederationSnapshot s = snapshot(now);
   nlohmann::json peers = nlohmann::json::array();
   for (const auto& p : s.peers) {
-    peers.push_back({{"id", p.id}, {"name", p.name}, {"state", p.state}, {"last_heard_s", p.last_heard_age_seconds},
-                     {"revision", p.revision}, {"channels", p.channels}});
+    peers.push_back({{"id", p.id},
+                     {"name", p.name},
+                     {"state", p.state},
+                     {"last_heard_s", p.last_heard_age_seconds},
+                     {"revision", p.revision},
+                     {"channels", p.channels}});
   }
   if (view_) {
     std::size_t i = 0;
     for (const auto& [id, peer] : view_->peers()) {
       nlohmann::json segments = nlohmann::json::array();
       for (const auto& seg : peer.announcement.segments) {
-        segments.push_back({{"name", seg.name}, {"type", cosmic::to_string(seg.type)}, {"network", seg.network}, {"load", seg.load},
+        segments.push_back({{"name", seg.name},
+                            {"type", cosmic::to_string(seg.type)},
+                            {"network", seg.network},
+                            {"load", seg.load},
                             {"frames", seg.frames.size()}});
       }
       peers[i++]["segments"] = segments;
     }
   }
   return {{"ok", true},
-          {"federation", {{"enabled", s.enabled}, {"segment", s.segment}, {"lease_s", std::chrono::duration<double>(spec_.lease).count()},
-                          {"error", start_error_}}},
+          {"federation",
+           {{"enabled", s.enabled},
+            {"segment", s.segment},
+            {"lease_s", std::chrono::duration<double>(spec_.lease).count()},
+            {"error", start_error_}}},
           {"peers", peers},
           {"counters",
-           {{"received", s.view.received}, {"applied", s.view.applied}, {"stale", s.view.stale}, {"refused", s.view.refused},
-            {"last_refusal", s.view.last_refusal}, {"dropped", s.link.dropped}, {"published", s.link.published},
-            {"publish_errors", s.link.publish_errors}, {"pending_takeovers", view_ ? view_->pending_takeovers() : 0},
+           {{"received", s.view.received},
+            {"applied", s.view.applied},
+            {"stale", s.view.stale},
+            {"refused", s.view.refused},
+            {"last_refusal", s.view.last_refusal},
+            {"dropped", s.link.dropped},
+            {"published", s.link.published},
+            {"publish_errors", s.link.publish_errors},
+            {"pending_takeovers", view_ ? view_->pending_takeovers() : 0},
             {"frames_over_cap", s.view.frames_over_cap}}}};
 }
 
@@ -205,8 +227,9 @@ FederationSnapshot FederationMember::snapshot(cosmic::Nanos now) const {
   s.segment = spec_.segment;
   if (!view_) return s;
   for (const auto& [id, peer] : view_->peers()) {
-    s.peers.push_back({cosmic::gateway_id_text(id), peer.announcement.name, cosmic::to_string(peer.state), seconds_between(peer.last_heard, now),
-                       peer.announcement.revision, peer.announcement.channels.size()});
+    s.peers.push_back({cosmic::gateway_id_text(id), peer.announcement.name, cosmic::to_string(peer.state),
+                       seconds_between(peer.last_heard, now), peer.announcement.revision,
+                       peer.announcement.channels.size()});
   }
   s.view = view_->counters();
   s.link = link_->counters();

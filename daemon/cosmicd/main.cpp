@@ -10,10 +10,13 @@ int main(int argc, char** argv) {
   cosmicd::DaemonOptions options;
   app.add_option("-c,--config", options.config, "Configuration file")->capture_default_str();
   app.add_option("-s,--socket", options.socket, "Control socket path (overrides gateway.control_socket)");
-  app.add_option("--state-file", options.state_file,
-                 "Where runtime bindings persist (default $STATE_DIRECTORY/bindings.json or /var/lib/cosmicd/bindings.json)");
-  app.add_option("--read-group", options.groups.read_group, "Group allowed to read gateway state")->capture_default_str();
-  app.add_option("--admin-group", options.groups.admin_group, "Group allowed to bind, unbind and reload")->capture_default_str();
+  app.add_option(
+      "--state-file", options.state_file,
+      "Where runtime bindings persist (default $STATE_DIRECTORY/bindings.json or /var/lib/cosmicd/bindings.json)");
+  app.add_option("--read-group", options.groups.read_group, "Group allowed to read gateway state")
+      ->capture_default_str();
+  app.add_option("--admin-group", options.groups.admin_group, "Group allowed to bind, unbind and reload")
+      ->capture_default_str();
   app.add_option("-l,--log-level", options.log_level, "debug, info, notice, warning or error")
       ->check(CLI::IsMember({"debug", "info", "notice", "warning", "error"}))
       ->capture_default_str();

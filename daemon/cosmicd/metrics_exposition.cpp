@@ -8,9 +8,12 @@ namespace {
 
 const char* type_name(MetricType type) {
   switch (type) {
-    case MetricType::counter: return "counter";
-    case MetricType::histogram: return "histogram";
-    case MetricType::gauge: break;
+    case MetricType::counter:
+      return "counter";
+    case MetricType::histogram:
+      return "histogram";
+    case MetricType::gauge:
+      break;
   }
   return "gauge";
 }
@@ -48,7 +51,7 @@ const char* content_type(ExpositionFormat format) {
 
 ExpositionFormat format_for_accept(std::string_view accept) {
   return accept.find("application/openmetrics-text") != std::string_view::npos ? ExpositionFormat::openmetrics
-                                                                                : ExpositionFormat::prometheus_text;
+                                                                               : ExpositionFormat::prometheus_text;
 }
 
 std::string format_number(double value) {
@@ -96,7 +99,8 @@ void Exposition::sample(const Labels& labels, double value) {
 void Exposition::histogram(const Labels& labels, const std::vector<double>& upper_bounds,
                            const std::vector<std::uint64_t>& cumulative) {
   for (std::size_t i = 0; i < cumulative.size(); ++i) {
-    const std::pair<std::string_view, std::string> le{"le", i < upper_bounds.size() ? format_number(upper_bounds[i]) : "+Inf"};
+    const std::pair<std::string_view, std::string> le{
+        "le", i < upper_bounds.size() ? format_number(upper_bounds[i]) : "+Inf"};
     line("_bucket", labels, std::to_string(cumulative[i]), &le);
   }
   line("_count", labels, std::to_string(cumulative.empty() ? 0 : cumulative.back()));

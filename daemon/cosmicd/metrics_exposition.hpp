@@ -34,13 +34,15 @@ class Exposition {
   void sample(const Labels& labels, double value);
   // A histogram's cumulative bucket counts: cumulative[i] against upper_bounds[i] (finite, in
   // the family's unit), then one more for +Inf, which is also written as NAME_count.
-  void histogram(const Labels& labels, const std::vector<double>& upper_bounds, const std::vector<std::uint64_t>& cumulative);
+  void histogram(const Labels& labels, const std::vector<double>& upper_bounds,
+                 const std::vector<std::uint64_t>& cumulative);
 
   // The document; the writer is spent afterwards.
   std::string finish();
 
  private:
-  void line(std::string_view suffix, const Labels& labels, std::string_view value, const std::pair<std::string_view, std::string>* extra = nullptr);
+  void line(std::string_view suffix, const Labels& labels, std::string_view value,
+            const std::pair<std::string_view, std::string>* extra = nullptr);
 
   ExpositionFormat format_;
   std::string out_;

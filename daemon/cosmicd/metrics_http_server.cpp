@@ -18,7 +18,8 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 std::string refusal(std::string_view status, std::string_view body) {
-  return "HTTP/1.1 " + std::string(status) + "\r\nContent-Type: text/plain\r\nContent-Length: " + std::to_string(body.size()) +
+  return "HTTP/1.1 " + std::string(status) +
+         "\r\nContent-Type: text/plain\r\nContent-Length: " + std::to_string(body.size()) +
          "\r\nConnection: close\r\n\r\n" + std::string(body);
 }
 const std::string kRequestTimeout = refusal("408 Request Timeout", "the request head did not arrive in time\n");
@@ -64,7 +65,9 @@ class ConnectionStream final : public httplib::Stream {
   ConnectionStream(int fd, std::string buffered, Clock::time_point read_deadline, Clock::time_point write_deadline)
       : fd_(fd), buffered_(std::move(buffered)), read_deadline_(read_deadline), write_deadline_(write_deadline) {}
 
-  bool is_readable() const override { return offset_ < buffered_.size() || (fd_ >= 0 && wait_for(fd_, POLLIN, read_deadline_)); }
+  bool is_readable() const override {
+    return offset_ < buffered_.size() || (fd_ >= 0 && wait_for(fd_, POLLIN, read_deadline_));
+  }
   bool is_writable() const override { return fd_ >= 0 && wait_for(fd_, POLLOUT, write_deadline_); }
 
   ssize_t read(char* ptr, size_t size) override {
@@ -131,7 +134,9 @@ class ConnectionStream final : public httplib::Stream {
 
 MetricsHttpServer::MetricsHttpServer(HttpLimits limits, std::function<void()> on_thread_start, cosmic::Logger* log)
     : limits_(limits), log_(log), registry_(limits.max_connections, [this](std::uint64_t n) { report_evictions(n); }) {
-  new_task_queue = [this, on_thread_start = std::move(on_thread_start)] { return new ConnectionPool(registry_, on_thread_start); };
+  new_task_queue = [this, on_thread_start = std::move(on_thread_start)] {
+    return new ConnectionPool(registry_, on_thread_start);
+  };
   // What cpp-httplib still applies itself: the Keep-Alive header it writes, request bodies.
   set_keep_alive_timeout(std::max<time_t>(1, std::chrono::ceil<std::chrono::seconds>(limits.keep_alive).count()));
   set_keep_alive_max_count(limits.max_requests_per_connection);
@@ -235,9 +240,10 @@ void MetricsHttpServer::report_evictions(std::uint64_t evictions) {
     reported_ = evictions;
     last_report_ = now;
   }
-  log_->log(cosmic::LogLevel::warning, "metrics endpoint: " + std::to_string(since_last) + " connection(s) closed at the cap of " +
-                                           std::to_string(limits_.max_connections) +
-                                           " connections (the longest idle first); next report in a minute at the earliest");
+  log_->log(cosmic::LogLevel::warning,
+            "metrics endpoint: " + std::to_string(since_last) + " connection(s) closed at the cap of " +
+                std::to_string(limits_.max_connections) +
+                " connections (the longest idle first); next report in a minute at the earliest");
 }
 
 }  // namespace cosmicd

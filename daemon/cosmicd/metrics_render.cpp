@@ -29,7 +29,8 @@ struct HopView {
 };
 
 const cosmic::ChannelStatsSnapshot* find_stats(const MetricsSnapshot& snapshot, const std::string& name) {
-  const auto it = std::find_if(snapshot.stats.begin(), snapshot.stats.end(), [&](const auto& s) { return s.name == name; });
+  const auto it =
+      std::find_if(snapshot.stats.begin(), snapshot.stats.end(), [&](const auto& s) { return s.name == name; });
   return it == snapshot.stats.end() ? nullptr : &*it;
 }
 
@@ -81,8 +82,10 @@ void render_gateway(Exposition& out, const MetricsSnapshot& s) {
 
 void render_segment_health(Exposition& out, const MetricsSnapshot& s) {
   out.family("cosmic_segment_up", MetricType::gauge, "1 when the segment is healthy, 0 when degraded or down.");
-  for (const auto& seg : s.segments) out.sample(segment_labels(seg), seg.health.state == cosmic::SegmentHealth::up ? 1.0 : 0.0);
-  out.family("cosmic_segment_health", MetricType::gauge, "1 for the segment's current health state (up, degraded, down), 0 for the others.");
+  for (const auto& seg : s.segments)
+    out.sample(segment_labels(seg), seg.health.state == cosmic::SegmentHealth::up ? 1.0 : 0.0);
+  out.family("cosmic_segment_health", MetricType::gauge,
+             "1 for the segment's current health state (up, degraded, down), 0 for the others.");
   for (const auto& seg : s.segments) {
     for (const auto state : {cosmic::SegmentHealth::up, cosmic::SegmentHealth::degraded, cosmic::SegmentHealth::down}) {
       Labels labels = segment_labels(seg);
@@ -90,9 +93,11 @@ void render_segment_health(Exposition& out, const MetricsSnapshot& s) {
       out.sample(labels, seg.health.state == state ? 1.0 : 0.0);
     }
   }
-  out.family("cosmic_segment_reserved_utilization_ratio", MetricType::gauge, "Share of the segment's bandwidth reserved by admission.");
+  out.family("cosmic_segment_reserved_utilization_ratio", MetricType::gauge,
+             "Share of the segment's bandwidth reserved by admission.");
   for (const auto& seg : s.segments) out.sample(segment_labels(seg), seg.utilization);
-  out.family("cosmic_segment_max_utilization_ratio", MetricType::gauge, "Share of the bandwidth the gateway may reserve (max_utilization).");
+  out.family("cosmic_segment_max_utilization_ratio", MetricType::gauge,
+             "Share of the bandwidth the gateway may reserve (max_utilization).");
   for (const auto& seg : s.segments) out.sample(segment_labels(seg), seg.spec.max_utilization);
   out.family("cosmic_segment_channels", MetricType::gauge, "Channels bound on the segment.");
   for (const auto& seg : s.segments) out.sample(segment_labels(seg), static_cast<std::uint64_t>(seg.channels));
@@ -106,19 +111,26 @@ void render_segment_counters(Exposition& out, const MetricsSnapshot& s) {
     std::uint64_t cosmic::AdapterStatistics::*adapter = nullptr;
   };
   const Counter counters[] = {
-      {"cosmic_segment_unrouted_events", "Events received on the segment for no channel bound there.", &cosmic::SegmentInfo::unrouted},
-      {"cosmic_segment_received_messages", "Messages or frames the adapter read from the network.", nullptr, &cosmic::AdapterStatistics::received},
-      {"cosmic_segment_sent_messages", "Messages or frames the adapter wrote to the network.", nullptr, &cosmic::AdapterStatistics::sent},
-      {"cosmic_segment_receive_errors", "Malformed or unreadable input on the segment.", nullptr, &cosmic::AdapterStatistics::receive_errors},
+      {"cosmic_segment_unrouted_events", "Events received on the segment for no channel bound there.",
+       &cosmic::SegmentInfo::unrouted},
+      {"cosmic_segment_received_messages", "Messages or frames the adapter read from the network.", nullptr,
+       &cosmic::AdapterStatistics::received},
+      {"cosmic_segment_sent_messages", "Messages or frames the adapter wrote to the network.", nullptr,
+       &cosmic::AdapterStatistics::sent},
+      {"cosmic_segment_receive_errors", "Malformed or unreadable input on the segment.", nullptr,
+       &cosmic::AdapterStatistics::receive_errors},
       {"cosmic_segment_send_errors", "Writes the network refused.", nullptr, &cosmic::AdapterStatistics::send_errors},
-      {"cosmic_segment_overflow_drops", "Messages lost before the adapter could read them (kernel receive queue overflow).", nullptr,
+      {"cosmic_segment_overflow_drops",
+       "Messages lost before the adapter could read them (kernel receive queue overflow).", nullptr,
        &cosmic::AdapterStatistics::overflow_drops},
   };
   for (const auto& counter : counters) {
     out.family(counter.name, MetricType::counter, counter.help);
-    for (const auto& seg : s.segments) out.sample(segment_labels(seg), counter.field ? seg.*counter.field : seg.adapter.*counter.adapter);
+    for (const auto& seg : s.segments)
+      out.sample(segment_labels(seg), counter.field ? seg.*counter.field : seg.adapter.*counter.adapter);
   }
-  out.family("cosmic_segment_send_backlog_messages", MetricType::gauge, "Messages waiting in the adapter's own send queue.");
+  out.family("cosmic_segment_send_backlog_messages", MetricType::gauge,
+             "Messages waiting in the adapter's own send queue.");
   for (const auto& seg : s.segments) out.sample(segment_labels(seg), seg.adapter.backlog);
   out.family("cosmic_segment_unexplained_frames", MetricType::counter,
              "CAN frames of an identifier no bound channel, binding protocol or background declaration explains.");
@@ -137,17 +149,20 @@ void render_segment_counters(Exposition& out, const MetricsSnapshot& s) {
 }
 
 void render_channel_state(Exposition& out, const MetricsSnapshot& s) {
-  out.family("cosmic_channel_verdict", MetricType::gauge, "1 for the channel's verdict (bound, degraded, rejected; failed: admitted but refused by a transport), 0 for the others.");
+  out.family("cosmic_channel_verdict", MetricType::gauge,
+             "1 for the channel's verdict (bound, degraded, rejected; failed: admitted but refused by a transport), 0 "
+             "for the others.");
   for (const auto& c : s.channels) {
-    for (const auto verdict : {cosmic::Verdict::bound, cosmic::Verdict::degraded, cosmic::Verdict::rejected,
-                               cosmic::Verdict::failed}) {
+    for (const auto verdict :
+         {cosmic::Verdict::bound, cosmic::Verdict::degraded, cosmic::Verdict::rejected, cosmic::Verdict::failed}) {
       Labels labels = channel_labels(c);
       labels.emplace_back("verdict", cosmic::to_string(verdict));
       out.sample(labels, c.verdict == verdict ? 1.0 : 0.0);
     }
   }
   out.family("cosmic_channel_runtime_state", MetricType::gauge,
-             "1 for the channel's runtime state (bound: no recent miss; violated: an HRT hop missed its bound), 0 for the other.");
+             "1 for the channel's runtime state (bound: no recent miss; violated: an HRT hop missed its bound), 0 for "
+             "the other.");
   for (const auto& c : s.channels) {
     const auto* stats = find_stats(s, c.name);
     const auto current = stats ? stats->runtime_state : cosmic::RuntimeState::bound;
@@ -157,12 +172,14 @@ void render_channel_state(Exposition& out, const MetricsSnapshot& s) {
       out.sample(labels, current == state ? 1.0 : 0.0);
     }
   }
-  out.family("cosmic_channel_violations", MetricType::counter, "Episodes of the violated runtime state since the channel was bound.");
+  out.family("cosmic_channel_violations", MetricType::counter,
+             "Episodes of the violated runtime state since the channel was bound.");
   for (const auto& c : s.channels) {
     const auto* stats = find_stats(s, c.name);
     out.sample(channel_labels(c), stats ? stats->violations : 0);
   }
-  out.family("cosmic_channel_forwarded_events", MetricType::counter, "Events accepted and queued for at least one subscriber segment.");
+  out.family("cosmic_channel_forwarded_events", MetricType::counter,
+             "Events accepted and queued for at least one subscriber segment.");
   for (const auto& c : s.channels) {
     const auto* stats = find_stats(s, c.name);
     out.sample(channel_labels(c), stats ? stats->forwarded : 0);
@@ -174,7 +191,8 @@ void render_channel_admission(Exposition& out, const MetricsSnapshot& s) {
   out.family("cosmic_channel_end_to_end_bound_seconds", MetricType::gauge,
              "Worst-case publisher-to-subscriber latency admission computed (+Inf: unbounded).");
   for (const auto& c : s.channels) out.sample(channel_labels(c), seconds_or_inf(c.end_to_end.latency));
-  out.family("cosmic_channel_reaction_time_seconds", MetricType::gauge, "The channel's reaction_time (channels that declare one).");
+  out.family("cosmic_channel_reaction_time_seconds", MetricType::gauge,
+             "The channel's reaction_time (channels that declare one).");
   for (const auto& c : s.channels) {
     if (c.end_to_end.reaction_time) out.sample(channel_labels(c), seconds(*c.end_to_end.reaction_time));
   }
@@ -185,29 +203,34 @@ void render_channel_admission(Exposition& out, const MetricsSnapshot& s) {
       out.sample(channel_labels(c), seconds(*c.end_to_end.reaction_time) - seconds_or_inf(c.end_to_end.latency));
     }
   }
-  out.family("cosmic_channel_temp_validity_seconds", MetricType::gauge, "The channel's temp_validity (channels that declare one).");
+  out.family("cosmic_channel_temp_validity_seconds", MetricType::gauge,
+             "The channel's temp_validity (channels that declare one).");
   for (const auto& c : s.channels) {
     if (c.end_to_end.temp_validity) out.sample(channel_labels(c), seconds(*c.end_to_end.temp_validity));
   }
 }
 
 void render_hop_admission(Exposition& out, const std::vector<HopView>& hops) {
-  out.family("cosmic_channel_hop_latency_bound_seconds", MetricType::gauge,
-             "Worst-case latency admission counts for this hop (CAN: response time; IP: latency_bound; +Inf: unbounded).");
+  out.family(
+      "cosmic_channel_hop_latency_bound_seconds", MetricType::gauge,
+      "Worst-case latency admission counts for this hop (CAN: response time; IP: latency_bound; +Inf: unbounded).");
   for (const auto& h : hops) out.sample(hop_labels(h), seconds_or_inf(h.hop->latency));
-  out.family("cosmic_channel_hop_response_time_seconds", MetricType::gauge,
-             "Predicted worst-case CAN response time R of the channel's frame on this hop (CAN hops only; +Inf: unbounded).");
+  out.family(
+      "cosmic_channel_hop_response_time_seconds", MetricType::gauge,
+      "Predicted worst-case CAN response time R of the channel's frame on this hop (CAN hops only; +Inf: unbounded).");
   for (const auto& h : hops) {
     if (h.hop->can) out.sample(hop_labels(h), seconds_or_inf(h.hop->can->response_time));
   }
 }
 
 void render_hop_counters(Exposition& out, const std::vector<HopView>& hops) {
-  out.family("cosmic_channel_received_events", MetricType::counter, "Events of the channel received on a publisher segment.");
+  out.family("cosmic_channel_received_events", MetricType::counter,
+             "Events of the channel received on a publisher segment.");
   for (const auto& h : hops) out.sample(hop_labels(h), h.counters ? h.counters->rx : 0);
   out.family("cosmic_channel_sent_events", MetricType::counter, "Events of the channel sent on a subscriber segment.");
   for (const auto& h : hops) out.sample(hop_labels(h), h.counters ? h.counters->tx : 0);
-  out.family("cosmic_channel_dropped_events", MetricType::counter, "Events of the channel dropped on this segment, by reason.");
+  out.family("cosmic_channel_dropped_events", MetricType::counter,
+             "Events of the channel dropped on this segment, by reason.");
   for (const auto& h : hops) {
     for (std::size_t r = 0; r < cosmic::kDropReasonCount; ++r) {
       Labels labels = hop_labels(h);
@@ -230,19 +253,23 @@ void render_residence(Exposition& out, const std::vector<HopView>& hops) {
   const auto egress = egress_of(hops);
   out.family("cosmic_channel_residence_seconds", MetricType::histogram,
              "Time from the event's arrival at the gateway to the end of its send on this subscriber segment.");
-  for (const auto& [h, e] : egress) out.histogram(hop_labels(*h), residence_bucket_bounds(), rebucket_residence(e->residence_buckets));
+  for (const auto& [h, e] : egress)
+    out.histogram(hop_labels(*h), residence_bucket_bounds(), rebucket_residence(e->residence_buckets));
   // Gauges of their own: a "quantile" label belongs to summaries, which these are not.
   const std::pair<const char*, cosmic::Nanos cosmic::HopRuntimeSnapshot::*> quantiles[] = {
       {"cosmic_channel_residence_p50_seconds", &cosmic::HopRuntimeSnapshot::residence_p50},
       {"cosmic_channel_residence_p99_seconds", &cosmic::HopRuntimeSnapshot::residence_p99},
       {"cosmic_channel_residence_p999_seconds", &cosmic::HopRuntimeSnapshot::residence_p999}};
   for (const auto& [name, field] : quantiles) {
-    out.family(name, MetricType::gauge, "Residence quantile since the channel was bound (upper end of the router's fine bucket).");
+    out.family(name, MetricType::gauge,
+               "Residence quantile since the channel was bound (upper end of the router's fine bucket).");
     for (const auto& [h, e] : egress) out.sample(hop_labels(*h), seconds(e->*field));
   }
-  out.family("cosmic_channel_residence_max_seconds", MetricType::gauge, "Longest residence since the channel was bound.");
+  out.family("cosmic_channel_residence_max_seconds", MetricType::gauge,
+             "Longest residence since the channel was bound.");
   for (const auto& [h, e] : egress) out.sample(hop_labels(*h), seconds(e->residence_max));
-  out.family("cosmic_channel_residence_misses", MetricType::counter, "Events whose residence exceeded gateway.residence_bound.");
+  out.family("cosmic_channel_residence_misses", MetricType::counter,
+             "Events whose residence exceeded gateway.residence_bound.");
   for (const auto& [h, e] : egress) out.sample(hop_labels(*h), e->residence_miss);
   out.family("cosmic_channel_deadline_misses", MetricType::counter,
              "Events whose age when sent on this segment exceeded the channel's reaction_time.");
@@ -275,20 +302,24 @@ std::vector<std::uint64_t> rebucket_residence(const std::vector<std::uint64_t>& 
 // Present only while the gateway is in a federation (gateway.federation).
 void render_federation(Exposition& out, const FederationSnapshot& f) {
   if (!f.enabled) return;
-  out.family("cosmic_federation_peers", MetricType::gauge, "Other gateways of the federation by state (alive, lost, left).");
+  out.family("cosmic_federation_peers", MetricType::gauge,
+             "Other gateways of the federation by state (alive, lost, left).");
   for (const char* state : {"alive", "lost", "left"}) {
     const auto count = std::count_if(f.peers.begin(), f.peers.end(), [&](const auto& p) { return p.state == state; });
     out.sample({{"state", state}}, static_cast<std::uint64_t>(count));
   }
   out.family("cosmic_federation_peer_last_heard_seconds", MetricType::gauge,
              "Time since the last announcement or liveliness change of each known gateway.");
-  for (const auto& p : f.peers) out.sample({{"peer", p.name}, {"id", p.id}, {"state", p.state}}, p.last_heard_age_seconds);
-  out.family("cosmic_federation_messages_received", MetricType::counter, "Federation messages received (announcements and liveliness).");
+  for (const auto& p : f.peers)
+    out.sample({{"peer", p.name}, {"id", p.id}, {"state", p.state}}, p.last_heard_age_seconds);
+  out.family("cosmic_federation_messages_received", MetricType::counter,
+             "Federation messages received (announcements and liveliness).");
   out.sample({}, f.view.received);
   out.family("cosmic_federation_announcements_refused", MetricType::counter,
              "Announcements refused as malformed, out of range or claiming another gateway's identity.");
   out.sample({}, f.view.refused);
-  out.family("cosmic_federation_messages_dropped", MetricType::counter, "Federation messages dropped by a full queue (a flood).");
+  out.family("cosmic_federation_messages_dropped", MetricType::counter,
+             "Federation messages dropped by a full queue (a flood).");
   out.sample({}, f.link.dropped);
   out.family("cosmic_federation_announcements_published", MetricType::counter, "This gateway's announcements written.");
   out.sample({}, f.link.published);

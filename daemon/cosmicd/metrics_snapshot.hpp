@@ -20,7 +20,7 @@ struct MetricsSnapshot {
   std::size_t router_queued = 0;
   std::uint64_t router_handled = 0;
   std::vector<cosmic::SegmentInfo> segments;
-  std::vector<cosmic::ChannelReport> channels;     // admission's verdicts and numbers
+  std::vector<cosmic::ChannelReport> channels;      // admission's verdicts and numbers
   std::vector<cosmic::ChannelStatsSnapshot> stats;  // the router's counters, by channel name
   FederationSnapshot federation;                    // filled in by the daemon
 };

@@ -18,7 +18,7 @@ BusyThreadJudge::BusyThreadJudge(std::chrono::nanoseconds window, double busy_sh
     : window_(window), busy_share_(busy_share) {}
 
 std::vector<BusyThreadJudge::Verdict> BusyThreadJudge::judge(const std::vector<ThreadSample>& samples,
-                                                            std::chrono::nanoseconds now) {
+                                                             std::chrono::nanoseconds now) {
   std::vector<Verdict> out;
   std::unordered_set<pid_t> seen;
   for (const ThreadSample& s : samples) {
@@ -37,7 +37,8 @@ std::vector<BusyThreadJudge::Verdict> BusyThreadJudge::judge(const std::vector<T
     if (share >= busy_share_) out.push_back(Verdict{s, share, elapsed});
     w = Watch{s.cpu_ns, now};
   }
-  for (auto it = watched_.begin(); it != watched_.end();) it = seen.contains(it->first) ? std::next(it) : watched_.erase(it);
+  for (auto it = watched_.begin(); it != watched_.end();)
+    it = seen.contains(it->first) ? std::next(it) : watched_.erase(it);
   return out;
 }
 
@@ -94,9 +95,11 @@ cpu_set_t demoted_thread_cpus(const std::vector<int>& keep_off) {
 std::optional<std::string> make_time_shared(pid_t tid, const cpu_set_t& cpus) {
   sched_param param{};
   param.sched_priority = 0;
-  if (::sched_setscheduler(tid, SCHED_OTHER, &param) != 0) return std::string("sched_setscheduler: ") + std::strerror(errno);
+  if (::sched_setscheduler(tid, SCHED_OTHER, &param) != 0)
+    return std::string("sched_setscheduler: ") + std::strerror(errno);
   // setpriority(PRIO_PROCESS, tid) sets the nice value of this one thread on Linux.
-  if (::setpriority(PRIO_PROCESS, static_cast<id_t>(tid), 19) != 0) return std::string("nice 19: ") + std::strerror(errno);
+  if (::setpriority(PRIO_PROCESS, static_cast<id_t>(tid), 19) != 0)
+    return std::string("nice 19: ") + std::strerror(errno);
   // Onto the control thread's CPUs. Time-shared but alone on a reserved CPU, a loop that retakes
   // a mutex as soon as it lets it go still shuts out a waiter on another CPU, which wakes too
   // late every time (Fast DDS 2.9's flow controller does that to the thread removing a matched
@@ -111,8 +114,8 @@ std::vector<std::string> RealtimeWatchdog::check(std::chrono::nanoseconds now) {
   for (const auto& v : judge_.judge(sample_process_threads(), now)) {
     char share[16];
     std::snprintf(share, sizeof share, "%.0f%%", 100.0 * v.share);
-    std::string line = "thread " + v.thread.name + " (" + std::to_string(v.thread.tid) + ") ran real-time for " + share +
-                       " of the last " + std::to_string(v.window.count() / 1'000'000) +
+    std::string line = "thread " + v.thread.name + " (" + std::to_string(v.thread.tid) + ") ran real-time for " +
+                       share + " of the last " + std::to_string(v.window.count() / 1'000'000) +
                        " ms, a busy loop that starves every thread below it on its CPU: ";
     if (const auto why = make_time_shared(v.thread.tid, demoted_thread_cpus(keep_off_))) {
       line += "it could not be made time-shared on the control thread's CPUs (" + *why + ")";

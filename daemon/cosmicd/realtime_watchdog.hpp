@@ -26,8 +26,8 @@ namespace cosmicd {
 struct ThreadSample {
   pid_t tid = 0;
   std::string name;
-  bool realtime = false;      // SCHED_FIFO or SCHED_RR
-  std::uint64_t cpu_ns = 0;   // time on a CPU since it started (schedstat)
+  bool realtime = false;     // SCHED_FIFO or SCHED_RR
+  std::uint64_t cpu_ns = 0;  // time on a CPU since it started (schedstat)
 };
 
 // The judgement, without I/O: which real-time threads were busy for at least `busy_share` of a
@@ -38,7 +38,7 @@ class BusyThreadJudge {
 
   struct Verdict {
     ThreadSample thread;
-    double share = 0;                 // of the window it was on a CPU
+    double share = 0;  // of the window it was on a CPU
     std::chrono::nanoseconds window{};
   };
   // The samples of every thread taken at `now` (steady clock); the threads to demote.

@@ -108,8 +108,9 @@ Config big_config(std::size_t can_channels = 1000, std::size_t ip_channels = 100
   for (std::size_t i = 0; i < ip_channels; ++i) {
     const ChannelClass cls = i % 3 == 0 ? ChannelClass::srt : ChannelClass::nrt;
     const bool up = i % 2 == 0;
-    config.channels.push_back(channel("ip" + std::to_string(i), 0x200000 + i, cls, up ? "lan" : "viz", up ? "viz" : "lan",
-                                      64 + (i * 13) % 960, kPeriods[(i * 5) % 6], 20 + static_cast<std::int64_t>(i % 50)));
+    config.channels.push_back(channel("ip" + std::to_string(i), 0x200000 + i, cls, up ? "lan" : "viz",
+                                      up ? "viz" : "lan", 64 + (i * 13) % 960, kPeriods[(i * 5) % 6],
+                                      20 + static_cast<std::int64_t>(i % 50)));
   }
   return config;
 }
@@ -128,7 +129,8 @@ Config lcm_channels(std::size_t n) {
   Config config = base_config();
   config.segments = {ip("lan", SegmentType::dds), ip("viz", SegmentType::lcm)};
   for (std::size_t i = 0; i < n; ++i) {
-    config.channels.push_back(channel("l" + std::to_string(i), 0x400000 + i, ChannelClass::nrt, "lan", "viz", 256, 1000, 0));
+    config.channels.push_back(
+        channel("l" + std::to_string(i), 0x400000 + i, ChannelClass::nrt, "lan", "viz", 256, 1000, 0));
   }
   return config;
 }
@@ -189,16 +191,18 @@ std::string duration(const std::optional<Nanos>& value) { return std::to_string(
 // The set as the YAML a user would write (DESIGN.md section 3).
 std::string to_yaml(const Config& config) {
   std::ostringstream out;
-  out << "gateway:\n  name: " << config.gateway.name << "\n  can_node_id: 1\n  residence_bound: "
-      << duration(config.gateway.residence_bound) << "\nsegments:\n";
+  out << "gateway:\n  name: " << config.gateway.name
+      << "\n  can_node_id: 1\n  residence_bound: " << duration(config.gateway.residence_bound) << "\nsegments:\n";
   for (const auto& s : config.segments) {
     out << "  - name: " << s.name << "\n    type: " << cosmic::to_string(s.type) << "\n";
     if (s.type == SegmentType::can) {
-      out << "    interface: " << s.can.interface << "\n    bitrate: " << s.can.bitrate.bits_per_second / 1000 << "kbit/s\n";
+      out << "    interface: " << s.can.interface << "\n    bitrate: " << s.can.bitrate.bits_per_second / 1000
+          << "kbit/s\n";
     } else {
-      out << "    latency_bound: " << duration(s.latency_bound) << "\n    bandwidth: "
-          << s.bandwidth.bits_per_second / 1000 << "kbit/s\n";
-      out << (s.type == SegmentType::dds ? "    domain: 0\n    realtime: true\n" : "    url: udpm://239.255.76.67:7667?ttl=0\n");
+      out << "    latency_bound: " << duration(s.latency_bound)
+          << "\n    bandwidth: " << s.bandwidth.bits_per_second / 1000 << "kbit/s\n";
+      out << (s.type == SegmentType::dds ? "    domain: 0\n    realtime: true\n"
+                                         : "    url: udpm://239.255.76.67:7667?ttl=0\n");
     }
   }
   out << "channels:\n";
@@ -238,7 +242,9 @@ void BM_OverloadedCanToCan(benchmark::State& state) {
 }
 BENCHMARK(BM_OverloadedCanToCan)->Arg(25)->Arg(50)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond);
 
-void BM_LcmChannels(benchmark::State& state) { admit_repeatedly(state, lcm_channels(static_cast<std::size_t>(state.range(0)))); }
+void BM_LcmChannels(benchmark::State& state) {
+  admit_repeatedly(state, lcm_channels(static_cast<std::size_t>(state.range(0))));
+}
 BENCHMARK(BM_LcmChannels)->Arg(1000)->Arg(2000)->Arg(4000)->Arg(10000)->Unit(benchmark::kMillisecond);
 
 // A body bus's DBC of n messages (issue 19): identifiers spread over the standard and extended
@@ -250,7 +256,8 @@ std::string body_dbc(std::size_t n) {
   for (std::size_t i = 0; i < n; ++i) {
     const bool extended = i % 4 == 3;
     const std::uint64_t id = extended ? 0x80000000ull | (0x10000000ull + i * 977) : 0x080 + (i * 3) % 0x700;
-    out << "BO_ " << id << " Msg" << i << ": " << 1 + i % 8 << " Ecu\n SG_ S" << i << " : 0|8@1+ (1,0) [0|255] \"\" Ecu\n\n";
+    out << "BO_ " << id << " Msg" << i << ": " << 1 + i % 8 << " Ecu\n SG_ S" << i
+        << " : 0|8@1+ (1,0) [0|255] \"\" Ecu\n\n";
   }
   out << "BA_DEF_ BO_ \"GenMsgCycleTime\" INT 0 65535;\nBA_DEF_DEF_ \"GenMsgCycleTime\" 0;\n";
   for (std::size_t i = 0; i < n; ++i) {

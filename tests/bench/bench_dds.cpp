@@ -91,12 +91,13 @@ struct Participant {
   bool open(unsigned domain, const std::string& topic_name, const std::string& native_type, std::uint64_t size) {
     fdds::DomainParticipantQos qos = fdds::PARTICIPANT_QOS_DEFAULT;
     qos.name("cosmic-bench-peer");
-    participant = fdds::DomainParticipantFactory::get_instance()->create_participant(
-        static_cast<fdds::DomainId_t>(domain), qos);
+    participant =
+        fdds::DomainParticipantFactory::get_instance()->create_participant(static_cast<fdds::DomainId_t>(domain), qos);
     if (participant == nullptr) return false;
-    fdds::TypeSupport type(native_type.empty() ? static_cast<fdds::TopicDataType*>(new cosmic::EnvelopePubSubType())
-                                               : new RawType(native_type, static_cast<std::uint32_t>(std::max<std::uint64_t>(
-                                                                              size + kHeader, 512))));
+    fdds::TypeSupport type(
+        native_type.empty()
+            ? static_cast<fdds::TopicDataType*>(new cosmic::EnvelopePubSubType())
+            : new RawType(native_type, static_cast<std::uint32_t>(std::max<std::uint64_t>(size + kHeader, 512))));
     type.register_type(participant);
     topic = participant->create_topic(topic_name, type.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
     return topic != nullptr;
@@ -114,7 +115,8 @@ class Matched {
   }
   bool wait(int n, double timeout_s) {
     std::unique_lock lock(mutex_);
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<int>(timeout_s * 1000));
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<int>(timeout_s * 1000));
     while (count_ < n && !g_stop) {
       if (cv_.wait_until(lock, std::min(deadline, std::chrono::steady_clock::now() + std::chrono::milliseconds(100))) ==
               std::cv_status::timeout &&
@@ -217,41 +219,44 @@ int dds_pub(const DdsOptions& o) {
   raw.bytes.reserve(kHeader + std::max<std::uint64_t>(o.size, kMinSize));
   void* const sample = native ? static_cast<void*>(&raw) : static_cast<void*>(&env);
   std::uint64_t retries = 0;
-  const int rc = publish_all(o.count, o.size, o.rate, o.warmup, [&](const std::vector<std::uint8_t>& payload) {
-    const auto index = static_cast<std::uint32_t>(get_le(payload.data() + 8, 4));
-    if (native) {
-      // Header, then the payload with the stamp the publisher just wrote (one copy, as any
-      // serialization of a native type would make).
-      raw.bytes.resize(kHeader + payload.size());
-      std::memcpy(raw.bytes.data(), kCdrLe, kHeader);
-      std::memcpy(raw.bytes.data() + kHeader, payload.data(), payload.size());
-    } else {
-      env.subject(0);
-      env.origin(0);
-      env.hop_count(0);
-      env.age_ns(0);
-      env.sequence(index);
-      env.created_ns(static_cast<std::int64_t>(get_le(payload.data(), 8)));
-      env.payload() = payload;
-    }
-    ReturnCode_t r = writer->write(sample, fdds::HANDLE_NIL);
-    // A reliable KEEP_ALL writer blocks (max_blocking_time 1 s) while its history is full of
-    // unacknowledged samples; retry until --stall seconds pass without success.
-    const std::int64_t give_up = mono_ns() + static_cast<std::int64_t>(o.stall * 1e9);
-    while (!g_stop && (r == ReturnCode_t::RETCODE_TIMEOUT || r == ReturnCode_t::RETCODE_OUT_OF_RESOURCES)) {
-      if (mono_ns() >= give_up) {
-        g_stalled = true;
-        char text[160];
-        std::snprintf(text, sizeof text, "STALLED: no write accepted for %.1f s at event index %u%s", o.stall,
-                      index & ~kWarmupBit, (index & kWarmupBit) != 0 ? " (warm-up)" : "");
-        err_line(text);
-        return false;
-      }
-      ++retries;
-      r = writer->write(sample, fdds::HANDLE_NIL);
-    }
-    return r == ReturnCode_t::RETCODE_OK;
-  }, o.max_rate);
+  const int rc = publish_all(
+      o.count, o.size, o.rate, o.warmup,
+      [&](const std::vector<std::uint8_t>& payload) {
+        const auto index = static_cast<std::uint32_t>(get_le(payload.data() + 8, 4));
+        if (native) {
+          // Header, then the payload with the stamp the publisher just wrote (one copy, as any
+          // serialization of a native type would make).
+          raw.bytes.resize(kHeader + payload.size());
+          std::memcpy(raw.bytes.data(), kCdrLe, kHeader);
+          std::memcpy(raw.bytes.data() + kHeader, payload.data(), payload.size());
+        } else {
+          env.subject(0);
+          env.origin(0);
+          env.hop_count(0);
+          env.age_ns(0);
+          env.sequence(index);
+          env.created_ns(static_cast<std::int64_t>(get_le(payload.data(), 8)));
+          env.payload() = payload;
+        }
+        ReturnCode_t r = writer->write(sample, fdds::HANDLE_NIL);
+        // A reliable KEEP_ALL writer blocks (max_blocking_time 1 s) while its history is full of
+        // unacknowledged samples; retry until --stall seconds pass without success.
+        const std::int64_t give_up = mono_ns() + static_cast<std::int64_t>(o.stall * 1e9);
+        while (!g_stop && (r == ReturnCode_t::RETCODE_TIMEOUT || r == ReturnCode_t::RETCODE_OUT_OF_RESOURCES)) {
+          if (mono_ns() >= give_up) {
+            g_stalled = true;
+            char text[160];
+            std::snprintf(text, sizeof text, "STALLED: no write accepted for %.1f s at event index %u%s", o.stall,
+                          index & ~kWarmupBit, (index & kWarmupBit) != 0 ? " (warm-up)" : "");
+            err_line(text);
+            return false;
+          }
+          ++retries;
+          r = writer->write(sample, fdds::HANDLE_NIL);
+        }
+        return r == ReturnCode_t::RETCODE_OK;
+      },
+      o.max_rate);
   if (!g_stalled) writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0));
   if (retries > 0) err_line("write retries: " + std::to_string(retries));
   return rc;

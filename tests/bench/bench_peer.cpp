@@ -150,7 +150,8 @@ void Recorder::wait(double timeout_s, double idle_s) {
     cv_.wait_for(lock, std::chrono::milliseconds(20));
     const std::int64_t now = mono_ns();
     if (now >= deadline) break;
-    if (measuring_.load(std::memory_order_relaxed) && now - last_any_ns_.load(std::memory_order_relaxed) > idle_ns) break;
+    if (measuring_.load(std::memory_order_relaxed) && now - last_any_ns_.load(std::memory_order_relaxed) > idle_ns)
+      break;
   }
 }
 
@@ -175,13 +176,13 @@ int Recorder::report() {
   for (const auto v : lat) mean += static_cast<double>(v);
   mean = lat.empty() ? 0 : mean / static_cast<double>(lat.size()) / 1e3;
   const double span = received_ > 1 ? static_cast<double>(last_ns_ - first_ns_) / 1e9 : 0;
-  std::printf(
-      "RESULT expected=%" PRIu64 " received=%" PRIu64 " lost=%" PRIu64 " duplicates=%" PRIu64 " malformed=%" PRIu64
-      " p50_us=%.1f p90_us=%.1f p99_us=%.1f p999_us=%.1f max_us=%.1f mean_us=%.1f span_s=%.6f rate=%.0f"
-      " warmup_received=%" PRIu64 "\n",
-      count_, received_, count_ - received_, duplicates_, malformed_, q(0.50), q(0.90), q(0.99), q(0.999),
-      lat.empty() ? 0.0 : static_cast<double>(lat.back()) / 1e3, mean, span,
-      span > 0 ? static_cast<double>(received_ - 1) / span : 0.0, warmup_received_);
+  std::printf("RESULT expected=%" PRIu64 " received=%" PRIu64 " lost=%" PRIu64 " duplicates=%" PRIu64
+              " malformed=%" PRIu64
+              " p50_us=%.1f p90_us=%.1f p99_us=%.1f p999_us=%.1f max_us=%.1f mean_us=%.1f span_s=%.6f rate=%.0f"
+              " warmup_received=%" PRIu64 "\n",
+              count_, received_, count_ - received_, duplicates_, malformed_, q(0.50), q(0.90), q(0.99), q(0.999),
+              lat.empty() ? 0.0 : static_cast<double>(lat.back()) / 1e3, mean, span,
+              span > 0 ? static_cast<double>(received_ - 1) / span : 0.0, warmup_received_);
   std::fflush(stdout);
   return received_ > 0 ? 0 : 1;
 }
@@ -227,18 +228,21 @@ int lcm_pub(const LcmOptions& o) {
   }
   cosmic::envelope e{};
   std::vector<std::uint8_t> buffer;
-  const int rc = publish_all(o.count, o.size, o.rate, o.warmup, [&](const std::vector<std::uint8_t>& payload) {
-    if (!o.envelope) {
-      return lcm_publish(lcm, o.channel.c_str(), payload.data(), static_cast<unsigned>(payload.size())) == 0;
-    }
-    e.sequence = static_cast<std::int32_t>(get_le(payload.data() + 8, 4));
-    e.created_ns = static_cast<std::int64_t>(get_le(payload.data(), 8));
-    e.payload_size = static_cast<std::int32_t>(payload.size());
-    e.payload = payload;
-    buffer.resize(static_cast<std::size_t>(e.getEncodedSize()));
-    e.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
-    return lcm_publish(lcm, o.channel.c_str(), buffer.data(), static_cast<unsigned>(buffer.size())) == 0;
-  }, o.max_rate);
+  const int rc = publish_all(
+      o.count, o.size, o.rate, o.warmup,
+      [&](const std::vector<std::uint8_t>& payload) {
+        if (!o.envelope) {
+          return lcm_publish(lcm, o.channel.c_str(), payload.data(), static_cast<unsigned>(payload.size())) == 0;
+        }
+        e.sequence = static_cast<std::int32_t>(get_le(payload.data() + 8, 4));
+        e.created_ns = static_cast<std::int64_t>(get_le(payload.data(), 8));
+        e.payload_size = static_cast<std::int32_t>(payload.size());
+        e.payload = payload;
+        buffer.resize(static_cast<std::size_t>(e.getEncodedSize()));
+        e.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
+        return lcm_publish(lcm, o.channel.c_str(), buffer.data(), static_cast<unsigned>(buffer.size())) == 0;
+      },
+      o.max_rate);
   lcm_destroy(lcm);
   return rc;
 }

@@ -79,7 +79,8 @@ int publish_all(std::uint64_t count, std::uint64_t size, double rate, std::uint6
     }
   }
   const double seconds = static_cast<double>(mono_ns() - start) / 1e9;
-  std::printf("RESULT sent=%" PRIu64 " failed=%" PRIu64 " seconds=%.6f rate=%.0f stalled=%d late_max_us=%.1f"
+  std::printf("RESULT sent=%" PRIu64 " failed=%" PRIu64
+              " seconds=%.6f rate=%.0f stalled=%d late_max_us=%.1f"
               " late_over_1ms=%" PRIu64 "\n",
               sent, failed, seconds, seconds > 0 ? static_cast<double>(sent) / seconds : 0.0, g_stalled ? 1 : 0,
               static_cast<double>(late_max) / 1e3, late_over_1ms);

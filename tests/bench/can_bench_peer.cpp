@@ -65,7 +65,9 @@ class Watcher {
  public:
   Watcher(int socket, std::size_t count, std::uint32_t tag, const char* name)
       : socket_(socket), tag_(tag), stamps_(count, kUnseen), name_(name) {}
-  void start() { thread_ = std::thread([this] { run(); }); }
+  void start() {
+    thread_ = std::thread([this] { run(); });
+  }
   void stop() {
     stopping_ = true;
     thread_.join();
@@ -159,7 +161,8 @@ int main(int argc, char** argv) {
   app.add_option("--out", out, "interface the forwarder writes them to")->required();
   app.add_option("--id", id_text, "standard identifier of the frames");
   app.add_option("--count", count, "frames to send")->check(CLI::Range(1, 10'000'000));
-  app.add_option("--rate", rate, "frames per second (0: as fast as the socket takes them)")->check(CLI::Range(0.0, 1e7));
+  app.add_option("--rate", rate, "frames per second (0: as fast as the socket takes them)")
+      ->check(CLI::Range(0.0, 1e7));
   app.add_option("--idle", idle, "seconds without a new frame on --out that end the run")->check(CLI::Range(0.1, 60.0));
   CLI11_PARSE(app, argc, argv);
   try {
@@ -216,10 +219,9 @@ int main(int argc, char** argv) {
         "{\"sent\": %zu, \"send_seconds\": %.3f, \"offered_per_s\": %.0f, \"refused_writes\": %zu, "
         "\"seen_in\": %zu, \"received_out\": %zu, \"reordered\": %zu, \"duplicates\": %zu, "
         "\"latency_us\": {\"samples\": %zu, \"p50\": %.1f, \"p99\": %.1f, \"p99_9\": %.1f, \"max\": %.1f}}\n",
-        count, send_seconds, send_seconds > 0 ? static_cast<double>(count) / send_seconds : 0.0, refused,
-        source.seen(), sink.seen(), sink.reordered(), sink.duplicates(), latency_us.size(),
-        percentile(latency_us, 50), percentile(latency_us, 99), percentile(latency_us, 99.9),
-        latency_us.empty() ? 0.0 : latency_us.back());
+        count, send_seconds, send_seconds > 0 ? static_cast<double>(count) / send_seconds : 0.0, refused, source.seen(),
+        sink.seen(), sink.reordered(), sink.duplicates(), latency_us.size(), percentile(latency_us, 50),
+        percentile(latency_us, 99), percentile(latency_us, 99.9), latency_us.empty() ? 0.0 : latency_us.back());
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "cosmic-can-bench: %s\n", e.what());

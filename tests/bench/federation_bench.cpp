@@ -99,7 +99,8 @@ Round run_round(std::vector<Gateway>& gateways, std::vector<cosmic::FederationMe
       std::string body = cosmic::encode(a);
       round.bytes += body.size();
       ++round.announcements;
-      published.push_back({cosmic::FederationMessage::Kind::announcement, "w" + std::to_string(g), gw.identity.id, std::move(body)});
+      published.push_back(
+          {cosmic::FederationMessage::Kind::announcement, "w" + std::to_string(g), gw.identity.id, std::move(body)});
     }
     round.work.push_back(seconds(Clock::now() - start));
   }
@@ -119,7 +120,8 @@ Round run_round(std::vector<Gateway>& gateways, std::vector<cosmic::FederationMe
   return round;
 }
 
-void converge(const char* what, std::vector<Gateway>& gateways, std::vector<cosmic::FederationMessage> first, Nanos now) {
+void converge(const char* what, std::vector<Gateway>& gateways, std::vector<cosmic::FederationMessage> first,
+              Nanos now) {
   std::size_t rounds = 0;
   std::size_t announcements = 0;
   std::size_t bytes = 0;
@@ -135,10 +137,12 @@ void converge(const char* what, std::vector<Gateway>& gateways, std::vector<cosm
   }
   std::sort(all.begin(), all.end());
   const double total_max = std::accumulate(per_round_max.begin(), per_round_max.end(), 0.0);
-  std::printf("%-28s rounds %zu  announcements %zu  bytes %zu (%.1f KiB/announcement)  per gateway and round: p50 %.2f ms, max %.2f ms;"
-              "  compute to converge %.1f ms + %zu deliveries\n",
-              what, rounds, announcements, bytes, announcements ? bytes / 1024.0 / announcements : 0.0,
-              all.empty() ? 0 : all[all.size() / 2] * 1e3, all.empty() ? 0 : all.back() * 1e3, total_max * 1e3, rounds);
+  std::printf(
+      "%-28s rounds %zu  announcements %zu  bytes %zu (%.1f KiB/announcement)  per gateway and round: p50 %.2f ms, max "
+      "%.2f ms;"
+      "  compute to converge %.1f ms + %zu deliveries\n",
+      what, rounds, announcements, bytes, announcements ? bytes / 1024.0 / announcements : 0.0,
+      all.empty() ? 0 : all[all.size() / 2] * 1e3, all.empty() ? 0 : all.back() * 1e3, total_max * 1e3, rounds);
 }
 
 }  // namespace
@@ -171,9 +175,10 @@ int main(int argc, char** argv) {
   converge("start (every gateway joins)", gateways, {}, Nanos(1s));
   // Afterwards nothing is announced until something changes; what keeps each gateway alive to the
   // others is its participant's DDS announcements, every lease / 3.
-  std::printf("%-28s 0 announcements; DDS participant announcements %.0f/s on the federation domain with lease 3 s "
-              "(each gateway every lease / 3)\n",
-              "steady state", static_cast<double>(gateways_count) / 1.0);
+  std::printf(
+      "%-28s 0 announcements; DDS participant announcements %.0f/s on the federation domain with lease 3 s "
+      "(each gateway every lease / 3)\n",
+      "steady state", static_cast<double>(gateways_count) / 1.0);
   // One gateway leaves: it withdraws; every other releases what it reserved and may re-announce.
   gateways[gateways_count / 2].alive = false;
   converge("one gateway leaves", gateways,

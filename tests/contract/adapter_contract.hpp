@@ -151,8 +151,8 @@ TYPED_TEST_P(AdapterContract, channel_bound_twice_in_one_role_is_refused_once_an
   this->start();
   ASSERT_TRUE(this->configure({this->sub(1, "speed"), this->sub(2, "torque")}).ok);
   ASSERT_EQ(this->send_on(1), SendStatus::sent);
-  const Status status = this->configure({this->sub(1, "speed"), this->pub(1, "speed"), this->sub(1, "speed"),
-                                         this->sub(2, "torque")});
+  const Status status =
+      this->configure({this->sub(1, "speed"), this->pub(1, "speed"), this->sub(1, "speed"), this->sub(2, "torque")});
   EXPECT_FALSE(status.ok);
   ASSERT_EQ(status.refused.size(), 1u) << status.error;
   EXPECT_EQ(status.refused[0].channel, 1u);
@@ -168,7 +168,8 @@ TYPED_TEST_P(AdapterContract, transport_refusal_names_the_channel_and_the_rest_i
   EXPECT_FALSE(status.ok);
   ASSERT_EQ(status.refused.size(), 1u) << status.error;
   EXPECT_EQ(status.refused[0].channel, 5u);
-  EXPECT_NE(status.refused[0].reason.find(this->target.collision_reason()), std::string::npos) << status.refused[0].reason;
+  EXPECT_NE(status.refused[0].reason.find(this->target.collision_reason()), std::string::npos)
+      << status.refused[0].reason;
   EXPECT_EQ(status.error.rfind("channel " + second.spec.name + ": ", 0), 0u) << status.error;
   EXPECT_EQ(this->send_on(1), SendStatus::sent);
 }

@@ -85,7 +85,8 @@ segments: [{name: a, type: dds}, {name: b, type: lcm}]
 channels:
   - {name: c, subject: 0x42, class: srt, max_rate: 300Hz, reaction_time: 5ms, omission_degree: 2,
      temp_validity: 1s, payload: 12B, etag: 200, encoding: raw, publishers: [a], subscribers: [b]}
-)", "t.yaml");
+)",
+                                           "t.yaml");
   ASSERT_TRUE(config.ok());
   const std::string yaml = cosmic::channel_to_yaml(config.config.channels[0]);
   const auto back = cosmic::parse_channels(yaml, "state", config.config);
@@ -133,13 +134,15 @@ TEST_F(BindingStoreTest, AFailedSaveSaysWhy) {
 }
 
 TEST(BindingEntryTest, AnEntryMustDefineExactlyTheChannelItIsNamedAfter) {
-  const auto config = cosmic::parse_config("segments: [{name: a, type: dds}, {name: b, type: lcm}]\nchannels: []\n", "t.yaml");
+  const auto config =
+      cosmic::parse_config("segments: [{name: a, type: dds}, {name: b, type: lcm}]\nchannels: []\n", "t.yaml");
   const auto parse = [&](const char* yaml) { return cosmic::parse_channels(yaml, "state", config.config).channels; };
   const char* other = "{name: other, subject: 7, class: nrt, publishers: [a], subscribers: [b]}";
   EXPECT_EQ(cosmicd::check_binding_entry({"other", other}, parse(other)), "");
   EXPECT_NE(cosmicd::check_binding_entry({"speed", other}, parse(other)), "");
-  const char* two = "[{name: speed, subject: 7, class: nrt, publishers: [a], subscribers: [b]},"
-                    " {name: other, subject: 8, class: nrt, publishers: [a], subscribers: [b]}]";
+  const char* two =
+      "[{name: speed, subject: 7, class: nrt, publishers: [a], subscribers: [b]},"
+      " {name: other, subject: 8, class: nrt, publishers: [a], subscribers: [b]}]";
   EXPECT_NE(cosmicd::check_binding_entry({"speed", two}, parse(two)), "");
 }
 

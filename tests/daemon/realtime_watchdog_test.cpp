@@ -30,7 +30,7 @@ ThreadSample sample(pid_t tid, bool realtime, std::uint64_t cpu_ms) {
 
 TEST(BusyThreadJudge, ARealtimeThreadBusyForTheWholeWindowIsNamed) {
   BusyThreadJudge judge(milliseconds(1000), 0.9);
-  EXPECT_TRUE(judge.judge({sample(7, true, 100)}, milliseconds(0)).empty());  // first sight
+  EXPECT_TRUE(judge.judge({sample(7, true, 100)}, milliseconds(0)).empty());    // first sight
   EXPECT_TRUE(judge.judge({sample(7, true, 600)}, milliseconds(500)).empty());  // window not over
   const auto verdicts = judge.judge({sample(7, true, 1050)}, milliseconds(1000));
   ASSERT_EQ(verdicts.size(), 1u);

@@ -84,11 +84,13 @@ channels:
 class ServiceNotifierTest : public ::testing::Test {
  protected:
   ServiceNotifierTest()
-      : gateway([this](const cosmic::SegmentSpec& spec, const cosmic::GatewayIdentity&, cosmic::Logger&) {
-          auto adapter = std::make_unique<cosmic::MemoryAdapter>(spec.name);
-          adapters[spec.name] = adapter.get();
-          return adapter;
-        }, log, 7) {
+      : gateway(
+            [this](const cosmic::SegmentSpec& spec, const cosmic::GatewayIdentity&, cosmic::Logger&) {
+              auto adapter = std::make_unique<cosmic::MemoryAdapter>(spec.name);
+              adapters[spec.name] = adapter.get();
+              return adapter;
+            },
+            log, 7) {
     ::setenv("WATCHDOG_USEC", "20000", 1);  // 20 ms: pings every 10 ms
     ::setenv("WATCHDOG_PID", std::to_string(::getpid()).c_str(), 1);
     gateway.start(cosmic::parse_config(kConfig, "t.yaml").config);

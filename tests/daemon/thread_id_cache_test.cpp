@@ -103,7 +103,7 @@ int child_after_forbidding_gettid() {
   sock_fprog filter{static_cast<unsigned short>(sizeof program / sizeof program[0]), program};
   if (::prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) != 0) return 11;
   if (::prctl(PR_SET_SECCOMP, SECCOMP_MODE_FILTER, &filter) != 0) return 12;
-  if (::syscall(SYS_gettid) != ::getpid()) return 13;  // cached: no system call made
+  if (::syscall(SYS_gettid) != ::getpid()) return 13;     // cached: no system call made
   if (thread_id_probe_gettid() != ::getpid()) return 15;  // a library's versioned call: the same
   long fresh = 0;
   std::thread other([&] { fresh = ::syscall(SYS_gettid); });

@@ -46,7 +46,8 @@ class FakeGateway {
       char request[1024];
       (void)::recv(client, request, sizeof request, 0);
       for (std::size_t at = 0; at < answer_.size();) {
-        const ssize_t n = ::send(client, answer_.data() + at, std::min<std::size_t>(65536, answer_.size() - at), MSG_NOSIGNAL);
+        const ssize_t n =
+            ::send(client, answer_.data() + at, std::min<std::size_t>(65536, answer_.size() - at), MSG_NOSIGNAL);
         if (n <= 0) break;
         at += static_cast<std::size_t>(n);
       }
@@ -82,7 +83,8 @@ TEST(ClientAnswers, WellFormedAnswersStillWork) {
   std::string verdict;
   EXPECT_EQ(check("{\"ok\":true,\"channel\":{\"verdict\":\"degraded\"}}\n", verdict), COSMIC_OK);
   EXPECT_EQ(verdict, "degraded");
-  EXPECT_EQ(check("{\"ok\":false,\"error\":{\"code\":\"rejected\",\"reasons\":[\"too slow\",3]}}\n", verdict), COSMIC_OK);
+  EXPECT_EQ(check("{\"ok\":false,\"error\":{\"code\":\"rejected\",\"reasons\":[\"too slow\",3]}}\n", verdict),
+            COSMIC_OK);
   EXPECT_EQ(verdict, "rejected (too slow)");
   EXPECT_EQ(check("{\"ok\":false,\"error\":{\"code\":\"not_found\"}}\n", verdict), COSMIC_OK);
   EXPECT_EQ(verdict, "not_found");

@@ -20,7 +20,8 @@ namespace {
 
 using namespace std::chrono_literals;
 
-constexpr cosmic_channel_desc kSpeed{"speed", 0x51, COSMIC_SRT, 10'000'000, 8'000'000, 40'000'000, 1, 4, COSMIC_PUBLISH};
+constexpr cosmic_channel_desc kSpeed{"speed",    0x51, COSMIC_SRT, 10'000'000,    8'000'000,
+                                     40'000'000, 1,    4,          COSMIC_PUBLISH};
 
 class QuietLog : public cosmic::Logger {
  public:
@@ -85,7 +86,8 @@ void expect_component_identity(const char* component_segment, const cosmic::Segm
   // Discovery takes its time: publish until two events arrived (deadline 20 s).
   const std::int32_t speed = 500;
   const auto deadline = std::chrono::steady_clock::now() + 20s;
-  while (!sink.wait_for(2, 20ms) && std::chrono::steady_clock::now() < deadline) cosmic_publish(out, &speed, sizeof speed);
+  while (!sink.wait_for(2, 20ms) && std::chrono::steady_clock::now() < deadline)
+    cosmic_publish(out, &speed, sizeof speed);
   cosmic_close(client);
   adapter->stop();
 

@@ -15,7 +15,8 @@
 
 namespace {
 
-constexpr cosmic_channel_desc kSpeed{"speed", 0x51, COSMIC_SRT, 10'000'000, 8'000'000, 40'000'000, 1, 4, COSMIC_PUBLISH};
+constexpr cosmic_channel_desc kSpeed{"speed",    0x51, COSMIC_SRT, 10'000'000,    8'000'000,
+                                     40'000'000, 1,    4,          COSMIC_PUBLISH};
 
 cosmic_channel_desc with_roles(cosmic_channel_desc d, int roles) {
   d.roles = roles;
@@ -30,7 +31,8 @@ struct Client {
 };
 
 TEST(Client, RefusesBadSegmentsWithAReason) {
-  for (const char* bad : {"", "dds", "dds:x", "dds:0?colour=red", "lcm:tcp://x", "can:vcan0", "can:vcan0?node=200", "zenoh:0"}) {
+  for (const char* bad :
+       {"", "dds", "dds:x", "dds:0?colour=red", "lcm:tcp://x", "can:vcan0", "can:vcan0?node=200", "zenoh:0"}) {
     Client c(bad);
     EXPECT_EQ(c.handle, nullptr) << bad;
     EXPECT_NE(std::string(c.error), "") << bad;
@@ -170,7 +172,9 @@ class ClientPair : public ::testing::Test {
 // Issue 18: a component must be able to stop its callbacks before the state they use goes.
 TEST_F(ClientPair, UnsubscribeWaitsForARunningCallbackAndStopsIt) {
   Watch watch;
-  ASSERT_EQ(cosmic_subscribe(in, [](const cosmic_event_info*, const std::uint8_t*, void* w) { static_cast<Watch*>(w)->on_event(); }, &watch),
+  ASSERT_EQ(cosmic_subscribe(
+                in, [](const cosmic_event_info*, const std::uint8_t*, void* w) { static_cast<Watch*>(w)->on_event(); },
+                &watch),
             COSMIC_OK);
   Flood flood(out);
   ASSERT_TRUE(wait_for([&] { return watch.calls >= 50; })) << "events did not reach the callback";
@@ -190,16 +194,18 @@ TEST_F(ClientPair, ACallbackMayUnsubscribeItself) {
     cosmic_channel* channel;
     std::atomic<int> calls{0};
   } self{in};
-  ASSERT_EQ(cosmic_subscribe(in,
-                             [](const cosmic_event_info*, const std::uint8_t*, void* user) {
-                               auto* s = static_cast<Self*>(user);
-                               if (++s->calls == 3) cosmic_unsubscribe(s->channel);  // would deadlock on its own lock
-                             },
-                             &self),
+  ASSERT_EQ(cosmic_subscribe(
+                in,
+                [](const cosmic_event_info*, const std::uint8_t*, void* user) {
+                  auto* s = static_cast<Self*>(user);
+                  if (++s->calls == 3) cosmic_unsubscribe(s->channel);  // would deadlock on its own lock
+                },
+                &self),
             COSMIC_OK);
   Flood flood(out);
   int queued = 0;
-  ASSERT_TRUE(wait_for([&] { return (queued += queued_events(in)) >= 10; })) << "events did not reach the queue after the stop";
+  ASSERT_TRUE(wait_for([&] { return (queued += queued_events(in)) >= 10; }))
+      << "events did not reach the queue after the stop";
   EXPECT_EQ(self.calls, 3);
 }
 
@@ -253,7 +259,8 @@ TEST(Client, ANewHandlerReplacesTheOldAndTheOldSubscriptionNoLongerStopsIt) {
   old.cancel();  // replaced already: must not stop the new handler
   ASSERT_TRUE(wait_for([&] { return second >= 10; })) << "the new handler stopped";
   EXPECT_EQ(first, first_at_switch);
-  EXPECT_THROW((void)out.on_event([](const cosmic_event_info&, std::span<const std::uint8_t>) {}), std::invalid_argument);
+  EXPECT_THROW((void)out.on_event([](const cosmic_event_info&, std::span<const std::uint8_t>) {}),
+               std::invalid_argument);
   sub.close();  // stops every handler: the subscription outlives its client harmlessly
   EXPECT_FALSE(now.active());
   EXPECT_THROW(sub.announce(kSpeed, 0), std::runtime_error);
@@ -304,7 +311,8 @@ TEST(Client, WaitReadyTimesOutWithoutAPeerAndReturnsOnceOneMatched) {
   ASSERT_EQ(cosmic_publish(out, &value, sizeof value), COSMIC_OK);
   cosmic_event_info info{};
   std::int32_t got = 0;
-  EXPECT_TRUE(wait_for([&] { return cosmic_get_event(in, &info, &got, sizeof got) == COSMIC_OK; }, std::chrono::seconds(10)));
+  EXPECT_TRUE(
+      wait_for([&] { return cosmic_get_event(in, &info, &got, sizeof got) == COSMIC_OK; }, std::chrono::seconds(10)));
   EXPECT_EQ(got, 7);
 }
 

@@ -31,9 +31,11 @@ namespace {
 using Clock = std::chrono::steady_clock;
 constexpr std::int32_t kNominal = 500;
 
-cosmic_channel_desc desc(const char* name, std::uint64_t subject, cosmic_class cls, std::int64_t period_ms, std::int64_t reaction_ms,
-                         std::int64_t validity_ms, std::uint32_t omission, std::uint32_t payload, int roles) {
-  return {name, subject, cls, period_ms * 1'000'000, reaction_ms * 1'000'000, validity_ms * 1'000'000, omission, payload, roles};
+cosmic_channel_desc desc(const char* name, std::uint64_t subject, cosmic_class cls, std::int64_t period_ms,
+                         std::int64_t reaction_ms, std::int64_t validity_ms, std::uint32_t omission,
+                         std::uint32_t payload, int roles) {
+  return {name,     subject, cls,  period_ms * 1'000'000, reaction_ms * 1'000'000, validity_ms * 1'000'000,
+          omission, payload, roles};
 }
 
 // Speed events as the drive sees them.
@@ -103,11 +105,13 @@ int main(int argc, char** argv) {
     // The channels as config/robot.yaml defines them.
     cosmic::client::Client body(arg(argc, argv, "--body", "lcm:udpm://239.255.76.68:7668?ttl=0"));
     cosmic::client::Client lan(arg(argc, argv, "--lan", "dds:0"));
-    auto& actual = body.announce(desc("actual_speed", 0x0000000100000070ull, COSMIC_NRT, 20, 0, 0, 5, 4, COSMIC_PUBLISH));
+    auto& actual =
+        body.announce(desc("actual_speed", 0x0000000100000070ull, COSMIC_NRT, 20, 0, 0, 5, 4, COSMIC_PUBLISH));
     auto& speed = body.announce(desc("speed", 0x0000000100000051ull, COSMIC_SRT, 10, 8, 40, 1, 4, COSMIC_SUBSCRIBE));
     auto& command = lan.announce(desc("command", 0x0000000100000060ull, COSMIC_SRT, 50, 20, 200, 1, 4, COSMIC_PUBLISH));
     auto& obstacle = lan.announce(desc("obstacle", 0x0000000100000050ull, COSMIC_HRT, 10, 4, 30, 0, 1, COSMIC_PUBLISH));
-    const auto on_speed = speed.on_event([&](const cosmic_event_info&, std::span<const std::uint8_t> e) { drive.push(e); });
+    const auto on_speed =
+        speed.on_event([&](const cosmic_event_info&, std::span<const std::uint8_t> e) { drive.push(e); });
 
     // Ready when the whole chain carries: repeat command and sensor until the drive hears.
     const auto started = Clock::now();
@@ -150,9 +154,10 @@ int main(int argc, char** argv) {
       stopped = drive.wait_for(0, t, t + std::chrono::milliseconds(200));
     }
     const auto ms = [](Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); };
-    std::cout << "{\"samples\":" << samples.size() << ",\"p50_us\":" << percentile(samples, 0.5) << ",\"p99_us\":" << percentile(samples, 0.99)
-              << ",\"max_us\":" << percentile(samples, 1.0) << ",\"obstacle_stop\":" << (stopped ? "true" : "false")
-              << ",\"ready_ms\":" << ms(*ready - started) << ",\"stop_ms\":" << (stopped ? ms(*stopped - obstacle_from) : -1) << "}" << std::endl;
+    std::cout << "{\"samples\":" << samples.size() << ",\"p50_us\":" << percentile(samples, 0.5)
+              << ",\"p99_us\":" << percentile(samples, 0.99) << ",\"max_us\":" << percentile(samples, 1.0)
+              << ",\"obstacle_stop\":" << (stopped ? "true" : "false") << ",\"ready_ms\":" << ms(*ready - started)
+              << ",\"stop_ms\":" << (stopped ? ms(*stopped - obstacle_from) : -1) << "}" << std::endl;
     return static_cast<int>(samples.size()) == count && stopped ? 0 : 1;
   } catch (const std::exception& e) {
     std::cerr << "speed-probe: " << e.what() << "\n";

@@ -122,13 +122,20 @@ json duration_json(const eprosima::fastrtps::Duration_t& d) {
 
 const char* policy_name(fdds::QosPolicyId_t id) {
   switch (id) {
-    case fdds::RELIABILITY_QOS_POLICY_ID: return "reliability";
-    case fdds::DURABILITY_QOS_POLICY_ID: return "durability";
-    case fdds::DEADLINE_QOS_POLICY_ID: return "deadline";
-    case fdds::LATENCYBUDGET_QOS_POLICY_ID: return "latency_budget";
-    case fdds::LIVELINESS_QOS_POLICY_ID: return "liveliness";
-    case fdds::OWNERSHIP_QOS_POLICY_ID: return "ownership";
-    default: return "other";
+    case fdds::RELIABILITY_QOS_POLICY_ID:
+      return "reliability";
+    case fdds::DURABILITY_QOS_POLICY_ID:
+      return "durability";
+    case fdds::DEADLINE_QOS_POLICY_ID:
+      return "deadline";
+    case fdds::LATENCYBUDGET_QOS_POLICY_ID:
+      return "latency_budget";
+    case fdds::LIVELINESS_QOS_POLICY_ID:
+      return "liveliness";
+    case fdds::OWNERSHIP_QOS_POLICY_ID:
+      return "ownership";
+    default:
+      return "other";
   }
 }
 
@@ -148,10 +155,18 @@ json locator_kinds(const eprosima::fastrtps::rtps::RemoteLocatorList& locators) 
   std::set<std::string> kinds;
   for (const auto& locator : locators.unicast) {
     switch (locator.kind) {
-      case LOCATOR_KIND_UDPv4: kinds.insert("udpv4"); break;
-      case LOCATOR_KIND_UDPv6: kinds.insert("udpv6"); break;
-      case LOCATOR_KIND_SHM: kinds.insert("shm"); break;
-      default: kinds.insert("kind " + std::to_string(locator.kind)); break;
+      case LOCATOR_KIND_UDPv4:
+        kinds.insert("udpv4");
+        break;
+      case LOCATOR_KIND_UDPv6:
+        kinds.insert("udpv6");
+        break;
+      case LOCATOR_KIND_SHM:
+        kinds.insert("shm");
+        break;
+      default:
+        kinds.insert("kind " + std::to_string(locator.kind));
+        break;
     }
   }
   return json(std::vector<std::string>(kinds.begin(), kinds.end()));
@@ -165,12 +180,8 @@ json qos_json(const char* kind, const std::string& topic, const Qos& qos,
               {"transports", locator_kinds(locators)},
               {"topic", topic},
               {"participant", prefix_hex(participant)},
-              {"reliability", qos.m_reliability.kind == fdds::RELIABLE_RELIABILITY_QOS
-                                  ? "reliable"
-                                  : "best_effort"},
-              {"durability", qos.m_durability.kind == fdds::VOLATILE_DURABILITY_QOS
-                                 ? "volatile"
-                                 : "non_volatile"},
+              {"reliability", qos.m_reliability.kind == fdds::RELIABLE_RELIABILITY_QOS ? "reliable" : "best_effort"},
+              {"durability", qos.m_durability.kind == fdds::VOLATILE_DURABILITY_QOS ? "volatile" : "non_volatile"},
               {"deadline_ns", duration_json(qos.m_deadline.period)},
               {"lifespan_ns", duration_json(qos.m_lifespan.duration)},
               {"latency_budget_ns", duration_json(qos.m_latencyBudget.duration)}};
@@ -198,28 +209,23 @@ class Listener : public fdds::DomainParticipantListener {
       diag(qos_json("subscription", topic_, info.info.m_qos, info.info.guid().guidPrefix, info.info.remote_locators()));
     }
   }
-  void on_publication_matched(fdds::DataWriter*,
-                              const fdds::PublicationMatchedStatus& status) override {
+  void on_publication_matched(fdds::DataWriter*, const fdds::PublicationMatchedStatus& status) override {
     matched(status.current_count);
   }
-  void on_subscription_matched(fdds::DataReader*,
-                               const fdds::SubscriptionMatchedStatus& status) override {
+  void on_subscription_matched(fdds::DataReader*, const fdds::SubscriptionMatchedStatus& status) override {
     matched(status.current_count);
   }
-  void on_offered_incompatible_qos(fdds::DataWriter*,
-                                   const fdds::OfferedIncompatibleQosStatus& status) override {
+  void on_offered_incompatible_qos(fdds::DataWriter*, const fdds::OfferedIncompatibleQosStatus& status) override {
     diag({{"event", "incompatible_qos"}, {"policy", policy_name(status.last_policy_id)}});
   }
-  void on_requested_incompatible_qos(fdds::DataReader*,
-                                     const fdds::RequestedIncompatibleQosStatus& status) override {
+  void on_requested_incompatible_qos(fdds::DataReader*, const fdds::RequestedIncompatibleQosStatus& status) override {
     diag({{"event", "incompatible_qos"}, {"policy", policy_name(status.last_policy_id)}});
   }
 
   bool wait_matched(int count, std::chrono::steady_clock::time_point deadline) {
     std::unique_lock lock(mutex_);
     while (!g_stop) {
-      const auto slice = std::min(deadline, std::chrono::steady_clock::now() +
-                                                std::chrono::milliseconds(100));
+      const auto slice = std::min(deadline, std::chrono::steady_clock::now() + std::chrono::milliseconds(100));
       if (cv_.wait_until(lock, slice, [&] { return matched_ >= count; })) return true;
       if (std::chrono::steady_clock::now() >= deadline) return false;
     }
@@ -281,10 +287,10 @@ bool open(const Options& o, Listener& listener, Entities& e) {
   fdds::DomainParticipantQos qos = fdds::PARTICIPANT_QOS_DEFAULT;
   qos.name("cosmic-dds-peer");
   // Only the endpoint-level callbacks and discovery go to the participant listener.
-  const fdds::StatusMask mask = fdds::StatusMask::publication_matched() <<
-                               fdds::StatusMask::subscription_matched() <<
-                               fdds::StatusMask::offered_incompatible_qos() <<
-                               fdds::StatusMask::requested_incompatible_qos();
+  const fdds::StatusMask mask = fdds::StatusMask::publication_matched()
+                                << fdds::StatusMask::subscription_matched()
+                                << fdds::StatusMask::offered_incompatible_qos()
+                                << fdds::StatusMask::requested_incompatible_qos();
   e.participant = fdds::DomainParticipantFactory::get_instance()->create_participant(
       static_cast<fdds::DomainId_t>(o.domain), qos, &listener, mask);
   if (e.participant == nullptr) {
@@ -327,9 +333,9 @@ int run_pub(const Options& o) {
     diag({{"event", "error"}, {"what", "cannot create writer"}});
     return 3;
   }
-  const auto match_deadline = std::chrono::steady_clock::now() +
-                              std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                  std::chrono::duration<double>(o.match_timeout));
+  const auto match_deadline =
+      std::chrono::steady_clock::now() +
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(o.match_timeout));
   if (!listener.wait_matched(o.wait_subscribers, match_deadline)) {
     diag({{"event", "error"}, {"what", "no subscriber matched"}});
     return 2;
@@ -355,9 +361,8 @@ int run_pub(const Options& o) {
   int last_error = 0;
   for (std::uint64_t q = 1; q <= o.count && !g_stop; ++q) {
     if (o.rate > 0) {
-      std::this_thread::sleep_until(
-          start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                      std::chrono::duration<double>(static_cast<double>(q - 1) / o.rate)));
+      std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                std::chrono::duration<double>(static_cast<double>(q - 1) / o.rate)));
     }
     for (std::uint64_t i = 0; i < o.size; ++i) {
       env.payload()[i] = static_cast<std::uint8_t>((q + i) & 0xff);
@@ -384,13 +389,16 @@ int run_pub(const Options& o) {
   }
   bool acked = true;
   if (reliable && !g_stop) {
-    acked = writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(10, 0)) ==
-            ReturnCode_t::RETCODE_OK;
+    acked = writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(10, 0)) == ReturnCode_t::RETCODE_OK;
   }
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  diag({{"event", "done"}, {"sent", sent}, {"failed", failed}, {"retries", retries},
-        {"last_error", last_error}, {"acknowledged", acked}, {"seconds", seconds}});
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  diag({{"event", "done"},
+        {"sent", sent},
+        {"failed", failed},
+        {"retries", retries},
+        {"last_error", last_error},
+        {"acknowledged", acked},
+        {"seconds", seconds}});
   return failed == 0 ? 0 : 4;
 }
 
@@ -400,10 +408,8 @@ int run_sub(const Options& o) {
   if (!open(o, listener, e)) return 3;
   e.subscriber = e.participant->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
   fdds::DataReaderQos qos = fdds::DATAREADER_QOS_DEFAULT;
-  qos.reliability().kind =
-      o.reliable ? fdds::RELIABLE_RELIABILITY_QOS : fdds::BEST_EFFORT_RELIABILITY_QOS;
-  qos.durability().kind =
-      o.transient_local ? fdds::TRANSIENT_LOCAL_DURABILITY_QOS : fdds::VOLATILE_DURABILITY_QOS;
+  qos.reliability().kind = o.reliable ? fdds::RELIABLE_RELIABILITY_QOS : fdds::BEST_EFFORT_RELIABILITY_QOS;
+  qos.durability().kind = o.transient_local ? fdds::TRANSIENT_LOCAL_DURABILITY_QOS : fdds::VOLATILE_DURABILITY_QOS;
   qos.history().kind = fdds::KEEP_ALL_HISTORY_QOS;
   qos.resource_limits().max_samples = 100000;
   qos.resource_limits().allocated_samples = 100;
@@ -413,9 +419,9 @@ int run_sub(const Options& o) {
     diag({{"event", "error"}, {"what", "cannot create reader"}});
     return 3;
   }
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                            std::chrono::duration<double>(o.timeout));
+  const auto deadline =
+      std::chrono::steady_clock::now() +
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(o.timeout));
   cosmic::Envelope env;
   fdds::SampleInfo info;
   std::uint64_t received = 0;
@@ -424,12 +430,10 @@ int run_sub(const Options& o) {
   while ((o.count == 0 || received < o.count) && !g_stop) {
     const auto now = std::chrono::steady_clock::now();
     if (now >= deadline) break;
-    const auto left = std::min<std::chrono::steady_clock::duration>(deadline - now,
-                                                                    std::chrono::milliseconds(200));
+    const auto left = std::min<std::chrono::steady_clock::duration>(deadline - now, std::chrono::milliseconds(200));
     const auto left_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(left).count();
     reader->wait_for_unread_message(eprosima::fastrtps::Duration_t(
-        static_cast<std::int32_t>(left_ns / 1'000'000'000),
-        static_cast<std::uint32_t>(left_ns % 1'000'000'000)));
+        static_cast<std::int32_t>(left_ns / 1'000'000'000), static_cast<std::uint32_t>(left_ns % 1'000'000'000)));
     while (reader->take_next_sample(&env, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
       const std::int64_t at = monotonic_ns();
@@ -441,10 +445,14 @@ int run_sub(const Options& o) {
         hex.push_back(kHex[b >> 4]);
         hex.push_back(kHex[b & 0xf]);
       }
-      json out{{"subject", env.subject()},     {"origin", env.origin()},
-               {"sequence", env.sequence()},   {"hop_count", env.hop_count()},
-               {"created_ns", env.created_ns()}, {"age_ns", env.age_ns()},
-               {"received_ns", at},            {"size", env.payload().size()},
+      json out{{"subject", env.subject()},
+               {"origin", env.origin()},
+               {"sequence", env.sequence()},
+               {"hop_count", env.hop_count()},
+               {"created_ns", env.created_ns()},
+               {"age_ns", env.age_ns()},
+               {"received_ns", at},
+               {"size", env.payload().size()},
                {"payload", hex}};
       line = out.dump();
       line.push_back('\n');
@@ -494,8 +502,7 @@ int main(int argc, char** argv) {
   pub->add_option("--origin", o.origin, "envelope origin (0: native source)");
   pub->add_option("--hop-count", o.hop_count, "envelope hop count")->check(CLI::Range(0, 255));
   pub->add_option("--age-ns", o.age_ns, "envelope age");
-  pub->add_option("--wait-subscribers", o.wait_subscribers,
-                  "matched subscribers to wait for before publishing");
+  pub->add_option("--wait-subscribers", o.wait_subscribers, "matched subscribers to wait for before publishing");
   pub->add_option("--match-timeout", o.match_timeout, "seconds to wait for them (exit 2)");
   pub->add_flag("--start-on-stdin", o.start_on_stdin,
                 "after matching, wait for a line on stdin (or EOF) before publishing");

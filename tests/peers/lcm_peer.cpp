@@ -114,9 +114,8 @@ int run_pub(const PubOptions& o) {
   int status = 0;
   for (std::uint64_t k = 1; k <= o.count; ++k) {
     if (o.rate > 0) {
-      std::this_thread::sleep_until(
-          start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                      std::chrono::duration<double>(static_cast<double>(k - 1) / o.rate)));
+      std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                std::chrono::duration<double>(static_cast<double>(k - 1) / o.rate)));
     }
     for (std::size_t i = 0; o.payload_hex.empty() && i < payload.size(); ++i)
       payload[i] = static_cast<std::uint8_t>((k * 31 + i) & 0xff);
@@ -172,9 +171,9 @@ void on_message(const lcm_recv_buf_t* rbuf, const char* channel, void* user) {
       std::fprintf(stderr, "not an envelope (%u bytes)\n", rbuf->data_size);
       return;
     }
-    const std::int32_t declared = static_cast<std::int32_t>(
-        (std::uint32_t{data[45]} << 24) | (std::uint32_t{data[46]} << 16) |
-        (std::uint32_t{data[47]} << 8) | std::uint32_t{data[48]});
+    const std::int32_t declared =
+        static_cast<std::int32_t>((std::uint32_t{data[45]} << 24) | (std::uint32_t{data[46]} << 16) |
+                                  (std::uint32_t{data[47]} << 8) | std::uint32_t{data[48]});
     if (declared < 0 || rbuf->data_size != kHeader + static_cast<std::size_t>(declared) ||
         e.decode(data, 0, static_cast<int>(rbuf->data_size)) != static_cast<int>(rbuf->data_size)) {
       std::fprintf(stderr, "not an envelope (%u bytes)\n", rbuf->data_size);
@@ -214,16 +213,15 @@ int run_sub(const SubOptions& o) {
   // The udpm provider has joined the group when lcm_subscribe returns.
   std::fputs("READY\n", stderr);
   std::fflush(stderr);
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                            std::chrono::duration<double>(o.timeout));
+  const auto deadline =
+      std::chrono::steady_clock::now() +
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(o.timeout));
   int status = 0;
   while (state.received < o.count) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        deadline - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) {
-      std::fprintf(stderr, "timeout: %llu of %llu messages\n",
-                   static_cast<unsigned long long>(state.received),
+      std::fprintf(stderr, "timeout: %llu of %llu messages\n", static_cast<unsigned long long>(state.received),
                    static_cast<unsigned long long>(o.count));
       status = 1;
       break;

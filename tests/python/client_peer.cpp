@@ -83,17 +83,21 @@ int pub(int argc, char** argv, cosmic::client::Client& client, std::uint32_t pay
   const auto start = Clock::now();
   for (long i = 0; i < count; ++i) {
     if (rate > 0 && i % 10 == 0) {  // paced in bursts of 10: a sleep per event would oversleep
-      std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(i / rate)));
+      std::this_thread::sleep_until(
+          start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(i / rate)));
     }
     std::memcpy(event.data(), &i, std::min(sizeof i, event.size()));
     const int rc = out.publish(event);
-    if (rc == COSMIC_OK) ++sent;
-    else if (rc == COSMIC_E_AGAIN) ++again;
-    else return 1;
+    if (rc == COSMIC_OK)
+      ++sent;
+    else if (rc == COSMIC_E_AGAIN)
+      ++again;
+    else
+      return 1;
   }
   const double took = seconds_since(start);
-  std::cout << "{\"published\":" << sent << ",\"again\":" << again << ",\"seconds\":" << took << ",\"rate\":" << sent / took << "}"
-            << std::endl;
+  std::cout << "{\"published\":" << sent << ",\"again\":" << again << ",\"seconds\":" << took
+            << ",\"rate\":" << sent / took << "}" << std::endl;
   return 0;
 }
 
@@ -111,13 +115,13 @@ int sub(int argc, char** argv, cosmic::client::Client& client, std::uint32_t pay
     if (received >= count) done.notify_all();
   });
   ready();
-  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(std::stod(arg(argc, argv, "--seconds", "30"))));
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                                           std::stod(arg(argc, argv, "--seconds", "30"))));
   std::unique_lock lock(mutex);
   done.wait_until(lock, deadline, [&] { return received >= count; });
   const double span = std::chrono::duration<double>(last - first).count();
-  std::cout << "{\"received\":" << received << ",\"seconds\":" << span << ",\"rate\":" << (span > 0 ? (received - 1) / span : 0)
-            << "}" << std::endl;
+  std::cout << "{\"received\":" << received << ",\"seconds\":" << span
+            << ",\"rate\":" << (span > 0 ? (received - 1) / span : 0) << "}" << std::endl;
   const bool all = received >= count;
   lock.unlock();
   on_in.cancel();

@@ -63,9 +63,13 @@ class Client {
   ~Client() { ::close(fd_); }
   bool connected() const { return connected_; }
   int fd() const { return fd_; }
-  void send_raw(const std::string& data) { ASSERT_EQ(::send(fd_, data.data(), data.size(), MSG_NOSIGNAL), static_cast<ssize_t>(data.size())); }
+  void send_raw(const std::string& data) {
+    ASSERT_EQ(::send(fd_, data.data(), data.size(), MSG_NOSIGNAL), static_cast<ssize_t>(data.size()));
+  }
   // For a peer that may close at any moment: false once the server has gone.
-  bool try_send(const std::string& data) { return ::send(fd_, data.data(), data.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(data.size()); }
+  bool try_send(const std::string& data) {
+    return ::send(fd_, data.data(), data.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(data.size());
+  }
   std::string read_line() {
     std::string line;
     char c;
@@ -89,12 +93,13 @@ class ControlTest : public ::testing::Test {
  protected:
   explicit ControlTest(const char* config = kConfig)
       : dir(std::filesystem::temp_directory_path() / ("cosmic-control-" + std::to_string(::getpid()))),
-        gateway([this](const SegmentSpec& spec, const GatewayIdentity&, Logger&) {
-                  auto adapter = std::make_unique<MemoryAdapter>(spec.name);
-                  adapters[spec.name] = adapter.get();
-                  return adapter;
-                },
-                log, 0x42) {
+        gateway(
+            [this](const SegmentSpec& spec, const GatewayIdentity&, Logger&) {
+              auto adapter = std::make_unique<MemoryAdapter>(spec.name);
+              adapters[spec.name] = adapter.get();
+              return adapter;
+            },
+            log, 0x42) {
     std::filesystem::remove_all(dir);
     socket_path = (dir / "run" / "control.sock").string();
     gateway.start(parse_config(config, "test.yaml").config);
@@ -138,8 +143,9 @@ class ControlTest : public ::testing::Test {
     Offload offload;
     if (setup.admission == Admission::server_worker) offload = server->offload();
     if (setup.admission == Admission::gated) offload = gated_offload();
-    protocol = std::make_unique<ControlProtocol>(gateway, [] { return parse_config("nonsense: [", "reload.yaml"); },
-                                                 setup.policy, log, setup.on_change, offload);
+    protocol = std::make_unique<ControlProtocol>(
+        gateway, [] { return parse_config("nonsense: [", "reload.yaml"); }, setup.policy, log, setup.on_change,
+        offload);
     const Status opened = server->open();
     ASSERT_TRUE(opened.ok) << opened.error;
     server_thread = std::thread([this] {

@@ -45,7 +45,9 @@ TEST_F(ControlTest, PipelinedRequestsAreAllAnsweredWhileOutputStaysBounded) {
   Client greedy(socket_path);
   std::string burst;
   constexpr int kRequests = 3000;  // about 2 MB of answers against an 8 KiB output allowance
-  for (int i = 0; i < kRequests; ++i) burst += R"({"command":"channels"})" "\n";
+  for (int i = 0; i < kRequests; ++i)
+    burst += R"({"command":"channels"})"
+             "\n";
   std::thread sender([&] { greedy.send_raw(burst); });
   Client other(socket_path);  // the server keeps serving others while the greedy one is paused
   EXPECT_EQ(other.call({{"command", "status"}})["ok"], true);
@@ -113,8 +115,9 @@ TEST_F(ControlTest, AGatedBindWaitsAndIsAdmittedAgainAgainstWhatChangedMeanwhile
     held.notify_all();
   });
   Client binder(socket_path);
-  const std::string heavy = "- {name: heavy, subject: 7000, class: srt, period: 1ms, reaction_time: 50ms, omission_degree: 1, "
-                            "payload: 1000B, publishers: [viz], subscribers: [lan]}\n";
+  const std::string heavy =
+      "- {name: heavy, subject: 7000, class: srt, period: 1ms, reaction_time: 50ms, omission_degree: 1, "
+      "payload: 1000B, publishers: [viz], subscribers: [lan]}\n";
   binder.send_raw(Json{{"command", "bind"}, {"yaml", heavy}}.dump() + "\n");
   {
     std::unique_lock lock(mutex);
@@ -144,7 +147,8 @@ TEST_F(ControlTest, AdmissionOnTheServersWorkerAnswersInOrder) {
   serve_with(setup);
   Client client(socket_path);
   // Pipelined: the status after the bind waits for the bind's deferred answer.
-  client.send_raw(Json{{"command", "bind"}, {"yaml", many_channels(200, 1000)}}.dump() + "\n" + R"({"command":"status"})" + "\n");
+  client.send_raw(Json{{"command", "bind"}, {"yaml", many_channels(200, 1000)}}.dump() + "\n" +
+                  R"({"command":"status"})" + "\n");
   const Json bound = Json::parse(client.read_line(), nullptr, false);
   EXPECT_EQ(bound["ok"], true) << bound.dump();
   EXPECT_EQ(bound["channels"].size(), 200u);  // the bind's answer comes first
@@ -303,7 +307,8 @@ TEST_F(ControlTest, DeepNestingIsRefusedBeforeParsingAndLogLinesStayBounded) {
   policy.may_modify = [](const PeerCredentials&) { return false; };
   serve(policy);
   Client client(socket_path);
-  const Json deep = client.call(Json::parse(R"({"command":"status","x":)" + std::string(20, '[') + std::string(20, ']') + "}"));
+  const Json deep =
+      client.call(Json::parse(R"({"command":"status","x":)" + std::string(20, '[') + std::string(20, ']') + "}"));
   EXPECT_EQ(deep["error"]["code"], "bad_request");
   client.send_raw(std::string(3000, '[') + "\n");
   EXPECT_EQ(Json::parse(client.read_line(), nullptr, false)["error"]["code"], "bad_request");
@@ -367,7 +372,8 @@ TEST(DenialLogTest, PowersOfTwoPerUidAndAQuietUidStartsOver) {
   EXPECT_EQ(denials.deny(1000, "made-up", t0), 1u);
   EXPECT_EQ(denials.deny(1000, "also-made-up", t0), 2u) << "unknown commands share one burst";
   EXPECT_EQ(denials.deny(1000, "reload", t0 + std::chrono::seconds(1)), std::nullopt);  // 21st of the burst
-  EXPECT_EQ(denials.deny(1000, "reload", t0 + std::chrono::seconds(1) + DenialLog::kQuiet), 1u) << "quiet for kQuiet: a new burst";
+  EXPECT_EQ(denials.deny(1000, "reload", t0 + std::chrono::seconds(1) + DenialLog::kQuiet), 1u)
+      << "quiet for kQuiet: a new burst";
   for (std::uint32_t uid = 0; uid < 2 * DenialLog::kTracked; ++uid) {
     EXPECT_EQ(denials.deny(10'000 + uid, "bind", t0 + std::chrono::minutes(5) + std::chrono::milliseconds(uid)), 1u);
   }

@@ -59,7 +59,8 @@ TEST_F(ControlTest, StatusSegmentsAndChannels) {
 // rejected and why (what libcosmic-client's cosmic_check_channel shows a component).
 TEST_F(ControlTest, AChannelRejectedAtLoadIsAnsweredRejectedWithTheReasons) {
   const std::string config = std::string(kConfig) +
-      "  - {name: hard, subject: 2, class: hrt, period: 10ms, reaction_time: 20ms, omission_degree: 1, publishers: [lan], subscribers: [viz]}\n";
+                             "  - {name: hard, subject: 2, class: hrt, period: 10ms, reaction_time: 20ms, "
+                             "omission_degree: 1, publishers: [lan], subscribers: [viz]}\n";
   const BindResult reloaded = gateway.reload(parse_config(config, "test.yaml").config);
   ASSERT_TRUE(reloaded.applied) << reloaded.error;
   serve();
@@ -68,7 +69,8 @@ TEST_F(ControlTest, AChannelRejectedAtLoadIsAnsweredRejectedWithTheReasons) {
   EXPECT_EQ(answer["ok"], false);
   ASSERT_EQ(answer["error"]["code"], "rejected") << answer.dump();
   ASSERT_FALSE(answer["error"]["reasons"].empty());
-  EXPECT_NE(answer["error"]["reasons"][0].get<std::string>().find("declares no real-time guarantee"), std::string::npos);
+  EXPECT_NE(answer["error"]["reasons"][0].get<std::string>().find("declares no real-time guarantee"),
+            std::string::npos);
   EXPECT_EQ(answer["error"]["admission"]["verdict"], "rejected");
   EXPECT_EQ(client.call({{"command", "channel"}, {"name", "nope"}})["error"]["code"], "not_found");
   EXPECT_EQ(client.call({{"command", "channel"}, {"name", "speed"}})["ok"], true);
@@ -111,7 +113,8 @@ TEST(ControlAnswers, IncompatiblePeersAndBindingRequestsOverTheLimit) {
       },
       log, 0x42);
   ASSERT_TRUE(gateway.start(parse_config(kConfig, "test.yaml").config).applied);
-  ControlProtocol protocol(gateway, [] { return parse_config("nonsense: [", "reload.yaml"); }, AccessPolicy{}, log);
+  ControlProtocol protocol(
+      gateway, [] { return parse_config("nonsense: [", "reload.yaml"); }, AccessPolicy{}, log);
   auto call = [&](const Json& request) { return Json::parse(protocol.handle(request.dump(), PeerCredentials{})); };
   auto hop = [](const Json& channel, const std::string& segment) {
     for (const auto& s : channel["segments"]) {
@@ -126,7 +129,8 @@ TEST(ControlAnswers, IncompatiblePeersAndBindingRequestsOverTheLimit) {
   EXPECT_EQ(speed["mismatches"], Json::array());
 
   incompatible = 2;  // two remote writers of `speed` refused on lan (the gateway reads there)
-  for (const Json& answer : {call({{"command", "channels"}})["channels"][0], call({{"command", "channel"}, {"name", "speed"}})["channel"]}) {
+  for (const Json& answer :
+       {call({{"command", "channels"}})["channels"][0], call({{"command", "channel"}, {"name", "speed"}})["channel"]}) {
     EXPECT_EQ(hop(answer, "lan")["incompatible"], 2) << answer;
     EXPECT_EQ(hop(answer, "lan")["matched"], 0) << answer;
     ASSERT_EQ(answer["mismatches"].size(), 1u) << answer;
@@ -157,8 +161,9 @@ TEST_F(ControlTest, AChannelASegmentRefusesIsFailedWithItsReason) {
   ASSERT_TRUE(client.connected());
   adapters.at("viz")->refuse_channel("speed", "LCM channel names have at most 63 characters");
   // Any change reconfigures every segment: this bind's own channel is carried, speed is not.
-  const Json bound = client.call({{"command", "bind"},
-                                  {"yaml", "{name: plot, subject: 7, class: nrt, omission_degree: 1, publishers: [lan], subscribers: [viz]}"}});
+  const Json bound = client.call(
+      {{"command", "bind"},
+       {"yaml", "{name: plot, subject: 7, class: nrt, omission_degree: 1, publishers: [lan], subscribers: [viz]}"}});
   EXPECT_EQ(bound["ok"], true) << bound.dump();
   const Json channels = client.call({{"command", "channels"}});
   ASSERT_EQ(channels["channels"].size(), 2u);
@@ -171,7 +176,8 @@ TEST_F(ControlTest, AChannelASegmentRefusesIsFailedWithItsReason) {
   EXPECT_EQ(one["channel"]["admission"]["verdict"], "failed");
   bool has_reason = false;
   for (const auto& reason : one["channel"]["reasons"]) {
-    has_reason |= reason.get<std::string>() == "segment viz does not carry it: LCM channel names have at most 63 characters";
+    has_reason |=
+        reason.get<std::string>() == "segment viz does not carry it: LCM channel names have at most 63 characters";
   }
   EXPECT_TRUE(has_reason) << one.dump();
   const Json status = client.call({{"command", "status"}});
@@ -179,11 +185,12 @@ TEST_F(ControlTest, AChannelASegmentRefusesIsFailedWithItsReason) {
   EXPECT_EQ(status["channels"]["failed"], 1);
   // A bind whose own channel is refused is refused as a whole, with the transport's reason.
   adapters.at("lan")->refuse_channel("more", "cannot create topic cosmic/more");
-  const Json refused = client.call({{"command", "bind"},
-                                    {"yaml", "{name: more, subject: 8, class: nrt, publishers: [lan], subscribers: [viz]}"}});
+  const Json refused = client.call(
+      {{"command", "bind"}, {"yaml", "{name: more, subject: 8, class: nrt, publishers: [lan], subscribers: [viz]}"}});
   EXPECT_EQ(refused["ok"], false);
   EXPECT_EQ(refused["error"]["code"], "bind_failed");
-  EXPECT_NE(refused["error"]["message"].get<std::string>().find("segment lan does not carry channel more: cannot create topic cosmic/more"),
+  EXPECT_NE(refused["error"]["message"].get<std::string>().find(
+                "segment lan does not carry channel more: cannot create topic cosmic/more"),
             std::string::npos)
       << refused.dump();
   ASSERT_EQ(refused["channels"].size(), 1u);
@@ -206,9 +213,10 @@ TEST_F(ControlTest, BadRequestsGetClearErrorsAndTheConnectionSurvives) {
 TEST_F(ControlTest, RejectedBindAnswersWithReasonAndChangesNothing) {
   serve();
   Client client(socket_path);
-  const Json answer = client.call(
-      {{"command", "bind"},
-       {"yaml", "{name: brake, subject: 9, class: hrt, period: 10ms, reaction_time: 5ms, publishers: [lan], subscribers: [viz]}"}});
+  const Json answer = client.call({{"command", "bind"},
+                                   {"yaml",
+                                    "{name: brake, subject: 9, class: hrt, period: 10ms, reaction_time: 5ms, "
+                                    "publishers: [lan], subscribers: [viz]}"}});
   EXPECT_EQ(answer["ok"], false);
   EXPECT_EQ(answer["error"]["code"], "rejected");
   EXPECT_EQ(answer["channels"][0]["verdict"], "rejected");

@@ -27,8 +27,8 @@ class RecordingLogger final : public Logger {
   }
   std::size_t count(std::string_view needle) {
     std::lock_guard lock(mutex);
-    return static_cast<std::size_t>(
-        std::count_if(lines.begin(), lines.end(), [&](const std::string& l) { return l.find(needle) != std::string::npos; }));
+    return static_cast<std::size_t>(std::count_if(
+        lines.begin(), lines.end(), [&](const std::string& l) { return l.find(needle) != std::string::npos; }));
   }
   std::mutex mutex;
   std::vector<std::string> lines;
@@ -213,7 +213,8 @@ segments:
   - {name: body, type: can, interface: can9, bitrate: 1Mbit/s}
 channels:
   - {name: bulk, subject: 7, class: nrt, payload: 4B, publishers: [lan], subscribers: [body]}
-)", "can.yaml");
+)",
+                                   "can.yaml");
   ASSERT_TRUE(parsed.ok()) << parsed.errors[0].to_string();
   ASSERT_TRUE(gateway.start(parsed.config).applied);
   ASSERT_NE(stuck, nullptr);
@@ -224,7 +225,8 @@ channels:
   ASSERT_TRUE(stuck->wait_nrt_stuck(5000ms));  // the lane holds the first event in its send
   for (std::size_t i = 1; i <= floor + 10; ++i) {
     const auto n = static_cast<std::uint32_t>(i);
-    ASSERT_TRUE(adapters["lan"]->inject("bulk", {static_cast<std::uint8_t>(n), static_cast<std::uint8_t>(n >> 8), 0, 0}));
+    ASSERT_TRUE(
+        adapters["lan"]->inject("bulk", {static_cast<std::uint8_t>(n), static_cast<std::uint8_t>(n >> 8), 0, 0}));
   }
   auto stats = gateway.channel_stats();
   ASSERT_EQ(stats.size(), 1u);
@@ -285,7 +287,7 @@ TEST(ForwardingTest, AnHrtChannelThatMissesIsViolatedLoggedOnceAndBoundAgainAfte
   gateway.refresh_runtime(t0 + Nanos(10'000'000));  // no new miss, but the interval is not over
   EXPECT_EQ(gateway.channel_stats().at(0).runtime_state, RuntimeState::violated);
   EXPECT_EQ(log.count("violated its admitted bounds"), 1u);  // once per episode
-  gateway.refresh_runtime(t0 + Nanos(60'000'000));  // a clean interval later
+  gateway.refresh_runtime(t0 + Nanos(60'000'000));           // a clean interval later
   EXPECT_EQ(gateway.channel_stats().at(0).runtime_state, RuntimeState::bound);
   EXPECT_EQ(gateway.violated_channels(), 0u);
   EXPECT_EQ(log.count("within its admitted bounds again"), 1u);
@@ -340,13 +342,15 @@ TEST(ForwardingTest, AReloadedResidenceBoundIsWhatTheLanesCheck) {
       log, 0x43);
   ASSERT_TRUE(gateway.start(parse_config(kHrtConfig, "hrt.yaml").config).applied);
   std::string relaxed = kHrtConfig;
-  relaxed.replace(relaxed.find("residence_bound: 1ns"), 20, "residence_bound: 40ms");  // 1 + 40 + 1 ms <= reaction_time 50 ms
+  relaxed.replace(relaxed.find("residence_bound: 1ns"), 20,
+                  "residence_bound: 40ms");  // 1 + 40 + 1 ms <= reaction_time 50 ms
   const auto reloaded = parse_config(relaxed, "hrt.yaml");
   ASSERT_TRUE(reloaded.ok());
   ASSERT_TRUE(gateway.reload(reloaded.config).applied);
   ASSERT_TRUE(adapters["lan"]->inject("distance", {1, 2, 3, 4}));
   ASSERT_EQ(adapters["rt"]->wait_sent(1, 5s), 1u);
-  for (auto deadline = steady_now() + Nanos(5'000'000'000); gateway.channel_stats().at(0).segments.back().egress->events == 0;) {
+  for (auto deadline = steady_now() + Nanos(5'000'000'000);
+       gateway.channel_stats().at(0).segments.back().egress->events == 0;) {
     ASSERT_LT(steady_now(), deadline);
     std::this_thread::yield();
   }

@@ -42,13 +42,16 @@ channels:
 class GatewayTest : public ::testing::Test {
  protected:
   GatewayTest()
-      : gateway([this](const SegmentSpec& spec, const GatewayIdentity&, Logger&) -> std::unique_ptr<SegmentAdapter> {
-          auto adapter = std::make_unique<MemoryAdapter>(spec.name);
-          for (const auto& [channel, reason] : refuse_at_creation[spec.name]) adapter->refuse_channel(channel, reason);
-          adapter->fail_configure(fail_at_creation[spec.name]);
-          adapters[spec.name] = adapter.get();
-          return adapter;
-        }, log, 0x1234) {}
+      : gateway(
+            [this](const SegmentSpec& spec, const GatewayIdentity&, Logger&) -> std::unique_ptr<SegmentAdapter> {
+              auto adapter = std::make_unique<MemoryAdapter>(spec.name);
+              for (const auto& [channel, reason] : refuse_at_creation[spec.name])
+                adapter->refuse_channel(channel, reason);
+              adapter->fail_configure(fail_at_creation[spec.name]);
+              adapters[spec.name] = adapter.get();
+              return adapter;
+            },
+            log, 0x1234) {}
 
   Config parse(const std::string& text) {
     auto result = parse_config(text, "test.yaml");
@@ -134,7 +137,8 @@ channels:
     return std::uint64_t{0};
   };
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
-  while (rate_drops() < 2 && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  while (rate_drops() < 2 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
   EXPECT_EQ(rate_drops(), 2u);
   EXPECT_EQ(adapters["viz"]->wait_sent(6, std::chrono::seconds(5)), 6u);
 }
@@ -142,13 +146,15 @@ channels:
 TEST_F(GatewayTest, RejectedRuntimeBindChangesNothing) {
   gateway.start(parse(kConfig));
   // HRT over LCM (no real-time guarantee, no retransmission): rejected.
-  const auto result = gateway.bind(channels(
-      "{name: brake, subject: 9, class: hrt, period: 10ms, reaction_time: 5ms, publishers: [lan], subscribers: [viz]}"));
+  const auto result =
+      gateway.bind(channels("{name: brake, subject: 9, class: hrt, period: 10ms, reaction_time: 5ms, publishers: "
+                            "[lan], subscribers: [viz]}"));
   EXPECT_FALSE(result.applied);
   ASSERT_EQ(result.channels.size(), 1u);
   EXPECT_EQ(result.channels[0].verdict, Verdict::rejected);
   bool mentions_realtime = false;
-  for (const auto& reason : result.channels[0].reasons) mentions_realtime |= reason.find("real-time") != std::string::npos;
+  for (const auto& reason : result.channels[0].reasons)
+    mentions_realtime |= reason.find("real-time") != std::string::npos;
   EXPECT_TRUE(mentions_realtime);
   EXPECT_EQ(gateway.knowledge_base().bound_channels().size(), 2u);
   EXPECT_EQ(adapters["viz"]->bindings().size(), 2u);
@@ -169,7 +175,8 @@ channels:
 TEST_F(GatewayTest, RuntimeBindAndUnbindWhileTrafficFlows) {
   gateway.start(parse(kConfig));
   expect_flow("speed", "lan", "viz");
-  ASSERT_TRUE(gateway.bind(channels("{name: extra, subject: 12, class: nrt, publishers: [lan], subscribers: [viz]}")).applied);
+  ASSERT_TRUE(
+      gateway.bind(channels("{name: extra, subject: 12, class: nrt, publishers: [lan], subscribers: [viz]}")).applied);
   expect_flow("extra", "lan", "viz");
   expect_flow("speed", "lan", "viz");
   EXPECT_TRUE(gateway.unbind("extra"));
@@ -254,7 +261,8 @@ TEST_F(GatewayTest, AChannelItsSegmentRefusesAtStartIsFailedWithTheReason) {
   ASSERT_EQ(result.channels.size(), 2u);
   EXPECT_EQ(result.channels[0].name, "speed");
   EXPECT_EQ(result.channels[0].verdict, Verdict::failed);
-  EXPECT_TRUE(has_reason(result.channels[0], "segment viz does not carry it: LCM channel names have at most 63 characters"));
+  EXPECT_TRUE(
+      has_reason(result.channels[0], "segment viz does not carry it: LCM channel names have at most 63 characters"));
   EXPECT_EQ(result.channels[1].name, "log");
   EXPECT_NE(result.channels[1].verdict, Verdict::failed);
   // What cosmicctl channels shows (admission()) says the same, and the log has one error line.
@@ -263,7 +271,9 @@ TEST_F(GatewayTest, AChannelItsSegmentRefusesAtStartIsFailedWithTheReason) {
   EXPECT_EQ(speed->verdict, Verdict::failed);
   EXPECT_TRUE(has_reason(*speed, "segment viz does not carry it"));
   expect_carried("log");
-  EXPECT_EQ(log.count("channel speed: segment viz does not carry it: LCM channel names have at most 63 characters", LogLevel::error), 1u);
+  EXPECT_EQ(log.count("channel speed: segment viz does not carry it: LCM channel names have at most 63 characters",
+                      LogLevel::error),
+            1u);
   // Admitted all the same: its reservation is held, so a later configuration can carry it.
   EXPECT_NE(gateway.knowledge_base().find_bound("speed"), nullptr);
   // The other channel flows; speed's other segment still has it.
@@ -276,13 +286,15 @@ TEST_F(GatewayTest, ARefusalIsLoggedOnceAndItsEndIsLoggedAndShown) {
   refuse_at_creation["viz"]["speed"] = "no room";
   gateway.start(parse(kConfig));
   // Other changes reconfigure every segment: the refusal stays visible, logged once.
-  ASSERT_TRUE(gateway.bind(channels("{name: extra, subject: 12, class: nrt, publishers: [lan], subscribers: [viz]}")).applied);
+  ASSERT_TRUE(
+      gateway.bind(channels("{name: extra, subject: 12, class: nrt, publishers: [lan], subscribers: [viz]}")).applied);
   EXPECT_TRUE(gateway.unbind("extra"));
   EXPECT_EQ(verdict_of("speed")->verdict, Verdict::failed);
   EXPECT_EQ(log.count("channel speed: segment viz does not carry it: no room", LogLevel::error), 1u);
   // A new reason is a new line.
   adapters["viz"]->refuse_channel("speed", "still no room");
-  ASSERT_TRUE(gateway.bind(channels("{name: extra, subject: 12, class: nrt, publishers: [lan], subscribers: [viz]}")).applied);
+  ASSERT_TRUE(
+      gateway.bind(channels("{name: extra, subject: 12, class: nrt, publishers: [lan], subscribers: [viz]}")).applied);
   EXPECT_EQ(log.count("channel speed: segment viz does not carry it: still no room", LogLevel::error), 1u);
   // The transport takes it at the next configuration: bound again, said once, and it flows.
   adapters["viz"]->refuse_channel("speed", "");
@@ -305,15 +317,18 @@ TEST_F(GatewayTest, ASegmentFailingAsAWholeFailsEveryChannelItDoesNotCarry) {
   // Once it takes its channels, everything is bound; a later whole failure concerns only what it
   // did not carry yet: the new channel of a bind, which is then refused.
   adapters["lan"]->fail_configure("");
-  ASSERT_TRUE(gateway.bind(channels("{name: extra, subject: 12, class: nrt, publishers: [lan], subscribers: [viz]}")).applied);
+  ASSERT_TRUE(
+      gateway.bind(channels("{name: extra, subject: 12, class: nrt, publishers: [lan], subscribers: [viz]}")).applied);
   expect_carried("speed");
   expect_carried("log");
   adapters["lan"]->fail_configure("cannot create a DataReader on cosmic/more");
-  const auto bind = gateway.bind(channels("{name: more, subject: 13, class: nrt, publishers: [lan], subscribers: [viz]}"));
+  const auto bind =
+      gateway.bind(channels("{name: more, subject: 13, class: nrt, publishers: [lan], subscribers: [viz]}"));
   EXPECT_FALSE(bind.applied);
   ASSERT_EQ(bind.channels.size(), 1u);
   EXPECT_EQ(bind.channels[0].verdict, Verdict::failed);
-  EXPECT_NE(bind.error.find("segment lan does not carry channel more: cannot create a DataReader on cosmic/more"), std::string::npos)
+  EXPECT_NE(bind.error.find("segment lan does not carry channel more: cannot create a DataReader on cosmic/more"),
+            std::string::npos)
       << bind.error;
   EXPECT_EQ(gateway.knowledge_base().find_bound("more"), nullptr);
   for (const char* name : {"speed", "log", "extra"}) expect_carried(name);
@@ -332,7 +347,8 @@ channels:
   ASSERT_EQ(result.channels.size(), 2u);
   EXPECT_NE(result.channels[0].verdict, Verdict::failed);
   EXPECT_EQ(result.channels[1].verdict, Verdict::failed);
-  EXPECT_TRUE(has_reason(result.channels[1], "segment viz does not carry it: LCM channel names have at most 63 characters"));
+  EXPECT_TRUE(
+      has_reason(result.channels[1], "segment viz does not carry it: LCM channel names have at most 63 characters"));
   EXPECT_NE(result.error.find("segment viz does not carry channel extra"), std::string::npos) << result.error;
   EXPECT_NE(result.error.find("nothing changed"), std::string::npos) << result.error;
   EXPECT_EQ(gateway.knowledge_base().find_bound("fine"), nullptr);
@@ -345,7 +361,8 @@ channels:
 TEST_F(GatewayTest, ARefusalOfABoundChannelDoesNotBlockOtherBinds) {
   refuse_at_creation["viz"]["speed"] = "no room";
   gateway.start(parse(kConfig));
-  const auto result = gateway.bind(channels("{name: extra, subject: 12, class: nrt, publishers: [lan], subscribers: [viz]}"));
+  const auto result =
+      gateway.bind(channels("{name: extra, subject: 12, class: nrt, publishers: [lan], subscribers: [viz]}"));
   EXPECT_TRUE(result.applied) << result.error;
   EXPECT_NE(result.channels.at(0).verdict, Verdict::failed);
   expect_flow("extra", "lan", "viz");

@@ -63,15 +63,18 @@ channels:
   - {name: log, subject: 9, class: nrt, payload: 4B, publishers: [lan], subscribers: [rt]}
 )";
   SilentLogger log;
-  Gateway gateway([&](const SegmentSpec& spec, const GatewayIdentity&, Logger&) -> std::unique_ptr<SegmentAdapter> {
-    return std::make_unique<MemoryAdapter>(spec.name);
-  }, log, 0x42);
+  Gateway gateway(
+      [&](const SegmentSpec& spec, const GatewayIdentity&, Logger&) -> std::unique_ptr<SegmentAdapter> {
+        return std::make_unique<MemoryAdapter>(spec.name);
+      },
+      log, 0x42);
   const auto parsed = parse_config(yaml, "placement.yaml");
   ASSERT_TRUE(parsed.ok()) << parsed.errors[0].to_string();
   ASSERT_TRUE(gateway.start(parsed.config).applied);
   // A lane thread applies its policy as it starts: wait until each class has one that did.
   const auto placed = [&](const std::string& name, const std::vector<int>& want) {
-    for (auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10); std::chrono::steady_clock::now() < deadline;) {
+    for (auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+         std::chrono::steady_clock::now() < deadline;) {
       const auto threads = threads_by_name();
       const auto [first, end] = threads.equal_range(name);
       if (first != end && std::all_of(first, end, [&](const auto& t) { return t.second == want; })) return true;

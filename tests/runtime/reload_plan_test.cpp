@@ -53,11 +53,13 @@ channels:
   Config config = parsed.config;
   for (int i = 0; i < 40; ++i) {
     const ChannelClass cls = i % 5 == 0 ? ChannelClass::hrt : i % 5 < 3 ? ChannelClass::srt : ChannelClass::nrt;
-    config.channels.push_back(channel("can" + std::to_string(i), 0x100 + i, cls, "bus", "lan", 1 + i % 8, 20 + 10 * (i % 7)));
+    config.channels.push_back(
+        channel("can" + std::to_string(i), 0x100 + i, cls, "bus", "lan", 1 + i % 8, 20 + 10 * (i % 7)));
   }
   for (int i = 0; i < 20; ++i) {
-    config.channels.push_back(channel("ip" + std::to_string(i), 0x200 + i, i % 2 ? ChannelClass::srt : ChannelClass::nrt,
-                                      i % 2 ? "lan" : "viz", i % 2 ? "viz" : "lan", 64, 100));
+    config.channels.push_back(channel("ip" + std::to_string(i), 0x200 + i,
+                                      i % 2 ? ChannelClass::srt : ChannelClass::nrt, i % 2 ? "lan" : "viz",
+                                      i % 2 ? "viz" : "lan", 64, 100));
   }
   config.channels.push_back(channel("estop", 0x300, ChannelClass::hrt, "lan", "viz", 1, 5));  // rejected
   return config;
@@ -85,9 +87,9 @@ void expect_same_as_from_scratch(const ReloadPlan& plan) {
 class ReloadPlanTest : public ::testing::Test {
  protected:
   ReloadPlanTest()
-      : gateway([](const SegmentSpec& spec, const GatewayIdentity&, Logger&) -> std::unique_ptr<SegmentAdapter> {
-          return std::make_unique<MemoryAdapter>(spec.name);
-        }, log, 0x42) {}
+      : gateway([](const SegmentSpec& spec, const GatewayIdentity&,
+                   Logger&) -> std::unique_ptr<SegmentAdapter> { return std::make_unique<MemoryAdapter>(spec.name); },
+                log, 0x42) {}
 
   QuietLogger log;
   Gateway gateway;
@@ -135,7 +137,7 @@ TEST_F(ReloadPlanTest, AnyOtherChangeIsAdmittedFromScratch) {
   ASSERT_TRUE(gateway.start(config).applied);
   const auto base = gateway.reload_base();
   std::vector<Config> changed(5, config);
-  changed[0].channels[3].payload = 2;                        // a channel changed
+  changed[0].channels[3].payload = 2;                          // a channel changed
   changed[1].channels.erase(changed[1].channels.begin() + 3);  // a channel removed
   std::swap(changed[2].channels[1], changed[2].channels[2]);   // the order changed
   changed[3].segments[0].can.bitrate = BitRate{250'000};       // a segment changed

@@ -50,11 +50,13 @@ class QuietLog final : public Logger {
 class ReplaceTest : public ::testing::Test {
  protected:
   ReplaceTest()
-      : gateway([this](const SegmentSpec& spec, const GatewayIdentity&, Logger&) -> std::unique_ptr<SegmentAdapter> {
-          auto adapter = std::make_unique<MemoryAdapter>(spec.name);
-          adapters[spec.name] = adapter.get();
-          return adapter;
-        }, log, 0x77) {
+      : gateway(
+            [this](const SegmentSpec& spec, const GatewayIdentity&, Logger&) -> std::unique_ptr<SegmentAdapter> {
+              auto adapter = std::make_unique<MemoryAdapter>(spec.name);
+              adapters[spec.name] = adapter.get();
+              return adapter;
+            },
+            log, 0x77) {
     const auto config = parse_config(kReplaceConfig, "test.yaml");
     EXPECT_TRUE(config.ok()) << (config.errors.empty() ? "" : config.errors[0].to_string());
     EXPECT_TRUE(gateway.start(config.config).applied);
@@ -88,7 +90,8 @@ class ReplaceTest : public ::testing::Test {
       out += "\n";
     }
     for (const auto& [name, adapter] : adapters) {
-      for (const auto& b : adapter->bindings()) out += name + " carries " + b.spec.name + "#" + std::to_string(b.id) + "\n";
+      for (const auto& b : adapter->bindings())
+        out += name + " carries " + b.spec.name + "#" + std::to_string(b.id) + "\n";
     }
     return out;
   }
@@ -174,12 +177,14 @@ TEST_F(ReplaceTest, ARejectedReplacementChangesNothing) {
 
 TEST_F(ReplaceTest, AChannelThatIsNotBoundRejectsTheWholeReplacement) {
   const std::string before = state();
-  const BindResult result = gateway.replace(channels(std::string("[") + kRangeFromSim +
-                                                     ", {name: pitch, subject: 0x12, class: nrt, payload: 4B, publishers: [viz], "
-                                                     "subscribers: [lan]}]"));
+  const BindResult result =
+      gateway.replace(channels(std::string("[") + kRangeFromSim +
+                               ", {name: pitch, subject: 0x12, class: nrt, payload: 4B, publishers: [viz], "
+                               "subscribers: [lan]}]"));
   EXPECT_FALSE(result.applied);
   ASSERT_EQ(result.channels.size(), 2u);
-  EXPECT_NE(result.channels[1].reasons.at(0).find("pitch is not bound"), std::string::npos) << result.channels[1].reasons[0];
+  EXPECT_NE(result.channels[1].reasons.at(0).find("pitch is not bound"), std::string::npos)
+      << result.channels[1].reasons[0];
   EXPECT_NE(result.channels[0].reasons.at(0).find("not replaced"), std::string::npos);
   EXPECT_EQ(state(), before);
   EXPECT_EQ(gateway.knowledge_base().find_bound("pitch"), nullptr);
@@ -191,12 +196,15 @@ TEST_F(ReplaceTest, TheReplacedSetIsAdmittedAsAWhole) {
   const std::string range_with_tilts_subject =
       "{name: range, subject: 0x11, class: srt, period: 10ms, reaction_time: 20ms, omission_degree: 1, payload: 4B, "
       "publishers: [body], subscribers: [lan, viz]}";
-  const std::string tilt_with_ranges_subject = "{name: tilt, subject: 0x10, class: nrt, payload: 4B, publishers: [viz], subscribers: [lan]}";
+  const std::string tilt_with_ranges_subject =
+      "{name: tilt, subject: 0x10, class: nrt, payload: 4B, publishers: [viz], subscribers: [lan]}";
   const BindResult alone = gateway.replace(channels(range_with_tilts_subject));
   EXPECT_FALSE(alone.applied);
-  EXPECT_NE(alone.channels.at(0).reasons.at(0).find("subject already carried by bound channel tilt"), std::string::npos);
+  EXPECT_NE(alone.channels.at(0).reasons.at(0).find("subject already carried by bound channel tilt"),
+            std::string::npos);
 
-  const BindResult together = gateway.replace(channels("[" + range_with_tilts_subject + ", " + tilt_with_ranges_subject + "]"));
+  const BindResult together =
+      gateway.replace(channels("[" + range_with_tilts_subject + ", " + tilt_with_ranges_subject + "]"));
   ASSERT_TRUE(together.applied) << together.error;
   EXPECT_EQ(gateway.knowledge_base().find_bound("range")->subject, 0x11u);
   EXPECT_EQ(gateway.knowledge_base().find_bound("tilt")->subject, 0x10u);
@@ -248,7 +256,8 @@ TEST_F(ReplaceTest, ARefusingTransportUndoesTheReplacement) {
   adapters["sim"]->refuse_channel("range", "no such topic");
   const BindResult result = gateway.replace(channels(kRangeFromSim));
   EXPECT_FALSE(result.applied);
-  EXPECT_NE(result.error.find("segment sim does not carry channel range: no such topic"), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find("segment sim does not carry channel range: no such topic"), std::string::npos)
+      << result.error;
   EXPECT_EQ(state(), before);
 }
 
@@ -324,7 +333,8 @@ TEST_F(ReplaceTest, ANewHopTheTransportRefusesIsClosedAgainWithoutWaiting) {
   ASSERT_EQ(replacing.wait_for(30s), std::future_status::ready) << "waited for a hop that was refused";
   const BindResult result = replacing.get();
   EXPECT_FALSE(result.applied);
-  EXPECT_NE(result.error.find("segment sim does not carry channel range: no such topic"), std::string::npos) << result.error;
+  EXPECT_NE(result.error.find("segment sim does not carry channel range: no such topic"), std::string::npos)
+      << result.error;
   EXPECT_EQ(state(), before);
 }
 
@@ -332,9 +342,10 @@ TEST_F(ReplaceTest, ANewHopTheTransportRefusesIsClosedAgainWithoutWaiting) {
 TEST_F(ReplaceTest, ARejectedReplacementOpensNoHop) {
   adapters["sim"]->simulate_discovery();
   const std::string before = state();
-  const BindResult result = gateway.replace(channels(
-      "{name: range, subject: 0x10, class: srt, period: 10ms, reaction_time: 20ms, omission_degree: 1, payload: 4KiB, "
-      "publishers: [sim], subscribers: [lan, body]}"), 60s);
+  const BindResult result = gateway.replace(channels("{name: range, subject: 0x10, class: srt, period: 10ms, "
+                                                     "reaction_time: 20ms, omission_degree: 1, payload: 4KiB, "
+                                                     "publishers: [sim], subscribers: [lan, body]}"),
+                                            60s);
   EXPECT_FALSE(result.applied);
   EXPECT_EQ(state(), before);
   EXPECT_EQ(carried_id("sim", "range", HopRole::publisher), kNoChannel);
@@ -349,21 +360,25 @@ namespace {
 TEST_F(ControlTest, ReplaceAnswersWhatChangedAndWhichHopsStay) {
   serve();
   Client client(socket_path);
-  const Json answer = client.call(
-      {{"command", "replace"},
-       {"yaml", "{name: speed, subject: 1, class: srt, period: 10ms, reaction_time: 20ms, omission_degree: 2, publishers: [viz], subscribers: [lan]}"}});
+  const Json answer = client.call({{"command", "replace"},
+                                   {"yaml",
+                                    "{name: speed, subject: 1, class: srt, period: 10ms, reaction_time: 20ms, "
+                                    "omission_degree: 2, publishers: [viz], subscribers: [lan]}"}});
   ASSERT_EQ(answer["ok"], true) << answer.dump();
   ASSERT_EQ(answer["replaced"].size(), 1u);
   const Json& speed = answer["replaced"][0];
   EXPECT_EQ(speed["name"], "speed");
-  EXPECT_EQ(speed["changes"], Json::array({"omission_degree: 1 -> 2", "publishers: [lan] -> [viz]", "subscribers: [viz] -> [lan]"}));
+  EXPECT_EQ(speed["changes"],
+            Json::array({"omission_degree: 1 -> 2", "publishers: [lan] -> [viz]", "subscribers: [viz] -> [lan]"}));
   EXPECT_TRUE(speed["hops"]["kept"].empty());
   EXPECT_EQ(speed["hops"]["added"].size(), 2u);
   EXPECT_EQ(speed["hops"]["removed"].size(), 2u);
 
-  const Json same = client.call({{"command", "replace"},
-                                 {"yaml", "{name: speed, subject: 1, class: srt, period: 10ms, reaction_time: 20ms, omission_degree: 1, "
-                                          "publishers: [viz], subscribers: [lan]}"}});
+  const Json same =
+      client.call({{"command", "replace"},
+                   {"yaml",
+                    "{name: speed, subject: 1, class: srt, period: 10ms, reaction_time: 20ms, omission_degree: 1, "
+                    "publishers: [viz], subscribers: [lan]}"}});
   ASSERT_EQ(same["ok"], true) << same.dump();
   EXPECT_EQ(same["replaced"][0]["hops"]["kept"].size(), 2u);
 }
@@ -393,9 +408,11 @@ TEST_F(SwitchOverTest, ReplaceWaitsForTheNewPublisherToMatchThenSaysSo) {
   Client client(socket_path);
   adapters["sim"]->simulate_discovery();
   const std::string from_sim =
-      "{name: speed, subject: 1, class: srt, period: 10ms, reaction_time: 20ms, omission_degree: 1, publishers: [sim], subscribers: [viz]}";
+      "{name: speed, subject: 1, class: srt, period: 10ms, reaction_time: 20ms, omission_degree: 1, publishers: [sim], "
+      "subscribers: [viz]}";
   const std::string from_lan =
-      "{name: speed, subject: 1, class: srt, period: 10ms, reaction_time: 20ms, omission_degree: 1, publishers: [lan], subscribers: [viz]}";
+      "{name: speed, subject: 1, class: srt, period: 10ms, reaction_time: 20ms, omission_degree: 1, publishers: [lan], "
+      "subscribers: [viz]}";
   const Json timed_out = client.call({{"command", "replace"}, {"yaml", from_sim}, {"match_timeout_s", 0.05}});
   ASSERT_EQ(timed_out["ok"], true) << timed_out.dump();
   const Json& switched = timed_out["switch_over"];
@@ -409,11 +426,14 @@ TEST_F(SwitchOverTest, ReplaceWaitsForTheNewPublisherToMatchThenSaysSo) {
   client.send_raw(Json{{"command", "replace"}, {"yaml", from_sim}, {"match_timeout_s", 30}}.dump() + "\n");
   // While the switch waits, the control thread answers reads; changes are busy.
   Client other(socket_path);
-  ASSERT_TRUE(eventually([&] {
-    const Json busy = other.call({{"command", "unbind"}, {"name", "speed"}});
-    return busy["error"]["code"] == "busy" &&
-           busy["error"]["message"].get<std::string>().find("waiting up to 30 s for its new publishers to match") != std::string::npos;
-  }, 5000ms));
+  ASSERT_TRUE(eventually(
+      [&] {
+        const Json busy = other.call({{"command", "unbind"}, {"name", "speed"}});
+        return busy["error"]["code"] == "busy" &&
+               busy["error"]["message"].get<std::string>().find("waiting up to 30 s for its new publishers to match") !=
+                   std::string::npos;
+      },
+      5000ms));
   EXPECT_EQ(other.call({{"command", "status"}})["ok"], true);
   EXPECT_EQ(gateway.knowledge_base().find_bound("speed")->publishers, std::vector<std::string>{"lan"});
   adapters["sim"]->set_matched("speed", 2);
@@ -427,7 +447,9 @@ TEST_F(SwitchOverTest, ReplaceWaitsForTheNewPublisherToMatchThenSaysSo) {
 TEST_F(ControlTest, ReplaceWithABadMatchTimeoutIsRefusedAndChangesNothing) {
   serve();
   Client client(socket_path);
-  const std::string yaml = "{name: speed, subject: 1, class: srt, period: 10ms, reaction_time: 20ms, omission_degree: 1, publishers: [viz], subscribers: [lan]}";
+  const std::string yaml =
+      "{name: speed, subject: 1, class: srt, period: 10ms, reaction_time: 20ms, omission_degree: 1, publishers: [viz], "
+      "subscribers: [lan]}";
   for (const Json& bad : {Json(-1), Json(61), Json("5s"), Json(nullptr)}) {
     const Json answer = client.call({{"command", "replace"}, {"yaml", yaml}, {"match_timeout_s", bad}});
     EXPECT_EQ(answer["ok"], false) << bad.dump();
@@ -441,7 +463,8 @@ TEST_F(ControlTest, ReplaceOfAChannelThatIsNotBoundIsNotFoundAndChangesNothing) 
   serve();
   Client client(socket_path);
   const Json answer =
-      client.call({{"command", "replace"}, {"yaml", "{name: nope, subject: 9, class: nrt, publishers: [lan], subscribers: [viz]}"}});
+      client.call({{"command", "replace"},
+                   {"yaml", "{name: nope, subject: 9, class: nrt, publishers: [lan], subscribers: [viz]}"}});
   EXPECT_EQ(answer["ok"], false);
   EXPECT_EQ(answer["error"]["code"], "not_found");
   EXPECT_NE(answer["error"]["message"].get<std::string>().find("'nope'"), std::string::npos);

@@ -65,7 +65,8 @@ class RouterTest : public ::testing::Test {
   // Delivers straight into the router with a chosen receive time.
   // The header carries the channel's own subject (a foreign one is refused at ingress).
   // `raw`: as a format without origin delivers it (raw LCM), marked for the fingerprint loop guard.
-  void deliver(ChannelId id, EventHeader header, Nanos at, std::vector<std::uint8_t> payload = {1, 2, 3}, bool raw = false) {
+  void deliver(ChannelId id, EventHeader header, Nanos at, std::vector<std::uint8_t> payload = {1, 2, 3},
+               bool raw = false) {
     header.subject = subjects[id];
     const FormatIdentity none{false, false, false, true};  // raw LCM's: nothing, and copies echo back
     router.inbox(0).on_event(InboundEvent{id, header, payload, at, raw ? none : FormatIdentity{}});
@@ -173,7 +174,7 @@ TEST_F(RouterTest, RateLimitHoldsTheReservedRateWithASmallBurst) {
   bind({channel("a", ChannelClass::srt, Nanos(10'000'000))});  // one event per 10 ms, burst 3
   const Nanos t0 = steady_now();
   for (int i = 0; i < 10; ++i) deliver(1, EventHeader{}, t0);  // a babbling source: 10 at once
-  deliver(1, EventHeader{}, t0 + Nanos(10'000'000));            // one period later: one token back
+  deliver(1, EventHeader{}, t0 + Nanos(10'000'000));           // one period later: one token back
   router.run_once(100);
   EXPECT_EQ(out.sent().size(), 4u);
   EXPECT_EQ(dropped("a", DropReason::rate), 7u);
@@ -213,8 +214,8 @@ TEST_F(RouterTest, APublisherAboveItsContractIsCutToIt) {
     router.run_once(100);
   }
   const std::size_t forwarded = out.sent().size();
-  EXPECT_GE(forwarded, 100u);      // one per period over the 100 ms
-  EXPECT_LE(forwarded, 6u + 100u); // plus at most the bucket's depth
+  EXPECT_GE(forwarded, 100u);       // one per period over the 100 ms
+  EXPECT_LE(forwarded, 6u + 100u);  // plus at most the bucket's depth
   EXPECT_EQ(dropped("a", DropReason::rate), 200u - forwarded);
 }
 
@@ -233,10 +234,10 @@ TEST_F(RouterTest, DuplicatesOwnEchoesAndLoopsAreCut) {
   bind({channel("a", ChannelClass::srt)});
   const Nanos now = steady_now();
   deliver(1, EventHeader{1, 0xBBBB, 5, 1, 0, 0}, now);
-  deliver(1, EventHeader{1, 0xBBBB, 5, 1, 0, 0}, now);        // same origin + sequence
-  deliver(1, EventHeader{1, kSelf, 9, 2, 0, 0}, now);         // our own event came back
+  deliver(1, EventHeader{1, 0xBBBB, 5, 1, 0, 0}, now);         // same origin + sequence
+  deliver(1, EventHeader{1, kSelf, 9, 2, 0, 0}, now);          // our own event came back
   deliver(1, EventHeader{1, 0xCCCC, 1, kMaxHops, 0, 0}, now);  // circled too long
-  deliver(1, EventHeader{1, 0xBBBB, 4, 1, 0, 0}, now);        // older but unseen: delivered
+  deliver(1, EventHeader{1, 0xBBBB, 4, 1, 0, 0}, now);         // older but unseen: delivered
   router.run_once(10);
   EXPECT_EQ(out.sent().size(), 2u);
   EXPECT_EQ(dropped("a", DropReason::duplicate), 3u);
@@ -377,7 +378,8 @@ TEST_F(RouterTest, ReapplyKeepsCountersOfKeptChannels) {
   bind({channel("a", ChannelClass::srt)});
   in.inject("a", {1});
   router.run_once(10);
-  std::vector<Route> routes{Route{1, channel("a", ChannelClass::srt), {0}, {1}}, Route{2, channel("b", ChannelClass::srt), {0}, {1}}};
+  std::vector<Route> routes{Route{1, channel("a", ChannelClass::srt), {0}, {1}},
+                            Route{2, channel("b", ChannelClass::srt), {0}, {1}}};
   router.apply(routes);
   EXPECT_EQ(counters("a", "out").tx, 1u);
   EXPECT_EQ(counters("b", "out").tx, 0u);
@@ -429,7 +431,6 @@ TEST(LatencyHistogramTest, BucketsTileTheRangeEightPerPowerOfTwo) {
   EXPECT_EQ(near_20us.quantile(0.0).count(), 22'527);
   EXPECT_EQ(near_20us.quantile(1.0).count(), 23'000);
 }
-
 
 }  // namespace
 }  // namespace cosmic

@@ -1,8 +1,8 @@
 // Incremental admission against the whole-set analysis: over a few hundred seeded random channel
-// sets (tests/unit/random_channels.hpp, 200 for binds and 100 for unbinds), every bind's answer and the bound set's report equal what
-// evaluate() gives for the same set from scratch, with the same policy (a newcomer is rejected if
-// it would reject a bound HRT channel). Unbinding keeps every remaining CAN identifier and never
-// rejects or slows down a remaining channel.
+// sets (tests/unit/random_channels.hpp, 200 for binds and 100 for unbinds), every bind's answer and the bound set's
+// report equal what evaluate() gives for the same set from scratch, with the same policy (a newcomer is rejected if it
+// would reject a bound HRT channel). Unbinding keeps every remaining CAN identifier and never rejects or slows down a
+// remaining channel.
 #include <gtest/gtest.h>
 
 #include <map>
@@ -56,7 +56,8 @@ ChannelReport from_scratch(const RandomSet& set, const KnowledgeBase& kb, const 
     const ChannelReport& existing = whole.channels[i];
     if (existing.cls != ChannelClass::hrt || existing.verdict != Verdict::rejected) continue;
     expected.verdict = Verdict::rejected;
-    for (const auto& reason : existing.reasons) expected.reasons.push_back("would break hrt channel " + existing.name + ": " + reason);
+    for (const auto& reason : existing.reasons)
+      expected.reasons.push_back("would break hrt channel " + existing.name + ": " + reason);
   }
   return expected;
 }

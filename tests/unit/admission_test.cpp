@@ -38,7 +38,8 @@ TEST(FrameFit, HrtAndSrtMustFitOneClassicFrame) {
     EXPECT_EQ(fit->unit, "B");
     EXPECT_TRUE(has_reason(r, "payload 9 B > frame 8 B on can")) << reasons_text(r);
   }
-  const auto ok = run({can_segment("can"), dds_segment("lan")}, {channel("small", 1, ChannelClass::hrt, {"can"}, {"lan"}, 8)});
+  const auto ok =
+      run({can_segment("can"), dds_segment("lan")}, {channel("small", 1, ChannelClass::hrt, {"can"}, {"lan"}, 8)});
   EXPECT_EQ(only(ok).verdict, Verdict::bound) << reasons_text(only(ok));
   EXPECT_TRUE(find_check(*find_hop(only(ok), "can"), "frame_fit")->ok);
 }
@@ -133,7 +134,8 @@ TEST(Bandwidth, IpUtilization) {
   // 1000 B + 96 B every 10 ms over a 1 Mbit/s link: 8768 bits / 0.01 s = 876.8 kbit/s: 87.68 %.
   SegmentSpec slow = dds_segment("slow");
   slow.bandwidth = BitRate{1'000'000};
-  const auto e = run({slow, dds_segment("lan")}, {channel("c", 1, ChannelClass::srt, {"slow"}, {"lan"}, 1000, Nanos(10ms), Nanos(10ms))});
+  const auto e = run({slow, dds_segment("lan")},
+                     {channel("c", 1, ChannelClass::srt, {"slow"}, {"lan"}, 1000, Nanos(10ms), Nanos(10ms))});
   EXPECT_NEAR(e.segments[0].utilization, 0.8768, 1e-12);
   EXPECT_EQ(only(e).verdict, Verdict::degraded);
   EXPECT_TRUE(has_reason(only(e), "utilization 87.7% > max_utilization 70.0% on slow")) << reasons_text(only(e));
@@ -211,15 +213,16 @@ TEST(ResponseTimeCheck, OverloadIsUnbounded) {
 // ---------------------------------------------------------------- priorities and identifiers
 
 TEST(Priorities, DeadlineMonotonicInsideBands) {
-  const auto e = run({can_segment("can"), dds_segment("lan")},
-                     {channel("s20", 1, ChannelClass::srt, {"can"}, {"lan"}, 1, Nanos(50ms), Nanos(20ms)),
-                      channel("s5", 2, ChannelClass::srt, {"can"}, {"lan"}, 1, Nanos(50ms), Nanos(5ms)),
-                      channel("n", 3, ChannelClass::nrt, {"can"}, {"lan"}, 1, Nanos(50ms)),
-                      channel("s10", 4, ChannelClass::srt, {"can"}, {"lan"}, 1, Nanos(50ms), Nanos(10ms)),
-                      channel("h9", 5, ChannelClass::hrt, {"can"}, {"lan"}, 1, Nanos(50ms), Nanos(9ms)),
-                      channel("h3", 6, ChannelClass::hrt, {"can"}, {"lan"}, 1, Nanos(50ms), Nanos(3ms)),
-                      channel("n_fast", 7, ChannelClass::nrt, {"can"}, {"lan"}, 1, Nanos(20ms))},
-                     {{"s20", 16383}, {"s5", 16382}, {"n", 16381}, {"s10", 16380}, {"h9", 16379}, {"h3", 16378}, {"n_fast", 200}});
+  const auto e =
+      run({can_segment("can"), dds_segment("lan")},
+          {channel("s20", 1, ChannelClass::srt, {"can"}, {"lan"}, 1, Nanos(50ms), Nanos(20ms)),
+           channel("s5", 2, ChannelClass::srt, {"can"}, {"lan"}, 1, Nanos(50ms), Nanos(5ms)),
+           channel("n", 3, ChannelClass::nrt, {"can"}, {"lan"}, 1, Nanos(50ms)),
+           channel("s10", 4, ChannelClass::srt, {"can"}, {"lan"}, 1, Nanos(50ms), Nanos(10ms)),
+           channel("h9", 5, ChannelClass::hrt, {"can"}, {"lan"}, 1, Nanos(50ms), Nanos(9ms)),
+           channel("h3", 6, ChannelClass::hrt, {"can"}, {"lan"}, 1, Nanos(50ms), Nanos(3ms)),
+           channel("n_fast", 7, ChannelClass::nrt, {"can"}, {"lan"}, 1, Nanos(20ms))},
+          {{"s20", 16383}, {"s5", 16382}, {"n", 16381}, {"s10", 16380}, {"h9", 16379}, {"h3", 16378}, {"n_fast", 200}});
   auto prio = [&](std::size_t i) { return e.channels[i].hops[0].can->priority; };
   EXPECT_EQ(prio(5), 0x00);  // h3
   EXPECT_EQ(prio(4), 0x01);  // h9
@@ -246,8 +249,8 @@ TEST(Priorities, EqualDeadlinesOrderedBySubject) {
 }
 
 TEST(Priorities, GatewayNodeInIdentifier) {
-  const auto e = run({can_segment("can"), dds_segment("lan")}, {channel("c", 1, ChannelClass::hrt, {"can"}, {"lan"}, 1)},
-                     {{"c", 4242}}, gateway(500us, 99));
+  const auto e = run({can_segment("can"), dds_segment("lan")},
+                     {channel("c", 1, ChannelClass::hrt, {"can"}, {"lan"}, 1)}, {{"c", 4242}}, gateway(500us, 99));
   const CanIdentifier id = decode_can_id(e.channels[0].hops[0].can->can_id);
   EXPECT_EQ(id, (CanIdentifier{0, 99, 4242}));
 }
@@ -489,7 +492,8 @@ TEST(FamousoProfile, SharedLevelsAreAnalysedInWireOrder) {
   EtagMap etags;
   for (int i = 0; i < 10; ++i) {
     const std::string name = "n" + std::to_string(i);
-    channels.push_back(channel(name, 100 + i, ChannelClass::nrt, {"lan"}, {"bus"}, 8, Nanos(10ms) + Nanos(i * 1'000'000)));
+    channels.push_back(
+        channel(name, 100 + i, ChannelClass::nrt, {"lan"}, {"bus"}, 8, Nanos(10ms) + Nanos(i * 1'000'000)));
     etags[name] = static_cast<std::uint16_t>(1000 - 10 * i);  // the later the deadline, the lower the etag
   }
   const auto e = run({famouso_segment("bus"), dds_segment("lan")}, channels, etags, gateway(500us, 9));

@@ -35,8 +35,8 @@ TEST(BindingPlan, AcceptsEveryWellFormedBindingInOrder) {
 
 TEST(BindingPlan, RefusesBindingsWithoutIdOrNameOneByOne) {
   const std::vector<ChannelBinding> given{binding(kNoChannel, "x", HopRole::subscriber),
-                                          binding(kNoChannel, "y", HopRole::subscriber), binding(4, "", HopRole::publisher),
-                                          binding(5, "kept", HopRole::publisher)};
+                                          binding(kNoChannel, "y", HopRole::subscriber),
+                                          binding(4, "", HopRole::publisher), binding(5, "kept", HopRole::publisher)};
   const BindingPlan plan(given);
   EXPECT_EQ(ids(plan.accepted()), (std::vector<ChannelId>{5}));
   const Status status = plan.status();
@@ -76,11 +76,12 @@ TEST(BindingPlan, ATransportRefusalKeepsTheFirstReasonAndTakesTheChannelOutOfEve
 TEST(BindingPlan, DiffNamesWhatIsAddedChangedAndRemovedByChannelAndRole) {
   const std::vector<ChannelBinding> before{binding(1, "a", HopRole::subscriber), binding(2, "b", HopRole::subscriber),
                                            binding(3, "c", HopRole::publisher), binding(4, "d", HopRole::publisher)};
-  const std::vector<ChannelBinding> given{binding(1, "a", HopRole::subscriber),        // kept as it was
-                                          binding(2, "b", HopRole::subscriber, 64),    // changed: payload
-                                          binding(3, "c", HopRole::subscriber),        // new role: added
-                                          binding(5, "e", HopRole::publisher),         // added
-                                          binding(4, "d", HopRole::publisher), binding(4, "d", HopRole::publisher)};
+  const std::vector<ChannelBinding> given{binding(1, "a", HopRole::subscriber),      // kept as it was
+                                          binding(2, "b", HopRole::subscriber, 64),  // changed: payload
+                                          binding(3, "c", HopRole::subscriber),      // new role: added
+                                          binding(5, "e", HopRole::publisher),       // added
+                                          binding(4, "d", HopRole::publisher),
+                                          binding(4, "d", HopRole::publisher)};
   const BindingPlan plan(given);  // d is refused (bound twice): it counts as removed
   const BindingDiff diff = plan.diff(before);
   EXPECT_EQ(ids(diff.added), (std::vector<ChannelId>{3, 5}));

@@ -24,7 +24,9 @@ using namespace cosmic::test;
 // A directory of its own per test, removed afterwards: the configuration and its DBC side by side.
 class TempDir {
  public:
-  TempDir() : path_(std::filesystem::temp_directory_path() / ("cosmic-bg-" + std::to_string(::getpid()) + "-" + std::to_string(++count_))) {
+  TempDir()
+      : path_(std::filesystem::temp_directory_path() /
+              ("cosmic-bg-" + std::to_string(::getpid()) + "-" + std::to_string(++count_))) {
     std::filesystem::create_directories(path_);
   }
   ~TempDir() { std::filesystem::remove_all(path_); }
@@ -78,7 +80,8 @@ segments:
     interface: vcan0
     bitrate: 500kbit/s
     max_utilization: 95%
-)" + background + R"(  - {name: lan, type: dds, latency_bound: 1ms, realtime: true}
+)" + background +
+         R"(  - {name: lan, type: dds, latency_bound: 1ms, realtime: true}
 channels:
   - {name: distance, subject: 0x42, class: hrt, period: 10ms, reaction_time: 5ms, omission_degree: 1, payload: 4B, publishers: [body], subscribers: [lan]}
   - {name: speed, subject: 0x51, class: srt, period: 10ms, reaction_time: 8ms, omission_degree: 1, payload: 8B, publishers: [lan], subscribers: [body]}
@@ -122,7 +125,8 @@ TEST(CanBackgroundConfig, YamlFramesAndTheDbcGiveIdenticalNumbers) {
 TEST(CanBackgroundConfig, AReloadReadsTheDbcAgain) {
   TempDir dir;
   dir.write("body.dbc", kBodyDbc);
-  const std::string yaml = dir.write("gw.yaml", config_with("    background: {dbc: body.dbc, periods: {DoorEvent: 50ms}}\n"));
+  const std::string yaml =
+      dir.write("gw.yaml", config_with("    background: {dbc: body.dbc, periods: {DoorEvent: 50ms}}\n"));
   ConfigFileLoader loader;
   ASSERT_TRUE(loader.load(yaml).ok());
   std::string faster = kBodyDbc;
@@ -142,7 +146,8 @@ TEST(CanBackgroundConfig, ErrorsAreLocatedAndNameTheMessage) {
   ASSERT_EQ(r.errors.size(), 1u) << test::errors_text(r);
   EXPECT_NE(r.errors[0].file.find("body.dbc"), std::string::npos);
   EXPECT_EQ(r.errors[0].line, 20);  // BO_ 800 DoorEvent
-  EXPECT_NE(r.errors[0].message.find("DoorEvent (0x320) has no GenMsgCycleTime"), std::string::npos) << test::errors_text(r);
+  EXPECT_NE(r.errors[0].message.find("DoorEvent (0x320) has no GenMsgCycleTime"), std::string::npos)
+      << test::errors_text(r);
   EXPECT_NE(r.errors[0].valid.find("periods: {DoorEvent: 50ms}"), std::string::npos);
   // ignore: leaves it out.
   r = load(dir, "    background: {dbc: body.dbc, ignore: [DoorEvent]}\n");
@@ -151,7 +156,8 @@ TEST(CanBackgroundConfig, ErrorsAreLocatedAndNameTheMessage) {
   // Names the DBC does not have, a missing file, periods without a DBC.
   r = load(dir, "    background: {dbc: body.dbc, periods: {DoorEvent: 50ms, Wiper: 1s}, ignore: [Horn]}\n");
   EXPECT_EQ(r.errors.size(), 2u) << test::errors_text(r);
-  EXPECT_NE(test::errors_text(r).find("segments[0].background.periods.Wiper: the DBC file"), std::string::npos) << test::errors_text(r);
+  EXPECT_NE(test::errors_text(r).find("segments[0].background.periods.Wiper: the DBC file"), std::string::npos)
+      << test::errors_text(r);
   EXPECT_NE(test::errors_text(r).find("no message named Horn"), std::string::npos) << test::errors_text(r);
   r = load(dir, "    background: {dbc: missing.dbc}\n");
   ASSERT_EQ(r.errors.size(), 1u);
@@ -160,7 +166,8 @@ TEST(CanBackgroundConfig, ErrorsAreLocatedAndNameTheMessage) {
   r = load(dir, "    background: {dbc: /dev/zero}\n");  // never read from a device or a FIFO
   EXPECT_NE(test::errors_text(r).find("not a regular file"), std::string::npos) << test::errors_text(r);
   r = load(dir, "    background: {periods: {DoorEvent: 50ms}}\n");
-  EXPECT_NE(test::errors_text(r).find("periods applies to a DBC's messages"), std::string::npos) << test::errors_text(r);
+  EXPECT_NE(test::errors_text(r).find("periods applies to a DBC's messages"), std::string::npos)
+      << test::errors_text(r);
 }
 
 TEST(CanBackgroundConfig, FrameValuesAreChecked) {
@@ -192,7 +199,8 @@ TEST(CanBackgroundConfig, FrameValuesAreChecked) {
 std::vector<CanBackgroundFrame> sixteen_frames(std::uint32_t first_id) {
   std::vector<CanBackgroundFrame> frames;
   for (std::uint32_t i = 0; i < 16; ++i) {
-    frames.push_back(CanBackgroundFrame{"F" + std::to_string(i), first_id + i, false, 8, Nanos(5ms), Nanos(0), "test", std::nullopt});
+    frames.push_back(CanBackgroundFrame{"F" + std::to_string(i), first_id + i, false, 8, Nanos(5ms), Nanos(0), "test",
+                                        std::nullopt});
   }
   return frames;
 }
@@ -218,8 +226,10 @@ TEST(CanBackgroundAdmission, FramesThatWinArbitrationDelayUsAndAreNamed) {
   EXPECT_EQ(speed.verdict, Verdict::degraded);
   ASSERT_EQ(hop->background.size(), 3u);
   EXPECT_EQ(hop->background[0], (BackgroundDelay{"F0", 0x010, false, Nanos(270'000), false}));
-  EXPECT_TRUE(has_reason(speed, "R = 6.14 ms > reaction_time 4 ms on body; background frames delaying it most: F0 (0x010) 270 us, "
-                                "F1 (0x011) 270 us, F2 (0x012) 270 us"))
+  EXPECT_TRUE(
+      has_reason(speed,
+                 "R = 6.14 ms > reaction_time 4 ms on body; background frames delaying it most: F0 (0x010) 270 us, "
+                 "F1 (0x011) 270 us, F2 (0x012) 270 us"))
       << reasons_text(speed);
   ASSERT_EQ(won.segments.size(), 2u);
   EXPECT_NEAR(won.segments[0].background, 16 * 270.0 / 5000.0, 1e-9);
@@ -238,25 +248,30 @@ TEST(CanBackgroundAdmission, OnEqualBaseBitsTheStandardFrameWins) {
   // A jitter of one period releases a winning frame twice in our queuing delay (2 x 270 us), while
   // a losing one only blocks once (270 us): the two outcomes differ, so the tie rule is what decides.
   // Base bits 0x080 as ours: the standard frame wins the tie (RTR/IDE dominant), so it interferes.
-  const Evaluation tie = speed_on_a_bus_with({CanBackgroundFrame{"Tie", 0x080, false, 8, Nanos(5ms), Nanos(5ms), "test", std::nullopt}});
+  const Evaluation tie =
+      speed_on_a_bus_with({CanBackgroundFrame{"Tie", 0x080, false, 8, Nanos(5ms), Nanos(5ms), "test", std::nullopt}});
   EXPECT_EQ(find_hop(tie.channels[0], "body")->can->response_time, Nanos(1'500'000 + 2 * 270'000 + 320'000));
   // An extended frame with the same base bits and higher low bits than ours loses: it blocks once
   // (0 data bytes, extended: 80 bits = 160 us).
-  const Evaluation ext =
-      speed_on_a_bus_with({CanBackgroundFrame{"Ext", (0x080u << 18) | 0x3FFFF, true, 0, Nanos(5ms), Nanos(5ms), "test", std::nullopt}});
+  const Evaluation ext = speed_on_a_bus_with(
+      {CanBackgroundFrame{"Ext", (0x080u << 18) | 0x3FFFF, true, 0, Nanos(5ms), Nanos(5ms), "test", std::nullopt}});
   EXPECT_EQ(find_hop(ext.channels[0], "body")->can->response_time, Nanos(1'500'000 + 160'000 + 320'000));
 }
 
 TEST(CanBackgroundAdmission, ABusFullOfBackgroundRejectsHrtAndSaysHowFull) {
   SegmentSpec body = can_segment("body", 500'000, 0.70);
   body.can.background = sixteen_frames(0x010);  // 86.4 %
-  const ChannelSpec distance = channel("distance", 0x42, ChannelClass::hrt, {"body"}, {"lan"}, 4, Nanos(10ms), Nanos(5ms));
-  const Evaluation e = evaluate(gateway(), std::vector<SegmentSpec>{body, dds_segment("lan")}, std::vector<ChannelSpec>{distance}, {});
+  const ChannelSpec distance =
+      channel("distance", 0x42, ChannelClass::hrt, {"body"}, {"lan"}, 4, Nanos(10ms), Nanos(5ms));
+  const Evaluation e =
+      evaluate(gateway(), std::vector<SegmentSpec>{body, dds_segment("lan")}, std::vector<ChannelSpec>{distance}, {});
   EXPECT_EQ(e.channels[0].verdict, Verdict::rejected);
-  EXPECT_TRUE(has_reason(e.channels[0], "(background 86.4%) > max_utilization 70.0% on body")) << reasons_text(e.channels[0]);
+  EXPECT_TRUE(has_reason(e.channels[0], "(background 86.4%) > max_utilization 70.0% on body"))
+      << reasons_text(e.channels[0]);
   // Without the background the same channel is bound.
   body.can.background.clear();
-  const Evaluation quiet = evaluate(gateway(), std::vector<SegmentSpec>{body, dds_segment("lan")}, std::vector<ChannelSpec>{distance}, {});
+  const Evaluation quiet =
+      evaluate(gateway(), std::vector<SegmentSpec>{body, dds_segment("lan")}, std::vector<ChannelSpec>{distance}, {});
   EXPECT_EQ(quiet.channels[0].verdict, Verdict::bound) << reasons_text(quiet.channels[0]);
 }
 
@@ -269,7 +284,8 @@ TEST(CanBackgroundAdmission, IncrementalBindsAndRemovalsKeepTheBackground) {
   AdmissionSet set(gateway(), segments);
   for (const auto& c : channels) set.commit(set.trial(c, 0));
   const Evaluation whole = evaluate(gateway(), segments, channels, {});
-  EXPECT_EQ(to_json(AdmissionReport{set.loads(), set.reports()}).dump(), to_json(AdmissionReport{whole.segments, whole.channels}).dump());
+  EXPECT_EQ(to_json(AdmissionReport{set.loads(), set.reports()}).dump(),
+            to_json(AdmissionReport{whole.segments, whole.channels}).dump());
   ASSERT_TRUE(set.remove("a"));
   ASSERT_TRUE(set.remove("b"));
   EXPECT_NEAR(set.loads()[0].utilization, 16 * 270.0 / 5000.0, 1e-9);  // back to the background alone

@@ -37,7 +37,8 @@ channels:
 ConfigResult parse(const std::string& channels) { return parse_config(std::string(kSegments) + channels, "gw.yaml"); }
 
 TEST(NativeCanConfig, StandardExtendedAndLcmIdentitiesAreRead) {
-  const ConfigResult r = parse(R"(  - {name: wheel, subject: 0x10, class: hrt, period: 10ms, reaction_time: 5ms, payload: 8B, publishers: [body], subscribers: [lan, viz],
+  const ConfigResult r = parse(
+      R"(  - {name: wheel, subject: 0x10, class: hrt, period: 10ms, reaction_time: 5ms, payload: 8B, publishers: [body], subscribers: [lan, viz],
      native: {body: {can_id: 0x123}, viz: {channel: WHEEL_SPEED}}}
   - {name: lamp, subject: 0x11, class: srt, period: 20ms, reaction_time: 20ms, payload: 2B, publishers: [lan], subscribers: [body],
      native: {body: {can_id: 0x18FF0123, extended: true}}}
@@ -58,7 +59,8 @@ TEST(NativeCanConfig, StandardExtendedAndLcmIdentitiesAreRead) {
 }
 
 TEST(NativeCanConfig, EveryProblemIsLocatedAtOnce) {
-  const ConfigResult r = parse(R"(  - {name: a, subject: 0x10, class: srt, period: 10ms, reaction_time: 5ms, publishers: [body], subscribers: [lan],
+  const ConfigResult r = parse(
+      R"(  - {name: a, subject: 0x10, class: srt, period: 10ms, reaction_time: 5ms, publishers: [body], subscribers: [lan],
      native: {body: {can_id: 0x800}}}
   - {name: b, subject: 0x11, class: srt, period: 10ms, reaction_time: 5ms, publishers: [body], subscribers: [lan],
      native: {body: {can_id: 0x18FF0002, extended: true}}}
@@ -79,18 +81,24 @@ TEST(NativeCanConfig, EveryProblemIsLocatedAtOnce) {
   - {name: j, subject: 0x19, class: srt, period: 10ms, reaction_time: 5ms, publishers: [lan], subscribers: [viz], native: [body]}
 )");
   const std::string text = errors_text(r.errors);
-  EXPECT_NE(text.find("gw.yaml:12:30: channels[0].native.body.can_id: '0x800' is out of range"), std::string::npos) << text;
-  EXPECT_NE(text.find("channels[1].native.body.can_id: extended identifier 0x18FF0002 has etag bits 2, which the binding protocols use"),
+  EXPECT_NE(text.find("gw.yaml:12:30: channels[0].native.body.can_id: '0x800' is out of range"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("channels[1].native.body.can_id: extended identifier 0x18FF0002 has etag bits 2, which the "
+                      "binding protocols use"),
             std::string::npos)
       << text;
-  EXPECT_NE(text.find("channels[2].native.body.can_id: 0x0C0 is declared as background frame Engine (gw.yaml:7:"), std::string::npos)
+  EXPECT_NE(text.find("channels[2].native.body.can_id: 0x0C0 is declared as background frame Engine (gw.yaml:7:"),
+            std::string::npos)
       << text;
   EXPECT_NE(text.find("channels[3].native.lan.type: missing required key 'type'"), std::string::npos) << text;
   EXPECT_NE(text.find("channels[3].native.nowhere: unknown segment 'nowhere'"), std::string::npos) << text;
-  EXPECT_NE(text.find("channels[4].native.body: segment 'body' is neither a publisher nor a subscriber of channel e"), std::string::npos)
+  EXPECT_NE(text.find("channels[4].native.body: segment 'body' is neither a publisher nor a subscriber of channel e"),
+            std::string::npos)
       << text;
   EXPECT_NE(text.find("channels[6].native.body.extra: unknown key 'extra'"), std::string::npos) << text;
-  EXPECT_NE(text.find("channels[8].native.body: 0x301 on segment body is already channel h's (line 26)"), std::string::npos) << text;
+  EXPECT_NE(text.find("channels[8].native.body: 0x301 on segment body is already channel h's (line 26)"),
+            std::string::npos)
+      << text;
   EXPECT_NE(text.find("channels[9].native: expected a map of segment names"), std::string::npos) << text;
   EXPECT_EQ(r.errors.size(), 9u) << text;
 }
@@ -103,9 +111,10 @@ Config native_bus() {
   return c;
 }
 
-ChannelSpec native_channel(const std::string& name, std::uint64_t subject, ChannelClass cls, NativeCanFrame frame, bool from_can = true,
-                           std::uint64_t payload = 8) {
-  ChannelSpec c = from_can ? channel(name, subject, cls, {"body"}, {"lan"}, payload) : channel(name, subject, cls, {"lan"}, {"body"}, payload);
+ChannelSpec native_channel(const std::string& name, std::uint64_t subject, ChannelClass cls, NativeCanFrame frame,
+                           bool from_can = true, std::uint64_t payload = 8) {
+  ChannelSpec c = from_can ? channel(name, subject, cls, {"body"}, {"lan"}, payload)
+                           : channel(name, subject, cls, {"lan"}, {"body"}, payload);
   c.native.push_back(NativeBinding{"body", frame, std::nullopt, std::nullopt});
   return c;
 }
@@ -142,7 +151,8 @@ TEST(NativeCanAdmission, TheIdentifierIsTheFramesPriorityAndOneFrameIsTheEvent) 
 // A native channel delays the gateway's other frames exactly as a background frame of the same
 // identifier, length and period does: the analysis knows no difference.
 TEST(NativeCanAdmission, ANativeChannelWeighsLikeTheSameBackgroundFrame) {
-  for (const NativeCanFrame frame : {NativeCanFrame{0x020, false}, NativeCanFrame{0x600, false}, NativeCanFrame{0x00FF1234, true}}) {
+  for (const NativeCanFrame frame :
+       {NativeCanFrame{0x020, false}, NativeCanFrame{0x600, false}, NativeCanFrame{0x00FF1234, true}}) {
     Config with_native = native_bus();
     with_native.channels = {channel("speed", 0x51, ChannelClass::srt, {"lan"}, {"body"}),
                             native_channel("wheel", 0x10, ChannelClass::srt, frame, true, 8)};
@@ -164,7 +174,8 @@ TEST(NativeCanAdmission, APayloadThatDoesNotFitOneFrameIsRefusedWhateverTheClass
   ASSERT_EQ(report.channels.size(), 1u);
   EXPECT_EQ(report.channels[0].verdict, Verdict::rejected);
   ASSERT_FALSE(report.channels[0].reasons.empty());
-  EXPECT_NE(report.channels[0].reasons[0].find("payload 9 B > native frame 8 B on body"), std::string::npos) << report.channels[0].reasons[0];
+  EXPECT_NE(report.channels[0].reasons[0].find("payload 9 B > native frame 8 B on body"), std::string::npos)
+      << report.channels[0].reasons[0];
   // CAN FD carries up to 64 bytes in one frame.
   c.segments[0].can.fd = true;
   c.segments[0].can.data_bitrate = BitRate{2'000'000};
@@ -174,7 +185,8 @@ TEST(NativeCanAdmission, APayloadThatDoesNotFitOneFrameIsRefusedWhateverTheClass
 
 TEST(NativeCanKnowledgeBase, IdentitiesAndEtagBitsAreNeverShared) {
   Config c = native_bus();
-  c.segments[0].can.background.push_back(CanBackgroundFrame{"J1939", 0x18EFFF01, true, 8, Nanos(100ms), Nanos(0), "test", std::nullopt});
+  c.segments[0].can.background.push_back(
+      CanBackgroundFrame{"J1939", 0x18EFFF01, true, 8, Nanos(100ms), Nanos(0), "test", std::nullopt});
   KnowledgeBase kb(c.gateway, c.segments, {});
   ASSERT_TRUE(kb.bind(native_channel("wheel", 0x10, ChannelClass::srt, NativeCanFrame{0x00FF3FFF, true})).bound());
   // A dynamic etag skips 16383 (the native identifier's etag bits) and the background frame's 16129.
@@ -191,21 +203,26 @@ TEST(NativeCanKnowledgeBase, IdentitiesAndEtagBitsAreNeverShared) {
     ASSERT_NE(kb.etag_of(second.name), 16129) << i;
   }
   // The same identifier again, on the same bus: refused with the owner named.
-  const BindOutcome again = kb.bind(native_channel("wheel2", 0x11, ChannelClass::srt, NativeCanFrame{0x00FF3FFF, true}, false));
+  const BindOutcome again =
+      kb.bind(native_channel("wheel2", 0x11, ChannelClass::srt, NativeCanFrame{0x00FF3FFF, true}, false));
   EXPECT_FALSE(again.bound());
   EXPECT_EQ(again.report.reasons.at(0), "0x00FF3FFF on segment body is already carried by bound channel wheel");
   // An extended identifier whose etag bits a bound COSMIC channel uses, and the reverse.
-  const BindOutcome clash = kb.bind(native_channel("lamp", 0x12, ChannelClass::srt, NativeCanFrame{0x00AA0000 | 16382, true}));
+  const BindOutcome clash =
+      kb.bind(native_channel("lamp", 0x12, ChannelClass::srt, NativeCanFrame{0x00AA0000 | 16382, true}));
   EXPECT_FALSE(clash.bound());
-  EXPECT_EQ(clash.report.reasons.at(0), "extended identifier 0x00AA3FFE reads as etag 16382 of bound channel speed to COSMIC devices");
+  EXPECT_EQ(clash.report.reasons.at(0),
+            "extended identifier 0x00AA3FFE reads as etag 16382 of bound channel speed to COSMIC devices");
   ChannelSpec fixed = channel("fixed", 0x53, ChannelClass::srt, {"lan"}, {"body"});
   fixed.etag = 16383;
   const BindOutcome taken = kb.bind(fixed);
   EXPECT_FALSE(taken.bound());
-  EXPECT_EQ(taken.report.reasons.at(0), "etag 16383 is the etag bits of bound channel wheel's native extended identifier");
+  EXPECT_EQ(taken.report.reasons.at(0),
+            "etag 16383 is the etag bits of bound channel wheel's native extended identifier");
   // Unbound, the identifier is free again.
   EXPECT_TRUE(kb.unbind("wheel"));
-  EXPECT_TRUE(kb.bind(native_channel("wheel2", 0x11, ChannelClass::srt, NativeCanFrame{0x00FF3FFF, true}, false)).bound());
+  EXPECT_TRUE(
+      kb.bind(native_channel("wheel2", 0x11, ChannelClass::srt, NativeCanFrame{0x00FF3FFF, true}, false)).bound());
 }
 
 TEST(NativeCanReport, TheHopShowsTheNativeIdentifier) {
@@ -226,16 +243,19 @@ TEST(NativeCanReport, TheHopShowsTheNativeIdentifier) {
 // channels whose identifier it beats, and only theirs.
 TEST(UndeclaredInterference, NamesTheHrtChannelsAFrameBeats) {
   Config c = native_bus();
-  c.channels = {native_channel("brake", 0x10, ChannelClass::hrt, NativeCanFrame{0x0F0, false}),
-                native_channel("wheel", 0x11, ChannelClass::srt, NativeCanFrame{0x050, false}),
-                channel("stop", 0x12, ChannelClass::hrt, {"lan"}, {"body"})};  // extended, priority 0x00: base bits 0x000
+  c.channels = {
+      native_channel("brake", 0x10, ChannelClass::hrt, NativeCanFrame{0x0F0, false}),
+      native_channel("wheel", 0x11, ChannelClass::srt, NativeCanFrame{0x050, false}),
+      channel("stop", 0x12, ChannelClass::hrt, {"lan"}, {"body"})};  // extended, priority 0x00: base bits 0x000
   const AdmissionReport report = admit_all(c);
   for (const char* name : {"brake", "wheel", "stop"}) ASSERT_NE(report.find(name)->verdict, Verdict::rejected) << name;
-  const std::vector<UnexplainedFrames> seen = {{0x0A0, false, 3, 100.0}, {0x1ABCFF00, true, 5, 10.0}, {0x010, false, 1, 0.0}};
+  const std::vector<UnexplainedFrames> seen = {
+      {0x0A0, false, 3, 100.0}, {0x1ABCFF00, true, 5, 10.0}, {0x010, false, 1, 0.0}};
   const auto hit = undeclared_interference(report, "body", seen);
   ASSERT_EQ(hit.size(), 1u);  // wheel is SRT; stop's identifier beats them all; 0x010 is silent
   EXPECT_EQ(hit.at("brake"),
-            "undeclared frames 0x0A0 at 100.0 Hz win arbitration over its identifier 0x0F0 on body: its response-time analysis did "
+            "undeclared frames 0x0A0 at 100.0 Hz win arbitration over its identifier 0x0F0 on body: its response-time "
+            "analysis did "
             "not count them (declare them as the segment's background)");
   EXPECT_TRUE(undeclared_interference(report, "lan", seen).empty());
   // A silent frame that wins counts once it sends again.

@@ -66,7 +66,9 @@ struct ArbitrationBits {
   std::array<std::uint8_t, 32> bits{};
   std::size_t length = 0;
   void send(std::uint32_t bit) { bits[length++] = static_cast<std::uint8_t>(bit & 1u); }
-  void send_id_bits(std::uint32_t id, int from, int to) { for (int b = from; b >= to; --b) send(id >> b); }
+  void send_id_bits(std::uint32_t id, int from, int to) {
+    for (int b = from; b >= to; --b) send(id >> b);
+  }
 };
 
 inline ArbitrationBits arbitration_bits(const OracleStream& s) {
@@ -141,7 +143,9 @@ inline Wide greatest_common_divisor(Wide a, Wide b) {
   return a;
 }
 
-struct Fraction { Wide numerator = 0, denominator = 1; };
+struct Fraction {
+  Wide numerator = 0, denominator = 1;
+};
 
 // a + n/d, or nullopt when the exact value no longer fits 127 bits.
 inline std::optional<Fraction> plus(Fraction a, std::int64_t n, std::int64_t d) {
@@ -157,7 +161,9 @@ inline std::optional<Fraction> plus(Fraction a, std::int64_t n, std::int64_t d) 
   return Fraction{sum.numerator / common, sum.denominator / common};
 }
 
-struct LoadTerm { std::int64_t numerator, denominator; };
+struct LoadTerm {
+  std::int64_t numerator, denominator;
+};
 
 inline std::vector<LoadTerm> load_terms(const OracleLevel& level, const OracleBus& bus) {
   std::vector<LoadTerm> terms{{level.self->transmission, level.self->period}};
@@ -179,7 +185,8 @@ inline bool level_overloaded(const OracleLevel& level, const OracleBus& bus) {
     approximate += static_cast<long double>(term.numerator) / static_cast<long double>(term.denominator);
   }
   if (exact) return exact->numerator >= exact->denominator;
-  if (std::fabs(approximate - 1.0L) < 1e-12L) ADD_FAILURE() << "oracle cannot decide a load of " << static_cast<double>(approximate);
+  if (std::fabs(approximate - 1.0L) < 1e-12L)
+    ADD_FAILURE() << "oracle cannot decide a load of " << static_cast<double>(approximate);
   return approximate >= 1.0L;
 }
 
@@ -187,7 +194,8 @@ inline bool level_overloaded(const OracleLevel& level, const OracleBus& bus) {
 
 inline std::int64_t higher_priority_demand(const OracleLevel& level, std::int64_t interval, std::int64_t offset) {
   std::int64_t demand = 0;
-  for (const OracleStream* k : level.higher) demand += ceiling_of(interval + k->jitter + offset, k->period) * k->transmission;
+  for (const OracleStream* k : level.higher)
+    demand += ceiling_of(interval + k->jitter + offset, k->period) * k->transmission;
   return demand;
 }
 
@@ -204,7 +212,8 @@ inline std::optional<std::int64_t> oracle_busy_period(const OracleLevel& level, 
   }
 }
 
-inline std::optional<std::int64_t> oracle_queuing_delay(const OracleLevel& level, const OracleBus& bus, std::int64_t q) {
+inline std::optional<std::int64_t> oracle_queuing_delay(const OracleLevel& level, const OracleBus& bus,
+                                                        std::int64_t q) {
   const OracleStream& m = *level.self;
   std::int64_t w = level.blocking + q * m.transmission;
   while (true) {
@@ -216,7 +225,8 @@ inline std::optional<std::int64_t> oracle_queuing_delay(const OracleLevel& level
   }
 }
 
-inline std::optional<Nanos> oracle_response_time(std::span<const OracleStream> streams, std::size_t m, const OracleBus& bus) {
+inline std::optional<Nanos> oracle_response_time(std::span<const OracleStream> streams, std::size_t m,
+                                                 const OracleBus& bus) {
   const OracleLevel level = level_of(streams, m);
   if (level_overloaded(level, bus)) return std::nullopt;
   const auto busy = oracle_busy_period(level, bus);
@@ -232,7 +242,8 @@ inline std::optional<Nanos> oracle_response_time(std::span<const OracleStream> s
   return Nanos(worst);
 }
 
-inline std::vector<std::optional<Nanos>> oracle_response_times(std::span<const OracleStream> streams, const OracleBus& bus) {
+inline std::vector<std::optional<Nanos>> oracle_response_times(std::span<const OracleStream> streams,
+                                                               const OracleBus& bus) {
   std::vector<std::optional<Nanos>> results;
   for (std::size_t m = 0; m < streams.size(); ++m) results.push_back(oracle_response_time(streams, m, bus));
   return results;
@@ -269,13 +280,15 @@ inline std::string describe(const TestBus& bus) {
   out << "bitrate " << bus.properties.bitrate.bits_per_second << ", errors " << bus.properties.errors.max_per_window
       << " per " << bus.properties.errors.window.count() << " ns\n";
   for (const OracleStream& s : bus.streams) {
-    out << "  " << (s.format == CanIdFormat::standard11 ? "std 0x" : "ext 0x") << std::hex << s.id << std::dec
-        << " C " << s.transmission << " T " << s.period << " J " << s.jitter << "\n";
+    out << "  " << (s.format == CanIdFormat::standard11 ? "std 0x" : "ext 0x") << std::hex << s.id << std::dec << " C "
+        << s.transmission << " T " << s.period << " J " << s.jitter << "\n";
   }
   return out.str();
 }
 
-inline std::string show(const std::optional<Nanos>& r) { return r ? std::to_string(r->count()) : std::string("unbounded"); }
+inline std::string show(const std::optional<Nanos>& r) {
+  return r ? std::to_string(r->count()) : std::string("unbounded");
+}
 
 inline constexpr std::int64_t kMs = 1'000'000;
 

@@ -26,7 +26,8 @@ std::size_t count_disagreements(const TestBus& bus, const std::vector<std::optio
   for (std::size_t i = 0; i < oracle.size(); ++i) {
     if (library[i] == oracle[i]) continue;
     ++wrong;
-    ADD_FAILURE() << what << ": stream " << i << " library " << show(library[i]) << " oracle " << show(oracle[i]) << "\n"
+    ADD_FAILURE() << what << ": stream " << i << " library " << show(library[i]) << " oracle " << show(oracle[i])
+                  << "\n"
                   << describe(bus);
   }
   return wrong;
@@ -42,7 +43,9 @@ class Dice {
     return low + static_cast<std::int64_t>(engine_() % static_cast<std::uint64_t>(high - low + 1));
   }
   bool percent(int chance) { return between(0, 99) < chance; }
-  std::size_t index(std::size_t size) { return static_cast<std::size_t>(between(0, static_cast<std::int64_t>(size) - 1)); }
+  std::size_t index(std::size_t size) {
+    return static_cast<std::size_t>(between(0, static_cast<std::int64_t>(size) - 1));
+  }
 
  private:
   std::mt19937_64 engine_;
@@ -73,7 +76,8 @@ void random_identifier(Dice& dice, const std::vector<OracleStream>& so_far, cons
     s.format = twin.format;
     return;
   }
-  const auto base = dice.percent(75) ? bases[dice.index(bases.size())] : static_cast<std::uint32_t>(dice.between(0, 0x7FF));
+  const auto base =
+      dice.percent(75) ? bases[dice.index(bases.size())] : static_cast<std::uint32_t>(dice.between(0, 0x7FF));
   s.format = dice.percent(50) ? CanIdFormat::standard11 : CanIdFormat::extended29;
   s.id = s.format == CanIdFormat::standard11 ? base : base << 18 | random_low_bits(dice);
 }
@@ -189,7 +193,8 @@ TEST(CanRtaOracle, ReuseOfPreviousAnalysisWithNewcomerMatchesFreshAndOracle) {
     const TestBus before = random_bus(dice, bases);
     TestBus after = before;
     const OracleStream newcomer = random_stream(dice, before, bases);
-    after.streams.insert(after.streams.begin() + dice.between(0, static_cast<std::int64_t>(before.streams.size())), newcomer);
+    after.streams.insert(after.streams.begin() + dice.between(0, static_cast<std::int64_t>(before.streams.size())),
+                         newcomer);
     const CanBusTiming timing = bus_timing(before.properties);
     const CanBusAnalysis previous(library_streams(before.streams), timing);
     const CanBusAnalysis reused(library_streams(after.streams), timing, &previous);

@@ -143,7 +143,7 @@ TEST(FdFrame, CrcLengthSwitchesAbove16Bytes) {
 TEST(FdFrame, FrameTime64BExtended500k2M) {
   CanSegmentProperties bus;
   bus.fd = true;
-  bus.bitrate = BitRate{500'000};        // 2 us per nominal bit
+  bus.bitrate = BitRate{500'000};         // 2 us per nominal bit
   bus.data_bitrate = BitRate{2'000'000};  // 0.5 us per data bit
   // 56 * 2 us + 679 * 0.5 us = 112 us + 339.5 us = 451.5 us.
   EXPECT_EQ(frame_time(bus, 64, CanIdFormat::extended29), Nanos(451'500));
@@ -226,7 +226,8 @@ TEST(ResponseTime, SingleStreamIsItsFrameTime) {
 // Blocking: a higher-priority 0.5 ms frame waits behind a lower-priority 2 ms frame that just
 // started: R = B + C = 2 + 0.5 = 2.5 ms. The lower one: w = ceil(0.001/10)*0.5 = 0.5, R = 2.5 ms.
 TEST(ResponseTime, BlockingByLowerPriorityLongerFrame) {
-  const std::array<CanStream, 2> streams{{{1, Nanos(500us), Nanos(10ms), Nanos(0)}, {2, Nanos(2ms), Nanos(10ms), Nanos(0)}}};
+  const std::array<CanStream, 2> streams{
+      {{1, Nanos(500us), Nanos(10ms), Nanos(0)}, {2, Nanos(2ms), Nanos(10ms), Nanos(0)}}};
   const auto r = response_times(streams, timing_with_bit(Nanos(1us)));
   EXPECT_EQ(r[0], Nanos(2500us));
   EXPECT_EQ(r[1], Nanos(2500us));
@@ -251,7 +252,8 @@ TEST(ResponseTime, ErrorTermRetransmitsLongestHigherOrEqualFrame) {
   // Low stream (C = 0.5 ms) under a high stream (C = 1 ms, T = 10 ms); one error per 100 ms.
   // Low: w = E(w + 0.5) + ceil((w + 0.001)/10) * 1: w0 = 0 -> 1.031 + 1 = 2.031 -> stays.
   // R = 2.031 + 0.5 = 2.531 ms (the error retransmits the 1 ms frame, not the 0.5 ms one).
-  const std::array<CanStream, 2> streams{{{1, Nanos(1ms), Nanos(10ms), Nanos(0)}, {2, Nanos(500us), Nanos(10ms), Nanos(0)}}};
+  const std::array<CanStream, 2> streams{
+      {{1, Nanos(1ms), Nanos(10ms), Nanos(0)}, {2, Nanos(500us), Nanos(10ms), Nanos(0)}}};
   const auto r = response_times(streams, timing_with_bit(Nanos(1us), {1, Nanos(100ms)}));
   EXPECT_EQ(r[1], Nanos(2'531'000));
 }
@@ -259,7 +261,8 @@ TEST(ResponseTime, ErrorTermRetransmitsLongestHigherOrEqualFrame) {
 TEST(ResponseTime, OverloadedBusIsUnbounded) {
   // Two 1 ms frames every 1.5 ms: 133 % load. The higher one still has a bound:
   // B = 1 ms, busy period 3 ms, Q = 2; q=0: R = 1 + 1 = 2 ms; q=1: R = 2 - 1.5 + 1 = 1.5 ms.
-  const std::array<CanStream, 2> streams{{{1, Nanos(1ms), Nanos(1500us), Nanos(0)}, {2, Nanos(1ms), Nanos(1500us), Nanos(0)}}};
+  const std::array<CanStream, 2> streams{
+      {{1, Nanos(1ms), Nanos(1500us), Nanos(0)}, {2, Nanos(1ms), Nanos(1500us), Nanos(0)}}};
   const auto r = response_times(streams, timing_with_bit(Nanos(1us)));
   EXPECT_EQ(r[0], Nanos(2ms));
   EXPECT_FALSE(r[1].has_value());
@@ -277,9 +280,11 @@ TEST(ResponseTime, JitterOfOwnAndHigherStreams) {
   EXPECT_EQ(response_times(own, timing_with_bit(Nanos(1us)))[0], Nanos(4ms));
   // Jitter of a higher stream (C = 1, T = 5, J = 4.5) lets two of its frames hit the low one:
   // w = 0 -> ceil(4.501/5) = 1 -> ceil(5.501/5) = 2 -> 2; R = 2 + 1 = 3 ms (2 ms without jitter).
-  const std::array<CanStream, 2> hp{{{1, Nanos(1ms), Nanos(5ms), Nanos(4500us)}, {2, Nanos(1ms), Nanos(100ms), Nanos(0)}}};
+  const std::array<CanStream, 2> hp{
+      {{1, Nanos(1ms), Nanos(5ms), Nanos(4500us)}, {2, Nanos(1ms), Nanos(100ms), Nanos(0)}}};
   EXPECT_EQ(response_times(hp, timing_with_bit(Nanos(1us)))[1], Nanos(3ms));
-  const std::array<CanStream, 2> no_jitter{{{1, Nanos(1ms), Nanos(5ms), Nanos(0)}, {2, Nanos(1ms), Nanos(100ms), Nanos(0)}}};
+  const std::array<CanStream, 2> no_jitter{
+      {{1, Nanos(1ms), Nanos(5ms), Nanos(0)}, {2, Nanos(1ms), Nanos(100ms), Nanos(0)}}};
   EXPECT_EQ(response_times(no_jitter, timing_with_bit(Nanos(1us)))[1], Nanos(2ms));
 }
 
@@ -288,7 +293,8 @@ TEST(ResponseTime, JitterOfOwnAndHigherStreams) {
 // Fifty 100 us frames with identifiers 10, 20, ..., 500, every 100 ms, plus one newcomer.
 std::vector<CanStream> fifty_and(std::optional<CanStream> newcomer) {
   std::vector<CanStream> streams;
-  for (std::uint32_t id = 10; id <= 500; id += 10) streams.push_back(CanStream{id, Nanos(100us), Nanos(100ms), Nanos(0)});
+  for (std::uint32_t id = 10; id <= 500; id += 10)
+    streams.push_back(CanStream{id, Nanos(100us), Nanos(100ms), Nanos(0)});
   if (newcomer) streams.push_back(*newcomer);
   return streams;
 }
@@ -336,7 +342,8 @@ TEST(CanWire, IdentifierLayout) {
   EXPECT_EQ(encode_can_id(CanIdentifier{0, 0, 0}), 0u);
   EXPECT_EQ(encode_can_id(CanIdentifier{0, 5, 101}), (5u << 14) | 101u);
   EXPECT_EQ(decode_can_id(0x2407FFF), (CanIdentifier{0x12, 1, 16383}));
-  for (const CanIdentifier id : {CanIdentifier{0xF0, 42, 2}, CanIdentifier{0x0F, 127, 3}, CanIdentifier{0x80, 0, 9999}}) {
+  for (const CanIdentifier id :
+       {CanIdentifier{0xF0, 42, 2}, CanIdentifier{0x0F, 127, 3}, CanIdentifier{0x80, 0, 9999}}) {
     EXPECT_EQ(decode_can_id(encode_can_id(id)), id);
   }
   // A lower priority number wins arbitration whatever node and etag.
@@ -362,9 +369,9 @@ TEST(CanWire, PriorityBands) {
   EXPECT_EQ(band_priority(ChannelClass::nrt, 0, 2), 0xF0);
   EXPECT_EQ(band_priority(ChannelClass::nrt, 15, 16), 0xFF);
   // More channels than levels: spread evenly, never outside the band.
-  EXPECT_EQ(band_priority(ChannelClass::hrt, 1, 32), 0x00);   // 1 * 16 / 32 = 0
-  EXPECT_EQ(band_priority(ChannelClass::hrt, 2, 32), 0x01);   // 2 * 16 / 32 = 1
-  EXPECT_EQ(band_priority(ChannelClass::hrt, 31, 32), 0x0F);  // 31 * 16 / 32 = 15
+  EXPECT_EQ(band_priority(ChannelClass::hrt, 1, 32), 0x00);      // 1 * 16 / 32 = 0
+  EXPECT_EQ(band_priority(ChannelClass::hrt, 2, 32), 0x01);      // 2 * 16 / 32 = 1
+  EXPECT_EQ(band_priority(ChannelClass::hrt, 31, 32), 0x0F);     // 31 * 16 / 32 = 15
   EXPECT_EQ(band_priority(ChannelClass::srt, 999, 1000), 0xEF);  // 0x10 + 999 * 224 / 1000
   EXPECT_EQ(band_priority(ChannelClass::nrt, 99, 100), 0xFF);
 }
@@ -372,7 +379,7 @@ TEST(CanWire, PriorityBands) {
 TEST(CanWire, Fragments) {
   EXPECT_EQ(fragments_needed(8, 8), 1u);
   EXPECT_EQ(fragments_needed(0, 8), 1u);
-  EXPECT_EQ(fragments_needed(9, 8), 2u);    // 6 data bytes per fragment after the 2-byte header
+  EXPECT_EQ(fragments_needed(9, 8), 2u);  // 6 data bytes per fragment after the 2-byte header
   EXPECT_EQ(fragments_needed(12, 8), 2u);
   EXPECT_EQ(fragments_needed(13, 8), 3u);
   EXPECT_EQ(fragments_needed(256, 8), 43u);  // ceil(256 / 6)

@@ -62,7 +62,8 @@ TEST(Config, RobotLoadsAndEveryChannelIsBound) {
   ASSERT_EQ(report.channels.size(), config.channels.size());
   for (std::size_t i = 0; i < report.channels.size(); ++i) {
     EXPECT_EQ(report.channels[i].name, config.channels[i].name);  // all bound: declaration order
-    EXPECT_EQ(report.channels[i].verdict, Verdict::bound) << report.channels[i].name << "\n" << reasons_text(report.channels[i]);
+    EXPECT_EQ(report.channels[i].verdict, Verdict::bound) << report.channels[i].name << "\n"
+                                                          << reasons_text(report.channels[i]);
     EXPECT_TRUE(report.channels[i].reasons.empty()) << reasons_text(report.channels[i]);
   }
   EXPECT_FALSE(report.any_rejected());
@@ -85,7 +86,8 @@ TEST(Config, OverloadedExampleTriggersEveryKindOnce) {
       {"wheel_speed", Verdict::bound, ""},
       {"battery", Verdict::bound, ""},
       {"diagnostics", Verdict::bound, ""},
-      {"collision_warning", Verdict::rejected, "would break hrt channel brake_pressure: end-to-end latency 5.34 ms > reaction_time 5 ms"},
+      {"collision_warning", Verdict::rejected,
+       "would break hrt channel brake_pressure: end-to-end latency 5.34 ms > reaction_time 5 ms"},
       {"emergency_stop", Verdict::rejected, "R = 2 ms > reaction_time 1.5 ms on body-can"},
       {"camera_status", Verdict::rejected, "payload 12 B > frame 8 B on body-can"},
       {"trailer_axle_load", Verdict::degraded, "utilization 64.0% > max_utilization 50.0% on trailer-can"},
@@ -244,9 +246,10 @@ channels:
 
 TEST(Config, MaxRateBecomesPeriod) {
   auto period_of = [](const std::string& rate) {
-    const Config config = parse_ok("segments:\n  - {name: a, type: dds}\n  - {name: b, type: lcm}\nchannels:\n"
-                                   "  - {name: c, subject: 1, class: nrt, max_rate: " +
-                                   rate + ", publishers: [a], subscribers: [b]}\n");
+    const Config config = parse_ok(
+        "segments:\n  - {name: a, type: dds}\n  - {name: b, type: lcm}\nchannels:\n"
+        "  - {name: c, subject: 1, class: nrt, max_rate: " +
+        rate + ", publishers: [a], subscribers: [b]}\n");
     return config.channels.empty() ? std::optional<Nanos>{} : config.channels[0].period;
   };
   EXPECT_EQ(period_of("100Hz"), Nanos(10ms));
@@ -324,8 +327,8 @@ channels:
 }
 
 TEST(BindDocument, ListOfChannels) {
-  const ChannelsResult r = parse_channels("- {name: a, subject: 10, class: nrt, publishers: [bus], subscribers: [lan]}\n",
-                                          "bind.yaml", running_config());
+  const ChannelsResult r = parse_channels(
+      "- {name: a, subject: 10, class: nrt, publishers: [bus], subscribers: [lan]}\n", "bind.yaml", running_config());
   ASSERT_TRUE(r.ok()) << describe(r.errors);
   ASSERT_EQ(r.channels.size(), 1u);
   EXPECT_EQ(r.channels[0].subject, 10u);
@@ -341,15 +344,17 @@ TEST(BindDocument, OneChannelMap) {
 
 TEST(BindDocument, ErrorsWithLocation) {
   // Segments are those of the running configuration.
-  ChannelsResult r = parse_channels("name: a\nsubject: 10\nclass: nrt\npublishers: [can9]\nsubscribers: [lan]\n", "bind.yaml",
-                                    running_config());
+  ChannelsResult r = parse_channels("name: a\nsubject: 10\nclass: nrt\npublishers: [can9]\nsubscribers: [lan]\n",
+                                    "bind.yaml", running_config());
   ASSERT_EQ(r.errors.size(), 1u) << describe(r.errors);
-  EXPECT_EQ(r.errors[0].to_string(), "bind.yaml:4:14: channel.publishers[0]: unknown segment 'can9' (one of the segments: bus, lan)");
+  EXPECT_EQ(r.errors[0].to_string(),
+            "bind.yaml:4:14: channel.publishers[0]: unknown segment 'can9' (one of the segments: bus, lan)");
   EXPECT_TRUE(r.channels.empty());
   // Duplicates inside one bind document.
-  r = parse_channels("- {name: a, subject: 10, class: nrt, publishers: [bus], subscribers: [lan]}\n"
-                     "- {name: a, subject: 10, class: nrt, publishers: [bus], subscribers: [lan]}\n",
-                     "bind.yaml", running_config());
+  r = parse_channels(
+      "- {name: a, subject: 10, class: nrt, publishers: [bus], subscribers: [lan]}\n"
+      "- {name: a, subject: 10, class: nrt, publishers: [bus], subscribers: [lan]}\n",
+      "bind.yaml", running_config());
   ASSERT_EQ(r.errors.size(), 2u) << describe(r.errors);
   EXPECT_EQ(r.errors[0].path, "channels[1].name");
   EXPECT_EQ(r.errors[1].path, "channels[1].subject");
@@ -372,7 +377,8 @@ TEST(BindDocument, ErrorsWithLocation) {
 
 // A running configuration with IP segments only: lan and lan2 (DDS), viz (LCM).
 Config ip_segments() {
-  return parse_ok("segments: [{name: lan, type: dds}, {name: lan2, type: dds, domain: 1}, {name: viz, type: lcm}]\nchannels: []\n");
+  return parse_ok(
+      "segments: [{name: lan, type: dds}, {name: lan2, type: dds, domain: 1}, {name: viz, type: lcm}]\nchannels: []\n");
 }
 
 TEST(BoundedYaml, AliasAmplificationInABindRequestIsRefusedWithItsLocation) {
@@ -407,7 +413,8 @@ TEST(BoundedYaml, EndlessEmptyDocumentsAreNotCounted) {
 
 TEST(BoundedYaml, ErrorsBeyondTheLimitAreCountedInOneLine) {
   std::string yaml = "segments: [{name: lan, type: dds}, {name: viz, type: lcm}]\nchannels:\n";
-  for (int i = 0; i < 250; ++i) yaml += "  - {name: c" + std::to_string(i) + ", subject: 0, class: nrt, publishers: [lan], subscribers: [viz]}\n";
+  for (int i = 0; i < 250; ++i)
+    yaml += "  - {name: c" + std::to_string(i) + ", subject: 0, class: nrt, publishers: [lan], subscribers: [viz]}\n";
   const auto r = parse_config(yaml, "many.yaml");
   ASSERT_EQ(r.errors.size(), 101u);
   EXPECT_EQ(r.errors[99].path, "channels[99].subject");
@@ -417,7 +424,7 @@ TEST(BoundedYaml, ErrorsBeyondTheLimitAreCountedInOneLine) {
 TEST(BoundedYaml, ALargeFileWithinTheLimitsStillLoads) {
   std::string yaml = "segments: [{name: lan, type: dds}, {name: viz, type: lcm}]\nchannels:\n";
   const std::string comment = "  # " + std::string(200, '-') + "\n";  // bytes without nodes: parsing stays quick
-  for (int i = 1; i <= 4000; ++i) {  // above 1 MiB: the node count runs too
+  for (int i = 1; i <= 4000; ++i) {                                   // above 1 MiB: the node count runs too
     yaml += comment + "  - {name: channel_number_" + std::to_string(i) + ", subject: " + std::to_string(i) +
             ", class: nrt, publishers: [lan], subscribers: [viz]}\n";
   }
@@ -429,8 +436,9 @@ TEST(BoundedYaml, ALargeFileWithinTheLimitsStillLoads) {
 }
 
 TEST(Quantities, MaxRateBecomesAPeriodWithoutOverflow) {
-  const auto slowest = parse_channels("{name: c, subject: 1, class: nrt, max_rate: 0.000000001Hz, publishers: [lan], subscribers: [viz]}",
-                                      "bind.yaml", ip_segments());
+  const auto slowest = parse_channels(
+      "{name: c, subject: 1, class: nrt, max_rate: 0.000000001Hz, publishers: [lan], subscribers: [viz]}", "bind.yaml",
+      ip_segments());
   ASSERT_TRUE(slowest.ok()) << describe(slowest.errors);
   ASSERT_TRUE(slowest.channels[0].period);
   EXPECT_GT(*slowest.channels[0].period, Nanos(999'999'999'000'000'000));  // 1e9 s, give or take rounding
@@ -441,10 +449,12 @@ TEST(Quantities, MaxRateBecomesAPeriodWithoutOverflow) {
 
 TEST(Quantities, ALongLcmNameIsRefusedOnlyWhereLcmCarriesIt) {
   const std::string name(64, 'n');
-  const auto over_dds = parse_channels("{name: " + name + ", subject: 1, class: nrt, publishers: [lan], subscribers: [lan2]}",
-                                       "bind.yaml", ip_segments());
-  const auto over_lcm = parse_channels("{name: " + name + ", subject: 1, class: nrt, publishers: [lan], subscribers: [viz]}",
-                                       "bind.yaml", ip_segments());
+  const auto over_dds =
+      parse_channels("{name: " + name + ", subject: 1, class: nrt, publishers: [lan], subscribers: [lan2]}",
+                     "bind.yaml", ip_segments());
+  const auto over_lcm =
+      parse_channels("{name: " + name + ", subject: 1, class: nrt, publishers: [lan], subscribers: [viz]}", "bind.yaml",
+                     ip_segments());
   EXPECT_FALSE(over_lcm.ok());
   EXPECT_NE(describe(over_lcm.errors).find("at most 63 characters"), std::string::npos) << describe(over_lcm.errors);
   EXPECT_TRUE(over_dds.ok()) << describe(over_dds.errors);
@@ -456,8 +466,9 @@ TEST(ConfigFileLoader, OnlyAnUnchangedValidFileSkipsParsing) {
   const std::string dir = ::testing::TempDir();
   const std::string path = dir + "/cosmic_loader_test.yaml";
   const std::string other = dir + "/cosmic_loader_test_other.yaml";
-  const std::string one = "segments: [{name: lan, type: dds}, {name: viz, type: lcm}]\nchannels:\n"
-                          "  - {name: a, subject: 1, class: nrt, publishers: [lan], subscribers: [viz]}\n";
+  const std::string one =
+      "segments: [{name: lan, type: dds}, {name: viz, type: lcm}]\nchannels:\n"
+      "  - {name: a, subject: 1, class: nrt, publishers: [lan], subscribers: [viz]}\n";
   auto write = [](const std::string& file, const std::string& text) { std::ofstream(file, std::ios::trunc) << text; };
   write(path, one);
   write(other, one);

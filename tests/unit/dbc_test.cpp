@@ -37,7 +37,8 @@ std::vector<std::string> messages_of(const DbcFile& file) {
 // "line:column: message" per error.
 std::vector<std::string> errors_of(const DbcFile& file) {
   std::vector<std::string> out;
-  for (const DbcError& e : file.errors) out.push_back(std::to_string(e.line) + ":" + std::to_string(e.column) + ": " + e.message);
+  for (const DbcError& e : file.errors)
+    out.push_back(std::to_string(e.line) + ":" + std::to_string(e.column) + ": " + e.message);
   return out;
 }
 
@@ -173,7 +174,8 @@ VAL_ 300 S 1 "one" 0 "zero" ;
 
 TEST(DbcParse, NewSymbolsMayStandUnindentedAndTheListEndsAtTheFirstStatement) {
   // A name alone on its line is a new symbol, even a keyword at column 1; a line of more tokens is a statement.
-  const DbcFile file = parse_dbc("NS_ : NS_DESC_\nCM_\nBA_\n BO_\nBO_TX_BU_\nVAL_TABLE_ T 1 \"a\" ;\nBO_ 7 Seven: 8 X\n");
+  const DbcFile file =
+      parse_dbc("NS_ : NS_DESC_\nCM_\nBA_\n BO_\nBO_TX_BU_\nVAL_TABLE_ T 1 \"a\" ;\nBO_ 7 Seven: 8 X\n");
   EXPECT_TRUE(file.ok()) << ::testing::PrintToString(errors_of(file));
   EXPECT_EQ(messages_of(file), std::vector<std::string>{"Seven 0x7 std 8 event 7:1"});
 }
@@ -187,7 +189,8 @@ TEST(DbcParse, StatementsMayShareALine) {
 TEST(DbcParse, EveryCanFdLengthIsAccepted) {
   std::string text;
   for (const int length : {0, 1, 8, 12, 16, 20, 24, 32, 48, 64}) {
-    text += "BO_ " + std::to_string(100 + length) + " L" + std::to_string(length) + ": " + std::to_string(length) + " X\n";
+    text +=
+        "BO_ " + std::to_string(100 + length) + " L" + std::to_string(length) + ": " + std::to_string(length) + " X\n";
   }
   const DbcFile file = parse_dbc(text);
   EXPECT_TRUE(file.ok()) << ::testing::PrintToString(errors_of(file));
@@ -213,15 +216,18 @@ BA_ "GenMsgCycleTime" BO_ 1 10;
 BA_ "GenMsgCycleTime" BO_ 3 0;
 )");
   EXPECT_TRUE(file.ok());
-  EXPECT_EQ(messages_of(file), (std::vector<std::string>{"A 0x1 std 8 10ms 1:1", "B 0x2 std 8 100ms 2:1", "C 0x3 std 8 event 3:1"}));
+  EXPECT_EQ(messages_of(file),
+            (std::vector<std::string>{"A 0x1 std 8 10ms 1:1", "B 0x2 std 8 100ms 2:1", "C 0x3 std 8 event 3:1"}));
   EXPECT_EQ(file.messages[0].cycle_time, Nanos(10'000'000));
 }
 
 TEST(DbcCycleTime, WithoutDefaultOrWithDefaultZeroOnlyExplicitValuesCount) {
   constexpr std::string_view kMessages = "BO_ 1 A: 8 X\nBO_ 2 B: 8 X\nBA_ \"GenMsgCycleTime\" BO_ 2 20;\n";
-  EXPECT_EQ(messages_of(parse_dbc(kMessages)), (std::vector<std::string>{"A 0x1 std 8 event 1:1", "B 0x2 std 8 20ms 2:1"}));
+  EXPECT_EQ(messages_of(parse_dbc(kMessages)),
+            (std::vector<std::string>{"A 0x1 std 8 event 1:1", "B 0x2 std 8 20ms 2:1"}));
   const std::string zero_default = std::string(kMessages) + "BA_DEF_DEF_ \"GenMsgCycleTime\" 0;\n";
-  EXPECT_EQ(messages_of(parse_dbc(zero_default)), (std::vector<std::string>{"A 0x1 std 8 event 1:1", "B 0x2 std 8 20ms 2:1"}));
+  EXPECT_EQ(messages_of(parse_dbc(zero_default)),
+            (std::vector<std::string>{"A 0x1 std 8 event 1:1", "B 0x2 std 8 20ms 2:1"}));
 }
 
 TEST(DbcCycleTime, ExtendedIdsAreNamedWithBit31AndTheLastValueWins) {
@@ -254,13 +260,18 @@ BA_ "Comment" BO_ 1 "GenMsgCycleTime";
 TEST(DbcErrors, MessageLineSyntax) {
   EXPECT_EQ(errors_of("BO_ abc Foo: 8 X\n"),
             std::vector<std::string>{"1:5: expected the message id (a decimal number) after BO_, found 'abc'"});
-  EXPECT_EQ(errors_of("BO_\nBO_ 1 A: 8 X\n"), std::vector<std::string>{"1:4: expected the message id (a decimal number) after BO_"});
-  EXPECT_EQ(errors_of("BO_ 100 : 8 X\n"), std::vector<std::string>{"1:9: expected the message name after the id, found ':'"});
-  EXPECT_EQ(errors_of("BO_ 100 Foo 8 X\n"), std::vector<std::string>{"1:13: expected ':' after the message name, found '8'"});
-  EXPECT_EQ(errors_of("BO_ 100 Foo: X\n"), std::vector<std::string>{"1:14: expected the message length in bytes after ':', found 'X'"});
+  EXPECT_EQ(errors_of("BO_\nBO_ 1 A: 8 X\n"),
+            std::vector<std::string>{"1:4: expected the message id (a decimal number) after BO_"});
+  EXPECT_EQ(errors_of("BO_ 100 : 8 X\n"),
+            std::vector<std::string>{"1:9: expected the message name after the id, found ':'"});
+  EXPECT_EQ(errors_of("BO_ 100 Foo 8 X\n"),
+            std::vector<std::string>{"1:13: expected ':' after the message name, found '8'"});
+  EXPECT_EQ(errors_of("BO_ 100 Foo: X\n"),
+            std::vector<std::string>{"1:14: expected the message length in bytes after ':', found 'X'"});
   EXPECT_EQ(errors_of("BO_ 100 Foo: 8\n SG_ A : 0|8@1+ (1,0) [0|0] \"\" X\n"),
             std::vector<std::string>{"1:15: expected the transmitting node after the length"});
-  EXPECT_EQ(errors_of("BO_ 100 Foo: 8 X Y\n"), std::vector<std::string>{"1:18: unexpected 'Y' after the transmitting node"});
+  EXPECT_EQ(errors_of("BO_ 100 Foo: 8 X Y\n"),
+            std::vector<std::string>{"1:18: unexpected 'Y' after the transmitting node"});
 }
 
 TEST(DbcErrors, MessageIdOutOfRange) {
@@ -270,24 +281,29 @@ TEST(DbcErrors, MessageIdOutOfRange) {
             std::vector<std::string>{"1:5: message id '0x100' is not a decimal number from 0 to 4294967295"});
   EXPECT_EQ(errors_of("BO_ -1 Foo: 8 X\n"),
             std::vector<std::string>{"1:5: message id '-1' is not a decimal number from 0 to 4294967295"});
-  EXPECT_EQ(errors_of("\n  BO_ 2048 Foo: 8 X\n"),
-            std::vector<std::string>{
-                "2:7: standard message id 2048 (0x800) is above 0x7FF (an extended id has bit 31 set: add 2147483648)"});
+  EXPECT_EQ(
+      errors_of("\n  BO_ 2048 Foo: 8 X\n"),
+      std::vector<std::string>{
+          "2:7: standard message id 2048 (0x800) is above 0x7FF (an extended id has bit 31 set: add 2147483648)"});
   // 0xA0000000: bit 31 and bit 29.
-  EXPECT_EQ(errors_of("BO_ 2684354560 Foo: 8 X\n"),
-            std::vector<std::string>{
-                "1:5: extended message id 2684354560 does not fit 29 bits: 0x20000000 > 0x1FFFFFFF after removing bit 31"});
+  EXPECT_EQ(
+      errors_of("BO_ 2684354560 Foo: 8 X\n"),
+      std::vector<std::string>{
+          "1:5: extended message id 2684354560 does not fit 29 bits: 0x20000000 > 0x1FFFFFFF after removing bit 31"});
   // The largest of each kind are fine.
   EXPECT_TRUE(parse_dbc("BO_ 2047 A: 8 X\nBO_ 2684354559 B: 8 X\n").ok());
 }
 
 TEST(DbcErrors, MessageLengthOutOfRange) {
-  EXPECT_EQ(errors_of("BO_ 1 A: 65 X\n"), std::vector<std::string>{"1:10: message length 65 is out of range (0..64 bytes)"});
-  EXPECT_EQ(errors_of("BO_ 1 A: 10 X\n"),
-            std::vector<std::string>{"1:10: message length 10 is not a CAN FD length (0..8, 12, 16, 20, 24, 32, 48 or 64)"});
+  EXPECT_EQ(errors_of("BO_ 1 A: 65 X\n"),
+            std::vector<std::string>{"1:10: message length 65 is out of range (0..64 bytes)"});
+  EXPECT_EQ(
+      errors_of("BO_ 1 A: 10 X\n"),
+      std::vector<std::string>{"1:10: message length 10 is not a CAN FD length (0..8, 12, 16, 20, 24, 32, 48 or 64)"});
   EXPECT_EQ(errors_of("BO_ 1 A: 8.5 X\n"),
             std::vector<std::string>{"1:10: message length '8.5' is not a whole number of bytes (0..64)"});
-  EXPECT_EQ(errors_of("BO_ 1 A: -8 X\n"), std::vector<std::string>{"1:10: message length '-8' is not a whole number of bytes (0..64)"});
+  EXPECT_EQ(errors_of("BO_ 1 A: -8 X\n"),
+            std::vector<std::string>{"1:10: message length '-8' is not a whole number of bytes (0..64)"});
   EXPECT_TRUE(parse_dbc("BO_ 1 A: 65 X\n").messages.empty());
 }
 
@@ -303,28 +319,32 @@ TEST(DbcErrors, DuplicateIdsAndNamesNameBothLines) {
   // A standard and an extended frame with the same number are different frames.
   EXPECT_TRUE(parse_dbc("BO_ 16 A: 8 X\nBO_ 2147483664 B: 8 X\n").ok());
   EXPECT_EQ(errors_of("BO_ 2147483664 A: 8 X\nBO_ 2147483664 B: 8 X\n"),
-            std::vector<std::string>{"2:5: duplicate message id 2147483664 (extended 0x10): 'B' repeats the id of 'A' declared at line 1"});
+            std::vector<std::string>{
+                "2:5: duplicate message id 2147483664 (extended 0x10): 'B' repeats the id of 'A' declared at line 1"});
 }
 
 TEST(DbcErrors, CycleTimeForAnUndeclaredMessage) {
   EXPECT_EQ(errors_of("BO_ 1 A: 8 X\nBA_ \"GenMsgCycleTime\" BO_ 2 10;\n"),
             std::vector<std::string>{"2:27: BA_ \"GenMsgCycleTime\" names message id 2 (0x2), which no BO_ declares"});
   // A message that is declared but refused (here its length) does not cause a second error.
-  EXPECT_EQ(errors_of("BO_ 1 A: 9 X\nBA_ \"GenMsgCycleTime\" BO_ 1 10;\n"),
-            std::vector<std::string>{"1:10: message length 9 is not a CAN FD length (0..8, 12, 16, 20, 24, 32, 48 or 64)"});
+  EXPECT_EQ(
+      errors_of("BO_ 1 A: 9 X\nBA_ \"GenMsgCycleTime\" BO_ 1 10;\n"),
+      std::vector<std::string>{"1:10: message length 9 is not a CAN FD length (0..8, 12, 16, 20, 24, 32, 48 or 64)"});
 }
 
 TEST(DbcErrors, CycleTimeValues) {
   EXPECT_EQ(errors_of("BO_ 1 A: 8 X\nBA_ \"GenMsgCycleTime\" BO_ 1 -10;\n"),
             std::vector<std::string>{"2:29: GenMsgCycleTime must not be negative, found '-10'"});
   EXPECT_EQ(errors_of("BO_ 1 A: 8 X\nBA_ \"GenMsgCycleTime\" BO_ 1 12.5;\n"),
-            std::vector<std::string>{"2:29: GenMsgCycleTime must be a whole number of milliseconds (0..4294967295), found '12.5'"});
+            std::vector<std::string>{
+                "2:29: GenMsgCycleTime must be a whole number of milliseconds (0..4294967295), found '12.5'"});
   EXPECT_EQ(errors_of("BO_ 1 A: 8 X\nBA_ \"GenMsgCycleTime\" BO_ 1 \"10\";\n"),
             std::vector<std::string>{"2:29: expected GenMsgCycleTime in whole milliseconds, found the string '10'"});
   EXPECT_EQ(errors_of("BA_DEF_DEF_ \"GenMsgCycleTime\" -1;\n"),
             std::vector<std::string>{"1:31: GenMsgCycleTime must not be negative, found '-1'"});
   EXPECT_EQ(errors_of("BA_DEF_DEF_ \"GenMsgCycleTime\" 1e2;\n"),
-            std::vector<std::string>{"1:31: GenMsgCycleTime must be a whole number of milliseconds (0..4294967295), found '1e2'"});
+            std::vector<std::string>{
+                "1:31: GenMsgCycleTime must be a whole number of milliseconds (0..4294967295), found '1e2'"});
   EXPECT_EQ(errors_of("BA_DEF_DEF_ \"GenMsgCycleTime\" 4294967296;\n"),
             std::vector<std::string>{
                 "1:31: GenMsgCycleTime must be a whole number of milliseconds (0..4294967295), found '4294967296'"});
@@ -345,12 +365,15 @@ TEST(DbcErrors, AttributeStatementSyntax) {
   EXPECT_EQ(errors_of("BA_ \"GenMsgCycleTime\" BO_ A 10;\n"),
             std::vector<std::string>{"1:27: expected the message id after BO_, found 'A'"});
   EXPECT_EQ(errors_of("BA_ GenMsgCycleTime BO_ 1 10;\n"),
-            std::vector<std::string>{"1:5: expected the attribute name as a quoted string after BA_, found 'GenMsgCycleTime'"});
-  EXPECT_EQ(errors_of("BA_DEF_DEF_ 10;\n"),
-            std::vector<std::string>{"1:13: expected the attribute name as a quoted string after BA_DEF_DEF_, found '10'"});
-  EXPECT_EQ(errors_of("BA_DEF_ XX_ \"A\" INT 0 1;\n"),
             std::vector<std::string>{
-                "1:9: expected BU_, BO_, SG_, EV_ or the attribute name as a quoted string after BA_DEF_, found 'XX_'"});
+                "1:5: expected the attribute name as a quoted string after BA_, found 'GenMsgCycleTime'"});
+  EXPECT_EQ(
+      errors_of("BA_DEF_DEF_ 10;\n"),
+      std::vector<std::string>{"1:13: expected the attribute name as a quoted string after BA_DEF_DEF_, found '10'"});
+  EXPECT_EQ(
+      errors_of("BA_DEF_ XX_ \"A\" INT 0 1;\n"),
+      std::vector<std::string>{
+          "1:9: expected BU_, BO_, SG_, EV_ or the attribute name as a quoted string after BA_DEF_, found 'XX_'"});
   EXPECT_EQ(errors_of("BA_DEF_ BO_ INT 0 1;\n"),
             std::vector<std::string>{"1:13: expected the attribute name as a quoted string, found 'INT'"});
 }
@@ -363,16 +386,19 @@ TEST(DbcErrors, SignalLineSyntax) {
   EXPECT_EQ(errors_of("BO_ 1 A: 8 X\n SG_ S 0|8@1+ (1,0) [0|0] \"\" X\n"),
             std::vector<std::string>{"2:8: expected ':' after the signal name, found '0'"});
   EXPECT_EQ(errors_of("BO_ 1 A: 8 X\n SG_ S x3 : 0|8@1+ (1,0) [0|0] \"\" X\n"),
-            std::vector<std::string>{"2:8: expected ':' or a multiplexer indicator (M, m<n> or m<n>M) after the signal name, found 'x3'"});
+            std::vector<std::string>{
+                "2:8: expected ':' or a multiplexer indicator (M, m<n> or m<n>M) after the signal name, found 'x3'"});
   EXPECT_EQ(errors_of("BO_ 1 A: 8 X\n SG_ S mM : 0|8@1+ (1,0) [0|0] \"\" X\n"),
-            std::vector<std::string>{"2:8: expected ':' or a multiplexer indicator (M, m<n> or m<n>M) after the signal name, found 'mM'"});
+            std::vector<std::string>{
+                "2:8: expected ':' or a multiplexer indicator (M, m<n> or m<n>M) after the signal name, found 'mM'"});
   EXPECT_EQ(errors_of("BO_ 1 A: 8 X\n SG_ S m1 0|8@1+ (1,0) [0|0] \"\" X\n"),
             std::vector<std::string>{"2:11: expected ':' after the multiplexer indicator, found '0'"});
 }
 
 TEST(DbcErrors, UnterminatedStringStopsAtItsStartAndKeepsWhatCameBefore) {
   const DbcFile file = parse_dbc("BO_ 1 A: 8 X\nCM_ BO_ 1 \"never\nclosed \\\";\nBO_ 2 B: 8 X\n");
-  EXPECT_EQ(errors_of(file), std::vector<std::string>{"2:11: unterminated string: no closing '\"' before the end of the text"});
+  EXPECT_EQ(errors_of(file),
+            std::vector<std::string>{"2:11: unterminated string: no closing '\"' before the end of the text"});
   EXPECT_EQ(messages_of(file), std::vector<std::string>{"A 0x1 std 8 event 1:1"});
   // Inside a statement that is being checked, the cut-off statement adds no error of its own.
   EXPECT_EQ(errors_of("BA_ \"GenMsgCycleTime\" BO_ 1 \"10;\n"),
@@ -392,7 +418,8 @@ TEST(DbcErrors, AllErrorsAreReportedInTextOrder) {
 
 TEST(DbcLimits, TextAbove8MiBIsOneErrorAndUnread) {
   const std::string too_long(kDbcMaxTextBytes + 1, ' ');
-  EXPECT_EQ(errors_of(too_long), std::vector<std::string>{"0:0: the DBC text has 8388609 bytes, more than the limit of 8388608 (8 MiB)"});
+  EXPECT_EQ(errors_of(too_long),
+            std::vector<std::string>{"0:0: the DBC text has 8388609 bytes, more than the limit of 8388608 (8 MiB)"});
   std::string largest = "BO_ 1 A: 8 X\n";
   largest.resize(kDbcMaxTextBytes, '\n');
   const DbcFile file = parse_dbc(largest);
@@ -425,7 +452,8 @@ TEST(DbcLimits, ErrorsAreCappedWithAClosingCount) {
 TEST(DbcLimits, HostileLongTokensAreQuotedShort) {
   const std::string name(100'000, 'N');
   const std::string cut = "'" + std::string(24, 'N') + "...' (100000 characters)";
-  EXPECT_EQ(errors_of("BO_ 1 A " + name + " 8 X\n"), std::vector<std::string>{"1:9: expected ':' after the message name, found " + cut});
+  EXPECT_EQ(errors_of("BO_ 1 A " + name + " 8 X\n"),
+            std::vector<std::string>{"1:9: expected ':' after the message name, found " + cut});
   EXPECT_EQ(errors_of("BO_ 1 " + name + ": 8 X\nBO_ 2 " + name + ": 8 X\n"),
             std::vector<std::string>{"2:7: duplicate message name " + cut + ": already declared at line 1"});
 }

@@ -33,12 +33,15 @@ segments:
 channels:
 )";
 
-ConfigResult parse_native(const std::string& channels) { return parse_config(std::string(kNativeSegments) + channels, "gw.yaml"); }
+ConfigResult parse_native(const std::string& channels) {
+  return parse_config(std::string(kNativeSegments) + channels, "gw.yaml");
+}
 
 constexpr const char* kTwist = "geometry_msgs::msg::dds_::Twist_";
 
 TEST(NativeDdsConfig, TopicTypeAndRepresentationAreReadAndPersisted) {
-  const ConfigResult r = parse_native(R"(  - {name: cmd_vel, subject: 0x20, class: srt, period: 10ms, reaction_time: 50ms, payload: 52B, publishers: [robot], subscribers: [lan, viz],
+  const ConfigResult r = parse_native(
+      R"(  - {name: cmd_vel, subject: 0x20, class: srt, period: 10ms, reaction_time: 50ms, payload: 52B, publishers: [robot], subscribers: [lan, viz],
      native: {robot: {topic: rt/cmd_vel, type: "geometry_msgs::msg::dds_::Twist_"}, lan: {topic: rt/ns1/cmd_vel, type: "geometry_msgs::msg::dds_::Twist_", representation: xcdr2, keyed: false}}}
 )");
   ASSERT_TRUE(r.ok()) << native_errors_text(r.errors);
@@ -52,7 +55,8 @@ TEST(NativeDdsConfig, TopicTypeAndRepresentationAreReadAndPersisted) {
 }
 
 TEST(NativeDdsConfig, EveryProblemIsLocatedAtOnce) {
-  const ConfigResult r = parse_native(R"(  - {name: a, subject: 0x10, class: nrt, payload: 52B, publishers: [robot], subscribers: [lan], native: {robot: {topic: "rt/cmd vel", type: T}}}
+  const ConfigResult r = parse_native(
+      R"(  - {name: a, subject: 0x10, class: nrt, payload: 52B, publishers: [robot], subscribers: [lan], native: {robot: {topic: "rt/cmd vel", type: T}}}
   - {name: b, subject: 0x11, class: nrt, payload: 52B, publishers: [robot], subscribers: [lan], native: {robot: {topic: cosmic/b, type: T}}}
   - {name: c, subject: 0x12, class: nrt, payload: 52B, publishers: [robot], subscribers: [lan], native: {robot: {topic: rt/c, type: "pkg::::T"}}}
   - {name: d, subject: 0x13, class: nrt, payload: 52B, publishers: [robot], subscribers: [lan], native: {robot: {topic: rt/d, type: "cosmic::Envelope"}}}
@@ -65,26 +69,39 @@ TEST(NativeDdsConfig, EveryProblemIsLocatedAtOnce) {
   - {name: k, subject: 0x1A, class: nrt, payload: 52B, publishers: [robot], subscribers: [lan], native: {robot: {topic: "rt/k\"\n", type: T}}}
 )");
   const std::string text = native_errors_text(r.errors);
-  EXPECT_NE(text.find("gw.yaml:7:121: channels[0].native.robot.topic: topic name 'rt/cmd vel' has 0x20 at position 7"), std::string::npos)
+  EXPECT_NE(text.find("gw.yaml:7:121: channels[0].native.robot.topic: topic name 'rt/cmd vel' has 0x20 at position 7"),
+            std::string::npos)
       << text;
-  EXPECT_NE(text.find("channels[1].native.robot.topic: topic name 'cosmic/b' is under cosmic/"), std::string::npos) << text;
-  EXPECT_NE(text.find("channels[2].native.robot.type: type name 'pkg::::T' has a part that is not an IDL identifier"), std::string::npos)
+  EXPECT_NE(text.find("channels[1].native.robot.topic: topic name 'cosmic/b' is under cosmic/"), std::string::npos)
       << text;
-  EXPECT_NE(text.find("channels[3].native.robot.type: cosmic::Envelope is the gateway's own envelope type"), std::string::npos) << text;
+  EXPECT_NE(text.find("channels[2].native.robot.type: type name 'pkg::::T' has a part that is not an IDL identifier"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("channels[3].native.robot.type: cosmic::Envelope is the gateway's own envelope type"),
+            std::string::npos)
+      << text;
   EXPECT_NE(text.find("channels[4].native.robot.keyed: keyed types are not carried"), std::string::npos) << text;
-  EXPECT_NE(text.find("channels[5].native.robot.representation: unknown representation 'xml'"), std::string::npos) << text;
-  EXPECT_NE(text.find("channels[6].native.robot.topic: missing required key 'topic'"), std::string::npos) << text;
-  EXPECT_NE(text.find("channels[8].native.robot: rt/h on segment robot is already channel h's (line 14)"), std::string::npos) << text;
-  EXPECT_NE(text.find("channels[9].native.robot.topic: topic name 'rt//j' has an empty part between '/' separators"), std::string::npos)
+  EXPECT_NE(text.find("channels[5].native.robot.representation: unknown representation 'xml'"), std::string::npos)
       << text;
-  EXPECT_NE(text.find("channels[10].native.robot.topic: topic name 'rt/k\"\\x0A' has '\"' at position 5"), std::string::npos) << text;
+  EXPECT_NE(text.find("channels[6].native.robot.topic: missing required key 'topic'"), std::string::npos) << text;
+  EXPECT_NE(text.find("channels[8].native.robot: rt/h on segment robot is already channel h's (line 14)"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("channels[9].native.robot.topic: topic name 'rt//j' has an empty part between '/' separators"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("channels[10].native.robot.topic: topic name 'rt/k\"\\x0A' has '\"' at position 5"),
+            std::string::npos)
+      << text;
   EXPECT_EQ(r.errors.size(), 10u) << text;
 }
 
 TEST(DdsNames, EnvelopeAndNativeTopicsAreNamedOneWayEverywhere) {
   ChannelSpec c = channel("robot.arm-left_2", 0x1, ChannelClass::srt, {"robot"}, {"lan"}, 52);
-  EXPECT_EQ(dds_topic_of(c, "lan"), (DdsTopicRef{"cosmic/robot_arm_left_2", kEnvelopeTypeName, false, DdsRepresentation::xcdr1}));
-  c.native.push_back(NativeBinding{"robot", std::nullopt, std::nullopt, NativeDdsTopic{"rt/arm", kTwist, DdsRepresentation::xcdr2}});
+  EXPECT_EQ(dds_topic_of(c, "lan"),
+            (DdsTopicRef{"cosmic/robot_arm_left_2", kEnvelopeTypeName, false, DdsRepresentation::xcdr1}));
+  c.native.push_back(
+      NativeBinding{"robot", std::nullopt, std::nullopt, NativeDdsTopic{"rt/arm", kTwist, DdsRepresentation::xcdr2}});
   EXPECT_EQ(dds_topic_of(c, "robot"), (DdsTopicRef{"rt/arm", kTwist, true, DdsRepresentation::xcdr2}));
   EXPECT_EQ(dds_topic_of(c, "lan").topic, "cosmic/robot_arm_left_2");
   // Two channels on one topic: named, whichever way they got there.
@@ -94,9 +111,11 @@ TEST(DdsNames, EnvelopeAndNativeTopicsAreNamedOneWayEverywhere) {
   EXPECT_EQ(dds_topic_collision(envelope, "lan"),
             "channels 'a-b' and 'a.b' both map to DDS topic cosmic/a_b ('-' and '.' become '_'); rename one of them");
   ChannelSpec d = channel("d", 0x4, ChannelClass::nrt, {"robot"}, {"lan"}, 8);
-  d.native.push_back(NativeBinding{"robot", std::nullopt, std::nullopt, NativeDdsTopic{"rt/arm", kTwist, DdsRepresentation::xcdr1}});
+  d.native.push_back(
+      NativeBinding{"robot", std::nullopt, std::nullopt, NativeDdsTopic{"rt/arm", kTwist, DdsRepresentation::xcdr1}});
   const std::array<const ChannelSpec*, 2> native{&c, &d};
-  EXPECT_EQ(dds_topic_collision(native, "robot"), "channels 'robot.arm-left_2' and 'd' both map to DDS topic rt/arm; rename one of them");
+  EXPECT_EQ(dds_topic_collision(native, "robot"),
+            "channels 'robot.arm-left_2' and 'd' both map to DDS topic rt/arm; rename one of them");
   EXPECT_EQ(dds_topic_collision(native, "lan"), std::nullopt);
   EXPECT_EQ(dds_topic_name_problem("rt/ns/cmd_vel"), std::nullopt);
   EXPECT_TRUE(dds_topic_name_problem(""));
@@ -119,9 +138,12 @@ TEST(DdsEncapsulation, NamesEveryCdrIdentifierAndRefusesTheRest) {
     const char* name;
   };
   const Case known[] = {
-      {{0x00, 0x00, 0, 0}, DdsRepresentation::xcdr1, false, "CDR_BE"},     {{0x00, 0x01, 0, 0}, DdsRepresentation::xcdr1, true, "CDR_LE"},
-      {{0x00, 0x03, 0, 0}, DdsRepresentation::xcdr1, true, "PL_CDR_LE"},   {{0x00, 0x06, 0, 0}, DdsRepresentation::xcdr2, false, "CDR2_BE"},
-      {{0x00, 0x07, 0, 3}, DdsRepresentation::xcdr2, true, "CDR2_LE"},     {{0x00, 0x09, 0, 0}, DdsRepresentation::xcdr2, true, "D_CDR2_LE"},
+      {{0x00, 0x00, 0, 0}, DdsRepresentation::xcdr1, false, "CDR_BE"},
+      {{0x00, 0x01, 0, 0}, DdsRepresentation::xcdr1, true, "CDR_LE"},
+      {{0x00, 0x03, 0, 0}, DdsRepresentation::xcdr1, true, "PL_CDR_LE"},
+      {{0x00, 0x06, 0, 0}, DdsRepresentation::xcdr2, false, "CDR2_BE"},
+      {{0x00, 0x07, 0, 3}, DdsRepresentation::xcdr2, true, "CDR2_LE"},
+      {{0x00, 0x09, 0, 0}, DdsRepresentation::xcdr2, true, "D_CDR2_LE"},
       {{0x00, 0x0b, 0, 0}, DdsRepresentation::xcdr2, true, "PL_CDR2_LE"},
   };
   for (const Case& c : known) {
@@ -150,7 +172,8 @@ Config two_domains() {
 
 ChannelSpec native_twist(const std::string& name, std::uint64_t subject, const std::string& topic) {
   ChannelSpec c = channel(name, subject, ChannelClass::srt, {"robot"}, {"lan"}, 52);
-  c.native.push_back(NativeBinding{"robot", std::nullopt, std::nullopt, NativeDdsTopic{topic, kTwist, DdsRepresentation::xcdr1}});
+  c.native.push_back(
+      NativeBinding{"robot", std::nullopt, std::nullopt, NativeDdsTopic{topic, kTwist, DdsRepresentation::xcdr1}});
   return c;
 }
 
@@ -174,10 +197,14 @@ TEST(NativeDdsReport, EveryDdsHopShowsItsTopicAndType) {
   const nlohmann::json hops = to_json(report)["channels"][0]["hops"];
   ASSERT_EQ(hops.size(), 2u);
   EXPECT_EQ(hops[0]["segment"], "robot");
-  EXPECT_EQ(hops[0]["dds"], (nlohmann::json{{"topic", "rt/cmd_vel"}, {"type", kTwist}, {"layout", "native"}, {"representation", "xcdr1"}}));
-  EXPECT_EQ(hops[1]["dds"], (nlohmann::json{{"topic", "cosmic/cmd_vel"}, {"type", "cosmic::Envelope"}, {"layout", "envelope"}}));
+  EXPECT_EQ(
+      hops[0]["dds"],
+      (nlohmann::json{{"topic", "rt/cmd_vel"}, {"type", kTwist}, {"layout", "native"}, {"representation", "xcdr1"}}));
+  EXPECT_EQ(hops[1]["dds"],
+            (nlohmann::json{{"topic", "cosmic/cmd_vel"}, {"type", "cosmic::Envelope"}, {"layout", "envelope"}}));
   const std::string text = render_channel_text(report.channels[0]);
-  EXPECT_NE(text.find("publisher robot  topic rt/cmd_vel type geometry_msgs::msg::dds_::Twist_"), std::string::npos) << text;
+  EXPECT_NE(text.find("publisher robot  topic rt/cmd_vel type geometry_msgs::msg::dds_::Twist_"), std::string::npos)
+      << text;
   EXPECT_NE(text.find("subscriber lan  topic cosmic/cmd_vel type cosmic::Envelope"), std::string::npos) << text;
 }
 

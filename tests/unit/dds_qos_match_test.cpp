@@ -64,7 +64,8 @@ TEST(DdsQosMatch, DataRepresentationReasonsAreWordedFromOurSide) {
   ASSERT_EQ(as_writer.size(), 1u);
   EXPECT_EQ(as_writer[0].reason.rfind("requests data representation XCDR2 only, this writer offers XCDR1 (", 0), 0u)
       << as_writer[0].reason;
-  EXPECT_NE(as_writer[0].reason.find("appendable or mutable, this one is final"), std::string::npos) << as_writer[0].reason;
+  EXPECT_NE(as_writer[0].reason.find("appendable or mutable, this one is final"), std::string::npos)
+      << as_writer[0].reason;
   const auto as_reader = dds_match_conflicts(ours, theirs, DdsLocalRole::reader);
   ASSERT_EQ(as_reader.size(), 1u);
   EXPECT_EQ(as_reader[0].reason.rfind("offers data representation XCDR2, this reader requests XCDR1 only (", 0), 0u)
@@ -212,8 +213,8 @@ TEST(DdsQosMatch, EveryBrokenRuleIsListedInPolicyOrder) {
   reader.reliability = DdsReliabilityKind::reliable;
   reader.destination_order = DdsDestinationOrderKind::by_source_timestamp;
   EXPECT_EQ(policies(dds_match_conflicts(writer, reader, DdsLocalRole::writer)),
-            (std::vector{DdsMatchPolicy::data_representation, DdsMatchPolicy::reliability, DdsMatchPolicy::latency_budget,
-                         DdsMatchPolicy::destination_order}));
+            (std::vector{DdsMatchPolicy::data_representation, DdsMatchPolicy::reliability,
+                         DdsMatchPolicy::latency_budget, DdsMatchPolicy::destination_order}));
   EXPECT_STREQ(to_string(DdsMatchPolicy::latency_budget), "latency_budget");
   EXPECT_STREQ(to_string(DdsMatchPolicy::data_representation), "data_representation");
   EXPECT_STREQ(to_string(DdsMatchPolicy::partition), "partition");

@@ -39,13 +39,16 @@ TEST(FederationConfig, EveryMistakeIsReportedWithItsPlace) {
     std::string expected;
   };
   const std::vector<Case> cases = {
-      {"  federation: {segment: wan}\n", "", "g.yaml:3:25: gateway.federation.segment: unknown segment 'wan' (a DDS segment: lan)"},
+      {"  federation: {segment: wan}\n", "",
+       "g.yaml:3:25: gateway.federation.segment: unknown segment 'wan' (a DDS segment: lan)"},
       {"  federation: {segment: body}\n", "", "gateway.federation.segment: segment 'body' is can"},
       {"  federation: {lease: 2s}\n", "", "gateway.federation.segment: missing required key 'segment'"},
-      {"  federation: {segment: lan, lease: 10ms}\n", "", "gateway.federation.lease: lease out of range (from 100ms to 1h"},
+      {"  federation: {segment: lan, lease: 10ms}\n", "",
+       "gateway.federation.lease: lease out of range (from 100ms to 1h"},
       {"  federation: {segment: lan, lease: forever}\n", "", "gateway.federation.lease"},
       {"  federation: {segment: lan, domain: 3}\n", "", "gateway.federation.domain"},
-      {"  federation: {segment: lan, claim_window: 50ms}\n", "", "gateway.federation.claim_window: claim_window out of range (from 300ms"},
+      {"  federation: {segment: lan, claim_window: 50ms}\n", "",
+       "gateway.federation.claim_window: claim_window out of range (from 300ms"},
       {"", "  - {name: body2, type: can, interface: can1, bitrate: 500kbit/s, network: body-bus}\n",
        "segments[2].network: segment 'body2' attaches the same network as segment 'body'"},
   };

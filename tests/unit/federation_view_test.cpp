@@ -24,7 +24,8 @@ Announcement peer(std::uint64_t id, const std::string& name, double lan_load, st
   a.gateway = id;
   a.name = name;
   a.revision = revision;
-  a.segments.push_back(AnnouncedSegment{"backbone", SegmentType::dds, "dds:domain=0", 0.5, lan_load, lan_load * 1e6, {}});
+  a.segments.push_back(
+      AnnouncedSegment{"backbone", SegmentType::dds, "dds:domain=0", 0.5, lan_load, lan_load * 1e6, {}});
   return a;
 }
 
@@ -157,7 +158,13 @@ TEST(FederationView, SharedNetworksAreMatchedByIdentity) {
   FederationView view(kSelf);
   Announcement a = peer(0x22, "gw2", 0.1);
   a.segments.push_back(AnnouncedSegment{"other-domain", SegmentType::dds, "dds:domain=5", 0.5, 0.3, 300'000, {}});
-  a.segments.push_back(AnnouncedSegment{"private", SegmentType::can, "", 0.7, 0.2, 0, {AnnouncedFrame{"x", 0x10, false, 8, Nanos(1ms), Nanos(0), std::nullopt}}});
+  a.segments.push_back(AnnouncedSegment{"private",
+                                        SegmentType::can,
+                                        "",
+                                        0.7,
+                                        0.2,
+                                        0,
+                                        {AnnouncedFrame{"x", 0x10, false, 8, Nanos(1ms), Nanos(0), std::nullopt}}});
   AnnouncedSegment bus{"chassis", SegmentType::can, "can:body", 0.7, 0.05, 0, {}};
   bus.frames.push_back(AnnouncedFrame{"steer", 0x00A0FFFF, true, 8, Nanos(10ms), Nanos(0), std::nullopt});
   a.segments.push_back(bus);
@@ -193,7 +200,8 @@ TEST(FederationAdmission, OtherGatewaysLoadOnASharedNetworkCounts) {
   ASSERT_TRUE(kb.bind(mine).bound());
   // 350 kbit/s of this 1 Mbit/s network, wherever the others declared its bandwidth; another
   // network (domain 1) is not this segment's.
-  kb.set_peer_reservations({{"dds:domain=0", PeerReservations{350'000, {}, {}}}, {"dds:domain=1", PeerReservations{900'000, {}, {}}}});
+  kb.set_peer_reservations(
+      {{"dds:domain=0", PeerReservations{350'000, {}, {}}}, {"dds:domain=1", PeerReservations{900'000, {}, {}}}});
   ChannelSpec more = mine;
   more.name = "more";
   more.subject = 2;
@@ -221,19 +229,23 @@ TEST(FederationAdmission, OtherGatewaysFramesDelayCanChannelsAndKeepTheirEtags) 
   body.network = "body";
   KnowledgeBase kb(gateway(100us), {body, dds_segment("lan", 100us)});
   // HRT, reaction 2.5 ms: alone R = 1.28 ms on the 125 kbit/s bus.
-  const ChannelSpec brake = channel("brake", 0x100, ChannelClass::hrt, {"body"}, {"lan"}, 8, Nanos(10ms), Nanos(2500us));
+  const ChannelSpec brake =
+      channel("brake", 0x100, ChannelClass::hrt, {"body"}, {"lan"}, 8, Nanos(10ms), Nanos(2500us));
   EXPECT_EQ(kb.probe(brake).verdict, Verdict::bound) << reasons_text(kb.probe(brake));
   // Another gateway's two frames that win arbitration against ours (priority 0, TxNode 0).
   PeerReservations theirs;
-  theirs.frames.push_back(CanBackgroundFrame{"gw2:steer", 0x00000001, true, 8, Nanos(5ms), Nanos(0), "gateway gw2", std::nullopt});
-  theirs.frames.push_back(CanBackgroundFrame{"gw2:yaw", 0x00000002, true, 8, Nanos(5ms), Nanos(0), "gateway gw2", std::nullopt});
+  theirs.frames.push_back(
+      CanBackgroundFrame{"gw2:steer", 0x00000001, true, 8, Nanos(5ms), Nanos(0), "gateway gw2", std::nullopt});
+  theirs.frames.push_back(
+      CanBackgroundFrame{"gw2:yaw", 0x00000002, true, 8, Nanos(5ms), Nanos(0), "gateway gw2", std::nullopt});
   kb.set_peer_reservations({{"can:body", theirs}});
   const ChannelReport refused = kb.probe(brake);
   EXPECT_EQ(refused.verdict, Verdict::rejected);
   EXPECT_TRUE(has_reason(refused, "gw2:steer")) << reasons_text(refused);
   EXPECT_GT(kb.loads()[0].peers, 0.1);
   // The etag bits of the peer's extended frame (16383, the first this gateway would hand out) are not.
-  const CanBackgroundFrame top{"gw2:log", 0x1F000000 | 16383, true, 8, Nanos(100ms), Nanos(0), "gateway gw2", std::nullopt};
+  const CanBackgroundFrame top{"gw2:log",    0x1F000000 | 16383, true,          8,
+                               Nanos(100ms), Nanos(0),           "gateway gw2", std::nullopt};
   kb.set_peer_reservations({{"can:body", PeerReservations{0, {top}, {}}}});
   ChannelSpec slow = channel("slow", 0x200, ChannelClass::nrt, {"lan"}, {"body"}, 8, Nanos(100ms));
   ASSERT_TRUE(kb.bind(slow).bound());
@@ -264,14 +276,17 @@ TEST(FederationAdmission, ABindThatWouldBreakAnotherGatewaysHrtFrameIsRejected) 
   KnowledgeBase kb(gateway(100us), {body, dds_segment("lan", 100us)});
   // gw1's HRT frame (priority 0, TxNode 1, etag 16383) every 1 ms, released with 200 us of jitter:
   // R = 0.2 + 0.32 = 0.52 ms alone; its channel there allows up to 0.8 ms.
-  const CanBackgroundFrame steer{"gw1:steer", (1u << 14) | 16383, true, 8, Nanos(1ms), Nanos(200us), "gateway gw1 (0000000000000001)",
-                                 Nanos(800us)};
+  const CanBackgroundFrame steer{
+      "gw1:steer", (1u << 14) | 16383, true, 8, Nanos(1ms), Nanos(200us), "gateway gw1 (0000000000000001)",
+      Nanos(800us)};
   kb.set_peer_reservations({{"can:body", PeerReservations{0, {steer}, {}}}});
   // An NRT frame of 8 bytes loses arbitration to it but may hold the bus when it is queued:
   // R = 0.2 + 0.32 + 0.32 = 0.84 ms > 0.8 ms.
-  const ChannelReport refused = kb.probe(channel("logbook", 0x600, ChannelClass::nrt, {"lan"}, {"body"}, 8, Nanos(10ms)));
+  const ChannelReport refused =
+      kb.probe(channel("logbook", 0x600, ChannelClass::nrt, {"lan"}, {"body"}, 8, Nanos(10ms)));
   EXPECT_EQ(refused.verdict, Verdict::rejected);
-  EXPECT_TRUE(has_reason(refused, "would break the hrt frame gw1:steer of gateway gw1 (0000000000000001): R = 840 us > 800 us"))
+  EXPECT_TRUE(
+      has_reason(refused, "would break the hrt frame gw1:steer of gateway gw1 (0000000000000001): R = 840 us > 800 us"))
       << reasons_text(refused);
   // One byte blocks for 0.18 ms: R = 0.70 ms, within.
   const BindOutcome tiny = kb.bind(channel("tiny", 0x601, ChannelClass::nrt, {"lan"}, {"body"}, 1, Nanos(10ms)));
@@ -284,21 +299,25 @@ TEST(FederationAdmission, TheDeadlineIsCheckedAgainstWhatIsAlreadyBoundHere) {
   KnowledgeBase kb(gateway(100us), {body, dds_segment("lan", 100us)});
   // A local 1-byte NRT channel first: the bus has a committed analysis when the peer's frame comes.
   ASSERT_TRUE(kb.bind(channel("tiny", 0x601, ChannelClass::nrt, {"lan"}, {"body"}, 1, Nanos(10ms))).bound());
-  const CanBackgroundFrame steer{"gw1:steer", (1u << 14) | 16383, true, 8, Nanos(1ms), Nanos(200us), "gateway gw1 (0000000000000001)",
-                                 Nanos(800us)};
+  const CanBackgroundFrame steer{
+      "gw1:steer", (1u << 14) | 16383, true, 8, Nanos(1ms), Nanos(200us), "gateway gw1 (0000000000000001)",
+      Nanos(800us)};
   kb.set_peer_reservations({{"can:body", PeerReservations{0, {steer}, {}}}});
   // tiny blocks steer by 0.18 ms (R = 0.70 ms); an 8-byte NRT frame would by 0.32 ms (R = 0.84 ms).
-  const ChannelReport refused = kb.probe(channel("logbook", 0x600, ChannelClass::nrt, {"lan"}, {"body"}, 8, Nanos(10ms)));
+  const ChannelReport refused =
+      kb.probe(channel("logbook", 0x600, ChannelClass::nrt, {"lan"}, {"body"}, 8, Nanos(10ms)));
   EXPECT_TRUE(has_reason(refused, "would break the hrt frame gw1:steer")) << reasons_text(refused);
   // A channel on the lan only does not touch the bus's analysis.
-  EXPECT_EQ(kb.probe(channel("chat", 0x602, ChannelClass::nrt, {"lan"}, {"lan"}, 8, Nanos(10ms))).verdict, Verdict::bound);
+  EXPECT_EQ(kb.probe(channel("chat", 0x602, ChannelClass::nrt, {"lan"}, {"lan"}, 8, Nanos(10ms))).verdict,
+            Verdict::bound);
 }
 
 TEST(FederationAnnouncement, AnHrtFrameCarriesTheMostResponseTimeItsChannelAllows) {
   SegmentSpec body = can_segment("body", 500'000);
   body.network = "body";
   KnowledgeBase kb(gateway(100us), {body, dds_segment("lan", 100us)});
-  ASSERT_TRUE(kb.bind(channel("steer", 0x500, ChannelClass::hrt, {"lan"}, {"body"}, 8, Nanos(1ms), Nanos(800us))).bound());
+  ASSERT_TRUE(
+      kb.bind(channel("steer", 0x500, ChannelClass::hrt, {"lan"}, {"body"}, 8, Nanos(1ms), Nanos(800us))).bound());
   const Announcement a = announcement_of(GatewayIdentity{0x42, "gw1"}, kb, 1);
   ASSERT_EQ(a.segments[0].frames.size(), 1u);
   // R = 0.2 (released after 0.1 on lan + 0.1 residence) + 0.32 = 0.52 ms, end to end 0.52 ms: 0.28 ms to spare.
@@ -310,7 +329,8 @@ TEST(FederationAnnouncement, SaysWhatThisGatewayReservesWhere) {
   SegmentSpec body = can_segment("body");
   body.network = "body";
   KnowledgeBase kb(gateway(), {body, lan()});
-  ASSERT_TRUE(kb.bind(channel("brake", 0x100, ChannelClass::srt, {"lan"}, {"body"}, 8, Nanos(10ms), Nanos(20ms))).bound());
+  ASSERT_TRUE(
+      kb.bind(channel("brake", 0x100, ChannelClass::srt, {"lan"}, {"body"}, 8, Nanos(10ms), Nanos(20ms))).bound());
   const double alone = kb.loads()[1].utilization;
   kb.set_peer_reservations({{"dds:domain=0", PeerReservations{200'000, {}, {}}}});
   const Announcement a = announcement_of(GatewayIdentity{0x42, "gw1"}, kb, 3);
@@ -340,7 +360,8 @@ Announcement upstream_gateway(Nanos front_latency, Nanos period = Nanos(10ms)) {
   steer.name = "steer-front";
   steer.subject = 0x77;
   steer.cls = ChannelClass::srt;
-  steer.hops = {AnnouncedHop{"front", HopRole::publisher, front_latency}, AnnouncedHop{"backbone", HopRole::subscriber, Nanos(1ms)}};
+  steer.hops = {AnnouncedHop{"front", HopRole::publisher, front_latency},
+                AnnouncedHop{"backbone", HopRole::subscriber, Nanos(1ms)}};
   steer.period = period;
   steer.reaction_time = Nanos(20ms);
   steer.payload = 8;
@@ -372,7 +393,14 @@ TEST(FederationEndToEnd, AChannelCrossingTwoGatewaysIsAdmittedOverTheWholePath) 
 
   // gw1's front bus gets slower (a rebind there): 18 + 0.5 + 3.5 = 22 ms > 20 ms, shown at once.
   view.apply(said(upstream_gateway(Nanos(18ms)), "w1"), Nanos(2s));
-  view.apply(said([] { auto a = upstream_gateway(Nanos(18ms)); a.revision = 2; return a; }(), "w1"), Nanos(2s));
+  view.apply(said(
+                 [] {
+                   auto a = upstream_gateway(Nanos(18ms));
+                   a.revision = 2;
+                   return a;
+                 }(),
+                 "w1"),
+             Nanos(2s));
   kb.set_peer_reservations(view.reservations());
   const AdmissionReport now = kb.report();
   ASSERT_NE(now.find("steer"), nullptr);
@@ -395,7 +423,8 @@ TEST(FederationEndToEnd, AnUpstreamViolatedAtRunTimeDegradesTheChannelHere) {
   a.channels[0].violated = true;
   ASSERT_TRUE(view.apply(said(a, "w1"), Nanos(1s)));
   KnowledgeBase kb(gateway(500us), {dds_segment("backbone", 1ms, false), lcm_segment("rear", 2ms)});
-  ASSERT_TRUE(kb.bind(channel("steer", 0x77, ChannelClass::srt, {"backbone"}, {"rear"}, 8, Nanos(10ms), Nanos(20ms))).bound());
+  ASSERT_TRUE(
+      kb.bind(channel("steer", 0x77, ChannelClass::srt, {"backbone"}, {"rear"}, 8, Nanos(10ms), Nanos(20ms))).bound());
   EXPECT_EQ(kb.report().find("steer")->verdict, Verdict::bound);
   kb.set_peer_reservations(view.reservations());
   const AdmissionReport report = kb.report();
@@ -413,8 +442,10 @@ TEST(FederationEndToEnd, ConflictingDefinitionsOfOneSubjectAreMismatchesWithReas
   ChannelSpec steer = channel("steer", 0x77, ChannelClass::srt, {"backbone"}, {"rear"}, 8, Nanos(10ms), Nanos(30ms));
   const ChannelReport report = kb.probe(steer);
   EXPECT_EQ(report.verdict, Verdict::degraded);
-  EXPECT_TRUE(has_reason(report, "period 5 ms at gateway gw1 (channel steer-front) < 10 ms here")) << reasons_text(report);
-  EXPECT_TRUE(has_reason(report, "reaction_time 20 ms at gateway gw1 (channel steer-front), 30 ms here")) << reasons_text(report);
+  EXPECT_TRUE(has_reason(report, "period 5 ms at gateway gw1 (channel steer-front) < 10 ms here"))
+      << reasons_text(report);
+  EXPECT_TRUE(has_reason(report, "reaction_time 20 ms at gateway gw1 (channel steer-front), 30 ms here"))
+      << reasons_text(report);
   // Another subject on the same network is not on that path.
   steer.subject = 0x78;
   EXPECT_TRUE(kb.probe(steer).upstream.empty());

@@ -111,9 +111,9 @@ TEST_F(IngressCheckTest, AnEmptyPayloadPasses) {
 }
 
 TEST_F(IngressCheckTest, EveryFaultHasAName) {
-  for (const IngressFault f : {IngressFault::none, IngressFault::negative_age, IngressFault::age_beyond_bound,
-                               IngressFault::foreign_subject, IngressFault::own_origin, IngressFault::hop_limit,
-                               IngressFault::oversize}) {
+  for (const IngressFault f :
+       {IngressFault::none, IngressFault::negative_age, IngressFault::age_beyond_bound, IngressFault::foreign_subject,
+        IngressFault::own_origin, IngressFault::hop_limit, IngressFault::oversize}) {
     EXPECT_STRNE(to_string(f), "?");
   }
 }

@@ -24,9 +24,13 @@ KnowledgeBase slow_bus_kb(std::set<std::uint16_t> reserved = {}) {
 
 // HRT, reaction 2.5 ms: alone R = 1.28 ms, e2e = 1.28 + 0.1 + 0.1 = 1.48 ms. Blocked by a 1 B
 // frame: R = 0.72 + 1.28 = 2.0 ms, e2e = 2.2 ms: still fine.
-ChannelSpec brake() { return channel("brake", 0x100, ChannelClass::hrt, {"can"}, {"lan"}, 8, Nanos(10ms), Nanos(2500us)); }
+ChannelSpec brake() {
+  return channel("brake", 0x100, ChannelClass::hrt, {"can"}, {"lan"}, 8, Nanos(10ms), Nanos(2500us));
+}
 // SRT, reaction 50 ms: lower priority than brake, but its 1.28 ms frame can block brake.
-ChannelSpec logger() { return channel("logger", 0x200, ChannelClass::srt, {"can"}, {"lan"}, 8, Nanos(10ms), Nanos(50ms)); }
+ChannelSpec logger() {
+  return channel("logger", 0x200, ChannelClass::srt, {"can"}, {"lan"}, 8, Nanos(10ms), Nanos(50ms));
+}
 ChannelSpec small(const std::string& name, std::uint64_t subject) {
   return channel(name, subject, ChannelClass::nrt, {"lan"}, {"can"}, 1, Nanos(100ms));
 }

@@ -67,23 +67,29 @@ TEST(MetricsConfig, BadAddressesAreLocated) {
       "    listen: 9877\n"
       "    allow_remote: yes\n");
   ASSERT_EQ(result.errors.size(), 2u) << errors_of(result);
-  EXPECT_EQ(result.errors[0].to_string(), "m.yaml:4:19: gateway.metrics.allow_remote: 'yes' is not a boolean (true or false)");
+  EXPECT_EQ(result.errors[0].to_string(),
+            "m.yaml:4:19: gateway.metrics.allow_remote: 'yes' is not a boolean (true or false)");
   EXPECT_EQ(result.errors[1].to_string(),
             "m.yaml:3:13: gateway.metrics.listen: '9877' has no port (IP:PORT such as 127.0.0.1:9877 or [::1]:9877)");
 }
 
 TEST(MetricsConfig, PortAndHostChecked) {
-  EXPECT_NE(errors_of(parse("  metrics: {listen: 127.0.0.1:70000}\n")).find("has no port from 1 to 65535"), std::string::npos);
-  EXPECT_NE(errors_of(parse("  metrics: {listen: 127.0.0.1:0}\n")).find("has no port from 1 to 65535"), std::string::npos);
-  EXPECT_NE(errors_of(parse("  metrics: {listen: \"::1:9877\"}\n")).find("has no IP address as host (IPv6 goes in brackets)"),
+  EXPECT_NE(errors_of(parse("  metrics: {listen: 127.0.0.1:70000}\n")).find("has no port from 1 to 65535"),
             std::string::npos);
-  EXPECT_NE(errors_of(parse("  metrics: {listen: gateway.example:9877}\n")).find("has no IP address"), std::string::npos);
+  EXPECT_NE(errors_of(parse("  metrics: {listen: 127.0.0.1:0}\n")).find("has no port from 1 to 65535"),
+            std::string::npos);
+  EXPECT_NE(
+      errors_of(parse("  metrics: {listen: \"::1:9877\"}\n")).find("has no IP address as host (IPv6 goes in brackets)"),
+      std::string::npos);
+  EXPECT_NE(errors_of(parse("  metrics: {listen: gateway.example:9877}\n")).find("has no IP address"),
+            std::string::npos);
 }
 
 TEST(MetricsConfig, ListenIsRequiredAndKeysAreKnown) {
   const auto missing = parse("  metrics: {allow_remote: true}\n");
   ASSERT_EQ(missing.errors.size(), 1u) << errors_of(missing);
-  EXPECT_NE(missing.errors[0].to_string().find("gateway.metrics.listen: missing required key 'listen'"), std::string::npos);
+  EXPECT_NE(missing.errors[0].to_string().find("gateway.metrics.listen: missing required key 'listen'"),
+            std::string::npos);
   const auto unknown = parse("  metrics: {listen: 127.0.0.1:9877, port: 9877}\n");
   ASSERT_EQ(unknown.errors.size(), 1u) << errors_of(unknown);
   EXPECT_NE(unknown.errors[0].to_string().find("unknown key 'port'"), std::string::npos);

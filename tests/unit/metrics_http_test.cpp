@@ -62,8 +62,9 @@ TEST(RequestHead, MoreThanTheBudgetIsTooLarge) {
 
 TEST(RequestHead, ForwardsEverythingButRangeFields) {
   RequestHead head(4096);
-  head.feed("GET /metrics HTTP/1.1\r\nRANGE: bytes=0-\r\nAccept: */*\r\nif-range: x\r\nRange : bytes=0-\r\n"
-            "X-Range: kept\r\n\r\n");
+  head.feed(
+      "GET /metrics HTTP/1.1\r\nRANGE: bytes=0-\r\nAccept: */*\r\nif-range: x\r\nRange : bytes=0-\r\n"
+      "X-Range: kept\r\n\r\n");
   EXPECT_EQ(head.forwarded(), "GET /metrics HTTP/1.1\r\nAccept: */*\r\nX-Range: kept\r\n\r\n");
   EXPECT_FALSE(ignored_field("Rangefinder: 1"));
   EXPECT_TRUE(ignored_field("range:"));

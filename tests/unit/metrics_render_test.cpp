@@ -65,7 +65,8 @@ MetricsSnapshot robot() {
   cosmic::ChannelReport distance;
   distance.name = "distance";
   distance.cls = cosmic::ChannelClass::hrt;
-  distance.hops = {hop("body-can", cosmic::HopRole::publisher, Nanos(1'500'000)), hop("lan", cosmic::HopRole::subscriber, Nanos(2'000'000))};
+  distance.hops = {hop("body-can", cosmic::HopRole::publisher, Nanos(1'500'000)),
+                   hop("lan", cosmic::HopRole::subscriber, Nanos(2'000'000))};
   distance.hops[0].can = cosmic::CanHopPlan{};
   distance.hops[0].can->response_time = Nanos(1'500'000);
   distance.end_to_end.latency = Nanos(4'000'000);
@@ -76,7 +77,8 @@ MetricsSnapshot robot() {
   plot.name = "plot";
   plot.cls = cosmic::ChannelClass::nrt;
   plot.verdict = cosmic::Verdict::degraded;
-  plot.hops = {hop("lan", cosmic::HopRole::publisher, std::nullopt), hop("body-can", cosmic::HopRole::subscriber, std::nullopt)};
+  plot.hops = {hop("lan", cosmic::HopRole::publisher, std::nullopt),
+               hop("body-can", cosmic::HopRole::subscriber, std::nullopt)};
   plot.end_to_end.reaction_time = Nanos(10'000'000);
   s.channels = {distance, plot};
 
@@ -165,22 +167,30 @@ TEST(MetricsRender, PerHopCountersAndEveryDropReason) {
   EXPECT_LINE(m, "cosmic_channel_dropped_events_total{" + out + ",reason=\"queue_full\"} 7");
   for (std::size_t r = 0; r < cosmic::kDropReasonCount; ++r) {
     const std::string reason = cosmic::to_string(static_cast<cosmic::DropReason>(r));
-    EXPECT_NE(m.find("cosmic_channel_dropped_events_total{" + out + ",reason=\"" + reason + "\"}"), std::string::npos) << reason;
+    EXPECT_NE(m.find("cosmic_channel_dropped_events_total{" + out + ",reason=\"" + reason + "\"}"), std::string::npos)
+        << reason;
   }
   // A channel the router has no counters for yet still shows zeros.
-  EXPECT_LINE(m, "cosmic_channel_sent_events_total{channel=\"plot\",class=\"nrt\",segment=\"body-can\",role=\"subscriber\"} 0");
+  EXPECT_LINE(
+      m, "cosmic_channel_sent_events_total{channel=\"plot\",class=\"nrt\",segment=\"body-can\",role=\"subscriber\"} 0");
   EXPECT_LINE(m, "cosmic_channel_forwarded_events_total{channel=\"distance\",class=\"hrt\"} 41");
 }
 
 TEST(MetricsRender, ResidenceHistogramIsRebucketedCumulatively) {
   const std::string m = text();
-  const std::string out = "cosmic_channel_residence_seconds_bucket{channel=\"distance\",class=\"hrt\",segment=\"lan\",role=\"subscriber\",le=\"";
-  const std::map<double, int> expected = {{5e-6, 2}, {10e-6, 3}, {25e-6, 3}, {50e-6, 4}, {1e-3, 4}, {2.5e-3, 5}, {1.0, 5}};
+  const std::string out =
+      "cosmic_channel_residence_seconds_bucket{channel=\"distance\",class=\"hrt\",segment=\"lan\",role=\"subscriber\","
+      "le=\"";
+  const std::map<double, int> expected = {{5e-6, 2}, {10e-6, 3},  {25e-6, 3}, {50e-6, 4},
+                                          {1e-3, 4}, {2.5e-3, 5}, {1.0, 5}};
   for (const auto& [le, count] : expected) EXPECT_LINE(m, out + format_number(le) + "\"} " + std::to_string(count));
   EXPECT_LINE(m, out + "+Inf\"} 5");
-  EXPECT_LINE(m, "cosmic_channel_residence_seconds_count{channel=\"distance\",class=\"hrt\",segment=\"lan\",role=\"subscriber\"} 5");
+  EXPECT_LINE(m,
+              "cosmic_channel_residence_seconds_count{channel=\"distance\",class=\"hrt\",segment=\"lan\",role="
+              "\"subscriber\"} 5");
   // Only egress hops carry residence.
-  EXPECT_EQ(m.find("cosmic_channel_residence_seconds_bucket{channel=\"distance\",class=\"hrt\",segment=\"body-can\""), std::string::npos);
+  EXPECT_EQ(m.find("cosmic_channel_residence_seconds_bucket{channel=\"distance\",class=\"hrt\",segment=\"body-can\""),
+            std::string::npos);
 }
 
 TEST(MetricsRender, ResidenceQuantilesAndMisses) {
@@ -222,9 +232,15 @@ TEST(MetricsRender, AdmissionNumbersAndSlack) {
   EXPECT_LINE(m, "cosmic_channel_temp_validity_seconds{channel=\"distance\",class=\"hrt\"} 0.05");
   EXPECT_LINE(m, "cosmic_channel_end_to_end_bound_seconds{channel=\"plot\",class=\"nrt\"} +Inf");
   EXPECT_LINE(m, "cosmic_channel_slack_seconds{channel=\"plot\",class=\"nrt\"} -Inf");
-  EXPECT_LINE(m, "cosmic_channel_hop_response_time_seconds{channel=\"distance\",class=\"hrt\",segment=\"body-can\",role=\"publisher\"} 0.0015");
-  EXPECT_LINE(m, "cosmic_channel_hop_latency_bound_seconds{channel=\"distance\",class=\"hrt\",segment=\"lan\",role=\"subscriber\"} 0.002");
-  EXPECT_LINE(m, "cosmic_channel_hop_latency_bound_seconds{channel=\"plot\",class=\"nrt\",segment=\"lan\",role=\"publisher\"} +Inf");
+  EXPECT_LINE(m,
+              "cosmic_channel_hop_response_time_seconds{channel=\"distance\",class=\"hrt\",segment=\"body-can\",role="
+              "\"publisher\"} 0.0015");
+  EXPECT_LINE(m,
+              "cosmic_channel_hop_latency_bound_seconds{channel=\"distance\",class=\"hrt\",segment=\"lan\",role="
+              "\"subscriber\"} 0.002");
+  EXPECT_LINE(m,
+              "cosmic_channel_hop_latency_bound_seconds{channel=\"plot\",class=\"nrt\",segment=\"lan\",role="
+              "\"publisher\"} +Inf");
   // No CAN plan, no response time.
   EXPECT_EQ(m.find("cosmic_channel_hop_response_time_seconds{channel=\"plot\""), std::string::npos);
 }
@@ -232,7 +248,8 @@ TEST(MetricsRender, AdmissionNumbersAndSlack) {
 TEST(MetricsRender, LabelValuesAreEscaped) {
   MetricsSnapshot s = robot();
   s.gateway_name = "a\"b\\c\nd";
-  EXPECT_LINE(render_metrics(s, ExpositionFormat::prometheus_text), "cosmic_gateway_info{gateway=\"a\\\"b\\\\c\\nd\",id=\"00000000000000ab\"} 1");
+  EXPECT_LINE(render_metrics(s, ExpositionFormat::prometheus_text),
+              "cosmic_gateway_info{gateway=\"a\\\"b\\\\c\\nd\",id=\"00000000000000ab\"} 1");
 }
 
 // Families as declared by "# TYPE" lines, checking that every sample follows its own family's
@@ -283,9 +300,11 @@ TEST(MetricsRender, OpenMetricsDeclaresCounterFamiliesAndEnds) {
   const std::string m = render_metrics(robot(), ExpositionFormat::openmetrics);
   const auto types = families(m, ExpositionFormat::openmetrics);
   EXPECT_EQ(types.at("cosmic_channel_sent_events"), "counter");
-  EXPECT_LINE(m, "cosmic_channel_sent_events_total{channel=\"distance\",class=\"hrt\",segment=\"lan\",role=\"subscriber\"} 40");
+  EXPECT_LINE(
+      m, "cosmic_channel_sent_events_total{channel=\"distance\",class=\"hrt\",segment=\"lan\",role=\"subscriber\"} 40");
   EXPECT_TRUE(m.ends_with("\n# EOF\n"));
-  EXPECT_EQ(format_for_accept("application/openmetrics-text;version=1.0.0,text/plain;version=0.0.4;q=0.5"), ExpositionFormat::openmetrics);
+  EXPECT_EQ(format_for_accept("application/openmetrics-text;version=1.0.0,text/plain;version=0.0.4;q=0.5"),
+            ExpositionFormat::openmetrics);
   EXPECT_EQ(format_for_accept("*/*"), ExpositionFormat::prometheus_text);
 }
 

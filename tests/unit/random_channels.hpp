@@ -52,7 +52,9 @@ class RandomSets {
     } else if (chance(3)) {
       s.can.profile = CanProfile::famouso;  // classic CAN only; its own identifiers and priorities
     }
-    if (chance(3)) s.can.errors = CanFaultHypothesis{static_cast<std::uint32_t>(1 + below(2)), Nanos(pick({10'000'000, 100'000'000}))};
+    if (chance(3))
+      s.can.errors =
+          CanFaultHypothesis{static_cast<std::uint32_t>(1 + below(2)), Nanos(pick({10'000'000, 100'000'000}))};
     return s;
   }
 
@@ -66,7 +68,8 @@ class RandomSets {
     if (!chance(8)) period = Nanos(pick({2'000'000, 5'000'000, 10'000'000, 20'000'000, 100'000'000, 1'000'000'000}));
     const Nanos reaction(pick({1'000'000, 3'000'000, 5'000'000, 10'000'000, 20'000'000, 50'000'000}));
     // Subjects collide now and then on purpose (deadline ties ordered by subject, duplicates refused).
-    ChannelSpec c = channel("c" + std::to_string(i), 1 + below(4 * (i + 1)), cls, {pub}, {sub}, payload, period, reaction);
+    ChannelSpec c =
+        channel("c" + std::to_string(i), 1 + below(4 * (i + 1)), cls, {pub}, {sub}, payload, period, reaction);
     c.omission_degree = static_cast<std::uint32_t>(below(2));
     if (chance(3)) c.temp_validity = Nanos(pick({5'000'000, 20'000'000, 100'000'000}));
     if (chance(10)) c.etag = static_cast<std::uint16_t>(200 + below(50));

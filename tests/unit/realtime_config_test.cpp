@@ -13,15 +13,17 @@ namespace {
 std::string document(const std::string& realtime, const std::string& dds_extra = "") {
   return "gateway:\n  name: gw1\n" + realtime +
          "segments:\n"
-         "  - {name: lan, type: dds, domain: 3" + dds_extra + "}\n"
+         "  - {name: lan, type: dds, domain: 3" +
+         dds_extra +
+         "}\n"
          "channels: []\n";
 }
 
 const unsigned kCpus = std::max(1u, std::thread::hardware_concurrency());
 
 TEST(RealtimeConfig, PrioritiesAndOneListOfCpusForEveryThread) {
-  const ConfigResult r =
-      parse_config(document("  realtime: {priorities: {hrt: 80, srt: 60, receive: 10}, cpus: [0], lock_memory: true}\n"), "g.yaml");
+  const ConfigResult r = parse_config(
+      document("  realtime: {priorities: {hrt: 80, srt: 60, receive: 10}, cpus: [0], lock_memory: true}\n"), "g.yaml");
   ASSERT_TRUE(r.ok()) << test::errors_text(r);
   const RealtimeSpec& rt = r.config.gateway.realtime;
   EXPECT_EQ(rt.hrt_priority, 80);
@@ -39,7 +41,8 @@ TEST(RealtimeConfig, PrioritiesAndOneListOfCpusForEveryThread) {
 
 TEST(RealtimeConfig, CpusByKindOfThread) {
   const int last = static_cast<int>(kCpus) - 1;
-  const std::string text = "  realtime: {cpus: {hrt: [" + std::to_string(last) + "], nrt: [0], receive: [0], other: [0]}}\n";
+  const std::string text =
+      "  realtime: {cpus: {hrt: [" + std::to_string(last) + "], nrt: [0], receive: [0], other: [0]}}\n";
   const ConfigResult r = parse_config(document(text), "g.yaml");
   ASSERT_TRUE(r.ok()) << test::errors_text(r);
   const CpuPlacement& c = r.config.gateway.realtime.cpus;
@@ -73,12 +76,16 @@ TEST(RealtimeConfig, EveryMistakeIsReportedWithItsPlace) {
   };
   const std::string missing_cpu = std::to_string(kCpus);
   const std::vector<Case> cases = {
-      {"  realtime: {cpus: [" + missing_cpu + "]}\n", "", "gateway.realtime.cpus[0]: CPU " + missing_cpu + " does not exist on this machine"},
-      {"  realtime: {cpus: {hrt: [" + missing_cpu + "]}}\n", "", "gateway.realtime.cpus.hrt[0]: CPU " + missing_cpu + " does not exist"},
+      {"  realtime: {cpus: [" + missing_cpu + "]}\n", "",
+       "gateway.realtime.cpus[0]: CPU " + missing_cpu + " does not exist on this machine"},
+      {"  realtime: {cpus: {hrt: [" + missing_cpu + "]}}\n", "",
+       "gateway.realtime.cpus.hrt[0]: CPU " + missing_cpu + " does not exist"},
       {"  realtime: {cpus: {fast: [0]}}\n", "", "gateway.realtime.cpus.fast"},
-      {"  realtime: {cpus: 1}\n", "", "g.yaml:3:20: gateway.realtime.cpus: expected a list of CPUs or a map of them by thread kind"},
+      {"  realtime: {cpus: 1}\n", "",
+       "g.yaml:3:20: gateway.realtime.cpus: expected a list of CPUs or a map of them by thread kind"},
       {"  realtime: {cpus: {other: 0}}\n", "", "gateway.realtime.cpus.other"},
-      {"  realtime: {priorities: {hrt: 10, srt: 60}}\n", "", "gateway.realtime.priorities: class priorities are out of order"},
+      {"  realtime: {priorities: {hrt: 10, srt: 60}}\n", "",
+       "gateway.realtime.priorities: class priorities are out of order"},
       {"", ", shared_memory: [hrt, fast]", "segments[0].shared_memory[1]"},
       {"", ", shared_memory: hrt", "segments[0].shared_memory"},
   };

@@ -147,11 +147,11 @@ TEST(JsonReport, Values) {
 
 TEST(JsonReport, UnboundedIsNull) {
   // Two 8 B frames every 2 ms on 125 kbit/s: 128 %, the lower one has no bound.
-  const auto e = evaluate(gateway(), std::vector<SegmentSpec>{can_segment("can", 125'000), dds_segment("lan")},
-                          std::vector<ChannelSpec>{
-                              channel("a", 1, ChannelClass::srt, {"can"}, {"lan"}, 8, Nanos(2ms), Nanos(10ms)),
-                              channel("b", 2, ChannelClass::srt, {"can"}, {"lan"}, 8, Nanos(2ms), Nanos(10ms))},
-                          {});
+  const auto e = evaluate(
+      gateway(), std::vector<SegmentSpec>{can_segment("can", 125'000), dds_segment("lan")},
+      std::vector<ChannelSpec>{channel("a", 1, ChannelClass::srt, {"can"}, {"lan"}, 8, Nanos(2ms), Nanos(10ms)),
+                               channel("b", 2, ChannelClass::srt, {"can"}, {"lan"}, 8, Nanos(2ms), Nanos(10ms))},
+      {});
   const json b = to_json(e.channels[1]);
   EXPECT_TRUE(b["hops"][0]["can"]["response_time_s"].is_null());
   EXPECT_TRUE(b["end_to_end"]["latency_s"].is_null());
@@ -224,7 +224,8 @@ TEST(JsonReport, FamousoHopsInFamousosLayout) {
   EXPECT_EQ(frag["fragment"], true);
   EXPECT_EQ(frag["can_id"], (0x78u << 22) | (1u << 21) | (9u << 14) | 202u);
   const std::string text = render_channel_text(*report.find("command"));
-  EXPECT_NE(text.find("id 0x0402412C (FAMOUSO layout: priority 0x10, fragment 0, TxNode 9, etag 300)"), std::string::npos)
+  EXPECT_NE(text.find("id 0x0402412C (FAMOUSO layout: priority 0x10, fragment 0, TxNode 9, etag 300)"),
+            std::string::npos)
       << text;
   EXPECT_EQ(can_identifier_text(0x1E2140C9u, CanProfile::famouso),
             "0x1E2140C9 (FAMOUSO layout: priority 0x78, fragment 1, TxNode 5, etag 201)");

@@ -36,7 +36,7 @@ TEST(DuplicateFilterTest, OneSpoofedMaximumSequenceDoesNotPoisonTheOrigin) {
   DuplicateFilter f;
   EXPECT_EQ(feed(f, 1, 10), 0u);
   f.seen(kOrigin, 0xFFFFFFFF);
-  EXPECT_EQ(feed(f, 11, 200), 0u);  // every later genuine event still passes
+  EXPECT_EQ(feed(f, 11, 200), 0u);    // every later genuine event still passes
   EXPECT_TRUE(f.seen(kOrigin, 210));  // and real duplicates are still caught
 }
 
@@ -88,13 +88,15 @@ TEST(DuplicateFilterTest, FarForwardJumpsPassAndAreCounted) {
 TEST(DuplicateFilterTest, TheLeastRecentlyUsedOriginIsEvicted) {
   DuplicateFilter f;
   for (std::uint64_t origin = 1; origin <= 16; ++origin) EXPECT_FALSE(f.seen(origin, 5));
-  EXPECT_TRUE(f.seen(1, 5));          // origin 1 is now the most recent
-  EXPECT_FALSE(f.seen(17, 5));        // evicts origin 2
-  EXPECT_FALSE(f.seen(2, 5));         // forgotten: new again
+  EXPECT_TRUE(f.seen(1, 5));    // origin 1 is now the most recent
+  EXPECT_FALSE(f.seen(17, 5));  // evicts origin 2
+  EXPECT_FALSE(f.seen(2, 5));   // forgotten: new again
   EXPECT_TRUE(f.seen(1, 5));
 }
 
-std::vector<std::uint8_t> payload(std::uint8_t tag, std::size_t size = 8) { return std::vector<std::uint8_t>(size, tag); }
+std::vector<std::uint8_t> payload(std::uint8_t tag, std::size_t size = 8) {
+  return std::vector<std::uint8_t>(size, tag);
+}
 
 TEST(RawLoopGuardTest, APayloadSeenAgainWithinTheWindowIsALoopCopy) {
   RawLoopGuard guard(Nanos(1'000'000));

@@ -45,9 +45,10 @@ inline SegmentSpec lcm_segment(const std::string& name, Nanos latency_bound = 5m
   return s;
 }
 
-inline ChannelSpec channel(const std::string& name, std::uint64_t subject, ChannelClass cls, std::vector<std::string> publishers,
-                           std::vector<std::string> subscribers, std::uint64_t payload = 8,
-                           std::optional<Nanos> period = Nanos(10ms), std::optional<Nanos> reaction_time = Nanos(5ms)) {
+inline ChannelSpec channel(const std::string& name, std::uint64_t subject, ChannelClass cls,
+                           std::vector<std::string> publishers, std::vector<std::string> subscribers,
+                           std::uint64_t payload = 8, std::optional<Nanos> period = Nanos(10ms),
+                           std::optional<Nanos> reaction_time = Nanos(5ms)) {
   ChannelSpec c;
   c.name = name;
   c.subject = subject;

@@ -39,7 +39,8 @@ const TopLine& row_of(const std::vector<TopLine>& frame, const std::string& chan
 TEST(TopView, AChannelItsTransportRefusedIsFailedAndRed) {
   const auto frame = top_frame(sample("failed", 1), std::nullopt);
   ASSERT_FALSE(frame.empty());
-  EXPECT_NE(frame[0].text.find("channels 0 bound, 0 degraded, 1 failed, 0 violated"), std::string::npos) << frame[0].text;
+  EXPECT_NE(frame[0].text.find("channels 0 bound, 0 degraded, 1 failed, 0 violated"), std::string::npos)
+      << frame[0].text;
   EXPECT_TRUE(frame[0].alert);
   const TopLine& speed = row_of(frame, "speed");
   EXPECT_NE(speed.text.find(" failed "), std::string::npos) << speed.text;
@@ -49,7 +50,8 @@ TEST(TopView, AChannelItsTransportRefusedIsFailedAndRed) {
 TEST(TopView, ABoundChannelShowsItsRuntimeState) {
   const auto frame = top_frame(sample("bound", 0), std::nullopt);
   ASSERT_FALSE(frame.empty());
-  EXPECT_NE(frame[0].text.find("channels 1 bound, 0 degraded, 0 failed, 0 violated"), std::string::npos) << frame[0].text;
+  EXPECT_NE(frame[0].text.find("channels 1 bound, 0 degraded, 0 failed, 0 violated"), std::string::npos)
+      << frame[0].text;
   EXPECT_FALSE(frame[0].alert);
   const TopLine& speed = row_of(frame, "speed");
   EXPECT_NE(speed.text.find(" bound "), std::string::npos) << speed.text;

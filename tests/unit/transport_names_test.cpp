@@ -34,13 +34,13 @@ TEST(LcmUrl, CanonicalSpellingsAreRead) {
 }
 
 TEST(LcmUrl, EverySpellingLcmWouldReadAsAnotherPortIsRefused) {
-  for (const char* bad : {"udpm://239.255.76.67:7667/", "udpm://239.255.76.67:7667 ", "udpm://239.255.76.67:0x1df3",
-                          "udpm://239.255.76.67:+7667", "udpm://239.255.76.67:07667x", "udpm://239.255.76.67:0",
-                          "udpm://239.255.76.67:65536", "udpm://239.255.76.67:", "udpm://10.0.0.1:7667",
-                          "udpm://239.255.076.67:7667", "udpm://239.255.76:7667", "udpm://239.255.76.67:7667?ttl=256",
-                          "udpm://239.255.76.67:7667?ttl=0x1", "udpm://239.255.76.67:7667?evil=1",
-                          "udpm://239.255.76.67:7667?ttl=0&", "udp://239.255.76.67:7667", "memq://x",
-                          "udpm://239.255.76.67:7667\"\n"}) {
+  for (const char* bad :
+       {"udpm://239.255.76.67:7667/", "udpm://239.255.76.67:7667 ", "udpm://239.255.76.67:0x1df3",
+        "udpm://239.255.76.67:+7667", "udpm://239.255.76.67:07667x", "udpm://239.255.76.67:0",
+        "udpm://239.255.76.67:65536", "udpm://239.255.76.67:", "udpm://10.0.0.1:7667", "udpm://239.255.076.67:7667",
+        "udpm://239.255.76:7667", "udpm://239.255.76.67:7667?ttl=256", "udpm://239.255.76.67:7667?ttl=0x1",
+        "udpm://239.255.76.67:7667?evil=1", "udpm://239.255.76.67:7667?ttl=0&", "udp://239.255.76.67:7667", "memq://x",
+        "udpm://239.255.76.67:7667\"\n"}) {
     const auto url = parse_lcm_url(bad);
     ASSERT_TRUE(std::holds_alternative<std::string>(url)) << bad << " was accepted";
     EXPECT_EQ(std::get<std::string>(url).find('\n'), std::string::npos) << std::get<std::string>(url);
@@ -50,16 +50,18 @@ TEST(LcmUrl, EverySpellingLcmWouldReadAsAnotherPortIsRefused) {
 constexpr const char* kHead = "gateway: {name: gw, can_node_id: 1}\nsegments:\n";
 
 TEST(LcmUrl, TwoSegmentsOnOnePortAreFoundWhateverTheSpellingAndBadUrlsAreLocated) {
-  const ConfigResult r = parse_config(std::string(kHead) + R"(  - {name: a, type: lcm, url: "udpm://239.255.76.67:7667?ttl=0"}
+  const ConfigResult r =
+      parse_config(std::string(kHead) + R"(  - {name: a, type: lcm, url: "udpm://239.255.76.67:7667?ttl=0"}
   - {name: b, type: lcm, url: "udpm://239.255.76.68?ttl=1"}
   - {name: c, type: lcm, url: "udpm://239.255.76.67:7667/"}
 channels: []
 )",
-                                      "gw.yaml");
+                   "gw.yaml");
   const std::string text = names_errors_text(r.errors);
   EXPECT_NE(text.find("segments[1].url"), std::string::npos) << text;  // default port 7667 = a's port
   EXPECT_NE(text.find("UDP port 7667"), std::string::npos) << text;
-  EXPECT_NE(text.find("gw.yaml:5:31: segments[2].url: unsupported LCM URL 'udpm://239.255.76.67:7667/': the port must be a decimal"),
+  EXPECT_NE(text.find("gw.yaml:5:31: segments[2].url: unsupported LCM URL 'udpm://239.255.76.67:7667/': the port must "
+                      "be a decimal"),
             std::string::npos)
       << text;
 }
@@ -72,17 +74,20 @@ TEST(InterfaceNames, QuotesAndControlCharactersAreRefusedWhereTheyAreWritten) {
   EXPECT_TRUE(interface_name_problem(".."));
   EXPECT_TRUE(interface_name_problem("can0/x"));
   EXPECT_TRUE(interface_name_problem("sixteen_chars_xx"));
-  const ConfigResult r = parse_config(std::string(kHead) + R"(  - {name: bus, type: can, interface: "vcan0\"\nint x;", bitrate: 500kbit/s}
+  const ConfigResult r =
+      parse_config(std::string(kHead) + R"(  - {name: bus, type: can, interface: "vcan0\"\nint x;", bitrate: 500kbit/s}
   - {name: lan, type: dds, interfaces: [eth0, "lo\"x"]}
 channels: []
 )",
-                                      "gw.yaml");
+                   "gw.yaml");
   const std::string text = names_errors_text(r.errors);
-  EXPECT_NE(text.find("gw.yaml:3:39: segments[0].interface: interface names hold letters, digits, '_', '.', '@' and '-' only; this one has '\"'"),
+  EXPECT_NE(text.find("gw.yaml:3:39: segments[0].interface: interface names hold letters, digits, '_', '.', '@' and "
+                      "'-' only; this one has '\"'"),
             std::string::npos)
       << text;
   EXPECT_NE(text.find("segments[1].interfaces[1]: invalid name"), std::string::npos) << text;
-  EXPECT_EQ(text.find("int x;"), std::string::npos) << "the value itself is never echoed with its control characters: " << text;
+  EXPECT_EQ(text.find("int x;"), std::string::npos)
+      << "the value itself is never echoed with its control characters: " << text;
 }
 
 TEST(LcmChannelNames, ANulOrControlCharacterIsRefusedBeforeItReachesTheWire) {
@@ -91,7 +96,8 @@ TEST(LcmChannelNames, ANulOrControlCharacterIsRefusedBeforeItReachesTheWire) {
   EXPECT_TRUE(transport_name_problem(SegmentType::lcm, std::string("A\0B", 3)));
   EXPECT_TRUE(transport_name_problem(SegmentType::lcm, "A\nB"));
   EXPECT_TRUE(transport_name_problem(SegmentType::lcm, "A\x7f"));
-  EXPECT_EQ(transport_name_problem(SegmentType::dds, std::string("A\0B", 3)), std::nullopt);  // DDS names are checked elsewhere
+  EXPECT_EQ(transport_name_problem(SegmentType::dds, std::string("A\0B", 3)),
+            std::nullopt);  // DDS names are checked elsewhere
   // In a native binding of the configuration, at its place.
   const ConfigResult r = parse_config(std::string(kHead) + R"(  - {name: lan, type: dds}
   - {name: viz, type: lcm}

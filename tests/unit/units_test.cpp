@@ -23,7 +23,7 @@ TEST(Units, DurationEveryUnit) {
   EXPECT_EQ(parse_duration("0.1ms").value, Nanos(100'000));  // 0.1 is inexact in binary: rounded
   EXPECT_EQ(parse_duration(".5ms").value, Nanos(500'000));
   EXPECT_EQ(parse_duration(" 10 ms ").value, Nanos(10'000'000));  // blanks around and between
-  EXPECT_EQ(parse_duration("0ms").value, Nanos(0));                 // >= 0 allowed here
+  EXPECT_EQ(parse_duration("0ms").value, Nanos(0));               // >= 0 allowed here
   EXPECT_TRUE(parse_duration("10ms").error.empty());
 }
 

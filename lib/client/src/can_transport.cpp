@@ -169,7 +169,8 @@ class CanTransport final : public Transport {
         delivery_->deliver(index, header, data);
         return;
       }
-      const auto result = reassembler_.accept(static_cast<std::uint32_t>(id.tx_node) << 14 | id.etag, data, c.spec.payload, steady_now());
+      const auto result = reassembler_.accept(static_cast<std::uint32_t>(id.tx_node) << 14 | id.etag, data,
+                                              c.spec.payload, steady_now());
       if (result.outcome != FragmentOutcome::complete) return;
       const std::size_t channel = index;
       lock.unlock();

@@ -70,7 +70,8 @@ struct cosmic_client final : Delivery {
       if (index < channels.size()) channel = channels[index].get();
     }
     if (!channel) return;
-    const cosmic_event_info info{header.subject, header.sequence, header.age_ns, static_cast<std::uint32_t>(payload.size())};
+    const cosmic_event_info info{header.subject, header.sequence, header.age_ns,
+                                 static_cast<std::uint32_t>(payload.size())};
     cosmic::LockGuard lock(channel->mutex);
     if (channel->callback) {
       channel->delivering.store(std::this_thread::get_id(), std::memory_order_relaxed);
@@ -101,11 +102,14 @@ std::unique_ptr<Transport> transport_for(const std::string& segment, std::string
   const std::string options = query == std::string::npos ? "" : rest.substr(query + 1);
   cosmic::SegmentSpec spec;
   spec.name = kind;
-  if (kind == "dds" && !target.empty() && target.find_first_not_of("0123456789") == std::string::npos && target.size() < 4) {
+  if (kind == "dds" && !target.empty() && target.find_first_not_of("0123456789") == std::string::npos &&
+      target.size() < 4) {
     spec.type = cosmic::SegmentType::dds;
     spec.dds.domain = static_cast<std::uint32_t>(std::stoul(target));
-    if (options == "reliability=best_effort") spec.reliability = cosmic::Reliability::best_effort;
-    else if (!options.empty() && options != "reliability=reliable") error = "unknown DDS option '" + options + "'";
+    if (options == "reliability=best_effort")
+      spec.reliability = cosmic::Reliability::best_effort;
+    else if (!options.empty() && options != "reliability=reliable")
+      error = "unknown DDS option '" + options + "'";
     return error.empty() ? cosmic::client_detail::make_ip_transport(spec) : nullptr;
   }
   if (kind == "lcm" && (rest.rfind("udpm://", 0) == 0 || rest.rfind("memq://", 0) == 0)) {
@@ -119,9 +123,11 @@ std::unique_ptr<Transport> transport_for(const std::string& segment, std::string
   }
   if (kind == "can" && !target.empty() && options.rfind("node=", 0) == 0) {
     const unsigned long node = std::strtoul(options.c_str() + 5, nullptr, 0);
-    if (node <= cosmic::kMaxTxNode) return cosmic::client_detail::make_can_transport(target, static_cast<std::uint8_t>(node));
+    if (node <= cosmic::kMaxTxNode)
+      return cosmic::client_detail::make_can_transport(target, static_cast<std::uint8_t>(node));
   }
-  error = "segment '" + segment + "' is none of dds:DOMAIN[?reliability=best_effort], lcm:udpm://GROUP:PORT?ttl=N, can:IFACE?node=0..127";
+  error = "segment '" + segment +
+          "' is none of dds:DOMAIN[?reliability=best_effort], lcm:udpm://GROUP:PORT?ttl=N, can:IFACE?node=0..127";
   return nullptr;
 }
 
@@ -155,7 +161,8 @@ std::string unmatched_roles(const Transport& transport, std::size_t index, int r
 }
 
 std::int64_t wall_clock_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
 }
 
 }  // namespace
@@ -213,7 +220,8 @@ int cosmic_wait_ready(cosmic_channel* channel, int timeout_ms) {
   if (!channel) return COSMIC_E_INVALID;
   cosmic_client* client = channel->client;
   if (timeout_ms < 0) {
-    return client->fail(COSMIC_E_INVALID, "cosmic_wait_ready: timeout_ms " + std::to_string(timeout_ms) + " is negative");
+    return client->fail(COSMIC_E_INVALID,
+                        "cosmic_wait_ready: timeout_ms " + std::to_string(timeout_ms) + " is negative");
   }
   // The transports offer no match notification through SegmentAdapter: the counts are polled
   // (shared locks and a status copy, microseconds) every millisecond until the deadline.
@@ -237,8 +245,9 @@ int cosmic_wait_ready(cosmic_channel* channel, int timeout_ms) {
 int cosmic_publish(cosmic_channel* channel, const void* data, size_t size) {
   if (!channel || (size && !data) || !(channel->roles & COSMIC_PUBLISH)) return COSMIC_E_INVALID;
   if (size > channel->spec.payload) {
-    return channel->client->fail(COSMIC_E_TOO_LARGE, "event of " + std::to_string(size) + " B on channel '" + channel->spec.name +
-                                                         "' whose payload is " + std::to_string(channel->spec.payload) + " B");
+    return channel->client->fail(COSMIC_E_TOO_LARGE, "event of " + std::to_string(size) + " B on channel '" +
+                                                         channel->spec.name + "' whose payload is " +
+                                                         std::to_string(channel->spec.payload) + " B");
   }
   cosmic::EventHeader header;
   header.subject = channel->spec.subject;
@@ -248,7 +257,8 @@ int cosmic_publish(cosmic_channel* channel, const void* data, size_t size) {
   }
   header.created_ns = wall_clock_ns();
   std::string why;
-  const int rc = channel->client->transport->send(channel->index, header, {static_cast<const std::uint8_t*>(data), size}, why);
+  const int rc =
+      channel->client->transport->send(channel->index, header, {static_cast<const std::uint8_t*>(data), size}, why);
   return rc == COSMIC_OK || rc == COSMIC_E_AGAIN ? rc : channel->client->fail(rc, why);
 }
 

@@ -82,8 +82,10 @@ class IpTransport final : public Transport, private EventSink {
   int announce(std::size_t index, const ChannelSpec& spec, int roles, int, std::string& error) override {
     LockGuard lock(mutex_);
     auto next = bindings_;
-    if (roles & COSMIC_PUBLISH) next.push_back(ChannelBinding{binding_id(index), spec, hop_role_of(COSMIC_PUBLISH), std::nullopt});
-    if (roles & COSMIC_SUBSCRIBE) next.push_back(ChannelBinding{binding_id(index), spec, hop_role_of(COSMIC_SUBSCRIBE), std::nullopt});
+    if (roles & COSMIC_PUBLISH)
+      next.push_back(ChannelBinding{binding_id(index), spec, hop_role_of(COSMIC_PUBLISH), std::nullopt});
+    if (roles & COSMIC_SUBSCRIBE)
+      next.push_back(ChannelBinding{binding_id(index), spec, hop_role_of(COSMIC_SUBSCRIBE), std::nullopt});
     const Status s = adapter_->configure(next);
     if (!s.ok) {
       error = s.error;
@@ -93,15 +95,19 @@ class IpTransport final : public Transport, private EventSink {
     return COSMIC_OK;
   }
 
-  int send(std::size_t index, const EventHeader& header, std::span<const std::uint8_t> payload, std::string& error) override {
+  int send(std::size_t index, const EventHeader& header, std::span<const std::uint8_t> payload,
+           std::string& error) override {
     // The component's events carry its own origin on DDS and LCM alike, so every gateway that
     // forwards them gives them the same identity (origin, sequence) and duplicates stay visible.
     EventHeader stamped = header;
     stamped.origin = self_.id;
     switch (adapter_->send(OutboundEvent{binding_id(index), stamped, payload})) {
-      case SendStatus::sent: return COSMIC_OK;
-      case SendStatus::queue_full: return COSMIC_E_AGAIN;
-      case SendStatus::failed: break;
+      case SendStatus::sent:
+        return COSMIC_OK;
+      case SendStatus::queue_full:
+        return COSMIC_E_AGAIN;
+      case SendStatus::failed:
+        break;
     }
     error = "the " + std::string(to_string(segment_.type)) + " transport refused the event: " + log_.last();
     return COSMIC_E_TRANSPORT;
@@ -143,6 +149,8 @@ class IpTransport final : public Transport, private EventSink {
 
 }  // namespace
 
-std::unique_ptr<Transport> make_ip_transport(const SegmentSpec& segment) { return std::make_unique<IpTransport>(segment); }
+std::unique_ptr<Transport> make_ip_transport(const SegmentSpec& segment) {
+  return std::make_unique<IpTransport>(segment);
+}
 
 }  // namespace cosmic::client_detail

@@ -30,7 +30,8 @@ class Transport {
   // Adds channel `index` (0, 1, 2, ... in announce order) with the component's roles.
   virtual int announce(std::size_t index, const ChannelSpec& spec, int roles, int timeout_ms, std::string& error) = 0;
   // One event of channel `index`, announced with COSMIC_PUBLISH. Never throws.
-  virtual int send(std::size_t index, const EventHeader& header, std::span<const std::uint8_t> payload, std::string& error) = 0;
+  virtual int send(std::size_t index, const EventHeader& header, std::span<const std::uint8_t> payload,
+                   std::string& error) = 0;
   // Remote endpoints matched with the component's endpoint of `role` on channel `index`
   // (COSMIC_PUBLISH: readers of its writer; COSMIC_SUBSCRIBE: writers of its reader), never
   // counting the component's own; nullopt where the transport has no discovery to ask (LCM, CAN).

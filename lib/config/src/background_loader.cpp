@@ -71,12 +71,14 @@ class BackgroundParser {
     } else {
       for (const char* only_with_dbc : {"periods", "ignore"}) {
         if (node[only_with_dbc]) {
-          reader_.error_at(node[only_with_dbc], key(path, only_with_dbc), std::string(only_with_dbc) + " applies to a DBC's messages",
+          reader_.error_at(node[only_with_dbc], key(path, only_with_dbc),
+                           std::string(only_with_dbc) + " applies to a DBC's messages",
                            "a dbc: FILE beside it, or remove it");
         }
       }
     }
-    if (!node["frames"] && !node["dbc"]) reader_.error_at(node, path, "no background frames declared", "frames: [...] and/or dbc: FILE");
+    if (!node["frames"] && !node["dbc"])
+      reader_.error_at(node, path, "no background frames declared", "frames: [...] and/or dbc: FILE");
   }
 
  private:
@@ -85,7 +87,8 @@ class BackgroundParser {
     CanBackgroundFrame frame;
     bool ok = true;
     if (node["extended"]) ok = assign(reader_.boolean(node["extended"], key(path, "extended")), frame.extended) && ok;
-    if (require(node, path, "can_id", "the frame's identifier, e.g. 0x123 (11 bits) or 0x18FF0001 with extended: true")) {
+    if (require(node, path, "can_id",
+                "the frame's identifier, e.g. 0x123 (11 bits) or 0x18FF0001 with extended: true")) {
       const std::uint64_t max = frame.extended ? kExtendedIdMax : kStandardIdMax;
       std::uint64_t id = 0;
       ok = assign(reader_.unsigned_int(node["can_id"], key(path, "can_id"), 0, max), id) && ok;
@@ -101,14 +104,17 @@ class BackgroundParser {
     }
     if (node["jitter"]) ok = assign(reader_.duration(node["jitter"], key(path, "jitter"), true), frame.jitter) && ok;
     if (!ok) return;
-    frame.name = node["name"] ? reader_.string(node["name"], key(path, "name")).value_or("") : can_id_text(frame.can_id, frame.extended);
+    frame.name = node["name"] ? reader_.string(node["name"], key(path, "name")).value_or("")
+                              : can_id_text(frame.can_id, frame.extended);
     frame.origin = location(reader_.file(), node.Mark());
-    if (const std::string conflict = add(std::move(frame)); !conflict.empty()) reader_.error_at(node, path, conflict, "one sender per identifier");
+    if (const std::string conflict = add(std::move(frame)); !conflict.empty())
+      reader_.error_at(node, path, conflict, "one sender per identifier");
   }
 
   // `dlc: 0..15` (the DLC code; 9..15 are FD lengths) or `length: NB` (data bytes).
   bool parse_length(const YAML::Node& node, const std::string& path, CanBackgroundFrame& frame) {
-    const char* valid = can_.fd ? "dlc: 0..15 or length: 0..8, 12, 16, 20, 24, 32, 48 or 64B" : "dlc: 0..8 or length: 0B..8B";
+    const char* valid =
+        can_.fd ? "dlc: 0..15 or length: 0..8, 12, 16, 20, 24, 32, 48 or 64B" : "dlc: 0..8 or length: 0B..8B";
     if (node["dlc"] && node["length"]) {
       reader_.error_at(node["length"], key(path, "length"), "dlc and length both given", valid);
       return false;
@@ -127,14 +133,16 @@ class BackgroundParser {
     if (!assign(reader_.size(node["length"], key(path, "length"), kFdMaxPayload), length)) return false;
     frame.length = static_cast<std::uint32_t>(length);
     if (is_frame_length(frame.length, can_.fd)) return true;
-    reader_.error_at(node["length"], key(path, "length"), "no frame of this bus has " + std::to_string(length) + " data bytes", valid);
+    reader_.error_at(node["length"], key(path, "length"),
+                     "no frame of this bus has " + std::to_string(length) + " data bytes", valid);
     return false;
   }
 
   void parse_dbc_options(const YAML::Node& node, const std::string& path) {
     if (const YAML::Node periods = node["periods"]) {
       if (!periods.IsMap()) {
-        reader_.error_at(periods, key(path, "periods"), "expected a map of message names to periods", "periods: {DoorEvent: 50ms}");
+        reader_.error_at(periods, key(path, "periods"), "expected a map of message names to periods",
+                         "periods: {DoorEvent: 50ms}");
       } else {
         for (const auto& entry : periods) {
           const std::string name = entry.first.Scalar();
@@ -155,15 +163,19 @@ class BackgroundParser {
   void load_dbc(const YAML::Node& where, const std::string& path, const std::string& file) {
     const std::filesystem::path relative(file);
     const std::string resolved =
-        relative.is_absolute() ? file : (std::filesystem::path(reader_.file()).parent_path() / relative).lexically_normal().string();
+        relative.is_absolute()
+            ? file
+            : (std::filesystem::path(reader_.file()).parent_path() / relative).lexically_normal().string();
     std::string text;
     if (const std::string error = read_regular_file(resolved, text); !error.empty()) {
-      reader_.error_at(where, key(path, "dbc"), "cannot read DBC file " + resolved + ": " + error, "a readable DBC file, relative to this file");
+      reader_.error_at(where, key(path, "dbc"), "cannot read DBC file " + resolved + ": " + error,
+                       "a readable DBC file, relative to this file");
       return;
     }
     included_.push_back(resolved);
     const DbcFile dbc = parse_dbc(text);
-    for (const DbcError& e : dbc.errors) reader_.error_in(ConfigError{resolved, e.line, e.column, key(path, "dbc"), e.message, ""});
+    for (const DbcError& e : dbc.errors)
+      reader_.error_in(ConfigError{resolved, e.line, e.column, key(path, "dbc"), e.message, ""});
     if (!dbc.ok()) return;
     std::set<std::string> seen;
     for (const DbcMessage& m : dbc.messages) {
@@ -195,9 +207,10 @@ class BackgroundParser {
       return;
     }
     if (!is_frame_length(m.length, can_.fd)) {
-      reader_.error_in(ConfigError{file, m.line, m.column, path,
-                                   "message " + m.name + " has " + std::to_string(m.length) + " data bytes, more than a frame of this bus",
-                                   can_.fd ? "at most 64 bytes" : "at most 8 bytes (fd: true for CAN FD messages)"});
+      reader_.error_in(ConfigError{
+          file, m.line, m.column, path,
+          "message " + m.name + " has " + std::to_string(m.length) + " data bytes, more than a frame of this bus",
+          can_.fd ? "at most 64 bytes" : "at most 8 bytes (fd: true for CAN FD messages)"});
       return;
     }
     if (const std::string conflict = add(std::move(frame)); !conflict.empty()) {
@@ -206,7 +219,8 @@ class BackgroundParser {
   }
 
   void unknown_name(const YAML::Node& node, const std::string& path, const std::string& name, const std::string& file) {
-    reader_.error_at(node, path, "the DBC file " + file + " has no message named " + name, "a BO_ message name of that file");
+    reader_.error_at(node, path, "the DBC file " + file + " has no message named " + name,
+                     "a BO_ message name of that file");
   }
 
   // Adds one more frame; the reason when it cannot be (two senders of one identifier would
@@ -214,7 +228,8 @@ class BackgroundParser {
   std::string add(CanBackgroundFrame frame) {
     const auto id = std::pair(frame.can_id, frame.extended);
     if (const auto earlier = ids_.find(id); earlier != ids_.end()) {
-      return "identifier " + can_id_text(frame.can_id, frame.extended) + " (" + frame.name + ") is already declared at " + earlier->second;
+      return "identifier " + can_id_text(frame.can_id, frame.extended) + " (" + frame.name +
+             ") is already declared at " + earlier->second;
     }
     if (can_.background.size() >= kMaxBackgroundFrames) {
       return "more than " + std::to_string(kMaxBackgroundFrames) + " background frames on one segment";

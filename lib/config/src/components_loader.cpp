@@ -36,7 +36,8 @@ std::map<std::string, ChannelNode> channel_nodes(const YAML::Node& root) {
   if (!list || !list.IsSequence()) return out;
   for (std::size_t i = 0; i < list.size(); ++i) {
     const YAML::Node node = list[i];
-    if (node.IsMap() && node["name"] && node["name"].IsScalar()) out.emplace(node["name"].Scalar(), ChannelNode{node, item_path("channels", i)});
+    if (node.IsMap() && node["name"] && node["name"].IsScalar())
+      out.emplace(node["name"].Scalar(), ChannelNode{node, item_path("channels", i)});
   }
   return out;
 }
@@ -64,12 +65,14 @@ class ComponentsLoader {
     if (!reader_.check_map(node, path, {"name", "segment", "publishes", "subscribes"})) return;
     const std::size_t errors_before = reader_.error_count();
     ComponentSpec c;
-    if (require(node, path, "name", "a component name")) c.name = reader_.name(node["name"], path + ".name").value_or("");
+    if (require(node, path, "name", "a component name"))
+      c.name = reader_.name(node["name"], path + ".name").value_or("");
     if (require(node, path, "segment", "the name of the segment the component lives on")) read_segment(node, path, c);
     read_list(node, path, "publishes", c.publishes);
     read_list(node, path, "subscribes", c.subscribes);
     if (!present(node, "publishes") && !present(node, "subscribes")) {
-      reader_.error_at(node, path, "component neither publishes nor subscribes", "publishes: [CHANNEL] and/or subscribes: [CHANNEL]");
+      reader_.error_at(node, path, "component neither publishes nor subscribes",
+                       "publishes: [CHANNEL] and/or subscribes: [CHANNEL]");
     }
     if (reader_.error_count() != errors_before) return;
     if (const auto [it, fresh] = names_.emplace(c.name, node["name"].Mark().line + 1); !fresh) {
@@ -84,7 +87,8 @@ class ComponentsLoader {
 
   bool require(const YAML::Node& node, const std::string& path, const char* name, const char* valid) {
     if (present(node, name)) return true;
-    if (!node[name]) reader_.error_at(node, path + "." + name, std::string("missing required key '") + name + "'", valid);
+    if (!node[name])
+      reader_.error_at(node, path + "." + name, std::string("missing required key '") + name + "'", valid);
     return false;
   }
 
@@ -94,7 +98,8 @@ class ComponentsLoader {
     if (!config_.find_segment(*name)) {
       std::vector<std::string> known;
       for (const auto& s : config_.segments) known.push_back(s.name);
-      reader_.error_at(node["segment"], path + ".segment", "unknown segment '" + *name + "'", "one of the segments: " + joined(known));
+      reader_.error_at(node["segment"], path + ".segment", "unknown segment '" + *name + "'",
+                       "one of the segments: " + joined(known));
       return;
     }
     c.segment = *name;
@@ -109,7 +114,8 @@ class ComponentsLoader {
     for (std::size_t i = 0; i < names->size(); ++i) {
       const std::string& name = (*names)[i];
       if (!channels_.count(name)) {
-        reader_.error_at(node[role][i], item_path(p, i), "unknown channel '" + name + "'", "one of the channels: " + channel_list());
+        reader_.error_at(node[role][i], item_path(p, i), "unknown channel '" + name + "'",
+                         "one of the channels: " + channel_list());
       } else if (!seen.insert(name).second) {
         reader_.error_at(node[role][i], item_path(p, i), "channel '" + name + "' listed twice", "each channel once");
       }
@@ -149,14 +155,15 @@ class ComponentsLoader {
         if (!contains(channel.publishers, s)) channel.subscribers.push_back(s);
       }
     }
-    report_empty(map, node->second.path, "publishers", channel.publishers, "a component that publishes it, or publishers: [SEGMENT]");
+    report_empty(map, node->second.path, "publishers", channel.publishers,
+                 "a component that publishes it, or publishers: [SEGMENT]");
     report_empty(map, node->second.path, "subscribers", channel.subscribers,
                  "a component on another segment that subscribes it, or subscribers: [SEGMENT]");
     check_agreement(channel);
   }
 
-  void report_empty(const YAML::Node& map, const std::string& path, const char* role, const std::vector<std::string>& list,
-                    const char* valid) {
+  void report_empty(const YAML::Node& map, const std::string& path, const char* role,
+                    const std::vector<std::string>& list, const char* valid) {
     if (!list.empty() || present(map, role)) return;
     reader_.error_at(map, path + "." + role, std::string("no ") + role + " given and none derived from components",
                      valid);
@@ -168,17 +175,20 @@ class ComponentsLoader {
     for (const auto& c : config_.components) {
       const Tags& tags = tags_.at(c.name);
       if (contains(c.publishes, channel.name) && !contains(channel.publishers, c.segment)) {
-        disagree(tags, "publishes", c, channel, "a segment listed in its publishers (" + joined(channel.publishers) + ")");
+        disagree(tags, "publishes", c, channel,
+                 "a segment listed in its publishers (" + joined(channel.publishers) + ")");
       }
       if (contains(c.subscribes, channel.name) && !contains(channel.publishers, c.segment) &&
           !contains(channel.subscribers, c.segment)) {
         disagree(tags, "subscribes", c, channel,
-                 "a segment among its publishers or subscribers (" + joined(channel.publishers) + "; " + joined(channel.subscribers) + ")");
+                 "a segment among its publishers or subscribers (" + joined(channel.publishers) + "; " +
+                     joined(channel.subscribers) + ")");
       }
     }
   }
 
-  void disagree(const Tags& tags, const char* role, const ComponentSpec& c, const ChannelSpec& channel, const std::string& valid) {
+  void disagree(const Tags& tags, const char* role, const ComponentSpec& c, const ChannelSpec& channel,
+                const std::string& valid) {
     const YAML::Node list = tags.node[role];
     std::size_t index = 0;
     for (std::size_t i = 0; i < list.size(); ++i) {

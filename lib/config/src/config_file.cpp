@@ -23,7 +23,8 @@ ConfigResult unreadable(const std::string& path, const std::string& error) {
 
 ConfigResult load_config_file(const std::string& path) {
   std::string text;
-  if (const std::string error = config_detail::read_yaml_file(path, text); !error.empty()) return unreadable(path, error);
+  if (const std::string error = config_detail::read_yaml_file(path, text); !error.empty())
+    return unreadable(path, error);
   return parse_config(text, path);
 }
 

@@ -95,11 +95,13 @@ class ConfigParser {
     }
     if (reader_.check_map(*root, "", {"gateway", "segments", "channels", "components"})) {
       if (has(*root, "gateway")) parse_gateway((*root)["gateway"]);
-      if (require(*root, "", "segments", "a list of segments (type can, dds or lcm)")) parse_segments((*root)["segments"]);
+      if (require(*root, "", "segments", "a list of segments (type can, dds or lcm)"))
+        parse_segments((*root)["segments"]);
       derive_bindings_ = config_detail::has_components(*root);
       if (require(*root, "", "channels", "a list of channels")) parse_channel_list((*root)["channels"], "channels");
       if (has(*root, "gateway") && has((*root)["gateway"], "federation")) {
-        config_detail::check_federation_segment(reader_, (*root)["gateway"]["federation"], "gateway.federation", config_);
+        config_detail::check_federation_segment(reader_, (*root)["gateway"]["federation"], "gateway.federation",
+                                                config_);
       }
       config_detail::load_components(reader_, *root, config_);
       native_.check_derived(reader_, config_);
@@ -123,7 +125,8 @@ class ConfigParser {
       } else if (root->IsMap()) {
         parse_channel_entry(*root, "channel");
       } else {
-        reader_.error_at(*root, "", "expected channel definitions", "a 'channels:' list, a list of channels or one channel map");
+        reader_.error_at(*root, "", "expected channel definitions",
+                         "a 'channels:' list, a list of channels or one channel map");
       }
       if (config_.channels.empty() && reader_.error_count() == 0) {
         reader_.error_at(*root, "channels", "no channel to bind", "at least one channel definition");
@@ -142,14 +145,16 @@ class ConfigParser {
   bool require(const YAML::Node& map, const std::string& path, const char* name, const char* valid) {
     if (has(map, name)) return true;
     if (map.IsMap() && map[name]) return false;  // present without a value: check_map reports it
-    reader_.error_at(map, path.empty() ? name : key(path, name), std::string("missing required key '") + name + "'", valid);
+    reader_.error_at(map, path.empty() ? name : key(path, name), std::string("missing required key '") + name + "'",
+                     valid);
     return false;
   }
 
   void parse_gateway(const YAML::Node& node) {
     const std::string path = "gateway";
-    if (!reader_.check_map(node, path, {"name", "can_node_id", "residence_bound", "clean_interval", "realtime", "control_socket", "metrics",
-                                        "federation"})) {
+    if (!reader_.check_map(node, path,
+                           {"name", "can_node_id", "residence_bound", "clean_interval", "realtime", "control_socket",
+                            "metrics", "federation"})) {
       return;
     }
     GatewaySpec& g = config_.gateway;
@@ -162,7 +167,8 @@ class ConfigParser {
       }
     }
     if (has(node, "residence_bound")) {
-      if (auto v = reader_.duration(node["residence_bound"], key(path, "residence_bound"), false)) g.residence_bound = *v;
+      if (auto v = reader_.duration(node["residence_bound"], key(path, "residence_bound"), false))
+        g.residence_bound = *v;
     }
     if (has(node, "clean_interval")) {
       if (auto v = reader_.duration(node["clean_interval"], key(path, "clean_interval"), false)) g.clean_interval = *v;
@@ -182,7 +188,8 @@ class ConfigParser {
       }
     }
     if (has(node, "metrics")) parse_metrics(node["metrics"], key(path, "metrics"));
-    if (has(node, "federation")) config_detail::parse_federation(reader_, node["federation"], key(path, "federation"), g.federation);
+    if (has(node, "federation"))
+      config_detail::parse_federation(reader_, node["federation"], key(path, "federation"), g.federation);
   }
 
   // A host outside loopback shows the gateway's channels and load to the network, so it needs
@@ -244,14 +251,18 @@ class ConfigParser {
     const std::size_t errors_before = reader_.error_count();
     SegmentSpec s;
     std::optional<std::size_t> type;
-    if (require(node, path, "type", "type: can, dds or lcm")) type = reader_.choice(node["type"], key(path, "type"), {"can", "dds", "lcm"});
+    if (require(node, path, "type", "type: can, dds or lcm"))
+      type = reader_.choice(node["type"], key(path, "type"), {"can", "dds", "lcm"});
     if (require(node, path, "name", "a segment name")) {
       if (auto v = reader_.name(node["name"], key(path, "name"))) s.name = *v;
     }
     if (!type) {
-      reader_.check_map(node, path, {"name", "type", "interface", "profile", "bitrate", "fd", "data_bitrate", "errors", "max_utilization",
-                                     "background", "domain", "latency_bound", "bandwidth", "reliability", "realtime", "max_message_size",
-                                     "interfaces", "discovery_server", "shared_memory", "url", "network", "own_datagrams"});
+      reader_.check_map(
+          node, path,
+          {"name",          "type",        "interface",       "profile",          "bitrate",    "fd",
+           "data_bitrate",  "errors",      "max_utilization", "background",       "domain",     "latency_bound",
+           "bandwidth",     "reliability", "realtime",        "max_message_size", "interfaces", "discovery_server",
+           "shared_memory", "url",         "network",         "own_datagrams"});
       return std::nullopt;
     }
     s.type = static_cast<SegmentType>(*type);
@@ -262,17 +273,24 @@ class ConfigParser {
       if (auto v = reader_.name(node["network"], key(path, "network"))) s.network = *v;
     }
     switch (s.type) {
-      case SegmentType::can: parse_can(node, path, s); break;
-      case SegmentType::dds: parse_dds(node, path, s); break;
-      case SegmentType::lcm: parse_lcm(node, path, s); break;
+      case SegmentType::can:
+        parse_can(node, path, s);
+        break;
+      case SegmentType::dds:
+        parse_dds(node, path, s);
+        break;
+      case SegmentType::lcm:
+        parse_lcm(node, path, s);
+        break;
     }
     if (reader_.error_count() != errors_before) return std::nullopt;
     return s;
   }
 
   void parse_can(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
-    reader_.check_map(node, path, {"name", "type", "interface", "profile", "bitrate", "fd", "data_bitrate", "errors", "max_utilization",
-                                   "background", "network"});
+    reader_.check_map(node, path,
+                      {"name", "type", "interface", "profile", "bitrate", "fd", "data_bitrate", "errors",
+                       "max_utilization", "background", "network"});
     CanSegmentProperties& can = s.can;
     if (require(node, path, "interface", "a network interface such as can0")) {
       if (auto v = reader_.string(node["interface"], key(path, "interface"))) {
@@ -306,13 +324,15 @@ class ConfigParser {
         reader_.error_at(node["data_bitrate"], p, "data_bitrate needs fd: true", "remove it, or set fd: true");
       } else if (auto v = reader_.bitrate(node["data_bitrate"], p)) {
         if (*v < can.bitrate || v->bits_per_second > kFdMaxDataBitrate) {
-          reader_.error_at(node["data_bitrate"], p, "data bit rate out of range", "from the nominal bitrate up to 8Mbit/s");
+          reader_.error_at(node["data_bitrate"], p, "data bit rate out of range",
+                           "from the nominal bitrate up to 8Mbit/s");
         }
         can.data_bitrate = *v;
       }
     }
     if (has(node, "errors")) parse_fault_hypothesis(node["errors"], key(path, "errors"), can.errors);
-    if (has(node, "background")) config_detail::parse_background(reader_, node["background"], key(path, "background"), can, included_);
+    if (has(node, "background"))
+      config_detail::parse_background(reader_, node["background"], key(path, "background"), can, included_);
   }
 
   void parse_fault_hypothesis(const YAML::Node& node, const std::string& path, CanFaultHypothesis& errors) {
@@ -351,12 +371,14 @@ class ConfigParser {
   }
 
   void parse_dds(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
-    reader_.check_map(node, path, {"name", "type", "domain", "latency_bound", "bandwidth", "reliability", "realtime",
-                                   "max_message_size", "interfaces", "discovery_server", "shared_memory", "max_utilization",
-                                   "network"});
+    reader_.check_map(
+        node, path,
+        {"name", "type", "domain", "latency_bound", "bandwidth", "reliability", "realtime", "max_message_size",
+         "interfaces", "discovery_server", "shared_memory", "max_utilization", "network"});
     parse_ip_common(node, path, s);
     if (has(node, "domain")) {
-      if (auto v = reader_.unsigned_int(node["domain"], key(path, "domain"), 0, 232)) s.dds.domain = static_cast<std::uint32_t>(*v);
+      if (auto v = reader_.unsigned_int(node["domain"], key(path, "domain"), 0, 232))
+        s.dds.domain = static_cast<std::uint32_t>(*v);
     }
     if (has(node, "reliability")) {
       if (auto v = reader_.choice(node["reliability"], key(path, "reliability"), {"reliable", "best_effort"})) {
@@ -389,8 +411,9 @@ class ConfigParser {
   }
 
   void parse_lcm(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
-    reader_.check_map(node, path, {"name", "type", "url", "latency_bound", "bandwidth", "realtime", "max_message_size",
-                                   "max_utilization", "network", "own_datagrams"});
+    reader_.check_map(node, path,
+                      {"name", "type", "url", "latency_bound", "bandwidth", "realtime", "max_message_size",
+                       "max_utilization", "network", "own_datagrams"});
     s.reliability = Reliability::best_effort;
     parse_ip_common(node, path, s);
     if (has(node, "url")) {
@@ -419,7 +442,8 @@ class ConfigParser {
     if (!channel) return;
     if (!check_unique(node, path, *channel)) return;
     if (node["native"]) {
-      native_.add(reader_, node["native"], key(path, "native"), *channel, derive_bindings_ && !(node["publishers"] && node["subscribers"]));
+      native_.add(reader_, node["native"], key(path, "native"), *channel,
+                  derive_bindings_ && !(node["publishers"] && node["subscribers"]));
     }
     config_.channels.push_back(std::move(*channel));
   }
@@ -447,18 +471,21 @@ class ConfigParser {
   }
 
   std::optional<ChannelSpec> parse_channel(const YAML::Node& node, const std::string& path) {
-    if (!reader_.check_map(node, path, {"name", "subject", "class", "period", "max_rate", "reaction_time", "omission_degree",
-                                        "temp_validity", "payload", "etag", "encoding", "publishers", "subscribers", "native"})) {
+    if (!reader_.check_map(node, path,
+                           {"name", "subject", "class", "period", "max_rate", "reaction_time", "omission_degree",
+                            "temp_validity", "payload", "etag", "encoding", "publishers", "subscribers", "native"})) {
       return std::nullopt;
     }
     const std::size_t errors_before = reader_.error_count();
     ChannelSpec c;
-    if (require(node, path, "name", "a channel name")) c.name = reader_.name(node["name"], key(path, "name")).value_or("");
+    if (require(node, path, "name", "a channel name"))
+      c.name = reader_.name(node["name"], key(path, "name")).value_or("");
     if (require(node, path, "subject", "a 64-bit subject UID, e.g. 0x0000000100000042")) {
       c.subject = reader_.unsigned_int(node["subject"], key(path, "subject"), 1, UINT64_MAX).value_or(0);
     }
     if (require(node, path, "class", "class: hrt, srt or nrt")) {
-      c.cls = static_cast<ChannelClass>(reader_.choice(node["class"], key(path, "class"), {"hrt", "srt", "nrt"}).value_or(2));
+      c.cls = static_cast<ChannelClass>(
+          reader_.choice(node["class"], key(path, "class"), {"hrt", "srt", "nrt"}).value_or(2));
     }
     parse_timing(node, path, c);
     if (has(node, "omission_degree")) {
@@ -467,10 +494,12 @@ class ConfigParser {
     }
     if (has(node, "payload")) c.payload = reader_.size(node["payload"], key(path, "payload"), kMaxPayload).value_or(0);
     if (has(node, "etag")) {
-      if (auto v = reader_.unsigned_int(node["etag"], key(path, "etag"), 101, 16383)) c.etag = static_cast<std::uint16_t>(*v);
+      if (auto v = reader_.unsigned_int(node["etag"], key(path, "etag"), 101, 16383))
+        c.etag = static_cast<std::uint16_t>(*v);
     }
     if (has(node, "encoding")) {
-      c.lcm_encoding = static_cast<LcmEncoding>(reader_.choice(node["encoding"], key(path, "encoding"), {"envelope", "raw"}).value_or(0));
+      c.lcm_encoding = static_cast<LcmEncoding>(
+          reader_.choice(node["encoding"], key(path, "encoding"), {"envelope", "raw"}).value_or(0));
     }
     parse_bindings(node, path, c);
     if (node["native"]) {
@@ -506,7 +535,8 @@ class ConfigParser {
       reader_.error_at(node, key(path, "reaction_time"), "an hrt or srt channel needs reaction_time",
                        "the end-to-end latency bound, e.g. reaction_time: 5ms");
     }
-    if (has(node, "temp_validity")) c.temp_validity = reader_.duration(node["temp_validity"], key(path, "temp_validity"), false);
+    if (has(node, "temp_validity"))
+      c.temp_validity = reader_.duration(node["temp_validity"], key(path, "temp_validity"), false);
   }
 
   void parse_bindings(const YAML::Node& node, const std::string& path, ChannelSpec& c) {
@@ -518,8 +548,7 @@ class ConfigParser {
       auto names = reader_.string_list(node[role], p);
       if (!names) continue;
       if (names->empty()) {
-        reader_.error_at(node[role], p, "no segment listed",
-                         "at least one segment name");
+        reader_.error_at(node[role], p, "no segment listed", "at least one segment name");
         continue;
       }
       std::set<std::string> seen;
@@ -555,8 +584,8 @@ class ConfigParser {
         if (!segment) continue;
         const auto problem = transport_name_problem(segment->type, c.name);
         if (problem && reported.insert(*problem).second) {
-          reader_.error_at(node["name"], key(path, "name"), "segment '" + name + "' cannot carry this channel: " + *problem,
-                           "a shorter name");
+          reader_.error_at(node["name"], key(path, "name"),
+                           "segment '" + name + "' cannot carry this channel: " + *problem, "a shorter name");
         }
       }
     }

@@ -33,12 +33,14 @@ std::string channel_to_yaml(const ChannelSpec& channel) {
       if (binding.can) {
         char id[16];
         std::snprintf(id, sizeof id, "0x%X", static_cast<unsigned>(binding.can->can_id));
-        out << YAML::Key << "can_id" << YAML::Value << id << YAML::Key << "extended" << YAML::Value << binding.can->extended;
+        out << YAML::Key << "can_id" << YAML::Value << id << YAML::Key << "extended" << YAML::Value
+            << binding.can->extended;
       }
       if (binding.lcm_channel) out << YAML::Key << "channel" << YAML::Value << *binding.lcm_channel;
       if (binding.dds) {
         out << YAML::Key << "topic" << YAML::Value << binding.dds->topic << YAML::Key << "type" << YAML::Value
-            << binding.dds->type << YAML::Key << "representation" << YAML::Value << to_string(binding.dds->representation);
+            << binding.dds->type << YAML::Key << "representation" << YAML::Value
+            << to_string(binding.dds->representation);
       }
       out << YAML::EndMap;
     }

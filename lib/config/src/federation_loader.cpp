@@ -23,7 +23,8 @@ bool has(const YAML::Node& map, const char* name) { return map.IsMap() && map[na
 void parse_federation(YamlReader& reader, const YAML::Node& node, const std::string& path, FederationSpec& out) {
   if (!reader.check_map(node, path, {"segment", "lease", "claim_window"})) return;
   if (!has(node, "segment")) {
-    reader.error_at(node, key(path, "segment"), "missing required key 'segment'", "the name of a DDS segment to federate over");
+    reader.error_at(node, key(path, "segment"), "missing required key 'segment'",
+                    "the name of a DDS segment to federate over");
     return;
   }
   if (auto v = reader.name(node["segment"], key(path, "segment"))) out.segment = *v;
@@ -39,7 +40,8 @@ void parse_federation(YamlReader& reader, const YAML::Node& node, const std::str
   if (has(node, "claim_window")) {
     if (auto v = reader.duration(node["claim_window"], key(path, "claim_window"), false)) {
       if (*v < kMinClaimWindow || *v > kMaxClaimWindow) {
-        reader.error_at(node["claim_window"], key(path, "claim_window"), "claim_window out of range", "from 300ms to 10s, e.g. 500ms");
+        reader.error_at(node["claim_window"], key(path, "claim_window"), "claim_window out of range",
+                        "from 300ms to 10s, e.g. 500ms");
       } else {
         out.claim_window = *v;
       }
@@ -47,7 +49,8 @@ void parse_federation(YamlReader& reader, const YAML::Node& node, const std::str
   }
 }
 
-void check_federation_segment(YamlReader& reader, const YAML::Node& node, const std::string& path, const Config& config) {
+void check_federation_segment(YamlReader& reader, const YAML::Node& node, const std::string& path,
+                              const Config& config) {
   const FederationSpec& federation = config.gateway.federation;
   if (!federation.enabled() || !has(node, "segment")) return;
   const SegmentSpec* segment = config.find_segment(federation.segment);
@@ -59,7 +62,8 @@ void check_federation_segment(YamlReader& reader, const YAML::Node& node, const 
     reader.error_at(node["segment"], key(path, "segment"), "unknown segment '" + federation.segment + "'",
                     dds.empty() ? "a DDS segment (none is configured)" : "a DDS segment: " + dds);
   } else if (segment->type != SegmentType::dds) {
-    reader.error_at(node["segment"], key(path, "segment"), "segment '" + federation.segment + "' is " + to_string(segment->type),
+    reader.error_at(node["segment"], key(path, "segment"),
+                    "segment '" + federation.segment + "' is " + to_string(segment->type),
                     "a DDS segment: gateways federate over DDS");
   }
 }

@@ -14,6 +14,7 @@ namespace cosmic::config_detail {
 void parse_federation(YamlReader& reader, const YAML::Node& node, const std::string& path, FederationSpec& out);
 
 // The named segment must exist and be a DDS segment; `node` is gateway.federation.
-void check_federation_segment(YamlReader& reader, const YAML::Node& node, const std::string& path, const Config& config);
+void check_federation_segment(YamlReader& reader, const YAML::Node& node, const std::string& path,
+                              const Config& config);
 
 }  // namespace cosmic::config_detail

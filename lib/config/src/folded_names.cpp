@@ -10,10 +10,11 @@ bool FoldedNames::add(YamlReader& reader, const YAML::Node& name_node, const std
   }
   const auto [it, fresh] = folded_.emplace(folded, First{name, name_node.Mark().line + 1});
   if (fresh || it->second.name == name) return true;
-  reader.error_at(name_node, path, kind + " name '" + name + "' and " + kind + " '" + it->second.name + "' (line " +
-                                       std::to_string(it->second.line) + ") differ only in '-', '.' or '_'",
-                  "names that stay distinct as identifiers: they become " + folded +
-                      " in DDS topics, generated code and diagrams");
+  reader.error_at(
+      name_node, path,
+      kind + " name '" + name + "' and " + kind + " '" + it->second.name + "' (line " +
+          std::to_string(it->second.line) + ") differ only in '-', '.' or '_'",
+      "names that stay distinct as identifiers: they become " + folded + " in DDS topics, generated code and diagrams");
   return false;
 }
 

@@ -26,7 +26,8 @@ bool parse_can(YamlReader& reader, const YAML::Node& node, const std::string& pa
                     "the frame's identifier, e.g. can_id: 0x123 (11 bits) or 0x18FF0001 with extended: true");
     return false;
   }
-  const auto id = reader.unsigned_int(node["can_id"], key(path, "can_id"), 0, frame.extended ? kExtendedIdMax : kStandardIdMax);
+  const auto id =
+      reader.unsigned_int(node["can_id"], key(path, "can_id"), 0, frame.extended ? kExtendedIdMax : kStandardIdMax);
   if (!id) return false;
   frame.can_id = static_cast<std::uint32_t>(*id);
   // COSMIC and FAMOUSO devices read an extended identifier's low 14 bits as an etag: one of the
@@ -34,8 +35,9 @@ bool parse_can(YamlReader& reader, const YAML::Node& node, const std::string& pa
   const auto etag = static_cast<std::uint16_t>(frame.can_id & kEtagMask);
   if (frame.extended && etag <= kHighestReservedEtag) {
     reader.error_at(node["can_id"], key(path, "can_id"),
-                    "extended identifier " + can_id_text(frame.can_id, true) + " has etag bits " + std::to_string(etag) +
-                        ", which the binding protocols use (0.." + std::to_string(kHighestReservedEtag) + ")",
+                    "extended identifier " + can_id_text(frame.can_id, true) + " has etag bits " +
+                        std::to_string(etag) + ", which the binding protocols use (0.." +
+                        std::to_string(kHighestReservedEtag) + ")",
                     "an extended identifier whose low 14 bits are above " + std::to_string(kHighestReservedEtag) +
                         ", or a standard identifier");
     return false;
@@ -46,8 +48,8 @@ bool parse_can(YamlReader& reader, const YAML::Node& node, const std::string& pa
   });
   if (declared != background.end()) {
     reader.error_at(node["can_id"], key(path, "can_id"),
-                    can_id_text(frame.can_id, frame.extended) + " is declared as background frame " + declared->name + " (" +
-                        declared->origin + ") of segment " + segment.name,
+                    can_id_text(frame.can_id, frame.extended) + " is declared as background frame " + declared->name +
+                        " (" + declared->origin + ") of segment " + segment.name,
                     "a frame is either background traffic or a channel: remove it from the background");
     return false;
   }
@@ -58,13 +60,15 @@ bool parse_can(YamlReader& reader, const YAML::Node& node, const std::string& pa
 bool parse_lcm(YamlReader& reader, const YAML::Node& node, const std::string& path, NativeBinding& binding) {
   if (!reader.check_map(node, path, {"channel"})) return false;
   if (!node["channel"]) {
-    reader.error_at(node, key(path, "channel"), "missing required key 'channel'", "the LCM channel name, e.g. channel: POSE");
+    reader.error_at(node, key(path, "channel"), "missing required key 'channel'",
+                    "the LCM channel name, e.g. channel: POSE");
     return false;
   }
   const auto name = reader.string(node["channel"], key(path, "channel"));
   if (!name) return false;
   if (name->empty()) {
-    reader.error_at(node["channel"], key(path, "channel"), "empty LCM channel name", "the LCM channel name, e.g. channel: POSE");
+    reader.error_at(node["channel"], key(path, "channel"), "empty LCM channel name",
+                    "the LCM channel name, e.g. channel: POSE");
     return false;
   }
   if (const auto problem = transport_name_problem(SegmentType::lcm, *name)) {
@@ -75,8 +79,8 @@ bool parse_lcm(YamlReader& reader, const YAML::Node& node, const std::string& pa
   return true;
 }
 
-std::optional<std::string> name_at(YamlReader& reader, const YAML::Node& node, const std::string& path, const char* name,
-                                   const char* hint) {
+std::optional<std::string> name_at(YamlReader& reader, const YAML::Node& node, const std::string& path,
+                                   const char* name, const char* hint) {
   if (!node[name]) {
     reader.error_at(node, key(path, name), std::string("missing required key '") + name + "'", hint);
     return std::nullopt;
@@ -85,7 +89,8 @@ std::optional<std::string> name_at(YamlReader& reader, const YAML::Node& node, c
 }
 
 constexpr const char* kTopicHint = "a DDS topic name, e.g. topic: rt/cmd_vel (ROS 2 names its topics rt/<name>)";
-constexpr const char* kTypeHint = "the DDS type name, e.g. type: geometry_msgs::msg::dds_::Twist_ (ROS 2: <pkg>::msg::dds_::<Name>_)";
+constexpr const char* kTypeHint =
+    "the DDS type name, e.g. type: geometry_msgs::msg::dds_::Twist_ (ROS 2: <pkg>::msg::dds_::<Name>_)";
 
 bool parse_dds(YamlReader& reader, const YAML::Node& node, const std::string& path, NativeBinding& binding) {
   if (!reader.check_map(node, path, {"topic", "type", "representation", "keyed"})) return false;
@@ -105,7 +110,8 @@ bool parse_dds(YamlReader& reader, const YAML::Node& node, const std::string& pa
       reader.error_at(node["type"], key(path, "type"), *problem, kTypeHint);
       ok = false;
     } else if (*name == kEnvelopeTypeName) {
-      reader.error_at(node["type"], key(path, "type"), std::string(kEnvelopeTypeName) + " is the gateway's own envelope type",
+      reader.error_at(node["type"], key(path, "type"),
+                      std::string(kEnvelopeTypeName) + " is the gateway's own envelope type",
                       "leave out `native` on this segment to carry the channel as an envelope");
       ok = false;
     }
@@ -128,10 +134,11 @@ bool parse_dds(YamlReader& reader, const YAML::Node& node, const std::string& pa
   if (node["keyed"]) {
     const auto keyed = reader.boolean(node["keyed"], key(path, "keyed"));
     if (keyed && *keyed) {
-      reader.error_at(node["keyed"], key(path, "keyed"),
-                      "keyed types are not carried: an instance's key hash is computed from the type's key members, which "
-                      "the gateway does not know when it carries a sample as bytes",
-                      "a keyless type (ROS 2 messages are keyless), or carry the data as an envelope channel");
+      reader.error_at(
+          node["keyed"], key(path, "keyed"),
+          "keyed types are not carried: an instance's key hash is computed from the type's key members, which "
+          "the gateway does not know when it carries a sample as bytes",
+          "a keyless type (ROS 2 messages are keyless), or carry the data as an envelope channel");
       ok = false;
     }
     if (!keyed) ok = false;
@@ -145,9 +152,10 @@ bool parse_dds(YamlReader& reader, const YAML::Node& node, const std::string& pa
 void parse_native(YamlReader& reader, const YAML::Node& node, const std::string& path, const Config& config,
                   ChannelSpec& channel) {
   if (!node.IsMap()) {
-    reader.error_at(node, path, "expected a map of segment names to native identities",
-                    "native: {body: {can_id: 0x123}}, native: {viz: {channel: POSE}} or native: {lan: {topic: rt/cmd_vel, type: "
-                    "geometry_msgs::msg::dds_::Twist_}}");
+    reader.error_at(
+        node, path, "expected a map of segment names to native identities",
+        "native: {body: {can_id: 0x123}}, native: {viz: {channel: POSE}} or native: {lan: {topic: rt/cmd_vel, type: "
+        "geometry_msgs::msg::dds_::Twist_}}");
     return;
   }
   for (const auto& entry : node) {
@@ -178,7 +186,8 @@ void parse_native(YamlReader& reader, const YAML::Node& node, const std::string&
   }
 }
 
-void check_native_segments(YamlReader& reader, const YAML::Node& node, const std::string& path, const ChannelSpec& channel) {
+void check_native_segments(YamlReader& reader, const YAML::Node& node, const std::string& path,
+                           const ChannelSpec& channel) {
   for (const NativeBinding& binding : channel.native) {
     const bool used = std::count(channel.publishers.begin(), channel.publishers.end(), binding.segment) +
                           std::count(channel.subscribers.begin(), channel.subscribers.end(), binding.segment) >
@@ -188,14 +197,15 @@ void check_native_segments(YamlReader& reader, const YAML::Node& node, const std
     for (const auto& entry : node) {
       if (entry.first.Scalar() == binding.segment) where = entry.first;
     }
-    reader.error_at(where, key(path, binding.segment),
-                    "segment '" + binding.segment + "' is neither a publisher nor a subscriber of channel " + channel.name,
-                    "a native identity on one of the channel's segments");
+    reader.error_at(
+        where, key(path, binding.segment),
+        "segment '" + binding.segment + "' is neither a publisher nor a subscriber of channel " + channel.name,
+        "a native identity on one of the channel's segments");
   }
 }
 
-void NativeDeclarations::add(YamlReader& reader, const YAML::Node& node, const std::string& path, const ChannelSpec& channel,
-                             bool derived) {
+void NativeDeclarations::add(YamlReader& reader, const YAML::Node& node, const std::string& path,
+                             const ChannelSpec& channel, bool derived) {
   if (derived) deferred_.push_back(Deferred{channel.name, node, path});
   for (const NativeBinding& binding : channel.native) {
     const std::string identity = native_identity(binding);
@@ -203,15 +213,16 @@ void NativeDeclarations::add(YamlReader& reader, const YAML::Node& node, const s
     const auto [it, fresh] = identities_.emplace(std::pair(binding.segment, identity), Owner{channel.name, line});
     if (fresh) continue;
     reader.error_at(node[binding.segment], key(path, binding.segment),
-                    identity + " on segment " + binding.segment + " is already channel " + it->second.channel + "'s (line " +
-                        std::to_string(it->second.line) + ")",
+                    identity + " on segment " + binding.segment + " is already channel " + it->second.channel +
+                        "'s (line " + std::to_string(it->second.line) + ")",
                     "one channel per native identity and segment");
   }
 }
 
 void NativeDeclarations::check_derived(YamlReader& reader, const Config& config) const {
   for (const Deferred& d : deferred_) {
-    if (const ChannelSpec* channel = config.find_channel(d.channel)) check_native_segments(reader, d.node, d.path, *channel);
+    if (const ChannelSpec* channel = config.find_channel(d.channel))
+      check_native_segments(reader, d.node, d.path, *channel);
   }
 }
 

@@ -21,7 +21,8 @@ void parse_native(YamlReader& reader, const YAML::Node& node, const std::string&
 
 // Once the channel's publishers and subscribers are final (given or derived from components):
 // every native entry names one of them. `node` is the channel's `native` map.
-void check_native_segments(YamlReader& reader, const YAML::Node& node, const std::string& path, const ChannelSpec& channel);
+void check_native_segments(YamlReader& reader, const YAML::Node& node, const std::string& path,
+                           const ChannelSpec& channel);
 
 // The native identities of one document's channels: two channels with the same identity on a
 // segment are an error (a CAN identifier has one sender; an LCM channel name carries one channel).
@@ -29,7 +30,8 @@ class NativeDeclarations {
  public:
   // `node` is the channel's `native` map. `derived`: the channel's publishers/subscribers come
   // from the components, so its entries are checked against them in check_derived().
-  void add(YamlReader& reader, const YAML::Node& node, const std::string& path, const ChannelSpec& channel, bool derived);
+  void add(YamlReader& reader, const YAML::Node& node, const std::string& path, const ChannelSpec& channel,
+           bool derived);
   void check_derived(YamlReader& reader, const Config& config) const;
 
  private:

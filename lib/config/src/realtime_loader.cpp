@@ -9,18 +9,22 @@ bool key_given(const YAML::Node& map, const char* name) { return map[name] && !m
 
 void parse_priorities(YamlReader& reader, const YAML::Node& node, const std::string& path, RealtimeSpec& out) {
   if (!reader.check_map(node, path, {"hrt", "srt", "nrt", "receive"})) return;
-  const std::pair<const char*, int*> fields[] = {
-      {"hrt", &out.hrt_priority}, {"srt", &out.srt_priority}, {"nrt", &out.nrt_priority}, {"receive", &out.receive_priority}};
+  const std::pair<const char*, int*> fields[] = {{"hrt", &out.hrt_priority},
+                                                 {"srt", &out.srt_priority},
+                                                 {"nrt", &out.nrt_priority},
+                                                 {"receive", &out.receive_priority}};
   for (const auto& [name, target] : fields) {
     if (!key_given(node, name)) continue;
     if (auto v = reader.unsigned_int(node[name], path + "." + name, 0, 99)) *target = static_cast<int>(*v);
   }
   // HRT must preempt SRT and NRT on the same CPU, so it may not be configured below them.
-  const bool hrt_below = out.hrt_priority != 0 && (out.hrt_priority < out.srt_priority || out.hrt_priority < out.nrt_priority);
+  const bool hrt_below =
+      out.hrt_priority != 0 && (out.hrt_priority < out.srt_priority || out.hrt_priority < out.nrt_priority);
   const bool srt_below = out.srt_priority != 0 && out.srt_priority < out.nrt_priority;
   if (hrt_below || srt_below) {
-    reader.error_at(node, path, "class priorities are out of order (hrt " + std::to_string(out.hrt_priority) + ", srt " +
-                                    std::to_string(out.srt_priority) + ", nrt " + std::to_string(out.nrt_priority) + ")",
+    reader.error_at(node, path,
+                    "class priorities are out of order (hrt " + std::to_string(out.hrt_priority) + ", srt " +
+                        std::to_string(out.srt_priority) + ", nrt " + std::to_string(out.nrt_priority) + ")",
                     "hrt >= srt >= nrt, so a lower class never preempts a higher one");
   }
 }

@@ -28,14 +28,16 @@ struct Overlap {
 std::optional<Overlap> overlap(const SegmentSpec& a, const SegmentSpec& b) {
   if (a.type != b.type) return std::nullopt;
   if (!a.network.empty() && a.network == b.network) {
-    return Overlap{"network", std::string(to_string(a.type)) + " network " + a.network, "a different network name for each segment"};
+    return Overlap{"network", std::string(to_string(a.type)) + " network " + a.network,
+                   "a different network name for each segment"};
   }
   switch (a.type) {
     case SegmentType::lcm: {
       const auto port = lcm_port(a.lcm.url);
       if (!port || port != lcm_port(b.lcm.url)) return std::nullopt;
-      return Overlap{"url", "UDP port " + std::to_string(*port),
-                     "a different port for each LCM segment of one gateway (LCM receives every group sent to its port)"};
+      return Overlap{
+          "url", "UDP port " + std::to_string(*port),
+          "a different port for each LCM segment of one gateway (LCM receives every group sent to its port)"};
     }
     case SegmentType::dds: {
       const bool separate_servers = !a.dds.discovery_server.empty() && !b.dds.discovery_server.empty() &&
@@ -74,8 +76,8 @@ void check_segment_overlap(const YAML::Node& segments, std::size_t index, const 
     // Located at the key when written out; at the segment when the default is what collides.
     const bool written = node[shared->key] && !node[shared->key].IsNull();
     reader.error_at(written ? node[shared->key] : node, path + "." + shared->key,
-                    "segment '" + segment.name + "' attaches the same network as segment '" + other.name +
-                        "' (line " + std::to_string(line_of(segments, index, other.name)) + "): " + shared->network +
+                    "segment '" + segment.name + "' attaches the same network as segment '" + other.name + "' (line " +
+                        std::to_string(line_of(segments, index, other.name)) + "): " + shared->network +
                         "; every message would come back in through the other one and loop",
                     shared->valid);
     return;  // one error per segment: the first segment it collides with

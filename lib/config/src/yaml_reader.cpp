@@ -55,11 +55,13 @@ class ExpansionCounter final : public YAML::EventHandler {
     const auto size = sizes_.find(anchor);
     add(size == sizes_.end() ? 1 : size->second, mark, true);
   }
-  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+                       YAML::EmitterStyle::value) override {
     open(mark, anchor);
   }
   void OnSequenceEnd() override { close(); }
-  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor, YAML::EmitterStyle::value) override {
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+                  YAML::EmitterStyle::value) override {
     open(mark, anchor);
   }
   void OnMapEnd() override { close(); }
@@ -108,7 +110,9 @@ class ExpansionCounter final : public YAML::EventHandler {
 };
 
 // Cheap first: a text without '*' has no alias, and a small one cannot hold many nodes.
-bool worth_counting(std::string_view text) { return text.find('*') != std::string_view::npos || text.size() > (1u << 20); }
+bool worth_counting(std::string_view text) {
+  return text.find('*') != std::string_view::npos || text.size() > (1u << 20);
+}
 
 }  // namespace
 
@@ -179,7 +183,8 @@ void YamlReader::error_at(const YAML::Node& node, const std::string& path, std::
   error(node.Mark(), path, std::move(message), std::move(valid));
 }
 
-bool YamlReader::check_map(const YAML::Node& node, const std::string& path, std::initializer_list<const char*> allowed) {
+bool YamlReader::check_map(const YAML::Node& node, const std::string& path,
+                           std::initializer_list<const char*> allowed) {
   if (!node.IsMap()) {
     error_at(node, path, "expected a map of keys", "keys: " + join(allowed));
     return false;
@@ -251,8 +256,8 @@ std::optional<bool> YamlReader::boolean(const YAML::Node& node, const std::strin
   return std::nullopt;
 }
 
-std::optional<std::uint64_t> YamlReader::unsigned_int(const YAML::Node& node, const std::string& path, std::uint64_t min,
-                                                      std::uint64_t max) {
+std::optional<std::uint64_t> YamlReader::unsigned_int(const YAML::Node& node, const std::string& path,
+                                                      std::uint64_t min, std::uint64_t max) {
   const std::string range = "a whole number from " + std::to_string(min) + " to " + std::to_string(max);
   const auto value = scalar(node, path, range.c_str());
   if (!value) return std::nullopt;
@@ -288,7 +293,8 @@ std::optional<T> report(YamlReader& reader, const YAML::Node& node, const std::s
   // Unit parse errors carry their own "(what would be valid)": do not add a second one.
   const auto open = parsed.error.rfind(" (");
   if (open != std::string::npos && parsed.error.back() == ')') {
-    reader.error_at(node, path, parsed.error.substr(0, open), parsed.error.substr(open + 2, parsed.error.size() - open - 3));
+    reader.error_at(node, path, parsed.error.substr(0, open),
+                    parsed.error.substr(open + 2, parsed.error.size() - open - 3));
     return std::nullopt;
   }
   reader.error_at(node, path, parsed.error, valid);

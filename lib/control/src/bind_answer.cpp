@@ -12,7 +12,9 @@ Json failure(const std::string& code, const std::string& message) {
   return Json{{"ok", false}, {"error", {{"code", code}, {"message", message}}}};
 }
 
-std::string render(const Json& response) { return response.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n"; }
+std::string render(const Json& response) {
+  return response.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n";
+}
 
 // A replacement's answer says per channel what changed and which hops stay (their endpoints and
 // the subscribers behind them keep running), which are new and which are gone.
@@ -30,7 +32,9 @@ Json replaced_answer(const BindResult& result) {
     if (now != result.channels.end()) {
       for (const auto& hop : now->hops) new_hops.emplace_back(hop.segment, hop.role);
     }
-    auto hop_json = [](const std::pair<std::string, HopRole>& h) { return Json{{"segment", h.first}, {"role", to_string(h.second)}}; };
+    auto hop_json = [](const std::pair<std::string, HopRole>& h) {
+      return Json{{"segment", h.first}, {"role", to_string(h.second)}};
+    };
     for (const auto& h : old_hops) {
       const bool kept = std::find(new_hops.begin(), new_hops.end(), h) != new_hops.end();
       hops[kept ? "kept" : "removed"].push_back(hop_json(h));
@@ -55,7 +59,8 @@ Json bind_answer(const BindResult& result) {
 Json switch_over_answer(const BindResult& result, Nanos match_timeout) {
   Json publishers = Json::array();
   for (const NewPublisher& p : result.new_publishers) {
-    publishers.push_back({{"channel", p.channel}, {"segment", p.segment}, {"matched", p.matched ? Json(*p.matched) : Json(nullptr)}});
+    publishers.push_back(
+        {{"channel", p.channel}, {"segment", p.segment}, {"matched", p.matched ? Json(*p.matched) : Json(nullptr)}});
   }
   return Json{{"waited_s", std::chrono::duration<double>(result.switch_wait).count()},
               {"match_timeout_s", std::chrono::duration<double>(match_timeout).count()},

@@ -64,7 +64,8 @@ std::optional<std::string> ControlProtocol::handle(std::string_view request_line
   const bool shallow = json_nesting_within(request_line, kMaxRequestNesting);
   const Json request = shallow ? Json::parse(request_line, nullptr, false) : Json(Json::value_t::discarded);
   if (!shallow) {
-    response = failure("bad_request", "the request nests deeper than " + std::to_string(kMaxRequestNesting) + " levels");
+    response =
+        failure("bad_request", "the request nests deeper than " + std::to_string(kMaxRequestNesting) + " levels");
   } else if (request.is_discarded() || !request.is_object()) {
     response = failure("bad_request", "the request is not a JSON object");
   } else if (!request.contains("command") || !request["command"].is_string()) {
@@ -93,7 +94,8 @@ std::string ControlProtocol::next_log_tag(const char* kind, const PeerCredential
          std::to_string(peer.pid);
 }
 
-ControlProtocol::Answer ControlProtocol::dispatch(const Json& request, const PeerCredentials& peer, const Reply& later) {
+ControlProtocol::Answer ControlProtocol::dispatch(const Json& request, const PeerCredentials& peer,
+                                                  const Reply& later) {
   const std::string command = request["command"].get<std::string>();
   const bool mutating = is_mutating(command);
   if (!(mutating ? policy_.may_modify(peer) : policy_.may_read(peer))) {
@@ -116,16 +118,19 @@ ControlProtocol::Answer ControlProtocol::dispatch(const Json& request, const Pee
   if (const auto reader = readers_.find(command); reader != readers_.end()) return reader->second();
   std::string known = "status, segments, channels, channel";
   for (const auto& [name, answer] : readers_) known += ", " + name;
-  return failure("unknown_command", "unknown command '" + printable(command) + "' (" + known + ", bind, replace, unbind, reload)");
+  return failure("unknown_command",
+                 "unknown command '" + printable(command) + "' (" + known + ", bind, replace, unbind, reload)");
 }
 
-ControlProtocol::Answer ControlProtocol::mutate(const std::string& command, const Json& request, const PeerCredentials& peer,
-                                                const Reply& later) {
+ControlProtocol::Answer ControlProtocol::mutate(const std::string& command, const Json& request,
+                                                const PeerCredentials& peer, const Reply& later) {
   std::string audit = next_log_tag("audit", peer) + " runs " + command;
-  if (request.contains("name") && request["name"].is_string()) audit += " " + printable(request["name"].get<std::string>());
+  if (request.contains("name") && request["name"].is_string())
+    audit += " " + printable(request["name"].get<std::string>());
   log_.log(LogLevel::notice, audit);
   if (admission_running()) {
-    return failure("busy", "an admission is running (" + running_ + "); " + command + " refused, try again when it finishes");
+    return failure("busy",
+                   "an admission is running (" + running_ + "); " + command + " refused, try again when it finishes");
   }
   if (command == "bind" || command == "replace") return bind(request, command == "replace", later);
   if (command == "reload") return reload(later);
@@ -183,7 +188,10 @@ Json ControlProtocol::status() const {
               {"gateway", {{"name", gateway_.identity().name}, {"id", id}, {"uptime_s", uptime}}},
               {"segments", {{"total", segments.size()}, {"up", up}}},
               {"channels",
-               {{"bound", counts.bound}, {"degraded", counts.degraded}, {"failed", counts.failed}, {"violated", gateway_.violated_channels()}}},
+               {{"bound", counts.bound},
+                {"degraded", counts.degraded},
+                {"failed", counts.failed},
+                {"violated", gateway_.violated_channels()}}},
               {"router", {{"queued", gateway_.router().queued()}, {"progress", gateway_.router().progress()}}}};
 }
 
@@ -207,9 +215,8 @@ Json ControlProtocol::segments() const {
                  {"send_errors", s.adapter.send_errors},
                  {"overflow_drops", s.adapter.overflow_drops},
                  {"backlog", s.adapter.backlog},
-                 {"binding_requests_over_limit", s.adapter.binding_requests_over_limit
-                                                     ? Json(*s.adapter.binding_requests_over_limit)
-                                                     : Json(nullptr)},
+                 {"binding_requests_over_limit",
+                  s.adapter.binding_requests_over_limit ? Json(*s.adapter.binding_requests_over_limit) : Json(nullptr)},
                  {"own_datagrams_dropped",
                   s.adapter.own_datagrams_dropped ? Json(*s.adapter.own_datagrams_dropped) : Json(nullptr)}}}};
     if (s.spec.type == SegmentType::can) {
@@ -217,8 +224,11 @@ Json ControlProtocol::segments() const {
       entry["bitrate"] = s.spec.can.bitrate.bits_per_second;
       Json unexplained = Json::array();
       for (const UnexplainedFrames& f : s.adapter.unexplained) {
-        unexplained.push_back({{"can_id", f.can_id}, {"id", can_id_text(f.can_id, f.extended)}, {"extended", f.extended},
-                               {"frames", f.frames}, {"rate_hz", f.rate_hz}});
+        unexplained.push_back({{"can_id", f.can_id},
+                               {"id", can_id_text(f.can_id, f.extended)},
+                               {"extended", f.extended},
+                               {"frames", f.frames},
+                               {"rate_hz", f.rate_hz}});
       }
       entry["unexplained"] = std::move(unexplained);
       entry["unexplained_others"] = s.adapter.unexplained_others;
@@ -261,8 +271,11 @@ Json hop_runtime(const HopReport& hop, const HopRuntimeSnapshot& measured) {
 
 Json ControlProtocol::channel_entry(const ChannelReport& verdict, const ChannelStatsSnapshot* stats) const {
   const ChannelSpec* spec = gateway_.knowledge_base().find_bound(verdict.name);
-  Json entry{{"name", verdict.name}, {"class", to_string(verdict.cls)}, {"verdict", to_string(verdict.verdict)},
-             {"reasons", verdict.reasons}, {"segments", Json::array()}};
+  Json entry{{"name", verdict.name},
+             {"class", to_string(verdict.cls)},
+             {"verdict", to_string(verdict.verdict)},
+             {"reasons", verdict.reasons},
+             {"segments", Json::array()}};
   if (spec) {
     char subject[24];
     std::snprintf(subject, sizeof subject, "0x%016llx", static_cast<unsigned long long>(spec->subject));
@@ -271,7 +284,8 @@ Json ControlProtocol::channel_entry(const ChannelReport& verdict, const ChannelS
   if (const auto etag = gateway_.knowledge_base().etag_of(verdict.name)) entry["etag"] = *etag;
   entry["mismatches"] = Json::array();
   for (const auto& hop : verdict.hops) {
-    Json seg{{"segment", hop.segment}, {"role", to_string(hop.role)}, {"rx", 0}, {"tx", 0}, {"dropped", Json::object()}};
+    Json seg{
+        {"segment", hop.segment}, {"role", to_string(hop.role)}, {"rx", 0}, {"tx", 0}, {"dropped", Json::object()}};
     const auto matched = gateway_.matched_peers(hop.segment, verdict.name);
     seg["matched"] = matched ? Json(*matched) : Json(nullptr);
     const auto incompatible = gateway_.incompatible_peers(hop.segment, verdict.name);
@@ -321,7 +335,8 @@ Json ControlProtocol::channel_entry(const ChannelReport& verdict, const ChannelS
 Json ControlProtocol::channels() const {
   const auto stats = gateway_.channel_stats();
   Json list = Json::array();
-  for (const auto& verdict : gateway_.admission().channels) list.push_back(channel_entry(verdict, find_stats(stats, verdict.name)));
+  for (const auto& verdict : gateway_.admission().channels)
+    list.push_back(channel_entry(verdict, find_stats(stats, verdict.name)));
   return Json{{"ok", true}, {"channels", list}};
 }
 
@@ -331,14 +346,16 @@ Json ControlProtocol::unbound_channel(const std::string& name) const {
   if (!rejected) return failure("not_found", "no bound channel named '" + name + "'");
   std::string reasons;
   for (const auto& r : rejected->reasons) reasons += (reasons.empty() ? "" : "; ") + r;
-  Json out = failure("rejected", "channel '" + name + "' of the configuration is not bound: admission rejected it (" + reasons + ")");
+  Json out = failure(
+      "rejected", "channel '" + name + "' of the configuration is not bound: admission rejected it (" + reasons + ")");
   out["error"]["reasons"] = rejected->reasons;
   out["error"]["admission"] = to_json(*rejected);
   return out;
 }
 
 Json ControlProtocol::channel(const Json& request) const {
-  if (!request.contains("name") || !request["name"].is_string()) return failure("bad_request", "\"name\" (string) is required");
+  if (!request.contains("name") || !request["name"].is_string())
+    return failure("bad_request", "\"name\" (string) is required");
   const std::string name = request["name"].get<std::string>();
   const AdmissionReport report = gateway_.admission();
   const ChannelReport* verdict = report.find(name);
@@ -353,7 +370,8 @@ ControlProtocol::Answer ControlProtocol::bind(const Json& request, bool replace,
   if (!request.contains("yaml") || !request["yaml"].is_string()) {
     return failure("bad_request", "\"yaml\" (string with channel definitions) is required");
   }
-  const std::string file = request.contains("file") && request["file"].is_string() ? request["file"].get<std::string>() : "request";
+  const std::string file =
+      request.contains("file") && request["file"].is_string() ? request["file"].get<std::string>() : "request";
   ChannelsResult parsed = parse_channels(request["yaml"].get<std::string>(), file, gateway_.config());
   if (!parsed.ok()) {
     Json out = failure("config_error", std::to_string(parsed.errors.size()) + " error(s) in the channel definitions");
@@ -391,14 +409,14 @@ ControlProtocol::Answer ControlProtocol::bind(const Json& request, bool replace,
         running_ = what + " (claiming the federation's shared networks)";
         try {
           gate_(*plan, [this, plan, request, command, later] {
-          running_.clear();
-          Answer answer;
-          try {
-            answer = conclude(plan, request, command, true, later);
-          } catch (const std::exception& e) {
-            answer = failure("internal_error", e.what());
-          }
-          if (answer) later(render(*answer));
+            running_.clear();
+            Answer answer;
+            try {
+              answer = conclude(plan, request, command, true, later);
+            } catch (const std::exception& e) {
+              answer = failure("internal_error", e.what());
+            }
+            if (answer) later(render(*answer));
           });
         } catch (const std::exception& e) {
           running_.clear();  // never left busy by a gate that failed
@@ -430,7 +448,8 @@ Json ControlProtocol::commit_planned(BindPlan plan, const Json& request, const s
 }
 
 Json ControlProtocol::unbind(const Json& request) {
-  if (!request.contains("name") || !request["name"].is_string()) return failure("bad_request", "\"name\" (string) is required");
+  if (!request.contains("name") || !request["name"].is_string())
+    return failure("bad_request", "\"name\" (string) is required");
   const std::string name = request["name"].get<std::string>();
   if (!gateway_.unbind(name)) return failure("not_found", "no bound channel named '" + name + "'");
   return Json{{"ok", true}, {"unbound", name}};
@@ -441,7 +460,8 @@ ControlProtocol::Answer ControlProtocol::reload(const Reply& later) {
   auto loaded = std::make_shared<ConfigResult>();
   auto plan = std::make_shared<ReloadPlan>();
   // Channels unchanged since the running bindings were admitted are not admitted again.
-  auto work = [this, loaded, plan, base = gateway_.reload_base(), peers = gateway_.knowledge_base().peer_reservations()] {
+  auto work = [this, loaded, plan, base = gateway_.reload_base(),
+               peers = gateway_.knowledge_base().peer_reservations()] {
     *loaded = reload_source_();
     if (loaded->ok()) *plan = Gateway::plan_reload(loaded->config, base, peers);
   };

@@ -90,7 +90,8 @@ Status ControlServer::open() {
   if (options_.socket_group && ::chown(options_.path.c_str(), static_cast<uid_t>(-1), *options_.socket_group) != 0) {
     return Status::failure(errno_text("chown " + options_.path));
   }
-  if (::chmod(options_.path.c_str(), options_.socket_mode) != 0) return Status::failure(errno_text("chmod " + options_.path));
+  if (::chmod(options_.path.c_str(), options_.socket_mode) != 0)
+    return Status::failure(errno_text("chmod " + options_.path));
   if (::listen(listen_fd_, 64) != 0) return Status::failure(errno_text("listen"));
   epoll_fd_ = ::epoll_create1(EPOLL_CLOEXEC);
   if (epoll_fd_ < 0) return Status::failure(errno_text("epoll_create1"));
@@ -114,7 +115,8 @@ void ControlServer::post(std::function<void()> task) {
     posted_.push_back(std::move(task));
   }
   const std::uint64_t one = 1;
-  if (wake_fd_ >= 0) [[maybe_unused]] const auto written = ::write(wake_fd_, &one, sizeof one);
+  if (wake_fd_ >= 0) [[maybe_unused]]
+    const auto written = ::write(wake_fd_, &one, sizeof one);
 }
 
 Offload ControlServer::offload() {
@@ -285,8 +287,8 @@ void ControlServer::read_input(Client& client, int fd) {
   answer_requests(fd, client);
   const std::size_t newline = client.in.find('\n');
   if ((newline == std::string::npos ? client.in.size() : newline) > options_.max_request_bytes) {
-    client.out += error_line("too_large", "request larger than the limit of " + std::to_string(options_.max_request_bytes) +
-                                              " bytes; connection closed");
+    client.out += error_line("too_large", "request larger than the limit of " +
+                                              std::to_string(options_.max_request_bytes) + " bytes; connection closed");
     client.in.clear();
     client.closing = true;
   }

@@ -38,10 +38,12 @@ ControlProtocol::Answer ControlProtocol::switch_planned(std::shared_ptr<BindPlan
     plan = std::move(fresh);
   }
   const double seconds = request.value("match_timeout_s", kDefaultMatchTimeoutS);
-  auto wait = std::make_shared<SwitchWait>(SwitchWait{plan, request, command, later, Steady::now(),
-                                                      std::chrono::duration_cast<Nanos>(std::chrono::duration<double>(seconds))});
+  auto wait = std::make_shared<SwitchWait>(
+      SwitchWait{plan, request, command, later, Steady::now(),
+                 std::chrono::duration_cast<Nanos>(std::chrono::duration<double>(seconds))});
   if (!gateway_.prepare_replace(*plan)) return switched(*wait, false);
-  if (!offload_ || !later) return switched(*wait, !gateway_.await_new_publishers(*plan, wait->prepared_at, wait->timeout));
+  if (!offload_ || !later)
+    return switched(*wait, !gateway_.await_new_publishers(*plan, wait->prepared_at, wait->timeout));
   char limit[32];
   std::snprintf(limit, sizeof limit, "%g", seconds);
   running_ = command + " of " + (plan->channels.empty() ? std::string() : plan->channels.front().name) +
@@ -51,22 +53,23 @@ ControlProtocol::Answer ControlProtocol::switch_planned(std::shared_ptr<BindPlan
 }
 
 void ControlProtocol::await_match(std::shared_ptr<SwitchWait> wait) {
-  offload_([] { std::this_thread::sleep_for(kMatchPoll); }, [this, wait] {
-    Json answer;
-    try {
-      const bool matched = Gateway::all_matched(gateway_.new_publishers(*wait->plan));
-      if (!matched && Steady::now() - wait->prepared_at < wait->timeout) {
-        await_match(wait);
-        return;
-      }
-      running_.clear();
-      answer = switched(*wait, !matched);
-    } catch (const std::exception& e) {
-      running_.clear();
-      answer = failure("internal_error", e.what());
-    }
-    wait->later(render(answer));
-  });
+  offload_([] { std::this_thread::sleep_for(kMatchPoll); },
+           [this, wait] {
+             Json answer;
+             try {
+               const bool matched = Gateway::all_matched(gateway_.new_publishers(*wait->plan));
+               if (!matched && Steady::now() - wait->prepared_at < wait->timeout) {
+                 await_match(wait);
+                 return;
+               }
+               running_.clear();
+               answer = switched(*wait, !matched);
+             } catch (const std::exception& e) {
+               running_.clear();
+               answer = failure("internal_error", e.what());
+             }
+             wait->later(render(answer));
+           });
 }
 
 Json ControlProtocol::switched(SwitchWait& wait, bool timed_out) {
@@ -80,8 +83,8 @@ Json ControlProtocol::switched(SwitchWait& wait, bool timed_out) {
       for (const NewPublisher& p : result.new_publishers) {
         if (p.matched && *p.matched == 0) late += (late.empty() ? "" : ", ") + p.channel + " on " + p.segment;
       }
-      log_.log(LogLevel::warning, wait.command + ": switched after the match timeout with no writer matched for " + late +
-                                      " (events published there before discovery completes are lost)");
+      log_.log(LogLevel::warning, wait.command + ": switched after the match timeout with no writer matched for " +
+                                      late + " (events published there before discovery completes are lost)");
     }
   }
   return finish(wait.command, wait.request, std::move(answer));

@@ -36,7 +36,7 @@ std::size_t segment_index(std::span<const SegmentSpec> segments, const std::stri
 // The background frames that delay a CAN hop most, when its response time misses the channel's
 // reaction time (what `cosmicctl check` names for a rejected channel); empty otherwise.
 std::vector<BackgroundDelay> background_delaying(const SegmentSpec& segment, std::span<const CanStream> background,
-                                                const ChannelSpec& channel, const CanHopPlan& plan) {
+                                                 const ChannelSpec& channel, const CanHopPlan& plan) {
   constexpr std::size_t kNamed = 3;
   if (segment.can.background.empty() || channel.cls == ChannelClass::nrt || !channel.reaction_time) return {};
   if (plan.response_time && *plan.response_time <= *channel.reaction_time) return {};
@@ -66,7 +66,8 @@ CanHopPlan frame_plan(const SegmentSpec& segment, const ChannelSpec& channel) {
     plan.extended = native->extended;
     plan.can_id = native->can_id;
   }
-  plan.transmission = frame_time(bus, plan.frame_bytes, plan.extended ? CanIdFormat::extended29 : CanIdFormat::standard11);
+  plan.transmission =
+      frame_time(bus, plan.frame_bytes, plan.extended ? CanIdFormat::extended29 : CanIdFormat::standard11);
   return plan;
 }
 
@@ -85,10 +86,14 @@ double hop_load(const SegmentSpec& segment, const ChannelSpec& channel) {
 
 const char* to_string(Verdict value) {
   switch (value) {
-    case Verdict::bound: return "bound";
-    case Verdict::degraded: return "degraded";
-    case Verdict::rejected: return "rejected";
-    case Verdict::failed: return "failed";
+    case Verdict::bound:
+      return "bound";
+    case Verdict::degraded:
+      return "degraded";
+    case Verdict::rejected:
+      return "rejected";
+    case Verdict::failed:
+      return "failed";
   }
   return "?";
 }
@@ -146,7 +151,8 @@ AdmissionSet AdmissionSet::whole(GatewaySpec gateway, std::vector<SegmentSpec> s
   for (const ChannelSpec& channel : channels) {
     const auto etag = etags.find(channel.name);
     ChannelData data = set.place(channel, etag == etags.end() ? 0 : etag->second);
-    for (const HopPlace& p : data.places) set.segments_[p.segment].load += hop_load(set.segment_specs_[p.segment], channel);
+    for (const HopPlace& p : data.places)
+      set.segments_[p.segment].load += hop_load(set.segment_specs_[p.segment], channel);
     set.append(channel, std::move(data));
   }
   set.apply(set.analyse_can(nullptr, true));
@@ -157,7 +163,8 @@ AdmissionSet::ChannelData AdmissionSet::place(const ChannelSpec& channel, std::u
   ChannelData data{etag, {}};
   auto add = [&](const std::string& name, HopRole role) {
     const std::size_t s = segment_index(segment_specs_, name);
-    const auto earlier = std::count_if(data.places.begin(), data.places.end(), [&](const auto& p) { return p.segment == s; });
+    const auto earlier =
+        std::count_if(data.places.begin(), data.places.end(), [&](const auto& p) { return p.segment == s; });
     data.places.push_back(HopPlace{s, segments_[s].hops.size() + static_cast<std::size_t>(earlier), role});
   };
   for (const auto& p : channel.publishers) add(p, HopRole::publisher);
@@ -167,7 +174,8 @@ AdmissionSet::ChannelData AdmissionSet::place(const ChannelSpec& channel, std::u
 
 void AdmissionSet::append(ChannelSpec spec, ChannelData data) {
   const std::size_t index = specs_.size();
-  for (std::size_t h = 0; h < data.places.size(); ++h) segments_[data.places[h].segment].hops.push_back(HopRef{index, h});
+  for (std::size_t h = 0; h < data.places.size(); ++h)
+    segments_[data.places[h].segment].hops.push_back(HopRef{index, h});
   index_[spec.name] = index;
   specs_.push_back(std::move(spec));
   data_.push_back(std::move(data));
@@ -192,7 +200,8 @@ AdmissionSet::Member AdmissionSet::member(std::size_t segment, std::size_t posit
 // priority, so only subscriber hops take a level of the bands there.
 std::vector<CanHopPlan> AdmissionSet::plan_bus(std::size_t segment, const Trial* newcomer) const {
   std::vector<Member> members;
-  for (std::size_t pos = 0; pos < segments_[segment].hops.size(); ++pos) members.push_back(member(segment, pos, nullptr));
+  for (std::size_t pos = 0; pos < segments_[segment].hops.size(); ++pos)
+    members.push_back(member(segment, pos, nullptr));
   if (newcomer) {
     for (const HopPlace& p : newcomer->data.places) {
       if (p.segment == segment) members.push_back(Member{&newcomer->spec, &newcomer->data, p.role});
@@ -232,7 +241,8 @@ std::vector<CanHopPlan> AdmissionSet::plan_bus(std::size_t segment, const Trial*
     const std::uint8_t planned = band_priority(spec.cls, k - first_of_class, count[static_cast<std::size_t>(spec.cls)]);
     if (famouso) {
       plan.priority = famouso_priority(planned);
-      plan.can_id = encode_famouso_id(FamousoIdentifier{plan.priority, plan.frames_per_event > 1, gateway_.can_node_id, plan.etag});
+      plan.can_id = encode_famouso_id(
+          FamousoIdentifier{plan.priority, plan.frames_per_event > 1, gateway_.can_node_id, plan.etag});
     } else {
       plan.priority = planned;
       plan.can_id = encode_can_id(CanIdentifier{plan.priority, gateway_.can_node_id, plan.etag});
@@ -257,7 +267,8 @@ bool AdmissionSet::update_jitters(CanSide& side, const Trial* newcomer) const {
                                                  : std::optional<Nanos>(segment_specs_[p.segment].latency_bound);
         upstream = upstream && latency ? std::optional<Nanos>(std::max(*upstream, *latency)) : std::nullopt;
       }
-      const Nanos jitter = upstream ? std::min(kUnboundedJitter, *upstream + gateway_.residence_bound) : kUnboundedJitter;
+      const Nanos jitter =
+          upstream ? std::min(kUnboundedJitter, *upstream + gateway_.residence_bound) : kUnboundedJitter;
       CanHopPlan& plan = side.plans[s][pos];
       if (plan.jitter == jitter) continue;
       plan.jitter = jitter;
@@ -269,8 +280,8 @@ bool AdmissionSet::update_jitters(CanSide& side, const Trial* newcomer) const {
 
 // Response times of every CAN bus with the holistic jitter iteration (from zero jitter to the
 // fixed point, as a whole-set analysis does). Buses the newcomer joins (all with replan_all) get
-// fresh priorities; the others keep theirs, which are fresh unless a removal pinned them. Each bus run reuses the committed run of the same
-// iteration for the streams whose higher-priority prefix did not change.
+// fresh priorities; the others keep theirs, which are fresh unless a removal pinned them. Each bus run reuses the
+// committed run of the same iteration for the streams whose higher-priority prefix did not change.
 AdmissionSet::CanSide AdmissionSet::analyse_can(const Trial* newcomer, bool replan_all) const {
   CanSide side;
   side.replanned.assign(segments_.size(), false);
@@ -278,8 +289,9 @@ AdmissionSet::CanSide AdmissionSet::analyse_can(const Trial* newcomer, bool repl
   side.runs.resize(segments_.size());
   for (std::size_t s = 0; s < segments_.size(); ++s) {
     if (segment_specs_[s].type != SegmentType::can) continue;
-    side.replanned[s] = replan_all || (newcomer && std::any_of(newcomer->data.places.begin(), newcomer->data.places.end(),
-                                                                [&](const HopPlace& p) { return p.segment == s; }));
+    side.replanned[s] =
+        replan_all || (newcomer && std::any_of(newcomer->data.places.begin(), newcomer->data.places.end(),
+                                               [&](const HopPlace& p) { return p.segment == s; }));
     side.plans[s] = side.replanned[s] ? plan_bus(s, newcomer) : segments_[s].plans;
     for (CanHopPlan& plan : side.plans[s]) plan.jitter = Nanos(0);
     side.runs[s].reserve(kMaxJitterIterations);
@@ -300,9 +312,9 @@ AdmissionSet::CanSide AdmissionSet::analyse_can(const Trial* newcomer, bool repl
       streams.insert(streams.end(), background.begin(), background.end());
       const auto& committed = segments_[s].runs;
       const CanBusAnalysis* memo = it < committed.size() ? &committed[it]
-                                   : it > 0             ? &side.runs[s][it - 1]
-                                   : committed.empty()  ? nullptr
-                                                        : &committed.back();
+                                   : it > 0              ? &side.runs[s][it - 1]
+                                   : committed.empty()   ? nullptr
+                                                         : &committed.back();
       side.runs[s].emplace_back(streams, bus_timing(segment_specs_[s].can), memo);
       const auto& results = side.runs[s].back().results();
       for (std::size_t pos = 0; pos < side.plans[s].size(); ++pos) side.plans[s][pos].response_time = results[pos];
@@ -425,7 +437,8 @@ std::vector<std::size_t> AdmissionSet::affected_by(const Trial& t) const {
         const CanHopPlan& before = segments_[s].plans[pos];
         const CanHopPlan& after = t.can->plans[s][pos];
         const HopRef& ref = segments_[s].hops[pos];
-        const bool bound_changed = t.can->diverged != diverged_ && data_[ref.channel].places[ref.hop].role == HopRole::subscriber;
+        const bool bound_changed =
+            t.can->diverged != diverged_ && data_[ref.channel].places[ref.hop].role == HopRole::subscriber;
         if (bound_changed || before.can_id != after.can_id || before.jitter != after.jitter ||
             before.response_time != after.response_time) {
           out.push_back(ref.channel);
@@ -484,7 +497,8 @@ bool AdmissionSet::remove(const std::string& name) {
       segments_[s].load += hop_load(segment_specs_[s], specs_[ref.channel]);
     }
   }
-  const bool can = std::any_of(touched.begin(), touched.end(), [&](std::size_t s) { return segment_specs_[s].type == SegmentType::can; });
+  const bool can = std::any_of(touched.begin(), touched.end(),
+                               [&](std::size_t s) { return segment_specs_[s].type == SegmentType::can; });
   if (can) apply(analyse_can(nullptr, false));
   return true;
 }
@@ -514,8 +528,9 @@ std::vector<SegmentLoad> AdmissionSet::loads() const {
   for (std::size_t s = 0; s < segments_.size(); ++s) {
     const SegmentSpec& spec = segment_specs_[s];
     const bool can = spec.type == SegmentType::can;
-    out.push_back(SegmentLoad{spec.name, spec.type, segments_[s].load, spec.max_utilization, can ? segments_[s].background_load : 0.0,
-                              can ? spec.can.background.size() : 0, spec.peer_load});
+    out.push_back(SegmentLoad{spec.name, spec.type, segments_[s].load, spec.max_utilization,
+                              can ? segments_[s].background_load : 0.0, can ? spec.can.background.size() : 0,
+                              spec.peer_load});
   }
   return out;
 }

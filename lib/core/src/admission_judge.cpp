@@ -23,9 +23,7 @@ bool segment_retransmits(const SegmentSpec& segment) {
   return segment.reliability == Reliability::reliable;
 }
 
-bool segment_realtime(const SegmentSpec& segment) {
-  return segment.type == SegmentType::can || segment.realtime;
-}
+bool segment_realtime(const SegmentSpec& segment) { return segment.type == SegmentType::can || segment.realtime; }
 
 void add_frame_fit(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) {
   double limit = 0;
@@ -33,8 +31,9 @@ void add_frame_fit(const ChannelSpec& channel, const SegmentSpec& segment, HopRe
     const std::uint32_t capacity = max_frame_payload(segment.can);
     // A native frame is the event: no fragmentation, whatever the class.
     const bool fragmentable = channel.cls == ChannelClass::nrt && !channel.native_can(segment.name);
-    limit = fragmentable && channel.payload > capacity ? static_cast<double>(kMaxFragments * (capacity - kFragmentHeaderBytes))
-                                                       : capacity;
+    limit = fragmentable && channel.payload > capacity
+                ? static_cast<double>(kMaxFragments * (capacity - kFragmentHeaderBytes))
+                : capacity;
   } else {
     limit = channel.cls == ChannelClass::nrt ? static_cast<double>(kMaxIpEventBytes)
                                              : static_cast<double>(segment.max_message_size - kIpOverheadBytes);
@@ -47,8 +46,9 @@ void add_frame_fit(const ChannelSpec& channel, const SegmentSpec& segment, HopRe
 std::string background_text(const HopReport& h) {
   std::string text;
   for (const BackgroundDelay& d : h.background) {
-    text += (text.empty() ? "; background frames delaying it most: " : ", ") + d.name + " (" + can_id_text(d.can_id, d.extended) + ") " +
-            format_seconds(to_seconds(d.delay)) + (d.blocking ? " blocking" : "");
+    text += (text.empty() ? "; background frames delaying it most: " : ", ") + d.name + " (" +
+            can_id_text(d.can_id, d.extended) + ") " + format_seconds(to_seconds(d.delay)) +
+            (d.blocking ? " blocking" : "");
   }
   return text;
 }
@@ -58,7 +58,9 @@ std::string failure_text(const Check& check, const HopReport& h, const SegmentSp
   if (check.check == "frame_fit") {
     const bool native = h.can && h.can->native;
     return "payload " + std::to_string(static_cast<long long>(check.value)) + " B > " +
-           (native ? "native frame " : segment.type == SegmentType::can ? "frame " : "message ") +
+           (native                             ? "native frame "
+            : segment.type == SegmentType::can ? "frame "
+                                               : "message ") +
            std::to_string(static_cast<long long>(check.limit)) + " B" + on;
   }
   if (check.check == "utilization") {
@@ -70,7 +72,8 @@ std::string failure_text(const Check& check, const HopReport& h, const SegmentSp
            " > max_utilization " + format_percent(check.limit) + on;
   }
   if (check.check == "response_time") {
-    return "R = " + format_seconds(check.value) + " > reaction_time " + format_seconds(check.limit) + on + background_text(h);
+    return "R = " + format_seconds(check.value) + " > reaction_time " + format_seconds(check.limit) + on +
+           background_text(h);
   }
   if (check.check == "latency") {
     return "latency_bound " + format_seconds(check.value) + " > reaction_time " + format_seconds(check.limit) + on;
@@ -104,13 +107,13 @@ void Judge::judge(const ChannelSpec& channel, ChannelReport& report) const {
   if (channel.cls != ChannelClass::nrt && channel.reaction_time && latency > to_seconds(*channel.reaction_time)) {
     e2e.latency_ok = false;
     worsen(consequence_of("latency", channel.cls), "end-to-end latency " + format_seconds(latency) +
-                                                    " > reaction_time " + format_duration(*channel.reaction_time));
+                                                       " > reaction_time " + format_duration(*channel.reaction_time));
   }
   if (channel.temp_validity && latency >= to_seconds(*channel.temp_validity)) {
     e2e.validity_ok = false;
     worsen(consequence_of("validity", channel.cls), "end-to-end latency " + format_seconds(latency) +
-                                                     " >= temp_validity " + format_duration(*channel.temp_validity) +
-                                                     ": events would arrive stale");
+                                                        " >= temp_validity " + format_duration(*channel.temp_validity) +
+                                                        ": events would arrive stale");
   }
 }
 
@@ -118,8 +121,8 @@ void Judge::add_hop_checks(const ChannelSpec& channel, const SegmentSpec& segmen
   add_frame_fit(channel, segment, h);
   if (channel.period) {
     const double load = loads_[static_cast<std::size_t>(&segment - segments_.data())];
-    h.checks.push_back(Check{"utilization", load, segment.max_utilization, "ratio", "<=",
-                             load <= segment.max_utilization + 1e-12});
+    h.checks.push_back(
+        Check{"utilization", load, segment.max_utilization, "ratio", "<=", load <= segment.max_utilization + 1e-12});
   }
   if (channel.cls != ChannelClass::nrt && channel.reaction_time) {
     const double value = seconds_or_infinity(h.latency);
@@ -128,8 +131,8 @@ void Judge::add_hop_checks(const ChannelSpec& channel, const SegmentSpec& segmen
     h.checks.push_back(Check{name, value, limit, "s", "<=", value <= limit});
   }
   const double min_omission = segment_retransmits(segment) ? 0.0 : 1.0;
-  h.checks.push_back(Check{"omission", static_cast<double>(channel.omission_degree), min_omission, "events", ">=",
-                           channel.omission_degree >= min_omission});
+  h.checks.push_back(Check{"omission", static_cast<double>(channel.omission_degree), min_omission, "events",
+                           ">=", channel.omission_degree >= min_omission});
   if (channel.cls == ChannelClass::hrt) {
     const double capable = segment_realtime(segment) ? 1.0 : 0.0;
     h.checks.push_back(Check{"realtime", capable, 1.0, "bool", ">=", capable >= 1.0});

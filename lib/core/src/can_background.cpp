@@ -19,7 +19,8 @@ std::vector<CanStream> background_streams(const CanSegmentProperties& bus) {
   streams.reserve(bus.background.size());
   for (const CanBackgroundFrame& f : bus.background) {
     const CanIdFormat format = id_format(f);
-    streams.push_back(CanStream{arbitration_key(f.can_id, format), frame_time(bus, f.length, format), f.period, f.jitter});
+    streams.push_back(
+        CanStream{arbitration_key(f.can_id, format), frame_time(bus, f.length, format), f.period, f.jitter});
   }
   return streams;
 }
@@ -38,7 +39,8 @@ std::vector<BackgroundDelay> dominant_background(const CanSegmentProperties& bus
     const CanStream& k = streams[i];
     const CanBackgroundFrame& f = bus.background[i];
     if (k.can_id < stream.can_id) {
-      const std::int64_t releases = std::max<std::int64_t>(1, ceil_div(queuing + k.jitter.count() + tau, k.period.count()));
+      const std::int64_t releases =
+          std::max<std::int64_t>(1, ceil_div(queuing + k.jitter.count() + tau, k.period.count()));
       delays.push_back(BackgroundDelay{f.name, f.can_id, f.extended, Nanos(releases * k.transmission.count()), false});
     } else if (k.can_id > stream.can_id && (!longest_lower || k.transmission > streams[*longest_lower].transmission)) {
       longest_lower = i;

@@ -17,7 +17,8 @@ std::map<std::string, std::string> undeclared_interference(const AdmissionReport
       const std::uint32_t ours = arbitration_key(*hop.can);
       std::string reason;
       for (const UnexplainedFrames& f : unexplained) {
-        const std::uint32_t theirs = arbitration_key(f.can_id, f.extended ? CanIdFormat::extended29 : CanIdFormat::standard11);
+        const std::uint32_t theirs =
+            arbitration_key(f.can_id, f.extended ? CanIdFormat::extended29 : CanIdFormat::standard11);
         if (f.rate_hz <= 0 || theirs >= ours) continue;
         char rate[32];
         std::snprintf(rate, sizeof rate, "%.1f Hz", f.rate_hz);

@@ -60,9 +60,10 @@ std::int64_t interference(const StreamContext& ctx, std::int64_t x, std::int64_t
 std::optional<std::int64_t> busy_period(const StreamContext& ctx, const CanBusTiming& timing) {
   std::int64_t t = ctx.self.transmission.count();
   while (true) {
-    const std::int64_t next = ctx.blocking + error_overhead(t, timing, ctx.largest_hep_frame) +
-                              ceil_div(t + ctx.self.jitter.count(), ctx.self.period.count()) * ctx.self.transmission.count() +
-                              interference(ctx, t, 0);
+    const std::int64_t next =
+        ctx.blocking + error_overhead(t, timing, ctx.largest_hep_frame) +
+        ceil_div(t + ctx.self.jitter.count(), ctx.self.period.count()) * ctx.self.transmission.count() +
+        interference(ctx, t, 0);
     if (next == t) return t;
     if (next > kHorizonNs) return std::nullopt;
     t = next;
@@ -151,11 +152,13 @@ bool level_full_exactly(std::span<const CanStream> streams, std::size_t index, c
   ExactShare load;
   bool exact = load.add(streams[index].transmission.count(), streams[index].period.count());
   for (std::size_t k = 0; k < streams.size(); ++k) {
-    if (k != index && streams[k].can_id < streams[index].can_id) exact = load.add(streams[k].transmission.count(), streams[k].period.count());
+    if (k != index && streams[k].can_id < streams[index].can_id)
+      exact = load.add(streams[k].transmission.count(), streams[k].period.count());
   }
   if (timing.errors.max_per_window > 0 && timing.errors.window.count() > 0) {
-    exact = load.add(static_cast<std::int64_t>(timing.errors.max_per_window) * (timing.error_frame_time.count() + largest_hep_frame),
-                     timing.errors.window.count());
+    exact = load.add(
+        static_cast<std::int64_t>(timing.errors.max_per_window) * (timing.error_frame_time.count() + largest_hep_frame),
+        timing.errors.window.count());
   }
   return !exact || load.at_least_one();
 }
@@ -204,9 +207,7 @@ FdFrameBits fd_frame_bits(std::uint32_t payload, CanIdFormat format) {
   return bits;
 }
 
-Nanos bit_time(BitRate rate) {
-  return Nanos(ceil_div(1'000'000'000, static_cast<std::int64_t>(rate.bits_per_second)));
-}
+Nanos bit_time(BitRate rate) { return Nanos(ceil_div(1'000'000'000, static_cast<std::int64_t>(rate.bits_per_second))); }
 
 namespace {
 std::int64_t bits_to_ns(std::uint64_t bits, BitRate rate) {
@@ -221,9 +222,7 @@ Nanos frame_time(const CanSegmentProperties& bus, std::uint32_t payload, CanIdFo
   return Nanos(bits_to_ns(bits.nominal_bits, bus.bitrate) + bits_to_ns(bits.data_bits, data_rate));
 }
 
-std::uint32_t max_frame_payload(const CanSegmentProperties& bus) {
-  return bus.fd ? kFdMaxPayload : kClassicMaxPayload;
-}
+std::uint32_t max_frame_payload(const CanSegmentProperties& bus) { return bus.fd ? kFdMaxPayload : kClassicMaxPayload; }
 
 CanBusTiming bus_timing(const CanSegmentProperties& bus) {
   return CanBusTiming{bit_time(bus.bitrate), Nanos(bits_to_ns(kErrorFrameBits, bus.bitrate)), bus.errors};
@@ -253,7 +252,8 @@ CanBusAnalysis::CanBusAnalysis(std::span<const CanStream> streams, const CanBusT
     entries_[p].period = s.period.count();
     entries_[p].jitter = s.jitter.count();
     entries_[p].tied = p > 0 && streams[order[p - 1]].can_id == s.can_id;
-    releases[p] = Release{s.period.count() - s.jitter.count(), p, s.transmission.count(), s.period.count(), s.jitter.count()};
+    releases[p] =
+        Release{s.period.count() - s.jitter.count(), p, s.transmission.count(), s.period.count(), s.jitter.count()};
   }
   std::sort(releases.begin(), releases.end(),
             [](const Release& a, const Release& b) { return a.threshold < b.threshold; });
@@ -265,7 +265,8 @@ CanBusAnalysis::CanBusAnalysis(std::span<const CanStream> streams, const CanBusT
   std::size_t same_prefix = 0;
   if (reusable) {
     const auto& old = previous->entries_;
-    while (same_prefix < n && same_prefix < old.size() && entries_[same_prefix].same_stream(old[same_prefix])) ++same_prefix;
+    while (same_prefix < n && same_prefix < old.size() && entries_[same_prefix].same_stream(old[same_prefix]))
+      ++same_prefix;
   }
   std::size_t first_of_level = 0;
   std::int64_t higher_frames = 0;
@@ -283,11 +284,12 @@ CanBusAnalysis::CanBusAnalysis(std::span<const CanStream> streams, const CanBusT
         if (o != m) blocking = std::max(blocking, entries_[o].transmission);
       }
       e.blocking = blocking;
-      if (reusable && m < same_prefix && previous->entries_[m].blocking == blocking && !previous->entries_[m].near_full) {
+      if (reusable && m < same_prefix && previous->entries_[m].blocking == blocking &&
+          !previous->entries_[m].near_full) {
         e.result = previous->entries_[m].result;
       } else {
         StreamContext ctx{streams[input], first_of_level, blocking, std::max(longest_higher, e.transmission),
-                          higher_frames, &releases};
+                          higher_frames,  &releases};
         double load = higher_load + share(streams[input]) + fault_share(timing, ctx.largest_hep_frame);
         e.near_full = std::abs(load - 1.0) < kRoundingMargin;
         const bool full = e.near_full ? level_full_exactly(streams, input, timing, ctx.largest_hep_frame) : load >= 1.0;

@@ -10,8 +10,8 @@ std::uint32_t encode_can_id(const CanIdentifier& id) {
 }
 
 CanIdentifier decode_can_id(std::uint32_t can_id) {
-  return CanIdentifier{static_cast<std::uint8_t>((can_id >> 21) & 0xFF), static_cast<std::uint8_t>((can_id >> 14) & 0x7F),
-                       static_cast<std::uint16_t>(can_id & 0x3FFF)};
+  return CanIdentifier{static_cast<std::uint8_t>((can_id >> 21) & 0xFF),
+                       static_cast<std::uint8_t>((can_id >> 14) & 0x7F), static_cast<std::uint16_t>(can_id & 0x3FFF)};
 }
 
 std::uint32_t encode_famouso_id(const FamousoIdentifier& id) {
@@ -21,7 +21,8 @@ std::uint32_t encode_famouso_id(const FamousoIdentifier& id) {
 
 FamousoIdentifier decode_famouso_id(std::uint32_t can_id) {
   return FamousoIdentifier{static_cast<std::uint8_t>((can_id >> 22) & 0x7F), ((can_id >> 21) & 1) != 0,
-                           static_cast<std::uint8_t>((can_id >> 14) & 0x7F), static_cast<std::uint16_t>(can_id & 0x3FFF)};
+                           static_cast<std::uint8_t>((can_id >> 14) & 0x7F),
+                           static_cast<std::uint16_t>(can_id & 0x3FFF)};
 }
 
 namespace {
@@ -44,9 +45,12 @@ std::uint32_t famouso_id_of(std::uint32_t cosmic_can_id, bool fragment) {
 
 PriorityBand band_of(ChannelClass cls) {
   switch (cls) {
-    case ChannelClass::hrt: return kHrtBand;
-    case ChannelClass::srt: return kSrtBand;
-    case ChannelClass::nrt: return kNrtBand;
+    case ChannelClass::hrt:
+      return kHrtBand;
+    case ChannelClass::srt:
+      return kSrtBand;
+    case ChannelClass::nrt:
+      return kNrtBand;
   }
   return kNrtBand;
 }

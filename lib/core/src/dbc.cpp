@@ -137,7 +137,8 @@ class Lexer {
       step();
     }
     if (pos_ >= text_.size()) {
-      failure_ = DbcError{token.at.line, token.at.column, "unterminated string: no closing '\"' before the end of the text"};
+      failure_ =
+          DbcError{token.at.line, token.at.column, "unterminated string: no closing '\"' before the end of the text"};
       return;
     }
     token.kind = TokenKind::string;
@@ -158,17 +159,21 @@ class Lexer {
 class ErrorList {
  public:
   void add(Position at, std::string message) {
-    if (kept_.size() < kDbcMaxReportedErrors) kept_.push_back(DbcError{at.line, at.column, std::move(message)});
-    else ++unreported_;
+    if (kept_.size() < kDbcMaxReportedErrors)
+      kept_.push_back(DbcError{at.line, at.column, std::move(message)});
+    else
+      ++unreported_;
   }
 
   // In text order (cross-reference errors are found after the parse), then the closing line.
   std::vector<DbcError> finish() && {
     const auto position = [](const DbcError& e) { return std::pair{e.line, e.column}; };
-    std::stable_sort(kept_.begin(), kept_.end(), [&](const auto& a, const auto& b) { return position(a) < position(b); });
+    std::stable_sort(kept_.begin(), kept_.end(),
+                     [&](const auto& a, const auto& b) { return position(a) < position(b); });
     if (unreported_ > 0) {
-      kept_.push_back(DbcError{0, 0, std::to_string(unreported_) + " more errors not reported (only the first " +
-                                         std::to_string(kDbcMaxReportedErrors) + " are)"});
+      kept_.push_back(DbcError{0, 0,
+                               std::to_string(unreported_) + " more errors not reported (only the first " +
+                                   std::to_string(kDbcMaxReportedErrors) + " are)"});
     }
     return std::move(kept_);
   }
@@ -211,7 +216,8 @@ std::optional<std::string> id_problem(std::uint32_t raw_id) {
            " > 0x1FFFFFFF after removing bit 31";
   }
   if (raw_id <= kMaxStandardId) return std::nullopt;
-  return "standard message id " + describe_id(raw_id) + " is above 0x7FF (an extended id has bit 31 set: add 2147483648)";
+  return "standard message id " + describe_id(raw_id) +
+         " is above 0x7FF (an extended id has bit 31 set: add 2147483648)";
 }
 
 std::optional<std::string> length_problem(std::uint32_t length) {
@@ -290,7 +296,9 @@ class Parser {
   bool statement_goes_on_with(TokenKind kind) const { return in_statement(peek()) && peek().kind == kind; }
   bool statement_goes_on_with(std::string_view word) const { return in_statement(peek()) && peek().is(word); }
 
-  void skip_line() { while (on_same_line(peek())) take(); }
+  void skip_line() {
+    while (on_same_line(peek())) take();
+  }
 
   void skip_statement() {
     while (in_statement(peek())) {
@@ -381,11 +389,17 @@ class Parser {
   void keep_message(const MessageLine& line) {
     const auto length = parse_uint32(line.length.text);
     if (!length) {
-      return error(line.length.at, "message length " + quote_value(line.length.text) + " is not a whole number of bytes (0..64)");
+      return error(line.length.at,
+                   "message length " + quote_value(line.length.text) + " is not a whole number of bytes (0..64)");
     }
     if (!names_a_frame(line, *length) || !below_message_limit(line.keyword_at)) return;
-    const DbcMessage message{std::string(line.name.text), line.raw_id & ~kExtendedFlag, (line.raw_id & kExtendedFlag) != 0,
-                             *length, std::nullopt, line.keyword_at.line, line.keyword_at.column};
+    const DbcMessage message{std::string(line.name.text),
+                             line.raw_id & ~kExtendedFlag,
+                             (line.raw_id & kExtendedFlag) != 0,
+                             *length,
+                             std::nullopt,
+                             line.keyword_at.line,
+                             line.keyword_at.column};
     found_.push_back(FoundMessage{message, line.raw_id, line.id_at, line.name.at, std::nullopt, false});
   }
 
@@ -400,7 +414,8 @@ class Parser {
 
   bool below_message_limit(Position at) {
     if (found_.size() < kDbcMaxMessages) return true;
-    if (!too_many_reported_) error(at, "more than " + std::to_string(kDbcMaxMessages) + " messages (the limit of one DBC file)");
+    if (!too_many_reported_)
+      error(at, "more than " + std::to_string(kDbcMaxMessages) + " messages (the limit of one DBC file)");
     too_many_reported_ = true;
     return false;
   }
@@ -441,7 +456,8 @@ class Parser {
 
   // BA_DEF_DEF_ "<name>" <default value> ;
   void attribute_default() {
-    if (!statement_goes_on_with(TokenKind::string)) return fail_statement("the attribute name as a quoted string after BA_DEF_DEF_");
+    if (!statement_goes_on_with(TokenKind::string))
+      return fail_statement("the attribute name as a quoted string after BA_DEF_DEF_");
     if (take().text != kCycleTimeAttribute) return skip_statement();
     const auto ms = cycle_time_value();
     if (!ms) return skip_statement();
@@ -450,7 +466,8 @@ class Parser {
 
   // BA_ "<name>" [BU_ <node> | BO_ <id> | SG_ <id> <signal> | EV_ <variable>] <value> ;
   void attribute_value() {
-    if (!statement_goes_on_with(TokenKind::string)) return fail_statement("the attribute name as a quoted string after BA_");
+    if (!statement_goes_on_with(TokenKind::string))
+      return fail_statement("the attribute name as a quoted string after BA_");
     if (take().text != kCycleTimeAttribute) return skip_statement();
     if (!statement_goes_on_with("BO_")) {
       return fail_statement("BO_ and a message id after \"GenMsgCycleTime\" (a message attribute)");
@@ -485,7 +502,8 @@ class Parser {
     }
     const auto ms = parse_uint32(value.text);
     if (!ms) {
-      error(value.at, "GenMsgCycleTime must be a whole number of milliseconds (0..4294967295), found " + quote_value(value.text));
+      error(value.at,
+            "GenMsgCycleTime must be a whole number of milliseconds (0..4294967295), found " + quote_value(value.text));
     }
     return ms;
   }
@@ -505,7 +523,8 @@ class Parser {
   std::vector<std::size_t> order_by(Key key) const {
     std::vector<std::size_t> order(found_.size());
     std::iota(order.begin(), order.end(), std::size_t{0});
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(found_[a]) < key(found_[b]); });
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return key(found_[a]) < key(found_[b]); });
     return order;
   }
 
@@ -529,8 +548,9 @@ class Parser {
   void mark_duplicate_ids() {
     mark_duplicates([](const FoundMessage& m) { return m.raw_id; },
                     [this](const FoundMessage& first, const FoundMessage& again) {
-                      error(again.id_at, "duplicate message id " + describe_id(again.raw_id) + ": " + quote_value(again.message.name) +
-                                             " repeats the id of " + quote_value(first.message.name) + " declared at line " +
+                      error(again.id_at, "duplicate message id " + describe_id(again.raw_id) + ": " +
+                                             quote_value(again.message.name) + " repeats the id of " +
+                                             quote_value(first.message.name) + " declared at line " +
                                              std::to_string(first.message.line));
                     });
   }
@@ -538,8 +558,8 @@ class Parser {
   void mark_duplicate_names() {
     mark_duplicates([](const FoundMessage& m) -> std::string_view { return m.message.name; },
                     [this](const FoundMessage& first, const FoundMessage& again) {
-                      error(again.name_at, "duplicate message name " + quote_value(again.message.name) + ": already declared at line " +
-                                               std::to_string(first.message.line));
+                      error(again.name_at, "duplicate message name " + quote_value(again.message.name) +
+                                               ": already declared at line " + std::to_string(first.message.line));
                     });
   }
 
@@ -556,7 +576,8 @@ class Parser {
       if (hit != by_id.end() && hit->first == value.raw_id) {
         found_[hit->second].explicit_cycle_ms = value.ms;
       } else if (!std::binary_search(declared_ids_.begin(), declared_ids_.end(), value.raw_id)) {
-        error(value.id_at, "BA_ \"GenMsgCycleTime\" names message id " + describe_id(value.raw_id) + ", which no BO_ declares");
+        error(value.id_at,
+              "BA_ \"GenMsgCycleTime\" names message id " + describe_id(value.raw_id) + ", which no BO_ declares");
       }
     }
   }
@@ -586,8 +607,10 @@ class Parser {
 DbcFile parse_dbc(std::string_view text) {
   if (text.size() > kDbcMaxTextBytes) {
     DbcFile file;
-    file.errors.push_back(DbcError{0, 0, "the DBC text has " + std::to_string(text.size()) + " bytes, more than the limit of " +
-                                             std::to_string(kDbcMaxTextBytes) + " (8 MiB)"});
+    file.errors.push_back(DbcError{0, 0,
+                                   "the DBC text has " + std::to_string(text.size()) +
+                                       " bytes, more than the limit of " + std::to_string(kDbcMaxTextBytes) +
+                                       " (8 MiB)"});
     return file;
   }
   if (text.starts_with(kUtf8Bom)) text.remove_prefix(kUtf8Bom.size());

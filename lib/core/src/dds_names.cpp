@@ -50,8 +50,8 @@ DdsTopicRef dds_topic_of(const ChannelSpec& channel, const std::string& segment)
   return DdsTopicRef{dds_topic_name(channel.name), kEnvelopeTypeName, false, DdsRepresentation::xcdr1};
 }
 
-std::vector<std::pair<const ChannelSpec*, std::string>> dds_topic_collisions(std::span<const ChannelSpec* const> channels,
-                                                                             const std::string& segment) {
+std::vector<std::pair<const ChannelSpec*, std::string>> dds_topic_collisions(
+    std::span<const ChannelSpec* const> channels, const std::string& segment) {
   std::vector<std::pair<const ChannelSpec*, std::string>> collisions;
   std::map<std::string, std::string_view> owner;  // topic -> channel name
   for (const ChannelSpec* channel : channels) {
@@ -66,7 +66,8 @@ std::vector<std::pair<const ChannelSpec*, std::string>> dds_topic_collisions(std
   return collisions;
 }
 
-std::optional<std::string> dds_topic_collision(std::span<const ChannelSpec* const> channels, const std::string& segment) {
+std::optional<std::string> dds_topic_collision(std::span<const ChannelSpec* const> channels,
+                                               const std::string& segment) {
   auto collisions = dds_topic_collisions(channels, segment);
   if (collisions.empty()) return std::nullopt;
   return std::move(collisions.front().second);
@@ -81,8 +82,8 @@ std::optional<std::string> dds_topic_name_problem(std::string_view name) {
       return "topic name " + quoted(name) + " has an empty part between '/' separators";
     }
     if (!is_letter(c) && !is_digit(c) && c != '_' && c != '/') {
-      return "topic name " + quoted(name) + " has " + character_text(c) +
-             " at position " + std::to_string(i + 1) + "; only letters, digits, '_' and '/' are accepted";
+      return "topic name " + quoted(name) + " has " + character_text(c) + " at position " + std::to_string(i + 1) +
+             "; only letters, digits, '_' and '/' are accepted";
     }
   }
   if (name.substr(0, kEnvelopeTopicPrefix.size()) == kEnvelopeTopicPrefix) {
@@ -97,7 +98,8 @@ std::optional<std::string> dds_type_name_problem(std::string_view name) {
   std::size_t start = 0;
   for (;;) {
     const std::size_t end = name.find("::", start);
-    const std::string_view part = name.substr(start, end == std::string_view::npos ? std::string_view::npos : end - start);
+    const std::string_view part =
+        name.substr(start, end == std::string_view::npos ? std::string_view::npos : end - start);
     if (part.empty() || !(is_letter(part.front()) || part.front() == '_')) {
       return "type name " + quoted(name) + " has a part that is not an IDL identifier (parts are joined by '::')";
     }

@@ -94,22 +94,23 @@ std::string representations_text(const std::vector<DdsDataRepresentationId>& ids
 // ("this writer offers" / "this reader requests") the other.
 class Wording {
  public:
-  Wording(DdsLocalRole role, std::vector<DdsMatchConflict>& out) : local_is_writer_(role == DdsLocalRole::writer), out_(out) {}
+  Wording(DdsLocalRole role, std::vector<DdsMatchConflict>& out)
+      : local_is_writer_(role == DdsLocalRole::writer), out_(out) {}
 
   // `what` of the writer and of the reader, with why the pair fails.
-  void add(DdsMatchPolicy policy, const std::string& what, const std::string& writer_value, const std::string& reader_value,
-           const std::string& rule) {
+  void add(DdsMatchPolicy policy, const std::string& what, const std::string& writer_value,
+           const std::string& reader_value, const std::string& rule) {
     const std::string& remote_value = local_is_writer_ ? reader_value : writer_value;
     const std::string& local_value = local_is_writer_ ? writer_value : reader_value;
     out_.push_back({policy, std::string(local_is_writer_ ? "requests " : "offers ") + what + " " + remote_value + ", " +
-                                (local_is_writer_ ? "this writer offers " : "this reader requests ") + local_value + " (" +
-                                rule + ")"});
+                                (local_is_writer_ ? "this writer offers " : "this reader requests ") + local_value +
+                                " (" + rule + ")"});
   }
   // A property both sides have (type name, keys): "its X is A, ours is B".
   void differ(DdsMatchPolicy policy, const std::string& what, const std::string& remote_value,
               const std::string& local_value, const std::string& rule) {
-    out_.push_back({policy, "its " + what + " is " + remote_value + ", this " + (local_is_writer_ ? "writer" : "reader") +
-                                "'s is " + local_value + " (" + rule + ")"});
+    out_.push_back({policy, "its " + what + " is " + remote_value + ", this " +
+                                (local_is_writer_ ? "writer" : "reader") + "'s is " + local_value + " (" + rule + ")"});
   }
   bool local_is_writer() const { return local_is_writer_; }
 
@@ -120,8 +121,8 @@ class Wording {
 
 void check_type(const DdsEndpointQos& local, const DdsEndpointQos& remote, Wording& say) {
   if (local.keyed != remote.keyed) {
-    say.differ(DdsMatchPolicy::topic_kind, "topic", remote.keyed ? "keyed" : "keyless", local.keyed ? "keyed" : "keyless",
-               "keyed and keyless endpoints never match");
+    say.differ(DdsMatchPolicy::topic_kind, "topic", remote.keyed ? "keyed" : "keyless",
+               local.keyed ? "keyed" : "keyless", "keyed and keyless endpoints never match");
   }
   if (local.type_name != remote.type_name) {
     say.differ(DdsMatchPolicy::type_name, "type", "'" + remote.type_name + "'", "'" + local.type_name + "'",
@@ -130,7 +131,8 @@ void check_type(const DdsEndpointQos& local, const DdsEndpointQos& remote, Wordi
   if (local.extensibility != DdsTypeExtensibility::unknown && remote.extensibility != DdsTypeExtensibility::unknown &&
       local.extensibility != remote.extensibility) {
     say.differ(DdsMatchPolicy::type_extensibility, "type's extensibility", kind_text(remote.extensibility),
-               kind_text(local.extensibility), "XTypes 1.3 7.6.3.4: types of different extensibility are not assignable");
+               kind_text(local.extensibility),
+               "XTypes 1.3 7.6.3.4: types of different extensibility are not assignable");
   }
 }
 
@@ -197,17 +199,20 @@ void check_qos(const DdsEndpointQos& w, const DdsEndpointQos& r, Wording& say) {
 
 const char* to_string(DdsMatchPolicy policy) {
   static constexpr std::array<const char*, kDdsMatchPolicyCount> kText = {
-      "topic_kind", "type_name",      "type_extensibility", "data_representation", "reliability",
-      "durability", "deadline",       "latency_budget",     "liveliness",          "ownership",
+      "topic_kind",        "type_name",    "type_extensibility", "data_representation", "reliability",
+      "durability",        "deadline",     "latency_budget",     "liveliness",          "ownership",
       "destination_order", "presentation", "partition"};
   return kText[static_cast<std::size_t>(policy)];
 }
 
 const char* to_string(DdsDataRepresentationId id) {
   switch (id) {
-    case DdsDataRepresentationId::xcdr1: return "XCDR1";
-    case DdsDataRepresentationId::xml: return "XML";
-    case DdsDataRepresentationId::xcdr2: return "XCDR2";
+    case DdsDataRepresentationId::xcdr1:
+      return "XCDR1";
+    case DdsDataRepresentationId::xml:
+      return "XML";
+    case DdsDataRepresentationId::xcdr2:
+      return "XCDR2";
   }
   return "?";
 }

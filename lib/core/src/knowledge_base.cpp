@@ -9,14 +9,18 @@ namespace cosmic {
 
 const char* to_string(SegmentHealth value) {
   switch (value) {
-    case SegmentHealth::up: return "up";
-    case SegmentHealth::degraded: return "degraded";
-    case SegmentHealth::down: return "down";
+    case SegmentHealth::up:
+      return "up";
+    case SegmentHealth::degraded:
+      return "degraded";
+    case SegmentHealth::down:
+      return "down";
   }
   return "?";
 }
 
-KnowledgeBase::KnowledgeBase(GatewaySpec gateway, std::vector<SegmentSpec> segments, std::set<std::uint16_t> reserved_etags)
+KnowledgeBase::KnowledgeBase(GatewaySpec gateway, std::vector<SegmentSpec> segments,
+                             std::set<std::uint16_t> reserved_etags)
     : set_(std::move(gateway), segments), reserved_etags_(std::move(reserved_etags)) {
   for (auto& spec : segments) segments_.push_back(SegmentState{std::move(spec), SegmentHealth::up, {}});
   for (const std::uint16_t etag : reserved_etags_) {
@@ -62,7 +66,8 @@ std::uint16_t etag_bits(const NativeCanFrame& frame) { return static_cast<std::u
 
 // A native identity another bound channel holds, or an extended native identifier whose etag bits
 // a bound COSMIC channel uses (or the reverse): the reason, or nothing.
-std::optional<std::string> KnowledgeBase::native_clash(const ChannelSpec& channel, std::optional<std::uint16_t> etag) const {
+std::optional<std::string> KnowledgeBase::native_clash(const ChannelSpec& channel,
+                                                       std::optional<std::uint16_t> etag) const {
   for (const NativeBinding& binding : channel.native) {
     const std::string identity = native_identity(binding);
     if (const auto owner = native_owners_.find({binding.segment, identity}); owner != native_owners_.end()) {
@@ -81,7 +86,8 @@ std::optional<std::string> KnowledgeBase::native_clash(const ChannelSpec& channe
   return std::nullopt;
 }
 
-KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel, std::optional<std::uint16_t> preferred_etag) const {
+KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel,
+                                              std::optional<std::uint16_t> preferred_etag) const {
   Attempt a;
   if (find_bound(channel.name)) {
     a.report = rejected_report(channel, "channel " + channel.name + " is already bound");
@@ -94,17 +100,20 @@ KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel, std::o
   if (needs_etag(channel)) {
     if (channel.etag) {
       if (const auto owner = static_etag_owner(etags_, *channel.etag)) {
-        a.report = rejected_report(channel, "etag " + std::to_string(*channel.etag) + " is already used by channel " + *owner);
+        a.report =
+            rejected_report(channel, "etag " + std::to_string(*channel.etag) + " is already used by channel " + *owner);
         return a;
       }
       if (const auto peer = peer_etags_.find(*channel.etag); peer != peer_etags_.end()) {
-        a.report = rejected_report(channel, "etag " + std::to_string(*channel.etag) + " is carried by another gateway's frame " +
-                                                peer->second + " on a shared CAN bus (cosmicctl peers)");
+        a.report = rejected_report(channel, "etag " + std::to_string(*channel.etag) +
+                                                " is carried by another gateway's frame " + peer->second +
+                                                " on a shared CAN bus (cosmicctl peers)");
         return a;
       }
       a.etag = *channel.etag;
     } else if (preferred_etag && *preferred_etag > kHighestReservedEtag && *preferred_etag <= kMaxEtag &&
-               !etag_taken_.test(*preferred_etag) && !peer_etags_.count(*preferred_etag) && !native_etags_.count(*preferred_etag)) {
+               !etag_taken_.test(*preferred_etag) && !peer_etags_.count(*preferred_etag) &&
+               !native_etags_.count(*preferred_etag)) {
       a.etag = *preferred_etag;
     } else if (const auto etag = allocate_etag()) {
       a.etag = *etag;
@@ -172,7 +181,8 @@ void KnowledgeBase::add_upstream(const ChannelSpec& channel, ChannelReport& repo
   if (peers_.empty()) return;
   const UpstreamPath* slowest = nullptr;
   for (const std::string& publisher : channel.publishers) {
-    const auto segment = std::find_if(segments_.begin(), segments_.end(), [&](const auto& s) { return s.spec.name == publisher; });
+    const auto segment =
+        std::find_if(segments_.begin(), segments_.end(), [&](const auto& s) { return s.spec.name == publisher; });
     const PeerReservations* peer = segment == segments_.end() ? nullptr : peers_on(segment->spec);
     if (!peer) continue;
     for (const UpstreamPath& path : peer->senders) {
@@ -246,12 +256,14 @@ AdmissionReport KnowledgeBase::report() const {
     if (const auto etag = etags_.find(channel.name); etag != etags_.end()) {
       if (const auto peer = peer_etags_.find(etag->second); peer != peer_etags_.end()) {
         channel.verdict = std::max(channel.verdict, Verdict::degraded);
-        channel.reasons.push_back("etag " + std::to_string(etag->second) + " is also carried by another gateway's frame " + peer->second +
+        channel.reasons.push_back("etag " + std::to_string(etag->second) +
+                                  " is also carried by another gateway's frame " + peer->second +
                                   " on a shared CAN bus: devices bound to one read the other's; give it a static etag");
       }
     }
     for (const auto& hop : channel.hops) {
-      const auto state = std::find_if(segments_.begin(), segments_.end(), [&](const auto& s) { return s.spec.name == hop.segment; });
+      const auto state =
+          std::find_if(segments_.begin(), segments_.end(), [&](const auto& s) { return s.spec.name == hop.segment; });
       if (state == segments_.end() || state->health == SegmentHealth::up) continue;
       channel.verdict = std::max(channel.verdict, Verdict::degraded);
       channel.reasons.push_back("segment " + hop.segment + " is " + to_string(state->health) +

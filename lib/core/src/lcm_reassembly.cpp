@@ -96,7 +96,8 @@ LcmReassembler::Outcome LcmReassembler::add(std::uint64_t sender, const LcmDatag
   p->slices.emplace_back(fragment.fragment_offset, static_cast<std::uint32_t>(fragment.data.size()));
   p->last_touch = ++clock_;
   if (fragment.fragment_no == 0) p->channel.assign(fragment.channel);
-  if (!fragment.data.empty()) std::memcpy(p->data.data() + fragment.fragment_offset, fragment.data.data(), fragment.data.size());
+  if (!fragment.data.empty())
+    std::memcpy(p->data.data() + fragment.fragment_offset, fragment.data.data(), fragment.data.size());
   if (p->fragments_received < p->fragment_count) return Outcome::pending;
   // Every fragment came once; the message is whole only when their slices tile it exactly
   // (slices that overlap leave a gap somewhere: the message is lost, not delivered with holes).

@@ -11,9 +11,7 @@ std::uint32_t read_u32(const std::uint8_t* p) {
   return (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) | (std::uint32_t{p[2]} << 8) | std::uint32_t{p[3]};
 }
 
-std::uint16_t read_u16(const std::uint8_t* p) {
-  return static_cast<std::uint16_t>((p[0] << 8) | p[1]);
-}
+std::uint16_t read_u16(const std::uint8_t* p) { return static_cast<std::uint16_t>((p[0] << 8) | p[1]); }
 
 void write_u32(std::uint8_t* p, std::uint32_t v) {
   p[0] = static_cast<std::uint8_t>(v >> 24);
@@ -92,8 +90,7 @@ std::array<std::uint8_t, kLcmShortHeaderSize> lcm_short_header(std::uint32_t seq
   return out;
 }
 
-std::array<std::uint8_t, kLcmFragmentHeaderSize> lcm_fragment_header(std::uint32_t sequence,
-                                                                     std::uint32_t message_size,
+std::array<std::uint8_t, kLcmFragmentHeaderSize> lcm_fragment_header(std::uint32_t sequence, std::uint32_t message_size,
                                                                      std::uint32_t fragment_offset,
                                                                      std::uint16_t fragment_no,
                                                                      std::uint16_t fragment_count) {

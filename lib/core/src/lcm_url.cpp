@@ -56,7 +56,8 @@ std::variant<LcmUrl, std::string> parse_lcm_url(std::string_view url) {
     network = network.substr(0, colon);
   }
   if (network.empty() && colon == std::string_view::npos) network = kLcmDefaultGroup;  // LCM's default
-  if (!multicast_group(network)) return hint + "the group must be an IPv4 multicast address (224.0.0.0 to 239.255.255.255)";
+  if (!multicast_group(network))
+    return hint + "the group must be an IPv4 multicast address (224.0.0.0 to 239.255.255.255)";
   out.group = std::string(network);
   while (query != std::string_view::npos && !options.empty()) {
     const std::size_t amp = options.find('&');

@@ -8,29 +8,31 @@ namespace cosmic {
 
 const char* to_string(ChannelClass value) {
   switch (value) {
-    case ChannelClass::hrt: return "hrt";
-    case ChannelClass::srt: return "srt";
-    case ChannelClass::nrt: return "nrt";
+    case ChannelClass::hrt:
+      return "hrt";
+    case ChannelClass::srt:
+      return "srt";
+    case ChannelClass::nrt:
+      return "nrt";
   }
   return "?";
 }
 
 const char* to_string(SegmentType value) {
   switch (value) {
-    case SegmentType::can: return "can";
-    case SegmentType::dds: return "dds";
-    case SegmentType::lcm: return "lcm";
+    case SegmentType::can:
+      return "can";
+    case SegmentType::dds:
+      return "dds";
+    case SegmentType::lcm:
+      return "lcm";
   }
   return "?";
 }
 
-const char* to_string(Reliability value) {
-  return value == Reliability::reliable ? "reliable" : "best_effort";
-}
+const char* to_string(Reliability value) { return value == Reliability::reliable ? "reliable" : "best_effort"; }
 
-const char* to_string(DdsRepresentation value) {
-  return value == DdsRepresentation::xcdr2 ? "xcdr2" : "xcdr1";
-}
+const char* to_string(DdsRepresentation value) { return value == DdsRepresentation::xcdr2 ? "xcdr2" : "xcdr1"; }
 
 std::string native_identity(const NativeBinding& binding) {
   if (binding.can) return can_id_text(binding.can->can_id, binding.can->extended);

@@ -9,7 +9,8 @@ namespace cosmic {
 std::string network_identity(const SegmentSpec& segment) {
   if (!segment.network.empty()) return std::string(to_string(segment.type)) + ":" + segment.network;
   switch (segment.type) {
-    case SegmentType::can: return {};
+    case SegmentType::can:
+      return {};
     case SegmentType::dds:
       return "dds:domain=" + std::to_string(segment.dds.domain) +
              (segment.dds.discovery_server.empty() ? "" : ";server=" + segment.dds.discovery_server);

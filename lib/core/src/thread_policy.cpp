@@ -78,7 +78,8 @@ std::vector<std::string> place_process_threads(const std::vector<int>& cpus) {
     // A thread that ended since the directory was read is no problem.
     if (::sched_setaffinity(tid, sizeof set, &set) != 0) {
       const int error = errno;  // before any allocation below can change it
-      if (error != ESRCH) problems.push_back("CPU affinity of thread " + std::to_string(tid) + ": " + std::strerror(error));
+      if (error != ESRCH)
+        problems.push_back("CPU affinity of thread " + std::to_string(tid) + ": " + std::strerror(error));
     }
   }
   ::closedir(tasks);

@@ -88,10 +88,10 @@ Parsed<long double> parse_with_units(std::string_view text, const std::array<Uni
   return {value, {}};
 }
 
-constexpr std::array<UnitFactor, 5> kDurationUnits{{
-    {"ns", 1.0L}, {"us", 1e3L}, {"ms", 1e6L}, {"s", 1e9L}, {"min", 60e9L}}};
-constexpr std::array<UnitFactor, 4> kBitrateUnits{{
-    {"bit/s", 1.0L}, {"kbit/s", 1e3L}, {"Mbit/s", 1e6L}, {"Gbit/s", 1e9L}}};
+constexpr std::array<UnitFactor, 5> kDurationUnits{
+    {{"ns", 1.0L}, {"us", 1e3L}, {"ms", 1e6L}, {"s", 1e9L}, {"min", 60e9L}}};
+constexpr std::array<UnitFactor, 4> kBitrateUnits{
+    {{"bit/s", 1.0L}, {"kbit/s", 1e3L}, {"Mbit/s", 1e6L}, {"Gbit/s", 1e9L}}};
 constexpr std::array<UnitFactor, 3> kSizeUnits{{{"B", 1.0L}, {"KiB", 1024.0L}, {"MiB", 1048576.0L}}};
 constexpr std::array<UnitFactor, 1> kPercentUnits{{{"%", 0.01L}}};
 constexpr std::array<UnitFactor, 3> kFrequencyUnits{{{"Hz", 1.0L}, {"kHz", 1e3L}, {"MHz", 1e6L}}};
@@ -112,7 +112,8 @@ Parsed<BitRate> parse_bitrate(std::string_view text) {
   const auto raw = parse_with_units<BitRate>(text, kBitrateUnits, "a bit rate such as 500kbit/s or 1Mbit/s");
   if (!raw.value) return {std::nullopt, raw.error};
   if (!is_whole(*raw.value)) return {std::nullopt, quote_value(text) + " is not a whole number of bit/s"};
-  if (*raw.value < 1.0L || *raw.value > 1e12L) return {std::nullopt, quote_value(text) + " is out of range (1bit/s to 1000Gbit/s)"};
+  if (*raw.value < 1.0L || *raw.value > 1e12L)
+    return {std::nullopt, quote_value(text) + " is out of range (1bit/s to 1000Gbit/s)"};
   return {BitRate{static_cast<std::uint64_t>(std::llround(*raw.value))}, {}};
 }
 
@@ -127,7 +128,8 @@ Parsed<std::uint64_t> parse_size(std::string_view text) {
 Parsed<double> parse_percent(std::string_view text) {
   const auto raw = parse_with_units<double>(text, kPercentUnits, "a percentage such as 70%");
   if (!raw.value) return {std::nullopt, raw.error};
-  if (*raw.value < 0.0L || *raw.value > 1.0L) return {std::nullopt, quote_value(text) + " is out of range (0% to 100%)"};
+  if (*raw.value < 0.0L || *raw.value > 1.0L)
+    return {std::nullopt, quote_value(text) + " is out of range (0% to 100%)"};
   return {static_cast<double>(*raw.value), {}};
 }
 

@@ -11,18 +11,21 @@ namespace {
 // under its own check (R <= reaction_time), and its share of the room under the end-to-end ones,
 // split evenly between the channel's `can_hops` (each may be on a bus other gateways share, and
 // their binds there must not spend the same room twice). Nullopt: none to give.
-std::optional<Nanos> slack_of(const ChannelSpec& spec, const HopReport& hop, const EndToEnd& e2e, std::size_t can_hops) {
+std::optional<Nanos> slack_of(const ChannelSpec& spec, const HopReport& hop, const EndToEnd& e2e,
+                              std::size_t can_hops) {
   if (spec.cls != ChannelClass::hrt || !spec.reaction_time || !hop.latency || !e2e.latency) return std::nullopt;
   Nanos end_to_end = *spec.reaction_time - *e2e.latency;
   if (spec.temp_validity) end_to_end = std::min(end_to_end, *spec.temp_validity - *e2e.latency - Nanos(1));
-  const Nanos slack = std::min(*spec.reaction_time - *hop.latency, end_to_end / static_cast<std::int64_t>(std::max<std::size_t>(1, can_hops)));
+  const Nanos slack = std::min(*spec.reaction_time - *hop.latency,
+                               end_to_end / static_cast<std::int64_t>(std::max<std::size_t>(1, can_hops)));
   if (slack < Nanos(0)) return std::nullopt;
   return slack;
 }
 
 // The frames a bound channel's CAN hop puts on the bus: one stream per hop, an event of n
 // fragments counted as n frames per period (the same load; the spacing is the sender's).
-std::optional<AnnouncedFrame> frame_of(const ChannelSpec& spec, const HopReport& hop, const EndToEnd& e2e, std::size_t can_hops) {
+std::optional<AnnouncedFrame> frame_of(const ChannelSpec& spec, const HopReport& hop, const EndToEnd& e2e,
+                                       std::size_t can_hops) {
   if (!hop.can || !spec.period || spec.period->count() <= 0) return std::nullopt;
   const auto frames = std::max<std::uint32_t>(1, hop.can->frames_per_event);
   AnnouncedFrame f;
@@ -96,7 +99,8 @@ Announcement announcement_of(const GatewayIdentity& self, const KnowledgeBase& k
       a.channels.push_back(channel_of(channel, *spec));
       a.channels.back().violated = violated.count(channel.name) > 0;
     }
-    const auto can_hops = static_cast<std::size_t>(std::count_if(channel.hops.begin(), channel.hops.end(), [](const HopReport& h) { return h.can.has_value(); }));
+    const auto can_hops = static_cast<std::size_t>(
+        std::count_if(channel.hops.begin(), channel.hops.end(), [](const HopReport& h) { return h.can.has_value(); }));
     for (const HopReport& hop : channel.hops) {
       const auto frame = frame_of(*spec, hop, channel.end_to_end, can_hops);
       if (!frame) continue;

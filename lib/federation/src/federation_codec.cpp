@@ -27,29 +27,49 @@ const char* role_text(HopRole role) { return role == HopRole::publisher ? "publi
 Json nanos_or_null(const std::optional<Nanos>& value) { return value ? Json(value->count()) : Json(nullptr); }
 
 Json frame_json(const AnnouncedFrame& f) {
-  return {{"channel", f.channel}, {"can_id", f.can_id}, {"extended", f.extended}, {"length", f.length},
-          {"period_ns", f.period.count()}, {"jitter_ns", f.jitter.count()}, {"deadline_ns", nanos_or_null(f.deadline)}};
+  return {{"channel", f.channel},
+          {"can_id", f.can_id},
+          {"extended", f.extended},
+          {"length", f.length},
+          {"period_ns", f.period.count()},
+          {"jitter_ns", f.jitter.count()},
+          {"deadline_ns", nanos_or_null(f.deadline)}};
 }
 
 Json segment_json(const AnnouncedSegment& s) {
   Json frames = Json::array();
   for (const auto& f : s.frames) frames.push_back(frame_json(f));
-  return {{"name", s.name}, {"type", to_string(s.type)}, {"network", s.network}, {"max_utilization", s.max_utilization},
-          {"load", s.load}, {"reserved_bps", s.reserved_bps}, {"frames", frames}};
+  return {{"name", s.name},       {"type", to_string(s.type)},
+          {"network", s.network}, {"max_utilization", s.max_utilization},
+          {"load", s.load},       {"reserved_bps", s.reserved_bps},
+          {"frames", frames}};
 }
 
 Json channel_json(const AnnouncedChannel& c) {
   Json hops = Json::array();
-  for (const auto& h : c.hops) hops.push_back({{"segment", h.segment}, {"role", role_text(h.role)}, {"latency_ns", nanos_or_null(h.latency)}});
+  for (const auto& h : c.hops)
+    hops.push_back({{"segment", h.segment}, {"role", role_text(h.role)}, {"latency_ns", nanos_or_null(h.latency)}});
   Json upstream = Json::array();
   for (const auto& h : c.upstream) {
-    upstream.push_back({{"gateway", h.gateway}, {"gateway_id", gateway_id_text(h.gateway_id)}, {"segment", h.segment},
-                        {"role", role_text(h.role)}, {"latency_ns", nanos_or_null(h.latency)}});
+    upstream.push_back({{"gateway", h.gateway},
+                        {"gateway_id", gateway_id_text(h.gateway_id)},
+                        {"segment", h.segment},
+                        {"role", role_text(h.role)},
+                        {"latency_ns", nanos_or_null(h.latency)}});
   }
-  return {{"name", c.name}, {"subject", c.subject}, {"class", to_string(c.cls)}, {"verdict", to_string(c.verdict)},
-          {"hops", hops}, {"end_to_end_ns", nanos_or_null(c.end_to_end)}, {"period_ns", nanos_or_null(c.period)},
-          {"reaction_time_ns", nanos_or_null(c.reaction_time)}, {"temp_validity_ns", nanos_or_null(c.temp_validity)},
-          {"payload", c.payload}, {"upstream", upstream}, {"upstream_ns", nanos_or_null(c.upstream_age)}, {"violated", c.violated}};
+  return {{"name", c.name},
+          {"subject", c.subject},
+          {"class", to_string(c.cls)},
+          {"verdict", to_string(c.verdict)},
+          {"hops", hops},
+          {"end_to_end_ns", nanos_or_null(c.end_to_end)},
+          {"period_ns", nanos_or_null(c.period)},
+          {"reaction_time_ns", nanos_or_null(c.reaction_time)},
+          {"temp_validity_ns", nanos_or_null(c.temp_validity)},
+          {"payload", c.payload},
+          {"upstream", upstream},
+          {"upstream_ns", nanos_or_null(c.upstream_age)},
+          {"violated", c.violated}};
 }
 
 // Reads one announcement; the first problem throws Refusal (caught by decode_announcement only).
@@ -69,10 +89,12 @@ class Reader {
     const Json& v = field(object, key, where);
     if (!v.is_string()) throw Refusal{where + "." + key + " is not a string"};
     const auto& s = v.get_ref<const std::string&>();
-    if (s.size() > kMaxAnnouncedName) throw Refusal{where + "." + key + " is longer than " + std::to_string(kMaxAnnouncedName) + " characters"};
+    if (s.size() > kMaxAnnouncedName)
+      throw Refusal{where + "." + key + " is longer than " + std::to_string(kMaxAnnouncedName) + " characters"};
     if (s.empty() && !may_be_empty) throw Refusal{where + "." + key + " is empty"};
     for (const char c : s) {
-      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) throw Refusal{where + "." + key + " holds a control character"};
+      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+        throw Refusal{where + "." + key + " holds a control character"};
     }
     return s;
   }
@@ -96,10 +118,13 @@ class Reader {
     const Json& v = field(object, key, where);
     if (!v.is_number()) throw Refusal{where + "." + key + " is not a number"};
     const double d = v.get<double>();
-    if (!std::isfinite(d) || d < 0 || d > max) throw Refusal{where + "." + key + " is outside 0.." + format_number(max)};
+    if (!std::isfinite(d) || d < 0 || d > max)
+      throw Refusal{where + "." + key + " is outside 0.." + format_number(max)};
     return d;
   }
-  double ratio(const Json& object, const char* key, const std::string& where) const { return number(object, key, where, 1); }
+  double ratio(const Json& object, const char* key, const std::string& where) const {
+    return number(object, key, where, 1);
+  }
   bool flag(const Json& object, const char* key, const std::string& where) const {
     const Json& v = field(object, key, where);
     if (!v.is_boolean()) throw Refusal{where + "." + key + " is not true or false"};
@@ -108,11 +133,14 @@ class Reader {
   const Json& list(const Json& object, const char* key, const std::string& where, std::size_t max) const {
     const Json& v = field(object, key, where);
     if (!v.is_array()) throw Refusal{where + "." + key + " is not a list"};
-    if (v.size() > max) throw Refusal{where + "." + key + " has " + std::to_string(v.size()) + " entries, more than " + std::to_string(max)};
+    if (v.size() > max)
+      throw Refusal{where + "." + key + " has " + std::to_string(v.size()) + " entries, more than " +
+                    std::to_string(max)};
     return v;
   }
   template <typename Enum>
-  Enum choice(const Json& object, const char* key, const std::string& where, std::initializer_list<std::pair<const char*, Enum>> values) const {
+  Enum choice(const Json& object, const char* key, const std::string& where,
+              std::initializer_list<std::pair<const char*, Enum>> values) const {
     const std::string s = text(object, key, where, false);
     for (const auto& [name, value] : values) {
       if (s == name) return value;
@@ -139,14 +167,17 @@ AnnouncedFrame read_frame(const Reader& r, const Json& j, const std::string& whe
 AnnouncedSegment read_segment(const Reader& r, const Json& j, const std::string& where) {
   AnnouncedSegment s;
   s.name = r.text(j, "name", where, false);
-  s.type = r.choice<SegmentType>(j, "type", where, {{"can", SegmentType::can}, {"dds", SegmentType::dds}, {"lcm", SegmentType::lcm}});
+  s.type = r.choice<SegmentType>(j, "type", where,
+                                 {{"can", SegmentType::can}, {"dds", SegmentType::dds}, {"lcm", SegmentType::lcm}});
   s.network = r.text(j, "network", where, true);
   s.max_utilization = r.ratio(j, "max_utilization", where);
   s.load = r.ratio(j, "load", where);
   s.reserved_bps = r.number(j, "reserved_bps", where, kMaxAnnouncedBitsPerSecond);
   const Json& frames = r.list(j, "frames", where, kMaxAnnouncedFrames);
-  if (s.type != SegmentType::can && !frames.empty()) throw Refusal{where + ".frames is not empty on a " + to_string(s.type) + " segment"};
-  for (std::size_t i = 0; i < frames.size(); ++i) s.frames.push_back(read_frame(r, frames[i], where + ".frames[" + std::to_string(i) + "]"));
+  if (s.type != SegmentType::can && !frames.empty())
+    throw Refusal{where + ".frames is not empty on a " + to_string(s.type) + " segment"};
+  for (std::size_t i = 0; i < frames.size(); ++i)
+    s.frames.push_back(read_frame(r, frames[i], where + ".frames[" + std::to_string(i) + "]"));
   return s;
 }
 
@@ -173,8 +204,10 @@ AnnouncedChannel read_channel(const Reader& r, const Json& j, const std::string&
   AnnouncedChannel c;
   c.name = r.text(j, "name", where, false);
   c.subject = r.whole(j, "subject", where, UINT64_MAX);
-  c.cls = r.choice<ChannelClass>(j, "class", where, {{"hrt", ChannelClass::hrt}, {"srt", ChannelClass::srt}, {"nrt", ChannelClass::nrt}});
-  c.verdict = r.choice<Verdict>(j, "verdict", where, {{"bound", Verdict::bound}, {"degraded", Verdict::degraded}, {"failed", Verdict::failed}});
+  c.cls = r.choice<ChannelClass>(j, "class", where,
+                                 {{"hrt", ChannelClass::hrt}, {"srt", ChannelClass::srt}, {"nrt", ChannelClass::nrt}});
+  c.verdict = r.choice<Verdict>(
+      j, "verdict", where, {{"bound", Verdict::bound}, {"degraded", Verdict::degraded}, {"failed", Verdict::failed}});
   const Json& hops = r.list(j, "hops", where, kMaxAnnouncedHops);
   for (std::size_t i = 0; i < hops.size(); ++i) {
     const std::string at = where + ".hops[" + std::to_string(i) + "]";
@@ -205,7 +238,6 @@ AnnouncedChannel read_channel(const Reader& r, const Json& j, const std::string&
   return c;
 }
 
-
 Announcement read_announcement(const Json& j) {
   const Reader r;
   if (r.text(j, "format", "announcement", false) != kFederationFormat) {
@@ -217,14 +249,17 @@ Announcement read_announcement(const Json& j) {
   a.revision = r.whole(j, "revision", "announcement", UINT64_MAX);
   a.residence = r.nanos(j, "residence_ns", "announcement");
   const Json& segments = r.list(j, "segments", "announcement", kMaxAnnouncedSegments);
-  for (std::size_t i = 0; i < segments.size(); ++i) a.segments.push_back(read_segment(r, segments[i], "segments[" + std::to_string(i) + "]"));
+  for (std::size_t i = 0; i < segments.size(); ++i)
+    a.segments.push_back(read_segment(r, segments[i], "segments[" + std::to_string(i) + "]"));
   if (!r.field(j, "claim", "announcement").is_null()) {
     const Json& claim = r.list(j, "claim", "announcement", kMaxAnnouncedSegments);
     a.claim.emplace();
-    for (std::size_t i = 0; i < claim.size(); ++i) a.claim->push_back(read_segment(r, claim[i], "claim[" + std::to_string(i) + "]"));
+    for (std::size_t i = 0; i < claim.size(); ++i)
+      a.claim->push_back(read_segment(r, claim[i], "claim[" + std::to_string(i) + "]"));
   }
   const Json& channels = r.list(j, "channels", "announcement", kMaxAnnouncedChannels);
-  for (std::size_t i = 0; i < channels.size(); ++i) a.channels.push_back(read_channel(r, channels[i], "channels[" + std::to_string(i) + "]"));
+  for (std::size_t i = 0; i < channels.size(); ++i)
+    a.channels.push_back(read_channel(r, channels[i], "channels[" + std::to_string(i) + "]"));
   return a;
 }
 
@@ -246,15 +281,22 @@ std::string encode(const Announcement& a) {
     claim = Json::array();
     for (const auto& s : *a.claim) claim.push_back(segment_json(s));
   }
-  const Json j = {{"format", kFederationFormat}, {"gateway", gateway_id_text(a.gateway)}, {"name", a.name},
-                  {"revision", a.revision}, {"residence_ns", a.residence.count()}, {"segments", segments}, {"channels", channels},
+  const Json j = {{"format", kFederationFormat},
+                  {"gateway", gateway_id_text(a.gateway)},
+                  {"name", a.name},
+                  {"revision", a.revision},
+                  {"residence_ns", a.residence.count()},
+                  {"segments", segments},
+                  {"channels", channels},
                   {"claim", claim}};
   return j.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
 DecodedAnnouncement decode_announcement(std::string_view text) {
-  if (text.size() > kMaxAnnouncementBytes) return {std::nullopt, "announcement of " + std::to_string(text.size()) + " bytes, more than 1 MiB"};
-  if (!json_nesting_within(text, kMaxNesting)) return {std::nullopt, "announcement nests deeper than " + std::to_string(kMaxNesting) + " levels"};
+  if (text.size() > kMaxAnnouncementBytes)
+    return {std::nullopt, "announcement of " + std::to_string(text.size()) + " bytes, more than 1 MiB"};
+  if (!json_nesting_within(text, kMaxNesting))
+    return {std::nullopt, "announcement nests deeper than " + std::to_string(kMaxNesting) + " levels"};
   const Json j = Json::parse(text, nullptr, false);
   if (j.is_discarded()) return {std::nullopt, "announcement is not JSON"};
   try {

@@ -25,8 +25,9 @@ void merge_heaviest(CanBackgroundFrame& kept, const CanBackgroundFrame& other) {
 // The path `channel` gives its events before the networks it sends them onto: its upstream, its
 // own publisher hops, and the age its events leave it with.
 UpstreamPath path_before(const Announcement& peer, const AnnouncedChannel& channel) {
-  UpstreamPath path{peer.name, channel.name, channel.subject, channel.cls, channel.period, channel.reaction_time,
-                    channel.temp_validity, channel.payload, channel.upstream, channel.upstream_age, channel.violated};
+  UpstreamPath path{peer.name,        channel.name,          channel.subject,       channel.cls,
+                    channel.period,   channel.reaction_time, channel.temp_validity, channel.payload,
+                    channel.upstream, channel.upstream_age,  channel.violated};
   Nanos slowest{0};
   for (const AnnouncedHop& hop : channel.hops) {
     if (hop.role != HopRole::publisher) continue;
@@ -66,9 +67,12 @@ const std::string* network_of(const Announcement& peer, const std::string& segme
 
 const char* to_string(PeerState value) {
   switch (value) {
-    case PeerState::alive: return "alive";
-    case PeerState::lost: return "lost";
-    case PeerState::left: return "left";
+    case PeerState::alive:
+      return "alive";
+    case PeerState::lost:
+      return "lost";
+    case PeerState::left:
+      return "left";
   }
   return "?";
 }
@@ -102,9 +106,11 @@ std::string FederationView::cheap_refusal(const FederationMessage& message) {
     std::erase_if(pending_, [&](const auto& p) { return p.second.source == message.source && p.first != message.key; });
     const auto waiting = pending_.find(message.key);
     if (waiting == pending_.end() || waiting->second.source == message.source) pending_[message.key] = message;
-    return "gateway " + gateway_id_text(message.key) + " (" + it->second.announcement.name + ") is announced by another writer";
+    return "gateway " + gateway_id_text(message.key) + " (" + it->second.announcement.name +
+           ") is announced by another writer";
   }
-  if (it == peers_.end() && peers_.size() >= max_peers_) return "more than " + std::to_string(max_peers_) + " gateways in the federation";
+  if (it == peers_.end() && peers_.size() >= max_peers_)
+    return "more than " + std::to_string(max_peers_) + " gateways in the federation";
   return {};
 }
 
@@ -114,13 +120,17 @@ bool FederationView::take_announcement(const FederationMessage& message, Nanos n
   if (!decoded.announcement) return refuse(message, decoded.error, refusal);
   Announcement& a = *decoded.announcement;
   if (a.gateway != message.key) {
-    return refuse(message, "announcement of gateway " + gateway_id_text(a.gateway) + " filed under " + gateway_id_text(message.key), refusal);
+    return refuse(
+        message,
+        "announcement of gateway " + gateway_id_text(a.gateway) + " filed under " + gateway_id_text(message.key),
+        refusal);
   }
   auto it = peers_.find(a.gateway);
   if (it == peers_.end()) {
     it = peers_.emplace(a.gateway, PeerRecord{}).first;
     it->second.first_heard = now;
-  } else if (it->second.source == message.source && a.revision <= it->second.announcement.revision && it->second.state == PeerState::alive) {
+  } else if (it->second.source == message.source && a.revision <= it->second.announcement.revision &&
+             it->second.state == PeerState::alive) {
     ++counters_.stale;
     it->second.last_heard = now;
     return false;
@@ -149,9 +159,9 @@ bool FederationView::apply(const FederationMessage& message, Nanos now, std::str
     }
     return false;
   }
-  const PeerState next = message.kind == FederationMessage::Kind::alive ? PeerState::alive
+  const PeerState next = message.kind == FederationMessage::Kind::alive  ? PeerState::alive
                          : message.kind == FederationMessage::Kind::lost ? PeerState::lost
-                                                                          : PeerState::left;
+                                                                         : PeerState::left;
   peer->last_heard = now;
   if (peer->state == next || peer->state == PeerState::left) return false;  // left is final until it announces again
   peer->state = next;
@@ -168,11 +178,13 @@ bool FederationView::apply(const FederationMessage& message, Nanos now, std::str
 }
 
 std::size_t FederationView::alive_peers() const {
-  return static_cast<std::size_t>(std::count_if(peers_.begin(), peers_.end(), [](const auto& p) { return p.second.state == PeerState::alive; }));
+  return static_cast<std::size_t>(
+      std::count_if(peers_.begin(), peers_.end(), [](const auto& p) { return p.second.state == PeerState::alive; }));
 }
 
 void FederationView::forget_before(Nanos when) {
-  std::erase_if(peers_, [&](const auto& p) { return p.second.state != PeerState::alive && p.second.state_since < when; });
+  std::erase_if(peers_,
+                [&](const auto& p) { return p.second.state != PeerState::alive && p.second.state_since < when; });
   std::erase_if(pending_, [&](const auto& p) { return !peers_.count(p.first); });
 }
 
@@ -189,14 +201,16 @@ bool FederationView::shared(const std::string& network) const {
 
 PeerNetworks FederationView::reservations() const {
   PeerNetworks out;
-  std::map<std::string, std::map<std::pair<std::uint32_t, bool>, CanBackgroundFrame>> frames;  // by network, by identifier
-  std::map<std::string, std::map<std::uint64_t, UpstreamPath>> senders;                         // by network, by subject
+  std::map<std::string, std::map<std::pair<std::uint32_t, bool>, CanBackgroundFrame>>
+      frames;                                                            // by network, by identifier
+  std::map<std::string, std::map<std::uint64_t, UpstreamPath>> senders;  // by network, by subject
   for (const auto& [id, peer] : peers_) {
     if (peer.state != PeerState::alive) continue;
     for (const AnnouncedChannel& channel : peer.announcement.channels) {
       std::optional<UpstreamPath> path;  // built once per channel, when it sends onto a shared network
       for (const AnnouncedHop& hop : channel.hops) {
-        const std::string* network = hop.role == HopRole::subscriber ? network_of(peer.announcement, hop.segment) : nullptr;
+        const std::string* network =
+            hop.role == HopRole::subscriber ? network_of(peer.announcement, hop.segment) : nullptr;
         if (!network) continue;
         if (!path) path = path_before(peer.announcement, channel);
         if (loops(*path, self_)) break;
@@ -211,8 +225,14 @@ PeerNetworks FederationView::reservations() const {
       PeerReservations& r = out[theirs.network];
       r.bits_per_second += theirs.reserved_bps;
       for (const AnnouncedFrame& f : theirs.frames) {
-        CanBackgroundFrame frame{peer.announcement.name + ":" + f.channel, f.can_id, f.extended, f.length, f.period, f.jitter,
-                                 "gateway " + peer.announcement.name + " (" + gateway_id_text(id) + ")", f.deadline};
+        CanBackgroundFrame frame{peer.announcement.name + ":" + f.channel,
+                                 f.can_id,
+                                 f.extended,
+                                 f.length,
+                                 f.period,
+                                 f.jitter,
+                                 "gateway " + peer.announcement.name + " (" + gateway_id_text(id) + ")",
+                                 f.deadline};
         const auto [kept, fresh] = frames[theirs.network].emplace(std::make_pair(f.can_id, f.extended), frame);
         if (!fresh) merge_heaviest(kept->second, frame);
       }

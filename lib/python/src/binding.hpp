@@ -49,7 +49,11 @@ class ClientState;
 struct ChannelState {
   ChannelState(ClientState& owner, cosmic_channel* channel_handle, std::string channel_name, std::uint32_t max_payload,
                int channel_roles)
-      : client(owner), handle(channel_handle), name(std::move(channel_name)), payload(max_payload), roles(channel_roles) {}
+      : client(owner),
+        handle(channel_handle),
+        name(std::move(channel_name)),
+        payload(max_payload),
+        roles(channel_roles) {}
 
   ClientState& client;
   cosmic_channel* handle;  // freed by cosmic_close()

@@ -15,7 +15,8 @@ namespace cosmic::python {
 namespace {
 
 Event make_event(const cosmic_event_info& info, const std::uint8_t* data, const std::string& channel) {
-  return Event{py::bytes(reinterpret_cast<const char*>(data), info.size), info.subject, info.sequence, info.age_ns, channel};
+  return Event{py::bytes(reinterpret_cast<const char*>(data), info.size), info.subject, info.sequence, info.age_ns,
+               channel};
 }
 
 bool interpreter_finalizing() {
@@ -46,8 +47,8 @@ class ContiguousBuffer {
 void require_role(const ChannelRef& self, int role, const char* call) {
   if (self.channel->roles & role) return;
   const char* has = role == COSMIC_PUBLISH ? "subscribe" : "publish";
-  raise_error(COSMIC_E_INVALID, std::string(call) + " on channel '" + self.channel->name + "', which was announced to " + has +
-                                    " only (announce it with roles that include " +
+  raise_error(COSMIC_E_INVALID, std::string(call) + " on channel '" + self.channel->name +
+                                    "', which was announced to " + has + " only (announce it with roles that include " +
                                     (role == COSMIC_PUBLISH ? "PUBLISH" : "SUBSCRIBE") + ")");
 }
 
@@ -56,8 +57,9 @@ void require_role(const ChannelRef& self, int role, const char* call) {
 void refuse_inside_other_callback(const ChannelRef& self, const char* call) {
   const RunningCallback& running = running_callback();
   if (running.channel && running.channel != self.channel) {
-    raise_error(COSMIC_E_INVALID, std::string(call) + " of channel '" + self.channel->name + "' from inside the callback of channel '" +
-                                      running.channel->name + "' (only a callback's own channel may be changed there)");
+    raise_error(COSMIC_E_INVALID, std::string(call) + " of channel '" + self.channel->name +
+                                      "' from inside the callback of channel '" + running.channel->name +
+                                      "' (only a callback's own channel may be changed there)");
   }
 }
 
@@ -80,7 +82,7 @@ void subscribe(const ChannelRef& self, py::object callback) {
   if (!PyCallable_Check(callback.ptr())) throw py::type_error("subscribe(): the callback must be callable");
   refuse_inside_other_callback(self, "subscribe()");
   ClientState::Use use(*self.client, "subscribe()");
-  self.channel->callback = std::move(callback);  // the next event sees it
+  self.channel->callback = std::move(callback);            // the next event sees it
   if (running_callback().channel == self.channel) return;  // takes effect when the running callback returns
   py::gil_scoped_release nogil;
   // Waits for a callback in progress (it may be the previous one): once this returns, the
@@ -107,8 +109,9 @@ void unsubscribe(const ChannelRef& self) {
 void wait_ready(const ChannelRef& self, double timeout) {
   if (!(timeout >= 0)) raise_error(COSMIC_E_INVALID, "wait_ready(): timeout must be >= 0 seconds");
   if (running_callback().channel) {
-    raise_error(COSMIC_E_INVALID, "wait_ready() of channel '" + self.channel->name + "' from inside the callback of channel '" +
-                                      running_callback().channel->name + "' (it would hold up the receive thread)");
+    raise_error(COSMIC_E_INVALID, "wait_ready() of channel '" + self.channel->name +
+                                      "' from inside the callback of channel '" + running_callback().channel->name +
+                                      "' (it would hold up the receive thread)");
   }
   ClientState::Use use(*self.client, "wait_ready()");
   const double ms = std::round(timeout * 1e3);
@@ -144,9 +147,10 @@ py::object get_event(const ChannelRef& self, std::optional<double> timeout) {
     return e ? py::cast(make_event(e->info, e->data.data(), channel.name)) : py::none();
   }
   constexpr double kForever = 1e9;  // s (31 years): longer waits are endless, and the arithmetic cannot overflow
-  const auto deadline = timeout && *timeout < kForever
-                            ? Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(*timeout))
-                            : Clock::time_point::max();
+  const auto deadline =
+      timeout && *timeout < kForever
+          ? Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(*timeout))
+          : Clock::time_point::max();
   while (true) {
     std::optional<QueuedEvent> e;
     bool timed_out = false;
@@ -154,12 +158,14 @@ py::object get_event(const ChannelRef& self, std::optional<double> timeout) {
       py::gil_scoped_release nogil;
       std::unique_lock lock(channel.queue_mutex);
       const auto slice_end = std::min(deadline, Clock::now() + kSignalCheck);
-      channel.queue_changed.wait_until(lock, slice_end, [&] { return !channel.queue.empty() || self.client->closed(); });
+      channel.queue_changed.wait_until(lock, slice_end,
+                                       [&] { return !channel.queue.empty() || self.client->closed(); });
       e = pop(channel);
       timed_out = Clock::now() >= deadline;
     }
     if (e) return py::cast(make_event(e->info, e->data.data(), channel.name));
-    if (self.client->closed()) raise_closed("get_event() on channel '" + channel.name + "': the client was closed while waiting");
+    if (self.client->closed())
+      raise_closed("get_event() on channel '" + channel.name + "': the client was closed while waiting");
     if (timed_out) return py::none();
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();
   }
@@ -207,17 +213,22 @@ void bind_channel(py::module_& m) {
       .def_readonly("subject", &Event::subject, "The channel's 64-bit subject.")
       .def_readonly("sequence", &Event::sequence, "Per publisher, counting from 1; 0 where the source has none (CAN).")
       .def_readonly("age_ns", &Event::age_ns, "Time in transit before the last gateway forwarded it, in nanoseconds.")
-      .def_property_readonly("age", [](const Event& e) { return static_cast<double>(e.age_ns) * 1e-9; }, "age_ns in seconds.")
+      .def_property_readonly(
+          "age", [](const Event& e) { return static_cast<double>(e.age_ns) * 1e-9; }, "age_ns in seconds.")
       .def_readonly("channel", &Event::channel, "The channel's name.")
       .def("__repr__", [](const Event& e) {
-        return "<cosmic.Event channel='" + e.channel + "' subject=" + std::to_string(e.subject) + " sequence=" +
-               std::to_string(e.sequence) + " size=" + std::to_string(PyBytes_GET_SIZE(e.payload.ptr())) + ">";
+        return "<cosmic.Event channel='" + e.channel + "' subject=" + std::to_string(e.subject) +
+               " sequence=" + std::to_string(e.sequence) +
+               " size=" + std::to_string(PyBytes_GET_SIZE(e.payload.ptr())) + ">";
       });
 
-  py::class_<ChannelRef>(m, "Channel", "An announced channel; returned by Client.announce(). Valid until its client is closed.")
+  py::class_<ChannelRef>(m, "Channel",
+                         "An announced channel; returned by Client.announce(). Valid until its client is closed.")
       .def_property_readonly("name", [](const ChannelRef& c) { return c.channel->name; })
-      .def_property_readonly("payload", [](const ChannelRef& c) { return c.channel->payload; }, "Largest event in bytes.")
-      .def_property_readonly("roles", [](const ChannelRef& c) { return c.channel->roles; }, "PUBLISH | SUBSCRIBE bits.")
+      .def_property_readonly(
+          "payload", [](const ChannelRef& c) { return c.channel->payload; }, "Largest event in bytes.")
+      .def_property_readonly(
+          "roles", [](const ChannelRef& c) { return c.channel->roles; }, "PUBLISH | SUBSCRIBE bits.")
       .def_property_readonly("segment", [](const ChannelRef& c) { return c.client->segment(); })
       .def("publish", &publish, "data"_a, R"doc(
 Publishes one event: bytes or any C-contiguous buffer-protocol object (bytearray, memoryview, a
@@ -247,7 +258,8 @@ The oldest queued event, or None when none arrived within `timeout` seconds (0: 
 polling of a fixed-step loop; None: wait until one arrives). Events are queued while no callback
 is subscribed; the newest 64 are kept. The GIL is released while waiting.)doc")
       .def("__repr__", [](const ChannelRef& c) {
-        return "<cosmic.Channel '" + c.channel->name + "' on '" + c.client->segment() + "'" + (c.client->closed() ? " (closed)" : "") + ">";
+        return "<cosmic.Channel '" + c.channel->name + "' on '" + c.client->segment() + "'" +
+               (c.client->closed() ? " (closed)" : "") + ">";
       });
 }
 

@@ -20,7 +20,8 @@ std::vector<ClientState*>& open_clients() {
 // cosmic_open() and cosmic_announce() return NULL without a code, only a reason; the reasons the
 // library gives for bad input (tests/python check them) are told apart from the network's refusals.
 int code_of_open_failure(const std::string& why) {
-  const bool bad_text = why.find("is none of") != std::string::npos || why.find("unknown DDS option") != std::string::npos;
+  const bool bad_text =
+      why.find("is none of") != std::string::npos || why.find("unknown DDS option") != std::string::npos;
   return bad_text ? COSMIC_E_INVALID : COSMIC_E_TRANSPORT;
 }
 
@@ -60,8 +61,9 @@ ClientState::~ClientState() {
 
 void ClientState::close() {
   if (running_callback().client == this) {
-    raise_error(COSMIC_E_INVALID, "close() from inside a callback of the same client (it would wait for itself); "
-                                  "close it from another thread, or after the callback returned");
+    raise_error(COSMIC_E_INVALID,
+                "close() from inside a callback of the same client (it would wait for itself); "
+                "close it from another thread, or after the callback returned");
   }
   if (closed_.exchange(true)) return;
   for (auto& channel : channels_) {  // wake get_event() waiters: they see the client closed
@@ -146,8 +148,9 @@ ChannelRef announce(const std::shared_ptr<ClientState>& client, const std::strin
                     std::uint32_t omission_degree, std::uint32_t payload, int roles, int timeout_ms) {
   if (cls < COSMIC_HRT || cls > COSMIC_NRT) raise_error(COSMIC_E_INVALID, "class must be 0 (hrt), 1 (srt) or 2 (nrt)");
   ClientState::Use use(*client, "announce()");
-  const cosmic_channel_desc desc{name.c_str(),    subject,         static_cast<cosmic_class>(cls), period_ns, reaction_time_ns,
-                                 temp_validity_ns, omission_degree, payload,                        roles};
+  const cosmic_channel_desc desc{name.c_str(),    subject,          static_cast<cosmic_class>(cls),
+                                 period_ns,       reaction_time_ns, temp_validity_ns,
+                                 omission_degree, payload,          roles};
   cosmic_channel* handle = nullptr;
   {
     py::gil_scoped_release nogil;  // CAN waits up to timeout_ms for the gateway's etag

@@ -62,7 +62,8 @@ std::string check_channel(const std::string& socket, const std::string& name) {
   }
   if (rc != COSMIC_OK) raise_error(rc, "check_channel('" + name + "') at " + socket + ": " + verdict);
   if (std::string(verdict) == "not_found") {
-    raise_error(COSMIC_E_UNBOUND, "check_channel('" + name + "') at " + socket + ": the gateway does not know the channel (not_found)");
+    raise_error(COSMIC_E_UNBOUND,
+                "check_channel('" + name + "') at " + socket + ": the gateway does not know the channel (not_found)");
   }
   return verdict;
 }

@@ -19,7 +19,8 @@ void raise_error(int code, const std::string& message) {
 }
 
 void raise_closed(const std::string& what) {
-  py::object error = py::module_::import("cosmic._errors").attr("ClosedError")(static_cast<int>(COSMIC_E_INVALID), what);
+  py::object error =
+      py::module_::import("cosmic._errors").attr("ClosedError")(static_cast<int>(COSMIC_E_INVALID), what);
   PyErr_SetObject(reinterpret_cast<PyObject*>(Py_TYPE(error.ptr())), error.ptr());
   throw py::error_already_set();
 }

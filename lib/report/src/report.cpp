@@ -21,11 +21,12 @@ nlohmann::json seconds_or_null(const std::optional<Nanos>& value) {
 
 nlohmann::json to_json(const Check& check) {
   return {{"check", check.check}, {"value", number_or_null(check.value)}, {"limit", number_or_null(check.limit)},
-          {"unit", check.unit},   {"relation", check.relation},             {"ok", check.ok}};
+          {"unit", check.unit},   {"relation", check.relation},           {"ok", check.ok}};
 }
 
 nlohmann::json to_json(const HopReport& hop) {
-  nlohmann::json out{{"segment", hop.segment}, {"role", to_string(hop.role)}, {"latency_s", seconds_or_null(hop.latency)}};
+  nlohmann::json out{
+      {"segment", hop.segment}, {"role", to_string(hop.role)}, {"latency_s", seconds_or_null(hop.latency)}};
   if (hop.can) {
     const CanHopPlan& can = *hop.can;
     if (can.native) {
@@ -41,14 +42,16 @@ nlohmann::json to_json(const HopReport& hop) {
                     {"etag", can.etag}};
     }
     out["can"].update({{"frame_bytes", can.frame_bytes},
-                  {"frames_per_event", can.frames_per_event},
-                  {"transmission_time_s", to_seconds(can.transmission)},
-                  {"jitter_s", to_seconds(can.jitter)},
+                       {"frames_per_event", can.frames_per_event},
+                       {"transmission_time_s", to_seconds(can.transmission)},
+                       {"jitter_s", to_seconds(can.jitter)},
                        {"response_time_s", seconds_or_null(can.response_time)}});
-    if (!can.native && can.profile == CanProfile::famouso) out["can"]["fragment"] = decode_famouso_id(can.can_id).fragment;
+    if (!can.native && can.profile == CanProfile::famouso)
+      out["can"]["fragment"] = decode_famouso_id(can.can_id).fragment;
   }
   if (hop.dds) {
-    out["dds"] = {{"topic", hop.dds->topic}, {"type", hop.dds->type}, {"layout", hop.dds->native ? "native" : "envelope"}};
+    out["dds"] = {
+        {"topic", hop.dds->topic}, {"type", hop.dds->type}, {"layout", hop.dds->native ? "native" : "envelope"}};
     if (hop.dds->native) out["dds"]["representation"] = to_string(hop.dds->representation);
   }
   out["checks"] = nlohmann::json::array();
@@ -56,14 +59,15 @@ nlohmann::json to_json(const HopReport& hop) {
   if (!hop.background.empty()) {
     out["background"] = nlohmann::json::array();
     for (const auto& d : hop.background) {
-      out["background"].push_back({{"name", d.name}, {"can_id", d.can_id}, {"extended", d.extended},
-                                   {"delay_s", to_seconds(d.delay)}, {"kind", d.blocking ? "blocking" : "interference"}});
+      out["background"].push_back({{"name", d.name},
+                                   {"can_id", d.can_id},
+                                   {"extended", d.extended},
+                                   {"delay_s", to_seconds(d.delay)},
+                                   {"kind", d.blocking ? "blocking" : "interference"}});
     }
   }
   return out;
 }
-
-
 
 std::string check_value_text(const Check& check) {
   if (check.unit == "s") return format_seconds(check.value);
@@ -95,13 +99,14 @@ std::string can_identifier_text(const CanHopPlan& plan) {
     std::snprintf(text, sizeof text, plan.extended ? "0x%08X (native, extended)" : "0x%03X (native, standard)", can_id);
   } else if (plan.profile == CanProfile::famouso) {
     const FamousoIdentifier id = decode_famouso_id(can_id);
-    std::snprintf(text, sizeof text, "0x%08X (FAMOUSO layout: priority 0x%02X, fragment %d, TxNode %u, etag %u)", can_id,
-                  static_cast<unsigned>(id.priority), id.fragment ? 1 : 0, static_cast<unsigned>(id.tx_node),
+    std::snprintf(text, sizeof text, "0x%08X (FAMOUSO layout: priority 0x%02X, fragment %d, TxNode %u, etag %u)",
+                  can_id, static_cast<unsigned>(id.priority), id.fragment ? 1 : 0, static_cast<unsigned>(id.tx_node),
                   static_cast<unsigned>(id.etag));
   } else {
     const CanIdentifier id = decode_can_id(can_id);
     std::snprintf(text, sizeof text, "0x%08X (priority 0x%02X, TxNode %u, etag %u)", can_id,
-                  static_cast<unsigned>(id.priority), static_cast<unsigned>(id.tx_node), static_cast<unsigned>(id.etag));
+                  static_cast<unsigned>(id.priority), static_cast<unsigned>(id.tx_node),
+                  static_cast<unsigned>(id.etag));
   }
   return text;
 }
@@ -111,7 +116,9 @@ std::string pad_column(const std::string& text, std::size_t width) {
 }
 
 nlohmann::json to_json(const ChannelReport& channel) {
-  nlohmann::json out{{"name", channel.name}, {"class", to_string(channel.cls)}, {"verdict", to_string(channel.verdict)},
+  nlohmann::json out{{"name", channel.name},
+                     {"class", to_string(channel.cls)},
+                     {"verdict", to_string(channel.verdict)},
                      {"reasons", channel.reasons}};
   out["hops"] = nlohmann::json::array();
   for (const auto& hop : channel.hops) {
@@ -123,7 +130,9 @@ nlohmann::json to_json(const ChannelReport& channel) {
     // The path on other gateways before this one's (federation): each hop names its gateway.
     out["upstream"] = nlohmann::json::array();
     for (const PathHop& hop : channel.upstream) {
-      out["upstream"].push_back({{"gateway", hop.gateway}, {"segment", hop.segment}, {"role", to_string(hop.role)},
+      out["upstream"].push_back({{"gateway", hop.gateway},
+                                 {"segment", hop.segment},
+                                 {"role", to_string(hop.role)},
                                  {"latency_s", seconds_or_null(hop.latency)}});
     }
   }
@@ -161,27 +170,37 @@ nlohmann::json to_json(const AdmissionReport& report) {
 nlohmann::json to_json(const std::vector<ConfigError>& errors) {
   nlohmann::json out = nlohmann::json::array();
   for (const auto& e : errors) {
-    out.push_back({{"file", e.file}, {"line", e.line}, {"column", e.column}, {"path", e.path}, {"message", e.message},
-                   {"valid", e.valid}, {"text", e.to_string()}});
+    out.push_back({{"file", e.file},
+                   {"line", e.line},
+                   {"column", e.column},
+                   {"path", e.path},
+                   {"message", e.message},
+                   {"valid", e.valid},
+                   {"text", e.to_string()}});
   }
   return out;
 }
 
 std::string render_text(const AdmissionReport& report) {
   std::ostringstream out;
-  out << pad_column("SEGMENT", 16) << pad_column("TYPE", 6) << pad_column("UTILIZATION", 13) << pad_column("LIMIT", 8) << "BACKGROUND\n";
+  out << pad_column("SEGMENT", 16) << pad_column("TYPE", 6) << pad_column("UTILIZATION", 13) << pad_column("LIMIT", 8)
+      << "BACKGROUND\n";
   for (const auto& s : report.segments) {
     const std::string background =
-        s.background_frames ? format_percent(s.background) + " (" + std::to_string(s.background_frames) + " frames)" : "-";
+        s.background_frames ? format_percent(s.background) + " (" + std::to_string(s.background_frames) + " frames)"
+                            : "-";
     out << pad_column(s.name, 16) << pad_column(to_string(s.type), 6) << pad_column(format_percent(s.utilization), 13)
         << pad_column(format_percent(s.max_utilization), 8) << background << "\n";
   }
-  out << "\n" << pad_column("CHANNEL", 20) << pad_column("CLASS", 6) << pad_column("VERDICT", 10) << pad_column("END-TO-END", 12) << "DETAILS\n";
+  out << "\n"
+      << pad_column("CHANNEL", 20) << pad_column("CLASS", 6) << pad_column("VERDICT", 10)
+      << pad_column("END-TO-END", 12) << "DETAILS\n";
   for (const auto& c : report.channels) {
     const std::string e2e = c.end_to_end.latency ? format_duration(*c.end_to_end.latency) : "unbounded";
     std::string details;
     if (c.end_to_end.reaction_time) details = "<= " + format_duration(*c.end_to_end.reaction_time) + " required";
-    out << pad_column(c.name, 20) << pad_column(to_string(c.cls), 6) << pad_column(to_string(c.verdict), 10) << pad_column(e2e, 12) << details << "\n";
+    out << pad_column(c.name, 20) << pad_column(to_string(c.cls), 6) << pad_column(to_string(c.verdict), 10)
+        << pad_column(e2e, 12) << details << "\n";
     for (const auto& reason : c.reasons) out << "    - " << reason << "\n";
   }
   std::size_t bound = 0;
@@ -207,8 +226,8 @@ std::string render_channel_text(const ChannelReport& channel) {
   for (const auto& hop : channel.hops) {
     out << "  " << to_string(hop.role) << " " << hop.segment;
     if (hop.can) {
-      out << "  id " << can_identifier_text(*hop.can) << " C "
-          << format_duration(hop.can->transmission) << " x" << hop.can->frames_per_event;
+      out << "  id " << can_identifier_text(*hop.can) << " C " << format_duration(hop.can->transmission) << " x"
+          << hop.can->frames_per_event;
     }
     if (hop.dds) out << "  topic " << hop.dds->topic << " type " << hop.dds->type;
     out << "\n";
@@ -220,7 +239,8 @@ std::string render_channel_text(const ChannelReport& channel) {
   const EndToEnd& e2e = channel.end_to_end;
   out << "  end-to-end " << (e2e.latency ? format_duration(*e2e.latency) : std::string("unbounded"));
   if (!channel.upstream.empty()) {
-    out << " (" << (e2e.upstream ? format_duration(*e2e.upstream) : std::string("unbounded")) << " before this gateway)";
+    out << " (" << (e2e.upstream ? format_duration(*e2e.upstream) : std::string("unbounded"))
+        << " before this gateway)";
   }
   if (e2e.reaction_time) out << ", reaction_time " << format_duration(*e2e.reaction_time);
   if (e2e.temp_validity) out << ", temp_validity " << format_duration(*e2e.temp_validity);

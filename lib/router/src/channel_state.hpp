@@ -29,7 +29,8 @@ struct ChannelState {
   PiMutex policy_mutex;  // guards bucket, dedup and loop_guard (ingress threads of several segments)
   TokenBucket bucket COSMIC_GUARDED_BY(policy_mutex);
   DuplicateFilter dedup COSMIC_GUARDED_BY(policy_mutex);
-  RawLoopGuard loop_guard COSMIC_GUARDED_BY(policy_mutex);  // raw LCM channels: their events carry no origin to cut loops by
+  RawLoopGuard loop_guard
+      COSMIC_GUARDED_BY(policy_mutex);    // raw LCM channels: their events carry no origin to cut loops by
   std::vector<SegmentCounters> counters;  // indexed by segment slot
   std::vector<EgressStats> egress;        // parallel to route.subscribers
   LatencyHistogram residence;             // over every egress hop

@@ -165,7 +165,8 @@ std::int64_t saturating_add(std::int64_t a, std::int64_t b) {
 
 std::optional<OutboundEvent> EgressLane::still_wanted(LaneItem& item) noexcept {
   ChannelState& channel = *item.channel;
-  if (channel.removed.load(std::memory_order_relaxed) || channel.retired_egress[segment_].load(std::memory_order_relaxed) ||
+  if (channel.removed.load(std::memory_order_relaxed) ||
+      channel.retired_egress[segment_].load(std::memory_order_relaxed) ||
       item.generation != current_generation_.load(std::memory_order_acquire)) {
     discard(item);
     return std::nullopt;
@@ -175,7 +176,8 @@ std::optional<OutboundEvent> EgressLane::still_wanted(LaneItem& item) noexcept {
   const Nanos age(saturating_add(item.header.age_ns, waited.count()));
   if (spec.temp_validity && age >= *spec.temp_validity) {
     channel.counters[segment_].drop(DropReason::expired);
-    if (spec.reaction_time && age > *spec.reaction_time) channel.egress[item.hop].deadline_miss.fetch_add(1, std::memory_order_relaxed);
+    if (spec.reaction_time && age > *spec.reaction_time)
+      channel.egress[item.hop].deadline_miss.fetch_add(1, std::memory_order_relaxed);
     discard(item);
     return std::nullopt;
   }
@@ -201,7 +203,8 @@ void EgressLane::account(LaneItem& item, SendStatus status) noexcept {
   const Nanos residence = context_.clock() - item.received;
   hop.residence.record(residence);
   channel.residence.record(residence);
-  if (residence.count() > context_.residence_bound_ns.load(std::memory_order_relaxed)) hop.residence_miss.fetch_add(1, std::memory_order_relaxed);
+  if (residence.count() > context_.residence_bound_ns.load(std::memory_order_relaxed))
+    hop.residence_miss.fetch_add(1, std::memory_order_relaxed);
   if (spec.reaction_time && Nanos(saturating_add(item.header.age_ns, residence.count())) > *spec.reaction_time)
     hop.deadline_miss.fetch_add(1, std::memory_order_relaxed);
   discard(item);

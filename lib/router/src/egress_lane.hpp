@@ -30,8 +30,8 @@ namespace cosmic {
 struct LaneItem {
   std::shared_ptr<ChannelState> channel;
   PayloadBuffer* payload = nullptr;
-  EventHeader header;  // as it leaves (origin, sequence, hop count set), age as it arrived
-  Nanos received{0};   // kernel arrival, steady clock
+  EventHeader header;     // as it leaves (origin, sequence, hop count set), age as it arrived
+  Nanos received{0};      // kernel arrival, steady clock
   std::uint32_t hop = 0;  // index of this lane's segment in the channel's route.subscribers
   std::uint64_t generation = 0;
 };
@@ -56,7 +56,8 @@ class EgressLane {
   bool push(LaneItem&& item) noexcept COSMIC_EXCLUDES(mutex_);
   // Starts sending to `adapter`; with `threaded`, on a new thread run under `policy`. The lane
   // holds up to `depth` events (at least 1) from now on.
-  void activate(SegmentAdapter* adapter, const ThreadPolicy& policy, bool threaded, std::size_t depth) COSMIC_EXCLUDES(mutex_);
+  void activate(SegmentAdapter* adapter, const ThreadPolicy& policy, bool threaded, std::size_t depth)
+      COSMIC_EXCLUDES(mutex_);
   // Stops sending: joins the thread (after its send in progress) and drops what is queued.
   void deactivate() COSMIC_EXCLUDES(mutex_);
   // Without a thread: handles up to `budget` queued events now; returns how many.
@@ -87,7 +88,7 @@ class EgressLane {
   const std::size_t segment_;
   const std::size_t byte_budget_;
 
-  mutable PiMutex mutex_;  // the ring; held for moves only, never across send()
+  mutable PiMutex mutex_;                                 // the ring; held for moves only, never across send()
   std::vector<LaneItem> ring_ COSMIC_GUARDED_BY(mutex_);  // its size is the depth; sized at activation
   std::size_t head_ COSMIC_GUARDED_BY(mutex_) = 0;
   std::size_t count_ COSMIC_GUARDED_BY(mutex_) = 0;

@@ -4,26 +4,36 @@ namespace cosmic {
 
 const char* to_string(IngressFault fault) {
   switch (fault) {
-    case IngressFault::none: return "none";
-    case IngressFault::negative_age: return "negative_age";
-    case IngressFault::age_beyond_bound: return "age_beyond_bound";
-    case IngressFault::foreign_subject: return "foreign_subject";
-    case IngressFault::own_origin: return "own_origin";
-    case IngressFault::hop_limit: return "hop_limit";
-    case IngressFault::oversize: return "oversize";
+    case IngressFault::none:
+      return "none";
+    case IngressFault::negative_age:
+      return "negative_age";
+    case IngressFault::age_beyond_bound:
+      return "age_beyond_bound";
+    case IngressFault::foreign_subject:
+      return "foreign_subject";
+    case IngressFault::own_origin:
+      return "own_origin";
+    case IngressFault::hop_limit:
+      return "hop_limit";
+    case IngressFault::oversize:
+      return "oversize";
   }
   return "?";
 }
 
 DropReason drop_reason(IngressFault fault) {
   switch (fault) {
-    case IngressFault::oversize: return DropReason::oversize;
+    case IngressFault::oversize:
+      return DropReason::oversize;
     case IngressFault::own_origin:
-    case IngressFault::hop_limit: return DropReason::duplicate;
+    case IngressFault::hop_limit:
+      return DropReason::duplicate;
     case IngressFault::none:
     case IngressFault::negative_age:
     case IngressFault::age_beyond_bound:
-    case IngressFault::foreign_subject: break;
+    case IngressFault::foreign_subject:
+      break;
   }
   return DropReason::invalid;
 }

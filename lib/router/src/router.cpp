@@ -110,7 +110,8 @@ void Router::apply(std::vector<Route> routes) {
     if (existing != current->channels.end() && (*existing)->route == route) {
       next->channels.push_back(*existing);
     } else {
-      next->channels.push_back(std::make_shared<ChannelState>(std::move(route), segment_names_.size(), limits_.rate_burst));
+      next->channels.push_back(
+          std::make_shared<ChannelState>(std::move(route), segment_names_.size(), limits_.rate_burst));
       // The same channel under a changed route goes on numbering what this gateway originates:
       // a receiver's duplicate window must not take the restarted numbers for copies.
       if (existing != current->channels.end() && (*existing)->route.id == next->channels.back()->route.id) {
@@ -118,7 +119,8 @@ void Router::apply(std::vector<Route> routes) {
       }
     }
   }
-  std::sort(next->channels.begin(), next->channels.end(), [](const auto& a, const auto& b) { return a->route.id < b->route.id; });
+  std::sort(next->channels.begin(), next->channels.end(),
+            [](const auto& a, const auto& b) { return a->route.id < b->route.id; });
   for (const auto& old : current->channels) {
     const auto kept = std::lower_bound(next->channels.begin(), next->channels.end(), old->route.id,
                                        [](const auto& s, ChannelId v) { return s->route.id < v; });
@@ -244,7 +246,8 @@ void Router::problem(std::size_t segment, ChannelId channel_id, InboundProblem w
     unrouted_[segment].fetch_add(1, std::memory_order_relaxed);
     return;
   }
-  channel->counters[segment].drop(what == InboundProblem::decode_error ? DropReason::decode_error : DropReason::no_route);
+  channel->counters[segment].drop(what == InboundProblem::decode_error ? DropReason::decode_error
+                                                                       : DropReason::no_route);
 }
 
 std::size_t Router::run_once(std::size_t budget) {

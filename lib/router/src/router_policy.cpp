@@ -39,7 +39,8 @@ std::int64_t serial_distance(std::uint32_t a, std::uint32_t b) {
 }  // namespace
 
 DuplicateFilter::OriginWindow& DuplicateFilter::window_of(std::uint64_t origin, std::uint32_t sequence, bool& fresh) {
-  auto it = std::find_if(windows_.begin(), windows_.end(), [&](const OriginWindow& w) { return w.origin == origin && w.last_use != 0; });
+  auto it = std::find_if(windows_.begin(), windows_.end(),
+                         [&](const OriginWindow& w) { return w.origin == origin && w.last_use != 0; });
   fresh = it == windows_.end();
   if (fresh) {
     it = std::min_element(windows_.begin(), windows_.end(),

@@ -6,15 +6,24 @@ namespace cosmic {
 
 const char* to_string(DropReason reason) {
   switch (reason) {
-    case DropReason::expired: return "expired";
-    case DropReason::rate: return "rate";
-    case DropReason::queue_full: return "queue_full";
-    case DropReason::duplicate: return "duplicate";
-    case DropReason::decode_error: return "decode_error";
-    case DropReason::no_route: return "no_route";
-    case DropReason::send_failed: return "send_failed";
-    case DropReason::invalid: return "invalid";
-    case DropReason::oversize: return "oversize";
+    case DropReason::expired:
+      return "expired";
+    case DropReason::rate:
+      return "rate";
+    case DropReason::queue_full:
+      return "queue_full";
+    case DropReason::duplicate:
+      return "duplicate";
+    case DropReason::decode_error:
+      return "decode_error";
+    case DropReason::no_route:
+      return "no_route";
+    case DropReason::send_failed:
+      return "send_failed";
+    case DropReason::invalid:
+      return "invalid";
+    case DropReason::oversize:
+      return "oversize";
   }
   return "?";
 }

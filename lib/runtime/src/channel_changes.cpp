@@ -41,7 +41,8 @@ std::vector<std::string> definition_changes(const ChannelSpec& before, const Cha
   note("omission_degree", std::to_string(before.omission_degree), std::to_string(after.omission_degree));
   note("temp_validity", duration(before.temp_validity), duration(after.temp_validity));
   note("payload", std::to_string(before.payload) + " B", std::to_string(after.payload) + " B");
-  note("etag", before.etag ? std::to_string(*before.etag) : "assigned", after.etag ? std::to_string(*after.etag) : "assigned");
+  note("etag", before.etag ? std::to_string(*before.etag) : "assigned",
+       after.etag ? std::to_string(*after.etag) : "assigned");
   note("lcm_encoding", before.lcm_encoding == LcmEncoding::raw ? "raw" : "envelope",
        after.lcm_encoding == LcmEncoding::raw ? "raw" : "envelope");
   note("publishers", list(before.publishers), list(after.publishers));

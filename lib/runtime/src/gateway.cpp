@@ -152,8 +152,8 @@ Gateway::Refusals Gateway::configure_adapters(const std::multimap<std::string, C
         const auto same = before->second.find(segment);
         if (same != before->second.end() && same->second == reason) continue;
       }
-      log_.log(LogLevel::error, "channel " + channel + ": segment " + segment + " does not carry it: " + reason +
-                                    " (verdict failed)");
+      log_.log(LogLevel::error,
+               "channel " + channel + ": segment " + segment + " does not carry it: " + reason + " (verdict failed)");
     }
   }
   for (const auto& [channel, segments] : refused_) {
@@ -161,7 +161,8 @@ Gateway::Refusals Gateway::configure_adapters(const std::multimap<std::string, C
     const auto now = refusals.find(channel);
     for (const auto& [segment, reason] : segments) {
       if (now != refusals.end() && now->second.count(segment)) continue;
-      if (slots_.count(segment)) log_.log(LogLevel::notice, "channel " + channel + ": segment " + segment + " carries it now");
+      if (slots_.count(segment))
+        log_.log(LogLevel::notice, "channel " + channel + ": segment " + segment + " carries it now");
     }
   }
   refused_ = refusals;
@@ -243,8 +244,10 @@ BindResult Gateway::commit_plan(BindPlan plan) {
   result.channels = std::move(plan.reports);
   const auto& channels = plan.channels;
   for (auto& before : plan.replaced) {
-    const auto now = std::find_if(channels.begin(), channels.end(), [&](const ChannelSpec& c) { return c.name == before.name; });
-    std::vector<std::string> changes = now != channels.end() ? definition_changes(before, *now) : std::vector<std::string>{};
+    const auto now =
+        std::find_if(channels.begin(), channels.end(), [&](const ChannelSpec& c) { return c.name == before.name; });
+    std::vector<std::string> changes =
+        now != channels.end() ? definition_changes(before, *now) : std::vector<std::string>{};
     result.replaced.push_back(ReplacedChannel{std::move(before), std::move(changes)});
   }
   if (plan.generation != generation_) {
@@ -269,7 +272,8 @@ BindResult Gateway::commit_plan(BindPlan plan) {
     if (found == refusals.end()) continue;
     mark_refused(report);
     for (const auto& [segment, reason] : found->second) {
-      refused += (refused.empty() ? "" : "; ") + ("segment " + segment + " does not carry channel " + report.name + ": " + reason);
+      refused += (refused.empty() ? "" : "; ") +
+                 ("segment " + segment + " does not carry channel " + report.name + ": " + reason);
     }
   }
   if (!refused.empty()) {
@@ -345,14 +349,16 @@ ReloadPlan Gateway::plan_reload(Config config, std::shared_ptr<const ReloadBase>
     plan.reports.push_back(plan.kb->bind(plan.config.channels[c]).report);
   }
   const bool unchanged = from_base && plan.reused == plan.config.channels.size();
-  plan.admitted = unchanged ? std::move(base) : std::make_shared<const ReloadBase>(ReloadBase{plan.config, *plan.kb, plan.reports});
+  plan.admitted =
+      unchanged ? std::move(base) : std::make_shared<const ReloadBase>(ReloadBase{plan.config, *plan.kb, plan.reports});
   return plan;
 }
 
 const ChannelReport* Gateway::rejected_at_load(const std::string& name) const {
   if (!base_ || kb_->find_bound(name)) return nullptr;
   const auto& reports = base_->reports;
-  const auto found = std::find_if(reports.begin(), reports.end(), [&](const ChannelReport& r) { return r.name == name; });
+  const auto found =
+      std::find_if(reports.begin(), reports.end(), [&](const ChannelReport& r) { return r.name == name; });
   return found != reports.end() && found->verdict == Verdict::rejected ? &*found : nullptr;
 }
 
@@ -423,9 +429,10 @@ BindResult Gateway::commit_reload(ReloadPlan plan) {
   }
   base_ = std::move(plan.admitted);
   base_generation_ = generation_;
-  log_.log(LogLevel::notice, "configuration reloaded" + (plan.reused > 0 ? " (" + std::to_string(plan.reused) +
-                                                                                " unchanged channels kept their admission)"
-                                                                          : std::string()));
+  log_.log(LogLevel::notice,
+           "configuration reloaded" +
+               (plan.reused > 0 ? " (" + std::to_string(plan.reused) + " unchanged channels kept their admission)"
+                                : std::string()));
   result.applied = true;
   return result;
 }
@@ -464,7 +471,8 @@ std::map<std::string, std::string> Gateway::undeclared_interference() const {
     const auto slot = slots_.find(spec.name);
     if (spec.type != SegmentType::can || slot == slots_.end()) continue;
     const AdapterStatistics stats = slot->second.adapter->statistics();
-    if (std::none_of(stats.unexplained.begin(), stats.unexplained.end(), [](const auto& f) { return f.rate_hz > 0; })) continue;
+    if (std::none_of(stats.unexplained.begin(), stats.unexplained.end(), [](const auto& f) { return f.rate_hz > 0; }))
+      continue;
     if (!report) report = kb_->report();
     out.merge(cosmic::undeclared_interference(*report, spec.name, stats.unexplained));
   }
@@ -507,8 +515,10 @@ void Gateway::judge(const ChannelMisses& counted, const ChannelSpec& spec, Runti
   if (missed && track.state == RuntimeState::bound) {
     track.state = RuntimeState::violated;
     ++track.violations;
-    log_.log(LogLevel::warning, foreign ? "channel " + spec.name + " violated its admitted bounds: " + *foreign : violation_line(spec));
-  } else if (!missed && track.state == RuntimeState::violated && now - track.last_miss >= config_.gateway.clean_interval) {
+    log_.log(LogLevel::warning,
+             foreign ? "channel " + spec.name + " violated its admitted bounds: " + *foreign : violation_line(spec));
+  } else if (!missed && track.state == RuntimeState::violated &&
+             now - track.last_miss >= config_.gateway.clean_interval) {
     track.state = RuntimeState::bound;
     log_.log(LogLevel::notice, "channel " + spec.name + " is within its admitted bounds again (no miss for " +
                                    format_duration(config_.gateway.clean_interval) + ")");
@@ -532,8 +542,8 @@ std::string Gateway::violation_line(const ChannelSpec& spec) const {
 }
 
 std::size_t Gateway::violated_channels() const {
-  return static_cast<std::size_t>(std::count_if(runtime_.begin(), runtime_.end(),
-                                                [](const auto& t) { return t.second.state == RuntimeState::violated; }));
+  return static_cast<std::size_t>(std::count_if(
+      runtime_.begin(), runtime_.end(), [](const auto& t) { return t.second.state == RuntimeState::violated; }));
 }
 
 std::set<std::string> Gateway::violated_channel_names() const {
@@ -544,7 +554,9 @@ std::set<std::string> Gateway::violated_channel_names() const {
   return names;
 }
 
-std::vector<std::string> Gateway::take_thread_problems() { return router_ ? router_->take_thread_problems() : std::vector<std::string>{}; }
+std::vector<std::string> Gateway::take_thread_problems() {
+  return router_ ? router_->take_thread_problems() : std::vector<std::string>{};
+}
 
 std::optional<std::size_t> Gateway::matched_peers(const std::string& segment, const std::string& channel) const {
   const auto slot = slots_.find(segment);
@@ -579,8 +591,8 @@ std::vector<SegmentInfo> Gateway::segments() const {
   for (const auto& spec : config_.segments) {
     const auto slot = slots_.find(spec.name);
     if (slot == slots_.end()) continue;
-    SegmentInfo info{spec, slot->second.adapter->health(), slot->second.adapter->statistics(), 0, 0,
-                     router_->unrouted(slot->second.index)};
+    SegmentInfo info{spec, slot->second.adapter->health(),       slot->second.adapter->statistics(), 0,
+                     0,    router_->unrouted(slot->second.index)};
     for (std::size_t s = 0; s < loads.size() && s < hops.size(); ++s) {
       if (loads[s].name != spec.name) continue;
       info.utilization = loads[s].utilization;

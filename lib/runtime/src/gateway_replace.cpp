@@ -31,10 +31,9 @@ void Gateway::plan_replace(BindPlan& plan) {
     plan.admitted = false;
     for (const auto& channel : plan.channels) {
       const bool missing = std::find(unbound.begin(), unbound.end(), channel.name) != unbound.end();
-      plan.reports.push_back(rejected_report(channel, missing ? "channel " + channel.name +
-                                                                 " is not bound: there is nothing to replace (bind it instead)"
-                                                           : "not replaced: the replacement names channels that are not bound (" +
-                                                                 names + ")"));
+      plan.reports.push_back(rejected_report(
+          channel, missing ? "channel " + channel.name + " is not bound: there is nothing to replace (bind it instead)"
+                           : "not replaced: the replacement names channels that are not bound (" + names + ")"));
     }
     return;
   }
@@ -51,7 +50,8 @@ void Gateway::plan_replace(BindPlan& plan) {
   }
 }
 
-std::map<std::string, std::pair<ChannelSpec, ChannelId>> Gateway::take_over_ids(const std::vector<ChannelSpec>& channels) {
+std::map<std::string, std::pair<ChannelSpec, ChannelId>> Gateway::take_over_ids(
+    const std::vector<ChannelSpec>& channels) {
   std::map<std::string, std::pair<ChannelSpec, ChannelId>> previous;
   for (const auto& channel : channels) {
     const auto it = channel_ids_.find(channel.name);
@@ -131,8 +131,8 @@ std::vector<NewPublisher> Gateway::new_publishers(const BindPlan& plan) const {
     const auto before = std::find_if(plan.replaced.begin(), plan.replaced.end(),
                                      [&](const ChannelSpec& c) { return c.name == channel.name; });
     for (const auto& segment : channel.publishers) {
-      const bool kept = before != plan.replaced.end() &&
-                        std::find(before->publishers.begin(), before->publishers.end(), segment) != before->publishers.end();
+      const bool kept = before != plan.replaced.end() && std::find(before->publishers.begin(), before->publishers.end(),
+                                                                   segment) != before->publishers.end();
       if (!kept) found.push_back(NewPublisher{channel.name, segment, matched_peers(segment, channel.name)});
     }
   }
@@ -140,7 +140,8 @@ std::vector<NewPublisher> Gateway::new_publishers(const BindPlan& plan) const {
 }
 
 bool Gateway::all_matched(const std::vector<NewPublisher>& publishers) {
-  return std::all_of(publishers.begin(), publishers.end(), [](const NewPublisher& p) { return !p.matched || *p.matched > 0; });
+  return std::all_of(publishers.begin(), publishers.end(),
+                     [](const NewPublisher& p) { return !p.matched || *p.matched > 0; });
 }
 
 BindResult Gateway::switch_over(BindPlan plan, std::chrono::steady_clock::time_point prepared_at, bool timed_out) {

@@ -77,11 +77,13 @@ CalibrationPhase run_phase(const GatewaySpec& gateway, const CalibrationOptions&
   Router router(GatewayIdentity{0xCA11B, "calibrate"}, 2, router_limits(gateway));
   router.set_segment(kIngress, "in", &in);
   router.set_segment(kEgress, "out", &out);
-  std::vector<Route> routes{Route{kHrtChannel, channel("hrt", kHrtSubject, ChannelClass::hrt, options.hrt_payload),
-                                  {kIngress}, {kEgress}}};
+  std::vector<Route> routes{
+      Route{kHrtChannel, channel("hrt", kHrtSubject, ChannelClass::hrt, options.hrt_payload), {kIngress}, {kEgress}}};
   if (with_flood) {
-    routes.push_back(Route{kFloodChannel, channel("flood", kFloodSubject, ChannelClass::nrt, options.flood_payload),
-                           {kIngress}, {kEgress}});
+    routes.push_back(Route{kFloodChannel,
+                           channel("flood", kFloodSubject, ChannelClass::nrt, options.flood_payload),
+                           {kIngress},
+                           {kEgress}});
   }
   router.apply(routes);
 

@@ -138,7 +138,8 @@ TEST_F(CanAdapterTest, ABatchOfEventsLeavesInItsOrder) {
   // The one-frame events only (the fragments' count depends on the fragment layout).
   Candump dump("vcan0", "vcan0," + hex_id(steer) + ":1FFFFFFF," + hex_id(lamp) + ":1FFFFFFF", 3);
   const std::vector<std::uint8_t> one{1}, two{2}, three{3}, big(20, 0xAB), stray{9};
-  const std::vector<OutboundEvent> events{{41, {}, one}, {43, {}, two}, {42, {}, big}, {41, {}, three}, {99, {}, stray}};
+  const std::vector<OutboundEvent> events{
+      {41, {}, one}, {43, {}, two}, {42, {}, big}, {41, {}, three}, {99, {}, stray}};
   std::vector<SendStatus> results(events.size(), SendStatus::failed);
   adapter_->send_batch(events, results);
   EXPECT_EQ(results, (std::vector<SendStatus>{SendStatus::sent, SendStatus::sent, SendStatus::sent, SendStatus::sent,
@@ -216,7 +217,8 @@ using DeviceReassembly = std::function<std::optional<std::vector<std::uint8_t>>(
 
 void expect_fragmented_events_arrive(SegmentAdapter& adapter, ChannelId channel, const std::string& interface,
                                      const std::vector<std::size_t>& sizes, std::size_t frames,
-                                     const std::function<bool(const CanLine&)>& ours, const DeviceReassembly& reassemble) {
+                                     const std::function<bool(const CanLine&)>& ours,
+                                     const DeviceReassembly& reassemble) {
   Candump dump(interface, interface, static_cast<int>(frames));
   std::vector<std::vector<std::uint8_t>> sent;
   for (std::size_t i = 0; i < sizes.size(); ++i) {
@@ -239,7 +241,8 @@ void expect_fragmented_events_arrive(SegmentAdapter& adapter, ChannelId channel,
         << sizes[i] << " B";
     // Whatever follows the event is its last FD frame's padding: zeros, less than one FD length step.
     EXPECT_LT(arrived[i].size() - sizes[i], 16u);
-    EXPECT_TRUE(std::all_of(arrived[i].begin() + static_cast<long>(sizes[i]), arrived[i].end(), [](auto b) { return b == 0; }));
+    EXPECT_TRUE(
+        std::all_of(arrived[i].begin() + static_cast<long>(sizes[i]), arrived[i].end(), [](auto b) { return b == 0; }));
   }
   EXPECT_EQ(adapter.statistics().sent, frames);
   EXPECT_EQ(adapter.statistics().send_errors, 0u);
@@ -269,8 +272,9 @@ TEST_F(CanAdapterTest, FdFragmentedEventsArriveWholeAndSentCountsTheirFrames) {
   std::size_t frames = 0;
   for (const std::size_t size : sizes) frames += fragment_count(size, 64);
   ASSERT_EQ(frames, 1u + 1 + 2 + 2 + 4 + 5 + 17 + 1);
-  expect_fragmented_events_arrive(*adapter_, 51, "vcan1", sizes, frames,
-                                  [&](const CanLine& l) { return l.id == id && l.fd; }, cosmic_device(kLargest));
+  expect_fragmented_events_arrive(
+      *adapter_, 51, "vcan1", sizes, frames, [&](const CanLine& l) { return l.id == id && l.fd; },
+      cosmic_device(kLargest));
 }
 
 TEST_F(CanAdapterTest, ClassicFragmentedEventsArriveWholeAndSentCountsTheirFrames) {
@@ -282,8 +286,9 @@ TEST_F(CanAdapterTest, ClassicFragmentedEventsArriveWholeAndSentCountsTheirFrame
   std::size_t frames = 0;
   for (const std::size_t size : sizes) frames += fragment_count(size, 8);
   ASSERT_EQ(frames, 1u + 1 + 2 + 2 + 11 + 11 + 11 + 34 + 50 + 250 + 1);
-  expect_fragmented_events_arrive(*adapter_, 52, "vcan0", sizes, frames,
-                                  [&](const CanLine& l) { return l.id == id && !l.fd; }, cosmic_device(kLargest));
+  expect_fragmented_events_arrive(
+      *adapter_, 52, "vcan0", sizes, frames, [&](const CanLine& l) { return l.id == id && !l.fd; },
+      cosmic_device(kLargest));
 }
 
 // FAMOUSO's AFP: events over 8 bytes leave as AFP fragments with the identifier's fragment flag;
@@ -309,9 +314,9 @@ TEST_F(CanAdapterTest, AfpFragmentedEventsArriveWholeAndSentCountsTheirFrames) {
     if (r.outcome != famouso::AfpOutcome::complete) return std::nullopt;
     return std::vector<std::uint8_t>(r.event.begin(), r.event.end());
   };
-  expect_fragmented_events_arrive(*adapter_, 53, "vcan0", sizes, frames,
-                                  [&](const CanLine& l) { return (l.id == plain || l.id == (plain | kFamousoFragmentFlag)) && !l.fd; },
-                                  device);
+  expect_fragmented_events_arrive(
+      *adapter_, 53, "vcan0", sizes, frames,
+      [&](const CanLine& l) { return (l.id == plain || l.id == (plain | kFamousoFragmentFlag)) && !l.fd; }, device);
 }
 
 // A 1 KiB NRT event leaves as 171 classic frames in order and reassembles to the event.
@@ -559,7 +564,7 @@ TEST_F(CanAdapterTest, ReceiveBufferHoldsWhatTheBusCarriesWhileTheThreadIsHeldUp
   const std::string id = device_id(261);
   sink_.block(true);
   ASSERT_EQ(shell("cansend vcan0 " + id + "#01"), 0);
-  ASSERT_TRUE(sink_.wait_events(1, kWait));  // the receive thread now waits inside on_event
+  ASSERT_TRUE(sink_.wait_events(1, kWait));                      // the receive thread now waits inside on_event
   const std::size_t burst = receive_buffer_frames(seg.can) - 1;  // the frame being delivered is out
   ASSERT_EQ(shell("cangen vcan0 -e -I " + id + " -L 8 -D i -n " + std::to_string(burst) + " -g 0"), 0);
   sink_.block(false);
@@ -632,9 +637,9 @@ TEST_F(CanAdapterTest, ARefusedBindingLeavesTheRestFlowing) {
   ASSERT_NO_FATAL_FAILURE(open(seg, {can_binding(141, "a", 0x141, 8, HopRole::publisher, 0x30, 280, seg)}));
   ChannelBinding no_plan = can_binding(143, "noplan", 0x143, 8, HopRole::publisher, 0x30, 282, seg);
   no_plan.can.reset();
-  const Status status = adapter_->configure(
-      std::vector{can_binding(141, "a", 0x141, 8, HopRole::publisher, 0x30, 280, seg),
-                  can_binding(142, "b", 0x142, 8, HopRole::publisher, 0x30, 281, seg), no_plan});
+  const Status status =
+      adapter_->configure(std::vector{can_binding(141, "a", 0x141, 8, HopRole::publisher, 0x30, 280, seg),
+                                      can_binding(142, "b", 0x142, 8, HopRole::publisher, 0x30, 281, seg), no_plan});
   EXPECT_FALSE(status.ok);
   ASSERT_EQ(status.refused.size(), 1u) << status.error;
   EXPECT_EQ(status.refused[0].channel, 143u);

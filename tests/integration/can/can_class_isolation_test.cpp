@@ -111,7 +111,8 @@ TEST(CanClassIsolation, AnNrtSendHeldInsideItsWriteDoesNotDelayAnHrtSend) {
   }
   ASSERT_TRUE(held) << "the NRT frame never reached write()";
   hrt_send = std::async(std::launch::async, [&] { return adapter->send(OutboundEvent{202, {}, brake}); });
-  ASSERT_EQ(hrt_send.wait_for(kIsolationWait), std::future_status::ready) << "the HRT send waited for the held NRT write";
+  ASSERT_EQ(hrt_send.wait_for(kIsolationWait), std::future_status::ready)
+      << "the HRT send waited for the held NRT write";
   EXPECT_EQ(hrt_send.get(), SendStatus::sent);
   EXPECT_TRUE(wait_until([&] { return !dump.lines().empty(); }, kIsolationWait));
   bool still_held = false;

@@ -40,10 +40,10 @@ TEST(FamousoId, BitsAsInFamousoLittleEndianPcLayout) {
 
 TEST(FamousoId, PrioritiesKeepClassBandsAndOrder) {
   EXPECT_EQ(famouso_priority(0x00), 0x00);
-  EXPECT_EQ(famouso_priority(0x0F), 0x0F);   // all 16 HRT levels
+  EXPECT_EQ(famouso_priority(0x0F), 0x0F);  // all 16 HRT levels
   EXPECT_EQ(famouso_priority(0x10), 0x10);
-  EXPECT_EQ(famouso_priority(0x77), 0x77);   // 104 SRT levels one to one
-  EXPECT_EQ(famouso_priority(0xEF), 0x77);   // beyond: the band's last level
+  EXPECT_EQ(famouso_priority(0x77), 0x77);  // 104 SRT levels one to one
+  EXPECT_EQ(famouso_priority(0xEF), 0x77);  // beyond: the band's last level
   EXPECT_EQ(famouso_priority(0xF0), 0x78);
   EXPECT_EQ(famouso_priority(0xF7), 0x7F);
   EXPECT_EQ(famouso_priority(0xFF), 0x7F);
@@ -131,8 +131,8 @@ TEST(FamousoAfp, FragmentsAsFamousoCutsThem) {
   EXPECT_EQ(frames[1], (std::vector<std::uint8_t>{0x01, 8, 9, 10, 11, 12, 13, 14}));
   EXPECT_EQ(frames[2], (std::vector<std::uint8_t>{0x00, 15, 16}));
   EXPECT_EQ(famouso::afp_fragment_count(9), 2u);
-  EXPECT_EQ(famouso::afp_fragment_count(224), 32u);   // 32 fragments of 7
-  EXPECT_EQ(famouso::afp_fragment_count(225), 33u);   // one more with a 2-byte header, 6 bytes
+  EXPECT_EQ(famouso::afp_fragment_count(224), 32u);  // 32 fragments of 7
+  EXPECT_EQ(famouso::afp_fragment_count(225), 33u);  // one more with a 2-byte header, 6 bytes
   EXPECT_EQ(famouso::afp_fragment_count(230), 33u);
   EXPECT_EQ(famouso::afp_fragment_count(231), 34u);
   const auto big = fragment(counting(1000));
@@ -236,7 +236,8 @@ struct CcpNode {
 TEST(FamousoCcp, AssignsTxNodesToNodesThatStartTogether) {
   famouso::CcpBroker broker;
   broker.reserve(1);
-  std::vector<CcpNode> nodes{CcpNode({'S', 'c', 'h', 'u', 'l', 'z', 'e', 0}), CcpNode({'S', 'c', 'h', 'u', 'l', 'z', 'e', 1}),
+  std::vector<CcpNode> nodes{CcpNode({'S', 'c', 'h', 'u', 'l', 'z', 'e', 0}),
+                             CcpNode({'S', 'c', 'h', 'u', 'l', 'z', 'e', 1}),
                              CcpNode({'N', 'o', 'd', 'e', '-', 'B', 0, 0})};
   // The bus: every node with a pending request sends; arbitration lets the lowest identifier
   // through first, the broker sees all of them in that order, every node sees every answer.
@@ -298,7 +299,7 @@ TEST(BindingGuard, RateLimitPerNodeAndPerBus) {
   BindingRateLimit limit(10, 100);
   int admitted = 0;
   for (int i = 0; i < 50; ++i) admitted += limit.admit(5, Nanos(0));
-  EXPECT_EQ(admitted, 4);  // burst of one node
+  EXPECT_EQ(admitted, 4);                 // burst of one node
   EXPECT_TRUE(limit.admit(6, Nanos(0)));  // another node has its own budget
   EXPECT_FALSE(limit.admit(5, Nanos(50'000'000)));
   EXPECT_TRUE(limit.admit(5, Nanos(100'000'000)));  // 10/s: one more after 100 ms

@@ -42,7 +42,7 @@ TEST(NativeFrames, ContentsAreTheDataBytesWithFdPaddingCut) {
   const std::uint8_t data[16] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 0, 0, 0, 0, 0, 0};
   EXPECT_EQ(can_native::contents(channel, std::span(data, 3), false)->size(), 3u);
   EXPECT_EQ(can_native::contents(channel, std::span(data, 12), true)->size(), 10u);  // 10 B padded to 12
-  EXPECT_FALSE(can_native::contents(channel, std::span(data, 16), true));          // longer than the padded payload
+  EXPECT_FALSE(can_native::contents(channel, std::span(data, 16), true));            // longer than the padded payload
   EXPECT_FALSE(can_native::contents(can_native::RxChannel{7, 0x42, 4}, std::span(data, 5), false));
 }
 

@@ -39,8 +39,7 @@ inline SegmentSpec dds_segment(std::uint32_t domain, Reliability reliability = R
   return s;
 }
 
-inline ChannelBinding binding(ChannelId id, const std::string& name, HopRole role,
-                              std::uint32_t omission_degree = 2) {
+inline ChannelBinding binding(ChannelId id, const std::string& name, HopRole role, std::uint32_t omission_degree = 2) {
   ChannelBinding b;
   b.id = id;
   b.role = role;
@@ -56,9 +55,7 @@ inline std::vector<std::string> peer(std::vector<std::string> args) {
   return args;
 }
 
-inline std::uint8_t pattern(std::uint64_t q, std::uint64_t i) {
-  return static_cast<std::uint8_t>((q * 7 + i) & 0xff);
-}
+inline std::uint8_t pattern(std::uint64_t q, std::uint64_t i) { return static_cast<std::uint8_t>((q * 7 + i) & 0xff); }
 
 inline std::string hex(const std::vector<std::uint8_t>& bytes) {
   static const char* digits = "0123456789abcdef";
@@ -88,8 +85,7 @@ inline std::function<bool(const std::string&)> matched_at_least(int n) {
 
 // Spawns a peer publisher (with --start-on-stdin) and lets it publish once its writer matched
 // and `ready` holds: our side matched it too (a reader drops what a writer sends before).
-inline std::unique_ptr<Child> start_pub(std::vector<std::string> args,
-                                        const std::function<bool()>& ready) {
+inline std::unique_ptr<Child> start_pub(std::vector<std::string> args, const std::function<bool()>& ready) {
   args.push_back("--start-on-stdin");
   auto pub = std::make_unique<Child>(peer(std::move(args)));
   EXPECT_TRUE(pub->wait_err(diag_event("waiting_for_start"), kWait)) << pub->describe();
@@ -100,8 +96,7 @@ inline std::unique_ptr<Child> start_pub(std::vector<std::string> args,
 
 struct Fixture {
   explicit Fixture(SegmentSpec segment, std::uint64_t id = kSelfId)
-      : spec(std::move(segment)),
-        adapter(make_dds_segment_adapter(spec, GatewayIdentity{id, "gw-test"}, log)) {}
+      : spec(std::move(segment)), adapter(make_dds_segment_adapter(spec, GatewayIdentity{id, "gw-test"}, log)) {}
   test::StderrLogger log;
   SegmentSpec spec;
   RecordingSink sink;

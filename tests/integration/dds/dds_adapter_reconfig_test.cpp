@@ -39,8 +39,7 @@ TEST(DdsAdapter, ChannelsMappingToOneTopicAreRefused) {
   ASSERT_TRUE(f.adapter->start(f.sink).ok);
   const ChannelBinding running = binding(1, "keep", HopRole::subscriber);
   ASSERT_TRUE(f.adapter->configure(std::span(&running, 1)).ok);
-  const ChannelBinding clash[] = {binding(1, "keep", HopRole::subscriber),
-                                  binding(2, "arm-left", HopRole::subscriber),
+  const ChannelBinding clash[] = {binding(1, "keep", HopRole::subscriber), binding(2, "arm-left", HopRole::subscriber),
                                   binding(3, "arm.left", HopRole::publisher)};
   const Status st = f.adapter->configure(clash);
   ASSERT_FALSE(st.ok);
@@ -55,11 +54,9 @@ TEST(DdsAdapter, ChannelsMappingToOneTopicAreRefused) {
   ASSERT_TRUE(f.matched(2, HopRole::subscriber)) << arm.describe();
   EXPECT_EQ(f.adapter->matched_endpoints(3, HopRole::publisher), 0u);
   // The running channel is untouched; one channel in both roles is no collision.
-  Child sub(peer({"sub", "--domain", "63", "--channel", "keep", "--count", "1", "--timeout",
-                  "30"}));
+  Child sub(peer({"sub", "--domain", "63", "--channel", "keep", "--count", "1", "--timeout", "30"}));
   ASSERT_TRUE(f.matched(1, HopRole::subscriber)) << sub.describe();
-  const ChannelBinding both[] = {binding(1, "keep", HopRole::subscriber),
-                                 binding(1, "keep", HopRole::publisher)};
+  const ChannelBinding both[] = {binding(1, "keep", HopRole::subscriber), binding(1, "keep", HopRole::publisher)};
   EXPECT_TRUE(f.adapter->configure(both).ok);
 }
 
@@ -79,13 +76,11 @@ TEST(DdsAdapter, NativePublisherSequenceIsItsSampleSequence) {
     return std::chrono::duration_cast<Nanos>(std::chrono::steady_clock::now().time_since_epoch());
   };
   const Nanos before = steady();
-  auto native = start_pub({"pub", "--domain", "64", "--channel", "native", "--count",
-                           std::to_string(kCount), "--size", "8", "--origin", "0",
-                           "--first-sequence", "1000"},
+  auto native = start_pub({"pub", "--domain", "64", "--channel", "native", "--count", std::to_string(kCount), "--size",
+                           "8", "--origin", "0", "--first-sequence", "1000"},
                           f.reader_matched(3));
-  auto relayed = start_pub({"pub", "--domain", "64", "--channel", "relayed", "--count",
-                            std::to_string(kCount), "--size", "8", "--origin", "77",
-                            "--first-sequence", "1000"},
+  auto relayed = start_pub({"pub", "--domain", "64", "--channel", "relayed", "--count", std::to_string(kCount),
+                            "--size", "8", "--origin", "77", "--first-sequence", "1000"},
                            f.reader_matched(4));
   ASSERT_TRUE(f.sink.wait_count(3, kCount, kWait)) << native->describe();
   ASSERT_TRUE(f.sink.wait_count(4, kCount, kWait)) << relayed->describe();
@@ -116,12 +111,12 @@ TEST(DdsAdapter, AddingAChannelLosesNothingOnTheOthers) {
   ASSERT_TRUE(f.adapter->configure(first).ok);
 
   constexpr int kCount = 400;
-  Child sub(peer({"sub", "--domain", "46", "--channel", "out.flowing", "--count",
-                  std::to_string(kCount), "--reliable", "--quiet", "--timeout", "60"}));
+  Child sub(peer({"sub", "--domain", "46", "--channel", "out.flowing", "--count", std::to_string(kCount), "--reliable",
+                  "--quiet", "--timeout", "60"}));
   ASSERT_TRUE(f.matched(2, HopRole::subscriber)) << sub.describe();
   ASSERT_TRUE(sub.wait_err(matched_at_least(1), kWait)) << sub.describe();
-  auto pub = start_pub({"pub", "--domain", "46", "--channel", "in.flowing", "--count",
-                        std::to_string(kCount), "--size", "8", "--rate", "400"},
+  auto pub = start_pub({"pub", "--domain", "46", "--channel", "in.flowing", "--count", std::to_string(kCount), "--size",
+                        "8", "--rate", "400"},
                        f.reader_matched(1));
 
   // The router thread keeps sending on the outgoing channel throughout.
@@ -162,12 +157,10 @@ TEST(DdsAdapter, AddingAChannelLosesNothingOnTheOthers) {
   for (std::uint32_t q = 1; q <= kCount; ++q) EXPECT_EQ(events[q - 1].header.sequence, q);
 
   // The added channels work in both directions.
-  auto pub_added = start_pub({"pub", "--domain", "46", "--channel", "in.added", "--count", "5",
-                              "--size", "8"},
-                             f.reader_matched(3));
+  auto pub_added =
+      start_pub({"pub", "--domain", "46", "--channel", "in.added", "--count", "5", "--size", "8"}, f.reader_matched(3));
   ASSERT_TRUE(f.sink.wait_count(3, 5, kWait)) << pub_added->describe();
-  Child sub_added(peer({"sub", "--domain", "46", "--channel", "out.added", "--count", "3",
-                        "--reliable"}));
+  Child sub_added(peer({"sub", "--domain", "46", "--channel", "out.added", "--count", "3", "--reliable"}));
   ASSERT_TRUE(f.matched(4, HopRole::subscriber)) << sub_added.describe();
   ASSERT_TRUE(sub_added.wait_err(matched_at_least(1), kWait)) << sub_added.describe();
   std::vector<std::uint8_t> storage;
@@ -187,8 +180,7 @@ TEST(DdsAdapter, RemovingAChannelStopsItsDelivery) {
   ASSERT_TRUE(f.adapter->configure(all).ok);
 
   {
-    auto pub = start_pub({"pub", "--domain", "47", "--channel", "removed.in", "--count", "5",
-                          "--size", "4"},
+    auto pub = start_pub({"pub", "--domain", "47", "--channel", "removed.in", "--count", "5", "--size", "4"},
                          f.reader_matched(2));
     ASSERT_TRUE(f.sink.wait_count(2, 5, kWait)) << pub->describe();
     ASSERT_EQ(pub->wait_exit(kWait), 0);
@@ -200,12 +192,11 @@ TEST(DdsAdapter, RemovingAChannelStopsItsDelivery) {
   EXPECT_EQ(f.adapter->send(outbound(3, 1, storage)), SendStatus::failed);
 
   // On the DDS side nobody reads the removed channel any more...
-  Child orphan(peer({"pub", "--domain", "47", "--channel", "removed.in", "--count", "5",
-                     "--size", "4", "--match-timeout", "3"}));
+  Child orphan(peer(
+      {"pub", "--domain", "47", "--channel", "removed.in", "--count", "5", "--size", "4", "--match-timeout", "3"}));
   // ...while the kept channel still flows.
-  auto pub = start_pub({"pub", "--domain", "47", "--channel", "kept", "--count", "20",
-                        "--size", "4"},
-                       f.reader_matched(1));
+  auto pub =
+      start_pub({"pub", "--domain", "47", "--channel", "kept", "--count", "20", "--size", "4"}, f.reader_matched(1));
   ASSERT_TRUE(f.sink.wait_count(1, 20, kWait)) << pub->describe();
   EXPECT_EQ(orphan.wait_exit(kWait), 2) << orphan.describe();  // no subscriber matched
   EXPECT_EQ(f.sink.count_on(2), 5u);
@@ -217,8 +208,7 @@ TEST(DdsAdapter, ChangedChannelQosReplacesTheEndpoint) {
   ChannelBinding b = binding(4, "odometry", HopRole::subscriber);
   b.spec.temp_validity = Nanos(20'000'000);
   ASSERT_TRUE(f.adapter->configure(std::span(&b, 1)).ok);
-  Child sub(peer({"sub", "--domain", "52", "--channel", "odometry", "--count", "1", "--reliable",
-                  "--timeout", "30"}));
+  Child sub(peer({"sub", "--domain", "52", "--channel", "odometry", "--count", "1", "--reliable", "--timeout", "30"}));
   auto announced_lifespan = [&](std::int64_t ns) {
     return [ns](const std::string& line) {
       const json j = parse(line);
@@ -253,10 +243,8 @@ TEST(DdsAdapter, DiscoveryServerClients) {
   constexpr std::uint32_t kDomain = 53;
   // A discovery server (id 0) on 127.0.0.1:11811, in this process.
   fdds::DomainParticipantQos server_qos = fdds::PARTICIPANT_QOS_DEFAULT;
-  server_qos.wire_protocol().builtin.discovery_config.discoveryProtocol =
-      rtps::DiscoveryProtocol_t::SERVER;
-  eprosima::fastdds::rtps::get_server_client_default_guidPrefix(0,
-                                                                server_qos.wire_protocol().prefix);
+  server_qos.wire_protocol().builtin.discovery_config.discoveryProtocol = rtps::DiscoveryProtocol_t::SERVER;
+  eprosima::fastdds::rtps::get_server_client_default_guidPrefix(0, server_qos.wire_protocol().prefix);
   rtps::Locator_t locator;
   rtps::IPLocator::setIPv4(locator, "127.0.0.1");
   locator.port = 11811;
@@ -331,8 +319,7 @@ TEST(DdsAdapter, ReportsBadConfigurationThroughStatus) {
     auto adapter = make_dds_segment_adapter(dds_segment(49), self_identity(), log);
     ASSERT_TRUE(adapter->start(sink).ok);
     EXPECT_FALSE(adapter->start(sink).ok);  // twice
-    const ChannelBinding dup[] = {binding(1, "x", HopRole::publisher),
-                                  binding(1, "x", HopRole::publisher)};
+    const ChannelBinding dup[] = {binding(1, "x", HopRole::publisher), binding(1, "x", HopRole::publisher)};
     const Status twice = adapter->configure(dup);
     EXPECT_FALSE(twice.ok);
     ASSERT_EQ(twice.refused.size(), 1u) << twice.error;
@@ -361,9 +348,9 @@ TEST(DdsAdapter, InterfaceAllowListByAddressAndName) {
     ASSERT_TRUE(f.adapter->start(f.sink).ok);
     const ChannelBinding b = binding(1, "allowed", HopRole::publisher);
     ASSERT_TRUE(f.adapter->configure(std::span(&b, 1)).ok);
-    auto pub = start_pub({"pub", "--domain", std::to_string(domain), "--channel", "allowed",
-                          "--count", "5", "--size", "4"},
-                         f.reader_matched(1));
+    auto pub =
+        start_pub({"pub", "--domain", std::to_string(domain), "--channel", "allowed", "--count", "5", "--size", "4"},
+                  f.reader_matched(1));
     ASSERT_TRUE(f.sink.wait_count(1, 5, kWait)) << pub->describe();
     EXPECT_EQ(pub->wait_exit(kWait), 0) << pub->describe();
   }

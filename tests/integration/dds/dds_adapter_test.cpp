@@ -116,8 +116,8 @@ TEST(DdsAdapter, EachClassHasAParticipantOfItsOwn) {
   const ChannelBinding moved[] = {hrt, nrt, srt};
   ASSERT_TRUE(f.adapter->configure(moved).ok);
   EXPECT_EQ(writer_participant("cosmic/log_nrt"), hrt_home);
-  Child sub(peer({"sub", "--domain", "66", "--topic", "cosmic/log_nrt", "--count", "3", "--reliable",
-                  "--timeout", "30"}));
+  Child sub(
+      peer({"sub", "--domain", "66", "--topic", "cosmic/log_nrt", "--count", "3", "--reliable", "--timeout", "30"}));
   ASSERT_TRUE(f.matched(2, HopRole::subscriber)) << sub.describe();
   ASSERT_TRUE(sub.wait_err(matched_at_least(1), kWait)) << sub.describe();
   std::vector<std::uint8_t> storage;
@@ -161,7 +161,9 @@ TEST(DdsAdapter, HrtParticipantSpeaksUdpAloneUnlessSharedMemoryIsAsked) {
     };
     const json hrt_kinds = transports_of("cosmic/ctl_hrt");
     const json nrt_kinds = transports_of("cosmic/log_nrt");
-    auto has = [](const json& kinds, const char* kind) { return std::find(kinds.begin(), kinds.end(), kind) != kinds.end(); };
+    auto has = [](const json& kinds, const char* kind) {
+      return std::find(kinds.begin(), kinds.end(), kind) != kinds.end();
+    };
     EXPECT_TRUE(has(hrt_kinds, "udpv4")) << hrt_kinds.dump();
     EXPECT_EQ(has(hrt_kinds, "shm"), hrt_shared) << hrt_kinds.dump();
     EXPECT_TRUE(has(nrt_kinds, "shm")) << nrt_kinds.dump();
@@ -178,8 +180,8 @@ TEST(DdsAdapter, SendsEnvelopesToNativeSubscriber) {
   ASSERT_TRUE(f.adapter->configure(std::span(&b, 1)).ok);
 
   constexpr int kCount = 50;
-  Child sub(peer({"sub", "--domain", "41", "--topic", "cosmic/robot_pose", "--count",
-                  std::to_string(kCount), "--reliable", "--timeout", "30"}));
+  Child sub(peer({"sub", "--domain", "41", "--topic", "cosmic/robot_pose", "--count", std::to_string(kCount),
+                  "--reliable", "--timeout", "30"}));
   // Discovery done in both directions: our writer sees the reader, the reader sees our writer.
   ASSERT_TRUE(f.matched(7, HopRole::subscriber)) << sub.describe();
   ASSERT_TRUE(sub.wait_err(matched_at_least(1), kWait)) << sub.describe();
@@ -218,9 +220,8 @@ TEST(DdsAdapter, DeliversEnvelopesFromNativePublisher) {
   ASSERT_TRUE(f.adapter->configure(std::span(&b, 1)).ok);
 
   constexpr int kCount = 100;
-  auto pub = start_pub({"pub", "--domain", "42", "--channel", "lidar.scan", "--count",
-                        std::to_string(kCount), "--size", "24", "--subject", "99", "--origin",
-                        "4242", "--hop-count", "2", "--age-ns", "777"},
+  auto pub = start_pub({"pub", "--domain", "42", "--channel", "lidar.scan", "--count", std::to_string(kCount), "--size",
+                        "24", "--subject", "99", "--origin", "4242", "--hop-count", "2", "--age-ns", "777"},
                        f.reader_matched(3));
   ASSERT_TRUE(f.sink.wait_count(3, kCount, kWait)) << pub->describe();
   ASSERT_EQ(pub->wait_exit(kWait), 0) << pub->describe();
@@ -251,15 +252,13 @@ TEST(DdsAdapter, OversizedPayloadIsADecodeError) {
   ASSERT_TRUE(f.adapter->start(f.sink).ok);
   const ChannelBinding b = binding(1, "big", HopRole::publisher);
   ASSERT_TRUE(f.adapter->configure(std::span(&b, 1)).ok);
-  auto big = start_pub({"pub", "--domain", "48", "--channel", "big", "--count", "3", "--size",
-                        "33"},
-                       f.reader_matched(1));
+  auto big =
+      start_pub({"pub", "--domain", "48", "--channel", "big", "--count", "3", "--size", "33"}, f.reader_matched(1));
   ASSERT_TRUE(f.sink.wait_problems(InboundProblem::decode_error, 3, kWait)) << big->describe();
   ASSERT_EQ(big->wait_exit(kWait), 0) << big->describe();
   ASSERT_TRUE(test::eventually([&] { return !f.reader_matched(1)(); }, kWait));
-  auto small = start_pub({"pub", "--domain", "48", "--channel", "big", "--count", "2", "--size",
-                          "32"},
-                         f.reader_matched(1));
+  auto small =
+      start_pub({"pub", "--domain", "48", "--channel", "big", "--count", "2", "--size", "32"}, f.reader_matched(1));
   ASSERT_TRUE(f.sink.wait_count(1, 2, kWait)) << small->describe();
   EXPECT_EQ(f.adapter->statistics().receive_errors, 3u);
 
@@ -281,8 +280,7 @@ TEST(DdsAdapter, NeverReceivesItsOwnPublications) {
   Fixture b(dds_segment(43));
   ASSERT_TRUE(a.adapter->start(a.sink).ok);
   ASSERT_TRUE(b.adapter->start(b.sink).ok);
-  const ChannelBinding both[] = {binding(5, "echo", HopRole::subscriber),
-                                 binding(5, "echo", HopRole::publisher)};
+  const ChannelBinding both[] = {binding(5, "echo", HopRole::subscriber), binding(5, "echo", HopRole::publisher)};
   ASSERT_TRUE(a.adapter->configure(both).ok);
   const ChannelBinding recv = binding(5, "echo", HopRole::publisher);
   ASSERT_TRUE(b.adapter->configure(std::span(&recv, 1)).ok);
@@ -315,9 +313,8 @@ TEST(DdsAdapter, NeverReceivesItsOwnPublications) {
   EXPECT_EQ(own_origin, 5u);
 
   // A native publisher claiming this gateway's origin is delivered to both, for the router to count.
-  auto forged = start_pub({"pub", "--domain", "43", "--channel", "echo", "--count", "3",
-                           "--size", "4", "--origin", std::to_string(kSelfId),
-                           "--wait-subscribers", "2"},
+  auto forged = start_pub({"pub", "--domain", "43", "--channel", "echo", "--count", "3", "--size", "4", "--origin",
+                           std::to_string(kSelfId), "--wait-subscribers", "2"},
                           [&] { return a.reader_matched(5, 2)() && b.reader_matched(5, 2)(); });
   ASSERT_TRUE(a.sink.wait_count(5, 3, kWait)) << forged->describe();
   ASSERT_TRUE(b.sink.wait_count(5, 13, kWait)) << forged->describe();
@@ -339,8 +336,7 @@ TEST(DdsAdapter, WritersOfferWhatDefaultReadersAccept) {
   b.spec.reaction_time = Nanos(5'000'000);
   ASSERT_TRUE(f.adapter->configure(std::span(&b, 1)).ok);
 
-  Child sub(peer({"sub", "--domain", "44", "--channel", "imu", "--count", "0", "--timeout",
-                  "30"}));
+  Child sub(peer({"sub", "--domain", "44", "--channel", "imu", "--count", "0", "--timeout", "30"}));
   ASSERT_TRUE(sub.wait_err(diag_event("publication"), kWait)) << sub.describe();
   json announced;
   for (const auto& line : sub.err_lines()) {
@@ -363,10 +359,9 @@ TEST(DdsAdapter, WritersServeReliableAndBestEffortReaders) {
   const ChannelBinding b = binding(2, "status", HopRole::subscriber);
   ASSERT_TRUE(f.adapter->configure(std::span(&b, 1)).ok);
 
-  Child reliable(peer({"sub", "--domain", "45", "--channel", "status", "--count", "1",
-                       "--reliable", "--timeout", "30"}));
-  Child best(peer({"sub", "--domain", "45", "--channel", "status", "--count", "1",
-                   "--timeout", "30"}));
+  Child reliable(
+      peer({"sub", "--domain", "45", "--channel", "status", "--count", "1", "--reliable", "--timeout", "30"}));
+  Child best(peer({"sub", "--domain", "45", "--channel", "status", "--count", "1", "--timeout", "30"}));
   ASSERT_TRUE(f.matched(2, HopRole::subscriber, 2)) << reliable.describe() << best.describe();
   ASSERT_TRUE(reliable.wait_err(matched_at_least(1), kWait)) << reliable.describe();
   ASSERT_TRUE(best.wait_err(matched_at_least(1), kWait)) << best.describe();
@@ -383,8 +378,8 @@ TEST(DdsAdapter, TransientLocalReadersMatch) {
   ASSERT_TRUE(f.adapter->start(f.sink).ok);
   const ChannelBinding b = binding(5, "map", HopRole::subscriber);
   ASSERT_TRUE(f.adapter->configure(std::span(&b, 1)).ok);
-  Child sub(peer({"sub", "--domain", "60", "--channel", "map", "--count", "1", "--reliable",
-                  "--transient-local", "--timeout", "30"}));
+  Child sub(peer({"sub", "--domain", "60", "--channel", "map", "--count", "1", "--reliable", "--transient-local",
+                  "--timeout", "30"}));
   ASSERT_TRUE(f.matched(5, HopRole::subscriber)) << sub.describe();
   ASSERT_TRUE(sub.wait_err(matched_at_least(1), kWait)) << sub.describe();
   std::vector<std::uint8_t> storage;
@@ -398,14 +393,12 @@ TEST(DdsAdapter, TransientLocalReadersMatch) {
 TEST(DdsAdapter, IncompatibleRemoteWriterIsCountedPerChannel) {
   Fixture f(dds_segment(61));
   ASSERT_TRUE(f.adapter->start(f.sink).ok);
-  const ChannelBinding bindings[] = {binding(6, "wheel", HopRole::publisher),
-                                     binding(8, "other", HopRole::publisher)};
+  const ChannelBinding bindings[] = {binding(6, "wheel", HopRole::publisher), binding(8, "other", HopRole::publisher)};
   ASSERT_TRUE(f.adapter->configure(bindings).ok);
   EXPECT_EQ(f.adapter->incompatible_peers(6), 0u);
-  Child pub(peer({"pub", "--domain", "61", "--channel", "wheel", "--count", "1", "--size", "8",
-                  "--best-effort", "--match-timeout", "30"}));
-  ASSERT_TRUE(test::eventually([&] { return f.adapter->incompatible_peers(6) >= 1u; }, kWait))
-      << pub.describe();
+  Child pub(peer({"pub", "--domain", "61", "--channel", "wheel", "--count", "1", "--size", "8", "--best-effort",
+                  "--match-timeout", "30"}));
+  ASSERT_TRUE(test::eventually([&] { return f.adapter->incompatible_peers(6) >= 1u; }, kWait)) << pub.describe();
   EXPECT_EQ(f.adapter->matched_endpoints(6, HopRole::publisher), 0u);
   EXPECT_EQ(f.adapter->incompatible_peers(8), 0u);
   EXPECT_EQ(f.adapter->incompatible_peers(99), 0u);  // not bound: nothing refused
@@ -419,8 +412,8 @@ TEST(DdsAdapter, BestEffortSegmentAcceptsBestEffortWriters) {
   ASSERT_TRUE(f.adapter->configure(std::span(&b, 1)).ok);
   // Best effort may lose samples (a loaded host, a shared-memory segment being recycled), so a
   // steady stream is offered and one delivered sample proves the match.
-  auto pub = start_pub({"pub", "--domain", "62", "--channel", "wheel", "--count", "200", "--rate", "100",
-                        "--size", "8", "--best-effort"},
+  auto pub = start_pub({"pub", "--domain", "62", "--channel", "wheel", "--count", "200", "--rate", "100", "--size", "8",
+                        "--best-effort"},
                        f.reader_matched(6));
   ASSERT_TRUE(f.sink.wait_count(6, 1, kWait)) << pub->describe();
   EXPECT_EQ(f.adapter->incompatible_peers(6), 0u);

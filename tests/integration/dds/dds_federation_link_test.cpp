@@ -25,7 +25,8 @@ SegmentSpec federation_segment() {
 }
 
 // Takes from `link` until `wanted` is among what it delivered (all kept in `heard`).
-bool hears(FederationLink& link, std::vector<FederationMessage>& heard, const std::function<bool(const FederationMessage&)>& wanted) {
+bool hears(FederationLink& link, std::vector<FederationMessage>& heard,
+           const std::function<bool(const FederationMessage&)>& wanted) {
   return test::eventually(
       [&] {
         for (auto& m : link.take()) heard.push_back(std::move(m));
@@ -45,9 +46,12 @@ TEST(DdsFederationLink, AnnouncesWithdrawsAndReportsAWriterThatGoes) {
   ASSERT_TRUE(b->publish(0xB, "b's own"));
   std::vector<FederationMessage> heard;
   // Durable, KEEP_LAST 1: the newest of a's announcements, whenever b matched.
-  ASSERT_TRUE(hears(*b, heard, [](const auto& m) { return m.kind == Kind::announcement && m.key == 0xA && m.body == "second"; }));
-  EXPECT_TRUE(std::none_of(heard.begin(), heard.end(), [](const auto& m) { return m.key == 0xB; })) << "a link never hears itself";
-  const std::string writer = std::find_if(heard.begin(), heard.end(), [](const auto& m) { return m.key == 0xA; })->source;
+  ASSERT_TRUE(hears(*b, heard,
+                    [](const auto& m) { return m.kind == Kind::announcement && m.key == 0xA && m.body == "second"; }));
+  EXPECT_TRUE(std::none_of(heard.begin(), heard.end(), [](const auto& m) { return m.key == 0xB; }))
+      << "a link never hears itself";
+  const std::string writer =
+      std::find_if(heard.begin(), heard.end(), [](const auto& m) { return m.key == 0xA; })->source;
   EXPECT_FALSE(writer.empty());
 
   a->withdraw();

@@ -57,7 +57,8 @@ ChannelBinding twist_binding(ChannelId id, HopRole role, DdsRepresentation repre
   b.spec.payload = 52;
   b.spec.publishers = {"robot"};
   b.spec.subscribers = {"robot"};
-  b.spec.native.push_back(NativeBinding{"robot", std::nullopt, std::nullopt, NativeDdsTopic{"rt/cmd_vel", kTwist, representation}});
+  b.spec.native.push_back(
+      NativeBinding{"robot", std::nullopt, std::nullopt, NativeDdsTopic{"rt/cmd_vel", kTwist, representation}});
   return b;
 }
 

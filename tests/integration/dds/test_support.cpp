@@ -100,22 +100,17 @@ void Child::pump(int fd, std::vector<std::string>& lines) {
   close(fd);
 }
 
-bool Child::wait_lines(const std::vector<std::string>& lines,
-                       const std::function<bool(const std::string&)>& match,
+bool Child::wait_lines(const std::vector<std::string>& lines, const std::function<bool(const std::string&)>& match,
                        std::chrono::milliseconds within) {
   std::unique_lock lock(mutex_);
-  return cv_.wait_until(lock, deadline_in(within), [&] {
-    return std::any_of(lines.begin(), lines.end(), match);
-  });
+  return cv_.wait_until(lock, deadline_in(within), [&] { return std::any_of(lines.begin(), lines.end(), match); });
 }
 
-bool Child::wait_out(const std::function<bool(const std::string&)>& match,
-                     std::chrono::milliseconds within) {
+bool Child::wait_out(const std::function<bool(const std::string&)>& match, std::chrono::milliseconds within) {
   return wait_lines(out_, match, within);
 }
 
-bool Child::wait_err(const std::function<bool(const std::string&)>& match,
-                     std::chrono::milliseconds within) {
+bool Child::wait_err(const std::function<bool(const std::string&)>& match, std::chrono::milliseconds within) {
   return wait_lines(err_, match, within);
 }
 
@@ -169,8 +164,7 @@ void RecordingSink::on_event(const InboundEvent& event) {
   {
     std::lock_guard lock(mutex_);
     events_.push_back(Event{event.channel, event.header,
-                            std::vector<std::uint8_t>(event.payload.begin(), event.payload.end()),
-                            event.received_at});
+                            std::vector<std::uint8_t>(event.payload.begin(), event.payload.end()), event.received_at});
   }
   cv_.notify_all();
 }
@@ -205,27 +199,22 @@ std::size_t RecordingSink::problems(InboundProblem problem) const {
   return it == problems_.end() ? 0 : it->second;
 }
 
-bool RecordingSink::wait(
-    const std::function<bool(const std::vector<Event>&, const Problems&)>& condition,
-    std::chrono::milliseconds within) {
+bool RecordingSink::wait(const std::function<bool(const std::vector<Event>&, const Problems&)>& condition,
+                         std::chrono::milliseconds within) {
   std::unique_lock lock(mutex_);
-  return cv_.wait_until(lock, deadline_in(within),
-                        [&] { return condition(events_, problems_); });
+  return cv_.wait_until(lock, deadline_in(within), [&] { return condition(events_, problems_); });
 }
 
-bool RecordingSink::wait_count(ChannelId channel, std::size_t n,
-                               std::chrono::milliseconds within) {
+bool RecordingSink::wait_count(ChannelId channel, std::size_t n, std::chrono::milliseconds within) {
   return wait(
       [&](const std::vector<Event>& events, const Problems&) {
-        return static_cast<std::size_t>(std::count_if(
-                   events.begin(), events.end(),
-                   [&](const Event& e) { return e.channel == channel; })) >= n;
+        return static_cast<std::size_t>(std::count_if(events.begin(), events.end(),
+                                                      [&](const Event& e) { return e.channel == channel; })) >= n;
       },
       within);
 }
 
-bool RecordingSink::wait_problems(InboundProblem problem, std::size_t n,
-                                  std::chrono::milliseconds within) {
+bool RecordingSink::wait_problems(InboundProblem problem, std::size_t n, std::chrono::milliseconds within) {
   return wait(
       [&](const std::vector<Event>&, const Problems& problems) {
         auto it = problems.find(problem);

@@ -35,10 +35,8 @@ class Child {
   Child& operator=(const Child&) = delete;
 
   // Waits until some stdout (stderr) line satisfies `match`, or the deadline passes.
-  bool wait_out(const std::function<bool(const std::string&)>& match,
-                std::chrono::milliseconds within);
-  bool wait_err(const std::function<bool(const std::string&)>& match,
-                std::chrono::milliseconds within);
+  bool wait_out(const std::function<bool(const std::string&)>& match, std::chrono::milliseconds within);
+  bool wait_err(const std::function<bool(const std::string&)>& match, std::chrono::milliseconds within);
   // Exit status (exit code, or 128 + signal), nullopt if still running at the deadline.
   std::optional<int> wait_exit(std::chrono::milliseconds within);
   // Writes one line to the child's stdin.
@@ -49,8 +47,7 @@ class Child {
 
  private:
   void pump(int fd, std::vector<std::string>& lines);
-  bool wait_lines(const std::vector<std::string>& lines,
-                  const std::function<bool(const std::string&)>& match,
+  bool wait_lines(const std::vector<std::string>& lines, const std::function<bool(const std::string&)>& match,
                   std::chrono::milliseconds within);
 
   std::vector<std::string> argv_;

@@ -43,9 +43,7 @@ using Bytes = std::vector<std::uint8_t>;
 
 inline constexpr auto kWait = 15s;
 
-inline std::string url_for(int port) {
-  return "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0";
-}
+inline std::string url_for(int port) { return "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0"; }
 
 // Payload byte i of message k as cosmic-lcm-peer pub writes it.
 inline Bytes peer_pattern(std::uint64_t k, std::size_t size) {
@@ -212,7 +210,8 @@ class RecordingSink final : public EventSink {
 
   void on_event(const InboundEvent& event) override {
     std::lock_guard lock(mutex_);
-    events_.push_back({event.channel, event.header, Bytes(event.payload.begin(), event.payload.end()), event.identity.needs_fingerprint_loop_guard()});
+    events_.push_back({event.channel, event.header, Bytes(event.payload.begin(), event.payload.end()),
+                       event.identity.needs_fingerprint_loop_guard()});
     changed_.notify_all();
   }
   void on_problem(ChannelId channel, InboundProblem problem) override {
@@ -222,8 +221,8 @@ class RecordingSink final : public EventSink {
   }
 
   std::size_t count_unlocked(ChannelId channel) const {
-    return static_cast<std::size_t>(std::count_if(
-        events_.begin(), events_.end(), [&](const Record& r) { return r.channel == channel; }));
+    return static_cast<std::size_t>(
+        std::count_if(events_.begin(), events_.end(), [&](const Record& r) { return r.channel == channel; }));
   }
   std::size_t problems_unlocked(ChannelId channel, InboundProblem problem) const {
     auto it = problems_.find({channel, problem});
@@ -234,8 +233,7 @@ class RecordingSink final : public EventSink {
     std::unique_lock lock(mutex_);
     return changed_.wait_for(lock, timeout, [&] { return count_unlocked(channel) >= n; });
   }
-  bool wait_problems(ChannelId channel, InboundProblem problem, std::size_t n,
-                     Clock::duration timeout = kWait) {
+  bool wait_problems(ChannelId channel, InboundProblem problem, std::size_t n, Clock::duration timeout = kWait) {
     std::unique_lock lock(mutex_);
     return changed_.wait_for(lock, timeout, [&] { return problems_unlocked(channel, problem) >= n; });
   }
@@ -379,8 +377,8 @@ inline std::vector<LogEvent> read_lcm_log(const std::string& path) {
 }
 
 inline std::size_t count_channel(const std::vector<LogEvent>& events, const std::string& channel) {
-  return static_cast<std::size_t>(std::count_if(
-      events.begin(), events.end(), [&](const LogEvent& e) { return e.channel == channel; }));
+  return static_cast<std::size_t>(
+      std::count_if(events.begin(), events.end(), [&](const LogEvent& e) { return e.channel == channel; }));
 }
 
 // Polls `condition` (e.g. a file another process writes) until it holds or the time is up.

@@ -38,11 +38,11 @@ TEST_F(LcmAdapterTest, ConfigureWhileFlowingLosesNothingOnOtherChannels) {
   ASSERT_TRUE(adapter->start(sink_).ok);
   ASSERT_TRUE(adapter->configure(configs[0]).ok);
 
-  Child sub({peer(), "sub", "--url", url, "--channel", "FLOW_OUT", "--count",
-             std::to_string(kCount), "--timeout", "20"});
+  Child sub(
+      {peer(), "sub", "--url", url, "--channel", "FLOW_OUT", "--count", std::to_string(kCount), "--timeout", "20"});
   ASSERT_TRUE(sub.wait_stderr("READY")) << sub.stderr_text();
-  Child pub({peer(), "pub", "--url", url, "--channel", "FLOW_IN", "--raw", "--count",
-             std::to_string(kCount), "--size", "16", "--rate", "250"});
+  Child pub({peer(), "pub", "--url", url, "--channel", "FLOW_IN", "--raw", "--count", std::to_string(kCount), "--size",
+             "16", "--rate", "250"});
 
   // Send on FLOW_OUT and reconfigure the segment over and over while FLOW_IN flows in.
   std::uint32_t sent = 0;
@@ -74,22 +74,19 @@ TEST_F(LcmAdapterTest, ConfigureWhileFlowingLosesNothingOnOtherChannels) {
   // An added channel receives; a removed one no longer does.
   ASSERT_TRUE(adapter->configure(configs[1]).ok);
   {
-    Child extra({peer(), "pub", "--url", url, "--channel", "EXTRA_IN", "--raw", "--count", "3",
-                 "--size", "8"});
+    Child extra({peer(), "pub", "--url", url, "--channel", "EXTRA_IN", "--raw", "--count", "3", "--size", "8"});
     ASSERT_EQ(extra.wait_exit(), std::optional<int>(0));
   }
   ASSERT_TRUE(sink_.wait_events(3, 3));
   const std::size_t extra_before = sink_.count(3);
   ASSERT_TRUE(adapter->configure(configs[0]).ok);
   {
-    Child extra({peer(), "pub", "--url", url, "--channel", "EXTRA_IN", "--raw", "--count", "3",
-                 "--size", "8"});
+    Child extra({peer(), "pub", "--url", url, "--channel", "EXTRA_IN", "--raw", "--count", "3", "--size", "8"});
     ASSERT_EQ(extra.wait_exit(), std::optional<int>(0));
   }
   // A later message on FLOW_IN marks that the EXTRA_IN ones had their chance to arrive.
   {
-    Child marker({peer(), "pub", "--url", url, "--channel", "FLOW_IN", "--raw", "--count", "1",
-                  "--size", "16"});
+    Child marker({peer(), "pub", "--url", url, "--channel", "FLOW_IN", "--raw", "--count", "1", "--size", "16"});
     ASSERT_EQ(marker.wait_exit(), std::optional<int>(0));
   }
   ASSERT_TRUE(sink_.wait_events(1, kCount + 1));
@@ -132,16 +129,15 @@ TEST_F(LcmAdapterTest, MalformedEnvelopesCountDecodeErrors) {
   wrong_hash[0] ^= 0xff;
   bad.push_back(wrong_hash);
   bad.push_back(with_payload_size(static_cast<std::uint32_t>(-5)));  // negative size
-  bad.push_back(with_payload_size(100));                              // truncated payload
-  bad.push_back(with_payload_size(0x7fffffff));                       // beyond max_message_size
+  bad.push_back(with_payload_size(100));                             // truncated payload
+  bad.push_back(with_payload_size(0x7fffffff));                      // beyond max_message_size
   Bytes trailing = valid;
   trailing.push_back(0);
   bad.push_back(trailing);
 
   lcm_t* publisher = lcm_create(url.c_str());
   ASSERT_NE(publisher, nullptr);
-  for (const auto& b : bad)
-    ASSERT_EQ(lcm_publish(publisher, "ENV_IN", b.data(), static_cast<unsigned>(b.size())), 0);
+  for (const auto& b : bad) ASSERT_EQ(lcm_publish(publisher, "ENV_IN", b.data(), static_cast<unsigned>(b.size())), 0);
   ASSERT_EQ(lcm_publish(publisher, "ENV_IN", valid.data(), static_cast<unsigned>(valid.size())), 0);
   lcm_destroy(publisher);
 
@@ -156,8 +152,7 @@ TEST_F(LcmAdapterTest, MalformedEnvelopesCountDecodeErrors) {
   EXPECT_EQ(events[0].payload, e.payload);
 
   // A native envelope publisher that is not us still gets through afterwards.
-  Child pub({peer(), "pub", "--url", url, "--channel", "ENV_IN", "--count", "2", "--size", "0",
-             "--origin", "99"});
+  Child pub({peer(), "pub", "--url", url, "--channel", "ENV_IN", "--count", "2", "--size", "0", "--origin", "99"});
   ASSERT_EQ(pub.wait_exit(), std::optional<int>(0)) << pub.stderr_text();
   ASSERT_TRUE(sink_.wait_events(8, 3));
   EXPECT_TRUE(sink_.events(8)[2].payload.empty());
@@ -196,11 +191,10 @@ TEST_F(LcmAdapterTest, EveryRefusedBindingIsNamedAndTheRestIsCarried) {
   auto adapter = make(7711);
   ASSERT_TRUE(adapter->start(sink_).ok);
   ASSERT_TRUE(adapter->configure(std::vector<ChannelBinding>{binding(1, "KEPT", HopRole::subscriber)}).ok);
-  const std::vector<ChannelBinding> bindings{binding(1, "KEPT", HopRole::subscriber),
-                                             binding(2, "KEPT", HopRole::subscriber),  // a name taken by id 1
-                                             binding(3, "NEW", HopRole::subscriber),
-                                             binding(3, "OTHER", HopRole::publisher),  // id 3 under a second name
-                                             binding(4, "", HopRole::subscriber)};
+  const std::vector<ChannelBinding> bindings{
+      binding(1, "KEPT", HopRole::subscriber), binding(2, "KEPT", HopRole::subscriber),  // a name taken by id 1
+      binding(3, "NEW", HopRole::subscriber), binding(3, "OTHER", HopRole::publisher),   // id 3 under a second name
+      binding(4, "", HopRole::subscriber)};
   const Status status = adapter->configure(bindings);
   EXPECT_FALSE(status.ok);
   std::map<ChannelId, std::string> refused;
@@ -298,9 +292,10 @@ TEST(LcmWire, RefusesAnythingButExactlyOneEnvelopeWithinTheLimit) {
   wrong_hash[7] ^= 1;
   Bytes trailing = valid;
   trailing.push_back(0);
-  for (const Bytes& bad : {Bytes{}, Bytes(valid.begin(), valid.begin() + 48), Bytes(valid.begin(), valid.end() - 1), trailing,
-                           wrong_hash, with_payload_size(static_cast<std::uint32_t>(-5)), with_payload_size(11),
-                           with_payload_size(9), with_payload_size(0x7fffffff), with_payload_size(0xffffffff)}) {
+  for (const Bytes& bad :
+       {Bytes{}, Bytes(valid.begin(), valid.begin() + 48), Bytes(valid.begin(), valid.end() - 1), trailing, wrong_hash,
+        with_payload_size(static_cast<std::uint32_t>(-5)), with_payload_size(11), with_payload_size(9),
+        with_payload_size(0x7fffffff), with_payload_size(0xffffffff)}) {
     EXPECT_FALSE(decode_lcm_envelope(bad, UINT64_MAX).has_value()) << bad.size();
   }
 }

@@ -62,8 +62,7 @@ TEST_F(LcmAdapterTest, HealthAndBadUrl) {
 }
 
 TEST_F(LcmAdapterTest, PeerSubscriberTimesOutWithoutMessages) {
-  Child sub({peer(), "sub", "--url", url_for(7701), "--channel", "NOBODY", "--count", "1",
-             "--timeout", "0.3"});
+  Child sub({peer(), "sub", "--url", url_for(7701), "--channel", "NOBODY", "--count", "1", "--timeout", "0.3"});
   ASSERT_TRUE(sub.wait_stderr("READY"));
   const auto code = sub.wait_exit();
   ASSERT_TRUE(code.has_value());
@@ -78,8 +77,8 @@ TEST_F(LcmAdapterTest, EnvelopeToNativeSubscriber) {
   ASSERT_TRUE(adapter->start(sink_).ok);
   ASSERT_TRUE(adapter->configure(bindings).ok);
 
-  Child sub({peer(), "sub", "--url", url_for(port), "--channel", "COSMIC_ENV", "--count",
-             std::to_string(kCount), "--timeout", "10"});
+  Child sub({peer(), "sub", "--url", url_for(port), "--channel", "COSMIC_ENV", "--count", std::to_string(kCount),
+             "--timeout", "10"});
   ASSERT_TRUE(sub.wait_stderr("READY")) << sub.stderr_text();
 
   for (std::uint32_t k = 1; k <= kCount; ++k) {
@@ -116,8 +115,7 @@ TEST_F(LcmAdapterTest, RawFromNativePublisherKeepsBytes) {
   constexpr int kCount = 60;
   constexpr std::size_t kSize = 64;
   auto adapter = make(port);
-  const std::vector<ChannelBinding> bindings{
-      binding(3, "NATIVE_POSE", HopRole::publisher, LcmEncoding::raw, 4242)};
+  const std::vector<ChannelBinding> bindings{binding(3, "NATIVE_POSE", HopRole::publisher, LcmEncoding::raw, 4242)};
   ASSERT_TRUE(adapter->start(sink_).ok);
   ASSERT_TRUE(adapter->configure(bindings).ok);
 
@@ -151,7 +149,8 @@ TEST_F(LcmAdapterTest, ANativeBindingNamesTheLcmChannelAndCarriesTheContentsRaw)
   wheel.spec.native.push_back(NativeBinding{"lcm0", std::nullopt, "WHEEL_SPEED", std::nullopt});
   ASSERT_TRUE(adapter->start(sink_).ok);
   ASSERT_TRUE(adapter->configure(std::vector<ChannelBinding>{wheel}).ok);
-  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "WHEEL_SPEED", "--raw", "--count", "5", "--size", "8", "--rate", "1000"});
+  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "WHEEL_SPEED", "--raw", "--count", "5", "--size", "8",
+             "--rate", "1000"});
   ASSERT_EQ(pub.wait_exit(), std::optional<int>(0)) << pub.stderr_text();
   ASSERT_TRUE(sink_.wait_events(9, 5)) << sink_.count(9);
   const auto events = sink_.events(9);
@@ -163,7 +162,8 @@ TEST_F(LcmAdapterTest, ANativeBindingNamesTheLcmChannelAndCarriesTheContentsRaw)
   // Nothing is read on the channel's own name.
   Child other({peer(), "pub", "--url", url_for(port), "--channel", "wheel", "--raw", "--count", "3", "--size", "8"});
   ASSERT_EQ(other.wait_exit(), std::optional<int>(0)) << other.stderr_text();
-  Child marker({peer(), "pub", "--url", url_for(port), "--channel", "WHEEL_SPEED", "--raw", "--count", "1", "--size", "4"});
+  Child marker(
+      {peer(), "pub", "--url", url_for(port), "--channel", "WHEEL_SPEED", "--raw", "--count", "1", "--size", "4"});
   ASSERT_EQ(marker.wait_exit(), std::optional<int>(0)) << marker.stderr_text();
   ASSERT_TRUE(sink_.wait_events(9, 6)) << sink_.count(9);
   EXPECT_EQ(sink_.count(9), 6u);  // the marker after the three on "wheel": those were never delivered
@@ -173,15 +173,13 @@ TEST_F(LcmAdapterTest, ANativeBindingNamesTheLcmChannelAndCarriesTheContentsRaw)
 TEST_F(LcmAdapterTest, RestartResubscribes) {
   const int port = 7709;
   auto adapter = make(port);
-  const std::vector<ChannelBinding> bindings{
-      binding(4, "AGAIN", HopRole::publisher, LcmEncoding::raw, 1)};
+  const std::vector<ChannelBinding> bindings{binding(4, "AGAIN", HopRole::publisher, LcmEncoding::raw, 1)};
   ASSERT_TRUE(adapter->start(sink_).ok);
   ASSERT_TRUE(adapter->configure(bindings).ok);
   adapter->stop();
-  ASSERT_TRUE(adapter->start(sink_).ok);  // stop() forgot the channels: a new start carries none
+  ASSERT_TRUE(adapter->start(sink_).ok);         // stop() forgot the channels: a new start carries none
   ASSERT_TRUE(adapter->configure(bindings).ok);  // until configured again, which joins the group
-  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "AGAIN", "--raw", "--count", "3",
-             "--size", "4"});
+  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "AGAIN", "--raw", "--count", "3", "--size", "4"});
   ASSERT_EQ(pub.wait_exit(), std::optional<int>(0)) << pub.stderr_text();
   ASSERT_TRUE(sink_.wait_events(4, 3));
   EXPECT_EQ(adapter->health().state, SegmentHealth::up);
@@ -192,9 +190,8 @@ TEST_F(LcmAdapterTest, RawSendIsRecordedByLcmLogger) {
   const int port = 7704;
   const std::string url = url_for(port);
   auto adapter = make(port);
-  const std::vector<ChannelBinding> bindings{
-      binding(1, "RAW_SCAN", HopRole::subscriber, LcmEncoding::raw),
-      binding(2, "COSMIC_PROBE", HopRole::subscriber, LcmEncoding::raw)};
+  const std::vector<ChannelBinding> bindings{binding(1, "RAW_SCAN", HopRole::subscriber, LcmEncoding::raw),
+                                             binding(2, "COSMIC_PROBE", HopRole::subscriber, LcmEncoding::raw)};
   ASSERT_TRUE(adapter->start(sink_).ok);
   ASSERT_TRUE(adapter->configure(bindings).ok);
 
@@ -209,8 +206,8 @@ TEST_F(LcmAdapterTest, RawSendIsRecordedByLcmLogger) {
   Child logger({COSMIC_LCM_LOGGER, "-q", "-f", "--flush-interval=10", "--lcm-url=" + url, log_path});
   // lcm-logger has no readiness signal: publish probes until one shows up in its file.
   const Bytes probe{0x50, 0x52, 0x4f, 0x42, 0x45};
-  ASSERT_TRUE(poll_until([&] { return count_channel(read_lcm_log(log_path), "COSMIC_PROBE") > 0; },
-                         kWait, [&] { adapter->send(outbound(2, probe)); }))
+  ASSERT_TRUE(poll_until([&] { return count_channel(read_lcm_log(log_path), "COSMIC_PROBE") > 0; }, kWait,
+                         [&] { adapter->send(outbound(2, probe)); }))
       << logger.stderr_text();
 
   // Sizes from 1 byte to a fragmented 20 kB message.
@@ -222,8 +219,8 @@ TEST_F(LcmAdapterTest, RawSendIsRecordedByLcmLogger) {
   // only when it writes an event, so probes keep nudging it until the message shows up.
   for (std::size_t i = 0; i < sent.size(); ++i) {
     ASSERT_EQ(adapter->send(outbound(1, sent[i])), SendStatus::sent);
-    ASSERT_TRUE(poll_until([&] { return count_channel(read_lcm_log(log_path), "RAW_SCAN") > i; },
-                           kWait, [&] { adapter->send(outbound(2, probe)); }))
+    ASSERT_TRUE(poll_until([&] { return count_channel(read_lcm_log(log_path), "RAW_SCAN") > i; }, kWait,
+                           [&] { adapter->send(outbound(2, probe)); }))
         << "message " << i << " not logged; " << logger.stderr_text();
   }
   logger.signal(SIGINT);
@@ -252,8 +249,8 @@ TEST_F(LcmAdapterTest, OwnEnvelopesAreNotReceivedBack) {
   for (std::uint32_t k = 1; k <= 10; ++k)
     ASSERT_EQ(adapter->send(outbound(5, own_pattern(k, 16), k, 0, self_.id)), SendStatus::sent);
 
-  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "LOOPED", "--count", "5", "--size",
-             "16", "--origin", "5", "--subject", "9"});
+  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "LOOPED", "--count", "5", "--size", "16", "--origin",
+             "5", "--subject", "9"});
   ASSERT_EQ(pub.wait_exit(), std::optional<int>(0)) << pub.stderr_text();
   ASSERT_TRUE(sink_.wait_events(5, 5));
 
@@ -275,8 +272,8 @@ TEST_F(LcmAdapterTest, OwnEnvelopesAreNotReceivedBack) {
 
   // Envelopes carrying this gateway's origin that it did not just publish (a loop through another
   // gateway, or a spoof) are delivered, for the router's ingress check to drop and count.
-  Child spoof({peer(), "pub", "--url", url_for(port), "--channel", "LOOPED", "--count", "3", "--size",
-               "16", "--origin", std::to_string(self_.id), "--subject", "9"});
+  Child spoof({peer(), "pub", "--url", url_for(port), "--channel", "LOOPED", "--count", "3", "--size", "16", "--origin",
+               std::to_string(self_.id), "--subject", "9"});
   ASSERT_EQ(spoof.wait_exit(), std::optional<int>(0)) << spoof.stderr_text();
   ASSERT_TRUE(sink_.wait_events(5, 8));
   for (std::size_t i = 5; i < 8; ++i) EXPECT_EQ(sink_.events(5).at(i).header.origin, self_.id);
@@ -296,11 +293,11 @@ TEST_F(LcmAdapterTest, DroppedOwnDatagramsAreNoOverflow) {
                                              binding(7, "LOOPED_DROP", HopRole::subscriber, LcmEncoding::raw, 12)};
   ASSERT_TRUE(adapter->start(sink_).ok);
   ASSERT_TRUE(adapter->configure(bindings).ok);
-  for (std::uint32_t k = 1; k <= 50; ++k)
-    ASSERT_EQ(adapter->send(outbound(7, own_pattern(k, 24))), SendStatus::sent);
+  for (std::uint32_t k = 1; k <= 50; ++k) ASSERT_EQ(adapter->send(outbound(7, own_pattern(k, 24))), SendStatus::sent);
   ASSERT_EQ(adapter->send(outbound(7, own_pattern(51, 150000))), SendStatus::sent);  // 3 fragments
 
-  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "LOOPED_DROP", "--raw", "--count", "5", "--size", "24"});
+  Child pub(
+      {peer(), "pub", "--url", url_for(port), "--channel", "LOOPED_DROP", "--raw", "--count", "5", "--size", "24"});
   ASSERT_EQ(pub.wait_exit(), std::optional<int>(0)) << pub.stderr_text();
   ASSERT_TRUE(sink_.wait_events(7, 5));
   const auto events = sink_.events(7);
@@ -318,10 +315,10 @@ TEST_F(LcmAdapterTest, DroppedOwnDatagramsAreNoOverflow) {
   // A new socket counts from 0 in the kernel and in the transmitter; the segment's figure goes on.
   ASSERT_TRUE(adapter->start(sink_).ok);
   ASSERT_TRUE(adapter->configure(bindings).ok);  // stop() forgot the channels
-  for (std::uint32_t k = 52; k <= 53; ++k)
-    ASSERT_EQ(adapter->send(outbound(7, own_pattern(k, 24))), SendStatus::sent);
+  for (std::uint32_t k = 52; k <= 53; ++k) ASSERT_EQ(adapter->send(outbound(7, own_pattern(k, 24))), SendStatus::sent);
   EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::optional<std::uint64_t>(55));
-  Child more({peer(), "pub", "--url", url_for(port), "--channel", "LOOPED_DROP", "--raw", "--count", "1", "--size", "24"});
+  Child more(
+      {peer(), "pub", "--url", url_for(port), "--channel", "LOOPED_DROP", "--raw", "--count", "1", "--size", "24"});
   ASSERT_EQ(more.wait_exit(), std::optional<int>(0)) << more.stderr_text();
   ASSERT_TRUE(sink_.wait_events(7, 6));
   EXPECT_EQ(udp_socket_drops(port), 2u);
@@ -341,7 +338,8 @@ TEST_F(LcmAdapterTest, ASegmentThatOnlySendsLeavesTheGroupUntilAChannelIsReceive
   ASSERT_TRUE(adapter->start(sink_).ok);
   ASSERT_TRUE(adapter->configure(std::vector{out}).ok);
 
-  Child sub({peer(), "sub", "--url", url_for(port), "--channel", "ONLY_OUT", "--raw", "--count", "10", "--timeout", "10"});
+  Child sub(
+      {peer(), "sub", "--url", url_for(port), "--channel", "ONLY_OUT", "--raw", "--count", "10", "--timeout", "10"});
   ASSERT_TRUE(sub.wait_stderr("READY")) << sub.stderr_text();
   for (std::uint32_t k = 1; k <= 10; ++k) ASSERT_EQ(adapter->send(outbound(8, own_pattern(k, 24))), SendStatus::sent);
   ASSERT_EQ(sub.wait_exit(), std::optional<int>(0)) << sub.stderr_text();
@@ -371,18 +369,16 @@ TEST_F(LcmAdapterTest, OwnRawMessagesAreNotReceivedBack) {
   const int port = 7706;
   segment_.lcm.own_datagrams = LcmOwnDatagrams::cut;
   auto adapter = make(port);
-  const std::vector<ChannelBinding> bindings{
-      binding(6, "LOOPED_RAW", HopRole::publisher, LcmEncoding::raw, 11),
-      binding(6, "LOOPED_RAW", HopRole::subscriber, LcmEncoding::raw, 11)};
+  const std::vector<ChannelBinding> bindings{binding(6, "LOOPED_RAW", HopRole::publisher, LcmEncoding::raw, 11),
+                                             binding(6, "LOOPED_RAW", HopRole::subscriber, LcmEncoding::raw, 11)};
   ASSERT_TRUE(adapter->start(sink_).ok);
   ASSERT_TRUE(adapter->configure(bindings).ok);
 
   // Raw messages carry no origin: only their source tells ours from a native program's.
-  for (std::uint32_t k = 1; k <= 10; ++k)
-    ASSERT_EQ(adapter->send(outbound(6, own_pattern(k, 24))), SendStatus::sent);
+  for (std::uint32_t k = 1; k <= 10; ++k) ASSERT_EQ(adapter->send(outbound(6, own_pattern(k, 24))), SendStatus::sent);
 
-  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "LOOPED_RAW", "--raw", "--count",
-             "5", "--size", "24"});
+  Child pub(
+      {peer(), "pub", "--url", url_for(port), "--channel", "LOOPED_RAW", "--raw", "--count", "5", "--size", "24"});
   ASSERT_EQ(pub.wait_exit(), std::optional<int>(0)) << pub.stderr_text();
   ASSERT_TRUE(sink_.wait_events(6, 5));
 

@@ -102,7 +102,8 @@ TEST_F(LcmAdapterTest, AnNrtSendStalledInTheKernelDoesNotDelayAnHrtSend) {
   auto nrt = std::async(std::launch::async, [&] { return adapter->send(outbound(1, payload, 1, 0, self_.id)); });
   {
     std::unique_lock lock(stall().mutex);
-    ASSERT_TRUE(stall().changed.wait_for(lock, kWait, [] { return stall().holding; })) << "the NRT send never reached sendmsg";
+    ASSERT_TRUE(stall().changed.wait_for(lock, kWait, [] { return stall().holding; }))
+        << "the NRT send never reached sendmsg";
   }
   // The NRT send is inside sendmsg now. An HRT send on the same segment completes regardless.
   auto hrt = std::async(std::launch::async, [&] { return adapter->send(outbound(2, payload, 1, 0, self_.id)); });
@@ -139,7 +140,8 @@ TEST_F(LcmAdapterTest, AnNrtBatchStalledInTheKernelDoesNotDelayAnHrtBatch) {
   auto nrt = std::async(std::launch::async, [&] { adapter->send_batch(nrt_events, nrt_results); });
   {
     std::unique_lock lock(stall().mutex);
-    ASSERT_TRUE(stall().changed.wait_for(lock, kWait, [] { return stall().holding; })) << "the NRT batch never reached sendmmsg";
+    ASSERT_TRUE(stall().changed.wait_for(lock, kWait, [] { return stall().holding; }))
+        << "the NRT batch never reached sendmmsg";
   }
   auto hrt = std::async(std::launch::async, [&] { adapter->send_batch(hrt_events, hrt_results); });
   const bool hrt_done = hrt.wait_for(kWait) == std::future_status::ready;

@@ -89,7 +89,9 @@ TEST(LcmSocketFilter, CutsOnlyTheExactSourceOfOwnTransmitSockets) {
     pollfd p{rx.fd, POLLIN, 0};
     if (::poll(&p, 1, 100) <= 0) continue;
     const int n = batch.receive(rx.fd);
-    for (int i = 0; i < n; ++i) size_by_sender[batch.sender(static_cast<std::size_t>(i)).key()] = batch.datagram(static_cast<std::size_t>(i)).size();
+    for (int i = 0; i < n; ++i)
+      size_by_sender[batch.sender(static_cast<std::size_t>(i)).key()] =
+          batch.datagram(static_cast<std::size_t>(i)).size();
   }
   ::close(rx.fd);
   ASSERT_EQ(size_by_sender.size(), 3u);
@@ -121,7 +123,9 @@ TEST(LcmSocketFilter, DropModeNeverQueuesOwnDatagramsAndTheKernelCountsThem) {
     pollfd p{rx.fd, POLLIN, 0};
     if (::poll(&p, 1, 100) <= 0) continue;
     const int n = batch.receive(rx.fd);
-    for (int i = 0; i < n; ++i) size_by_sender[batch.sender(static_cast<std::size_t>(i)).key()] = batch.datagram(static_cast<std::size_t>(i)).size();
+    for (int i = 0; i < n; ++i)
+      size_by_sender[batch.sender(static_cast<std::size_t>(i)).key()] =
+          batch.datagram(static_cast<std::size_t>(i)).size();
     drops = batch.kernel_drops();
   }
   ::close(rx.fd);

@@ -142,8 +142,8 @@ TEST(LcmTransmitReopen, ASocketWhoseAddressWentAwayIsReopenedOnTheNewOne) {
   }
   ASSERT_TRUE(after.has_value()) << "no datagram from a reopened socket";
   EXPECT_EQ(after->address, kSecondAddress);
-  EXPECT_TRUE(transmitter.is_own(*after));     // the receive side knows the new source as ours
-  EXPECT_FALSE(transmitter.is_own(*first));    // and the old one no longer
+  EXPECT_TRUE(transmitter.is_own(*after));         // the receive side knows the new source as ours
+  EXPECT_FALSE(transmitter.is_own(*first));        // and the old one no longer
   EXPECT_GE(rig.counters.send_errors.load(), 1u);  // the send that met the missing address
   EXPECT_TRUE(rig.log.has("transmit socket reopened"));
   // The receive socket's filter now cuts what the new source sends: its datagrams arrive empty.
@@ -156,7 +156,8 @@ TEST(LcmTransmitReopen, ASocketWhoseAddressWentAwayIsReopenedOnTheNewOne) {
     if (::poll(&p, 1, 100) <= 0) continue;
     const int n = batch.receive(rx.fd);
     for (int i = 0; i < n; ++i) {
-      if (batch.sender(static_cast<std::size_t>(i)) == *after) echo_size = batch.datagram(static_cast<std::size_t>(i)).size();
+      if (batch.sender(static_cast<std::size_t>(i)) == *after)
+        echo_size = batch.datagram(static_cast<std::size_t>(i)).size();
     }
   }
   ASSERT_TRUE(echo_size.has_value()) << "no echo of the new source on the receive socket";

@@ -29,7 +29,8 @@ TEST_F(LcmAdapterTest, MessagesBeyondOneDatagramCrossInFragmentsBothWays) {
   ASSERT_EQ(pub.wait_exit(), std::optional<int>(0)) << pub.stderr_text();
   ASSERT_TRUE(sink_.wait_events(1, 3)) << sink_.count(1) << " of 3 large messages";
   const auto in = sink_.events(1);
-  for (std::size_t i = 0; i < in.size(); ++i) EXPECT_EQ(in[i].payload, peer_pattern(i + 1, kLarge)) << "message " << i + 1;
+  for (std::size_t i = 0; i < in.size(); ++i)
+    EXPECT_EQ(in[i].payload, peer_pattern(i + 1, kLarge)) << "message " << i + 1;
 
   // We fragment, liblcm reassembles.
   Child sub({peer(), "sub", "--url", url_for(port), "--channel", "BIG_OUT", "--count", "3", "--timeout", "10"});
@@ -104,7 +105,8 @@ TEST_F(LcmAdapterTest, ABatchGoesOutInOrderWithEachEventsOwnStatus) {
   ASSERT_TRUE(adapter->configure(bindings).ok);
   ASSERT_TRUE(adapter->batches_sends());
   Child env({peer(), "sub", "--url", url_for(port), "--channel", "BATCH_ENV", "--count", "41", "--timeout", "10"});
-  Child raw({peer(), "sub", "--url", url_for(port), "--channel", "BATCH_RAW", "--raw", "--count", "4", "--timeout", "10"});
+  Child raw(
+      {peer(), "sub", "--url", url_for(port), "--channel", "BATCH_RAW", "--raw", "--count", "4", "--timeout", "10"});
   ASSERT_TRUE(env.wait_stderr("READY")) << env.stderr_text();
   ASSERT_TRUE(raw.wait_stderr("READY")) << raw.stderr_text();
 
@@ -143,7 +145,8 @@ TEST_F(LcmAdapterTest, ABatchGoesOutInOrderWithEachEventsOwnStatus) {
   const auto raw_lines = raw.stdout_lines();
   ASSERT_EQ(raw_lines.size(), 4u);
   for (std::size_t i = 0; i < raw_lines.size(); ++i)
-    EXPECT_EQ(nlohmann::json::parse(raw_lines[i])["payload"].get<std::string>(), hex(own_pattern(100 + 5 + 10 * i, 12)));
+    EXPECT_EQ(nlohmann::json::parse(raw_lines[i])["payload"].get<std::string>(),
+              hex(own_pattern(100 + 5 + 10 * i, 12)));
   EXPECT_EQ(adapter->statistics().sent, 45u);
   EXPECT_EQ(adapter->statistics().send_errors, 1u);
   adapter->stop();
@@ -178,7 +181,8 @@ class BlockingSink final : public EventSink {
 
 // `count` raw 64-byte messages on FLOOD from a peer; its exit status once it is done.
 std::optional<int> publish_flood(int port, int count) {
-  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "FLOOD", "--raw", "--count", std::to_string(count), "--size", "64"});
+  Child pub({peer(), "pub", "--url", url_for(port), "--channel", "FLOOD", "--raw", "--count", std::to_string(count),
+             "--size", "64"});
   return pub.wait_exit();
 }
 
@@ -202,7 +206,8 @@ TEST_F(LcmAdapterTest, DatagramsTheKernelDropsForAFullBufferAreCounted) {
     publish_flood(port, 1);
     drops = adapter->statistics().overflow_drops;
     return drops > 0;
-  })) << "no drop counted; received " << adapter->statistics().received;
+  })) << "no drop counted; received "
+      << adapter->statistics().received;
   const auto stats = adapter->statistics();
   EXPECT_LE(stats.received + stats.overflow_drops, 1u + 500u + 200u) << "more accounted for than were sent";
   EXPECT_GT(stats.received, 1u);
@@ -222,8 +227,9 @@ TEST_F(LcmAdapterTest, OwnDropsAndAFullBufferAreToldApart) {
   auto adapter = make_lcm_adapter(segment_, self_, logger_);
   BlockingSink sink;
   ASSERT_TRUE(adapter->start(sink).ok);
-  ASSERT_TRUE(adapter->configure(std::vector{binding(1, "FLOOD", HopRole::publisher, LcmEncoding::raw, 3),
-                                             binding(2, "MINE", HopRole::subscriber, LcmEncoding::raw, 4)})
+  ASSERT_TRUE(adapter
+                  ->configure(std::vector{binding(1, "FLOOD", HopRole::publisher, LcmEncoding::raw, 3),
+                                          binding(2, "MINE", HopRole::subscriber, LcmEncoding::raw, 4)})
                   .ok);
   ASSERT_EQ(publish_flood(port, 1), std::optional<int>(0));
   ASSERT_TRUE(sink.wait_events(1));  // the receive thread is held now
@@ -237,7 +243,8 @@ TEST_F(LcmAdapterTest, OwnDropsAndAFullBufferAreToldApart) {
     publish_flood(port, 1);
     socket_drops = udp_socket_drops(port);
     return socket_drops > 300 && adapter->statistics().overflow_drops == socket_drops - 300;
-  })) << "socket drops " << socket_drops << ", overflow_drops " << adapter->statistics().overflow_drops;
+  })) << "socket drops "
+      << socket_drops << ", overflow_drops " << adapter->statistics().overflow_drops;
   EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::optional<std::uint64_t>(300));
   adapter->stop();
 }

@@ -145,7 +145,8 @@ std::shared_ptr<CanAdapter::Table> CanAdapter::build_table(BindingPlan& plan) co
       // largest events).
       const std::uint32_t planned = b.can->can_id & CAN_EFF_MASK;
       const std::uint32_t can_id = famouso_ ? planned & ~kFamousoFragmentFlag : planned;
-      table->tx[b.id] = TxChannel{b.id, can_id, planned | kFamousoFragmentFlag, etag, payload, fragmented, std::nullopt};
+      table->tx[b.id] =
+          TxChannel{b.id, can_id, planned | kFamousoFragmentFlag, etag, payload, fragmented, std::nullopt};
       table->tx_etags.insert(etag);
       if (fragmented) {
         const std::size_t frames = famouso_ ? famouso::afp_fragment_count(payload) : fragment_count(payload, capacity_);
@@ -163,7 +164,8 @@ std::shared_ptr<CanAdapter::Table> CanAdapter::build_table(BindingPlan& plan) co
   table->filters = protocol_filters(famouso_);
   const std::vector<can_filter> native_filters = table->native.filters();
   if (table->rx.size() + native_filters.size() + table->filters.size() <= CAN_RAW_FILTER_MAX) {
-    for (const auto& [etag, channel] : table->rx) table->filters.push_back(can_filter{etag | CAN_EFF_FLAG, kEtagFilterMask});
+    for (const auto& [etag, channel] : table->rx)
+      table->filters.push_back(can_filter{etag | CAN_EFF_FLAG, kEtagFilterMask});
     table->filters.insert(table->filters.end(), native_filters.begin(), native_filters.end());
   } else {
     table->filters.assign(1, can_filter{0, 0});  // too many: every frame, filtered in user space
@@ -174,7 +176,8 @@ std::shared_ptr<CanAdapter::Table> CanAdapter::build_table(BindingPlan& plan) co
 
 std::optional<std::string> CanAdapter::bind_native(const ChannelBinding& b, Table& table) const {
   if (b.spec.payload > capacity_) {
-    return "payload " + std::to_string(b.spec.payload) + " B does not fit one native frame (" + std::to_string(capacity_) + " B)";
+    return "payload " + std::to_string(b.spec.payload) + " B does not fit one native frame (" +
+           std::to_string(capacity_) + " B)";
   }
   const NativeCanFrame frame{b.can->can_id, b.can->extended};
   const auto payload = static_cast<std::size_t>(b.spec.payload);

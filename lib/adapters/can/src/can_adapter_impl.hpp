@@ -66,16 +66,18 @@ constexpr Nanos kLinkCheckWhileDown = milliseconds(200);
 constexpr Nanos kLinkCheckWhileUp = milliseconds(1000);
 constexpr Nanos kEnobufsRetry = milliseconds(1);
 constexpr int kFramesPerWakeup = 256;
-constexpr std::size_t kReadBatch = 32;  // frames per recvmmsg
+constexpr std::size_t kReadBatch = 32;                        // frames per recvmmsg
 constexpr std::size_t kWriteBatch = FrameBacklog::kMaxTaken;  // frames per sendmmsg
-constexpr std::size_t kFdPaddingSlack = 15;  // 48 -> 64 is the largest step between FD lengths
+constexpr std::size_t kFdPaddingSlack = 15;                   // 48 -> 64 is the largest step between FD lengths
 constexpr can_err_mask_t kErrorMask = CAN_ERR_CRTL | CAN_ERR_BUSOFF | CAN_ERR_RESTARTED;
 constexpr Nanos kDeferredRequestRetry = std::chrono::milliseconds(20);  // well below one token (100 ms)
-constexpr std::size_t kMaxPendingRequests = 64;     // FAMOUSO: unanswered GET_ETAGs kept for a later bind
+constexpr std::size_t kMaxPendingRequests = 64;          // FAMOUSO: unanswered GET_ETAGs kept for a later bind
 constexpr std::size_t kMaxAnnouncedSubscriptions = 256;  // FAMOUSO: subscriptions logged once each
 constexpr canid_t kEtagFilterMask = 0x3FFF | CAN_EFF_FLAG;
 
-inline std::uint32_t source_key(const CanIdentifier& id) { return (static_cast<std::uint32_t>(id.tx_node) << 14) | id.etag; }
+inline std::uint32_t source_key(const CanIdentifier& id) {
+  return (static_cast<std::uint32_t>(id.tx_node) << 14) | id.etag;
+}
 
 // Binding answers leave one at a time, two frame times apart (an extended 8-byte frame is at
 // most 160 bits with stuffing), so at most one is in the kernel's FIFO ahead of a real-time frame.
@@ -200,7 +202,8 @@ class CanAdapter final : public SegmentAdapter {
   void handle_afp(const RxChannel& channel, const CanIdentifier& id, std::span<const std::uint8_t> data, Nanos now);
   void handle_protocol_timeouts(Nanos now);
   void deliver(const RxChannel& channel, std::span<const std::uint8_t> payload, Nanos now);
-  void deliver_native(const can_native::RxChannel& channel, std::span<const std::uint8_t> data, bool fd_frame, Nanos now);
+  void deliver_native(const can_native::RxChannel& channel, std::span<const std::uint8_t> data, bool fd_frame,
+                      Nanos now);
   void problem(ChannelId channel, InboundProblem what);
   void drain_backlog() COSMIC_EXCLUDES(io_mutex_);
   void refresh_rx_table() COSMIC_EXCLUDES(io_mutex_);  // the receive thread's snapshot of the bindings (rx_table_)
@@ -234,7 +237,8 @@ class CanAdapter final : public SegmentAdapter {
   void log_unlocked(const std::string& line) COSMIC_EXCLUDES(io_mutex_);  // a warning; nothing when empty
   SendStatus send_fragments(const TxChannel& channel, std::span<const std::uint8_t> payload, std::uint8_t sequence);
   // The event's channel when it can go out now as exactly one frame (send() takes the others).
-  const TxChannel* single_frame_channel(const Table& table, const OutboundEvent& event) const COSMIC_REQUIRES(io_mutex_);
+  const TxChannel* single_frame_channel(const Table& table, const OutboundEvent& event) const
+      COSMIC_REQUIRES(io_mutex_);
   canfd_frame single_frame(const TxChannel& channel, std::span<const std::uint8_t> payload) const;
   void queue_answer(std::uint32_t can_id, std::span<const std::uint8_t> data) COSMIC_REQUIRES(io_mutex_);
   void queue_supply_etag(std::uint8_t requester, std::uint16_t etag, std::uint64_t subject, const Table& table)
@@ -261,7 +265,7 @@ class CanAdapter final : public SegmentAdapter {
   // Receive-thread state.
   Reassembler reassembler_;
   famouso::AfpReassembler afp_;
-  std::optional<famouso::CcpBroker> ccp_;  // FAMOUSO segments only
+  std::optional<famouso::CcpBroker> ccp_;                          // FAMOUSO segments only
   std::vector<std::pair<std::uint8_t, std::uint64_t>> announced_;  // FAMOUSO subscriptions seen (node, subject)
   std::shared_ptr<const Table> rx_table_;
   std::uint64_t rx_generation_ = ~0ull;
@@ -272,9 +276,9 @@ class CanAdapter final : public SegmentAdapter {
   // send() and the receive thread take a reference to it under io_mutex_ and write outside it.
   // A priority-inheriting mutex: the lanes of all three classes and the receive thread take it.
   mutable PiMutex io_mutex_;
-  int sock_ COSMIC_GUARDED_BY(io_mutex_) = -1;  // the receive thread reads it unlocked: receive_socket()
+  int sock_ COSMIC_GUARDED_BY(io_mutex_) = -1;          // the receive thread reads it unlocked: receive_socket()
   TxSocketRef tx_socket_ COSMIC_GUARDED_BY(io_mutex_);  // owns sock_'s descriptor
-  int census_sock_ = -1;  // only the receive thread opens, reads and closes it
+  int census_sock_ = -1;                                // only the receive thread opens, reads and closes it
   bool census_error_logged_ = false;
   bool receive_buffer_warned_ = false;  // receive thread
   std::shared_ptr<const Table> table_ COSMIC_GUARDED_BY(io_mutex_);

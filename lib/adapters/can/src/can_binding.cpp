@@ -38,7 +38,8 @@ std::uint32_t supply_etag_id(std::uint8_t gateway_node) {
 }
 
 std::uint32_t supply_etag_new_bp_id() {
-  return encode_famouso_id(FamousoIdentifier{kFamousoProtocolPriority, false, kFamousoBrokerNode, kEtagSupplyEtagNewBp});
+  return encode_famouso_id(
+      FamousoIdentifier{kFamousoProtocolPriority, false, kFamousoBrokerNode, kEtagSupplyEtagNewBp});
 }
 
 std::optional<SupplyEtag> decode_supply_etag(std::span<const std::uint8_t> data) {

@@ -22,7 +22,7 @@ void CanAdapter::handle_frame(const canfd_frame& frame, bool fd_frame, Nanos now
     return;
   }
   if (table.native.is_background(frame.can_id)) return;  // another device's declared frame
-  if (!(frame.can_id & CAN_EFF_FLAG)) {  // an 11-bit frame: not ours (only without kernel filters)
+  if (!(frame.can_id & CAN_EFF_FLAG)) {                  // an 11-bit frame: not ours (only without kernel filters)
     problem(kNoChannel, InboundProblem::unknown_channel);
     return;
   }
@@ -89,7 +89,8 @@ void CanAdapter::reassembly_losses(ChannelId channel, std::optional<std::uint32_
 }
 
 // FAMOUSO segments: CCP requests (node ids) and SUBSCRIBE announcements.
-void CanAdapter::handle_famouso_protocol(const CanIdentifier& id, const canfd_frame& frame, std::size_t len, Nanos now) {
+void CanAdapter::handle_famouso_protocol(const CanIdentifier& id, const canfd_frame& frame, std::size_t len,
+                                         Nanos now) {
   const Table& table = *rx_table_;
   if (id.etag == kEtagCcpRsi) {
     if (table.tx_node) ccp_->reserve(*table.tx_node);
@@ -99,7 +100,8 @@ void CanAdapter::handle_famouso_protocol(const CanIdentifier& id, const canfd_fr
       queue_answer(answer->can_id, answer->data);
     } else if (ccp_->exhausted()) {
       problem(kNoChannel, InboundProblem::decode_error);
-      log_.log(LogLevel::warning, "segment " + segment_.name + ": CCP: every TxNode is taken, a node stays unconfigured");
+      log_.log(LogLevel::warning,
+               "segment " + segment_.name + ": CCP: every TxNode is taken, a node stays unconfigured");
     }
     return;
   }
@@ -193,7 +195,9 @@ void CanAdapter::defer_request(const can_binding::GetEtagRequest& request) {
   if (over % 1000 == 1) {
     log_.log(LogLevel::warning, "segment " + segment_.name + ": GET_ETAG from TxNode " +
                                     std::to_string(request.requester) + " over the rate limit, " +
-                                    (kept ? "answered later" : known ? "already waiting" : "deferred queue full, dropped") +
+                                    (kept    ? "answered later"
+                                     : known ? "already waiting"
+                                             : "deferred queue full, dropped") +
                                     " (" + std::to_string(over) + " over the limit so far)");
   }
 }
@@ -223,9 +227,11 @@ void CanAdapter::answer_request(const can_binding::GetEtagRequest& request, cons
   if (famouso_ && !known && pending_requests_.size() < kMaxPendingRequests) pending_requests_.push_back(request);
 }
 
-void CanAdapter::queue_supply_etag(std::uint8_t requester, std::uint16_t etag, std::uint64_t subject, const Table& table) {
+void CanAdapter::queue_supply_etag(std::uint8_t requester, std::uint16_t etag, std::uint64_t subject,
+                                   const Table& table) {
   if (!famouso_ && !table.tx_node) return;  // no channel bound yet: the gateway has no TxNode here
-  const std::uint32_t id = famouso_ ? can_binding::supply_etag_new_bp_id() : can_binding::supply_etag_id(*table.tx_node);
+  const std::uint32_t id =
+      famouso_ ? can_binding::supply_etag_new_bp_id() : can_binding::supply_etag_id(*table.tx_node);
   const auto frames = can_binding::supply_etag_data(requester, etag, subject);
   if (!answers_.room_for(frames.size())) {
     send_errors_ += frames.size();

@@ -49,8 +49,8 @@ std::size_t write_frames(int fd, std::span<const canfd_frame> frames, bool fd_fr
 std::string CanAdapter::drop_backlog(const char* why) {
   if (backlog_.empty()) return {};
   send_errors_ += backlog_.size();
-  std::string line = "segment " + segment_.name + ": dropped " + std::to_string(backlog_.size()) +
-                     " queued frames (" + why + ")";
+  std::string line =
+      "segment " + segment_.name + ": dropped " + std::to_string(backlog_.size()) + " queued frames (" + why + ")";
   backlog_.clear();
   backlog_size_ = 0;
   wait_pollout_ = false;
@@ -227,11 +227,10 @@ SendStatus CanAdapter::send(const OutboundEvent& event) {
         return SendStatus::failed;
       }
       found = &it->second;
-      const std::size_t frames = famouso_ && event.payload.size() > famouso::kAfpMtu
-                                     ? famouso::afp_fragment_count(event.payload.size())
-                                 : found->fragmented && !famouso_ && !found->native
-                                     ? fragment_count(event.payload.size(), capacity_)
-                                     : 1;
+      const std::size_t frames =
+          famouso_ && event.payload.size() > famouso::kAfpMtu ? famouso::afp_fragment_count(event.payload.size())
+          : found->fragmented && !famouso_ && !found->native  ? fragment_count(event.payload.size(), capacity_)
+                                                              : 1;
       if (frames > 1 && !backlog_.empty() && !backlog_.room_for(frames)) {
         ++send_errors_;
         return SendStatus::queue_full;
@@ -266,7 +265,8 @@ canfd_frame CanAdapter::single_frame(const TxChannel& channel, std::span<const s
   frame.can_id = channel.can_id | CAN_EFF_FLAG;
   frame.flags = fd && brs_ ? CANFD_BRS : 0;
   std::memcpy(frame.data, payload.data(), payload.size());
-  frame.len = static_cast<std::uint8_t>(fd ? fd_padded_length(static_cast<std::uint32_t>(payload.size())) : payload.size());
+  frame.len =
+      static_cast<std::uint8_t>(fd ? fd_padded_length(static_cast<std::uint32_t>(payload.size())) : payload.size());
   return frame;
 }
 
@@ -304,7 +304,8 @@ void CanAdapter::send_batch(std::span<const OutboundEvent> events, std::span<Sen
       continue;
     }
     const SendStatus status = to_send_status(submit(std::span(frames.data(), count), fd));
-    std::fill(results.begin() + static_cast<std::ptrdiff_t>(first), results.begin() + static_cast<std::ptrdiff_t>(i), status);
+    std::fill(results.begin() + static_cast<std::ptrdiff_t>(first), results.begin() + static_cast<std::ptrdiff_t>(i),
+              status);
   }
 }
 
@@ -330,21 +331,25 @@ SendStatus CanAdapter::send_fragments(const TxChannel& channel, std::span<const 
                                       std::uint8_t sequence) {
   const bool fd = segment_.can.fd;
   Fragmenter fragments(payload, capacity_, sequence);
-  return submit_in_batches(fd, [&] { return fragments.done(); }, [&](canfd_frame& frame) {
-    frame.can_id = channel.can_id | CAN_EFF_FLAG;
-    frame.flags = fd && brs_ ? CANFD_BRS : 0;
-    const std::size_t len = fragments.next(std::span<std::uint8_t>(frame.data, capacity_));
-    frame.len = static_cast<std::uint8_t>(fd ? fd_padded_length(static_cast<std::uint32_t>(len)) : len);
-  });
+  return submit_in_batches(
+      fd, [&] { return fragments.done(); },
+      [&](canfd_frame& frame) {
+        frame.can_id = channel.can_id | CAN_EFF_FLAG;
+        frame.flags = fd && brs_ ? CANFD_BRS : 0;
+        const std::size_t len = fragments.next(std::span<std::uint8_t>(frame.data, capacity_));
+        frame.len = static_cast<std::uint8_t>(fd ? fd_padded_length(static_cast<std::uint32_t>(len)) : len);
+      });
 }
 
 // FAMOUSO: an event of more than 8 bytes as AFP fragments with the identifier's fragment flag.
 SendStatus CanAdapter::send_afp(const TxChannel& channel, std::span<const std::uint8_t> payload) {
   famouso::AfpFragmenter fragments(payload);
-  return submit_in_batches(false, [&] { return fragments.done(); }, [&](canfd_frame& frame) {
-    frame.can_id = channel.afp_id | CAN_EFF_FLAG;
-    frame.len = static_cast<std::uint8_t>(fragments.next(std::span<std::uint8_t>(frame.data, famouso::kAfpMtu)));
-  });
+  return submit_in_batches(
+      false, [&] { return fragments.done(); },
+      [&](canfd_frame& frame) {
+        frame.can_id = channel.afp_id | CAN_EFF_FLAG;
+        frame.len = static_cast<std::uint8_t>(fragments.next(std::span<std::uint8_t>(frame.data, famouso::kAfpMtu)));
+      });
 }
 
 }  // namespace cosmic::can_detail

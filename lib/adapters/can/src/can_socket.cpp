@@ -105,8 +105,8 @@ void CanAdapter::size_receive_buffer(int s) {
                std::to_string(held) + " frames, not the " + std::to_string(wanted) + " the bus carries in " +
                std::to_string(kReceiveHold.count() / 1'000'000) +
                " ms: frames of a longer burst are lost when the receive thread falls behind (counted as "
-               "overflow drops). Set net.core.rmem_max to at least " + std::to_string(request) +
-               " or give cosmicd CAP_NET_ADMIN (SO_RCVBUFFORCE); see docs/operations.md");
+               "overflow drops). Set net.core.rmem_max to at least " +
+               std::to_string(request) + " or give cosmicd CAP_NET_ADMIN (SO_RCVBUFFORCE); see docs/operations.md");
 }
 
 // Unfiltered and with a small receive buffer: when the receive thread falls behind, the kernel
@@ -120,7 +120,8 @@ void CanAdapter::open_census_socket(int ifindex) {
   sockaddr_can addr{};
   addr.can_family = AF_CAN;
   addr.can_ifindex = ifindex;
-  const bool ok = s >= 0 && (!segment_.can.fd || ::setsockopt(s, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on, sizeof on) == 0) &&
+  const bool ok = s >= 0 &&
+                  (!segment_.can.fd || ::setsockopt(s, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on, sizeof on) == 0) &&
                   ::setsockopt(s, SOL_SOCKET, SO_RCVBUF, &buffer, sizeof buffer) == 0 &&
                   ::bind(s, reinterpret_cast<const sockaddr*>(&addr), sizeof addr) == 0;
   if (ok) {
@@ -131,7 +132,8 @@ void CanAdapter::open_census_socket(int ifindex) {
   if (s >= 0) ::close(s);
   if (!census_error_logged_) {
     census_error_logged_ = true;
-    log_.log(LogLevel::warning, "segment " + segment_.name + ": no census socket (unexplained frames are not counted): " + errno_text(err));
+    log_.log(LogLevel::warning, "segment " + segment_.name +
+                                    ": no census socket (unexplained frames are not counted): " + errno_text(err));
   }
 }
 
@@ -242,7 +244,8 @@ void CanAdapter::read_frames() {
   };
   std::array<Slot, kReadBatch> slots;
   std::array<mmsghdr, kReadBatch> messages;
-  for (int round = 0; round < kFramesPerWakeup / static_cast<int>(kReadBatch) && s >= 0 && receive_socket() == s; ++round) {
+  for (int round = 0; round < kFramesPerWakeup / static_cast<int>(kReadBatch) && s >= 0 && receive_socket() == s;
+       ++round) {
     for (std::size_t i = 0; i < kReadBatch; ++i) {
       slots[i].iov = iovec{&slots[i].frame, sizeof(canfd_frame)};
       messages[i] = mmsghdr{};

@@ -75,7 +75,8 @@ std::size_t AfpFragmenter::next(std::span<std::uint8_t> out) {
   return header + take;
 }
 
-AfpReassembler::AfpReassembler(AfpLimits limits) : limits_(limits), slots_(std::max<std::size_t>(1, limits.max_partial_events)) {}
+AfpReassembler::AfpReassembler(AfpLimits limits)
+    : limits_(limits), slots_(std::max<std::size_t>(1, limits.max_partial_events)) {}
 
 AfpReassembler::Slot* AfpReassembler::find(std::uint32_t source) {
   for (Slot& s : slots_) {

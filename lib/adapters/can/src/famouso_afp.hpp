@@ -55,8 +55,8 @@ struct AfpLimits {
 enum class AfpOutcome { partial, complete, rejected };
 struct AfpResult {
   AfpOutcome outcome = AfpOutcome::partial;
-  std::span<const std::uint8_t> event;  // complete: valid until the next call
-  bool dropped_event = false;           // a partial event of this source was given up
+  std::span<const std::uint8_t> event;     // complete: valid until the next call
+  bool dropped_event = false;              // a partial event of this source was given up
   std::optional<std::uint32_t> displaced;  // source whose partial event made room for this one
 };
 

@@ -42,7 +42,8 @@ std::optional<CcpFrame> CcpBroker::on_request(std::uint32_t can_id, Nanos now) {
   if (stage == kCcpFirstStage) uid_ = {};
   uid_[7] = static_cast<std::uint8_t>((uid_[7] & 0xF0) | stage);
   std::uint8_t& byte = uid_[7 - stage / 2];
-  byte = static_cast<std::uint8_t>(stage % 2 ? (byte & 0x0F) | (request->nibble << 4) : (byte & 0xF0) | request->nibble);
+  byte =
+      static_cast<std::uint8_t>(stage % 2 ? (byte & 0x0F) | (request->nibble << 4) : (byte & 0xF0) | request->nibble);
   last_round_ = now;
   if (stage > 0) {
     --stage_;

@@ -45,8 +45,10 @@ std::vector<can_filter> FrameTable::filters() const {
   return out;
 }
 
-std::optional<std::span<const std::uint8_t>> contents(const RxChannel& channel, std::span<const std::uint8_t> data, bool fd_frame) {
-  const std::size_t allowed = fd_frame ? fd_padded_length(static_cast<std::uint32_t>(channel.payload)) : channel.payload;
+std::optional<std::span<const std::uint8_t>> contents(const RxChannel& channel, std::span<const std::uint8_t> data,
+                                                      bool fd_frame) {
+  const std::size_t allowed =
+      fd_frame ? fd_padded_length(static_cast<std::uint32_t>(channel.payload)) : channel.payload;
   if (data.size() > allowed) return std::nullopt;
   return data.first(std::min(data.size(), channel.payload));
 }

@@ -58,7 +58,8 @@ class FrameTable {
 // A received frame's contents for `channel`: its data bytes, cut at the channel's payload where
 // a CAN FD frame carries padding up to the next FD length; nullopt for a frame longer than the
 // channel allows (a decode error).
-std::optional<std::span<const std::uint8_t>> contents(const RxChannel& channel, std::span<const std::uint8_t> data, bool fd_frame);
+std::optional<std::span<const std::uint8_t>> contents(const RxChannel& channel, std::span<const std::uint8_t> data,
+                                                      bool fd_frame);
 
 // The frame carrying `payload` as native frame `frame` (the caller checked it fits one frame).
 // `fd`: a CAN FD bus (data padded to the next FD length, `brs` sets bit-rate switching).

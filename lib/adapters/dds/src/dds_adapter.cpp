@@ -61,8 +61,7 @@ Status DdsAdapter::start(EventSink& sink) {
     log_attached_ = true;
   }
   try {
-    if (Status st = open_participant(ChannelClass::nrt, sink.receive_thread_policy(), "rx:" + segment_.name);
-        !st.ok) {
+    if (Status st = open_participant(ChannelClass::nrt, sink.receive_thread_policy(), "rx:" + segment_.name); !st.ok) {
       return fail(st.error);
     }
   } catch (const std::exception& e) {
@@ -72,8 +71,7 @@ Status DdsAdapter::start(EventSink& sink) {
   }
   sink_ = &sink;
   set_health(SegmentHealth::up, "domain " + std::to_string(segment_.dds.domain));
-  log_.log(LogLevel::info, prefix() + "participant up in domain " +
-                               std::to_string(segment_.dds.domain));
+  log_.log(LogLevel::info, prefix() + "participant up in domain " + std::to_string(segment_.dds.domain));
   return Status::success();
 }
 
@@ -193,9 +191,9 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
 }
 
 template <typename Entry>
-std::unique_ptr<Entry> DdsAdapter::create_endpoint(
-    const ChannelBinding& binding, std::string& error,
-    std::unique_ptr<Entry> (DdsAdapter::*create)(const ChannelBinding&, std::string&)) {
+std::unique_ptr<Entry> DdsAdapter::create_endpoint(const ChannelBinding& binding, std::string& error,
+                                                   std::unique_ptr<Entry> (DdsAdapter::*create)(const ChannelBinding&,
+                                                                                                std::string&)) {
   try {
     if (Status st = ensure_class_participant(binding.spec.cls); !st.ok) {
       error = st.error;
@@ -221,7 +219,8 @@ SendStatus DdsAdapter::send(const OutboundEvent& event) {
     std::uint16_t first_bytes = 0;
     if (const auto refusal = w.format->fill(event, first_bytes); refusal != FillRefusal::none) {
       counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
-      if (!w.refusal_logged.exchange(true, std::memory_order_relaxed)) warn_refused(w, refusal, first_bytes, event.payload.size());
+      if (!w.refusal_logged.exchange(true, std::memory_order_relaxed))
+        warn_refused(w, refusal, first_bytes, event.payload.size());
       return SendStatus::failed;
     }
     const ReturnCode_t rc = w.writer->write(w.format->sample(), dds::HANDLE_NIL);
@@ -324,14 +323,12 @@ void DdsAdapter::stop() {
 
 }  // namespace dds_detail
 
-std::unique_ptr<DdsSegmentAdapter> make_dds_segment_adapter(const SegmentSpec& segment,
-                                                            const GatewayIdentity& self,
+std::unique_ptr<DdsSegmentAdapter> make_dds_segment_adapter(const SegmentSpec& segment, const GatewayIdentity& self,
                                                             Logger& log) {
   return std::make_unique<dds_detail::DdsAdapter>(segment, self, log);
 }
 
-std::unique_ptr<SegmentAdapter> make_dds_adapter(const SegmentSpec& segment,
-                                                 const GatewayIdentity& self, Logger& log) {
+std::unique_ptr<SegmentAdapter> make_dds_adapter(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log) {
   return make_dds_segment_adapter(segment, self, log);
 }
 

@@ -58,10 +58,12 @@ struct ClassParticipant {
 
 struct WriterEntry : dds::DataWriterListener {
   WriterEntry(DdsAdapter& owner, ChannelId id, const ChannelSpec& spec, EndpointShape shape)
-      : owner(owner), id(id), spec(spec), shape(std::move(shape)),
+      : owner(owner),
+        id(id),
+        spec(spec),
+        shape(std::move(shape)),
         format(make_sample_format(this->shape.topic, spec)) {}
-  void on_offered_incompatible_qos(dds::DataWriter*,
-                                   const dds::OfferedIncompatibleQosStatus& status) override;
+  void on_offered_incompatible_qos(dds::DataWriter*, const dds::OfferedIncompatibleQosStatus& status) override;
 
   DdsAdapter& owner;
   std::atomic<std::uint64_t> incompatible{0};  // remote readers refused for their QoS
@@ -78,11 +80,13 @@ struct WriterEntry : dds::DataWriterListener {
 
 struct ReaderEntry : dds::DataReaderListener {
   ReaderEntry(DdsAdapter& owner, ChannelId id, const ChannelSpec& spec, EndpointShape shape)
-      : owner(owner), id(id), spec(spec), shape(std::move(shape)),
+      : owner(owner),
+        id(id),
+        spec(spec),
+        shape(std::move(shape)),
         format(make_sample_format(this->shape.topic, spec)) {}
   void on_data_available(dds::DataReader* reader) override;
-  void on_requested_incompatible_qos(dds::DataReader*,
-                                     const dds::RequestedIncompatibleQosStatus& status) override;
+  void on_requested_incompatible_qos(dds::DataReader*, const dds::RequestedIncompatibleQosStatus& status) override;
   void on_sample_lost(dds::DataReader*, const dds::SampleLostStatus& status) override;
 
   DdsAdapter& owner;
@@ -131,8 +135,7 @@ class DdsAdapter final : public DdsSegmentAdapter {
   }
   void count_lost(std::uint64_t n) { counters_.overflow_drops.fetch_add(n, std::memory_order_relaxed); }
   void warn(const std::string& text) { log_.log(LogLevel::warning, prefix() + text); }
-  void warn_refused(const WriterEntry& writer, FillRefusal refusal, std::uint16_t first_bytes,
-                    std::size_t size);
+  void warn_refused(const WriterEntry& writer, FillRefusal refusal, std::uint16_t first_bytes, std::size_t size);
 
  private:
   std::string prefix() const { return "dds segment " + segment_.name + ": "; }
@@ -150,7 +153,8 @@ class DdsAdapter final : public DdsSegmentAdapter {
   // included) comes back as nullptr and `error`.
   template <typename Entry>
   std::unique_ptr<Entry> create_endpoint(const ChannelBinding& binding, std::string& error,
-                                         std::unique_ptr<Entry> (DdsAdapter::*create)(const ChannelBinding&, std::string&));
+                                         std::unique_ptr<Entry> (DdsAdapter::*create)(const ChannelBinding&,
+                                                                                      std::string&));
   void destroy_writer(std::unique_ptr<WriterEntry> entry);
   void deactivate(ReaderEntry& entry);
   void destroy_reader(std::unique_ptr<ReaderEntry> entry);
@@ -177,7 +181,6 @@ class DdsAdapter final : public DdsSegmentAdapter {
   HealthCell health_;
   // Every participant's listener: the remote endpoints discovered, for peer_qos_conflicts().
   DiscoveryBook discovery_;
-
 };
 
 // Fast DDS's reception stamp (realtime clock) on the steady clock, never later than now.

@@ -19,9 +19,12 @@ std::optional<std::chrono::nanoseconds> duration_of(const eprosima::fastrtps::Du
 
 DdsDataRepresentationId representation_of(dds::DataRepresentationId_t id) {
   switch (id) {
-    case dds::XCDR2_DATA_REPRESENTATION: return DdsDataRepresentationId::xcdr2;
-    case dds::XML_DATA_REPRESENTATION: return DdsDataRepresentationId::xml;
-    default: return DdsDataRepresentationId::xcdr1;
+    case dds::XCDR2_DATA_REPRESENTATION:
+      return DdsDataRepresentationId::xcdr2;
+    case dds::XML_DATA_REPRESENTATION:
+      return DdsDataRepresentationId::xml;
+    default:
+      return DdsDataRepresentationId::xcdr1;
   }
 }
 
@@ -40,13 +43,14 @@ struct Policies {
 
 void fill(DdsEndpointQos& out, const Policies& p) {
   out.reliability = p.reliability.kind == dds::RELIABLE_RELIABILITY_QOS ? DdsReliabilityKind::reliable
-                                                                         : DdsReliabilityKind::best_effort;
+                                                                        : DdsReliabilityKind::best_effort;
   out.durability = static_cast<DdsDurabilityKind>(std::clamp(static_cast<int>(p.durability.kind), 0, 3));
   out.deadline = duration_of(p.deadline.period);
   out.latency_budget = duration_of(p.latency_budget.duration).value_or(std::chrono::nanoseconds::max());
   out.liveliness = static_cast<DdsLivelinessKind>(std::clamp(static_cast<int>(p.liveliness.kind), 0, 2));
   out.liveliness_lease = duration_of(p.liveliness.lease_duration);
-  out.ownership = p.ownership.kind == dds::EXCLUSIVE_OWNERSHIP_QOS ? DdsOwnershipKind::exclusive : DdsOwnershipKind::shared;
+  out.ownership =
+      p.ownership.kind == dds::EXCLUSIVE_OWNERSHIP_QOS ? DdsOwnershipKind::exclusive : DdsOwnershipKind::shared;
   out.destination_order = p.destination_order.kind == dds::BY_SOURCE_TIMESTAMP_DESTINATIONORDER_QOS
                               ? DdsDestinationOrderKind::by_source_timestamp
                               : DdsDestinationOrderKind::by_reception_timestamp;

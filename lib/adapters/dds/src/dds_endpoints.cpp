@@ -19,34 +19,39 @@ namespace {
 
 const char* policy_name(dds::QosPolicyId_t id) {
   switch (id) {
-    case dds::RELIABILITY_QOS_POLICY_ID: return "reliability";
-    case dds::DURABILITY_QOS_POLICY_ID: return "durability";
-    case dds::DEADLINE_QOS_POLICY_ID: return "deadline";
-    case dds::LATENCYBUDGET_QOS_POLICY_ID: return "latency_budget";
-    case dds::LIVELINESS_QOS_POLICY_ID: return "liveliness";
-    case dds::OWNERSHIP_QOS_POLICY_ID: return "ownership";
-    case dds::PARTITION_QOS_POLICY_ID: return "partition";
-    case dds::DATAREPRESENTATION_QOS_POLICY_ID: return "data_representation";
-    default: return "other";
+    case dds::RELIABILITY_QOS_POLICY_ID:
+      return "reliability";
+    case dds::DURABILITY_QOS_POLICY_ID:
+      return "durability";
+    case dds::DEADLINE_QOS_POLICY_ID:
+      return "deadline";
+    case dds::LATENCYBUDGET_QOS_POLICY_ID:
+      return "latency_budget";
+    case dds::LIVELINESS_QOS_POLICY_ID:
+      return "liveliness";
+    case dds::OWNERSHIP_QOS_POLICY_ID:
+      return "ownership";
+    case dds::PARTITION_QOS_POLICY_ID:
+      return "partition";
+    case dds::DATAREPRESENTATION_QOS_POLICY_ID:
+      return "data_representation";
+    default:
+      return "other";
   }
 }
 
 }  // namespace
 
-void WriterEntry::on_offered_incompatible_qos(dds::DataWriter*,
-                                              const dds::OfferedIncompatibleQosStatus& status) {
-  incompatible.fetch_add(static_cast<std::uint64_t>(status.total_count_change),
-                         std::memory_order_relaxed);
-  owner.warn("a reader of " + shape.topic.topic + " requests incompatible QoS (" +
-             policy_name(status.last_policy_id) + "); not matched");
+void WriterEntry::on_offered_incompatible_qos(dds::DataWriter*, const dds::OfferedIncompatibleQosStatus& status) {
+  incompatible.fetch_add(static_cast<std::uint64_t>(status.total_count_change), std::memory_order_relaxed);
+  owner.warn("a reader of " + shape.topic.topic + " requests incompatible QoS (" + policy_name(status.last_policy_id) +
+             "); not matched");
 }
 
-void ReaderEntry::on_requested_incompatible_qos(
-    dds::DataReader*, const dds::RequestedIncompatibleQosStatus& status) {
-  incompatible.fetch_add(static_cast<std::uint64_t>(status.total_count_change),
-                         std::memory_order_relaxed);
-  owner.warn("a writer of " + shape.topic.topic + " offers incompatible QoS (" +
-             policy_name(status.last_policy_id) + "); not matched");
+void ReaderEntry::on_requested_incompatible_qos(dds::DataReader*, const dds::RequestedIncompatibleQosStatus& status) {
+  incompatible.fetch_add(static_cast<std::uint64_t>(status.total_count_change), std::memory_order_relaxed);
+  owner.warn("a writer of " + shape.topic.topic + " offers incompatible QoS (" + policy_name(status.last_policy_id) +
+             "); not matched");
 }
 
 void ReaderEntry::on_sample_lost(dds::DataReader*, const dds::SampleLostStatus& status) {
@@ -117,11 +122,13 @@ std::vector<PeerQosConflict> DdsAdapter::peer_qos_conflicts(ChannelId channel) c
     std::optional<std::pair<DdsTopicRef, ChannelSpec>> writer, reader;
     {
       std::shared_lock lock(writers_mutex_);
-      if (auto it = writers_.find(channel); it != writers_.end()) writer.emplace(it->second->shape.topic, it->second->spec);
+      if (auto it = writers_.find(channel); it != writers_.end())
+        writer.emplace(it->second->shape.topic, it->second->spec);
     }
     {
       std::shared_lock lock(readers_mutex_);
-      if (auto it = readers_.find(channel); it != readers_.end()) reader.emplace(it->second->shape.topic, it->second->spec);
+      if (auto it = readers_.find(channel); it != readers_.end())
+        reader.emplace(it->second->shape.topic, it->second->spec);
     }
     std::vector<PeerQosConflict> out;
     if (writer) {
@@ -146,10 +153,11 @@ void DdsAdapter::warn_refused(const WriterEntry& writer, FillRefusal refusal, st
   char id[8];
   std::snprintf(id, sizeof id, "0x%04X", static_cast<unsigned>(first_bytes));
   const char* wanted = to_string(writer.shape.topic.representation);
-  const std::string why = refusal == FillRefusal::wrong_representation
-                              ? std::string("its encapsulation ") + id + " is not " + wanted + ", which the writer announces"
-                              : size < kDdsEncapsulationBytes ? "it is shorter than an encapsulation header"
-                                                              : std::string("it starts with ") + id + ", no CDR encapsulation";
+  const std::string why =
+      refusal == FillRefusal::wrong_representation
+          ? std::string("its encapsulation ") + id + " is not " + wanted + ", which the writer announces"
+      : size < kDdsEncapsulationBytes ? "it is shorter than an encapsulation header"
+                                      : std::string("it starts with ") + id + ", no CDR encapsulation";
   warn("channel " + writer.spec.name + ": an event of " + std::to_string(size) + " bytes is not a serialized " +
        writer.shape.topic.type + " sample for " + writer.shape.topic.topic + " (" + why +
        "); such events are not sent and count as send errors (logged once)");
@@ -182,15 +190,15 @@ dds::DomainParticipant* DdsAdapter::create_participant_as(const ThreadPolicy& th
 
 // Creates the participant of `cls` with its publisher and subscriber; on failure nothing of it
 // remains. Control thread, control_mutex_ held.
-Status DdsAdapter::open_participant(ChannelClass cls, const ThreadPolicy& threads,
-                                    const std::string& thread_name) {
+Status DdsAdapter::open_participant(ChannelClass cls, const ThreadPolicy& threads, const std::string& thread_name) {
   static const char* const kClassName[3] = {"hrt", "srt", "nrt"};
   ClassParticipant& home = home_of(cls);
   const std::string gateway = self_.name.empty() ? std::string("cosmicd") : self_.name;
   std::string name = gateway + "/" + segment_.name;
   if (cls != ChannelClass::nrt) name += std::string("/") + kClassName[static_cast<std::size_t>(cls)];
   dds::DomainParticipantQos qos;
-  if (Status st = participant_qos(segment_, name, segment_.dds.shared_memory[static_cast<std::size_t>(cls)], qos); !st.ok) {
+  if (Status st = participant_qos(segment_, name, segment_.dds.shared_memory[static_cast<std::size_t>(cls)], qos);
+      !st.ok) {
     return st;
   }
   ThreadPolicy policy = threads;
@@ -199,8 +207,9 @@ Status DdsAdapter::open_participant(ChannelClass cls, const ThreadPolicy& thread
   if (cls == ChannelClass::nrt) discovery_.clear();
   home.participant = create_participant_as(policy, qos);
   if (home.participant == nullptr) {
-    return Status::failure("cannot create a DDS participant (" + std::string(kClassName[static_cast<std::size_t>(cls)]) +
-                           ") in domain " + std::to_string(segment_.dds.domain));
+    return Status::failure("cannot create a DDS participant (" +
+                           std::string(kClassName[static_cast<std::size_t>(cls)]) + ") in domain " +
+                           std::to_string(segment_.dds.domain));
   }
   dds::TypeSupport type(new cosmic::EnvelopePubSubType());
   if (type.register_type(home.participant) != ReturnCode_t::RETCODE_OK) {
@@ -241,8 +250,7 @@ void DdsAdapter::close_participant(ClassParticipant& home) {
   if (home.publisher != nullptr) home.participant->delete_publisher(home.publisher);
   if (home.subscriber != nullptr) home.participant->delete_subscriber(home.subscriber);
   for (auto& [name, ref] : home.topics) home.participant->delete_topic(ref.topic);
-  if (dds::DomainParticipantFactory::get_instance()->delete_participant(home.participant) !=
-      ReturnCode_t::RETCODE_OK) {
+  if (dds::DomainParticipantFactory::get_instance()->delete_participant(home.participant) != ReturnCode_t::RETCODE_OK) {
     warn("cannot delete the DDS participant");
   }
   home = ClassParticipant{};
@@ -288,15 +296,13 @@ void DdsAdapter::release_topic(ClassParticipant& home, dds::Topic* topic) {
   }
 }
 
-std::unique_ptr<WriterEntry> DdsAdapter::create_writer(const ChannelBinding& binding,
-                                                       std::string& error) {
+std::unique_ptr<WriterEntry> DdsAdapter::create_writer(const ChannelBinding& binding, std::string& error) {
   auto entry = std::make_unique<WriterEntry>(*this, binding.id, binding.spec, shape_of(segment_, binding.spec));
   entry->home = &home_of(binding.spec.cls);
   entry->topic = acquire_topic(*entry->home, entry->shape.topic, error);
   if (entry->topic == nullptr) return nullptr;
-  entry->writer = entry->home->publisher->create_datawriter(entry->topic,
-                                                writer_qos(segment_, binding.spec),
-                                                entry.get(), dds::StatusMask::offered_incompatible_qos());
+  entry->writer = entry->home->publisher->create_datawriter(entry->topic, writer_qos(segment_, binding.spec),
+                                                            entry.get(), dds::StatusMask::offered_incompatible_qos());
   if (entry->writer == nullptr) {
     release_topic(*entry->home, entry->topic);
     error = "cannot create a DataWriter on " + entry->shape.topic.topic;
@@ -306,8 +312,7 @@ std::unique_ptr<WriterEntry> DdsAdapter::create_writer(const ChannelBinding& bin
   return entry;
 }
 
-std::unique_ptr<ReaderEntry> DdsAdapter::create_reader(const ChannelBinding& binding,
-                                                       std::string& error) {
+std::unique_ptr<ReaderEntry> DdsAdapter::create_reader(const ChannelBinding& binding, std::string& error) {
   auto entry = std::make_unique<ReaderEntry>(*this, binding.id, binding.spec, shape_of(segment_, binding.spec));
   entry->home = &home_of(binding.spec.cls);
   entry->own_prefix = entry->home->prefix;
@@ -315,11 +320,10 @@ std::unique_ptr<ReaderEntry> DdsAdapter::create_reader(const ChannelBinding& bin
   if (entry->topic == nullptr) return nullptr;
   entry->active = true;  // before the reader exists: no callback can race with this
   entry->format->reserve(std::min<std::uint64_t>(binding.spec.payload, segment_.max_message_size));
-  const dds::StatusMask mask = dds::StatusMask::data_available() <<
-                               dds::StatusMask::requested_incompatible_qos() <<
-                               dds::StatusMask::sample_lost();
-  entry->reader = entry->home->subscriber->create_datareader(
-      entry->topic, reader_qos(segment_, binding.spec), entry.get(), mask);
+  const dds::StatusMask mask = dds::StatusMask::data_available()
+                               << dds::StatusMask::requested_incompatible_qos() << dds::StatusMask::sample_lost();
+  entry->reader =
+      entry->home->subscriber->create_datareader(entry->topic, reader_qos(segment_, binding.spec), entry.get(), mask);
   if (entry->reader == nullptr) {
     release_topic(*entry->home, entry->topic);
     error = "cannot create a DataReader on " + entry->shape.topic.topic;

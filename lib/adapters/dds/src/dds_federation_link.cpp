@@ -62,8 +62,10 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
 
   std::string start() override {
     dds::DomainParticipantQos qos;
-    if (Status st = dds_detail::participant_qos(segment_, (self_.name.empty() ? "cosmicd" : self_.name) + "/federation",
-                                              segment_.dds.shared_memory[static_cast<std::size_t>(ChannelClass::nrt)], qos); !st.ok) {
+    if (Status st =
+            dds_detail::participant_qos(segment_, (self_.name.empty() ? "cosmicd" : self_.name) + "/federation",
+                                        segment_.dds.shared_memory[static_cast<std::size_t>(ChannelClass::nrt)], qos);
+        !st.ok) {
       return st.error;
     }
     // The participant's lease is what the others judge this gateway by: each reader drops a remote
@@ -71,14 +73,17 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
     qos.wire_protocol().builtin.discovery_config.leaseDuration = duration_of(lease_);
     qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod = duration_of(lease_ / 3);
     participant_ = create_participant(qos);
-    if (participant_ == nullptr) return "cannot create the federation's DDS participant in domain " + std::to_string(segment_.dds.domain);
+    if (participant_ == nullptr)
+      return "cannot create the federation's DDS participant in domain " + std::to_string(segment_.dds.domain);
     own_prefix_ = participant_->guid().guidPrefix;
     dds::TypeSupport type(new cosmic_federation::AnnouncementPubSubType());
-    if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK) return fail("cannot register the federation type");
+    if (type.register_type(participant_) != ReturnCode_t::RETCODE_OK)
+      return fail("cannot register the federation type");
     topic_ = participant_->create_topic(kTopic, type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
     publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
     subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
-    if (!topic_ || !publisher_ || !subscriber_) return fail("cannot create the federation topic, publisher or subscriber");
+    if (!topic_ || !publisher_ || !subscriber_)
+      return fail("cannot create the federation topic, publisher or subscriber");
     writer_ = publisher_->create_datawriter(topic_, writer_qos());
     const dds::StatusMask mask = dds::StatusMask::data_available() << dds::StatusMask::subscription_matched();
     reader_ = subscriber_->create_datareader(topic_, reader_qos(), this, mask);
@@ -103,7 +108,8 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
     cosmic_federation::Announcement sample;
     sample.gateway(announced_);
     if (writer_->dispose(&sample, dds::HANDLE_NIL) != ReturnCode_t::RETCODE_OK) {
-      log_.log(LogLevel::warning, "federation: cannot withdraw this gateway's announcement; peers release it after the lease");
+      log_.log(LogLevel::warning,
+               "federation: cannot withdraw this gateway's announcement; peers release it after the lease");
     }
     // Asynchronous publishing: give the dispose a moment to leave before the writer goes.
     writer_->wait_for_acknowledgments(duration_of(Nanos(500'000'000)));
@@ -158,7 +164,8 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
     const std::string name = ("fed:" + segment_.name).substr(0, 15);
     std::thread creator([&] {
       pthread_setname_np(pthread_self(), name.c_str());
-      created = dds::DomainParticipantFactory::get_instance()->create_participant(static_cast<dds::DomainId_t>(segment_.dds.domain), qos);
+      created = dds::DomainParticipantFactory::get_instance()->create_participant(
+          static_cast<dds::DomainId_t>(segment_.dds.domain), qos);
     });
     creator.join();
     return created;
@@ -211,7 +218,7 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
         m.body = std::move(sample.body());
       } else {
         m.kind = info.instance_state == dds::NOT_ALIVE_DISPOSED_INSTANCE_STATE ? FederationMessage::Kind::withdrawn
-                                                                              : FederationMessage::Kind::lost;
+                                                                               : FederationMessage::Kind::lost;
       }
       std::lock_guard lock(mutex_);
       queue(std::move(m));
@@ -247,8 +254,8 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
 
 }  // namespace
 
-std::unique_ptr<FederationLink> make_dds_federation_link(const SegmentSpec& segment, const GatewayIdentity& self, Nanos lease,
-                                                         Logger& log) {
+std::unique_ptr<FederationLink> make_dds_federation_link(const SegmentSpec& segment, const GatewayIdentity& self,
+                                                         Nanos lease, Logger& log) {
   return std::make_unique<DdsFederationLink>(segment, self, lease, log);
 }
 

@@ -49,9 +49,7 @@ class LogRouter {
  private:
   class Consumer : public dds::LogConsumer {
    public:
-    void Consume(const dds::Log::Entry& entry) override {
-      LogRouter::instance().forward(entry);
-    }
+    void Consume(const dds::Log::Entry& entry) override { LogRouter::instance().forward(entry); }
   };
   void forward(const dds::Log::Entry& entry) {
     LogLevel level = entry.kind == dds::Log::Error     ? LogLevel::error
@@ -87,8 +85,10 @@ class LogRouter {
   static bool is_peer_key_only_dispose(const dds::Log::Entry& entry) {
     const std::string_view category = entry.context.category ? entry.context.category : "";
     const std::string_view message = entry.message;
-    return (category == "RTPS_MSG_IN" && message.find("Ignoring Serialized Payload for too large key-only data") != std::string_view::npos) ||
-           (category == "RTPS_PDP" && message.find("Problem getting the key of the change, removing") != std::string_view::npos) ||
+    return (category == "RTPS_MSG_IN" &&
+            message.find("Ignoring Serialized Payload for too large key-only data") != std::string_view::npos) ||
+           (category == "RTPS_PDP" &&
+            message.find("Problem getting the key of the change, removing") != std::string_view::npos) ||
            (category == "RTPS_EDP" && message.find("Received change with no Key") != std::string_view::npos);
   }
   static constexpr const char* kKeyOnlyNote =

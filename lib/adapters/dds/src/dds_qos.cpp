@@ -77,8 +77,7 @@ bool is_ipv4(const std::string& text) {
 
 std::int32_t history_depth(std::uint32_t omission_degree) {
   const std::uint64_t depth = static_cast<std::uint64_t>(omission_degree) + 1;
-  return static_cast<std::int32_t>(
-      std::min<std::uint64_t>(std::max<std::uint64_t>(depth, 1), kMaxHistoryDepth));
+  return static_cast<std::int32_t>(std::min<std::uint64_t>(std::max<std::uint64_t>(depth, 1), kMaxHistoryDepth));
 }
 
 EndpointShape shape_of(const SegmentSpec& segment, const ChannelSpec& channel) {
@@ -96,7 +95,7 @@ dds::DataWriterQos writer_qos(const SegmentSpec& segment, const ChannelSpec& cha
   // (send() refuses others). The envelope keeps the default (XCDR), which every reader accepts.
   if (const auto native = channel.native_dds(segment.name)) {
     qos.representation().m_value = {native->representation == DdsRepresentation::xcdr2 ? dds::XCDR2_DATA_REPRESENTATION
-                                                                                        : dds::XCDR_DATA_REPRESENTATION};
+                                                                                       : dds::XCDR_DATA_REPRESENTATION};
   }
   // Offered QoS is chosen so that any requested QoS a default reader can have is satisfied:
   // RELIABLE serves reliable and best-effort readers, TRANSIENT_LOCAL serves volatile and
@@ -120,8 +119,7 @@ dds::DataWriterQos writer_qos(const SegmentSpec& segment, const ChannelSpec& cha
   // far beyond a real-time channel: half the reaction time, within [5 ms, 100 ms].
   Nanos heartbeat(kMaxHeartbeatNs);
   if (channel.reaction_time) {
-    heartbeat = std::clamp(*channel.reaction_time / 2, Nanos(kMinHeartbeatNs),
-                           Nanos(kMaxHeartbeatNs));
+    heartbeat = std::clamp(*channel.reaction_time / 2, Nanos(kMinHeartbeatNs), Nanos(kMaxHeartbeatNs));
   }
   qos.reliable_writer_qos().times.heartbeatPeriod = to_duration(heartbeat);
   // Synchronous publication: write() hands the sample to the transport on the calling thread,
@@ -164,7 +162,8 @@ dds::DataReaderQos reader_qos(const SegmentSpec& segment, const ChannelSpec& cha
 
 namespace {
 // Puts the segment's interface allow-list (IPv4 addresses or interface names) on `udp`.
-Status allow_interfaces(const std::vector<std::string>& interfaces, eprosima::fastdds::rtps::UDPv4TransportDescriptor& udp) {
+Status allow_interfaces(const std::vector<std::string>& interfaces,
+                        eprosima::fastdds::rtps::UDPv4TransportDescriptor& udp) {
   if (interfaces.empty()) return Status::success();
   const LocalAddresses local = local_ipv4_addresses();
   for (const std::string& entry : interfaces) {
@@ -205,7 +204,8 @@ Status participant_qos(const SegmentSpec& segment, const std::string& participan
     qos.transport().user_transports.push_back(udp);
     // Shared memory only reaches participants on this host, so an allow-list leaves it on.
     if (shared_memory) {
-      qos.transport().user_transports.push_back(std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
+      qos.transport().user_transports.push_back(
+          std::make_shared<eprosima::fastdds::rtps::SharedMemTransportDescriptor>());
     }
   }
 
@@ -218,10 +218,8 @@ Status participant_qos(const SegmentSpec& segment, const std::string& participan
     const std::string ip = text.substr(0, colon);
     const std::string port_text = text.substr(colon + 1);
     unsigned port = 0;
-    const auto [end, ec] =
-        std::from_chars(port_text.data(), port_text.data() + port_text.size(), port);
-    if (!is_ipv4(ip) || ec != std::errc() || end != port_text.data() + port_text.size() ||
-        port == 0 || port > 65535) {
+    const auto [end, ec] = std::from_chars(port_text.data(), port_text.data() + port_text.size(), port);
+    if (!is_ipv4(ip) || ec != std::errc() || end != port_text.data() + port_text.size() || port == 0 || port > 65535) {
       return Status::failure("DDS discovery_server '" + text + "' is not IPv4:PORT");
     }
     rtps::Locator_t locator;

@@ -51,10 +51,8 @@ EndpointShape shape_of(const SegmentSpec& segment, const ChannelSpec& channel);
 // not request (no deadline, latency_budget 0); readers request the least (the segment's
 // reliability, VOLATILE, no deadline). docs/dds-mapping.md lists every policy and why. A native
 // topic's writer announces its representation (XCDR or XCDR2); its reader accepts both.
-eprosima::fastdds::dds::DataWriterQos writer_qos(const SegmentSpec& segment,
-                                                 const ChannelSpec& channel);
-eprosima::fastdds::dds::DataReaderQos reader_qos(const SegmentSpec& segment,
-                                                 const ChannelSpec& channel);
+eprosima::fastdds::dds::DataWriterQos writer_qos(const SegmentSpec& segment, const ChannelSpec& channel);
+eprosima::fastdds::dds::DataReaderQos reader_qos(const SegmentSpec& segment, const ChannelSpec& channel);
 
 // Transports (interface allow-list; shared memory or UDP alone) and discovery (simple or
 // discovery-server client) of one of the segment's participants. Without `shared_memory` the

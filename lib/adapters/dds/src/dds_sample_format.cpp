@@ -63,7 +63,8 @@ class OpaqueFormat final : public DdsSampleFormat {
   FillRefusal fill(const OutboundEvent& event, std::uint16_t& first_bytes) override {
     const std::optional<DdsEncapsulation> header = read_dds_encapsulation(event.payload);
     if (!header || header->representation != representation_) {
-      first_bytes = event.payload.size() >= 2 ? static_cast<std::uint16_t>((event.payload[0] << 8) | event.payload[1]) : 0;
+      first_bytes =
+          event.payload.size() >= 2 ? static_cast<std::uint16_t>((event.payload[0] << 8) | event.payload[1]) : 0;
       return header ? FillRefusal::wrong_representation : FillRefusal::not_encapsulated;
     }
     sample_.bytes.assign(event.payload.begin(), event.payload.end());

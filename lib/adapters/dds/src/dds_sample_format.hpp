@@ -22,8 +22,8 @@ namespace cosmic::dds_detail {
 // Why an outbound event cannot go out in a format (hot path: no text, no allocation).
 enum class FillRefusal {
   none,
-  not_encapsulated,        // opaque: fewer than 4 bytes, or no CDR encapsulation identifier
-  wrong_representation,    // opaque: the header names the other extended CDR version
+  not_encapsulated,      // opaque: fewer than 4 bytes, or no CDR encapsulation identifier
+  wrong_representation,  // opaque: the header names the other extended CDR version
 };
 
 enum class DecodeResult { event, too_large };

@@ -28,8 +28,8 @@ int pthread_mutex_clocklock(pthread_mutex_t* restrict mutex, clockid_t clock_id,
   clock_gettime(clock_id, &now_on_clock);
   clock_gettime(CLOCK_REALTIME, &now_realtime);
   const long long kNs = 1000000000LL;
-  long long remaining = (long long)(abstime->tv_sec - now_on_clock.tv_sec) * kNs +
-                        (abstime->tv_nsec - now_on_clock.tv_nsec);
+  long long remaining =
+      (long long)(abstime->tv_sec - now_on_clock.tv_sec) * kNs + (abstime->tv_nsec - now_on_clock.tv_nsec);
   if (remaining < 0) {
     remaining = 0;
   }

@@ -64,7 +64,8 @@ BindingDiff BindingPlan::diff(std::span<const ChannelBinding> carried) const {
   BindingDiff d;
   const std::vector<const ChannelBinding*> wanted = accepted();
   for (const ChannelBinding* b : wanted) {
-    const auto before = std::find_if(carried.begin(), carried.end(), [&](const ChannelBinding& c) { return same_hop(c, *b); });
+    const auto before =
+        std::find_if(carried.begin(), carried.end(), [&](const ChannelBinding& c) { return same_hop(c, *b); });
     if (before == carried.end()) {
       d.added.push_back(b);
     } else if (!same_plan(*before, *b)) {
@@ -72,7 +73,8 @@ BindingDiff BindingPlan::diff(std::span<const ChannelBinding> carried) const {
     }
   }
   for (const ChannelBinding& c : carried) {
-    const bool kept = std::any_of(wanted.begin(), wanted.end(), [&](const ChannelBinding* b) { return same_hop(c, *b); });
+    const bool kept =
+        std::any_of(wanted.begin(), wanted.end(), [&](const ChannelBinding* b) { return same_hop(c, *b); });
     if (!kept) d.removed.push_back(c);
   }
   return d;

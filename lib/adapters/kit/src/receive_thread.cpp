@@ -10,7 +10,8 @@
 
 namespace cosmic {
 
-Result<void> ReceiveThread::start(ThreadPolicy policy, Logger& log, std::string log_prefix, std::function<void()> loop) {
+Result<void> ReceiveThread::start(ThreadPolicy policy, Logger& log, std::string log_prefix,
+                                  std::function<void()> loop) {
   if (running()) return Error{"the receive thread is running already"};
   if (wake_fd() < 0) {
     auto fd = posix_call("eventfd for the receive thread", [] { return ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC); });
@@ -21,7 +22,8 @@ Result<void> ReceiveThread::start(ThreadPolicy policy, Logger& log, std::string 
   stopping_.store(false, std::memory_order_release);
   try {
     thread_ = std::thread([&log, policy = std::move(policy), prefix = std::move(log_prefix), loop = std::move(loop)] {
-      for (const auto& problem : apply_thread_policy(policy)) log.log(LogLevel::warning, prefix + "receive thread: " + problem);
+      for (const auto& problem : apply_thread_policy(policy))
+        log.log(LogLevel::warning, prefix + "receive thread: " + problem);
       loop();
     });
   } catch (const std::exception& e) {

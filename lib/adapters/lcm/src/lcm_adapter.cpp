@@ -105,7 +105,8 @@ class LcmAdapter final : public SegmentAdapter {
     LockGuard control(control_mutex_);
     if (started_) return Status::failure("LCM segment " + segment_.name + " already started");
     const auto parsed = parse_lcm_url(segment_.lcm.url);
-    if (const auto* why = std::get_if<std::string>(&parsed)) return fail_start("bad LCM URL " + segment_.lcm.url + ": " + *why);
+    if (const auto* why = std::get_if<std::string>(&parsed))
+      return fail_start("bad LCM URL " + segment_.lcm.url + ": " + *why);
     const LcmUrl& url = std::get<LcmUrl>(parsed);
     if (url.memq) {
       // memq:// is private to one LCM instance: nothing reaches this segment and what it sends
@@ -133,7 +134,8 @@ class LcmAdapter final : public SegmentAdapter {
       rx.warnings.push_back("own datagrams are read back in full and skipped here (" + *why + ")");
       own_dropped = false;
     }
-    for (const auto& warning : rx.warnings) log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + warning);
+    for (const auto& warning : rx.warnings)
+      log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + warning);
     rx_fd_ = rx.fd;
     rx_url_ = url;
     member_ = true;  // open_receive_socket() joined the group
@@ -151,8 +153,8 @@ class LcmAdapter final : public SegmentAdapter {
     attach_sink(&sink);
     ThreadPolicy policy = sink.receive_thread_policy();
     policy.name = "rx:" + segment_.name;
-    auto running = receiver_.start(policy, log_, "LCM segment " + segment_.name + ": ",
-                                   [this, fd = rx_fd_] { receive_loop(fd); });
+    auto running =
+        receiver_.start(policy, log_, "LCM segment " + segment_.name + ": ", [this, fd = rx_fd_] { receive_loop(fd); });
     if (!running) {
       attach_sink(nullptr);
       transmit_.close();
@@ -245,7 +247,8 @@ class LcmAdapter final : public SegmentAdapter {
         for (std::size_t i = 0; i < count; ++i) results[from + i] = channels[i] ? memq_sent() : transmit_.unbound();
         continue;
       }
-      transmit_.send_batch(events.subspan(from, count), std::span(channels.data(), count), results.subspan(from, count));
+      transmit_.send_batch(events.subspan(from, count), std::span(channels.data(), count),
+                           results.subspan(from, count));
     }
   }
 
@@ -326,10 +329,11 @@ class LcmAdapter final : public SegmentAdapter {
     if (own_counting_) own_dropped_before_ += transmit_.own_drops();
     own_counting_ = from_now_on;
     if (from_now_on)
-      log_.log(LogLevel::notice, "LCM segment " + segment_.name +
-                                     ": while a channel is received here, its own datagrams loop back and its receive filter "
-                                     "drops them (own_datagrams: drop); each counts once in the host's UDP InErrors and "
-                                     "none in RcvbufErrors; cosmicctl segments --json reports them as own_datagrams_dropped");
+      log_.log(LogLevel::notice,
+               "LCM segment " + segment_.name +
+                   ": while a channel is received here, its own datagrams loop back and its receive filter "
+                   "drops them (own_datagrams: drop); each counts once in the host's UDP InErrors and "
+                   "none in RcvbufErrors; cosmicctl segments --json reports them as own_datagrams_dropped");
   }
 
   const Channel* transmitting(ChannelId id) const COSMIC_REQUIRES_SHARED(table_mutex_) {
@@ -474,9 +478,11 @@ class LcmAdapter final : public SegmentAdapter {
     } catch (const std::bad_alloc&) {
       outcome = LcmReassembler::Outcome::refused;  // no memory for the message: it is lost
     }
-    const std::uint64_t lost = reassembler_.abandoned() - abandoned_before + (outcome == LcmReassembler::Outcome::refused);
+    const std::uint64_t lost =
+        reassembler_.abandoned() - abandoned_before + (outcome == LcmReassembler::Outcome::refused);
     if (lost != 0) counters_.receive_errors.fetch_add(lost, std::memory_order_relaxed);
-    if (outcome == LcmReassembler::Outcome::complete) deliver(reassembler_.channel(), reassembler_.payload(), received_at, arrival);
+    if (outcome == LcmReassembler::Outcome::complete)
+      deliver(reassembler_.channel(), reassembler_.payload(), received_at, arrival);
   }
 
   bool receives(std::string_view name) const COSMIC_REQUIRES_SHARED(table_mutex_) {
@@ -524,7 +530,7 @@ class LcmAdapter final : public SegmentAdapter {
   ReceiveThread receiver_;  // runs receive_loop(); stop() ends it through its eventfd
   int rx_fd_ COSMIC_GUARDED_BY(control_mutex_) = -1;
   std::optional<LcmUrl> rx_url_ COSMIC_GUARDED_BY(control_mutex_);
-  bool member_ COSMIC_GUARDED_BY(control_mutex_) = false;  // rx_fd_ is a member of the group
+  bool member_ COSMIC_GUARDED_BY(control_mutex_) = false;     // rx_fd_ is a member of the group
   bool may_leave_ COSMIC_GUARDED_BY(control_mutex_) = false;  // leaving stops all of the group's datagrams
   // memq://: set by start() before the sink is attached, cleared by stop() after it is detached.
   std::atomic<bool> memq_{false};
@@ -537,8 +543,8 @@ class LcmAdapter final : public SegmentAdapter {
   lcm_detail::LcmTransmitter transmit_;
   // Receive thread only.
   LcmReassembler reassembler_;
-  std::uint32_t overflow_seen_ = 0;    // drops less own drops, modulo 2^32, at the last report
-  std::int64_t overflow_total_ = 0;    // ... followed without wrapping
+  std::uint32_t overflow_seen_ = 0;     // drops less own drops, modulo 2^32, at the last report
+  std::int64_t overflow_total_ = 0;     // ... followed without wrapping
   std::int64_t overflow_reported_ = 0;  // what overflow_drops got from this socket so far
 
   mutable Mutex own_count_mutex_;  // statistics() from any thread; start()/stop() write

@@ -19,7 +19,7 @@ struct Channel {
   std::string name;  // the LCM channel name, 1-63 bytes
   std::uint64_t subject = 0;
   std::shared_ptr<const LcmMessageFormat> format;  // envelope or raw: how its messages read and write
-  ChannelClass cls = ChannelClass::nrt;  // which transmit socket sends it
+  ChannelClass cls = ChannelClass::nrt;            // which transmit socket sends it
   bool rx = false;
   bool tx = false;
 };

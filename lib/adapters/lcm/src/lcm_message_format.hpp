@@ -22,8 +22,8 @@ namespace cosmic::lcm_detail {
 
 // What the receiving side knows of a message beside its bytes, for formats that carry less.
 struct LcmArrival {
-  std::uint64_t subject = 0;       // the channel's subject
-  std::int64_t realtime_ns = 0;    // when the kernel took it (wall clock, informational)
+  std::uint64_t subject = 0;     // the channel's subject
+  std::int64_t realtime_ns = 0;  // when the kernel took it (wall clock, informational)
 };
 
 // The parts of one message, in order: at most a header and the contents.

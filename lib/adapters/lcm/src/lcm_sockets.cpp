@@ -32,9 +32,7 @@ std::optional<sockaddr_in> group_address(const LcmUrl& url) {
   return out;
 }
 
-int set_int(int fd, int level, int name, int value) {
-  return ::setsockopt(fd, level, name, &value, sizeof value);
-}
+int set_int(int fd, int level, int name, int value) { return ::setsockopt(fd, level, name, &value, sizeof value); }
 
 // The socket's receive buffer as close to `bytes` as this process may make it; a warning when
 // it falls short.
@@ -42,9 +40,10 @@ void warn_if_short(int fd, std::size_t bytes, OpenedSocket& out) {
   const ReceiveBufferSize size = size_receive_buffer(fd, static_cast<long long>(std::min<std::size_t>(bytes, INT_MAX)));
   if (size.reported == 0 || !size.short_of_request()) return;
   out.warnings.push_back("the receive buffer holds " + std::to_string(size.usable()) + " bytes, not the " +
-                         std::to_string(size.requested) + " asked for: a burst beyond it is lost (counted as overflow "
-                         "drops). Set net.core.rmem_max to at least " + std::to_string(size.requested) +
-                         " or give cosmicd CAP_NET_ADMIN");
+                         std::to_string(size.requested) +
+                         " asked for: a burst beyond it is lost (counted as overflow "
+                         "drops). Set net.core.rmem_max to at least " +
+                         std::to_string(size.requested) + " or give cosmicd CAP_NET_ADMIN");
 }
 
 OpenedSocket failed(OpenedSocket out, int fd, std::string why) {
@@ -79,7 +78,8 @@ OpenedSocket open_receive_socket(const LcmUrl& url, std::size_t buffer_bytes) {
     out.sees_own_groups_only = true;
   if (set_int(fd, SOL_SOCKET, SO_TIMESTAMPNS, 1) != 0)
     out.warnings.push_back(failed_call("SO_TIMESTAMPNS (residence then starts when the datagram is read)"));
-  if (set_int(fd, SOL_SOCKET, SO_RXQ_OVFL, 1) != 0) out.warnings.push_back(failed_call("SO_RXQ_OVFL (drops not counted)"));
+  if (set_int(fd, SOL_SOCKET, SO_RXQ_OVFL, 1) != 0)
+    out.warnings.push_back(failed_call("SO_RXQ_OVFL (drops not counted)"));
   warn_if_short(fd, url.recv_buf_size ? *url.recv_buf_size : buffer_bytes, out);
   out.fd = fd;
   return out;
@@ -91,7 +91,8 @@ std::optional<std::string> set_group_membership(int fd, const LcmUrl& url, bool 
   ip_mreq membership{};
   membership.imr_multiaddr = group->sin_addr;
   membership.imr_interface.s_addr = htonl(INADDR_ANY);
-  if (::setsockopt(fd, IPPROTO_IP, member ? IP_ADD_MEMBERSHIP : IP_DROP_MEMBERSHIP, &membership, sizeof membership) == 0)
+  if (::setsockopt(fd, IPPROTO_IP, member ? IP_ADD_MEMBERSHIP : IP_DROP_MEMBERSHIP, &membership, sizeof membership) ==
+      0)
     return std::nullopt;
   return member ? failed_call(("joining " + url.group + " (check the multicast route)").c_str())
                 : failed_call(("leaving " + url.group).c_str());
@@ -104,10 +105,13 @@ OpenedSocket open_send_socket(const LcmUrl& url) {
   const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
   if (fd < 0) return failed(std::move(out), fd, failed_call("socket"));
   const int ttl = static_cast<int>(url.ttl.value_or(0));
-  if (set_int(fd, IPPROTO_IP, IP_MULTICAST_TTL, ttl) != 0) return failed(std::move(out), fd, failed_call("IP_MULTICAST_TTL"));
-  if (set_int(fd, IPPROTO_IP, IP_MULTICAST_LOOP, 1) != 0) return failed(std::move(out), fd, failed_call("IP_MULTICAST_LOOP"));
+  if (set_int(fd, IPPROTO_IP, IP_MULTICAST_TTL, ttl) != 0)
+    return failed(std::move(out), fd, failed_call("IP_MULTICAST_TTL"));
+  if (set_int(fd, IPPROTO_IP, IP_MULTICAST_LOOP, 1) != 0)
+    return failed(std::move(out), fd, failed_call("IP_MULTICAST_LOOP"));
   if (::connect(fd, reinterpret_cast<const sockaddr*>(&*group), sizeof *group) != 0)
-    return failed(std::move(out), fd, failed_call(("no route to " + url.group + " (check the multicast route)").c_str()));
+    return failed(std::move(out), fd,
+                  failed_call(("no route to " + url.group + " (check the multicast route)").c_str()));
   sockaddr_in local{};
   socklen_t length = sizeof local;
   if (::getsockname(fd, reinterpret_cast<sockaddr*>(&local), &length) != 0)
@@ -155,11 +159,13 @@ std::optional<std::string> self_test(const LcmUrl& url, int fd, std::chrono::mil
   const std::array<std::span<const std::uint8_t>, 1> parts{std::span<const std::uint8_t>(token)};
   const SendFailure sent = send_lcm_message(probe.fd, 0, kChannel, parts);
   ::close(probe.fd);
-  if (sent.failed()) return std::string("self test: ") + sent.what + (sent.error ? std::string(": ") + std::strerror(sent.error) : "");
+  if (sent.failed())
+    return std::string("self test: ") + sent.what + (sent.error ? std::string(": ") + std::strerror(sent.error) : "");
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   ReceiveBatch batch(8);
   for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) break;
     pollfd p{fd, POLLIN, 0};
     if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) continue;
@@ -172,9 +178,8 @@ std::optional<std::string> self_test(const LcmUrl& url, int fd, std::chrono::mil
         return std::nullopt;
     }
   }
-  return "self test: our own message on " + url.group + ":" + std::to_string(url.port) +
-         " did not come back within " + std::to_string(timeout.count()) +
-         " ms (check the multicast route, multicast loopback and the firewall)";
+  return "self test: our own message on " + url.group + ":" + std::to_string(url.port) + " did not come back within " +
+         std::to_string(timeout.count()) + " ms (check the multicast route, multicast loopback and the firewall)";
 }
 
 ReceiveBatch::ReceiveBatch(std::size_t slots) : slots_(slots), iovecs_(slots), headers_(slots) {
@@ -220,7 +225,8 @@ int ReceiveBatch::receive(int fd) {
 }
 
 std::span<const std::uint8_t> ReceiveBatch::datagram(std::size_t i) const {
-  return std::span<const std::uint8_t>(slots_[i].bytes.data(), std::min<std::size_t>(headers_[i].msg_len, kLcmMaxDatagram));
+  return std::span<const std::uint8_t>(slots_[i].bytes.data(),
+                                       std::min<std::size_t>(headers_[i].msg_len, kLcmMaxDatagram));
 }
 
 bool ReceiveBatch::truncated(std::size_t i) const {

@@ -218,9 +218,10 @@ void LcmTransmitter::reopen(ClassSender& sender, std::size_t index) {
   sender.last_reopen = now;
   OpenedSocket tx = open_send_socket(*url_);
   if (tx.fd < 0) {
-    health_.set(SegmentHealth::degraded, std::string("the ") + class_name(index) + " transmit socket cannot reopen: " + tx.error);
-    log_.log(LogLevel::error, "LCM segment " + segment_name_ + ": " + class_name(index) +
-                                  " transmit socket cannot reopen: " + tx.error);
+    health_.set(SegmentHealth::degraded,
+                std::string("the ") + class_name(index) + " transmit socket cannot reopen: " + tx.error);
+    log_.log(LogLevel::error,
+             "LCM segment " + segment_name_ + ": " + class_name(index) + " transmit socket cannot reopen: " + tx.error);
     return;
   }
   if (sender.fd >= 0) ::close(sender.fd);

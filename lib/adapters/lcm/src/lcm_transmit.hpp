@@ -94,7 +94,7 @@ class LcmTransmitter {
   HealthCell& health_;
   const std::atomic<bool>& receive_failing_;
 
-  std::optional<LcmUrl> url_;  // set by open() before any send, cleared by close() after them
+  std::optional<LcmUrl> url_;           // set by open() before any send, cleared by close() after them
   std::array<ClassSender, 3> senders_;  // indexed by ChannelClass
   // Each sender's source (Endpoint::key()), 0 when closed: written under its sender's mutex,
   // read by the receive thread.

@@ -21,7 +21,7 @@ void write_be(std::uint8_t* p, std::uint64_t v, std::size_t bytes) {
 }  // namespace
 
 std::array<std::uint8_t, kLcmEnvelopeHeaderSize> encode_lcm_envelope_header(const EventHeader& header,
-                                                                           std::uint32_t payload_size) {
+                                                                            std::uint32_t payload_size) {
   std::array<std::uint8_t, kLcmEnvelopeHeaderSize> out{};
   std::uint8_t* p = out.data();
   write_be(p, kLcmEnvelopeHash, 8);

@@ -50,9 +50,8 @@ const ChannelBinding* MemoryAdapter::find(const std::string& name) const {
 SendStatus MemoryAdapter::send(const OutboundEvent& event) {
   UniqueLock lock(mutex_);
   while (held_) lock.wait(released_);
-  const auto it = std::find_if(bindings_.begin(), bindings_.end(), [&](const auto& b) {
-    return b.id == event.channel && b.role == HopRole::subscriber;
-  });
+  const auto it = std::find_if(bindings_.begin(), bindings_.end(),
+                               [&](const auto& b) { return b.id == event.channel && b.role == HopRole::subscriber; });
   if (it == bindings_.end()) {
     ++stats_.send_errors;
     return SendStatus::failed;
@@ -165,7 +164,8 @@ std::vector<ChannelBinding> MemoryAdapter::bindings() const {
 std::optional<std::size_t> MemoryAdapter::matched_peers(ChannelId channel) const {
   LockGuard lock(mutex_);
   if (!discovery_) return std::nullopt;
-  const auto bound = std::find_if(bindings_.begin(), bindings_.end(), [&](const ChannelBinding& b) { return b.id == channel; });
+  const auto bound =
+      std::find_if(bindings_.begin(), bindings_.end(), [&](const ChannelBinding& b) { return b.id == channel; });
   if (bound == bindings_.end()) return std::nullopt;
   const auto peers = matched_.find(bound->spec.name);
   return peers == matched_.end() ? 0 : peers->second;

@@ -56,22 +56,22 @@ enum {
 
 /* A channel as the model (the YAML) describes it. Durations in nanoseconds, 0 = not given. */
 typedef struct {
-  const char* name;          /* the channel's name: DDS topic cosmic/<name>, LCM channel <name> */
-  uint64_t subject;          /* 64-bit subject UID */
+  const char* name; /* the channel's name: DDS topic cosmic/<name>, LCM channel <name> */
+  uint64_t subject; /* 64-bit subject UID */
   cosmic_class cls;
   int64_t period_ns;
   int64_t reaction_time_ns;
   int64_t temp_validity_ns;
   uint32_t omission_degree;
-  uint32_t payload;          /* largest event in bytes */
-  int roles;                 /* COSMIC_PUBLISH | COSMIC_SUBSCRIBE */
+  uint32_t payload; /* largest event in bytes */
+  int roles;        /* COSMIC_PUBLISH | COSMIC_SUBSCRIBE */
 } cosmic_channel_desc;
 
 typedef struct {
   uint64_t subject;
-  uint32_t sequence;  /* per publisher; 0 where the source has none (CAN) */
-  int64_t age_ns;     /* time spent in transit before the last gateway forwarded it */
-  uint32_t size;      /* bytes of the event */
+  uint32_t sequence; /* per publisher; 0 where the source has none (CAN) */
+  int64_t age_ns;    /* time spent in transit before the last gateway forwarded it */
+  uint32_t size;     /* bytes of the event */
 } cosmic_event_info;
 
 typedef void (*cosmic_event_fn)(const cosmic_event_info* info, const uint8_t* data, void* user);

@@ -66,7 +66,8 @@ class [[nodiscard]] Subscription {
 
  private:
   friend class Channel;
-  Subscription(std::weak_ptr<Channel> channel, std::uint64_t generation) : channel_(std::move(channel)), generation_(generation) {}
+  Subscription(std::weak_ptr<Channel> channel, std::uint64_t generation)
+      : channel_(std::move(channel)), generation_(generation) {}
   std::weak_ptr<Channel> channel_;
   std::uint64_t generation_ = 0;
 };
@@ -185,7 +186,8 @@ class Client {
   Channel& announce(const cosmic_channel_desc& desc, int timeout_ms = 5000) {
     if (!client_) throw std::runtime_error(std::string("cosmic_announce(") + desc.name + "): the client is closed");
     cosmic_channel* handle = cosmic_announce(client_, &desc, timeout_ms);
-    if (!handle) throw std::runtime_error(std::string("cosmic_announce(") + desc.name + "): " + cosmic_last_error(client_));
+    if (!handle)
+      throw std::runtime_error(std::string("cosmic_announce(") + desc.name + "): " + cosmic_last_error(client_));
     channels_.push_back(std::make_shared<Channel>(handle, client_));
     return *channels_.back();
   }

@@ -12,8 +12,8 @@ namespace cosmic {
 
 struct ConfigError {
   std::string file;
-  int line = 0;    // 1-based
-  int column = 0;  // 1-based
+  int line = 0;         // 1-based
+  int column = 0;       // 1-based
   std::string path;     // key path, e.g. channels[2].period
   std::string message;  // what is wrong
   std::string valid;    // what would be valid (may be empty)

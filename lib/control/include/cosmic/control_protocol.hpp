@@ -72,7 +72,9 @@ class ControlProtocol {
   bool admission_running() const { return !running_.empty(); }
   // Adds a read-only command (may_read applies) answered by `answer` on the control thread, e.g.
   // `peers` from the daemon's federation; its answer carries "ok" itself.
-  void add_reader(std::string command, std::function<nlohmann::json()> answer) { readers_[std::move(command)] = std::move(answer); }
+  void add_reader(std::string command, std::function<nlohmann::json()> answer) {
+    readers_[std::move(command)] = std::move(answer);
+  }
   // Installs the gate binds pass before their commit (only with an Offload: inline binds commit at once).
   void set_bind_gate(BindGate gate) { gate_ = std::move(gate); }
 
@@ -122,7 +124,7 @@ class ControlProtocol {
   ChangeObserver on_change_;
   Offload offload_;
   std::chrono::steady_clock::time_point started_;
-  std::string running_;  // what admission runs off the control thread, for `busy` answers
+  std::string running_;             // what admission runs off the control thread, for `busy` answers
   std::uint64_t log_sequence_ = 0;  // numbers audit and denial lines: no two are alike, none folded
   DenialLog denials_;               // which denials are logged (a burst is summarised)
   std::map<std::string, std::function<Json()>> readers_;  // add_reader()

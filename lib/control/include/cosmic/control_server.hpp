@@ -45,7 +45,7 @@ struct ControlServerOptions {
   // A connection with no request in progress and nothing to send is closed after this.
   std::chrono::milliseconds idle_timeout{30'000};
   mode_t socket_mode = 0660;
-  mode_t directory_mode = 0750;      // for a directory the server has to create
+  mode_t directory_mode = 0750;       // for a directory the server has to create
   std::optional<gid_t> socket_group;  // chown the socket to this group
   // Peers that may use the reserved slots and are not limited per uid (e.g. root and the admin
   // group). Called on the control thread at accept().

@@ -24,7 +24,8 @@ class DenialLog {
 
   // The count of this burst's denials when this one is to be logged, else nullopt (counted, not
   // logged). `command`: the request's command text (only known commands are told apart).
-  std::optional<std::uint64_t> deny(std::uint32_t uid, std::string_view command, std::chrono::steady_clock::time_point now);
+  std::optional<std::uint64_t> deny(std::uint32_t uid, std::string_view command,
+                                    std::chrono::steady_clock::time_point now);
 
  private:
   struct Burst {

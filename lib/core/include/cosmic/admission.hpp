@@ -60,11 +60,11 @@ struct CanHopPlan {
   std::uint8_t priority = 0;  // the identifier's priority field (7 bits in the FAMOUSO profile)
   std::uint32_t can_id = 0;   // 29-bit identifier of the hop's frames
   std::uint16_t etag = 0;
-  std::uint32_t frame_bytes = 0;        // data bytes of one frame (FD: padded length)
-  std::uint32_t frames_per_event = 1;   // > 1 for fragmented NRT events
-  Nanos transmission{0};                // worst-case time of one frame
-  Nanos jitter{0};                      // release jitter used in the analysis
-  std::optional<Nanos> response_time;   // nullopt: unbounded
+  std::uint32_t frame_bytes = 0;       // data bytes of one frame (FD: padded length)
+  std::uint32_t frames_per_event = 1;  // > 1 for fragmented NRT events
+  Nanos transmission{0};               // worst-case time of one frame
+  Nanos jitter{0};                     // release jitter used in the analysis
+  std::optional<Nanos> response_time;  // nullopt: unbounded
 };
 
 // The plan's identifier as the bus orders it (standard and extended identifiers compared the way
@@ -78,7 +78,7 @@ struct HopReport {
   HopRole role = HopRole::publisher;
   std::optional<CanHopPlan> can;
   std::optional<DdsTopicRef> dds;  // DDS hops: the topic and type the channel travels as
-  std::optional<Nanos> latency;  // worst-case latency this hop adds; nullopt: unbounded
+  std::optional<Nanos> latency;    // worst-case latency this hop adds; nullopt: unbounded
   std::vector<Check> checks;
   // CAN hops whose response time misses the reaction time: the background frames delaying it most.
   std::vector<BackgroundDelay> background;
@@ -134,9 +134,9 @@ struct SegmentLoad {
   SegmentType type = SegmentType::dds;
   double utilization = 0;  // everything the bus carries: the bound channels plus the background
   double max_utilization = 0;
-  double background = 0;   // CAN: the other devices' frames (segment key `background`), other gateways' included
+  double background = 0;  // CAN: the other devices' frames (segment key `background`), other gateways' included
   std::size_t background_frames = 0;
-  double peers = 0;        // what other gateways of the federation reserve (SegmentSpec::peer_load)
+  double peers = 0;  // what other gateways of the federation reserve (SegmentSpec::peer_load)
 };
 
 struct AdmissionReport {
@@ -202,13 +202,13 @@ class AdmissionSet {
     std::size_t hop;
   };
   struct Segment {
-    std::vector<HopRef> hops;  // bind order
-    double load = 0.0;                   // background_load plus the bound channels' hops
-    std::vector<CanStream> background;   // CAN: the background frames as streams, fixed with the spec
+    std::vector<HopRef> hops;           // bind order
+    double load = 0.0;                  // background_load plus the bound channels' hops
+    std::vector<CanStream> background;  // CAN: the background frames as streams, fixed with the spec
     double background_load = 0.0;
     std::vector<CanHopPlan> plans;     // CAN: one per hop, same order
     std::vector<CanBusAnalysis> runs;  // CAN: one per jitter iteration of the last analysis
-    bool pinned = false;  // CAN: priorities kept over a removal, not those a fresh plan gives
+    bool pinned = false;               // CAN: priorities kept over a removal, not those a fresh plan gives
   };
   struct CanSide {
     std::vector<bool> replanned;                 // by segment: priorities planned afresh
@@ -220,22 +220,23 @@ class AdmissionSet {
  public:
   // A newcomer analysed on top of the set; commit() binds it as analysed.
   struct Trial {
-    ChannelReport report;                  // the newcomer in the new set
+    ChannelReport report;                   // the newcomer in the new set
     std::vector<ChannelReport> broken_hrt;  // bound HRT channels the newcomer would reject, bind order
     // Background frames with a deadline (other gateways' HRT frames) that met it and would not.
     struct BrokenFrame {
-      std::string name;    // e.g. "gw1:steer"
-      std::string origin;  // e.g. "gateway gw1 (00000000000010ab)"
+      std::string name;               // e.g. "gw1:steer"
+      std::string origin;             // e.g. "gateway gw1 (00000000000010ab)"
       std::optional<Nanos> response;  // nullopt: unbounded
       Nanos deadline{0};
     };
     std::vector<BrokenFrame> broken_frames;
+
    private:
     friend class AdmissionSet;
     ChannelSpec spec;
     ChannelData data;
     std::vector<std::pair<std::size_t, double>> loads;  // touched segments
-    std::optional<CanSide> can;                          // nullopt: the CAN side is unchanged
+    std::optional<CanSide> can;                         // nullopt: the CAN side is unchanged
   };
   Trial trial(const ChannelSpec& channel, std::uint16_t etag) const;
   void commit(Trial trial);

@@ -79,8 +79,8 @@ struct CanStream {
 };
 
 struct CanBusTiming {
-  Nanos bit_time{0};           // tau_bit
-  Nanos error_frame_time{0};   // kErrorFrameBits nominal bits
+  Nanos bit_time{0};          // tau_bit
+  Nanos error_frame_time{0};  // kErrorFrameBits nominal bits
   CanFaultHypothesis errors;
   friend bool operator==(const CanBusTiming&, const CanBusTiming&) = default;
 };
@@ -106,7 +106,8 @@ std::vector<std::optional<Nanos>> response_times(std::span<const CanStream> stre
 class CanBusAnalysis {
  public:
   CanBusAnalysis() = default;
-  CanBusAnalysis(std::span<const CanStream> streams, const CanBusTiming& timing, const CanBusAnalysis* previous = nullptr);
+  CanBusAnalysis(std::span<const CanStream> streams, const CanBusTiming& timing,
+                 const CanBusAnalysis* previous = nullptr);
 
   // Same order as the input streams.
   const std::vector<std::optional<Nanos>>& results() const { return results_; }

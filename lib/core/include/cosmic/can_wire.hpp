@@ -20,7 +20,7 @@ std::uint32_t encode_can_id(const CanIdentifier& id);
 CanIdentifier decode_can_id(std::uint32_t can_id);
 
 inline constexpr std::uint16_t kMaxEtag = 16383;
-inline constexpr std::uint32_t kEtagMask = 0x3FFF;  // the etag bits of an extended identifier
+inline constexpr std::uint32_t kEtagMask = 0x3FFF;          // the etag bits of an extended identifier
 inline constexpr std::uint16_t kHighestReservedEtag = 100;  // 0..100 belong to protocols
 inline constexpr std::uint16_t kEtagGetEtag = 2;
 inline constexpr std::uint16_t kEtagSupplyEtag = 3;

@@ -16,12 +16,13 @@
 namespace cosmic {
 
 struct DbcMessage {
-  std::string name;                 // BO_ name
-  std::uint32_t can_id = 0;         // identifier without the extended flag (11 or 29 bits)
-  bool extended = false;            // bit 31 of the DBC id was set
-  std::uint32_t length = 0;         // data bytes as the DBC declares (0..64; > 8 means CAN FD)
-  std::optional<Nanos> cycle_time;  // GenMsgCycleTime (explicit BA_, else the BA_DEF_DEF_ default); nullopt when none or 0
-  int line = 0, column = 0;         // 1-based, of the BO_ keyword
+  std::string name;          // BO_ name
+  std::uint32_t can_id = 0;  // identifier without the extended flag (11 or 29 bits)
+  bool extended = false;     // bit 31 of the DBC id was set
+  std::uint32_t length = 0;  // data bytes as the DBC declares (0..64; > 8 means CAN FD)
+  std::optional<Nanos>
+      cycle_time;            // GenMsgCycleTime (explicit BA_, else the BA_DEF_DEF_ default); nullopt when none or 0
+  int line = 0, column = 0;  // 1-based, of the BO_ keyword
 };
 
 // line and column are 1-based; both are 0 for a problem of the whole text (its size) and for the

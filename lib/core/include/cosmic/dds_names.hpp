@@ -40,11 +40,12 @@ DdsTopicRef dds_topic_of(const ChannelSpec& channel, const std::string& segment)
 
 // Why two distinct channels among `channels` cannot share the DDS segment `segment` (both
 // map to one topic), or nullopt.
-std::optional<std::string> dds_topic_collision(std::span<const ChannelSpec* const> channels, const std::string& segment);
+std::optional<std::string> dds_topic_collision(std::span<const ChannelSpec* const> channels,
+                                               const std::string& segment);
 // Every channel among `channels` whose topic on `segment` an earlier, distinct channel already
 // maps to, with the reason (the first of them is what dds_topic_collision() says).
-std::vector<std::pair<const ChannelSpec*, std::string>> dds_topic_collisions(std::span<const ChannelSpec* const> channels,
-                                                                             const std::string& segment);
+std::vector<std::pair<const ChannelSpec*, std::string>> dds_topic_collisions(
+    std::span<const ChannelSpec* const> channels, const std::string& segment);
 
 // Why `name` cannot be a native topic name, or nullopt. Topic names are letters, digits, '_' and
 // '/' separators (ROS 2: rt/<name>, possibly namespaced), start with a letter, at most

@@ -17,11 +17,11 @@ inline constexpr ChannelId kNoChannel = 0xFFFFFFFF;
 // (a CAN device, a raw LCM publisher) have origin 0, sequence 0 and age 0.
 struct EventHeader {
   std::uint64_t subject = 0;
-  std::uint64_t origin = 0;    // id of the gateway that first forwarded the event, 0 = native source
-  std::uint32_t sequence = 0;  // per origin and channel, starts at 1
-  std::uint8_t hop_count = 0;  // gateways crossed so far
-  std::int64_t created_ns = 0; // creation time on the origin's clock (informational, no clock sync)
-  std::int64_t age_ns = 0;     // time already spent in transit when it reached this gateway
+  std::uint64_t origin = 0;     // id of the gateway that first forwarded the event, 0 = native source
+  std::uint32_t sequence = 0;   // per origin and channel, starts at 1
+  std::uint8_t hop_count = 0;   // gateways crossed so far
+  std::int64_t created_ns = 0;  // creation time on the origin's clock (informational, no clock sync)
+  std::int64_t age_ns = 0;      // time already spent in transit when it reached this gateway
 };
 
 // What a wire format carries of an event's identity, as the format unit says (envelopes: all of

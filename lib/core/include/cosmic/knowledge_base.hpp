@@ -42,7 +42,7 @@ struct SegmentState {
 
 // What the other gateways of a federation reserve on one network (docs/federation.md).
 struct PeerReservations {
-  double bits_per_second = 0;  // DDS and LCM: the bandwidth their channels reserve
+  double bits_per_second = 0;              // DDS and LCM: the bandwidth their channels reserve
   std::vector<CanBackgroundFrame> frames;  // CAN: their frames, analysed like background frames
   // Channels they send onto the network: a channel of this gateway with the same subject that it
   // receives from there is admitted over the whole path (cosmic/upstream_path.hpp).
@@ -126,8 +126,8 @@ class KnowledgeBase {
   // the name of one frame carrying each.
   std::map<std::uint16_t, std::string> peer_etags_;
   std::set<std::uint16_t> reserved_etags_;
-  EtagMap etags_;                                         // bound CAN channels
-  std::bitset<kMaxEtag + 1> etag_taken_;                  // reserved or bound: never handed out
+  EtagMap etags_;                                            // bound CAN channels
+  std::bitset<kMaxEtag + 1> etag_taken_;                     // reserved or bound: never handed out
   std::unordered_map<std::uint64_t, std::string> subjects_;  // subject -> bound channel
   // Native identities of bound channels: (segment, identity) -> channel, and the etag bits of
   // their extended CAN identifiers (never handed out while such a channel is bound).

@@ -34,10 +34,10 @@ class LcmReassembler {
   explicit LcmReassembler(std::size_t max_message_size);
 
   enum class Outcome {
-    pending,    // kept; the message is not complete yet
-    complete,   // the message is whole: see channel() and payload()
-    refused,    // this fragment was not taken (too large, inconsistent, duplicate)
-    ignored,    // a fragment of a message completed or skipped lately: nothing wrong, nothing kept
+    pending,   // kept; the message is not complete yet
+    complete,  // the message is whole: see channel() and payload()
+    refused,   // this fragment was not taken (too large, inconsistent, duplicate)
+    ignored,   // a fragment of a message completed or skipped lately: nothing wrong, nothing kept
   };
 
   // One fragment (LcmDatagram::fragment set) from `sender`. After `complete`, channel() and
@@ -81,8 +81,8 @@ class LcmReassembler {
   const std::size_t max_message_size_;
   const std::size_t budget_;
   std::vector<Partial> partials_;
-  std::size_t bytes_held_ = 0;    // payload buffers
-  std::size_t bookkeeping_ = 0;   // per-fragment flags and slices, counted in the budget too
+  std::size_t bytes_held_ = 0;   // payload buffers
+  std::size_t bookkeeping_ = 0;  // per-fragment flags and slices, counted in the budget too
   // The messages completed last (sender, sequence): a late duplicate of theirs is refused.
   std::array<std::pair<std::uint64_t, std::uint32_t>, kMaxSenders> finished_{};
   std::size_t next_finished_ = 0;

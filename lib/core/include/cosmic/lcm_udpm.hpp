@@ -32,7 +32,7 @@ inline constexpr std::size_t kLcmFragmentHeaderSize = 20;
 inline constexpr std::size_t kLcmShortMessageMax = 65499;  // channel + NUL + payload
 inline constexpr std::size_t kLcmFragmentMaxData = 65487;  // bytes after a fragment's header
 inline constexpr std::size_t kLcmMaxDatagram = kLcmFragmentHeaderSize + kLcmFragmentMaxData;
-inline constexpr std::size_t kLcmMaxChannelBytes = 63;      // LCM_MAX_CHANNEL_NAME_LENGTH
+inline constexpr std::size_t kLcmMaxChannelBytes = 63;  // LCM_MAX_CHANNEL_NAME_LENGTH
 
 // One parsed datagram. Spans point into the parsed bytes.
 struct LcmDatagram {
@@ -55,8 +55,7 @@ std::optional<LcmDatagram> parse_lcm_datagram(std::span<const std::uint8_t> byte
 
 // Headers to send (big-endian, as above).
 std::array<std::uint8_t, kLcmShortHeaderSize> lcm_short_header(std::uint32_t sequence);
-std::array<std::uint8_t, kLcmFragmentHeaderSize> lcm_fragment_header(std::uint32_t sequence,
-                                                                     std::uint32_t message_size,
+std::array<std::uint8_t, kLcmFragmentHeaderSize> lcm_fragment_header(std::uint32_t sequence, std::uint32_t message_size,
                                                                      std::uint32_t fragment_offset,
                                                                      std::uint16_t fragment_no,
                                                                      std::uint16_t fragment_count);

@@ -15,11 +15,11 @@ namespace cosmic {
 inline constexpr std::uint16_t kLcmDefaultPort = 7667;
 
 struct LcmUrl {
-  bool memq = false;          // memq://: in-process, private to each LCM instance
-  std::string group;          // udpm: IPv4 multicast group, dotted decimal as written
+  bool memq = false;  // memq://: in-process, private to each LCM instance
+  std::string group;  // udpm: IPv4 multicast group, dotted decimal as written
   std::uint16_t port = kLcmDefaultPort;
-  std::optional<unsigned> ttl;             // ?ttl=N (0..255)
-  std::optional<unsigned> recv_buf_size;   // ?recv_buf_size=BYTES
+  std::optional<unsigned> ttl;            // ?ttl=N (0..255)
+  std::optional<unsigned> recv_buf_size;  // ?recv_buf_size=BYTES
 };
 
 // `url` parsed: "memq://", or "udpm://A.B.C.D[:PORT][?ttl=N][&recv_buf_size=N]" (bare "udpm://" is

@@ -40,13 +40,13 @@ enum class CanProfile { cosmic, famouso };
 // YAML): it delays the gateway's frames like any frame does (interference when its identifier
 // wins arbitration, blocking when it loses), so the response-time analysis and the bus load count it.
 struct CanBackgroundFrame {
-  std::string name;           // the DBC message's name, or "0x123" / "0x18FF0001x" from the YAML
-  std::uint32_t can_id = 0;   // 11 or 29 bits, without flags
-  bool extended = false;      // 29-bit identifier
-  std::uint32_t length = 0;   // data bytes (FD: one of the FD lengths)
-  Nanos period{0};            // minimum inter-arrival time (> 0)
-  Nanos jitter{0};            // queuing jitter
-  std::string origin;         // where it was declared: "body.dbc:12:1" or "robot.yaml:20:9"
+  std::string name;          // the DBC message's name, or "0x123" / "0x18FF0001x" from the YAML
+  std::uint32_t can_id = 0;  // 11 or 29 bits, without flags
+  bool extended = false;     // 29-bit identifier
+  std::uint32_t length = 0;  // data bytes (FD: one of the FD lengths)
+  Nanos period{0};           // minimum inter-arrival time (> 0)
+  Nanos jitter{0};           // queuing jitter
+  std::string origin;        // where it was declared: "body.dbc:12:1" or "robot.yaml:20:9"
   // Another gateway's frame of an HRT channel (federation): the longest response time it may have
   // with that channel still admitted there. A bind here that would push it beyond is rejected.
   std::optional<Nanos> deadline;
@@ -96,7 +96,7 @@ struct SegmentSpec {
   BitRate bandwidth{100'000'000};
   Nanos latency_bound{Nanos(10'000'000)};
   Reliability reliability = Reliability::reliable;
-  bool realtime = false;                 // network guarantees latency_bound (e.g. TSN)
+  bool realtime = false;                   // network guarantees latency_bound (e.g. TSN)
   std::uint64_t max_message_size = 65000;  // largest event the network carries in one message
   CanSegmentProperties can;
   DdsSegmentProperties dds;
@@ -126,17 +126,17 @@ const char* to_string(DdsRepresentation value);
 
 // A DDS topic of any type, carried as its serialized payload (encapsulation header included).
 struct NativeDdsTopic {
-  std::string topic;  // e.g. rt/cmd_vel (ROS 2: rt/<name>)
-  std::string type;   // e.g. geometry_msgs::msg::dds_::Twist_
+  std::string topic;                                            // e.g. rt/cmd_vel (ROS 2: rt/<name>)
+  std::string type;                                             // e.g. geometry_msgs::msg::dds_::Twist_
   DdsRepresentation representation = DdsRepresentation::xcdr1;  // what our writer announces
   friend bool operator==(const NativeDdsTopic&, const NativeDdsTopic&) = default;
 };
 
 struct NativeBinding {
   std::string segment;
-  std::optional<NativeCanFrame> can;  // CAN segments: the channel is this frame
+  std::optional<NativeCanFrame> can;       // CAN segments: the channel is this frame
   std::optional<std::string> lcm_channel;  // LCM segments: raw contents on this LCM channel name
-  std::optional<NativeDdsTopic> dds;  // DDS segments: the serialized samples of this topic
+  std::optional<NativeDdsTopic> dds;       // DDS segments: the serialized samples of this topic
   friend bool operator==(const NativeBinding&, const NativeBinding&) = default;
 };
 // How errors and reports name a native identity: "0x123", "0x18FF0001", the LCM channel name or
@@ -147,12 +147,12 @@ struct ChannelSpec {
   std::string name;
   std::uint64_t subject = 0;
   ChannelClass cls = ChannelClass::nrt;
-  std::optional<Nanos> period;          // minimum inter-arrival time (from period or max_rate)
-  std::optional<Nanos> reaction_time;   // end-to-end latency bound
-  std::uint32_t omission_degree = 0;    // consecutive losses tolerated
-  std::optional<Nanos> temp_validity;   // event is stale after this age
-  std::uint64_t payload = 8;            // maximum payload bytes
-  std::optional<std::uint16_t> etag;    // static CAN etag, otherwise assigned
+  std::optional<Nanos> period;         // minimum inter-arrival time (from period or max_rate)
+  std::optional<Nanos> reaction_time;  // end-to-end latency bound
+  std::uint32_t omission_degree = 0;   // consecutive losses tolerated
+  std::optional<Nanos> temp_validity;  // event is stale after this age
+  std::uint64_t payload = 8;           // maximum payload bytes
+  std::optional<std::uint16_t> etag;   // static CAN etag, otherwise assigned
   LcmEncoding lcm_encoding = LcmEncoding::envelope;
   std::vector<std::string> publishers;   // P segments
   std::vector<std::string> subscribers;  // S segments
@@ -169,7 +169,7 @@ struct ChannelSpec {
 // Opt-in HTTP endpoint serving the gateway's metrics (docs/metrics.md). Off unless configured.
 struct MetricsSpec {
   bool enabled = false;
-  std::string host;           // an IPv4 or IPv6 literal (IPv6 without brackets)
+  std::string host;  // an IPv4 or IPv6 literal (IPv6 without brackets)
   std::uint16_t port = 0;
   bool allow_remote = false;  // true: the operator opted in to a non-loopback host
   friend bool operator==(const MetricsSpec&, const MetricsSpec&) = default;
@@ -203,7 +203,9 @@ struct RealtimeSpec {
   int receive_priority = 0;  // the adapters' receive threads that cosmicd owns (CAN, LCM)
   CpuPlacement cpus;         // CPU affinity of those threads and of the rest
   bool lock_memory = false;  // mlockall(MCL_CURRENT | MCL_FUTURE) at start
-  bool requested() const { return hrt_priority || srt_priority || nrt_priority || receive_priority || cpus.any() || lock_memory; }
+  bool requested() const {
+    return hrt_priority || srt_priority || nrt_priority || receive_priority || cpus.any() || lock_memory;
+  }
   friend bool operator==(const RealtimeSpec&, const RealtimeSpec&) = default;
 };
 
@@ -222,7 +224,7 @@ struct FederationSpec {
 struct GatewaySpec {
   std::string name = "cosmicd";
   std::uint8_t can_node_id = 1;
-  Nanos residence_bound{Nanos(1'000'000)};  // worst-case time an event spends inside the gateway
+  Nanos residence_bound{Nanos(1'000'000)};      // worst-case time an event spends inside the gateway
   Nanos clean_interval{Nanos(10'000'000'000)};  // a violated channel is bound again after this long without a miss
   RealtimeSpec realtime;
   std::string control_socket = "/run/cosmicd/control.sock";

@@ -9,8 +9,8 @@
 // send() contract: it returns within a bounded, short time (microseconds; a transport that can
 // block, like a reliable DDS writer, is given a small blocking bound) and never waits on another
 // segment or on a lower class's send for longer than one frame or message. What the transport
-// cannot take now is refused with SendStatus::queue_full (the router counts it), not waited for. Inbound events go to the EventSink from threads the
-// adapter owns, between start() and the return of stop().
+// cannot take now is refused with SendStatus::queue_full (the router counts it), not waited for. Inbound events go to
+// the EventSink from threads the adapter owns, between start() and the return of stop().
 #pragma once
 
 #include <array>
@@ -183,9 +183,7 @@ class SegmentAdapter {
   // with ours (counted each time one is refused, never reset while the channel stays bound);
   // nullopt where the transport has no such negotiation. A non-zero count is a per-channel
   // mismatch the operator must see: the peer is there and receives or sends nothing.
-  virtual std::optional<std::uint64_t> incompatible_peers(ChannelId /*channel*/) const {
-    return std::nullopt;
-  }
+  virtual std::optional<std::uint64_t> incompatible_peers(ChannelId /*channel*/) const { return std::nullopt; }
   // Remote endpoints of `channel` discovered here whose QoS or type the far side refuses (or
   // neither side accepts) by rules this transport's own matching does not apply or report, so
   // that neither matched_peers nor incompatible_peers shows them (DDS: cosmic/dds_qos_match.hpp).

@@ -8,10 +8,10 @@
 namespace cosmic {
 
 struct ThreadPolicy {
-  std::string name;        // at most 15 characters are kept (the kernel's limit)
-  int fifo_priority = 0;   // 1..99: SCHED_FIFO at that priority; 0: the normal time-sharing class
-  int nice = 0;            // for the time-sharing class (positive values need no privilege)
-  std::vector<int> cpus;   // empty: any CPU
+  std::string name;       // at most 15 characters are kept (the kernel's limit)
+  int fifo_priority = 0;  // 1..99: SCHED_FIFO at that priority; 0: the normal time-sharing class
+  int nice = 0;           // for the time-sharing class (positive values need no privilege)
+  std::vector<int> cpus;  // empty: any CPU
 };
 
 // Applies `policy` to the calling thread. Returns what could not be applied (e.g. "SCHED_FIFO 80:

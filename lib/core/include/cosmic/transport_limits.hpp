@@ -46,13 +46,13 @@ inline std::optional<std::string> transport_name_problem(SegmentType type, std::
 inline std::optional<std::string> interface_name_problem(std::string_view name) {
   if (name.empty()) return std::string("empty interface name");
   if (name.size() > kMaxInterfaceName) {
-    return "interface name '" + std::string(name.substr(0, 20)) + (name.size() > 20 ? "..." : "") + "' is too long (at most " +
-           std::to_string(kMaxInterfaceName) + " characters)";
+    return "interface name '" + std::string(name.substr(0, 20)) + (name.size() > 20 ? "..." : "") +
+           "' is too long (at most " + std::to_string(kMaxInterfaceName) + " characters)";
   }
   if (name == "." || name == "..") return "'" + std::string(name) + "' is not an interface name";
   for (const char c : name) {
-    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '.' ||
-                    c == '@' || c == '-';
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+                    c == '.' || c == '@' || c == '-';
     if (!ok) {
       char shown[8];
       std::snprintf(shown, sizeof shown, c > ' ' && c < 0x7f ? "'%c'" : "0x%02X", static_cast<unsigned char>(c));

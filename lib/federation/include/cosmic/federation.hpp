@@ -52,11 +52,11 @@ struct AnnouncedFrame {
 };
 
 struct AnnouncedSegment {
-  std::string name;     // the gateway's own name for it
+  std::string name;  // the gateway's own name for it
   SegmentType type = SegmentType::dds;
   std::string network;  // network_identity(); empty: not shared with other gateways
   double max_utilization = 0.7;
-  double load = 0;      // share of the network the gateway's channels reserve (background excluded)
+  double load = 0;  // share of the network the gateway's channels reserve (background excluded)
   // DDS and LCM: the bandwidth behind `load`, which other gateways relate to their own `bandwidth`
   // of the network (their shares would differ where the gateways declare different bandwidths).
   double reserved_bps = 0;

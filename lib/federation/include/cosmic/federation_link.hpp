@@ -17,8 +17,8 @@ namespace cosmic {
 struct FederationLinkCounters {
   std::uint64_t published = 0;  // announcements written
   std::uint64_t publish_errors = 0;
-  std::uint64_t received = 0;   // messages queued for take()
-  std::uint64_t dropped = 0;    // messages dropped because the queue was full (a flood)
+  std::uint64_t received = 0;  // messages queued for take()
+  std::uint64_t dropped = 0;   // messages dropped because the queue was full (a flood)
 };
 
 class FederationLink {

@@ -45,7 +45,7 @@ struct PeerRecord {
   std::string source;
   PeerState state = PeerState::alive;
   Nanos first_heard{0};
-  Nanos last_heard{0};   // last announcement or change of state
+  Nanos last_heard{0};  // last announcement or change of state
   Nanos state_since{0};
   std::uint64_t announcements = 0;  // applied
 };
@@ -55,7 +55,7 @@ struct FederationCounters {
   std::uint64_t applied = 0;   // announcements taken
   std::uint64_t stale = 0;     // older or repeated revisions
   std::uint64_t refused = 0;
-  std::string last_refusal;    // why, with the source
+  std::string last_refusal;                   // why, with the source
   mutable std::uint64_t frames_over_cap = 0;  // at the last reservations()
 };
 
@@ -84,8 +84,8 @@ class FederationView {
   // kMaxPeerFramesPerNetwork identifiers per network (the lowest, which delay the most), the rest
   // counted in counters().frames_over_cap. `senders`: the channels peers send onto the network,
   // with the path before it, one per subject (the slowest path when several peers send it); a path
-  // through this gateway or through any gateway twice (a ring) is left out. A peer with a lower gateway id than this one's that is claiming (a
-  // bind in its claim window) counts with what it claims.
+  // through this gateway or through any gateway twice (a ring) is left out. A peer with a lower gateway id than this
+  // one's that is claiming (a bind in its claim window) counts with what it claims.
   static constexpr std::size_t kMaxPeerFramesPerNetwork = 4096;
   PeerNetworks reservations() const;
   // Whether an alive peer attaches `network` (a bind adding load there must claim it first).

@@ -20,12 +20,12 @@ inline constexpr std::int64_t kMaxIngressAgeNs = 3'600'000'000'000;  // one hour
 // Why an inbound event is refused; `none` lets it pass.
 enum class IngressFault : std::uint8_t {
   none,
-  negative_age,     // age_ns < 0
-  age_beyond_bound, // age_ns > kMaxIngressAgeNs
-  foreign_subject,  // subject is not the channel's
-  own_origin,       // claims to come from this gateway: a loop or a spoof
-  hop_limit,        // hop_count >= kMaxHops: a loop between gateways
-  oversize,         // payload larger than the channel's admitted `payload`
+  negative_age,      // age_ns < 0
+  age_beyond_bound,  // age_ns > kMaxIngressAgeNs
+  foreign_subject,   // subject is not the channel's
+  own_origin,        // claims to come from this gateway: a loop or a spoof
+  hop_limit,         // hop_count >= kMaxHops: a loop between gateways
+  oversize,          // payload larger than the channel's admitted `payload`
 };
 
 const char* to_string(IngressFault fault);

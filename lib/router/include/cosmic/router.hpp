@@ -53,8 +53,8 @@ struct RouterLimits {
   std::size_t hrt_queue = 256;  // events per egress lane of each class
   std::size_t srt_queue = 1024;
   std::size_t nrt_queue = 1024;
-  std::size_t queue_bytes = 16u << 20;  // each lane is also bounded by bytes (large events)
-  std::uint32_t rate_burst = 3;         // the least a channel's rate bucket banks (see policing_depth)
+  std::size_t queue_bytes = 16u << 20;      // each lane is also bounded by bytes (large events)
+  std::uint32_t rate_burst = 3;             // the least a channel's rate bucket banks (see policing_depth)
   Nanos residence_bound{Nanos(1'000'000)};  // gateway.residence_bound: what each hop is checked against
   // How the lane threads of each class run (index: ChannelClass). The name is completed with the
   // segment's name. Without lane threads (false) nothing is sent until run_once() (tests).
@@ -83,8 +83,8 @@ class Router {
   EventSink& inbox(std::size_t index);
   // Names slot `index` and sets the adapter that sends there; starts that segment's lane threads.
   // Each lane holds its class's queue depth (RouterLimits); SRT and NRT lanes hold
-  // `lane_depth_floor` events where that is more (a CAN bus's burst: egress_lane_floor()). Null: stops them (after the send in
-  // progress) and drops what they had queued. Control thread.
+  // `lane_depth_floor` events where that is more (a CAN bus's burst: egress_lane_floor()). Null: stops them (after the
+  // send in progress) and drops what they had queued. Control thread.
   void set_segment(std::size_t index, std::string name, SegmentAdapter* adapter, std::size_t lane_depth_floor = 0);
   std::size_t segment_capacity() const { return segment_names_.size(); }
 

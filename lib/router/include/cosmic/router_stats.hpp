@@ -19,7 +19,15 @@ namespace cosmic {
 // refused it; invalid: a header field out of range (negative or absurd age, foreign subject,
 // our own origin); oversize: larger than the channel's admitted payload.
 enum class DropReason : std::size_t {
-  expired, rate, queue_full, duplicate, decode_error, no_route, send_failed, invalid, oversize
+  expired,
+  rate,
+  queue_full,
+  duplicate,
+  decode_error,
+  no_route,
+  send_failed,
+  invalid,
+  oversize
 };
 inline constexpr std::size_t kDropReasonCount = 9;
 const char* to_string(DropReason reason);
@@ -106,7 +114,7 @@ struct ChannelStatsSnapshot {
   Nanos residence_max{0};
   std::uint64_t residence_miss = 0;  // sums over the egress hops
   std::uint64_t deadline_miss = 0;
-  std::uint64_t forwarded = 0;  // events accepted and queued for at least one subscriber segment
+  std::uint64_t forwarded = 0;                       // events accepted and queued for at least one subscriber segment
   RuntimeState runtime_state = RuntimeState::bound;  // filled in by the Gateway
   std::uint64_t violations = 0;                      // episodes since the channel was bound (Gateway)
 };

@@ -34,8 +34,8 @@
 
 namespace cosmic {
 
-using AdapterFactory =
-    std::function<std::unique_ptr<SegmentAdapter>(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log)>;
+using AdapterFactory = std::function<std::unique_ptr<SegmentAdapter>(const SegmentSpec& segment,
+                                                                     const GatewayIdentity& self, Logger& log)>;
 
 // A channel whose definition a replacement takes the place of.
 struct ReplacedChannel {
@@ -78,11 +78,11 @@ struct SegmentInfo {
 // Admission of a bind, split so a long one can run off the control thread: the plan is pure
 // (any thread, on its own copy of the knowledge base), the commit runs on the control thread.
 struct BindPlan {
-  std::uint64_t generation = 0;           // Gateway::generation() the copy was taken at
+  std::uint64_t generation = 0;  // Gateway::generation() the copy was taken at
   std::vector<ChannelSpec> channels;
-  std::shared_ptr<KnowledgeBase> kb;      // the copy; holds `channels` once planned and admitted
-  std::vector<ChannelReport> reports;     // verdict of each channel, once planned
-  bool admitted = false;                  // every channel bound in `kb`
+  std::shared_ptr<KnowledgeBase> kb;   // the copy; holds `channels` once planned and admitted
+  std::vector<ChannelReport> reports;  // verdict of each channel, once planned
+  bool admitted = false;               // every channel bound in `kb`
   // A replacement (Gateway::replace): `channels` take the place of the bound definitions of the
   // same names, which are `replaced` (taken with the copy).
   bool replacing = false;
@@ -104,7 +104,7 @@ struct ReloadPlan {
   Config config;
   std::shared_ptr<KnowledgeBase> kb;
   std::vector<ChannelReport> reports;
-  std::size_t reused = 0;  // channels taken over from the ReloadBase, not admitted again
+  std::size_t reused = 0;                      // channels taken over from the ReloadBase, not admitted again
   std::shared_ptr<const ReloadBase> admitted;  // this plan's admission, for the next reload
 };
 
@@ -177,7 +177,8 @@ class Gateway {
   // deterministic); any other configuration is admitted from scratch.
   // `peers`: what other gateways reserve (knowledge_base().peer_reservations(), copied on the
   // control thread), counted by the new configuration's admission.
-  static ReloadPlan plan_reload(Config config, std::shared_ptr<const ReloadBase> base = nullptr, PeerNetworks peers = {});
+  static ReloadPlan plan_reload(Config config, std::shared_ptr<const ReloadBase> base = nullptr,
+                                PeerNetworks peers = {});
   BindResult commit_reload(ReloadPlan plan);
   // Control thread: what the running bindings were admitted from; null once a bind or unbind
   // changed them since start or the last reload.
@@ -260,7 +261,8 @@ class Gateway {
   // Makes `report` say `failed`, with the reasons, when a segment refused its channel.
   void mark_refused(ChannelReport& report) const;
   // `foreign`: why the channel's analysis does not hold now (undeclared frames beat it), or null.
-  void judge(const ChannelMisses& counted, const ChannelSpec& spec, RuntimeTrack& track, Nanos now, const std::string* foreign);
+  void judge(const ChannelMisses& counted, const ChannelSpec& spec, RuntimeTrack& track, Nanos now,
+             const std::string* foreign);
   // HRT channels that frames unknown to admission beat on a CAN bus: name -> reason.
   std::map<std::string, std::string> undeclared_interference() const;
   std::string violation_line(const ChannelSpec& spec) const;
@@ -282,11 +284,11 @@ class Gateway {
   std::unique_ptr<Router> router_;
   std::map<std::string, RuntimeTrack> runtime_;  // by channel name
   Refusals refused_;                             // after the last configure_adapters()
-  std::map<std::string, SegmentSlot> slots_;  // by segment name
+  std::map<std::string, SegmentSlot> slots_;     // by segment name
   std::map<std::string, std::pair<ChannelSpec, ChannelId>> channel_ids_;
   ChannelId next_channel_id_ = 1;
   std::uint64_t generation_ = 0;
-  bool prepared_ = false;  // adapters carry a replacement's added hops (prepare_replace)
+  bool prepared_ = false;                   // adapters carry a replacement's added hops (prepare_replace)
   std::shared_ptr<const ReloadBase> base_;  // valid while generation_ == base_generation_
   std::uint64_t base_generation_ = 0;
 };

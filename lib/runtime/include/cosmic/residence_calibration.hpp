@@ -29,7 +29,7 @@ struct CalibrationOptions {
 };
 
 struct CalibrationPhase {
-  std::string name;  // "idle" or "nrt-flood"
+  std::string name;                       // "idle" or "nrt-flood"
   std::uint64_t hrt_events = 0;           // HRT events offered
   std::uint64_t hrt_sent = 0;             // HRT events the lane sent (the histogram's events)
   Nanos p50{0}, p99{0}, p999{0}, max{0};  // HRT residence
@@ -41,8 +41,8 @@ struct CalibrationPhase {
 
 struct CalibrationResult {
   std::vector<CalibrationPhase> phases;
-  Nanos residence_bound{0};               // gateway.residence_bound of the configuration
-  Nanos worst_p999{0};                    // the larger p99.9 of the phases
+  Nanos residence_bound{0};                  // gateway.residence_bound of the configuration
+  Nanos worst_p999{0};                       // the larger p99.9 of the phases
   std::vector<std::string> thread_problems;  // realtime policy parts this process could not get
   bool bound_covers_p999() const { return residence_bound >= worst_p999; }
 };

@@ -27,8 +27,8 @@
 #include "Envelope.h"
 
 struct options {
-  const char *mode;
-  const char *topic;
+  const char* mode;
+  const char* topic;
   long domain;
   long count;
   long size;
@@ -36,7 +36,7 @@ struct options {
   long timeout_s;
 };
 
-static int parse(int argc, char **argv, struct options *o) {
+static int parse(int argc, char** argv, struct options* o) {
   memset(o, 0, sizeof *o);
   o->domain = -1;
   o->period_ms = 10;
@@ -44,26 +44,33 @@ static int parse(int argc, char **argv, struct options *o) {
   if (argc < 2) return 0;
   o->mode = argv[1];
   for (int i = 2; i + 1 < argc; i += 2) {
-    const char *key = argv[i];
-    const char *value = argv[i + 1];
-    if (strcmp(key, "--topic") == 0) o->topic = value;
-    else if (strcmp(key, "--domain") == 0) o->domain = strtol(value, NULL, 10);
-    else if (strcmp(key, "--count") == 0) o->count = strtol(value, NULL, 10);
-    else if (strcmp(key, "--size") == 0) o->size = strtol(value, NULL, 10);
-    else if (strcmp(key, "--period-ms") == 0) o->period_ms = strtol(value, NULL, 10);
-    else if (strcmp(key, "--timeout") == 0) o->timeout_s = strtol(value, NULL, 10);
-    else return 0;
+    const char* key = argv[i];
+    const char* value = argv[i + 1];
+    if (strcmp(key, "--topic") == 0)
+      o->topic = value;
+    else if (strcmp(key, "--domain") == 0)
+      o->domain = strtol(value, NULL, 10);
+    else if (strcmp(key, "--count") == 0)
+      o->count = strtol(value, NULL, 10);
+    else if (strcmp(key, "--size") == 0)
+      o->size = strtol(value, NULL, 10);
+    else if (strcmp(key, "--period-ms") == 0)
+      o->period_ms = strtol(value, NULL, 10);
+    else if (strcmp(key, "--timeout") == 0)
+      o->timeout_s = strtol(value, NULL, 10);
+    else
+      return 0;
   }
   if (argc % 2 != 0) return 0;
   const int is_pub = strcmp(o->mode, "pub") == 0;
   const int is_sub = strcmp(o->mode, "sub") == 0;
-  return (is_pub || is_sub) && o->topic != NULL && o->domain >= 0 && o->count > 0 &&
-         (is_sub || o->size >= 0) && o->period_ms >= 0 && o->timeout_s > 0;
+  return (is_pub || is_sub) && o->topic != NULL && o->domain >= 0 && o->count > 0 && (is_sub || o->size >= 0) &&
+         o->period_ms >= 0 && o->timeout_s > 0;
 }
 
 /* Blocks until `entity` has a status in `mask` set and `matched()` holds, or the timeout. */
-static int wait_matched(dds_entity_t participant, dds_entity_t entity, uint32_t mask,
-                        int (*matched)(dds_entity_t), dds_duration_t timeout) {
+static int wait_matched(dds_entity_t participant, dds_entity_t entity, uint32_t mask, int (*matched)(dds_entity_t),
+                        dds_duration_t timeout) {
   dds_entity_t waitset = dds_create_waitset(participant);
   dds_set_status_mask(entity, mask);
   dds_waitset_attach(waitset, entity, entity);
@@ -86,15 +93,13 @@ static int writer_matched(dds_entity_t writer) {
 
 static int reader_matched(dds_entity_t reader) {
   dds_subscription_matched_status_t st;
-  return dds_get_subscription_matched_status(reader, &st) == DDS_RETCODE_OK &&
-         st.current_count > 0;
+  return dds_get_subscription_matched_status(reader, &st) == DDS_RETCODE_OK && st.current_count > 0;
 }
 
-static int run_pub(dds_entity_t participant, dds_entity_t topic, const struct options *o) {
+static int run_pub(dds_entity_t participant, dds_entity_t topic, const struct options* o) {
   dds_entity_t writer = dds_create_writer(participant, topic, NULL, NULL); /* default QoS */
   if (writer < 0) return 3;
-  if (!wait_matched(participant, writer, DDS_PUBLICATION_MATCHED_STATUS, writer_matched,
-                    DDS_SECS(o->timeout_s))) {
+  if (!wait_matched(participant, writer, DDS_PUBLICATION_MATCHED_STATUS, writer_matched, DDS_SECS(o->timeout_s))) {
     fprintf(stderr, "no reader matched\n");
     return 1;
   }
@@ -124,20 +129,18 @@ static int run_pub(dds_entity_t participant, dds_entity_t topic, const struct op
   return dds_wait_for_acks(writer, DDS_SECS(o->timeout_s)) == DDS_RETCODE_OK ? 0 : 1;
 }
 
-static void print_envelope(const cosmic_Envelope *env) {
-  printf("{\"origin\":%" PRIu64 ",\"sequence\":%" PRIu32 ",\"hop_count\":%u,\"subject\":%" PRIu64
-         ",\"payload\":\"",
+static void print_envelope(const cosmic_Envelope* env) {
+  printf("{\"origin\":%" PRIu64 ",\"sequence\":%" PRIu32 ",\"hop_count\":%u,\"subject\":%" PRIu64 ",\"payload\":\"",
          env->origin, env->sequence, (unsigned)env->hop_count, env->subject);
   for (uint32_t i = 0; i < env->payload._length; ++i) printf("%02x", env->payload._buffer[i]);
   printf("\"}\n");
   fflush(stdout);
 }
 
-static int run_sub(dds_entity_t participant, dds_entity_t topic, const struct options *o) {
+static int run_sub(dds_entity_t participant, dds_entity_t topic, const struct options* o) {
   dds_entity_t reader = dds_create_reader(participant, topic, NULL, NULL); /* default QoS */
   if (reader < 0) return 3;
-  if (!wait_matched(participant, reader, DDS_SUBSCRIPTION_MATCHED_STATUS, reader_matched,
-                    DDS_SECS(o->timeout_s))) {
+  if (!wait_matched(participant, reader, DDS_SUBSCRIPTION_MATCHED_STATUS, reader_matched, DDS_SECS(o->timeout_s))) {
     fprintf(stderr, "no writer matched\n");
     return 1;
   }
@@ -149,11 +152,11 @@ static int run_sub(dds_entity_t participant, dds_entity_t topic, const struct op
   long received = 0;
   while (received < o->count && dds_time() < deadline) {
     dds_waitset_wait_until(waitset, NULL, 0, deadline);
-    void *samples[1] = {NULL};
+    void* samples[1] = {NULL};
     dds_sample_info_t info[1];
     while (received < o->count && dds_take(reader, samples, info, 1, 1) > 0) {
       if (info[0].valid_data) {
-        print_envelope((const cosmic_Envelope *)samples[0]);
+        print_envelope((const cosmic_Envelope*)samples[0]);
         ++received;
       }
       dds_return_loan(reader, samples, 1);
@@ -164,7 +167,7 @@ static int run_sub(dds_entity_t participant, dds_entity_t topic, const struct op
   return received == o->count ? 0 : 1;
 }
 
-int main(int argc, char **argv) {
+int main(int argc, char** argv) {
   struct options o;
   if (!parse(argc, argv, &o)) {
     fprintf(stderr,
@@ -184,8 +187,7 @@ int main(int argc, char **argv) {
     dds_delete(participant);
     return 3;
   }
-  const int rc = strcmp(o.mode, "pub") == 0 ? run_pub(participant, topic, &o)
-                                            : run_sub(participant, topic, &o);
+  const int rc = strcmp(o.mode, "pub") == 0 ? run_pub(participant, topic, &o) : run_sub(participant, topic, &o);
   dds_delete(participant);
   return rc;
 }

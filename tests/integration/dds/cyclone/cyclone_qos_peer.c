@@ -32,14 +32,14 @@
 
 struct options {
   bool writer;
-  const char *topic;
+  const char* topic;
   long domain;
-  const char *representation;
+  const char* representation;
   long latency_budget_ms;
   long timeout_s;
 };
 
-static bool parse(int argc, char **argv, struct options *o) {
+static bool parse(int argc, char** argv, struct options* o) {
   memset(o, 0, sizeof *o);
   o->domain = -1;
   o->representation = "default";
@@ -51,12 +51,18 @@ static bool parse(int argc, char **argv, struct options *o) {
   for (int i = 2; i + 1 < argc; i += 2) {
     const char *key = argv[i], *value = argv[i + 1];
     bool ok = true;
-    if (strcmp(key, "--topic") == 0) o->topic = value;
-    else if (strcmp(key, "--domain") == 0) ok = parse_long(value, &o->domain);
-    else if (strcmp(key, "--representation") == 0) o->representation = value;
-    else if (strcmp(key, "--latency-budget-ms") == 0) ok = parse_long(value, &o->latency_budget_ms);
-    else if (strcmp(key, "--timeout-s") == 0) ok = parse_long(value, &o->timeout_s);
-    else ok = false;
+    if (strcmp(key, "--topic") == 0)
+      o->topic = value;
+    else if (strcmp(key, "--domain") == 0)
+      ok = parse_long(value, &o->domain);
+    else if (strcmp(key, "--representation") == 0)
+      o->representation = value;
+    else if (strcmp(key, "--latency-budget-ms") == 0)
+      ok = parse_long(value, &o->latency_budget_ms);
+    else if (strcmp(key, "--timeout-s") == 0)
+      ok = parse_long(value, &o->timeout_s);
+    else
+      ok = false;
     if (!ok) return false;
   }
   const bool known = strcmp(o->representation, "default") == 0 || strcmp(o->representation, "xcdr1") == 0 ||
@@ -64,14 +70,16 @@ static bool parse(int argc, char **argv, struct options *o) {
   return known && o->topic != NULL && o->domain >= 0 && o->domain <= 232 && o->timeout_s > 0;
 }
 
-static const char *representation_of(dds_entity_t entity) {
-  dds_qos_t *qos = dds_create_qos();
-  const char *name = "unknown";
+static const char* representation_of(dds_entity_t entity) {
+  dds_qos_t* qos = dds_create_qos();
+  const char* name = "unknown";
   uint32_t n = 0;
-  dds_data_representation_id_t *ids = NULL;
+  dds_data_representation_id_t* ids = NULL;
   if (dds_get_qos(entity, qos) == DDS_RETCODE_OK && dds_qget_data_representation(qos, &n, &ids) && n > 0) {
-    if (n > 1) name = "XCDR1+XCDR2";
-    else name = ids[0] == DDS_DATA_REPRESENTATION_XCDR2 ? "XCDR2" : "XCDR1";
+    if (n > 1)
+      name = "XCDR1+XCDR2";
+    else
+      name = ids[0] == DDS_DATA_REPRESENTATION_XCDR2 ? "XCDR2" : "XCDR1";
   }
   dds_free(ids);
   dds_delete_qos(qos);
@@ -79,7 +87,7 @@ static const char *representation_of(dds_entity_t entity) {
 }
 
 /* What Cyclone says about cosmicd's endpoints: matched now, and refused for QoS so far. */
-static void status_of(dds_entity_t entity, bool writer, long *matched, long *incompatible, long *policy) {
+static void status_of(dds_entity_t entity, bool writer, long* matched, long* incompatible, long* policy) {
   if (writer) {
     dds_publication_matched_status_t m;
     dds_offered_incompatible_qos_status_t q;
@@ -105,11 +113,13 @@ static bool stdin_closed(void) {
   return read(0, buffer, sizeof buffer) <= 0;
 }
 
-int main(int argc, char **argv) {
+int main(int argc, char** argv) {
   struct options o;
   if (!parse(argc, argv, &o)) {
-    fprintf(stderr, "usage: %s reader|writer --domain D --topic T [--representation xcdr1|xcdr2|default] "
-                    "[--latency-budget-ms N] [--timeout-s S]\n", argv[0]);
+    fprintf(stderr,
+            "usage: %s reader|writer --domain D --topic T [--representation xcdr1|xcdr2|default] "
+            "[--latency-budget-ms N] [--timeout-s S]\n",
+            argv[0]);
     return 2;
   }
   const dds_entity_t participant = dds_create_participant((dds_domainid_t)o.domain, NULL, NULL);
@@ -119,7 +129,7 @@ int main(int argc, char **argv) {
     fprintf(stderr, "cannot create topic %s: %s\n", o.topic, dds_strretcode(topic));
     return 3;
   }
-  dds_qos_t *qos = dds_create_qos();
+  dds_qos_t* qos = dds_create_qos();
   if (strcmp(o.representation, "default") != 0) {
     const dds_data_representation_id_t id =
         strcmp(o.representation, "xcdr2") == 0 ? DDS_DATA_REPRESENTATION_XCDR2 : DDS_DATA_REPRESENTATION_XCDR1;
@@ -159,7 +169,7 @@ int main(int argc, char **argv) {
       e.payload._length = e.payload._maximum = sizeof payload;
       if (dds_write(entity, &e) == DDS_RETCODE_OK) ++count;
     } else {
-      void *samples[1] = {NULL};
+      void* samples[1] = {NULL};
       dds_sample_info_t info[1];
       while (dds_take(entity, samples, info, 1, 1) > 0) {
         if (info[0].valid_data) ++count;

@@ -43,8 +43,8 @@
 #define TWIST_CDR_SIZE 52u
 
 struct options {
-  const char *mode;
-  const char *topic;
+  const char* mode;
+  const char* topic;
   long domain;
   long count;
   long period_ms;
@@ -53,7 +53,7 @@ struct options {
   bool gate;
 };
 
-static bool parse(int argc, char **argv, struct options *o) {
+static bool parse(int argc, char** argv, struct options* o) {
   memset(o, 0, sizeof *o);
   o->domain = -1;
   o->period_ms = 10;
@@ -62,28 +62,36 @@ static bool parse(int argc, char **argv, struct options *o) {
   if (argc < 2 || argc % 2 != 0) return false;
   o->mode = argv[1];
   for (int i = 2; i + 1 < argc; i += 2) {
-    const char *key = argv[i];
-    const char *value = argv[i + 1];
+    const char* key = argv[i];
+    const char* value = argv[i + 1];
     bool ok = true;
-    if (strcmp(key, "--topic") == 0) o->topic = value;
-    else if (strcmp(key, "--domain") == 0) ok = parse_long(value, &o->domain);
-    else if (strcmp(key, "--count") == 0) ok = parse_long(value, &o->count);
-    else if (strcmp(key, "--period-ms") == 0) ok = parse_long(value, &o->period_ms);
-    else if (strcmp(key, "--wait-readers") == 0) ok = parse_long(value, &o->wait_readers);
-    else if (strcmp(key, "--timeout-s") == 0) ok = parse_long(value, &o->timeout_s);
-    else if (strcmp(key, "--gate") == 0) ok = o->gate = strcmp(value, "stdin") == 0;
-    else ok = false;
+    if (strcmp(key, "--topic") == 0)
+      o->topic = value;
+    else if (strcmp(key, "--domain") == 0)
+      ok = parse_long(value, &o->domain);
+    else if (strcmp(key, "--count") == 0)
+      ok = parse_long(value, &o->count);
+    else if (strcmp(key, "--period-ms") == 0)
+      ok = parse_long(value, &o->period_ms);
+    else if (strcmp(key, "--wait-readers") == 0)
+      ok = parse_long(value, &o->wait_readers);
+    else if (strcmp(key, "--timeout-s") == 0)
+      ok = parse_long(value, &o->timeout_s);
+    else if (strcmp(key, "--gate") == 0)
+      ok = o->gate = strcmp(value, "stdin") == 0;
+    else
+      ok = false;
     if (!ok) return false;
   }
   const bool is_pub = strcmp(o->mode, "pub") == 0;
   const bool is_sub = strcmp(o->mode, "sub") == 0;
-  return (is_pub || is_sub) && o->topic != NULL && o->domain >= 0 && o->domain <= 232 &&
-         o->count > 0 && o->period_ms >= 0 && o->wait_readers >= 0 && o->timeout_s > 0;
+  return (is_pub || is_sub) && o->topic != NULL && o->domain >= 0 && o->domain <= 232 && o->count > 0 &&
+         o->period_ms >= 0 && o->wait_readers >= 0 && o->timeout_s > 0;
 }
 
 /* ROS 2's default QoS profile (rmw_qos_profile_default) as rmw_cyclonedds maps it, XCDR1. */
-static dds_qos_t *ros2_default_qos(void) {
-  dds_qos_t *qos = dds_create_qos();
+static dds_qos_t* ros2_default_qos(void) {
+  dds_qos_t* qos = dds_create_qos();
   dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
   dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
   dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);
@@ -94,21 +102,17 @@ static dds_qos_t *ros2_default_qos(void) {
 
 static long publication_matched(dds_entity_t writer) {
   dds_publication_matched_status_t st;
-  return dds_get_publication_matched_status(writer, &st) == DDS_RETCODE_OK ? (long)st.current_count
-                                                                           : -1;
+  return dds_get_publication_matched_status(writer, &st) == DDS_RETCODE_OK ? (long)st.current_count : -1;
 }
 
 static long subscription_matched(dds_entity_t reader) {
   dds_subscription_matched_status_t st;
-  return dds_get_subscription_matched_status(reader, &st) == DDS_RETCODE_OK
-             ? (long)st.current_count
-             : -1;
+  return dds_get_subscription_matched_status(reader, &st) == DDS_RETCODE_OK ? (long)st.current_count : -1;
 }
 
 /* Waits (on the writer's status condition, re-checking the count) until `writer` matched at
  * least `readers` readers or the deadline passes; returns the count it saw last. */
-static long wait_publication_matched(dds_entity_t participant, dds_entity_t writer, long readers,
-                                     dds_time_t deadline) {
+static long wait_publication_matched(dds_entity_t participant, dds_entity_t writer, long readers, dds_time_t deadline) {
   dds_entity_t waitset = dds_create_waitset(participant);
   dds_set_status_mask(writer, DDS_PUBLICATION_MATCHED_STATUS);
   dds_waitset_attach(waitset, writer, writer);
@@ -123,7 +127,7 @@ static long wait_publication_matched(dds_entity_t participant, dds_entity_t writ
   return matched;
 }
 
-static void twist_of(long i, geometry_msgs_msg_dds__Twist_ *t) {
+static void twist_of(long i, geometry_msgs_msg_dds__Twist_* t) {
   const double d = (double)i;
   t->linear.x = d;
   t->linear.y = d + 0.5;
@@ -133,13 +137,12 @@ static void twist_of(long i, geometry_msgs_msg_dds__Twist_ *t) {
   t->angular.z = 1000.0 + d;
 }
 
-static const char *representation_name(dds_entity_t writer) {
-  dds_qos_t *qos = dds_create_qos();
-  const char *name = "unknown";
+static const char* representation_name(dds_entity_t writer) {
+  dds_qos_t* qos = dds_create_qos();
+  const char* name = "unknown";
   uint32_t n = 0;
-  dds_data_representation_id_t *ids = NULL;
-  if (dds_get_qos(writer, qos) == DDS_RETCODE_OK && dds_qget_data_representation(qos, &n, &ids) &&
-      n > 0) {
+  dds_data_representation_id_t* ids = NULL;
+  if (dds_get_qos(writer, qos) == DDS_RETCODE_OK && dds_qget_data_representation(qos, &n, &ids) && n > 0) {
     name = ids[0] == DDS_DATA_REPRESENTATION_XCDR1   ? "XCDR1"
            : ids[0] == DDS_DATA_REPRESENTATION_XCDR2 ? "XCDR2"
                                                      : "other";
@@ -149,8 +152,8 @@ static const char *representation_name(dds_entity_t writer) {
   return name;
 }
 
-static int run_pub(dds_entity_t participant, dds_entity_t topic, const struct options *o) {
-  dds_qos_t *qos = ros2_default_qos();
+static int run_pub(dds_entity_t participant, dds_entity_t topic, const struct options* o) {
+  dds_qos_t* qos = ros2_default_qos();
   dds_entity_t writer = dds_create_writer(participant, topic, qos, NULL);
   dds_delete_qos(qos);
   if (writer < 0) {
@@ -184,17 +187,17 @@ static int run_pub(dds_entity_t participant, dds_entity_t topic, const struct op
   dds_duration_t left = deadline - dds_time();
   if (left < DDS_MSECS(1)) left = DDS_MSECS(1);
   const bool acked = written == o->count && dds_wait_for_acks(writer, left) == DDS_RETCODE_OK;
-  printf("{\"mode\":\"pub\",\"domain\":%ld,\"topic\":\"%s\",\"type\":\"%s\","
-         "\"representation\":\"%s\",\"matched\":%ld,\"written\":%ld,\"acked\":%s}\n",
-         o->domain, o->topic, geometry_msgs_msg_dds__Twist__desc.m_typename,
-         representation_name(writer), publication_matched(writer), written,
-         acked ? "true" : "false");
+  printf(
+      "{\"mode\":\"pub\",\"domain\":%ld,\"topic\":\"%s\",\"type\":\"%s\","
+      "\"representation\":\"%s\",\"matched\":%ld,\"written\":%ld,\"acked\":%s}\n",
+      o->domain, o->topic, geometry_msgs_msg_dds__Twist__desc.m_typename, representation_name(writer),
+      publication_matched(writer), written, acked ? "true" : "false");
   fflush(stdout);
   return acked ? 0 : 1;
 }
 
 /* One sample: its values, decoded by Cyclone from the serialized form, and that form itself. */
-static bool print_sample(struct ddsi_serdata *sd) {
+static bool print_sample(struct ddsi_serdata* sd) {
   const uint32_t size = ddsi_serdata_size(sd);
   unsigned char cdr[4 * TWIST_CDR_SIZE];
   if (size < 4 || size > sizeof cdr) {
@@ -208,17 +211,17 @@ static bool print_sample(struct ddsi_serdata *sd) {
     fprintf(stderr, "a sample Cyclone could not decode\n");
     return false;
   }
-  printf("{\"linear\":[%.17g,%.17g,%.17g],\"angular\":[%.17g,%.17g,%.17g],\"cdr\":\"", t.linear.x,
-         t.linear.y, t.linear.z, t.angular.x, t.angular.y, t.angular.z);
+  printf("{\"linear\":[%.17g,%.17g,%.17g],\"angular\":[%.17g,%.17g,%.17g],\"cdr\":\"", t.linear.x, t.linear.y,
+         t.linear.z, t.angular.x, t.angular.y, t.angular.z);
   for (uint32_t i = 0; i < size; ++i) printf("%02x", cdr[i]);
   printf("\"}\n");
   fflush(stdout);
   return true;
 }
 
-static int run_sub(dds_entity_t participant, dds_entity_t topic, const struct options *o) {
+static int run_sub(dds_entity_t participant, dds_entity_t topic, const struct options* o) {
   const dds_time_t deadline = dds_time() + DDS_SECS(o->timeout_s);
-  dds_qos_t *qos = ros2_default_qos();
+  dds_qos_t* qos = ros2_default_qos();
   dds_entity_t reader = dds_create_reader(participant, topic, qos, NULL);
   dds_delete_qos(qos);
   if (reader < 0) {
@@ -242,7 +245,7 @@ static int run_sub(dds_entity_t participant, dds_entity_t topic, const struct op
       fprintf(stderr, "MATCHED\n");
       announced = true;
     }
-    struct ddsi_serdata *sd[1] = {NULL};
+    struct ddsi_serdata* sd[1] = {NULL};
     dds_sample_info_t info[1];
     while (received < o->count && dds_takecdr(reader, sd, 1, info, DDS_ANY_STATE) > 0) {
       if (info[0].valid_data) {
@@ -261,7 +264,7 @@ static int run_sub(dds_entity_t participant, dds_entity_t topic, const struct op
   return received == o->count && !broken ? 0 : 1;
 }
 
-int main(int argc, char **argv) {
+int main(int argc, char** argv) {
   struct options o;
   if (!parse(argc, argv, &o)) {
     fprintf(stderr,
@@ -276,15 +279,13 @@ int main(int argc, char **argv) {
     fprintf(stderr, "cannot create a participant: %s\n", dds_strretcode(participant));
     return 3;
   }
-  dds_entity_t topic =
-      dds_create_topic(participant, &geometry_msgs_msg_dds__Twist__desc, o.topic, NULL, NULL);
+  dds_entity_t topic = dds_create_topic(participant, &geometry_msgs_msg_dds__Twist__desc, o.topic, NULL, NULL);
   if (topic < 0) {
     fprintf(stderr, "cannot create topic %s: %s\n", o.topic, dds_strretcode(topic));
     dds_delete(participant);
     return 3;
   }
-  const int rc = strcmp(o.mode, "pub") == 0 ? run_pub(participant, topic, &o)
-                                            : run_sub(participant, topic, &o);
+  const int rc = strcmp(o.mode, "pub") == 0 ? run_pub(participant, topic, &o) : run_sub(participant, topic, &o);
   dds_delete(participant);
   return rc;
 }

@@ -7,8 +7,8 @@
 #include <stdlib.h>
 
 /* A whole decimal number, nothing else: "12" yes, "12x" or "" no. */
-static inline bool parse_long(const char *text, long *out) {
-  char *end = NULL;
+static inline bool parse_long(const char* text, long* out) {
+  char* end = NULL;
   const long value = strtol(text, &end, 10);
   if (end == text || *end != '\0') return false;
   *out = value;

@@ -92,10 +92,8 @@ class DdsSegmentAdapter : public SegmentAdapter {
 };
 
 // Never throws for bad input: errors come back from start() and configure().
-std::unique_ptr<DdsSegmentAdapter> make_dds_segment_adapter(const SegmentSpec& segment,
-                                                            const GatewayIdentity& self,
+std::unique_ptr<DdsSegmentAdapter> make_dds_segment_adapter(const SegmentSpec& segment, const GatewayIdentity& self,
                                                             Logger& log);
-std::unique_ptr<SegmentAdapter> make_dds_adapter(const SegmentSpec& segment,
-                                                 const GatewayIdentity& self, Logger& log);
+std::unique_ptr<SegmentAdapter> make_dds_adapter(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log);
 
 }  // namespace cosmic

@@ -23,7 +23,7 @@
 namespace cosmic {
 
 // `segment` is the DDS segment named by gateway.federation.segment.
-std::unique_ptr<FederationLink> make_dds_federation_link(const SegmentSpec& segment, const GatewayIdentity& self, Nanos lease,
-                                                         Logger& log);
+std::unique_ptr<FederationLink> make_dds_federation_link(const SegmentSpec& segment, const GatewayIdentity& self,
+                                                         Nanos lease, Logger& log);
 
 }  // namespace cosmic

@@ -22,7 +22,6 @@
 namespace cosmic {
 
 // Never throws for a bad specification: errors surface through start()/configure() and health().
-std::unique_ptr<SegmentAdapter> make_lcm_adapter(const SegmentSpec& segment,
-                                                 const GatewayIdentity& self, Logger& log);
+std::unique_ptr<SegmentAdapter> make_lcm_adapter(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log);
 
 }  // namespace cosmic

@@ -40,6 +40,6 @@ std::optional<LcmEnvelope> decode_lcm_envelope(std::span<const std::uint8_t> byt
 // INT32_MAX; the adapter refuses larger ones before): the header and that payload, back to back,
 // are one envelope exactly as lcm-gen encodes it.
 std::array<std::uint8_t, kLcmEnvelopeHeaderSize> encode_lcm_envelope_header(const EventHeader& header,
-                                                                           std::uint32_t payload_size);
+                                                                            std::uint32_t payload_size);
 
 }  // namespace cosmic
