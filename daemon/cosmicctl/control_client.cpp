@@ -1,4 +1,5 @@
 #include "control_client.hpp"
+#include "cosmic/posix_call.hpp"
 
 #include <poll.h>
 #include <sys/socket.h>
@@ -11,20 +12,6 @@
 
 namespace cosmicctl {
 namespace {
-
-class Descriptor {
- public:
-  explicit Descriptor(int fd) : fd_(fd) {}
-  ~Descriptor() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  Descriptor(const Descriptor&) = delete;
-  Descriptor& operator=(const Descriptor&) = delete;
-  int get() const { return fd_; }
-
- private:
-  int fd_;
-};
 
 ClientResult failure(std::string why, bool permission_denied = false) {
   return ClientResult{std::nullopt, std::move(why), permission_denied};
@@ -103,8 +90,9 @@ ClientResult request(const std::string& socket_path, const nlohmann::json& reque
   address.sun_family = AF_UNIX;
   if (socket_path.size() >= sizeof address.sun_path) return failure("socket path too long: " + socket_path);
   std::memcpy(address.sun_path, socket_path.c_str(), socket_path.size() + 1);
-  Descriptor fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0));
-  if (fd.get() < 0) return failure(std::string("socket: ") + std::strerror(errno));
+  auto opened = cosmic::posix_call("socket", [] { return ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0); });
+  if (!opened) return failure(opened.error().text);
+  const cosmic::OwnedFd fd(opened.value());
   if (::connect(fd.get(), reinterpret_cast<const sockaddr*>(&address), sizeof address) != 0) {
     const bool denied = errno == EACCES || errno == EPERM;
     return failure("cannot reach cosmicd at " + socket_path + ": " + std::strerror(errno) +

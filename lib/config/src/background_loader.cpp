@@ -20,8 +20,6 @@ namespace {
 // Frames of one segment's background, YAML and DBC together: a bus carries far fewer.
 constexpr std::size_t kMaxBackgroundFrames = 20'000;
 
-std::string key(const std::string& path, const std::string& name) { return path.empty() ? name : path + "." + name; }
-
 std::string location(const std::string& file, const YAML::Mark& mark) {
   return file + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1);
 }

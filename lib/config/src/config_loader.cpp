@@ -5,10 +5,8 @@
 #include "cosmic/lcm_url.hpp"
 #include "cosmic/transport_limits.hpp"
 
-#include <arpa/inet.h>
 #include <yaml-cpp/yaml.h>
 
-#include <charconv>
 #include <fstream>
 #include <map>
 #include <set>
@@ -21,66 +19,23 @@
 #include "federation_loader.hpp"
 #include "realtime_loader.hpp"
 #include "folded_names.hpp"
+#include "listen_address.hpp"
 #include "segment_overlap.hpp"
 #include "yaml_reader.hpp"
 
 namespace cosmic {
 namespace {
 
+using config_detail::has;
+using config_detail::indexed;
+using config_detail::key;
+using config_detail::ListenAddress;
+using config_detail::parse_listen_address;
 using config_detail::YamlReader;
 
 constexpr std::uint64_t kMaxPayload = 1 << 20;
 constexpr std::uint64_t kClassicCanMaxBitrate = 1'000'000;
 constexpr std::uint64_t kFdMaxDataBitrate = 8'000'000;
-
-std::string indexed(const std::string& path, std::size_t index) { return path + "[" + std::to_string(index) + "]"; }
-std::string key(const std::string& path, const char* name) { return path + "." + name; }
-
-// Present and not explicitly null.
-bool has(const YAML::Node& map, const char* name) { return map.IsMap() && map[name] && !map[name].IsNull(); }
-
-struct ListenAddress {
-  std::string host;
-  std::uint16_t port = 0;
-  bool loopback = false;
-  std::string error;  // why the text is not HOST:PORT
-};
-
-ListenAddress invalid_listen(std::string why) {
-  ListenAddress out;
-  out.error = std::move(why);
-  return out;
-}
-
-// "127.0.0.1:9877", "[::1]:9877" or "localhost:9877": an IP literal (never a name to resolve,
-// so what is checked is what gets bound) and a port.
-ListenAddress parse_listen_address(const std::string& text) {
-  ListenAddress out;
-  const auto colon = text.rfind(':');
-  if (colon == std::string::npos) return invalid_listen("has no port");
-  std::string host = text.substr(0, colon);
-  const std::string port = text.substr(colon + 1);
-  unsigned value = 0;
-  const auto [end, ec] = std::from_chars(port.data(), port.data() + port.size(), value);
-  if (port.empty() || ec != std::errc() || end != port.data() + port.size() || value == 0 || value > 65535) {
-    return invalid_listen("has no port from 1 to 65535");
-  }
-  out.port = static_cast<std::uint16_t>(value);
-  const bool bracketed = host.size() >= 2 && host.front() == '[' && host.back() == ']';
-  if (bracketed) host = host.substr(1, host.size() - 2);
-  if (host == "localhost") host = "127.0.0.1";
-  in_addr v4{};
-  in6_addr v6{};
-  if (!bracketed && inet_pton(AF_INET, host.c_str(), &v4) == 1) {
-    out.loopback = (ntohl(v4.s_addr) >> 24) == 127;
-  } else if (bracketed && inet_pton(AF_INET6, host.c_str(), &v6) == 1) {
-    out.loopback = IN6_IS_ADDR_LOOPBACK(&v6);
-  } else {
-    return invalid_listen("has no IP address as host (IPv6 goes in brackets)");
-  }
-  out.host = host;
-  return out;
-}
 
 class ConfigParser {
  public:

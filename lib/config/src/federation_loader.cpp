@@ -15,9 +15,6 @@ constexpr Nanos kMaxLease{3'600'000'000'000};
 constexpr Nanos kMinClaimWindow{300'000'000};
 constexpr Nanos kMaxClaimWindow{10'000'000'000};
 
-std::string key(const std::string& path, const char* name) { return path + "." + name; }
-bool has(const YAML::Node& map, const char* name) { return map.IsMap() && map[name] && !map[name].IsNull(); }
-
 }  // namespace
 
 void parse_federation(YamlReader& reader, const YAML::Node& node, const std::string& path, FederationSpec& out) {

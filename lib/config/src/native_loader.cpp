@@ -10,8 +10,6 @@
 namespace cosmic::config_detail {
 namespace {
 
-std::string key(const std::string& path, const std::string& name) { return path + "." + name; }
-
 bool parse_can(YamlReader& reader, const YAML::Node& node, const std::string& path, const SegmentSpec& segment,
                NativeBinding& binding) {
   if (!reader.check_map(node, path, {"can_id", "extended"})) return false;

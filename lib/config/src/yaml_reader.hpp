@@ -74,4 +74,14 @@ class YamlReader {
 
 std::string join(std::initializer_list<const char*> words);
 
+// Key paths as errors name them: "channels[2]", "gateway.metrics" (a top-level key: its name).
+inline std::string key(const std::string& path, const std::string& name) {
+  return path.empty() ? name : path + "." + name;
+}
+inline std::string indexed(const std::string& path, std::size_t index) {
+  return path + "[" + std::to_string(index) + "]";
+}
+// Present and not explicitly null.
+inline bool has(const YAML::Node& map, const char* name) { return map.IsMap() && map[name] && !map[name].IsNull(); }
+
 }  // namespace cosmic::config_detail

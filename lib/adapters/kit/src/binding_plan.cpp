@@ -1,6 +1,6 @@
 #include "cosmic/binding_plan.hpp"
 
-#include <algorithm>
+#include <map>
 #include <set>
 #include <utility>
 
@@ -8,22 +8,12 @@ namespace cosmic {
 
 namespace {
 
-bool same_hop(const ChannelBinding& a, const ChannelBinding& b) { return a.id == b.id && a.role == b.role; }
-
-bool same_plan(const ChannelBinding& a, const ChannelBinding& b) {
-  if (a.spec != b.spec || a.can.has_value() != b.can.has_value()) return false;
-  if (!a.can) return true;
-  const CanHopPlan& x = *a.can;
-  const CanHopPlan& y = *b.can;
-  return x.profile == y.profile && x.native == y.native && x.extended == y.extended && x.priority == y.priority &&
-         x.can_id == y.can_id && x.etag == y.etag && x.frame_bytes == y.frame_bytes &&
-         x.frames_per_event == y.frames_per_event;
-}
+using Hop = std::pair<ChannelId, HopRole>;
 
 }  // namespace
 
 BindingPlan::BindingPlan(std::span<const ChannelBinding> bindings) : bindings_(bindings) {
-  std::set<std::pair<ChannelId, HopRole>> seen;
+  std::set<Hop> seen;
   for (const ChannelBinding& b : bindings_) {
     if (b.id == kNoChannel || b.spec.name.empty()) {
       refuse(b, "the binding has no channel id or name");
@@ -35,15 +25,13 @@ BindingPlan::BindingPlan(std::span<const ChannelBinding> bindings) : bindings_(b
 
 void BindingPlan::refuse(const ChannelBinding& binding, std::string_view why) {
   // Bindings without an id are refused one by one: kNoChannel names no channel to refuse twice.
-  if (binding.id != kNoChannel && refused(binding.id)) return;
+  if (binding.id != kNoChannel && !refused_ids_.insert(binding.id).second) return;
   refusals_.push_back(ChannelRefusal{binding.id, std::string(why)});
   refused_names_.push_back(binding.spec.name.empty() ? "(unnamed, id " + std::to_string(binding.id) + ")"
                                                      : binding.spec.name);
 }
 
-bool BindingPlan::refused(ChannelId channel) const noexcept {
-  return std::any_of(refusals_.begin(), refusals_.end(), [&](const ChannelRefusal& r) { return r.channel == channel; });
-}
+bool BindingPlan::refused(ChannelId channel) const noexcept { return refused_ids_.count(channel) > 0; }
 
 std::vector<const ChannelBinding*> BindingPlan::accepted() const {
   std::vector<const ChannelBinding*> out;
@@ -62,20 +50,19 @@ std::vector<ChannelBinding> BindingPlan::carried() const {
 
 BindingDiff BindingPlan::diff(std::span<const ChannelBinding> carried) const {
   BindingDiff d;
-  const std::vector<const ChannelBinding*> wanted = accepted();
-  for (const ChannelBinding* b : wanted) {
-    const auto before =
-        std::find_if(carried.begin(), carried.end(), [&](const ChannelBinding& c) { return same_hop(c, *b); });
-    if (before == carried.end()) {
+  std::map<Hop, const ChannelBinding*> before;
+  for (const ChannelBinding& c : carried) before.emplace(Hop{c.id, c.role}, &c);
+  for (const ChannelBinding* b : accepted()) {
+    const auto found = before.find(Hop{b->id, b->role});
+    if (found == before.end()) {
       d.added.push_back(b);
-    } else if (!same_plan(*before, *b)) {
-      d.changed.push_back(b);
+      continue;
     }
+    if (!(*found->second == *b)) d.changed.push_back(b);
+    before.erase(found);  // what is left was carried and is not any more
   }
   for (const ChannelBinding& c : carried) {
-    const bool kept =
-        std::any_of(wanted.begin(), wanted.end(), [&](const ChannelBinding* b) { return same_hop(c, *b); });
-    if (!kept) d.removed.push_back(c);
+    if (before.count(Hop{c.id, c.role})) d.removed.push_back(c);
   }
   return d;
 }

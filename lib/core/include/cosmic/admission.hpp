@@ -65,6 +65,7 @@ struct CanHopPlan {
   Nanos transmission{0};               // worst-case time of one frame
   Nanos jitter{0};                     // release jitter used in the analysis
   std::optional<Nanos> response_time;  // nullopt: unbounded
+  friend bool operator==(const CanHopPlan&, const CanHopPlan&) = default;
 };
 
 // The plan's identifier as the bus orders it (standard and extended identifiers compared the way

@@ -34,6 +34,7 @@ struct ChannelBinding {
   ChannelSpec spec;
   HopRole role = HopRole::publisher;  // publisher: the gateway receives it here; subscriber: sends it here
   std::optional<CanHopPlan> can;      // CAN segments only
+  friend bool operator==(const ChannelBinding&, const ChannelBinding&) = default;
 };
 
 // Why an inbound message could not become an event.

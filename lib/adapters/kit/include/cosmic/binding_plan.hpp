@@ -13,6 +13,7 @@
 // refers to the bindings it was made from, which must outlive it.
 #pragma once
 
+#include <set>
 #include <span>
 #include <string>
 #include <string_view>
@@ -53,6 +54,7 @@ class BindingPlan {
  private:
   std::span<const ChannelBinding> bindings_;
   std::vector<ChannelRefusal> refusals_;
+  std::set<ChannelId> refused_ids_;         // the channels of refusals_, for refused()
   std::vector<std::string> refused_names_;  // parallel to refusals_, for the joined text
 };
 
