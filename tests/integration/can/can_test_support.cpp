@@ -127,7 +127,11 @@ Candump::Candump(const std::string& interface, const std::string& spec, int coun
   ::close(fd);
   file_ = name;
   const int before = raw_receivers(interface);
-  const std::string command = "exec candump -L -n " + std::to_string(count) + " " + spec + " >" + file_ + " 2>&1";
+  // vcan delivers a burst at once, unpaced by any bus: with the default receive buffer (about 200
+  // frames) a candump slowed by a loaded host loses part of a 334-frame burst in its own socket
+  // (seen once under scripts/test). 4 MiB holds every burst these tests send.
+  const std::string command =
+      "exec candump -r 4194304 -L -n " + std::to_string(count) + " " + spec + " >" + file_ + " 2>&1";
   const char* argv[] = {"sh", "-c", command.c_str(), nullptr};
   if (::posix_spawnp(&pid_, "sh", nullptr, nullptr, const_cast<char* const*>(argv), environ) != 0) {
     throw std::runtime_error("cannot start candump");
