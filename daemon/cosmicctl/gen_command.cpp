@@ -7,20 +7,15 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "cosmic/build_paths.hpp"
 #include "cosmic/config_loader.hpp"
 #include "gen_skeleton.hpp"
 
-// Where the skeleton's find_package(cosmic_client) looks first (daemon/CMakeLists.txt defines them):
-// a cosmicctl in its build tree (COSMICCTL_BUILD_DIR) hints that tree's libcosmic-client
-// (COSMIC_CLIENT_CONFIG_DIR); an installed one, the library installed beside it (PREFIX/bin/cosmicctl
-// -> PREFIX/COSMIC_CLIENT_INSTALL_CONFIG_DIR, /usr/lib/<triplet>/cmake/cosmic_client from the
-// package libcosmic-client-dev), never the tree it was built in.
-#ifndef COSMIC_CLIENT_CONFIG_DIR
-#define COSMIC_CLIENT_CONFIG_DIR ""
-#endif
-#ifndef COSMICCTL_BUILD_DIR
-#define COSMICCTL_BUILD_DIR ""
-#endif
+// Where the skeleton's find_package(cosmic_client) looks first: a cosmicctl in its build tree
+// (build_paths::cosmicctl_build_dir, daemon/CMakeLists.txt) hints that tree's libcosmic-client
+// (build_paths::client_config_dir); an installed one, the library installed beside it
+// (PREFIX/bin/cosmicctl -> PREFIX/COSMIC_CLIENT_INSTALL_CONFIG_DIR, /usr/lib/<triplet>/cmake/cosmic_client
+// from the package libcosmic-client-dev), never the tree it was built in.
 #ifndef COSMIC_CLIENT_INSTALL_CONFIG_DIR
 #define COSMIC_CLIENT_INSTALL_CONFIG_DIR "lib/cmake/cosmic_client"
 #endif
@@ -52,7 +47,9 @@ std::string client_config_dir() {
   std::error_code ec;
   const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
   if (ec) return "";
-  if (std::filesystem::equivalent(self.parent_path(), COSMICCTL_BUILD_DIR, ec)) return COSMIC_CLIENT_CONFIG_DIR;
+  if (std::filesystem::equivalent(self.parent_path(), cosmic::build_paths::cosmicctl_build_dir, ec)) {
+    return cosmic::build_paths::client_config_dir;
+  }
   return (self.parent_path().parent_path() / COSMIC_CLIENT_INSTALL_CONFIG_DIR).string();
 }
 

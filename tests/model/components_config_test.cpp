@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "cosmic/build_paths.hpp"
 #include "cosmic/config_loader.hpp"
 #include "cosmic/knowledge_base.hpp"
 
@@ -99,7 +100,7 @@ components:
 }
 
 TEST(Components, RobotDerivesTodaysBindings) {
-  const auto r = cosmic::load_config_file(std::string(COSMIC_SOURCE_DIR) + "/config/robot.yaml");
+  const auto r = cosmic::load_config_file(std::string(cosmic::build_paths::source_dir) + "/config/robot.yaml");
   ASSERT_TRUE(r.ok()) << errors(r);
   using L = std::vector<std::string>;
   const std::map<std::string, std::pair<L, L>> expected{{"distance", {{"body-can"}, {"lan"}}},

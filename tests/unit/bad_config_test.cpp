@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "cosmic/build_paths.hpp"
 #include "cosmic/config_loader.hpp"
 
 namespace cosmic {
@@ -24,7 +25,9 @@ struct BadConfig {
   std::vector<Expected> errors;  // every error of the file, in order
 };
 
-std::string bad_config_path(const std::string& name) { return std::string(COSMIC_BAD_CONFIG_DIR) + "/" + name; }
+std::string bad_config_path(const std::string& name) {
+  return std::string(cosmic::build_paths::bad_config_dir) + "/" + name;
+}
 
 std::string describe_errors(const std::vector<ConfigError>& errors) {
   std::string out;
@@ -166,7 +169,7 @@ INSTANTIATE_TEST_SUITE_P(Files, BadConfigTest, ::testing::ValuesIn(kBadConfigs),
 
 TEST(BadConfigs, AtLeast25DistinctFilesAllCovered) {
   std::set<std::string> on_disk;
-  for (const auto& entry : std::filesystem::directory_iterator(COSMIC_BAD_CONFIG_DIR)) {
+  for (const auto& entry : std::filesystem::directory_iterator(cosmic::build_paths::bad_config_dir)) {
     if (entry.path().extension() == ".yaml") on_disk.insert(entry.path().filename().string());
   }
   std::set<std::string> in_table;

@@ -1,5 +1,6 @@
 // YAML configuration: the bundled robot, documented defaults (lib/core/include/cosmic/model.hpp),
 // units and derived values, the fault-hypothesis switch, and bind documents.
+#include "cosmic/build_paths.hpp"
 #include "cosmic/config_loader.hpp"
 
 #include <gtest/gtest.h>
@@ -31,7 +32,7 @@ Config parse_ok(const std::string& text) {
 }
 
 TEST(Config, RobotLoadsAndEveryChannelIsBound) {
-  const ConfigResult loaded = load_config_file(std::string(COSMIC_SOURCE_DIR) + "/config/robot.yaml");
+  const ConfigResult loaded = load_config_file(std::string(cosmic::build_paths::source_dir) + "/config/robot.yaml");
   ASSERT_TRUE(loaded.ok()) << describe(loaded.errors);
   const Config& config = loaded.config;
   EXPECT_EQ(config.gateway.name, "q-robot");
@@ -76,7 +77,8 @@ TEST(Config, RobotLoadsAndEveryChannelIsBound) {
 }
 
 TEST(Config, OverloadedExampleTriggersEveryKindOnce) {
-  const ConfigResult loaded = load_config_file(std::string(COSMIC_SOURCE_DIR) + "/config/overloaded.yaml");
+  const ConfigResult loaded =
+      load_config_file(std::string(cosmic::build_paths::source_dir) + "/config/overloaded.yaml");
   ASSERT_TRUE(loaded.ok()) << describe(loaded.errors);
   const AdmissionReport report = admit_all(loaded.config);
   EXPECT_TRUE(report.any_rejected());

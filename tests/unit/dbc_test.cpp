@@ -1,6 +1,7 @@
 // The DBC reader (cosmic/dbc.hpp): messages, their identifiers, lengths and GenMsgCycleTime from
 // real-looking files; every statement of the format walked without error; every error located
 // at its line and column; the limits that keep hostile input cheap.
+#include "cosmic/build_paths.hpp"
 #include "cosmic/dbc.hpp"
 
 #include <gtest/gtest.h>
@@ -45,7 +46,7 @@ std::vector<std::string> errors_of(const DbcFile& file) {
 std::vector<std::string> errors_of(std::string_view text) { return errors_of(parse_dbc(text)); }
 
 std::string read_sample(const std::string& name) {
-  std::ifstream in(std::string(COSMIC_DBC_DIR) + "/" + name, std::ios::binary);
+  std::ifstream in(std::string(cosmic::build_paths::dbc_dir) + "/" + name, std::ios::binary);
   std::ostringstream text;
   text << in.rdbuf();
   return text.str();

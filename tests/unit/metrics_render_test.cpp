@@ -7,6 +7,7 @@
 #include <sstream>
 #include <string>
 
+#include "cosmic/build_paths.hpp"
 #include "cosmic/router_stats.hpp"
 #include "metrics_render.hpp"
 
@@ -310,7 +311,7 @@ TEST(MetricsRender, OpenMetricsDeclaresCounterFamiliesAndEnds) {
 
 // Every family the renderer emits is described in docs/metrics.md.
 TEST(MetricsRender, EveryFamilyIsDocumented) {
-  std::ifstream file(std::string(COSMIC_SOURCE_DIR) + "/docs/metrics.md");
+  std::ifstream file(std::string(cosmic::build_paths::source_dir) + "/docs/metrics.md");
   ASSERT_TRUE(file) << "docs/metrics.md is missing";
   std::stringstream docs;
   docs << file.rdbuf();

@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cosmic/build_paths.hpp"
 #include "cosmic/dds_adapter.hpp"
 #include "test_support.hpp"
 
@@ -51,7 +52,7 @@ inline ChannelBinding binding(ChannelId id, const std::string& name, HopRole rol
 }
 
 inline std::vector<std::string> peer(std::vector<std::string> args) {
-  args.insert(args.begin(), COSMIC_DDS_PEER);
+  args.insert(args.begin(), cosmic::build_paths::dds_peer);
   return args;
 }
 

@@ -33,6 +33,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cosmic/build_paths.hpp"
 #include "cosmic/lcm_adapter.hpp"
 
 namespace cosmic::lcm_test {
@@ -299,7 +300,7 @@ inline OutboundEvent outbound(ChannelId channel, const Bytes& payload, std::uint
   return e;
 }
 
-inline std::string peer() { return COSMIC_LCM_PEER; }
+inline std::string peer() { return cosmic::build_paths::lcm_peer; }
 
 // The drops the kernel counted for the UDP socket bound to `port` (the last column of
 // /proc/net/udp); 0 when there is none.

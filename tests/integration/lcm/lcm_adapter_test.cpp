@@ -22,6 +22,7 @@
 #include <sstream>
 #include <string>
 
+#include "cosmic/build_paths.hpp"
 #include "cosmic/lcm_adapter.hpp"
 #include "lcm_adapter_fixture.hpp"
 
@@ -203,7 +204,7 @@ TEST_F(LcmAdapterTest, RawSendIsRecordedByLcmLogger) {
   } remove_dir{dir_template};
   const std::string log_path = std::string(dir_template) + "/scan.lcmlog";
 
-  Child logger({COSMIC_LCM_LOGGER, "-q", "-f", "--flush-interval=10", "--lcm-url=" + url, log_path});
+  Child logger({cosmic::build_paths::lcm_logger, "-q", "-f", "--flush-interval=10", "--lcm-url=" + url, log_path});
   // lcm-logger has no readiness signal: publish probes until one shows up in its file.
   const Bytes probe{0x50, 0x52, 0x4f, 0x42, 0x45};
   ASSERT_TRUE(poll_until([&] { return count_channel(read_lcm_log(log_path), "COSMIC_PROBE") > 0; }, kWait,
