@@ -5,13 +5,13 @@
 
 namespace cosmic::build_paths {
 
-extern const char* const source_dir;         // the checkout's top directory
-extern const char* const bad_config_dir;     // tests/unit/bad_configs
-extern const char* const dbc_dir;            // tests/unit/dbc
-extern const char* const dds_peer;           // the cosmic-dds-peer program
-extern const char* const lcm_peer;           // the cosmic-lcm-peer program
-extern const char* const lcm_logger;         // Debian's lcm-logger ("" when not installed)
-extern const char* const client_config_dir;  // the build tree's cosmic_client CMake package
+extern const char* const source_dir;           // the checkout's top directory
+extern const char* const bad_config_dir;       // tests/unit/bad_configs
+extern const char* const dbc_dir;              // tests/unit/dbc
+extern const char* const dds_peer;             // the cosmic-dds-peer program
+extern const char* const lcm_peer;             // the cosmic-lcm-peer program
+extern const char* const lcm_logger;           // Debian's lcm-logger ("" when not installed)
+extern const char* const client_config_dir;    // the build tree's cosmic_client CMake package
 extern const char* const cosmicctl_build_dir;  // where cosmicctl is built
 
 }  // namespace cosmic::build_paths
