@@ -11,13 +11,16 @@
 //
 // Threads and locks:
 // - control_mutex_ serialises start/configure/stop (control thread).
-// - writers_mutex_ (shared_mutex) guards the channel -> writer table: send() (router thread)
-//   takes it shared, configure()/stop() exclusive only to swap entries in or out. DDS entities
-//   are created before and deleted after that exclusive section, so the router never waits for
-//   Fast DDS discovery work.
+// - writers_ is the channel -> writer table as a snapshot (cosmic/snapshot_table.hpp): send()
+//   (lane threads) takes the current table under a priority-inheriting mutex (a pointer copy) and
+//   writes with no table lock held; configure()/stop() build the next table outside any lock,
+//   swap it in, and delete the DataWriters it no longer holds after the last send on the old
+//   table has ended. DDS entities are created before and deleted after the swap, so the router
+//   never waits for Fast DDS discovery work.
 // - Each writer has its own sample in its topic's format (dds_sample_format: envelope or opaque),
 //   reused for every send (its buffer keeps its capacity: no allocation per event in steady
-//   state), guarded by the writer's mutex.
+//   state), guarded by the writer's priority-inheriting mutex. What send() logs, it logs after
+//   letting go of it.
 // - Each reader has its own sample and mutex; Fast DDS calls on_data_available on its
 //   receive threads. A reader is retired by clearing its `active` flag under its mutex (after
 //   which it never calls the sink) before Fast DDS deletes it; its listener object is kept until
@@ -96,14 +99,16 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
     }
   }
 
+  // Only this (control) thread replaces the writer table.
+  const WriterTable& current_writers = writers_.current_for_publisher();
   // 1. Create what is new or changed, before touching anything that runs. A channel whose
   //    endpoint cannot be created is refused; the others go on.
   std::vector<std::unique_ptr<WriterEntry>> new_writers;
   std::vector<std::unique_ptr<ReaderEntry>> new_readers;
   for (const auto& [id, b] : want_writers) {
     if (plan.refused(id)) continue;
-    auto it = writers_.find(id);  // only this (control) thread changes writers_
-    if (it != writers_.end() && it->second->shape == shape_of(segment_, b->spec) &&
+    auto it = current_writers.find(id);
+    if (it != current_writers.end() && it->second->shape == shape_of(segment_, b->spec) &&
         it->second->home == &home_of(b->spec.cls)) {
       continue;
     }
@@ -116,14 +121,18 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
   }
   for (const auto& [id, b] : want_readers) {
     if (plan.refused(id)) continue;
-    auto it = readers_.find(id);
-    if (it != readers_.end()) {
-      if (it->second->shape == shape_of(segment_, b->spec) && it->second->home == &home_of(b->spec.cls)) {
+    ReaderEntry* existing = nullptr;  // stays valid: only this (control) thread changes readers_
+    {
+      SharedLock lock(readers_mutex_);
+      if (auto it = readers_.find(id); it != readers_.end()) existing = it->second.get();
+    }
+    if (existing != nullptr) {
+      if (existing->shape == shape_of(segment_, b->spec) && existing->home == &home_of(b->spec.cls)) {
         continue;
       }
       // Changed QoS: stop the old reader first so that an event is never delivered twice. If
       // its successor cannot be created, the channel is refused and the old reader goes too.
-      deactivate(*it->second);
+      deactivate(*existing);
     }
     std::string error;
     if (auto entry = create_endpoint(*b, error, &DdsAdapter::create_reader)) {
@@ -137,7 +146,7 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
   std::erase_if(want_readers, [&](const auto& r) { return plan.refused(r.first); });
   std::erase_if(new_writers, [&](std::unique_ptr<WriterEntry>& w) {
     if (!plan.refused(w->id)) return false;
-    destroy_writer(std::move(w));
+    destroy_writer(*w);
     return true;
   });
   std::erase_if(new_readers, [&](std::unique_ptr<ReaderEntry>& r) {
@@ -148,27 +157,17 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
   Status status = plan.status();
   if (!status.ok) log_.log(LogLevel::error, prefix() + status.error);
 
-  // 2. Swap: the router sees the new writer table at once.
-  std::vector<std::unique_ptr<WriterEntry>> old_writers;
-  {
-    std::unique_lock lock(writers_mutex_);
-    for (auto it = writers_.begin(); it != writers_.end();) {
-      if (want_writers.count(it->first) == 0) {
-        old_writers.push_back(std::move(it->second));
-        it = writers_.erase(it);
-      } else {
-        ++it;
-      }
-    }
-    for (auto& w : new_writers) {
-      auto& slot = writers_[w->id];
-      if (slot) old_writers.push_back(std::move(slot));
-      slot = std::move(w);
-    }
+  // 2. Swap: the router sees the new writer table at once; the old one comes back once no send
+  //    uses it any more.
+  WriterTable next_writers;
+  for (const auto& [id, w] : current_writers) {
+    if (want_writers.count(id) != 0) next_writers.emplace(id, w);
   }
+  for (auto& w : new_writers) next_writers[w->id] = std::move(w);
+  WriterTable old_writers = SnapshotTable<WriterTable>::retire(writers_.publish(std::move(next_writers)));
   std::vector<std::unique_ptr<ReaderEntry>> old_readers;
   {
-    std::unique_lock lock(readers_mutex_);
+    LockGuard lock(readers_mutex_);
     for (auto it = readers_.begin(); it != readers_.end();) {
       if (want_readers.count(it->first) == 0) {
         old_readers.push_back(std::move(it->second));
@@ -185,7 +184,10 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
   }
 
   // 3. Delete what is gone (no send() can still use these writers).
-  for (auto& w : old_writers) destroy_writer(std::move(w));
+  const WriterTable& kept = writers_.current_for_publisher();
+  for (auto& [id, w] : old_writers) {
+    if (auto it = kept.find(id); it == kept.end() || it->second != w) destroy_writer(*w);
+  }
   for (auto& r : old_readers) destroy_reader(std::move(r));
   return status;
 }
@@ -208,22 +210,27 @@ std::unique_ptr<Entry> DdsAdapter::create_endpoint(const ChannelBinding& binding
 
 SendStatus DdsAdapter::send(const OutboundEvent& event) {
   try {
-    std::shared_lock lock(writers_mutex_);
-    auto it = writers_.find(event.channel);
-    if (it == writers_.end() || event.payload.size() > segment_.max_message_size) {
+    const auto writers = writers_.read();
+    auto it = writers->find(event.channel);
+    if (it == writers->end() || event.payload.size() > segment_.max_message_size) {
       counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
       return SendStatus::failed;
     }
     WriterEntry& w = *it->second;
-    std::lock_guard sample_lock(w.sample_mutex);
     std::uint16_t first_bytes = 0;
-    if (const auto refusal = w.format->fill(event, first_bytes); refusal != FillRefusal::none) {
+    FillRefusal refusal = FillRefusal::none;
+    ReturnCode_t rc = ReturnCode_t::RETCODE_OK;
+    {
+      PiLock sample(w.sample_mutex);
+      refusal = w.format->fill(event, first_bytes);
+      if (refusal == FillRefusal::none) rc = w.writer->write(w.format->sample(), dds::HANDLE_NIL);
+    }
+    if (refusal != FillRefusal::none) {
       counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
       if (!w.refusal_logged.exchange(true, std::memory_order_relaxed))
         warn_refused(w, refusal, first_bytes, event.payload.size());
       return SendStatus::failed;
     }
-    const ReturnCode_t rc = w.writer->write(w.format->sample(), dds::HANDLE_NIL);
     if (rc == ReturnCode_t::RETCODE_OK) {
       counters_.sent.fetch_add(1, std::memory_order_relaxed);
       return SendStatus::sent;
@@ -242,16 +249,16 @@ SendStatus DdsAdapter::send(const OutboundEvent& event) {
 std::size_t DdsAdapter::matched_endpoints(ChannelId channel, HopRole role) const {
   try {
     if (role == HopRole::subscriber) {
-      std::shared_lock lock(writers_mutex_);
-      auto it = writers_.find(channel);
+      const auto writers = writers_.read();
+      auto it = writers->find(channel);
       dds::PublicationMatchedStatus status;
-      if (it == writers_.end() ||
+      if (it == writers->end() ||
           it->second->writer->get_publication_matched_status(status) != ReturnCode_t::RETCODE_OK) {
         return 0;
       }
       return static_cast<std::size_t>(std::max(0, status.current_count));
     }
-    std::shared_lock lock(readers_mutex_);
+    SharedLock lock(readers_mutex_);
     auto it = readers_.find(channel);
     dds::SubscriptionMatchedStatus status;
     if (it == readers_.end() ||
@@ -267,12 +274,12 @@ std::size_t DdsAdapter::matched_endpoints(ChannelId channel, HopRole role) const
 std::optional<std::uint64_t> DdsAdapter::incompatible_peers(ChannelId channel) const {
   std::uint64_t total = 0;
   {
-    std::shared_lock lock(writers_mutex_);
-    if (auto it = writers_.find(channel); it != writers_.end()) {
+    const auto writers = writers_.read();
+    if (auto it = writers->find(channel); it != writers->end()) {
       total += it->second->incompatible.load(std::memory_order_relaxed);
     }
   }
-  std::shared_lock lock(readers_mutex_);
+  SharedLock lock(readers_mutex_);
   if (auto it = readers_.find(channel); it != readers_.end()) {
     total += it->second->incompatible.load(std::memory_order_relaxed);
   }
@@ -282,21 +289,17 @@ std::optional<std::uint64_t> DdsAdapter::incompatible_peers(ChannelId channel) c
 void DdsAdapter::teardown() {
   // Readers first: after deactivation no callback reaches the sink any more.
   {
-    std::shared_lock lock(readers_mutex_);
+    SharedLock lock(readers_mutex_);
     for (auto& [id, r] : readers_) deactivate(*r);
   }
-  std::unordered_map<ChannelId, std::unique_ptr<WriterEntry>> writers;
-  {
-    std::unique_lock lock(writers_mutex_);
-    writers.swap(writers_);
-  }
+  WriterTable writers = SnapshotTable<WriterTable>::retire(writers_.publish({}));
   std::unordered_map<ChannelId, std::unique_ptr<ReaderEntry>> readers;
   {
-    std::unique_lock lock(readers_mutex_);
+    LockGuard lock(readers_mutex_);
     readers.swap(readers_);
   }
   try {
-    for (auto& [id, w] : writers) destroy_writer(std::move(w));
+    for (auto& [id, w] : writers) destroy_writer(*w);
     for (auto& [id, r] : readers) destroy_reader(std::move(r));
     for (ClassParticipant& home : classes_) close_participant(home);
   } catch (...) {

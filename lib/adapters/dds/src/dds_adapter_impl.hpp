@@ -29,6 +29,9 @@
 #include "cosmic/dds_adapter.hpp"
 #include "cosmic/dds_names.hpp"
 #include "cosmic/health_cell.hpp"
+#include "cosmic/mutex.hpp"
+#include "cosmic/pi_mutex.hpp"
+#include "cosmic/snapshot_table.hpp"
 #include "cosmic/thread_policy.hpp"
 #include "dds_discovery.hpp"
 #include "dds_qos.hpp"
@@ -73,10 +76,17 @@ struct WriterEntry : dds::DataWriterListener {
   ClassParticipant* home = nullptr;  // the participant of the channel's class
   dds::Topic* topic = nullptr;
   dds::DataWriter* writer = nullptr;
-  std::mutex sample_mutex;  // guards format's sample
-  std::unique_ptr<DdsSampleFormat> format;
+  // Guards format's sample, which every send of this channel fills. Held across write(), which
+  // takes Fast DDS's own lock of this same writer anyway: only sends of this one channel can wait
+  // for it (the router sends a channel from its class's lane alone), never another channel, class
+  // or segment. Priority-inheriting, as every lock a forwarding thread takes.
+  PiMutex sample_mutex;
+  std::unique_ptr<DdsSampleFormat> format COSMIC_GUARDED_BY(sample_mutex);
   std::atomic<bool> refusal_logged{false};  // one log line for events the format cannot carry
 };
+
+// The writers of the segment by channel: what send() reads.
+using WriterTable = std::unordered_map<ChannelId, std::shared_ptr<WriterEntry>>;
 
 struct ReaderEntry : dds::DataReaderListener {
   ReaderEntry(DdsAdapter& owner, ChannelId id, const ChannelSpec& spec, EndpointShape shape)
@@ -100,9 +110,11 @@ struct ReaderEntry : dds::DataReaderListener {
   rtps::GuidPrefix_t own_prefix;
   dds::Topic* topic = nullptr;
   dds::DataReader* reader = nullptr;
-  std::mutex mutex;     // serialises callbacks; guards `active` and format's sample
-  bool active = false;  // false: never calls the sink
-  std::unique_ptr<DdsSampleFormat> format;
+  // Serialises callbacks; guards `active` and format's sample. Priority-inheriting: the control
+  // thread takes it to retire the reader while the class's receive thread may wait for it.
+  PiMutex mutex;
+  bool active COSMIC_GUARDED_BY(mutex) = false;  // false: never calls the sink
+  std::unique_ptr<DdsSampleFormat> format COSMIC_GUARDED_BY(mutex);
 };
 
 class DdsAdapter final : public DdsSegmentAdapter {
@@ -126,7 +138,7 @@ class DdsAdapter final : public DdsSegmentAdapter {
   std::vector<PeerQosConflict> peer_qos_conflicts(ChannelId channel) const override;
 
   // Reader callbacks (Fast DDS threads, reader mutex held).
-  void deliver(ReaderEntry& entry, const dds::SampleInfo& info);
+  void deliver(ReaderEntry& entry, const dds::SampleInfo& info) COSMIC_REQUIRES(entry.mutex);
   void count_receive_error(ReaderEntry& entry) {
     counters_.receive_errors.fetch_add(1, std::memory_order_relaxed);
     if (sink_ != nullptr) {
@@ -155,7 +167,7 @@ class DdsAdapter final : public DdsSegmentAdapter {
   std::unique_ptr<Entry> create_endpoint(const ChannelBinding& binding, std::string& error,
                                          std::unique_ptr<Entry> (DdsAdapter::*create)(const ChannelBinding&,
                                                                                       std::string&));
-  void destroy_writer(std::unique_ptr<WriterEntry> entry);
+  void destroy_writer(WriterEntry& entry);
   void deactivate(ReaderEntry& entry);
   void destroy_reader(std::unique_ptr<ReaderEntry> entry);
   void teardown();
@@ -170,11 +182,13 @@ class DdsAdapter final : public DdsSegmentAdapter {
   std::array<ClassParticipant, 3> classes_;  // indexed by ChannelClass; entries point into it
   bool log_attached_ = false;
 
-  mutable std::shared_mutex writers_mutex_;
-  std::unordered_map<ChannelId, std::unique_ptr<WriterEntry>> writers_;
+  // send() (lane threads, components' threads) reads the table without holding a lock across the
+  // write; configure()/stop() replace it (cosmic/snapshot_table.hpp) and delete the DataWriters of
+  // a replaced table only after its last send has ended.
+  SnapshotTable<WriterTable> writers_;
   // Readers: only the control thread changes this table; matched_endpoints() reads it shared.
-  mutable std::shared_mutex readers_mutex_;
-  std::unordered_map<ChannelId, std::unique_ptr<ReaderEntry>> readers_;
+  mutable SharedMutex readers_mutex_;
+  std::unordered_map<ChannelId, std::unique_ptr<ReaderEntry>> readers_ COSMIC_GUARDED_BY(readers_mutex_);
   std::vector<std::unique_ptr<ReaderEntry>> retired_readers_;
 
   AdapterCounters counters_;

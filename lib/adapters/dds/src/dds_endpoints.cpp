@@ -61,7 +61,7 @@ void ReaderEntry::on_sample_lost(dds::DataReader*, const dds::SampleLostStatus& 
 }
 
 void ReaderEntry::on_data_available(dds::DataReader* dr) {
-  std::lock_guard lock(mutex);
+  PiLock lock(mutex);
   if (!active) {
     return;
   }
@@ -121,12 +121,12 @@ std::vector<PeerQosConflict> DdsAdapter::peer_qos_conflicts(ChannelId channel) c
   try {
     std::optional<std::pair<DdsTopicRef, ChannelSpec>> writer, reader;
     {
-      std::shared_lock lock(writers_mutex_);
-      if (auto it = writers_.find(channel); it != writers_.end())
+      const auto writers = writers_.read();
+      if (auto it = writers->find(channel); it != writers->end())
         writer.emplace(it->second->shape.topic, it->second->spec);
     }
     {
-      std::shared_lock lock(readers_mutex_);
+      SharedLock lock(readers_mutex_);
       if (auto it = readers_.find(channel); it != readers_.end())
         reader.emplace(it->second->shape.topic, it->second->spec);
     }
@@ -308,7 +308,10 @@ std::unique_ptr<WriterEntry> DdsAdapter::create_writer(const ChannelBinding& bin
     error = "cannot create a DataWriter on " + entry->shape.topic.topic;
     return nullptr;
   }
-  entry->format->reserve(std::min<std::uint64_t>(binding.spec.payload, segment_.max_message_size));
+  {
+    PiLock sample(entry->sample_mutex);  // nothing sends on it yet; the analysis asks for it all the same
+    entry->format->reserve(std::min<std::uint64_t>(binding.spec.payload, segment_.max_message_size));
+  }
   return entry;
 }
 
@@ -318,8 +321,11 @@ std::unique_ptr<ReaderEntry> DdsAdapter::create_reader(const ChannelBinding& bin
   entry->own_prefix = entry->home->prefix;
   entry->topic = acquire_topic(*entry->home, entry->shape.topic, error);
   if (entry->topic == nullptr) return nullptr;
-  entry->active = true;  // before the reader exists: no callback can race with this
-  entry->format->reserve(std::min<std::uint64_t>(binding.spec.payload, segment_.max_message_size));
+  {
+    PiLock lock(entry->mutex);  // the reader does not exist yet: no callback can race with this
+    entry->active = true;
+    entry->format->reserve(std::min<std::uint64_t>(binding.spec.payload, segment_.max_message_size));
+  }
   const dds::StatusMask mask = dds::StatusMask::data_available()
                                << dds::StatusMask::requested_incompatible_qos() << dds::StatusMask::sample_lost();
   entry->reader =
@@ -332,16 +338,16 @@ std::unique_ptr<ReaderEntry> DdsAdapter::create_reader(const ChannelBinding& bin
   return entry;
 }
 
-void DdsAdapter::destroy_writer(std::unique_ptr<WriterEntry> entry) {
-  if (entry->writer != nullptr &&
-      entry->home->publisher->delete_datawriter(entry->writer) != ReturnCode_t::RETCODE_OK) {
-    warn("cannot delete the DataWriter of " + entry->shape.topic.topic);
+void DdsAdapter::destroy_writer(WriterEntry& entry) {
+  if (entry.writer != nullptr && entry.home->publisher->delete_datawriter(entry.writer) != ReturnCode_t::RETCODE_OK) {
+    warn("cannot delete the DataWriter of " + entry.shape.topic.topic);
   }
-  release_topic(*entry->home, entry->topic);
+  entry.writer = nullptr;
+  release_topic(*entry.home, entry.topic);
 }
 
 void DdsAdapter::deactivate(ReaderEntry& entry) {
-  std::lock_guard lock(entry.mutex);  // waits for a callback in progress
+  PiLock lock(entry.mutex);  // waits for a callback in progress
   entry.active = false;
 }
 
@@ -353,7 +359,10 @@ void DdsAdapter::destroy_reader(std::unique_ptr<ReaderEntry> entry) {
   }
   entry->reader = nullptr;
   release_topic(*entry->home, entry->topic);
-  entry->format->release();  // release the buffer; the listener object itself stays
+  {
+    PiLock lock(entry->mutex);  // inactive already: no callback holds it for long
+    entry->format->release();   // release the buffer; the listener object itself stays
+  }
   retired_readers_.push_back(std::move(entry));
 }
 

@@ -8,10 +8,12 @@
 // Threads and locks:
 //   control_mutex_  serialises start/configure/stop (control thread) and guards the receive
 //                   socket and thread.
-//   table_mutex_    shared_mutex over the channel table and the sink. send() (lane threads) takes
-//                   it shared for one event or batch, the receive thread for one batch of
-//                   datagrams; configure() and stop() take it exclusively only to swap the table
-//                   or the sink, never around I/O.
+//   table_          the channel table and the sink as a snapshot (cosmic/snapshot_table.hpp).
+//                   send() (lane threads) reads it for one event or batch, the receive thread for
+//                   one batch of datagrams: a pointer copy under a priority-inheriting mutex, then
+//                   no lock while they send or hand events on. configure(), start() and stop()
+//                   (the control thread, under control_mutex_) build the next table outside any
+//                   lock, swap it in and wait until the last reading of the old one has ended.
 //   transmit_       the per-class transmit sockets, each under its own mutex (lcm_transmit.hpp).
 //   own_count_mutex_ the own_datagrams_dropped bookkeeping: statistics() from any thread, start()
 //                   and stop() write it; never taken on the forwarding path.
@@ -21,8 +23,9 @@
 // the default) or cuts them down to nothing, which the receive thread then skips by that source.
 // The receive socket is a member of the group only while a channel is received here (join_group,
 // leave_group), so a segment that only sends gets none of them back.
-// The EventSink is called with table_mutex_ held shared: it must hand the event on (the router
-// queues it) and not call back into this adapter.
+// The EventSink is called while the receive thread reads the table: it must hand the event on
+// (the router queues it) and not call back into this adapter's configure() or stop(), which
+// would wait for that reading to end.
 #include "cosmic/lcm_adapter.hpp"
 
 #include <poll.h>
@@ -54,6 +57,7 @@
 #include "cosmic/receive_thread.hpp"
 #include "cosmic/lcm_wire.hpp"
 #include "cosmic/mutex.hpp"
+#include "cosmic/snapshot_table.hpp"
 #include "cosmic/result.hpp"
 #include "cosmic/steady_clock.hpp"
 #include "cosmic/thread_annotations.hpp"
@@ -83,6 +87,17 @@ struct StringHash {
 
 using lcm_detail::Channel;
 using lcm_detail::LcmArrival;
+
+// The channels bound on the segment, built by configure() and never changed after.
+struct ChannelIndex {
+  std::unordered_map<ChannelId, Channel> by_id;
+  std::unordered_map<std::string, const Channel*, StringHash, std::equal_to<>> by_name;  // into by_id
+};
+// What send() and the receive thread read: the channels, and the sink (null: not started).
+struct ChannelTable {
+  std::shared_ptr<const ChannelIndex> channels = std::make_shared<const ChannelIndex>();
+  EventSink* sink = nullptr;
+};
 using lcm_detail::make_lcm_message_format;
 
 class LcmAdapter final : public SegmentAdapter {
@@ -140,12 +155,7 @@ class LcmAdapter final : public SegmentAdapter {
     rx_url_ = url;
     member_ = true;  // open_receive_socket() joined the group
     may_leave_ = rx.sees_own_groups_only;
-    bool receives = false;
-    {
-      SharedLock table(table_mutex_);
-      receives = receives_any();
-    }
-    if (!receives) leave_group();
+    if (!receives_any(table_.current_for_publisher())) leave_group();
     receive_failing_.store(false, std::memory_order_relaxed);
     overflow_seen_ = 0;  // a new socket and transmitter count from 0; its thread starts below
     overflow_total_ = 0;
@@ -209,16 +219,12 @@ class LcmAdapter final : public SegmentAdapter {
         receives = false;
       }
     }
-    // Swap the table (brief exclusive lock; channels kept keep flowing through it). Reception is a
-    // lookup by name, no subscription: every datagram of the group reaches the receive socket
-    // while it is a member.
-    std::unordered_map<std::string, Channel*, StringHash, std::equal_to<>> by_name;
-    {
-      LockGuard table(table_mutex_);
-      channels_ = std::move(wanted);
-      for (auto& [id, channel] : channels_) by_name.emplace(channel.name, &channel);
-      by_name_ = std::move(by_name);
-    }
+    // Swap the table (channels kept keep flowing through it). Reception is a lookup by name, no
+    // subscription: every datagram of the group reaches the receive socket while it is a member.
+    auto index = std::make_shared<ChannelIndex>();
+    index->by_id = std::move(wanted);
+    for (const auto& [id, channel] : index->by_id) index->by_name.emplace(channel.name, &channel);
+    replace_table(ChannelTable{std::move(index), table_.current_for_publisher().sink});
     if (started_ && rx_fd_ >= 0 && !receives) leave_group();
     Status status = plan.status();
     if (!status.ok) log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + status.error);
@@ -226,8 +232,8 @@ class LcmAdapter final : public SegmentAdapter {
   }
 
   SendStatus send(const OutboundEvent& event) override {
-    SharedLock table(table_mutex_);
-    const Channel* channel = transmitting(event.channel);
+    const auto table = table_.read();
+    const Channel* channel = transmitting(*table, event.channel);
     if (channel == nullptr) return transmit_.unbound();
     if (memq_.load(std::memory_order_relaxed)) return memq_sent();
     return transmit_.send(*channel, event);
@@ -238,11 +244,11 @@ class LcmAdapter final : public SegmentAdapter {
   void send_batch(std::span<const OutboundEvent> events, std::span<SendStatus> results) override {
     constexpr std::size_t kChunk = lcm_detail::SendBatch::kCapacity;
     const std::size_t n = std::min(events.size(), results.size());
-    SharedLock table(table_mutex_);
+    const auto table = table_.read();
     for (std::size_t from = 0; from < n; from += kChunk) {
       const std::size_t count = std::min(kChunk, n - from);
       std::array<const Channel*, kChunk> channels{};
-      for (std::size_t i = 0; i < count; ++i) channels[i] = transmitting(events[from + i].channel);
+      for (std::size_t i = 0; i < count; ++i) channels[i] = transmitting(*table, events[from + i].channel);
       if (memq_.load(std::memory_order_relaxed)) {
         for (std::size_t i = 0; i < count; ++i) results[from + i] = channels[i] ? memq_sent() : transmit_.unbound();
         continue;
@@ -270,12 +276,9 @@ class LcmAdapter final : public SegmentAdapter {
     LockGuard control(control_mutex_);
     if (!started_) return;
     started_ = false;
-    attach_sink(nullptr);  // waits for sends in flight; no send starts after it
-    {
-      LockGuard table(table_mutex_);  // stop() forgets the bindings (SegmentAdapter's lifecycle)
-      channels_.clear();
-      by_name_.clear();
-    }
+    // No sink and no channel (stop() forgets the bindings: SegmentAdapter's lifecycle); returns
+    // once the sends and the batch of received datagrams in flight have ended.
+    replace_table(ChannelTable{});
     if (receiver_.running()) {
       receiver_.stop();
       ::close(std::exchange(rx_fd_, -1));
@@ -289,8 +292,15 @@ class LcmAdapter final : public SegmentAdapter {
   }
 
  private:
-  bool receives_any() const COSMIC_REQUIRES_SHARED(table_mutex_) {
-    return std::any_of(channels_.begin(), channels_.end(), [](const auto& c) { return c.second.rx; });
+  static bool receives_any(const ChannelTable& table) {
+    const auto& channels = table.channels->by_id;
+    return std::any_of(channels.begin(), channels.end(), [](const auto& c) { return c.second.rx; });
+  }
+
+  // Control thread (control_mutex_ held: one replacement at a time). Returns once no send or
+  // received batch still reads the old table.
+  void replace_table(ChannelTable next) COSMIC_REQUIRES(control_mutex_) {
+    SnapshotTable<ChannelTable>::retire(table_.publish(std::move(next)));
   }
 
   // The receive socket is a member of the group only while a channel is received here. A segment
@@ -336,9 +346,10 @@ class LcmAdapter final : public SegmentAdapter {
                    "none in RcvbufErrors; cosmicctl segments --json reports them as own_datagrams_dropped");
   }
 
-  const Channel* transmitting(ChannelId id) const COSMIC_REQUIRES_SHARED(table_mutex_) {
-    const auto it = channels_.find(id);
-    if (sink_ == nullptr || it == channels_.end() || !it->second.tx) return nullptr;
+  static const Channel* transmitting(const ChannelTable& table, ChannelId id) {
+    const auto& channels = table.channels->by_id;
+    const auto it = channels.find(id);
+    if (table.sink == nullptr || it == channels.end() || !it->second.tx) return nullptr;
     return &it->second;
   }
 
@@ -348,9 +359,8 @@ class LcmAdapter final : public SegmentAdapter {
     return Status::failure(why);
   }
 
-  void attach_sink(EventSink* sink) {
-    LockGuard table(table_mutex_);
-    sink_ = sink;
+  void attach_sink(EventSink* sink) COSMIC_REQUIRES(control_mutex_) {
+    replace_table(ChannelTable{table_.current_for_publisher().channels, sink});
   }
 
   // Why binding `b` under LCM channel `name` cannot be carried, given the names taken so far.
@@ -370,7 +380,7 @@ class LcmAdapter final : public SegmentAdapter {
   }
 
   // The segment's receive thread: waits for datagrams or stop(), then reads all that are queued
-  // in batches and hands each batch's events on under one shared table lock.
+  // in batches and hands each batch's events on under one reading of the table.
   void receive_loop(int fd) {
     lcm_detail::ReceiveBatch batch(kReceiveBatch);
     while (!receiver_.stopping()) {
@@ -441,8 +451,9 @@ class LcmAdapter final : public SegmentAdapter {
     const std::int64_t steady = steady_now().count();
     const std::int64_t realtime_now =
         std::chrono::duration_cast<Nanos>(std::chrono::system_clock::now().time_since_epoch()).count();
-    SharedLock table(table_mutex_);
-    if (sink_ == nullptr) return;
+    const auto reading = table_.read();
+    const ChannelTable& table = *reading;
+    if (table.sink == nullptr) return;
     for (std::size_t i = 0; i < count; ++i) {
       const Endpoint from = batch.sender(i);
       if (transmit_.is_own(from)) continue;  // ours, looped back (emptied by a cutting filter, or none attached)
@@ -455,19 +466,19 @@ class LcmAdapter final : public SegmentAdapter {
       if (arrival == 0) arrival = realtime_now;
       const Nanos received_at = steady_arrival(arrival, Nanos(steady), realtime_now);
       if (!parsed->fragment) {
-        deliver(parsed->channel, parsed->data, received_at, arrival);
+        deliver(table, parsed->channel, parsed->data, received_at, arrival);
         continue;
       }
-      reassemble(from, *parsed, received_at, arrival);
+      reassemble(table, from, *parsed, received_at, arrival);
     }
   }
 
   // One fragment. Messages of channels not received here are skipped whole (fragment 0 names the
   // channel; the fragments after it do not); what the reassembler refuses or gives up is a
   // receive error, as a malformed datagram is.
-  void reassemble(Endpoint from, const LcmDatagram& fragment, Nanos received_at, std::int64_t arrival)
-      COSMIC_REQUIRES_SHARED(table_mutex_) {
-    if (!fragment.channel.empty() && !receives(fragment.channel)) {
+  void reassemble(const ChannelTable& table, Endpoint from, const LcmDatagram& fragment, Nanos received_at,
+                  std::int64_t arrival) {
+    if (!fragment.channel.empty() && !receives(table, fragment.channel)) {
       reassembler_.skip(from.key(), fragment.sequence);
       return;
     }
@@ -482,19 +493,19 @@ class LcmAdapter final : public SegmentAdapter {
         reassembler_.abandoned() - abandoned_before + (outcome == LcmReassembler::Outcome::refused);
     if (lost != 0) counters_.receive_errors.fetch_add(lost, std::memory_order_relaxed);
     if (outcome == LcmReassembler::Outcome::complete)
-      deliver(reassembler_.channel(), reassembler_.payload(), received_at, arrival);
+      deliver(table, reassembler_.channel(), reassembler_.payload(), received_at, arrival);
   }
 
-  bool receives(std::string_view name) const COSMIC_REQUIRES_SHARED(table_mutex_) {
-    const auto it = by_name_.find(name);
-    return it != by_name_.end() && it->second->rx;
+  static bool receives(const ChannelTable& table, std::string_view name) {
+    const auto it = table.channels->by_name.find(name);
+    return it != table.channels->by_name.end() && it->second->rx;
   }
 
-  // One whole message of LCM channel `name`; table_mutex_ held shared by the caller.
-  void deliver(std::string_view name, std::span<const std::uint8_t> bytes, Nanos received_at,
-               std::int64_t arrival_realtime_ns) COSMIC_REQUIRES_SHARED(table_mutex_) {
-    const auto it = by_name_.find(name);
-    if (it == by_name_.end() || !it->second->rx) return;  // not bound for reception here
+  // One whole message of LCM channel `name`, from the receive thread's reading of `table`.
+  void deliver(const ChannelTable& table, std::string_view name, std::span<const std::uint8_t> bytes, Nanos received_at,
+               std::int64_t arrival_realtime_ns) {
+    const auto it = table.channels->by_name.find(name);
+    if (it == table.channels->by_name.end() || !it->second->rx) return;  // not bound for reception here
     const Channel& channel = *it->second;
     counters_.received.fetch_add(1, std::memory_order_relaxed);
     InboundEvent event;
@@ -505,10 +516,10 @@ class LcmAdapter final : public SegmentAdapter {
     const LcmArrival arrival{channel.subject, arrival_realtime_ns};
     if (!channel.format->decode(bytes, arrival, segment_.max_message_size, event)) {
       counters_.receive_errors.fetch_add(1, std::memory_order_relaxed);
-      sink_->on_problem(channel.id, InboundProblem::decode_error);
+      table.sink->on_problem(channel.id, InboundProblem::decode_error);
       return;
     }
-    sink_->on_event(event);
+    table.sink->on_event(event);
   }
 
   // memq://: nothing to send on, and nothing lost by it.
@@ -535,10 +546,7 @@ class LcmAdapter final : public SegmentAdapter {
   // memq://: set by start() before the sink is attached, cleared by stop() after it is detached.
   std::atomic<bool> memq_{false};
 
-  mutable SharedMutex table_mutex_;
-  EventSink* sink_ COSMIC_GUARDED_BY(table_mutex_) = nullptr;
-  std::unordered_map<ChannelId, Channel> channels_ COSMIC_GUARDED_BY(table_mutex_);
-  std::unordered_map<std::string, Channel*, StringHash, std::equal_to<>> by_name_ COSMIC_GUARDED_BY(table_mutex_);
+  SnapshotTable<ChannelTable> table_;
 
   lcm_detail::LcmTransmitter transmit_;
   // Receive thread only.

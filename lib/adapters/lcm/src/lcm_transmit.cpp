@@ -120,13 +120,20 @@ SendStatus LcmTransmitter::unbound() {
 
 SendStatus LcmTransmitter::send(const Channel& channel, const OutboundEvent& event) {
   ClassSender& sender = senders_.at(static_cast<std::size_t>(channel.cls));
-  LockGuard transmit(sender.mutex);
-  return send_one(sender, channel, event);
+  SendLog later;
+  SendStatus status = SendStatus::failed;
+  {
+    LockGuard transmit(sender.mutex);
+    status = send_one(sender, channel, event, later);
+  }
+  write(later);
+  return status;
 }
 
 void LcmTransmitter::send_batch(std::span<const OutboundEvent> events, std::span<const Channel* const> channels,
                                 std::span<SendStatus> results) {
   const std::size_t n = std::min({events.size(), channels.size(), results.size()});
+  SendLog later;
   std::size_t i = 0;
   while (i < n) {
     const Channel* first = channels[i];
@@ -147,14 +154,23 @@ void LcmTransmitter::send_batch(std::span<const OutboundEvent> events, std::span
       staged[count++] = i;
     }
     if (count == 0) {  // the message at i needs fragments, or there is no socket (memq, stopped)
-      results[i] = send_one(sender, *first, events[i]);
+      results[i] = send_one(sender, *first, events[i], later);
       ++i;
       continue;
     }
     note_sending(count);  // one datagram each (stage())
     const SendFailure why = sender.batch.send(sender.fd);
     for (std::size_t k = 0; k < count; ++k)
-      results[staged[k]] = sender.batch.failed(k) ? failed(sender, *channels[staged[k]], why) : sent(sender);
+      results[staged[k]] = sender.batch.failed(k) ? failed(sender, *channels[staged[k]], why, later) : sent(sender);
+  }
+  write(later);
+}
+
+void LcmTransmitter::write(SendLog& later) noexcept {
+  try {
+    for (auto& [level, text] : later) log_.log(level, text);
+  } catch (...) {
+    // A logger that cannot take the line: the failure is counted all the same.
   }
 }
 
@@ -163,17 +179,18 @@ void LcmTransmitter::note_sending(std::size_t datagrams) {
     own_drops_.fetch_add(datagrams, std::memory_order_release);
 }
 
-SendStatus LcmTransmitter::send_one(ClassSender& sender, const Channel& channel, const OutboundEvent& event) {
-  if (sender.fd < 0) return failed(sender, channel, SendFailure{0, "no transmit socket"});
+SendStatus LcmTransmitter::send_one(ClassSender& sender, const Channel& channel, const OutboundEvent& event,
+                                    SendLog& later) {
+  if (sender.fd < 0) return failed(sender, channel, SendFailure{0, "no transmit socket"}, later);
   LcmMessageParts parts{};
   const std::size_t count = channel.format->encode(event, sender.envelope_headers[0], parts);
-  if (count == 0) return failed(sender, channel, SendFailure{0, "payload too large"});
+  if (count == 0) return failed(sender, channel, SendFailure{0, "payload too large"}, later);
   std::size_t payload_size = 0;
   for (std::size_t k = 0; k < count; ++k) payload_size += parts[k].size();
   if (const auto plan = plan_lcm_message(channel.name.size(), payload_size))
     note_sending(std::max<std::size_t>(1, plan->fragment_count));
   const SendFailure why = send_lcm_message(sender.fd, sender.sequence++, channel.name, std::span(parts.data(), count));
-  return why.failed() ? failed(sender, channel, why) : sent(sender);
+  return why.failed() ? failed(sender, channel, why, later) : sent(sender);
 }
 
 bool LcmTransmitter::stage(ClassSender& sender, const Channel& channel, const OutboundEvent& event) {
@@ -193,26 +210,28 @@ SendStatus LcmTransmitter::sent(ClassSender& sender) {
   return SendStatus::sent;
 }
 
-// Counts the failure; logs the first of a run (per class, so NRT trouble never hides HRT's);
-// reopens a socket whose source went away. Never throws: the log line is the one allocation.
-SendStatus LcmTransmitter::failed(ClassSender& sender, const Channel& channel, SendFailure why) {
+// Counts the failure; logs the first of a run (per class, so NRT trouble never hides HRT's), after
+// the mutex is let go; reopens a socket whose source went away. Never throws: the log line is the
+// one allocation.
+SendStatus LcmTransmitter::failed(ClassSender& sender, const Channel& channel, SendFailure why, SendLog& later) {
   counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
   const auto index = static_cast<std::size_t>(&sender - senders_.data());
   const bool first = !sender.failing.exchange(true, std::memory_order_relaxed);
   try {
     if (first) {
-      log_.log(LogLevel::warning, "LCM segment " + segment_name_ + ": send on channel " + channel.name + " (" +
-                                      class_name(index) + "): " + why.what +
-                                      (why.error != 0 ? std::string(": ") + errno_text(why.error) : std::string()));
+      later.emplace_back(LogLevel::warning,
+                         "LCM segment " + segment_name_ + ": send on channel " + channel.name + " (" +
+                             class_name(index) + "): " + why.what +
+                             (why.error != 0 ? std::string(": ") + errno_text(why.error) : std::string()));
     }
-    if (source_gone(why.error)) reopen(sender, index);
+    if (source_gone(why.error)) reopen(sender, index, later);
   } catch (const std::exception&) {
     // Out of memory for a log line: the failure is counted all the same.
   }
   return SendStatus::failed;
 }
 
-void LcmTransmitter::reopen(ClassSender& sender, std::size_t index) {
+void LcmTransmitter::reopen(ClassSender& sender, std::size_t index, SendLog& later) {
   const auto now = std::chrono::steady_clock::now();
   if (!url_ || now - sender.last_reopen < kReopenPause) return;
   sender.last_reopen = now;
@@ -220,16 +239,18 @@ void LcmTransmitter::reopen(ClassSender& sender, std::size_t index) {
   if (tx.fd < 0) {
     health_.set(SegmentHealth::degraded,
                 std::string("the ") + class_name(index) + " transmit socket cannot reopen: " + tx.error);
-    log_.log(LogLevel::error,
-             "LCM segment " + segment_name_ + ": " + class_name(index) + " transmit socket cannot reopen: " + tx.error);
+    later.emplace_back(LogLevel::error, "LCM segment " + segment_name_ + ": " + class_name(index) +
+                                            " transmit socket cannot reopen: " + tx.error);
     return;
   }
   if (sender.fd >= 0) ::close(sender.fd);
   sender.fd = tx.fd;
   own_keys_[index].store(tx.local.key(), std::memory_order_relaxed);
-  log_.log(LogLevel::notice, "LCM segment " + segment_name_ + ": " + class_name(index) + " transmit socket reopened");
+  later.emplace_back(LogLevel::notice,
+                     "LCM segment " + segment_name_ + ": " + class_name(index) + " transmit socket reopened");
   if (const auto why = attach_filter())
-    log_.log(LogLevel::warning, "LCM segment " + segment_name_ + ": own datagrams read back in full (" + *why + ")");
+    later.emplace_back(LogLevel::warning,
+                       "LCM segment " + segment_name_ + ": own datagrams read back in full (" + *why + ")");
 }
 
 }  // namespace cosmic::lcm_detail

@@ -1,6 +1,9 @@
 // The LCM adapter's transmit side: one connected socket per channel class, each with its own LCM
 // sequence number, envelope headers and batch, under its own mutex held across sendmsg/sendmmsg,
-// so an NRT send stalled in the kernel never holds what an HRT send needs (issue 20, item 2).
+// so an NRT send stalled in the kernel never holds what an HRT send needs (issue 20, item 2). Only
+// the class's own lane and the control thread (open, close, joining) ever take a class's mutex; it
+// inherits priority, so a control thread holding it runs at the lane's priority until it lets go.
+// What a send logs is written after its mutex is let go.
 //
 // Threads: open()/close() on the control thread (close() waits for sends in flight); send() and
 // send_batch() on the egress lanes; is_own() on the receive thread. A socket whose source
@@ -16,6 +19,8 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "cosmic/adapter_counters.hpp"
 #include "cosmic/health_cell.hpp"
@@ -23,6 +28,7 @@
 #include "cosmic/lcm_wire.hpp"
 #include "cosmic/log.hpp"
 #include "cosmic/mutex.hpp"
+#include "cosmic/pi_mutex.hpp"
 #include "cosmic/segment_adapter.hpp"
 #include "cosmic/thread_annotations.hpp"
 #include "lcm_channel.hpp"
@@ -66,8 +72,10 @@ class LcmTransmitter {
   SendStatus unbound();
 
  private:
+  // The lines one send has to log, written once its sender's mutex is free (empty: no allocation).
+  using SendLog = std::vector<std::pair<LogLevel, std::string>>;
   struct ClassSender {
-    Mutex mutex;
+    PiMutex mutex;
     int fd COSMIC_GUARDED_BY(mutex) = -1;
     std::uint32_t sequence COSMIC_GUARDED_BY(mutex) = 0;  // LCM's per-sender message number
     // Envelope headers of the messages in flight, one per batch slot.
@@ -78,12 +86,14 @@ class LcmTransmitter {
     std::atomic<bool> failing{false};  // a run of failures is logged once
   };
 
-  SendStatus send_one(ClassSender& sender, const Channel& channel, const OutboundEvent& event)
+  SendStatus send_one(ClassSender& sender, const Channel& channel, const OutboundEvent& event, SendLog& later)
       COSMIC_REQUIRES(sender.mutex);
   bool stage(ClassSender& sender, const Channel& channel, const OutboundEvent& event) COSMIC_REQUIRES(sender.mutex);
   SendStatus sent(ClassSender& sender);
-  SendStatus failed(ClassSender& sender, const Channel& channel, SendFailure why) COSMIC_REQUIRES(sender.mutex);
-  void reopen(ClassSender& sender, std::size_t index) COSMIC_REQUIRES(sender.mutex);
+  SendStatus failed(ClassSender& sender, const Channel& channel, SendFailure why, SendLog& later)
+      COSMIC_REQUIRES(sender.mutex);
+  void reopen(ClassSender& sender, std::size_t index, SendLog& later) COSMIC_REQUIRES(sender.mutex);
+  void write(SendLog& later) noexcept;
   std::optional<std::string> attach_filter();
   // Before `datagrams` leave: counted while they loop back to a filter that drops them.
   void note_sending(std::size_t datagrams);
