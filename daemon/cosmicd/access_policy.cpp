@@ -26,7 +26,7 @@ bool in_group(unsigned uid, unsigned gid, const std::string& group) {
   return false;
 }
 
-cosmic::AccessPolicy make_access_policy(AccessGroups groups) {
+cosmic::AccessPolicy make_access_policy(const AccessGroups& groups) {
   cosmic::AccessPolicy policy;
   policy.may_modify = [groups](const cosmic::PeerCredentials& peer) {
     return peer.uid == 0 || in_group(peer.uid, peer.gid, groups.admin_group);

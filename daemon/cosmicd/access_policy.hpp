@@ -13,7 +13,7 @@ struct AccessGroups {
   std::string admin_group = "cosmic-admin";
 };
 
-cosmic::AccessPolicy make_access_policy(AccessGroups groups);
+cosmic::AccessPolicy make_access_policy(const AccessGroups& groups);
 // True when `uid` (or `gid`, its primary group) belongs to the named group.
 bool in_group(unsigned uid, unsigned gid, const std::string& group);
 

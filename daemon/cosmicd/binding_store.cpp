@@ -135,14 +135,14 @@ std::string save_binding_state(const std::string& path, const BindingState& stat
   if (fd < 0) return errno_text("create a temporary file beside " + path);
   const bool written =
       write_all(fd, doc.dump(2, ' ', false, Json::error_handler_t::replace) + "\n") && ::fsync(fd) == 0;
-  const std::string write_error = written ? std::string() : errno_text("write " + temporary);
+  std::string write_error = written ? std::string() : errno_text("write " + temporary);
   ::close(fd);
   if (!written) {
     ::unlink(temporary.c_str());
     return write_error;
   }
   if (::rename(temporary.c_str(), path.c_str()) != 0) {
-    const std::string error = errno_text("rename to " + path);
+    std::string error = errno_text("rename to " + path);
     ::unlink(temporary.c_str());
     return error;
   }

@@ -97,8 +97,8 @@ class Daemon {
     server_options.privileged = policy.may_modify;  // admins keep reserved control slots
     if (const ::group* g = ::getgrnam(options_.groups.read_group.c_str())) server_options.socket_group = g->gr_gid;
     cosmic::ControlServer server(server_options, [this](std::string_view line, const cosmic::PeerCredentials& peer,
-                                                        cosmic::ControlServer::Responder later) {
-      return protocol_->handle(line, peer, std::move(later));
+                                                        const cosmic::ControlServer::Responder& later) {
+      return protocol_->handle(line, peer, later);
     });
     // Admission of bind and reload runs on the server's worker thread, so status answers and
     // watchdog keep-alives continue meanwhile.
@@ -272,9 +272,8 @@ class Daemon {
   }
 
   std::string persist() {
-    const std::string error = state_file_usable_
-                                  ? save_binding_state(state_file_, state_)
-                                  : state_file_ + " is unusable and could not be set aside; not overwritten";
+    std::string error = state_file_usable_ ? save_binding_state(state_file_, state_)
+                                           : state_file_ + " is unusable and could not be set aside; not overwritten";
     if (!error.empty()) log_.log(cosmic::LogLevel::error, "cannot save runtime bindings: " + error);
     return error;
   }

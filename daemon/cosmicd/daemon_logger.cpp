@@ -32,8 +32,7 @@ spdlog::level::level_enum to_spdlog(cosmic::LogLevel level) {
     case cosmic::LogLevel::debug:
       return spdlog::level::debug;
     case cosmic::LogLevel::info:
-      return spdlog::level::info;
-    case cosmic::LogLevel::notice:
+    case cosmic::LogLevel::notice:  // spdlog has no notice level
       return spdlog::level::info;
     case cosmic::LogLevel::warning:
       return spdlog::level::warn;

@@ -158,7 +158,7 @@ void MetricsHttpServer::serve_metrics(DocumentSource document) {
       response.set_content("cosmicd did not answer with a snapshot in time\n", "text/plain");
       return;
     }
-    response.set_content(std::move(*text), content_type(format));
+    response.set_content(*text, content_type(format));
   });
   Get("/", [](const httplib::Request&, httplib::Response& response) {
     response.set_content("cosmicd: metrics at /metrics\n", "text/plain");

@@ -289,6 +289,7 @@ std::vector<std::uint64_t> rebucket_residence(const std::vector<std::uint64_t>& 
   std::vector<std::uint64_t> counts(bounds.size() + 1, 0);
   // Compared in whole nanoseconds: 10 us must hold a bucket ending at exactly 10000 ns.
   std::vector<std::uint64_t> bounds_ns;
+  bounds_ns.reserve(bounds.size());
   for (const double bound : bounds) bounds_ns.push_back(static_cast<std::uint64_t>(std::llround(bound * 1e9)));
   for (std::size_t i = 0; i < source.size(); ++i) {
     const std::uint64_t upper = cosmic::LatencyHistogram::upper_bound_of(i);

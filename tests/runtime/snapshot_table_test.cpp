@@ -54,7 +54,7 @@ TEST(SnapshotTable, RetireWaitsForTheLastReadingOfTheOldTable) {
       changed.wait(lock, [&] { return may_end; });
     }
     EXPECT_EQ(reading->at(1), "one");  // still the old table, though a new one was published
-    reading_ended = true;               // the Reading ends right after this
+    reading_ended = true;              // the Reading ends right after this
   });
   {
     std::unique_lock lock(mutex);

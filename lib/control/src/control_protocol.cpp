@@ -59,7 +59,7 @@ bool ControlProtocol::is_mutating(std::string_view command) {
 }
 
 std::optional<std::string> ControlProtocol::handle(std::string_view request_line, const PeerCredentials& peer,
-                                                   Reply later) {
+                                                   const Reply& later) {
   Answer response;
   const bool shallow = json_nesting_within(request_line, kMaxRequestNesting);
   const Json request = shallow ? Json::parse(request_line, nullptr, false) : Json(Json::value_t::discarded);

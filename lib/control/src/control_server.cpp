@@ -307,7 +307,7 @@ void ControlServer::answer_requests(int fd, Client& client) {
     client.awaiting_answer = true;
     const std::uint64_t id = client.id;
     client.in_handler = true;
-    auto answer = handler_(line, client.peer, [this, fd, id](std::string text) { deliver(fd, id, std::move(text)); });
+    auto answer = handler_(line, client.peer, [this, fd, id](const std::string& text) { deliver(fd, id, text); });
     client.in_handler = false;
     if (answer) {
       client.awaiting_answer = false;
@@ -317,7 +317,7 @@ void ControlServer::answer_requests(int fd, Client& client) {
 }
 
 // A deferred answer: only for the connection that asked (a reused descriptor has another id).
-void ControlServer::deliver(int fd, std::uint64_t id, std::string line) {
+void ControlServer::deliver(int fd, std::uint64_t id, const std::string& line) {
   const auto it = clients_.find(fd);
   if (it == clients_.end() || it->second.id != id || !it->second.awaiting_answer) return;
   Client& client = it->second;

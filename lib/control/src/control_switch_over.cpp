@@ -48,11 +48,11 @@ ControlProtocol::Answer ControlProtocol::switch_planned(std::shared_ptr<BindPlan
   std::snprintf(limit, sizeof limit, "%g", seconds);
   running_ = command + " of " + (plan->channels.empty() ? std::string() : plan->channels.front().name) +
              " (waiting up to " + limit + " s for its new publishers to match before the switch)";
-  await_match(std::move(wait));
+  await_match(wait);
   return std::nullopt;
 }
 
-void ControlProtocol::await_match(std::shared_ptr<SwitchWait> wait) {
+void ControlProtocol::await_match(const std::shared_ptr<SwitchWait>& wait) {
   offload_([] { std::this_thread::sleep_for(kMatchPoll); },
            [this, wait] {
              Json answer;

@@ -240,6 +240,7 @@ void KnowledgeBase::set_health(const std::string& segment, SegmentHealth health,
     if (state.spec.name != segment) continue;
     state.health = health;
     state.health_detail = std::move(detail);
+    return;  // names are unique: the detail is moved once
   }
 }
 

@@ -79,7 +79,7 @@ const char* to_string(PeerState value) {
 
 FederationView::FederationView(std::uint64_t self, std::size_t max_peers) : self_(self), max_peers_(max_peers) {}
 
-bool FederationView::refuse(const FederationMessage& message, std::string why, std::string* refusal) {
+bool FederationView::refuse(const FederationMessage& message, const std::string& why, std::string* refusal) {
   ++counters_.refused;
   counters_.last_refusal = why + " (from writer " + quoted_source(message.source) + ")";
   if (refusal) *refusal = counters_.last_refusal;
@@ -115,7 +115,7 @@ std::string FederationView::cheap_refusal(const FederationMessage& message) {
 }
 
 bool FederationView::take_announcement(const FederationMessage& message, Nanos now, std::string* refusal) {
-  if (std::string why = cheap_refusal(message); !why.empty()) return refuse(message, std::move(why), refusal);
+  if (std::string why = cheap_refusal(message); !why.empty()) return refuse(message, why, refusal);
   DecodedAnnouncement decoded = decode_announcement(message.body);
   if (!decoded.announcement) return refuse(message, decoded.error, refusal);
   Announcement& a = *decoded.announcement;

@@ -121,7 +121,7 @@ std::size_t EgressLane::run_once(std::size_t budget) {
   return handled;
 }
 
-void EgressLane::worker(ThreadPolicy policy) {
+void EgressLane::worker(const ThreadPolicy& policy) {
   if (auto problems = apply_thread_policy(policy); !problems.empty() && context_.report_thread_problems) {
     for (auto& p : problems) p = "thread " + policy.name + ": " + p;
     context_.report_thread_problems(problems);

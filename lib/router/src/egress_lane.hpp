@@ -82,7 +82,7 @@ class EgressLane {
   // After a send: counters and residence by the adapter's answer; the item is released.
   void account(LaneItem& item, SendStatus status) noexcept;
   void discard(LaneItem& item) noexcept;
-  void worker(ThreadPolicy policy);
+  void worker(const ThreadPolicy& policy);
 
   LaneContext& context_;
   const std::size_t segment_;

@@ -17,7 +17,7 @@ std::int64_t wall_clock_ns() {
 }
 // Buffers that once held a large event give its memory back, so a burst of big NRT events does
 // not pin lane-depth times their size.
-constexpr std::size_t kRetainedPayloadBytes = 64 * 1024;
+constexpr std::size_t kRetainedPayloadBytes = std::size_t{64} * 1024;
 constexpr std::size_t kClassCount = 3;
 const char* const kClassPrefix[kClassCount] = {"hrt:", "srt:", "nrt:"};
 

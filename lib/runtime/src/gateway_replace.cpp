@@ -62,7 +62,7 @@ std::map<std::string, std::pair<ChannelSpec, ChannelId>> Gateway::take_over_ids(
   return previous;
 }
 
-void Gateway::undo_takeover(std::map<std::string, std::pair<ChannelSpec, ChannelId>> previous) {
+void Gateway::undo_takeover(std::map<std::string, std::pair<ChannelSpec, ChannelId>>&& previous) {
   for (auto& [name, entry] : previous) channel_ids_[name] = std::move(entry);
 }
 

@@ -28,7 +28,7 @@ std::array<std::array<std::uint8_t, kFrameBytes>, 2> supply_etag_data(std::uint8
     f[1] = part;
     f[2] = static_cast<std::uint8_t>((etag >> 8) & 0x3F);
     f[3] = static_cast<std::uint8_t>(etag & 0xFF);
-    for (std::size_t i = 0; i < 4; ++i) f[4 + i] = subject_bytes[4 * part + i];
+    for (std::size_t i = 0; i < 4; ++i) f[4 + i] = subject_bytes[std::size_t{4} * part + i];
   }
   return frames;
 }

@@ -66,7 +66,7 @@ class ControlProtocol {
 
   // The answer line now, or nullopt when a bind or reload runs off the control thread: `later`
   // then gets the answer. While one runs, every bind, unbind and reload is answered `busy`.
-  std::optional<std::string> handle(std::string_view request_line, const PeerCredentials& peer, Reply later);
+  std::optional<std::string> handle(std::string_view request_line, const PeerCredentials& peer, const Reply& later);
   // The same for callers without an Offload (every answer is immediate).
   std::string handle(std::string_view request_line, const PeerCredentials& peer);
   bool admission_running() const { return !running_.empty(); }
@@ -103,7 +103,7 @@ class ControlProtocol {
   struct SwitchWait;
   Answer switch_planned(std::shared_ptr<BindPlan> plan, const Json& request, const std::string& command, bool replan,
                         const Reply& later);
-  void await_match(std::shared_ptr<SwitchWait> wait);
+  void await_match(const std::shared_ptr<SwitchWait>& wait);
   Json switched(SwitchWait& wait, bool timed_out);
   std::string next_log_tag(const char* kind, const PeerCredentials& peer);
   Json status() const;

@@ -31,7 +31,7 @@ namespace cosmic {
 
 struct ControlServerOptions {
   std::string path;
-  std::size_t max_request_bytes = 64 * 1024;
+  std::size_t max_request_bytes = std::size_t{64} * 1024;
   std::size_t max_clients = 32;
   // Slots only privileged peers may take, so unprivileged readers cannot lock admins (and
   // `systemctl reload` through cosmicctl) out.
@@ -107,7 +107,7 @@ class ControlServer {
   void flush(int fd, Client& client);
   // Answers the complete request lines buffered for `client` while its output has room.
   void answer_requests(int fd, Client& client);
-  void deliver(int fd, std::uint64_t id, std::string line);
+  void deliver(int fd, std::uint64_t id, const std::string& line);
   void drop(int fd);
   void expire();
   void run_posted() COSMIC_EXCLUDES(posted_mutex_);

@@ -40,7 +40,7 @@ struct DbcFile {
 };
 
 // A longer text is refused as a whole, unread.
-inline constexpr std::size_t kDbcMaxTextBytes = 8 * 1024 * 1024;
+inline constexpr std::size_t kDbcMaxTextBytes = std::size_t{8} * 1024 * 1024;
 // BO_ lines beyond this many are an error and not returned.
 inline constexpr std::size_t kDbcMaxMessages = 20'000;
 // Errors beyond this many are counted in one closing line instead of reported.

@@ -92,7 +92,7 @@ class FederationView {
   bool shared(const std::string& network) const;
 
  private:
-  bool refuse(const FederationMessage& message, std::string why, std::string* refusal);
+  bool refuse(const FederationMessage& message, const std::string& why, std::string* refusal);
   bool take_announcement(const FederationMessage& message, Nanos now, std::string* refusal);
   // The ids, the writer and the room for a new gateway, before decoding: the reason, or empty.
   std::string cheap_refusal(const FederationMessage& message);

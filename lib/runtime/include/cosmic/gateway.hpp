@@ -271,7 +271,7 @@ class Gateway {
   // A replacement's new definitions take over their channels' ids; returns the entries they
   // replaced, for undo_takeover().
   std::map<std::string, std::pair<ChannelSpec, ChannelId>> take_over_ids(const std::vector<ChannelSpec>& channels);
-  void undo_takeover(std::map<std::string, std::pair<ChannelSpec, ChannelId>> previous);
+  void undo_takeover(std::map<std::string, std::pair<ChannelSpec, ChannelId>>&& previous);
   // Lowest slot index used neither by a running segment nor by one in `also_taken`.
   std::size_t free_slot(const std::set<std::size_t>& also_taken = {}) const;
   static std::unique_ptr<KnowledgeBase> knowledge_base_for(const Config& config);
