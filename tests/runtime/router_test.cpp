@@ -112,10 +112,12 @@ TEST_F(RouterTest, ForwardsFromPublisherToSubscriberAndStampsOrigin) {
 // call on CAN), in their order, each counted and accounted as if sent alone (one already expired
 // on arrival never reaches the lane); a refused batch is counted as dropped, event by event.
 TEST_F(RouterTest, QueuedEventsGoToTheAdapterInOneBatchInOrder) {
-  bind({channel("a", ChannelClass::srt, std::nullopt, Nanos(1'000'000)), channel("b", ChannelClass::srt)});
+  // a's temp_validity is a second, so that the fresh events stay valid however slowly a loaded
+  // machine (or a sanitizer) runs this test (it was 1 ms, and a fresh one expired under ASan).
+  bind({channel("a", ChannelClass::srt, std::nullopt, Nanos(1'000'000'000)), channel("b", ChannelClass::srt)});
   for (std::uint8_t k = 0; k < 3; ++k) ASSERT_TRUE(in.inject("a", {k}));
   EventHeader stale{};
-  stale.age_ns = 1'000'000;  // a's temp_validity: expired in the lane
+  stale.age_ns = 1'000'000'000;  // a's temp_validity: expired in the lane
   deliver(1, stale, steady_now(), {99});
   ASSERT_TRUE(in.inject("b", {3}));
   EXPECT_EQ(router.run_once(10), 4u);

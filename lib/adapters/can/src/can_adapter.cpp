@@ -5,7 +5,7 @@ namespace cosmic::can_detail {
 // ------------------------------------------------------------------------------ lifecycle
 
 Status CanAdapter::start(EventSink& sink) {
-  if (started_) return Status::failure("segment " + segment_.name + " already started");
+  if (started_) return Status::failure(prefix_ + "already started");
   if (segment_.can.interface.empty() || segment_.can.interface.size() >= IFNAMSIZ) {
     return Status::failure("invalid CAN interface name '" + segment_.can.interface + "'");
   }
@@ -17,7 +17,7 @@ Status CanAdapter::start(EventSink& sink) {
   check_link();  // opens the socket now when the interface is there: health is right at once
   ThreadPolicy policy = sink.receive_thread_policy();
   policy.name = "rx:" + segment_.name;
-  if (auto running = receiver_.start(policy, log_, "segment " + segment_.name + ": ", [this] { run(); }); !running) {
+  if (auto running = receiver_.start(policy, log_, prefix_, [this] { run(); }); !running) {
     close_socket();
     ::close(ctl_fd_);
     ctl_fd_ = -1;
@@ -53,7 +53,8 @@ void CanAdapter::stop() {
   link_ = Link::unknown;
   link_detail_ = "stopped";
   controller_ = Controller::ok;
-  health_ = {SegmentHealth::down, "stopped"};
+  shown_ = {SegmentHealth::down, "stopped"};
+  health_.set(SegmentHealth::down, "stopped");
 }
 
 void CanAdapter::wake() { receiver_.wake(); }
@@ -71,7 +72,7 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
                                  static_cast<socklen_t>(table->filters.size() * sizeof(can_filter))) != 0) {
     // The kernel keeps the old filters, so the old table stays: the whole segment failed.
     const std::string error = "CAN_RAW_FILTER: " + errno_text(errno) + "; the previous channels stay";
-    log_.log(LogLevel::error, "segment " + segment_.name + ": " + error);
+    log_.log(LogLevel::error, prefix_ + error);
     return Status::failure(error);
   }
   backlog_.set_capacity(table->backlog_frames);
@@ -90,7 +91,7 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
   table_ = std::move(table);
   generation_.fetch_add(1, std::memory_order_release);
   if (!answers_.empty()) wake();
-  if (!status.ok) log_.log(LogLevel::error, "segment " + segment_.name + ": " + status.error);
+  if (!status.ok) log_.log(LogLevel::error, prefix_ + status.error);
   return status;
 }
 
@@ -217,13 +218,13 @@ void CanAdapter::update_health() {
   } else {
     next = {SegmentHealth::up, ""};
   }
-  if (next.state == health_.state && next.detail == health_.detail) return;
-  health_ = next;
-  const std::string prefix = "segment " + segment_.name + ": ";
+  if (next.state == shown_.state && next.detail == shown_.detail) return;
+  shown_ = next;
+  health_.set(next.state, next.detail);
   if (next.state == SegmentHealth::up) {
-    log_.log(LogLevel::notice, prefix + "interface " + ifname + " is up");
+    log_.log(LogLevel::notice, prefix_ + "interface " + ifname + " is up");
   } else {
-    log_.log(LogLevel::warning, prefix + std::string(to_string(next.state)) + ": " + next.detail);
+    log_.log(LogLevel::warning, prefix_ + std::string(to_string(next.state)) + ": " + next.detail);
   }
 }
 
@@ -264,17 +265,11 @@ void CanAdapter::set_controller(Controller state) {
   update_health();
 }
 
-HealthReport CanAdapter::health() const {
-  LockGuard lock(health_mutex_);
-  return health_;
-}
+HealthReport CanAdapter::health() const { return health_.get(); }
 
 AdapterStatistics CanAdapter::statistics() const {
-  AdapterStatistics s;
-  s.received = received_.load();
-  s.sent = sent_.load();
-  s.receive_errors = receive_errors_.load();
-  s.send_errors = send_errors_.load();
+  AdapterStatistics s = counters_.snapshot();
+  // The kernel's drops: the closed sockets', the open socket's and the controller's.
   s.overflow_drops = overflow_closed_.load() + overflow_socket_.load() + overflow_controller_.load();
   s.backlog = backlog_size_.load();
   s.binding_requests_over_limit = refused_requests_.load();

@@ -34,6 +34,9 @@
 
 #include "binding_guard.hpp"
 #include "can_binding.hpp"
+#include "cosmic/adapter_counters.hpp"
+#include "cosmic/health_cell.hpp"
+#include "cosmic/log_prefix.hpp"
 #include "cosmic/arrival_clock.hpp"
 #include "cosmic/binding_plan.hpp"
 #include "cosmic/posix_call.hpp"
@@ -120,6 +123,7 @@ class CanAdapter final : public SegmentAdapter {
   CanAdapter(const SegmentSpec& segment, Logger& log)
       : segment_(segment),
         log_(log),
+        prefix_(segment_log_prefix(SegmentType::can, segment.name)),
         capacity_(max_frame_payload(segment.can)),
         brs_(segment.can.fd && segment.can.data_bitrate > segment.can.bitrate),
         famouso_(segment.can.profile == CanProfile::famouso),
@@ -253,6 +257,7 @@ class CanAdapter final : public SegmentAdapter {
 
   const SegmentSpec segment_;
   Logger& log_;
+  const std::string prefix_;      // "CAN segment NAME: " (cosmic/log_prefix.hpp)
   const std::uint32_t capacity_;  // data bytes of one frame on this bus
   const bool brs_;
   const bool famouso_;  // FAMOUSO profile: its identifier layout, CCP, etag-4 answers, AFP
@@ -307,13 +312,12 @@ class CanAdapter final : public SegmentAdapter {
   Link link_ COSMIC_GUARDED_BY(health_mutex_) = Link::unknown;
   std::string link_detail_ COSMIC_GUARDED_BY(health_mutex_) = "not started";
   Controller controller_ COSMIC_GUARDED_BY(health_mutex_) = Controller::ok;
-  HealthReport health_ COSMIC_GUARDED_BY(health_mutex_){SegmentHealth::down, "not started"};
+  HealthReport shown_ COSMIC_GUARDED_BY(health_mutex_){SegmentHealth::down, "not started"};  // last logged
+  HealthCell health_;  // what health() answers, any thread
 
   // Statistics.
-  std::atomic<std::uint64_t> received_{0};
-  std::atomic<std::uint64_t> sent_{0};
-  std::atomic<std::uint64_t> receive_errors_{0};
-  std::atomic<std::uint64_t> send_errors_{0};
+  // received, sent and the errors (the kit's counters); overflow_drops is the sum below.
+  AdapterCounters counters_;
   std::atomic<std::uint64_t> overflow_closed_{0};  // SO_RXQ_OVFL of sockets already closed
   std::atomic<std::uint64_t> overflow_socket_{0};  // SO_RXQ_OVFL of the open socket
   std::atomic<std::uint64_t> overflow_controller_{0};

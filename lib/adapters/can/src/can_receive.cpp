@@ -3,7 +3,7 @@
 namespace cosmic::can_detail {
 
 void CanAdapter::problem(ChannelId channel, InboundProblem what) {
-  ++receive_errors_;
+  counters_.receive_errors.fetch_add(1, std::memory_order_relaxed);
   if (sink_) sink_->on_problem(channel, what);
 }
 
@@ -12,7 +12,7 @@ void CanAdapter::handle_frame(const canfd_frame& frame, bool fd_frame, Nanos now
     handle_error_frame(frame);
     return;
   }
-  ++received_;
+  counters_.received.fetch_add(1, std::memory_order_relaxed);
   const std::size_t len = std::min<std::size_t>(frame.len, fd_frame ? CANFD_MAX_DLEN : CAN_MAX_DLEN);
   refresh_rx_table();
   const Table& table = *rx_table_;
@@ -100,8 +100,7 @@ void CanAdapter::handle_famouso_protocol(const CanIdentifier& id, const canfd_fr
       queue_answer(answer->can_id, answer->data);
     } else if (ccp_->exhausted()) {
       problem(kNoChannel, InboundProblem::decode_error);
-      log_.log(LogLevel::warning,
-               "segment " + segment_.name + ": CCP: every TxNode is taken, a node stays unconfigured");
+      log_.log(LogLevel::warning, prefix_ + "CCP: every TxNode is taken, a node stays unconfigured");
     }
     return;
   }
@@ -122,8 +121,8 @@ void CanAdapter::handle_famouso_protocol(const CanIdentifier& id, const canfd_fr
   const bool bound = table.etag_of.count(subject) != 0;
   char text[64];
   std::snprintf(text, sizeof text, "0x%016llx", static_cast<unsigned long long>(subject));
-  log_.log(LogLevel::notice, "segment " + segment_.name + ": FAMOUSO node " + std::to_string(id.tx_node) +
-                                 " subscribes subject " + text + (bound ? "" : " (no channel bound for it)"));
+  log_.log(LogLevel::notice, prefix_ + "FAMOUSO node " + std::to_string(id.tx_node) + " subscribes subject " + text +
+                                 (bound ? "" : " (no channel bound for it)"));
 }
 
 void CanAdapter::deliver(const RxChannel& channel, std::span<const std::uint8_t> payload, Nanos now) {
@@ -178,7 +177,7 @@ void CanAdapter::handle_get_etag(const canfd_frame& frame, std::size_t len, Nano
   const Table& table = *rx_table_;
   PiLock lock(io_mutex_);
   if (!request_limit_.admit(request->requester, now)) {
-    ++receive_errors_;
+    counters_.receive_errors.fetch_add(1, std::memory_order_relaxed);
     defer_request(*request);
     return;
   }
@@ -193,8 +192,8 @@ void CanAdapter::defer_request(const can_binding::GetEtagRequest& request) {
   if (kept) deferred_requests_.push_back(request);
   const std::uint64_t over = refused_requests_.fetch_add(1) + 1;
   if (over % 1000 == 1) {
-    log_.log(LogLevel::warning, "segment " + segment_.name + ": GET_ETAG from TxNode " +
-                                    std::to_string(request.requester) + " over the rate limit, " +
+    log_.log(LogLevel::warning, prefix_ + "GET_ETAG from TxNode " + std::to_string(request.requester) +
+                                    " over the rate limit, " +
                                     (kept    ? "answered later"
                                      : known ? "already waiting"
                                              : "deferred queue full, dropped") +
@@ -234,7 +233,7 @@ void CanAdapter::queue_supply_etag(std::uint8_t requester, std::uint16_t etag, s
       famouso_ ? can_binding::supply_etag_new_bp_id() : can_binding::supply_etag_id(*table.tx_node);
   const auto frames = can_binding::supply_etag_data(requester, etag, subject);
   if (!answers_.room_for(frames.size())) {
-    send_errors_ += frames.size();
+    counters_.send_errors.fetch_add(frames.size(), std::memory_order_relaxed);
     return;
   }
   for (const auto& data : frames) queue_answer(id, data);
@@ -242,7 +241,7 @@ void CanAdapter::queue_supply_etag(std::uint8_t requester, std::uint16_t etag, s
 
 void CanAdapter::queue_answer(std::uint32_t can_id, std::span<const std::uint8_t> data) {
   if (!answers_.room_for(1)) {
-    ++send_errors_;
+    counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
     return;
   }
   can_frame out{};
@@ -274,7 +273,7 @@ void CanAdapter::drain_answers() {
   PiLock lock(io_mutex_);
   if (answers_.empty()) return;  // stop() cleared the queue meanwhile
   if (n == static_cast<ssize_t>(CAN_MTU)) {
-    ++sent_;
+    counters_.sent.fetch_add(1, std::memory_order_relaxed);
     answers_.sent(now);
     return;
   }
@@ -282,7 +281,7 @@ void CanAdapter::drain_answers() {
     answers_.wait(now);  // the kernel's queue is full: try again one gap later
     return;
   }
-  ++send_errors_;
+  counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
   answers_.sent(now);  // dropped
 }
 

@@ -48,9 +48,8 @@ std::size_t write_frames(int fd, std::span<const canfd_frame> frames, bool fd_fr
 
 std::string CanAdapter::drop_backlog(const char* why) {
   if (backlog_.empty()) return {};
-  send_errors_ += backlog_.size();
-  std::string line =
-      "segment " + segment_.name + ": dropped " + std::to_string(backlog_.size()) + " queued frames (" + why + ")";
+  counters_.send_errors.fetch_add(backlog_.size(), std::memory_order_relaxed);
+  std::string line = prefix_ + "dropped " + std::to_string(backlog_.size()) + " queued frames (" + why + ")";
   backlog_.clear();
   backlog_size_ = 0;
   wait_pollout_ = false;
@@ -70,7 +69,7 @@ bool CanAdapter::behind_backlog(canid_t can_id) const {
 
 CanAdapter::WriteResult CanAdapter::queue_frames(std::span<const canfd_frame> frames, bool fd) {
   if (!backlog_.room_for(frames.size())) {
-    send_errors_ += frames.size();
+    counters_.send_errors.fetch_add(frames.size(), std::memory_order_relaxed);
     return WriteResult::full;
   }
   for (const canfd_frame& frame : frames) backlog_.push(frame, fd);
@@ -84,10 +83,10 @@ void CanAdapter::note_refusal(int err) {
 }
 
 std::string CanAdapter::count_send_error(int err) {
-  ++send_errors_;
+  counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
   if (send_error_logged_) return {};
   send_error_logged_ = true;
-  return "segment " + segment_.name + ": write to " + segment_.can.interface + ": " + errno_text(err) +
+  return prefix_ + "write to " + segment_.can.interface + ": " + errno_text(err) +
          " (further errors counted, not logged)";
 }
 
@@ -110,7 +109,7 @@ CanAdapter::WriteResult CanAdapter::submit(std::span<const canfd_frame> frames, 
   {
     PiLock lock(io_mutex_);
     if (!tx_socket_) {
-      send_errors_ += frames.size();
+      counters_.send_errors.fetch_add(frames.size(), std::memory_order_relaxed);
       return WriteResult::failed;
     }
     const bool one_identifier = std::all_of(frames.begin(), frames.end(),
@@ -131,7 +130,7 @@ CanAdapter::WriteResult CanAdapter::submit(std::span<const canfd_frame> frames, 
   while (written < frames.size()) {
     const std::size_t n = write_frames(socket->fd(), frames.subspan(written), fd, err);
     written += n;
-    sent_ += n;
+    counters_.sent.fetch_add(n, std::memory_order_relaxed);
     if (err != 0) break;
   }
   if (written == frames.size()) return WriteResult::written;
@@ -142,7 +141,7 @@ CanAdapter::WriteResult CanAdapter::submit(std::span<const canfd_frame> frames, 
     if (!kernel_full(err) || !tx_socket_) {
       // Refused for good, or the socket went away mid-event: the rest of the event is worthless.
       log_line = count_send_error(err);
-      send_errors_ += frames.size() - written - 1;
+      counters_.send_errors.fetch_add(frames.size() - written - 1, std::memory_order_relaxed);
     } else {
       // The kernel's queue is full: the rest waits in the backlog (in order: one identifier).
       result = queue_frames(frames.subspan(written), fd);
@@ -178,14 +177,14 @@ void CanAdapter::drain_backlog() {
     for (std::size_t i = 0; i < count; ++i) frames[i] = taken[i].frame;
     int err = 0;
     const std::size_t written = write_frames(socket->fd(), std::span(frames.data(), count), fd, err);
-    sent_ += written;
+    counters_.sent.fetch_add(written, std::memory_order_relaxed);
     std::string log_line;
     {
       PiLock lock(io_mutex_);
       draining_key_.reset();
       std::size_t next = written;
       if (err != 0 && !kernel_full(err) && err != ENETDOWN && next < count) {
-        ++send_errors_;  // this frame cannot be sent; the others may
+        counters_.send_errors.fetch_add(1, std::memory_order_relaxed);  // this frame cannot be sent; the others may
         ++next;
       }
       backlog_.settle(next);
@@ -223,7 +222,7 @@ SendStatus CanAdapter::send(const OutboundEvent& event) {
       table = table_;
       const auto it = table->tx.find(event.channel);
       if (it == table->tx.end() || !started_ || !link_up_ || !tx_socket_ || event.payload.size() > it->second.payload) {
-        ++send_errors_;
+        counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
         return SendStatus::failed;
       }
       found = &it->second;
@@ -232,7 +231,7 @@ SendStatus CanAdapter::send(const OutboundEvent& event) {
           : found->fragmented && !famouso_ && !found->native  ? fragment_count(event.payload.size(), capacity_)
                                                               : 1;
       if (frames > 1 && !backlog_.empty() && !backlog_.room_for(frames)) {
-        ++send_errors_;
+        counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
         return SendStatus::queue_full;
       }
       if (found->fragmented && !famouso_ && !found->native) {  // every event of the channel is numbered
@@ -253,7 +252,7 @@ SendStatus CanAdapter::send(const OutboundEvent& event) {
     const canfd_frame frame = single_frame(channel, event.payload);
     return to_send_status(submit(std::span(&frame, 1), fd));
   } catch (...) {
-    ++send_errors_;
+    counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
     return SendStatus::failed;
   }
 }

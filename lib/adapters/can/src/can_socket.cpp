@@ -72,7 +72,7 @@ bool CanAdapter::open_socket(int ifindex) {
                    static_cast<socklen_t>(table_->filters.size() * sizeof(can_filter))) != 0) {
     const int err = errno;
     ::close(s);
-    log_.log(LogLevel::error, "segment " + segment_.name + ": CAN_RAW_FILTER: " + errno_text(err));
+    log_.log(LogLevel::error, prefix_ + "CAN_RAW_FILTER: " + errno_text(err));
     return false;
   }
   if (sock_ >= 0) overflow_closed_ += overflow_socket_.exchange(0);
@@ -101,8 +101,8 @@ void CanAdapter::size_receive_buffer(int s) {
   if (held >= wanted || receive_buffer_warned_) return;
   receive_buffer_warned_ = true;
   log_.log(LogLevel::warning,
-           "segment " + segment_.name + ": the receive buffer of " + segment_.can.interface + " holds " +
-               std::to_string(held) + " frames, not the " + std::to_string(wanted) + " the bus carries in " +
+           prefix_ + "the receive buffer of " + segment_.can.interface + " holds " + std::to_string(held) +
+               " frames, not the " + std::to_string(wanted) + " the bus carries in " +
                std::to_string(kReceiveHold.count() / 1'000'000) +
                " ms: frames of a longer burst are lost when the receive thread falls behind (counted as "
                "overflow drops). Set net.core.rmem_max to at least " +
@@ -132,8 +132,7 @@ void CanAdapter::open_census_socket(int ifindex) {
   if (s >= 0) ::close(s);
   if (!census_error_logged_) {
     census_error_logged_ = true;
-    log_.log(LogLevel::warning, "segment " + segment_.name +
-                                    ": no census socket (unexplained frames are not counted): " + errno_text(err));
+    log_.log(LogLevel::warning, prefix_ + "no census socket (unexplained frames are not counted): " + errno_text(err));
   }
 }
 
@@ -218,7 +217,7 @@ void CanAdapter::run() {
     const auto wait_ms = std::chrono::ceil<milliseconds>(std::max(Nanos(0), deadline - now)).count();
     const int ready = ::poll(fds, 3, static_cast<int>(std::min<std::int64_t>(wait_ms, 1000)));
     if (ready < 0 && errno != EINTR) {
-      log_.log(LogLevel::error, "segment " + segment_.name + ": poll: " + errno_text(errno));
+      log_.log(LogLevel::error, prefix_ + "poll: " + errno_text(errno));
       std::this_thread::sleep_for(milliseconds(10));
       continue;
     }
@@ -309,8 +308,8 @@ void CanAdapter::handle_read_error(int err) {
     next_link_check_ = steady_now() + kLinkCheckWhileDown;
     return;
   }
-  ++receive_errors_;
-  log_.log(LogLevel::warning, "segment " + segment_.name + ": recvmmsg: " + errno_text(err));
+  counters_.receive_errors.fetch_add(1, std::memory_order_relaxed);
+  log_.log(LogLevel::warning, prefix_ + "recvmmsg: " + errno_text(err));
 }
 
 void CanAdapter::handle_datagram(canfd_frame& frame, msghdr& msg, std::size_t bytes) {

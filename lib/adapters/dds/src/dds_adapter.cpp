@@ -44,7 +44,7 @@ namespace dds_detail {
 Status DdsAdapter::start(EventSink& sink) {
   std::lock_guard control(control_mutex_);
   if (started()) {
-    return Status::failure("DDS segment " + segment_.name + " already started");
+    return Status::failure(prefix() + "already started");
   }
   auto fail = [&](std::string why) {
     set_health(SegmentHealth::down, why);

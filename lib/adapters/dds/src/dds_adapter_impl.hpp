@@ -29,6 +29,7 @@
 #include "cosmic/dds_adapter.hpp"
 #include "cosmic/dds_names.hpp"
 #include "cosmic/health_cell.hpp"
+#include "cosmic/log_prefix.hpp"
 #include "cosmic/mutex.hpp"
 #include "cosmic/pi_mutex.hpp"
 #include "cosmic/snapshot_table.hpp"
@@ -120,7 +121,7 @@ struct ReaderEntry : dds::DataReaderListener {
 class DdsAdapter final : public DdsSegmentAdapter {
  public:
   DdsAdapter(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log)
-      : segment_(segment), self_(self), log_(log) {}
+      : segment_(segment), self_(self), log_(log), prefix_(segment_log_prefix(SegmentType::dds, segment.name)) {}
   ~DdsAdapter() override { stop(); }
 
   Status start(EventSink& sink) override;
@@ -150,7 +151,7 @@ class DdsAdapter final : public DdsSegmentAdapter {
   void warn_refused(const WriterEntry& writer, FillRefusal refusal, std::uint16_t first_bytes, std::size_t size);
 
  private:
-  std::string prefix() const { return "dds segment " + segment_.name + ": "; }
+  const std::string& prefix() const { return prefix_; }
   void set_health(SegmentHealth state, std::string detail) { health_.set(state, std::move(detail)); }
   ClassParticipant& home_of(ChannelClass cls) { return classes_.at(static_cast<std::size_t>(cls)); }
   bool started() const { return classes_[static_cast<std::size_t>(ChannelClass::nrt)].participant != nullptr; }
@@ -176,6 +177,7 @@ class DdsAdapter final : public DdsSegmentAdapter {
   const SegmentSpec segment_;
   const GatewayIdentity self_;
   Logger& log_;
+  const std::string prefix_;  // "DDS segment NAME: " (cosmic/log_prefix.hpp)
 
   std::mutex control_mutex_;
   EventSink* sink_ = nullptr;

@@ -56,6 +56,7 @@
 #include "cosmic/lcm_url.hpp"
 #include "cosmic/receive_thread.hpp"
 #include "cosmic/lcm_wire.hpp"
+#include "cosmic/log_prefix.hpp"
 #include "cosmic/mutex.hpp"
 #include "cosmic/snapshot_table.hpp"
 #include "cosmic/result.hpp"
@@ -107,6 +108,7 @@ class LcmAdapter final : public SegmentAdapter {
   LcmAdapter(const SegmentSpec& segment, Logger& log)
       : segment_(segment),
         log_(log),
+        prefix_(segment_log_prefix(SegmentType::lcm, segment.name)),
         transmit_(segment.name, log, counters_, health_, receive_failing_),
         // An envelope's payload may be max_message_size bytes: the message is its header longer.
         reassembler_(segment.max_message_size + kLcmEnvelopeHeaderSize) {}
@@ -118,7 +120,7 @@ class LcmAdapter final : public SegmentAdapter {
 
   Status start(EventSink& sink) override {
     LockGuard control(control_mutex_);
-    if (started_) return Status::failure("LCM segment " + segment_.name + " already started");
+    if (started_) return Status::failure(prefix_ + "already started");
     const auto parsed = parse_lcm_url(segment_.lcm.url);
     if (const auto* why = std::get_if<std::string>(&parsed))
       return fail_start("bad LCM URL " + segment_.lcm.url + ": " + *why);
@@ -149,8 +151,7 @@ class LcmAdapter final : public SegmentAdapter {
       rx.warnings.push_back("own datagrams are read back in full and skipped here (" + *why + ")");
       own_dropped = false;
     }
-    for (const auto& warning : rx.warnings)
-      log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + warning);
+    for (const auto& warning : rx.warnings) log_.log(LogLevel::warning, prefix_ + warning);
     rx_fd_ = rx.fd;
     rx_url_ = url;
     member_ = true;  // open_receive_socket() joined the group
@@ -163,8 +164,7 @@ class LcmAdapter final : public SegmentAdapter {
     attach_sink(&sink);
     ThreadPolicy policy = sink.receive_thread_policy();
     policy.name = "rx:" + segment_.name;
-    auto running =
-        receiver_.start(policy, log_, "LCM segment " + segment_.name + ": ", [this, fd = rx_fd_] { receive_loop(fd); });
+    auto running = receiver_.start(policy, log_, prefix_, [this, fd = rx_fd_] { receive_loop(fd); });
     if (!running) {
       attach_sink(nullptr);
       transmit_.close();
@@ -174,7 +174,7 @@ class LcmAdapter final : public SegmentAdapter {
     count_own_drops(own_dropped);
     started_ = true;
     set_health(SegmentHealth::up, "");
-    log_.log(LogLevel::info, "LCM segment " + segment_.name + " up on " + segment_.lcm.url);
+    log_.log(LogLevel::info, prefix_ + "up on " + segment_.lcm.url);
     return Status{};
   }
 
@@ -227,7 +227,7 @@ class LcmAdapter final : public SegmentAdapter {
     replace_table(ChannelTable{std::move(index), table_.current_for_publisher().sink});
     if (started_ && rx_fd_ >= 0 && !receives) leave_group();
     Status status = plan.status();
-    if (!status.ok) log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": " + status.error);
+    if (!status.ok) log_.log(LogLevel::warning, prefix_ + status.error);
     return status;
   }
 
@@ -288,7 +288,7 @@ class LcmAdapter final : public SegmentAdapter {
     transmit_.close();
     memq_.store(false, std::memory_order_relaxed);
     set_health(SegmentHealth::down, "stopped");
-    log_.log(LogLevel::info, "LCM segment " + segment_.name + " stopped");
+    log_.log(LogLevel::info, prefix_ + "stopped");
   }
 
  private:
@@ -314,7 +314,7 @@ class LcmAdapter final : public SegmentAdapter {
       return why;
     }
     member_ = true;
-    log_.log(LogLevel::info, "LCM segment " + segment_.name + ": a channel is received here: joined " + rx_url_->group);
+    log_.log(LogLevel::info, prefix_ + "a channel is received here: joined " + rx_url_->group);
     return std::nullopt;
   }
 
@@ -323,13 +323,13 @@ class LcmAdapter final : public SegmentAdapter {
     // would go on receiving ours while any other program is a member: it stays a member.
     if (!member_ || !may_leave_) return;
     if (const auto why = lcm_detail::set_group_membership(rx_fd_, *rx_url_, false)) {
-      log_.log(LogLevel::warning, "LCM segment " + segment_.name + ": stays a member of the group (" + *why + ")");
+      log_.log(LogLevel::warning, prefix_ + "stays a member of the group (" + *why + ")");
       return;
     }
     transmit_.count_looped_back(false);  // after the leave: the count never falls short
     member_ = false;
-    log_.log(LogLevel::info, "LCM segment " + segment_.name + ": no channel is received here: left " + rx_url_->group +
-                                 " (joins it again when one is bound)");
+    log_.log(LogLevel::info,
+             prefix_ + "no channel is received here: left " + rx_url_->group + " (joins it again when one is bound)");
   }
 
   // own_datagrams_dropped: the datagrams sent while the filter drops our own copies. The
@@ -340,8 +340,8 @@ class LcmAdapter final : public SegmentAdapter {
     own_counting_ = from_now_on;
     if (from_now_on)
       log_.log(LogLevel::notice,
-               "LCM segment " + segment_.name +
-                   ": while a channel is received here, its own datagrams loop back and its receive filter "
+               prefix_ +
+                   "while a channel is received here, its own datagrams loop back and its receive filter "
                    "drops them (own_datagrams: drop); each counts once in the host's UDP InErrors and "
                    "none in RcvbufErrors; cosmicctl segments --json reports them as own_datagrams_dropped");
   }
@@ -355,7 +355,7 @@ class LcmAdapter final : public SegmentAdapter {
 
   Status fail_start(const std::string& why) {
     set_health(SegmentHealth::down, why);
-    log_.log(LogLevel::error, "LCM segment " + segment_.name + ": " + why);
+    log_.log(LogLevel::error, prefix_ + why);
     return Status::failure(why);
   }
 
@@ -410,7 +410,7 @@ class LcmAdapter final : public SegmentAdapter {
       }
       if (receive_failing_.exchange(false, std::memory_order_relaxed)) {
         set_health(SegmentHealth::up, "");
-        log_.log(LogLevel::notice, "LCM segment " + segment_.name + " receiving again");
+        log_.log(LogLevel::notice, prefix_ + "receiving again");
       }
       if (n == 0) return;
       handle_batch(batch, static_cast<std::size_t>(n));
@@ -422,7 +422,7 @@ class LcmAdapter final : public SegmentAdapter {
     if (receive_failing_.exchange(true, std::memory_order_relaxed)) return;
     const std::string what = std::string(call) + ": " + errno_text(error);
     set_health(SegmentHealth::degraded, what + " on " + segment_.lcm.url);
-    log_.log(LogLevel::error, "LCM segment " + segment_.name + ": " + what);
+    log_.log(LogLevel::error, prefix_ + what);
   }
 
   // The socket's drop count is cumulative, 32 bits wide, and starts again with every socket; so
@@ -532,6 +532,7 @@ class LcmAdapter final : public SegmentAdapter {
 
   const SegmentSpec segment_;
   Logger& log_;
+  const std::string prefix_;  // "LCM segment NAME: " (cosmic/log_prefix.hpp)
   AdapterCounters counters_;
   HealthCell health_;
   std::atomic<bool> receive_failing_{false};  // a read failed; cleared by the next that works

@@ -35,9 +35,9 @@ const char* class_name(std::size_t index) {
 
 }  // namespace
 
-LcmTransmitter::LcmTransmitter(std::string segment_name, Logger& log, AdapterCounters& counters, HealthCell& health,
-                               const std::atomic<bool>& receive_failing)
-    : segment_name_(std::move(segment_name)),
+LcmTransmitter::LcmTransmitter(const std::string& segment_name, Logger& log, AdapterCounters& counters,
+                               HealthCell& health, const std::atomic<bool>& receive_failing)
+    : prefix_(segment_log_prefix(SegmentType::lcm, segment_name)),
       log_(log),
       counters_(counters),
       health_(health),
@@ -220,8 +220,7 @@ SendStatus LcmTransmitter::failed(ClassSender& sender, const Channel& channel, S
   try {
     if (first) {
       later.emplace_back(LogLevel::warning,
-                         "LCM segment " + segment_name_ + ": send on channel " + channel.name + " (" +
-                             class_name(index) + "): " + why.what +
+                         prefix_ + "send on channel " + channel.name + " (" + class_name(index) + "): " + why.what +
                              (why.error != 0 ? std::string(": ") + errno_text(why.error) : std::string()));
     }
     if (source_gone(why.error)) reopen(sender, index, later);
@@ -239,18 +238,15 @@ void LcmTransmitter::reopen(ClassSender& sender, std::size_t index, SendLog& lat
   if (tx.fd < 0) {
     health_.set(SegmentHealth::degraded,
                 std::string("the ") + class_name(index) + " transmit socket cannot reopen: " + tx.error);
-    later.emplace_back(LogLevel::error, "LCM segment " + segment_name_ + ": " + class_name(index) +
-                                            " transmit socket cannot reopen: " + tx.error);
+    later.emplace_back(LogLevel::error, prefix_ + class_name(index) + " transmit socket cannot reopen: " + tx.error);
     return;
   }
   if (sender.fd >= 0) ::close(sender.fd);
   sender.fd = tx.fd;
   own_keys_[index].store(tx.local.key(), std::memory_order_relaxed);
-  later.emplace_back(LogLevel::notice,
-                     "LCM segment " + segment_name_ + ": " + class_name(index) + " transmit socket reopened");
+  later.emplace_back(LogLevel::notice, prefix_ + class_name(index) + " transmit socket reopened");
   if (const auto why = attach_filter())
-    later.emplace_back(LogLevel::warning,
-                       "LCM segment " + segment_name_ + ": own datagrams read back in full (" + *why + ")");
+    later.emplace_back(LogLevel::warning, prefix_ + "own datagrams read back in full (" + *why + ")");
 }
 
 }  // namespace cosmic::lcm_detail

@@ -27,6 +27,7 @@
 #include "cosmic/lcm_url.hpp"
 #include "cosmic/lcm_wire.hpp"
 #include "cosmic/log.hpp"
+#include "cosmic/log_prefix.hpp"
 #include "cosmic/mutex.hpp"
 #include "cosmic/pi_mutex.hpp"
 #include "cosmic/segment_adapter.hpp"
@@ -39,7 +40,7 @@ namespace cosmic::lcm_detail {
 class LcmTransmitter {
  public:
   // `receive_failing` is the receive side's own trouble: a transmit recovery does not clear it.
-  LcmTransmitter(std::string segment_name, Logger& log, AdapterCounters& counters, HealthCell& health,
+  LcmTransmitter(const std::string& segment_name, Logger& log, AdapterCounters& counters, HealthCell& health,
                  const std::atomic<bool>& receive_failing);
 
   // Opens the three sockets; the reason when one fails (none is left open then).
@@ -98,7 +99,7 @@ class LcmTransmitter {
   // Before `datagrams` leave: counted while they loop back to a filter that drops them.
   void note_sending(std::size_t datagrams);
 
-  const std::string segment_name_;
+  const std::string prefix_;  // "LCM segment NAME: " (cosmic/log_prefix.hpp)
   Logger& log_;
   AdapterCounters& counters_;
   HealthCell& health_;

@@ -11,6 +11,12 @@
 // segment or on a lower class's send for longer than one frame or message. What the transport
 // cannot take now is refused with SendStatus::queue_full (the router counts it), not waited for. Inbound events go to
 // the EventSink from threads the adapter owns, between start() and the return of stop().
+//
+// Lock discipline on the send path (every adapter): what send() needs is taken under a
+// priority-inheriting mutex (the binding table as a SnapshotTable of the adapter kit: a pointer
+// copy), the write happens outside it, and what it logs is written after. The only lock a send
+// may hold across its write is one that no other class's send takes (DDS: the channel's writer;
+// LCM: the class's socket; CAN: its io mutex decides, the frames leave after).
 #pragma once
 
 #include <array>
