@@ -4,11 +4,13 @@
 // counter) and then uses it with no lock held: a send on it may write to the network for as long as
 // the transport takes, and no other thread waits for that.
 //
-// Who owns what: the SnapshotTable owns the current table; a Reading keeps the table it took alive
-// until it ends. publish() hands the replaced table back to the control thread, whose retire() waits
-// until the last Reading of it has ended (readers hold one for one send, microseconds) and then
-// gives the table back to be torn down there: what a transport must close (a DDS DataWriter, a
-// socket) is closed on the control thread, never on a forwarding thread that happened to read last.
+// Who owns what: the SnapshotTable shares the current table with every Reading of it; a table lives
+// until the last of its owners lets go (a Replaced that is never retired included), so no order of
+// destruction can free a table under a reader. publish() hands the replaced table to the control
+// thread, whose retire() waits until the last Reading of it has ended (readers hold one for one
+// send, microseconds) and then gives the table back to be torn down there: what a transport must
+// close (a DDS DataWriter, a socket) is closed on the control thread, never on a forwarding thread
+// that happened to read last.
 //
 // Threads: read() from any thread (the egress lanes, a component's threads); publish() and retire()
 // from one control thread at a time.
@@ -42,7 +44,7 @@ class SnapshotTable {
    public:
     Reading(const Reading&) = delete;
     Reading& operator=(const Reading&) = delete;
-    Reading(Reading&& other) noexcept : node_(std::exchange(other.node_, nullptr)) {}
+    Reading(Reading&& other) noexcept = default;
     Reading& operator=(Reading&&) = delete;
     ~Reading() {
       // release: what this reader did with the table happens before retire() hands it back.
@@ -53,8 +55,8 @@ class SnapshotTable {
 
    private:
     friend class SnapshotTable;
-    explicit Reading(Node* node) : node_(node) {}
-    Node* node_;
+    explicit Reading(std::shared_ptr<Node> node) : node_(std::move(node)) {}
+    std::shared_ptr<Node> node_;  // moved from: null, and its destructor does nothing
   };
 
   // The control thread's hold on a replaced table; retire() turns it back into the table.
@@ -65,23 +67,23 @@ class SnapshotTable {
 
    private:
     friend class SnapshotTable;
-    explicit Replaced(std::unique_ptr<Node> node) : node_(std::move(node)) {}
-    std::unique_ptr<Node> node_;
+    explicit Replaced(std::shared_ptr<Node> node) : node_(std::move(node)) {}
+    std::shared_ptr<Node> node_;
   };
 
-  explicit SnapshotTable(Table initial = Table{}) : current_(std::make_unique<Node>(std::move(initial))) {}
+  explicit SnapshotTable(Table initial = Table{}) : current_(std::make_shared<Node>(std::move(initial))) {}
   SnapshotTable(const SnapshotTable&) = delete;
   SnapshotTable& operator=(const SnapshotTable&) = delete;
 
   Reading read() const COSMIC_EXCLUDES(mutex_) {
     PiLock lock(mutex_);
     current_->readers.fetch_add(1, std::memory_order_relaxed);
-    return Reading(current_.get());
+    return Reading(current_);  // a reference count raised under the mutex: no allocation
   }
 
   // Makes `next` current; readers from now on see it. The old table is handed back.
   [[nodiscard]] Replaced publish(Table next) COSMIC_EXCLUDES(mutex_) {
-    auto node = std::make_unique<Node>(std::move(next));
+    auto node = std::make_shared<Node>(std::move(next));
     {
       PiLock lock(mutex_);
       node.swap(current_);
@@ -105,7 +107,7 @@ class SnapshotTable {
 
  private:
   mutable PiMutex mutex_;
-  std::unique_ptr<Node> current_ COSMIC_GUARDED_BY(mutex_);
+  std::shared_ptr<Node> current_ COSMIC_GUARDED_BY(mutex_);
 };
 
 }  // namespace cosmic
