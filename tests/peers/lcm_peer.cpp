@@ -8,7 +8,8 @@
 // created_ns = CLOCK_REALTIME), with --raw the bare payload bytes. Payload byte i of message
 // number k (1..N) is (k * 31 + i) & 0xff; with --stamp the first 8 bytes (if size >= 8) are
 // replaced by CLOCK_MONOTONIC nanoseconds at send time, little-endian (latency benchmarks).
-// --rate 0 (default) sends as fast as possible.
+// --rate 0 (default) sends as fast as possible; --rate HZ sends each message at least 1/HZ after
+// the one before.
 //
 // sub prints READY on stderr once subscribed, then one JSON line per message on stdout:
 //   envelope: {"channel","subject","origin","sequence","hop_count","created_ns","age_ns",
@@ -110,12 +111,17 @@ int run_pub(const PubOptions& o) {
   if (!o.payload_hex.empty()) payload = *fixed;
   std::vector<std::uint8_t> buffer;
   cosmic::envelope e{};
-  const auto start = std::chrono::steady_clock::now();
+  // Each message at least 1/rate after the one before (not on a fixed schedule): a publisher
+  // stalled by a loaded machine never catches up in a burst, so identical raw payloads keep their
+  // spacing and are never taken for a loop's copies (the router's RawLoopGuard window is 20 ms).
+  const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(o.rate > 0 ? 1.0 / o.rate : 0.0));
+  auto last_sent = std::chrono::steady_clock::now() - period;
   int status = 0;
   for (std::uint64_t k = 1; k <= o.count; ++k) {
     if (o.rate > 0) {
-      std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                std::chrono::duration<double>(static_cast<double>(k - 1) / o.rate)));
+      std::this_thread::sleep_until(last_sent + period);
+      last_sent = std::chrono::steady_clock::now();
     }
     for (std::size_t i = 0; o.payload_hex.empty() && i < payload.size(); ++i)
       payload[i] = static_cast<std::uint8_t>((k * 31 + i) & 0xff);
