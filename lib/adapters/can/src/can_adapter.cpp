@@ -95,7 +95,7 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
   return status;
 }
 
-std::shared_ptr<CanAdapter::Table> CanAdapter::plan_table(BindingPlan& plan) const {
+std::shared_ptr<CanAdapter::Table> CanAdapter::plan_table(BindingPlan& plan) {
   std::shared_ptr<Table> table = build_table(plan);
   // A channel refused in one role may have entered the table in another: build it again without.
   // Fewer bindings only take reasons to refuse away, so the second build refuses nothing more.
@@ -103,66 +103,21 @@ std::shared_ptr<CanAdapter::Table> CanAdapter::plan_table(BindingPlan& plan) con
   return table;
 }
 
-std::shared_ptr<CanAdapter::Table> CanAdapter::build_table(BindingPlan& plan) const {
+std::shared_ptr<CanAdapter::Table> CanAdapter::build_table(BindingPlan& plan) {
   auto table = std::make_shared<Table>();
-  auto refuse = [&](const ChannelBinding& b, const std::string& why) { plan.refuse(b, why); };
   for (const CanBackgroundFrame& frame : segment_.can.background) table->native.add_background(frame);
   for (const ChannelBinding* binding : plan.accepted()) {
     const ChannelBinding& b = *binding;
-    if (!b.can) {
-      refuse(b, "no CAN plan");
-      continue;
-    }
-    if (b.can->native) {
-      if (const auto why = bind_native(b, *table)) refuse(b, *why);
-      continue;
-    }
-    if (b.can->profile != segment_.can.profile) {
-      refuse(b, "the plan is for another identifier layout than the segment's profile");
-      continue;
-    }
-    const std::uint16_t etag = b.can->etag;
-    if (etag <= kHighestReservedEtag || etag > kMaxEtag) {
-      refuse(b, "etag " + std::to_string(etag) + " is reserved or out of range");
-      continue;
-    }
-    const bool fragmented = needs_fragmentation(b.spec.payload, capacity_);
-    if (fragmented && b.spec.payload > max_fragmented_event(capacity_)) {
-      refuse(b, "payload " + std::to_string(b.spec.payload) + " B exceeds " +
-                    std::to_string(max_fragmented_event(capacity_)) + " B (" + std::to_string(kMaxFragments) +
-                    " fragments)");
-      continue;
-    }
-    const CanIdentifier id = decode_can_id(b.can->can_id & CAN_EFF_MASK);
-    const auto payload = static_cast<std::size_t>(b.spec.payload);
-    if (b.role == HopRole::publisher) {
-      if (!table->rx.emplace(etag, RxChannel{b.id, b.spec.subject, payload, fragmented}).second) {
-        refuse(b, "etag " + std::to_string(etag) + " bound twice as publisher");
-        continue;
-      }
-    } else {
-      // Admission's identifier, in the segment's layout. FAMOUSO: a single frame goes without
-      // the fragment flag, AFP fragments with it (admission planned the flag of the channel's
-      // largest events).
-      const std::uint32_t planned = b.can->can_id & CAN_EFF_MASK;
-      const std::uint32_t can_id = famouso_ ? planned & ~kFamousoFragmentFlag : planned;
-      table->tx[b.id] =
-          TxChannel{b.id, can_id, planned | kFamousoFragmentFlag, etag, payload, fragmented, std::nullopt};
-      table->tx_etags.insert(etag);
-      if (fragmented) {
-        const std::size_t frames = famouso_ ? famouso::afp_fragment_count(payload) : fragment_count(payload, capacity_);
-        table->backlog_frames = std::max<std::size_t>(table->backlog_frames, 2 * frames);
-      }
-      if (!table->tx_node) table->tx_node = id.tx_node;
-    }
-    table->etag_of[b.spec.subject] = etag;
-    // FAMOUSO: a publisher hop's plan carries the nodes' TxNode, not the gateway's.
-    if (!famouso_ && !table->tx_node) table->tx_node = id.tx_node;
+    const Result<void> bound = !b.can          ? Result<void>(Error{"no CAN plan"})
+                               : b.can->native ? bind_native(b, *table)
+                                               : bind_etag(b, *table);
+    if (!bound) plan.refuse(b, bound.error().text);
   }
-  if (famouso_) table->etag_of[kFamousoSubscribeSubject] = kEtagFamousoSubscribe;  // FAMOUSO nodes bind it at start
+  if (famouso_protocol_)
+    table->etag_of[kFamousoSubscribeSubject] = kEtagFamousoSubscribe;  // FAMOUSO nodes bind it at start
   // Kernel filters: the 14 etag bits of every etag bound as publisher, plus the protocols' etags;
   // extended frames only. Everything else stays in the kernel.
-  table->filters = protocol_filters(famouso_);
+  table->filters = protocol_filters(famouso_protocol_);
   const std::vector<can_filter> native_filters = table->native.filters();
   if (table->rx.size() + native_filters.size() + table->filters.size() <= CAN_RAW_FILTER_MAX) {
     for (const auto& [etag, channel] : table->rx)
@@ -175,22 +130,66 @@ std::shared_ptr<CanAdapter::Table> CanAdapter::build_table(BindingPlan& plan) co
   return table;
 }
 
-std::optional<std::string> CanAdapter::bind_native(const ChannelBinding& b, Table& table) const {
-  if (b.spec.payload > capacity_) {
-    return "payload " + std::to_string(b.spec.payload) + " B does not fit one native frame (" +
-           std::to_string(capacity_) + " B)";
-  }
+CanFrameFormat& CanAdapter::format_of(const CanHopPlan& plan) {
+  if (plan.native) return native_frames_;
+  return plan.profile == CanProfile::famouso ? static_cast<CanFrameFormat&>(famouso_frames_) : cosmic_frames_;
+}
+
+Result<void> CanAdapter::bind_native(const ChannelBinding& b, Table& table) {
+  if (Result<void> fits = native_frames_.check_payload(b.spec.payload); !fits) return fits;
   const NativeCanFrame frame{b.can->can_id, b.can->extended};
   const auto payload = static_cast<std::size_t>(b.spec.payload);
   if (b.role == HopRole::publisher) {
     if (!table.native.add_publisher(frame, can_native::RxChannel{b.id, b.spec.subject, payload})) {
-      return "native identifier bound twice as publisher";
+      return Error{"native identifier bound twice as publisher"};
     }
   } else {
-    table.tx[b.id] = TxChannel{b.id, 0, 0, 0, payload, false, frame};
+    table.tx[b.id] = CanTxBinding{b.id, &native_frames_, frame.can_id, frame.can_id, frame.extended, 0, payload, false};
     table.native.add_subscriber(frame);
   }
-  return std::nullopt;
+  return {};
+}
+
+Result<void> CanAdapter::bind_etag(const ChannelBinding& b, Table& table) {
+  // The binding protocol (who hands out etags and TxNodes) is the segment's: a binding in the
+  // other layout would reach nodes that cannot bind it.
+  if (b.can->profile != segment_.can.profile) {
+    return Error{"the plan is for another identifier layout than the segment's profile"};
+  }
+  const std::uint16_t etag = b.can->etag;
+  if (etag <= kHighestReservedEtag || etag > kMaxEtag)
+    return Error{"etag " + std::to_string(etag) + " is reserved or out of range"};
+  CanFrameFormat& format = format_of(*b.can);
+  if (Result<void> fits = format.check_payload(b.spec.payload); !fits) return fits;
+  const bool fragmented = format.fragments(b.spec.payload);
+  const CanIdentifier id = decode_can_id(b.can->can_id & CAN_EFF_MASK);
+  const auto payload = static_cast<std::size_t>(b.spec.payload);
+  if (b.role == HopRole::publisher) {
+    if (!table.rx.emplace(etag, CanRxBinding{b.id, &format, b.spec.subject, payload, fragmented}).second) {
+      return Error{"etag " + std::to_string(etag) + " bound twice as publisher"};
+    }
+  } else {
+    // Admission's identifier, in the segment's layout. FAMOUSO: a single frame goes without the
+    // fragment flag, AFP fragments with it (admission planned the flag of the channel's largest events).
+    const std::uint32_t planned = b.can->can_id & CAN_EFF_MASK;
+    const bool famouso = b.can->profile == CanProfile::famouso;
+    const CanTxBinding tx{b.id,
+                          &format,
+                          famouso ? planned & ~kFamousoFragmentFlag : planned,
+                          famouso ? planned | kFamousoFragmentFlag : planned,
+                          true,
+                          etag,
+                          payload,
+                          fragmented};
+    table.tx[b.id] = tx;
+    table.tx_etags.insert(etag);
+    if (fragmented) table.backlog_frames = std::max(table.backlog_frames, 2 * format.frame_count(tx, payload));
+    if (!table.tx_node) table.tx_node = id.tx_node;
+  }
+  table.etag_of[b.spec.subject] = etag;
+  // FAMOUSO: a publisher hop's plan carries the nodes' TxNode, not the gateway's.
+  if (!famouso_protocol_ && !table.tx_node) table.tx_node = id.tx_node;
+  return {};
 }
 
 void CanAdapter::refresh_rx_table() {
@@ -250,8 +249,8 @@ void CanAdapter::set_link(Link link, std::string detail) {
     log_unlocked(dropped);
   }
   if (came_up || went_down) {
-    reassembler_.clear();
-    afp_.clear();
+    cosmic_frames_.clear();
+    famouso_frames_.clear();
   }
   if (came_up) {
     PiLock lock(io_mutex_);
@@ -272,7 +271,7 @@ AdapterStatistics CanAdapter::statistics() const {
   // The kernel's drops: the closed sockets', the open socket's and the controller's.
   s.overflow_drops = overflow_closed_.load() + overflow_socket_.load() + overflow_controller_.load();
   s.backlog = backlog_size_.load();
-  s.binding_requests_over_limit = refused_requests_.load();
+  s.transport.push_back(TransportCounter{"binding_requests_over_limit", refused_requests_.load()});
   s.unexplained = census_.snapshot(steady_now());
   s.unexplained_others = census_.others();
   return s;

@@ -1,8 +1,9 @@
 // The SocketCAN adapter's class, shared by its translation units (internal to the CAN adapter):
 //   can_adapter.cpp   lifecycle, configure (the binding tables), health, statistics
 //   can_socket.cpp    the sockets and the link, the receive thread's loop and reads, the census
-//   can_receive.cpp   frames to events: both layouts, native frames, FAMOUSO protocols, binding answers
-//   can_send.cpp      events to frames: single frames, fragments, AFP, the backlog
+//   can_receive.cpp   frames to events (each binding's format), FAMOUSO protocols, binding answers
+//   can_send.cpp      events to frames (each binding's format), the submit, the backlog
+//   can_frame_format  the wire formats of bindings: cosmic, famouso, native
 // Threads: see cosmic/segment_adapter.hpp; the members say which thread owns them.
 #pragma once
 
@@ -49,7 +50,7 @@
 #include "cosmic/can_fragment.hpp"
 #include "cosmic/can_timing.hpp"
 #include "cosmic/can_wire.hpp"
-#include "famouso_afp.hpp"
+#include "can_frame_format.hpp"
 #include "famouso_ccp.hpp"
 #include "frame_backlog.hpp"
 #include "bus_census.hpp"
@@ -71,16 +72,12 @@ constexpr Nanos kEnobufsRetry = milliseconds(1);
 constexpr int kFramesPerWakeup = 256;
 constexpr std::size_t kReadBatch = 32;                        // frames per recvmmsg
 constexpr std::size_t kWriteBatch = FrameBacklog::kMaxTaken;  // frames per sendmmsg
-constexpr std::size_t kFdPaddingSlack = 15;                   // 48 -> 64 is the largest step between FD lengths
+static_assert(kWriteBatch == kFramesPerSubmit, "a format's batch is one submit");
 constexpr can_err_mask_t kErrorMask = CAN_ERR_CRTL | CAN_ERR_BUSOFF | CAN_ERR_RESTARTED;
 constexpr Nanos kDeferredRequestRetry = std::chrono::milliseconds(20);  // well below one token (100 ms)
 constexpr std::size_t kMaxPendingRequests = 64;          // FAMOUSO: unanswered GET_ETAGs kept for a later bind
 constexpr std::size_t kMaxAnnouncedSubscriptions = 256;  // FAMOUSO: subscriptions logged once each
 constexpr canid_t kEtagFilterMask = 0x3FFF | CAN_EFF_FLAG;
-
-inline std::uint32_t source_key(const CanIdentifier& id) {
-  return (static_cast<std::uint32_t>(id.tx_node) << 14) | id.etag;
-}
 
 // Binding answers leave one at a time, two frame times apart (an extended 8-byte frame is at
 // most 160 bits with stuffing), so at most one is in the kernel's FIFO ahead of a real-time frame.
@@ -126,9 +123,11 @@ class CanAdapter final : public SegmentAdapter {
         prefix_(segment_log_prefix(SegmentType::can, segment.name)),
         capacity_(max_frame_payload(segment.can)),
         brs_(segment.can.fd && segment.can.data_bitrate > segment.can.bitrate),
-        famouso_(segment.can.profile == CanProfile::famouso),
-        reassembler_(ReassemblyLimits{kMaxPartialEvents, kReassemblyTimeout, segment.can.fd ? kFdPaddingSlack : 0}),
-        afp_(famouso::AfpLimits{kMaxPartialEvents, kReassemblyTimeout}),
+        famouso_protocol_(segment.can.profile == CanProfile::famouso),
+        cosmic_frames_(CanBus{capacity_, segment.can.fd, brs_},
+                       CanReassemblyBounds{kMaxPartialEvents, kReassemblyTimeout}),
+        famouso_frames_(CanReassemblyBounds{kMaxPartialEvents, kReassemblyTimeout}),
+        native_frames_(CanBus{capacity_, segment.can.fd, brs_}),
         ccp_(segment.can.profile == CanProfile::famouso ? std::optional<famouso::CcpBroker>(std::in_place)
                                                         : std::nullopt),
         table_(std::make_shared<const Table>()),
@@ -139,7 +138,7 @@ class CanAdapter final : public SegmentAdapter {
   Status start(EventSink& sink) override;
   Status configure(std::span<const ChannelBinding> bindings) override;
   SendStatus send(const OutboundEvent& event) override;
-  // Runs of events that are one frame each (native, unfragmented, FAMOUSO up to 8 bytes) go out
+  // Runs of events that are one frame each in their binding's format go out
   // in one submit (one sendmmsg); the others as send() sends them.
   void send_batch(std::span<const OutboundEvent> events, std::span<SendStatus> results) override;
   bool batches_sends() const override { return true; }
@@ -149,24 +148,9 @@ class CanAdapter final : public SegmentAdapter {
   void stop() override;
 
  private:
-  struct RxChannel {
-    ChannelId id = kNoChannel;
-    std::uint64_t subject = 0;
-    std::size_t payload = 0;
-    bool fragmented = false;
-  };
-  struct TxChannel {
-    ChannelId id = kNoChannel;
-    std::uint32_t can_id = 0;  // 29 bits, in the segment's profile
-    std::uint32_t afp_id = 0;  // FAMOUSO: the identifier with the fragment flag
-    std::uint16_t etag = 0;
-    std::size_t payload = 0;
-    bool fragmented = false;
-    std::optional<NativeCanFrame> native;  // a native channel: this frame, no etag (native_frames.hpp)
-  };
   struct Table {
-    std::unordered_map<std::uint16_t, RxChannel> rx;           // etag -> channel bound as publisher
-    std::unordered_map<ChannelId, TxChannel> tx;               // channels bound as subscriber
+    std::unordered_map<std::uint16_t, CanRxBinding> rx;        // etag -> channel bound as publisher
+    std::unordered_map<ChannelId, CanTxBinding> tx;            // channels bound as subscriber, every format
     std::unordered_map<std::uint64_t, std::uint16_t> etag_of;  // subject -> etag, both roles
     can_native::FrameTable native;                             // native channels, background frames
     std::unordered_set<std::uint16_t> tx_etags;                // etags of the channels bound as subscriber
@@ -203,20 +187,24 @@ class CanAdapter final : public SegmentAdapter {
   void serve_deferred_requests(Nanos now) COSMIC_EXCLUDES(io_mutex_);
   void reassembly_losses(ChannelId channel, std::optional<std::uint32_t> displaced, bool lost);
   void handle_famouso_protocol(const CanIdentifier& id, const canfd_frame& frame, std::size_t len, Nanos now);
-  void handle_afp(const RxChannel& channel, const CanIdentifier& id, std::span<const std::uint8_t> data, Nanos now);
   void handle_protocol_timeouts(Nanos now);
-  void deliver(const RxChannel& channel, std::span<const std::uint8_t> payload, Nanos now);
-  void deliver_native(const can_native::RxChannel& channel, std::span<const std::uint8_t> data, bool fd_frame,
-                      Nanos now);
+  // A data frame of `binding`, through its format: the event it completes, or the loss it costs.
+  void receive(const CanRxBinding& binding, canid_t can_id, std::span<const std::uint8_t> data, bool fd_frame,
+               Nanos now);
+  void deliver(const CanRxBinding& binding, std::span<const std::uint8_t> payload, Nanos now);
   void problem(ChannelId channel, InboundProblem what);
   void drain_backlog() COSMIC_EXCLUDES(io_mutex_);
   void refresh_rx_table() COSMIC_EXCLUDES(io_mutex_);  // the receive thread's snapshot of the bindings (rx_table_)
   // configure(): the tables of the bindings `plan` accepts, refusing in it what cannot be carried
   // (a refused channel is carried in no role).
-  std::shared_ptr<Table> plan_table(BindingPlan& plan) const;
-  std::shared_ptr<Table> build_table(BindingPlan& plan) const;
-  // configure(): a native channel's binding into `table`; the reason when it cannot be carried.
-  std::optional<std::string> bind_native(const ChannelBinding& b, Table& table) const;
+  std::shared_ptr<Table> plan_table(BindingPlan& plan);
+  std::shared_ptr<Table> build_table(BindingPlan& plan);
+  // configure(): the format a binding's plan names (native identifier, or its profile's layout).
+  CanFrameFormat& format_of(const CanHopPlan& plan);
+  // configure(): one binding into `table`, or why it cannot be carried. The tables
+  // point at the adapter's formats, through which the receive thread decodes.
+  Result<void> bind_native(const ChannelBinding& b, Table& table);
+  Result<void> bind_etag(const ChannelBinding& b, Table& table);
 
   // --- health
   void set_link(Link link, std::string detail);
@@ -239,18 +227,12 @@ class CanAdapter final : public SegmentAdapter {
   // Counts; the first time, returns the line to log once io_mutex_ is given up (log_unlocked).
   std::string count_send_error(int err) COSMIC_REQUIRES(io_mutex_);
   void log_unlocked(const std::string& line) COSMIC_EXCLUDES(io_mutex_);  // a warning; nothing when empty
-  SendStatus send_fragments(const TxChannel& channel, std::span<const std::uint8_t> payload, std::uint8_t sequence);
-  // The event's channel when it can go out now as exactly one frame (send() takes the others).
-  const TxChannel* single_frame_channel(const Table& table, const OutboundEvent& event) const
-      COSMIC_REQUIRES(io_mutex_);
-  canfd_frame single_frame(const TxChannel& channel, std::span<const std::uint8_t> payload) const;
+  // The event's binding when it can go out now as exactly one frame (send() takes the others).
+  static const CanTxBinding* single_frame_binding(const Table& table, const OutboundEvent& event);
   void queue_answer(std::uint32_t can_id, std::span<const std::uint8_t> data) COSMIC_REQUIRES(io_mutex_);
   void queue_supply_etag(std::uint8_t requester, std::uint16_t etag, std::uint64_t subject, const Table& table)
       COSMIC_REQUIRES(io_mutex_);
   void drain_answers() COSMIC_EXCLUDES(io_mutex_);
-  SendStatus send_afp(const TxChannel& channel, std::span<const std::uint8_t> payload);
-  template <typename Done, typename FillNext>
-  SendStatus submit_in_batches(bool fd, Done done, FillNext fill_next);  // send_fragments, send_afp
   void wake();
   // Returns the warning to log once io_mutex_ is given up (empty when nothing was queued).
   std::string drop_backlog(const char* why) COSMIC_REQUIRES(io_mutex_);
@@ -260,7 +242,14 @@ class CanAdapter final : public SegmentAdapter {
   const std::string prefix_;      // "CAN segment NAME: " (cosmic/log_prefix.hpp)
   const std::uint32_t capacity_;  // data bytes of one frame on this bus
   const bool brs_;
-  const bool famouso_;  // FAMOUSO profile: its identifier layout, CCP, etag-4 answers, AFP
+  // The segment's binding protocol is FAMOUSO's: CCP, SUBSCRIBE announcements, etag-4 answers
+  // (the frames of each binding are its format's).
+  const bool famouso_protocol_;
+  // The bindings' formats (can_frame_format.hpp): encoding is const and shared by the lanes;
+  // their reassembly state is the receive thread's.
+  CosmicFrames cosmic_frames_;
+  FamousoFrames famouso_frames_;
+  NativeFrames native_frames_;
 
   EventSink* sink_ = nullptr;
   ReceiveThread receiver_;  // runs run(); woken by senders that queued frames or answers
@@ -268,8 +257,6 @@ class CanAdapter final : public SegmentAdapter {
   int ctl_fd_ = -1;  // for interface ioctls (AF_UNIX: works without AF_CAN)
 
   // Receive-thread state.
-  Reassembler reassembler_;
-  famouso::AfpReassembler afp_;
   std::optional<famouso::CcpBroker> ccp_;                          // FAMOUSO segments only
   std::vector<std::pair<std::uint8_t, std::uint64_t>> announced_;  // FAMOUSO subscriptions seen (node, subject)
   std::shared_ptr<const Table> rx_table_;

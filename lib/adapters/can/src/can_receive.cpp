@@ -18,7 +18,8 @@ void CanAdapter::handle_frame(const canfd_frame& frame, bool fd_frame, Nanos now
   const Table& table = *rx_table_;
   // Native identifiers first: an extended one may have any bits in the etag field.
   if (const can_native::RxChannel* native = table.native.find(frame.can_id)) {
-    deliver_native(*native, std::span<const std::uint8_t>(frame.data, len), fd_frame, now);
+    receive(CanRxBinding{native->id, &native_frames_, native->subject, native->payload, false}, frame.can_id,
+            std::span<const std::uint8_t>(frame.data, len), fd_frame, now);
     return;
   }
   if (table.native.is_background(frame.can_id)) return;  // another device's declared frame
@@ -35,7 +36,7 @@ void CanAdapter::handle_frame(const canfd_frame& frame, bool fd_frame, Nanos now
     }
     return;
   }
-  if (famouso_ && (id.etag == kEtagCcpRsi || id.etag == kEtagFamousoSubscribe)) {
+  if (famouso_protocol_ && (id.etag == kEtagCcpRsi || id.etag == kEtagFamousoSubscribe)) {
     handle_famouso_protocol(id, frame, len, now);
     return;
   }
@@ -44,38 +45,18 @@ void CanAdapter::handle_frame(const canfd_frame& frame, bool fd_frame, Nanos now
     problem(kNoChannel, InboundProblem::unknown_channel);
     return;
   }
-  const RxChannel& channel = it->second;
   if (frame.can_id & CAN_RTR_FLAG) {
-    problem(channel.id, InboundProblem::decode_error);
+    problem(it->second.id, InboundProblem::decode_error);
     return;
   }
-  const std::span<const std::uint8_t> data(frame.data, len);
-  if (famouso_ && decode_famouso_id(frame.can_id & CAN_EFF_MASK).fragment) {
-    handle_afp(channel, id, data, now);
-    return;
-  }
-  if (!channel.fragmented || famouso_) {  // FAMOUSO: events of up to 8 bytes are plain frames
-    // A device may send shorter events; on CAN FD the frame may carry padding up to the next
-    // FD length, which is cut off at the channel's payload.
-    const std::size_t allowed =
-        fd_frame ? fd_padded_length(static_cast<std::uint32_t>(channel.payload)) : channel.payload;
-    if (len > allowed) {
-      problem(channel.id, InboundProblem::decode_error);
-      return;
-    }
-    deliver(channel, data.first(std::min(len, channel.payload)), now);
-    return;
-  }
-  const FragmentResult r = reassembler_.accept(source_key(id), data, channel.payload, now);
-  reassembly_losses(channel.id, r.displaced, r.dropped_event || r.outcome == FragmentOutcome::rejected);
-  if (r.outcome == FragmentOutcome::complete) deliver(channel, r.event, now);
+  receive(it->second, frame.can_id, std::span<const std::uint8_t>(frame.data, len), fd_frame, now);
 }
 
-void CanAdapter::handle_afp(const RxChannel& channel, const CanIdentifier& id, std::span<const std::uint8_t> data,
-                            Nanos now) {
-  const famouso::AfpResult r = afp_.accept(source_key(id), data, channel.payload, now);
-  reassembly_losses(channel.id, r.displaced, r.dropped_event || r.outcome == famouso::AfpOutcome::rejected);
-  if (r.outcome == famouso::AfpOutcome::complete) deliver(channel, r.event, now);
+void CanAdapter::receive(const CanRxBinding& binding, canid_t can_id, std::span<const std::uint8_t> data, bool fd_frame,
+                         Nanos now) {
+  const CanDecoded decoded = binding.format->decode(binding, can_id, data, fd_frame, now);
+  reassembly_losses(binding.id, decoded.displaced, decoded.lost);
+  if (decoded.event) deliver(binding, *decoded.event, now);
 }
 
 // Every event lost in reassembly is counted on its channel; `displaced` is a source (TxNode and
@@ -125,26 +106,16 @@ void CanAdapter::handle_famouso_protocol(const CanIdentifier& id, const canfd_fr
                                  (bound ? "" : " (no channel bound for it)"));
 }
 
-void CanAdapter::deliver(const RxChannel& channel, std::span<const std::uint8_t> payload, Nanos now) {
+void CanAdapter::deliver(const CanRxBinding& binding, std::span<const std::uint8_t> payload, Nanos now) {
   InboundEvent event;
-  event.channel = channel.id;
-  event.header.subject = channel.subject;
+  event.channel = binding.id;
+  event.header.subject = binding.subject;
   event.payload = payload;
   event.received_at = now;
-  // CAN frames carry no origin, sequence or hop count (the TxNode names a node, not an event), and
-  // CAN_RAW never hands a socket its own frames back: no fingerprint guard either.
-  event.identity = FormatIdentity{false, false, false, false};
+  // What the format carries (none of CAN's carries an event's identity); CAN_RAW never hands a
+  // socket its own frames back, so no fingerprint guard either.
+  event.identity = binding.format->identity();
   if (sink_) sink_->on_event(event);
-}
-
-void CanAdapter::deliver_native(const can_native::RxChannel& channel, std::span<const std::uint8_t> data, bool fd_frame,
-                                Nanos now) {
-  const auto event = can_native::contents(channel, data, fd_frame);
-  if (!event) {
-    problem(channel.id, InboundProblem::decode_error);
-    return;
-  }
-  deliver(RxChannel{channel.id, channel.subject, channel.payload, false}, *event, now);
 }
 
 void CanAdapter::handle_error_frame(const canfd_frame& frame) {
@@ -223,14 +194,15 @@ void CanAdapter::answer_request(const can_binding::GetEtagRequest& request, cons
   const bool known = std::any_of(pending_requests_.begin(), pending_requests_.end(), [&](const auto& p) {
     return p.requester == request.requester && p.subject == request.subject;
   });
-  if (famouso_ && !known && pending_requests_.size() < kMaxPendingRequests) pending_requests_.push_back(request);
+  if (famouso_protocol_ && !known && pending_requests_.size() < kMaxPendingRequests)
+    pending_requests_.push_back(request);
 }
 
 void CanAdapter::queue_supply_etag(std::uint8_t requester, std::uint16_t etag, std::uint64_t subject,
                                    const Table& table) {
-  if (!famouso_ && !table.tx_node) return;  // no channel bound yet: the gateway has no TxNode here
+  if (!famouso_protocol_ && !table.tx_node) return;  // no channel bound yet: the gateway has no TxNode here
   const std::uint32_t id =
-      famouso_ ? can_binding::supply_etag_new_bp_id() : can_binding::supply_etag_id(*table.tx_node);
+      famouso_protocol_ ? can_binding::supply_etag_new_bp_id() : can_binding::supply_etag_id(*table.tx_node);
   const auto frames = can_binding::supply_etag_data(requester, etag, subject);
   if (!answers_.room_for(frames.size())) {
     counters_.send_errors.fetch_add(frames.size(), std::memory_order_relaxed);
@@ -286,7 +258,6 @@ void CanAdapter::drain_answers() {
 }
 
 void CanAdapter::handle_protocol_timeouts(Nanos now) {
-  afp_.expire(now, [this](std::uint32_t source) { reassembly_losses(kNoChannel, source, false); });
   if (!ccp_) return;
   if (const auto reset = ccp_->expire(now)) {
     PiLock lock(io_mutex_);

@@ -214,9 +214,10 @@ void CanAdapter::drain_backlog() {
 
 SendStatus CanAdapter::send(const OutboundEvent& event) {
   try {
-    std::shared_ptr<const Table> table;  // keeps `channel` alive without the lock
+    std::shared_ptr<const Table> table;  // keeps `binding` alive without the lock
     std::uint8_t sequence = 0;
-    const TxChannel* found = nullptr;
+    std::size_t frames = 1;
+    const CanTxBinding* found = nullptr;
     {
       PiLock lock(io_mutex_);
       table = table_;
@@ -226,56 +227,41 @@ SendStatus CanAdapter::send(const OutboundEvent& event) {
         return SendStatus::failed;
       }
       found = &it->second;
-      const std::size_t frames =
-          famouso_ && event.payload.size() > famouso::kAfpMtu ? famouso::afp_fragment_count(event.payload.size())
-          : found->fragmented && !famouso_ && !found->native  ? fragment_count(event.payload.size(), capacity_)
-                                                              : 1;
+      frames = found->format->frame_count(*found, event.payload.size());
       if (frames > 1 && !backlog_.empty() && !backlog_.room_for(frames)) {
         counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
         return SendStatus::queue_full;
       }
-      if (found->fragmented && !famouso_ && !found->native) {  // every event of the channel is numbered
+      if (found->format->numbered(*found)) {  // every event of the channel is numbered
         std::uint8_t& next = tx_sequence_[found->etag];
         sequence = next;
         next = static_cast<std::uint8_t>((next + 1) % kFragmentSequenceModulo);
       }
     }
-    const TxChannel& channel = *found;
+    const CanTxBinding& binding = *found;
     const bool fd = segment_.can.fd;
-    if (channel.native) {
-      const canfd_frame frame = can_native::encode(*channel.native, event.payload, fd, brs_);
-      return to_send_status(submit(std::span(&frame, 1), fd));
-    }
-    if (famouso_ && event.payload.size() > famouso::kAfpMtu) return send_afp(channel, event.payload);
-    if (channel.fragmented && !famouso_) return send_fragments(channel, event.payload, sequence);
-    // FAMOUSO: events of up to 8 bytes are plain frames.
-    const canfd_frame frame = single_frame(channel, event.payload);
-    return to_send_status(submit(std::span(&frame, 1), fd));
+    // The first refused batch ends the event: no frame the kernel did not take counts as sent.
+    WriteResult refused = WriteResult::written;
+    // Batch by batch to submit(): one system call each.
+    CanFrameBatchTo sink([&](std::span<const canfd_frame> frames) {
+      const WriteResult r = submit(frames, fd);
+      if (r == WriteResult::failed || r == WriteResult::full) refused = r;
+      return refused == WriteResult::written;
+    });
+    if (binding.format->encode(binding, event.payload, sequence, sink)) return SendStatus::sent;
+    // One frame refused: as the kernel or the backlog answered; part of a fragmented event: lost.
+    return frames == 1 ? to_send_status(refused) : SendStatus::failed;
   } catch (...) {
     counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
     return SendStatus::failed;
   }
 }
 
-canfd_frame CanAdapter::single_frame(const TxChannel& channel, std::span<const std::uint8_t> payload) const {
-  const bool fd = segment_.can.fd;
-  if (channel.native) return can_native::encode(*channel.native, payload, fd, brs_);
-  canfd_frame frame{};
-  frame.can_id = channel.can_id | CAN_EFF_FLAG;
-  frame.flags = fd && brs_ ? CANFD_BRS : 0;
-  std::memcpy(frame.data, payload.data(), payload.size());
-  frame.len =
-      static_cast<std::uint8_t>(fd ? fd_padded_length(static_cast<std::uint32_t>(payload.size())) : payload.size());
-  return frame;
-}
-
-const CanAdapter::TxChannel* CanAdapter::single_frame_channel(const Table& table, const OutboundEvent& event) const {
+const CanTxBinding* CanAdapter::single_frame_binding(const Table& table, const OutboundEvent& event) {
   const auto it = table.tx.find(event.channel);
   if (it == table.tx.end() || event.payload.size() > it->second.payload) return nullptr;
-  const TxChannel& channel = it->second;
-  if (channel.native) return &channel;
-  if (famouso_) return event.payload.size() <= famouso::kAfpMtu ? &channel : nullptr;
-  return channel.fragmented ? nullptr : &channel;
+  const CanTxBinding& binding = it->second;
+  return binding.format->frame_count(binding, event.payload.size()) == 1 ? &binding : nullptr;
 }
 
 void CanAdapter::send_batch(std::span<const OutboundEvent> events, std::span<SendStatus> results) {
@@ -283,7 +269,7 @@ void CanAdapter::send_batch(std::span<const OutboundEvent> events, std::span<Sen
   std::array<canfd_frame, kWriteBatch> frames;
   std::size_t i = 0;
   while (i < events.size() && i < results.size()) {
-    std::shared_ptr<const Table> table;  // keeps the channels alive without the lock
+    std::shared_ptr<const Table> table;  // keeps the bindings alive without the lock
     const std::size_t first = i;
     std::size_t count = 0;
     {
@@ -291,9 +277,9 @@ void CanAdapter::send_batch(std::span<const OutboundEvent> events, std::span<Sen
       if (started_ && link_up_ && tx_socket_) {
         table = table_;
         for (; i < events.size() && i < results.size() && count < kWriteBatch; ++i) {
-          const TxChannel* channel = single_frame_channel(*table, events[i]);
-          if (channel == nullptr) break;
-          frames[count++] = single_frame(*channel, events[i].payload);
+          const CanTxBinding* binding = single_frame_binding(*table, events[i]);
+          if (binding == nullptr) break;
+          frames[count++] = binding->format->single_frame(*binding, events[i].payload);
         }
       }
     }
@@ -306,49 +292,6 @@ void CanAdapter::send_batch(std::span<const OutboundEvent> events, std::span<Sen
     std::fill(results.begin() + static_cast<std::ptrdiff_t>(first), results.begin() + static_cast<std::ptrdiff_t>(i),
               status);
   }
-}
-
-// The frames `fill_next` writes (one per call, until `done`), kWriteBatch per submit (one system
-// call each); the first refused batch fails the event.
-template <typename Done, typename FillNext>
-SendStatus CanAdapter::submit_in_batches(bool fd, Done done, FillNext fill_next) {
-  std::array<canfd_frame, kWriteBatch> batch{};
-  while (!done()) {
-    std::size_t count = 0;
-    for (; count < kWriteBatch && !done(); ++count) {
-      batch[count] = canfd_frame{};
-      fill_next(batch[count]);
-    }
-    const WriteResult r = submit(std::span(batch.data(), count), fd);
-    if (r == WriteResult::failed || r == WriteResult::full) return SendStatus::failed;
-  }
-  return SendStatus::sent;
-}
-
-// A fragmented event in the COSMIC layout.
-SendStatus CanAdapter::send_fragments(const TxChannel& channel, std::span<const std::uint8_t> payload,
-                                      std::uint8_t sequence) {
-  const bool fd = segment_.can.fd;
-  Fragmenter fragments(payload, capacity_, sequence);
-  return submit_in_batches(
-      fd, [&] { return fragments.done(); },
-      [&](canfd_frame& frame) {
-        frame.can_id = channel.can_id | CAN_EFF_FLAG;
-        frame.flags = fd && brs_ ? CANFD_BRS : 0;
-        const std::size_t len = fragments.next(std::span<std::uint8_t>(frame.data, capacity_));
-        frame.len = static_cast<std::uint8_t>(fd ? fd_padded_length(static_cast<std::uint32_t>(len)) : len);
-      });
-}
-
-// FAMOUSO: an event of more than 8 bytes as AFP fragments with the identifier's fragment flag.
-SendStatus CanAdapter::send_afp(const TxChannel& channel, std::span<const std::uint8_t> payload) {
-  famouso::AfpFragmenter fragments(payload);
-  return submit_in_batches(
-      false, [&] { return fragments.done(); },
-      [&](canfd_frame& frame) {
-        frame.can_id = channel.afp_id | CAN_EFF_FLAG;
-        frame.len = static_cast<std::uint8_t>(fragments.next(std::span<std::uint8_t>(frame.data, famouso::kAfpMtu)));
-      });
 }
 
 }  // namespace cosmic::can_detail

@@ -54,7 +54,7 @@ bool CanAdapter::open_socket(int ifindex) {
       generation = generation_.load();
       filters = table_->filters;
     }
-    if (filters.empty()) filters = protocol_filters(famouso_);
+    if (filters.empty()) filters = protocol_filters(famouso_protocol_);
     if (::setsockopt(s, SOL_CAN_RAW, CAN_RAW_FILTER, filters.data(),
                      static_cast<socklen_t>(filters.size() * sizeof(can_filter))) != 0) {
       return fail("CAN_RAW_FILTER");
@@ -194,14 +194,19 @@ void CanAdapter::run() {
       next_link_check_ = now + (link_up_ ? kLinkCheckWhileUp : kLinkCheckWhileDown);
     }
     refresh_rx_table();
-    reassembler_.expire(now, [this](std::uint32_t source) { reassembly_losses(kNoChannel, source, false); });
+    const std::function<void(std::uint32_t)> expired = [this](std::uint32_t source) {
+      reassembly_losses(kNoChannel, source, false);
+    };
+    cosmic_frames_.expire(now, expired);
+    famouso_frames_.expire(now, expired);
     handle_protocol_timeouts(now);
     serve_deferred_requests(now);
 
     pollfd fds[3] = {{receiver_.wake_fd(), POLLIN, 0}, {-1, 0, 0}, {census_sock_, POLLIN, 0}};
     Nanos deadline = next_link_check_;
-    if (const auto d = reassembler_.next_deadline()) deadline = std::min(deadline, *d + Nanos(1));
-    if (const auto d = afp_.next_deadline()) deadline = std::min(deadline, *d + Nanos(1));
+    for (const auto d : {cosmic_frames_.next_deadline(), famouso_frames_.next_deadline()}) {
+      if (d) deadline = std::min(deadline, *d + Nanos(1));
+    }
     if (const auto d = ccp_ ? ccp_->deadline() : std::nullopt) deadline = std::min(deadline, *d);
     {
       PiLock lock(io_mutex_);

@@ -70,7 +70,7 @@ std::size_t AfpFragmenter::next(std::span<std::uint8_t> out) {
   const std::size_t header = encode_afp_header(remaining_, first_, out);
   first_ = false;
   const std::size_t take = std::min(rest_.size(), kAfpMtu - header);
-  std::memcpy(out.data() + header, rest_.data(), take);
+  std::copy_n(rest_.begin(), take, out.begin() + static_cast<std::ptrdiff_t>(header));
   rest_ = rest_.subspan(take);
   return header + take;
 }

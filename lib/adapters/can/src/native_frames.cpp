@@ -56,7 +56,8 @@ std::optional<std::span<const std::uint8_t>> contents(const RxChannel& channel, 
 canfd_frame encode(const NativeCanFrame& frame, std::span<const std::uint8_t> payload, bool fd, bool brs) {
   canfd_frame out{};
   out.can_id = socket_id(frame);
-  std::memcpy(out.data, payload.data(), std::min(payload.size(), sizeof out.data));
+  // copy_n, not memcpy: an empty event's bytes may be a null pointer (found by fuzz_can_native_frames).
+  std::copy_n(payload.begin(), std::min(payload.size(), sizeof out.data), out.data);
   const auto len = static_cast<std::uint32_t>(payload.size());
   out.len = static_cast<std::uint8_t>(fd ? fd_padded_length(len) : len);
   out.flags = fd && brs ? CANFD_BRS : 0;
