@@ -45,7 +45,6 @@ Router::Router(GatewayIdentity self, std::size_t segment_capacity, RouterLimits 
       limits_(std::move(limits)),
       clock_(clock),
       unrouted_(new std::atomic<std::uint64_t>[segment_names_.size()]()),
-      table_(std::make_shared<const Table>()),
       lane_extra_(segment_capacity, 0),
       pool_(std::make_unique<PayloadPool>(4 * (limits_.hrt_queue + limits_.srt_queue + limits_.nrt_queue),
                                           kRetainedPayloadBytes)) {
@@ -99,33 +98,34 @@ void Router::set_segment(std::size_t index, std::string name, SegmentAdapter* ad
 
 void Router::apply(std::vector<Route> routes) {
   LockGuard serial(apply_mutex_);
-  const std::shared_ptr<const Table> current = load_table();
-  auto next = std::make_shared<Table>();
-  next->channels.reserve(routes.size());
+  // This thread alone publishes: the current table needs no reading.
+  const Table& current = table_.current_for_publisher();
+  Table next;
+  next.channels.reserve(routes.size());
   for (auto& route : routes) {
-    const auto existing = std::lower_bound(current->channels.begin(), current->channels.end(), route.id,
+    const auto existing = std::lower_bound(current.channels.begin(), current.channels.end(), route.id,
                                            [](const auto& s, ChannelId v) { return s->route.id < v; });
     // A route is never changed in place: ingress and lane threads read it without any lock. A
     // changed route gets a fresh state (and fresh counters).
-    if (existing != current->channels.end() && (*existing)->route == route) {
-      next->channels.push_back(*existing);
+    if (existing != current.channels.end() && (*existing)->route == route) {
+      next.channels.push_back(*existing);
     } else {
-      next->channels.push_back(
+      next.channels.push_back(
           std::make_shared<ChannelState>(std::move(route), segment_names_.size(), limits_.rate_burst));
       // The same channel under a changed route goes on numbering what this gateway originates:
       // a receiver's duplicate window must not take the restarted numbers for copies.
-      if (existing != current->channels.end() && (*existing)->route.id == next->channels.back()->route.id) {
-        next->channels.back()->next_sequence.store((*existing)->next_sequence.load());
+      if (existing != current.channels.end() && (*existing)->route.id == next.channels.back()->route.id) {
+        next.channels.back()->next_sequence.store((*existing)->next_sequence.load());
       }
     }
   }
-  std::sort(next->channels.begin(), next->channels.end(),
+  std::sort(next.channels.begin(), next.channels.end(),
             [](const auto& a, const auto& b) { return a->route.id < b->route.id; });
-  for (const auto& old : current->channels) {
-    const auto kept = std::lower_bound(next->channels.begin(), next->channels.end(), old->route.id,
+  for (const auto& old : current.channels) {
+    const auto kept = std::lower_bound(next.channels.begin(), next.channels.end(), old->route.id,
                                        [](const auto& s, ChannelId v) { return s->route.id < v; });
-    if (kept != next->channels.end() && *kept == old) continue;
-    if (kept == next->channels.end() || (*kept)->route.id != old->route.id) {
+    if (kept != next.channels.end() && *kept == old) continue;
+    if (kept == next.channels.end() || (*kept)->route.id != old->route.id) {
       old->removed.store(true);
       continue;
     }
@@ -138,21 +138,13 @@ void Router::apply(std::vector<Route> routes) {
       }
     }
   }
-  // Readers holding the old snapshot keep it alive until they let go (their last event of it).
-  std::shared_ptr<const Table> retired;
-  {
-    PiLock lock(table_mutex_);
-    retired = std::exchange(table_, std::move(next));
-  }
-}
-
-std::shared_ptr<const Router::Table> Router::load_table() const {
-  PiLock lock(table_mutex_);
-  return table_;
+  // The old table is freed here, on the control thread, once its last reader is done
+  // (microseconds: readers hold it for one event or one statistics pass).
+  const Table retired = SnapshotTable<Table>::retire(table_.publish(std::move(next)));
 }
 
 std::shared_ptr<ChannelState> Router::find(ChannelId id) const {
-  const std::shared_ptr<const Table> table = load_table();
+  const auto table = table_.read();
   const auto it = std::lower_bound(table->channels.begin(), table->channels.end(), id,
                                    [](const auto& s, ChannelId v) { return s->route.id < v; });
   if (it == table->channels.end() || (*it)->route.id != id) return nullptr;
@@ -308,7 +300,7 @@ SegmentCountersSnapshot counters_snapshot(const std::string& name, const Segment
 }  // namespace
 
 std::vector<ChannelMisses> Router::misses() const {
-  const std::shared_ptr<const Table> table = load_table();
+  const auto table = table_.read();
   std::vector<ChannelMisses> out;
   for (const auto& state : table->channels) {
     std::uint64_t residence = 0;
@@ -323,7 +315,7 @@ std::vector<ChannelMisses> Router::misses() const {
 }
 
 std::vector<ChannelStatsSnapshot> Router::snapshot() const {
-  const std::shared_ptr<const Table> table = load_table();
+  const auto table = table_.read();
   std::vector<ChannelStatsSnapshot> out;
   out.reserve(table->channels.size());
   for (const auto& state : table->channels) {

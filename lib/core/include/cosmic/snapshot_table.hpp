@@ -1,8 +1,8 @@
-// A table that send paths read and the control thread replaces, as the router's route table: the
-// next table is built outside any lock, publish() swaps it in under a priority-inheriting mutex (a
-// pointer swap), and a reader takes the current table under that mutex (a pointer copy and a
-// counter) and then uses it with no lock held: a send on it may write to the network for as long as
-// the transport takes, and no other thread waits for that.
+// A table that forwarding and send paths read and the control thread replaces (the router's route
+// table, the DDS adapter's writers, the LCM adapter's channels): the next table is built outside any lock, publish()
+// swaps it in under a priority-inheriting mutex (a pointer swap), and a reader takes the current table under that mutex
+// (a pointer copy and a counter) and then uses it with no lock held: a send on it may write to the network for as long
+// as the transport takes, and no other thread waits for that.
 //
 // Who owns what: the SnapshotTable shares the current table with every Reading of it; a table lives
 // until the last of its owners lets go (a Replaced that is never retired included), so no order of

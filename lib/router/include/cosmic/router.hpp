@@ -29,6 +29,7 @@
 #include "cosmic/mutex.hpp"
 #include "cosmic/pi_mutex.hpp"
 #include "cosmic/router_stats.hpp"
+#include "cosmic/snapshot_table.hpp"
 #include "cosmic/segment_adapter.hpp"
 #include "cosmic/steady_clock.hpp"
 #include "cosmic/thread_annotations.hpp"
@@ -90,7 +91,7 @@ class Router {
 
   // Replaces the route table. Channels whose route is unchanged keep their counters, rate and
   // duplicate state; queued events of removed or changed channels are dropped silently.
-  void apply(std::vector<Route> routes) COSMIC_EXCLUDES(apply_mutex_, table_mutex_);
+  void apply(std::vector<Route> routes) COSMIC_EXCLUDES(apply_mutex_);
 
   // Without lane threads: dispatches queued events, HRT lanes first, then SRT, then NRT, until
   // none is left or `budget` were handled; returns how many.
@@ -130,14 +131,11 @@ class Router {
   std::vector<std::unique_ptr<SegmentInbox>> inboxes_;
   std::unique_ptr<std::atomic<std::uint64_t>[]> unrouted_;
 
-  // The current route table. Readers copy the pointer under table_mutex_ (a pointer copy, never
-  // any I/O) and then work on an immutable table that stays alive while they hold it; apply()
-  // builds the next table outside the lock and swaps it in. (libstdc++ 12's
-  // std::atomic<std::shared_ptr> would do the same with a spin bit that ThreadSanitizer cannot
-  // see through.)
-  std::shared_ptr<const Table> load_table() const COSMIC_EXCLUDES(table_mutex_);
-  mutable PiMutex table_mutex_;
-  std::shared_ptr<const Table> table_ COSMIC_GUARDED_BY(table_mutex_);
+  // The current route table (cosmic/snapshot_table.hpp): the ingress and lane threads read it
+  // with a pointer copy under its priority-inheriting mutex, never any I/O, and then use it with
+  // no lock held; apply() builds the next table outside the lock, swaps it in, and frees the old
+  // one itself once its last reader is done, so no forwarding thread ever frees a table.
+  SnapshotTable<Table> table_;
   Mutex apply_mutex_;  // serialises apply() (control thread) against itself
 
   std::atomic<std::uint64_t> progress_{0};
