@@ -145,7 +145,7 @@ void render_segment_counters(Exposition& out, const MetricsSnapshot& s) {
              "LCM datagrams the gateway sent whose looped-back copy its receive filter dropped (own_datagrams: drop); "
              "each is one in the host's UDP InErrors.");
   for (const auto& seg : s.segments)
-    if (seg.adapter.own_datagrams_dropped) out.sample(segment_labels(seg), *seg.adapter.own_datagrams_dropped);
+    if (const auto own = seg.adapter.transport_counter("own_datagrams_dropped")) out.sample(segment_labels(seg), *own);
 }
 
 void render_channel_state(Exposition& out, const MetricsSnapshot& s) {

@@ -150,7 +150,7 @@ TEST(MetricsRender, SegmentsHealthLoadAndAdapterCounters) {
 TEST(MetricsRender, OwnDatagramsDroppedOnlyWhereTheFilterDropsThem) {
   MetricsSnapshot s = robot();
   cosmic::SegmentInfo viz = segment("viz", cosmic::SegmentType::lcm, cosmic::SegmentHealth::up);
-  viz.adapter.own_datagrams_dropped = 1234;
+  viz.adapter.transport.push_back(cosmic::TransportCounter{"own_datagrams_dropped", 1234});
   s.segments.push_back(viz);
   const std::string m = render_metrics(s, ExpositionFormat::prometheus_text);
   EXPECT_LINE(m, "cosmic_segment_own_datagrams_dropped_total{segment=\"viz\",type=\"lcm\"} 1234");

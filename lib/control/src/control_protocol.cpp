@@ -214,11 +214,8 @@ Json ControlProtocol::segments() const {
                  {"receive_errors", s.adapter.receive_errors},
                  {"send_errors", s.adapter.send_errors},
                  {"overflow_drops", s.adapter.overflow_drops},
-                 {"backlog", s.adapter.backlog},
-                 {"binding_requests_over_limit",
-                  s.adapter.binding_requests_over_limit ? Json(*s.adapter.binding_requests_over_limit) : Json(nullptr)},
-                 {"own_datagrams_dropped",
-                  s.adapter.own_datagrams_dropped ? Json(*s.adapter.own_datagrams_dropped) : Json(nullptr)}}}};
+                 {"backlog", s.adapter.backlog}}}};
+    for (const TransportCounter& c : s.adapter.transport) entry["adapter"][c.name] = c.value;
     if (s.spec.type == SegmentType::can) {
       entry["interface"] = s.spec.can.interface;
       entry["bitrate"] = s.spec.can.bitrate.bits_per_second;

@@ -269,7 +269,7 @@ TEST_F(LcmAdapterTest, OwnEnvelopesAreNotReceivedBack) {
   EXPECT_EQ(adapter->statistics().overflow_drops, 0u);
   EXPECT_EQ(adapter->statistics().receive_errors, 0u);
   EXPECT_EQ(udp_socket_drops(port), 0u);
-  EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::nullopt);
+  EXPECT_EQ(adapter->statistics().transport_counter("own_datagrams_dropped"), std::nullopt);
 
   // Envelopes carrying this gateway's origin that it did not just publish (a loop through another
   // gateway, or a spoof) are delivered, for the router's ingress check to drop and count.
@@ -309,15 +309,15 @@ TEST_F(LcmAdapterTest, DroppedOwnDatagramsAreNoOverflow) {
   EXPECT_EQ(adapter->statistics().receive_errors, 0u);
   // The kernel did drop them: the receive socket's drop count (/proc/net/udp) is our 53 datagrams.
   EXPECT_EQ(udp_socket_drops(port), 53u);
-  EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::optional<std::uint64_t>(53));
+  EXPECT_EQ(adapter->statistics().transport_counter("own_datagrams_dropped"), std::optional<std::uint64_t>(53));
   adapter->stop();
-  EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::optional<std::uint64_t>(53));
+  EXPECT_EQ(adapter->statistics().transport_counter("own_datagrams_dropped"), std::optional<std::uint64_t>(53));
 
   // A new socket counts from 0 in the kernel and in the transmitter; the segment's figure goes on.
   ASSERT_TRUE(adapter->start(sink_).ok);
   ASSERT_TRUE(adapter->configure(bindings).ok);  // stop() forgot the channels
   for (std::uint32_t k = 52; k <= 53; ++k) ASSERT_EQ(adapter->send(outbound(7, own_pattern(k, 24))), SendStatus::sent);
-  EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::optional<std::uint64_t>(55));
+  EXPECT_EQ(adapter->statistics().transport_counter("own_datagrams_dropped"), std::optional<std::uint64_t>(55));
   Child more(
       {peer(), "pub", "--url", url_for(port), "--channel", "LOOPED_DROP", "--raw", "--count", "1", "--size", "24"});
   ASSERT_EQ(more.wait_exit(), std::optional<int>(0)) << more.stderr_text();
@@ -346,7 +346,7 @@ TEST_F(LcmAdapterTest, ASegmentThatOnlySendsLeavesTheGroupUntilAChannelIsReceive
   ASSERT_EQ(sub.wait_exit(), std::optional<int>(0)) << sub.stderr_text();
   EXPECT_EQ(sub.stdout_lines().size(), 10u);
   EXPECT_EQ(udp_socket_drops(port), 0u);
-  EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::optional<std::uint64_t>(0));
+  EXPECT_EQ(adapter->statistics().transport_counter("own_datagrams_dropped"), std::optional<std::uint64_t>(0));
 
   ASSERT_TRUE(adapter->configure(std::vector{out, in}).ok);
   for (std::uint32_t k = 11; k <= 15; ++k) ASSERT_EQ(adapter->send(outbound(8, own_pattern(k, 24))), SendStatus::sent);
@@ -355,13 +355,13 @@ TEST_F(LcmAdapterTest, ASegmentThatOnlySendsLeavesTheGroupUntilAChannelIsReceive
   ASSERT_TRUE(sink_.wait_events(9, 3));
   for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(sink_.events(9).at(i).payload, peer_pattern(i + 1, 24));
   EXPECT_EQ(udp_socket_drops(port), 5u);  // a member again: ours loop back and are dropped
-  EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::optional<std::uint64_t>(5));
+  EXPECT_EQ(adapter->statistics().transport_counter("own_datagrams_dropped"), std::optional<std::uint64_t>(5));
 
   ASSERT_TRUE(adapter->configure(std::vector{out}).ok);
   for (std::uint32_t k = 16; k <= 19; ++k) ASSERT_EQ(adapter->send(outbound(8, own_pattern(k, 24))), SendStatus::sent);
   EXPECT_EQ(adapter->statistics().sent, 19u);
   EXPECT_EQ(udp_socket_drops(port), 5u);
-  EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::optional<std::uint64_t>(5));
+  EXPECT_EQ(adapter->statistics().transport_counter("own_datagrams_dropped"), std::optional<std::uint64_t>(5));
   EXPECT_EQ(adapter->statistics().overflow_drops, 0u);
   adapter->stop();
 }

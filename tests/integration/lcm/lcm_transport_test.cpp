@@ -245,7 +245,7 @@ TEST_F(LcmAdapterTest, OwnDropsAndAFullBufferAreToldApart) {
     return socket_drops > 300 && adapter->statistics().overflow_drops == socket_drops - 300;
   })) << "socket drops "
       << socket_drops << ", overflow_drops " << adapter->statistics().overflow_drops;
-  EXPECT_EQ(adapter->statistics().own_datagrams_dropped, std::optional<std::uint64_t>(300));
+  EXPECT_EQ(adapter->statistics().transport_counter("own_datagrams_dropped"), std::optional<std::uint64_t>(300));
   adapter->stop();
 }
 

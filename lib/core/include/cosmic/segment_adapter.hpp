@@ -24,6 +24,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "cosmic/admission.hpp"
@@ -111,6 +112,13 @@ struct UnexplainedFrames {
   friend bool operator==(const UnexplainedFrames&, const UnexplainedFrames&) = default;
 };
 
+// A counter of one transport's own (AdapterStatistics::transport).
+struct TransportCounter {
+  std::string name;
+  std::uint64_t value = 0;
+  friend bool operator==(const TransportCounter&, const TransportCounter&) = default;
+};
+
 struct AdapterStatistics {
   std::uint64_t received = 0;        // messages/frames read from the network
   std::uint64_t sent = 0;            // messages/frames written to the network
@@ -118,14 +126,20 @@ struct AdapterStatistics {
   std::uint64_t send_errors = 0;
   std::uint64_t overflow_drops = 0;  // lost before we could read them (e.g. SO_RXQ_OVFL)
   std::uint64_t backlog = 0;         // frames waiting in the adapter's own send queue
-  // Requests of the transport's binding protocol over its rate limit (CAN: GET_ETAG, answered
-  // later or not at all; also counted in receive_errors); nullopt where there is no such protocol.
-  std::optional<std::uint64_t> binding_requests_over_limit;
-  // LCM with own_datagrams: drop: the datagrams the gateway sent whose looped-back copy its own
-  // receive filter dropped in the kernel, one per datagram sent; each is also one in the host's
-  // UDP InErrors and in the socket's drops (/proc/net/udp), and none in overflow_drops. Nullopt
-  // where the filter does not drop them.
-  std::optional<std::uint64_t> own_datagrams_dropped;
+  // What only some transports count, each under its name (docs/control-protocol.md says what each
+  // means), absent where a transport has no such thing:
+  //  - binding_requests_over_limit (CAN): requests of the binding protocol (GET_ETAG) over its rate
+  //    limit, answered later or not at all; also counted in receive_errors;
+  //  - own_datagrams_dropped (LCM with own_datagrams: drop): the datagrams the gateway sent whose
+  //    looped-back copy its own receive filter dropped in the kernel, one per datagram sent; each is
+  //    also one in the host's UDP InErrors and in the socket's drops, and none in overflow_drops.
+  std::vector<TransportCounter> transport;
+  std::optional<std::uint64_t> transport_counter(std::string_view name) const {
+    for (const TransportCounter& c : transport) {
+      if (c.name == name) return c.value;
+    }
+    return std::nullopt;
+  }
   // CAN: the unexplained identifiers (at most 64, lowest identifier first) and the frames of any
   // further ones; empty where the transport cannot see foreign traffic.
   std::vector<UnexplainedFrames> unexplained;
