@@ -38,7 +38,7 @@ MetricsServer::MetricsServer(cosmic::Logger& log) : log_(log) {}
 
 MetricsServer::~MetricsServer() { endpoint_.reset(); }
 
-std::unique_ptr<MetricsServer::Endpoint> MetricsServer::open(const cosmic::MetricsSpec& spec, std::string& error) {
+cosmic::Result<std::unique_ptr<MetricsServer::Endpoint>> MetricsServer::open(const cosmic::MetricsSpec& spec) {
   auto endpoint = std::make_unique<Endpoint>(log_);
   MetricsHttpServer& http = endpoint->http;
   http.serve_metrics([this](ExpositionFormat format) -> std::optional<std::string> {
@@ -48,8 +48,9 @@ std::unique_ptr<MetricsServer::Endpoint> MetricsServer::open(const cosmic::Metri
   });
   errno = 0;
   if (!http.bind(spec.host, spec.port)) {
-    error = "cannot listen on " + url_of(spec) + (errno ? std::string(": ") + std::strerror(errno) : std::string());
-    return nullptr;
+    const int err = errno;
+    if (err != 0) return cosmic::Error::from_errno("cannot listen on " + url_of(spec), err);
+    return cosmic::Error{"cannot listen on " + url_of(spec)};
   }
   endpoint->thread = std::thread([&http] {
     name_this_thread();
@@ -69,23 +70,22 @@ void MetricsServer::follow(const cosmic::MetricsSpec& spec) {
     if (!old_url.empty()) log_.log(cosmic::LogLevel::notice, "metrics endpoint " + old_url + " closed");
     return;
   }
-  std::string error;
-  endpoint_ = open(spec, error);
-  if (endpoint_) {
+  if (auto opened = open(spec)) {
+    endpoint_ = std::move(opened).value();
     serving_spec_ = spec;
     url_ = url_of(spec);
     log_.log(cosmic::LogLevel::notice, "metrics endpoint listening on " + url_);
     return;
+  } else {
+    log_.log(cosmic::LogLevel::error, "metrics endpoint: " + opened.error().text);
   }
-  log_.log(cosmic::LogLevel::error, "metrics endpoint: " + error);
   if (old_url.empty()) return;
-  std::string again;
-  endpoint_ = open(old_spec, again);
-  if (endpoint_) {
+  if (auto again = open(old_spec)) {
+    endpoint_ = std::move(again).value();
     url_ = old_url;
     log_.log(cosmic::LogLevel::warning, "metrics endpoint stays on " + old_url);
   } else {
-    log_.log(cosmic::LogLevel::error, "metrics endpoint: " + again + "; no metrics are served");
+    log_.log(cosmic::LogLevel::error, "metrics endpoint: " + again.error().text + "; no metrics are served");
   }
 }
 

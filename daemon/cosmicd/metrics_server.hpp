@@ -14,6 +14,7 @@
 
 #include "cosmic/log.hpp"
 #include "cosmic/model.hpp"
+#include "cosmic/result.hpp"
 #include "metrics_relay.hpp"
 #include "metrics_snapshot.hpp"
 
@@ -45,7 +46,7 @@ class MetricsServer {
 
  private:
   class Endpoint;
-  std::unique_ptr<Endpoint> open(const cosmic::MetricsSpec& spec, std::string& error);
+  cosmic::Result<std::unique_ptr<Endpoint>> open(const cosmic::MetricsSpec& spec);
 
   cosmic::Logger& log_;
   cosmic::MetricsSpec requested_;

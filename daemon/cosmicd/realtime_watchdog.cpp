@@ -92,21 +92,20 @@ cpu_set_t demoted_thread_cpus(const std::vector<int>& keep_off) {
   return CPU_COUNT(&out) > 0 ? out : control;
 }
 
-std::optional<std::string> make_time_shared(pid_t tid, const cpu_set_t& cpus) {
+cosmic::Result<void> make_time_shared(pid_t tid, const cpu_set_t& cpus) {
   sched_param param{};
   param.sched_priority = 0;
   if (::sched_setscheduler(tid, SCHED_OTHER, &param) != 0)
-    return std::string("sched_setscheduler: ") + std::strerror(errno);
+    return cosmic::Error::from_errno("sched_setscheduler", errno);
   // setpriority(PRIO_PROCESS, tid) sets the nice value of this one thread on Linux.
-  if (::setpriority(PRIO_PROCESS, static_cast<id_t>(tid), 19) != 0)
-    return std::string("nice 19: ") + std::strerror(errno);
+  if (::setpriority(PRIO_PROCESS, static_cast<id_t>(tid), 19) != 0) return cosmic::Error::from_errno("nice 19", errno);
   // Onto the control thread's CPUs. Time-shared but alone on a reserved CPU, a loop that retakes
   // a mutex as soon as it lets it go still shuts out a waiter on another CPU, which wakes too
   // late every time (Fast DDS 2.9's flow controller does that to the thread removing a matched
   // reader); sharing the waiter's CPUs, the kernel preempts it for the waiter.
   if (::sched_setaffinity(tid, sizeof cpus, &cpus) != 0)
-    return std::string("time-shared, but its CPU affinity: ") + std::strerror(errno);
-  return std::nullopt;
+    return cosmic::Error::from_errno("time-shared, but its CPU affinity", errno);
+  return {};
 }
 
 std::vector<std::string> RealtimeWatchdog::check(std::chrono::nanoseconds now) {
@@ -117,8 +116,8 @@ std::vector<std::string> RealtimeWatchdog::check(std::chrono::nanoseconds now) {
     std::string line = "thread " + v.thread.name + " (" + std::to_string(v.thread.tid) + ") ran real-time for " +
                        share + " of the last " + std::to_string(v.window.count() / 1'000'000) +
                        " ms, a busy loop that starves every thread below it on its CPU: ";
-    if (const auto why = make_time_shared(v.thread.tid, demoted_thread_cpus(keep_off_))) {
-      line += "it could not be made time-shared on the control thread's CPUs (" + *why + ")";
+    if (const cosmic::Result<void> shared = make_time_shared(v.thread.tid, demoted_thread_cpus(keep_off_)); !shared) {
+      line += "it could not be made time-shared on the control thread's CPUs (" + shared.error().text + ")";
     } else {
       line += "it runs time-shared (nice 19), on the control thread's CPUs, from now on";
     }

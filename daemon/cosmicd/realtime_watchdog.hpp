@@ -20,6 +20,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "cosmic/result.hpp"
+
 namespace cosmicd {
 
 // One thread of the process as the watchdog sees it.
@@ -63,9 +65,9 @@ std::vector<ThreadSample> sample_process_threads();
 // (the CPUs reserved for the real-time lanes); all of the calling thread's when that leaves none.
 cpu_set_t demoted_thread_cpus(const std::vector<int>& keep_off);
 
-// Makes thread `tid` of this process time-shared at nice 19, on `cpus`; the reason when it
-// cannot, naming the step that failed.
-std::optional<std::string> make_time_shared(pid_t tid, const cpu_set_t& cpus);
+// Makes thread `tid` of this process time-shared at nice 19, on `cpus`; the error names the step
+// that failed.
+cosmic::Result<void> make_time_shared(pid_t tid, const cpu_set_t& cpus);
 
 // The judge over this process's threads, demoting and describing what it found.
 class RealtimeWatchdog {

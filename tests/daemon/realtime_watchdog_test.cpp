@@ -174,7 +174,7 @@ TEST(RealtimeWatchdog, SeesRealtimeThreadsAndTheirCpuTimeAndMakesOneTimeShared) 
     }
   }
 
-  EXPECT_EQ(make_time_shared(threads.fifo_tid.load(), demoted_thread_cpus(reserved)), std::nullopt);
+  EXPECT_TRUE(make_time_shared(threads.fifo_tid.load(), demoted_thread_cpus(reserved)).ok());
   EXPECT_EQ(sched_getscheduler(threads.fifo_tid.load()), SCHED_OTHER);
   errno = 0;
   EXPECT_EQ(getpriority(PRIO_PROCESS, static_cast<id_t>(threads.fifo_tid.load())), 19);

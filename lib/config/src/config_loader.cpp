@@ -374,8 +374,8 @@ class ConfigParser {
     if (has(node, "url")) {
       if (auto v = reader_.string(node["url"], key(path, "url"))) {
         const auto lcm_url = parse_lcm_url(*v);
-        if (const auto* problem = std::get_if<std::string>(&lcm_url)) {
-          reader_.error_at(node["url"], key(path, "url"), "unsupported LCM URL " + *problem,
+        if (!lcm_url) {
+          reader_.error_at(node["url"], key(path, "url"), "unsupported LCM URL " + lcm_url.error().text,
                            "udpm://GROUP:PORT?ttl=N or memq://");
         }
         s.lcm.url = *v;

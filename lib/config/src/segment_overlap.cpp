@@ -13,10 +13,9 @@ namespace {
 // UDP port of an LCM udpm URL, parsed canonically; nullopt for memq:// (private to each instance)
 // and for URLs the loader refuses anyway.
 std::optional<unsigned> lcm_port(const std::string& url) {
-  const auto parsed = parse_lcm_url(url);
-  const auto* lcm = std::get_if<LcmUrl>(&parsed);
-  if (lcm == nullptr || lcm->memq) return std::nullopt;
-  return lcm->port;
+  const Result<LcmUrl> parsed = parse_lcm_url(url);
+  if (!parsed || parsed.value().memq) return std::nullopt;
+  return parsed.value().port;
 }
 
 struct Overlap {

@@ -39,10 +39,11 @@ bool multicast_group(std::string_view text) {
 
 }  // namespace
 
-std::variant<LcmUrl, std::string> parse_lcm_url(std::string_view url) {
+Result<LcmUrl> parse_lcm_url(std::string_view url) {
   const std::string hint = "'" + shown(url) + "': ";
   if (url == kMemq) return LcmUrl{true, "", 0, std::nullopt, std::nullopt};
-  if (url.substr(0, kUdpm.size()) != kUdpm) return hint + "only udpm://GROUP:PORT?ttl=N and memq:// are supported";
+  if (url.substr(0, kUdpm.size()) != kUdpm)
+    return Error{hint + "only udpm://GROUP:PORT?ttl=N and memq:// are supported"};
   std::string_view rest = url.substr(kUdpm.size());
   const std::size_t query = rest.find('?');
   std::string_view network = rest.substr(0, query);
@@ -51,13 +52,13 @@ std::variant<LcmUrl, std::string> parse_lcm_url(std::string_view url) {
   const std::size_t colon = network.find(':');
   if (colon != std::string_view::npos) {
     const auto port = decimal(network.substr(colon + 1), 1, 65535);
-    if (!port) return hint + "the port must be a decimal number 1..65535 and end the address";
+    if (!port) return Error{hint + "the port must be a decimal number 1..65535 and end the address"};
     out.port = static_cast<std::uint16_t>(*port);
     network = network.substr(0, colon);
   }
   if (network.empty() && colon == std::string_view::npos) network = kLcmDefaultGroup;  // LCM's default
   if (!multicast_group(network))
-    return hint + "the group must be an IPv4 multicast address (224.0.0.0 to 239.255.255.255)";
+    return Error{hint + "the group must be an IPv4 multicast address (224.0.0.0 to 239.255.255.255)"};
   out.group = std::string(network);
   while (query != std::string_view::npos && !options.empty()) {
     const std::size_t amp = options.find('&');
@@ -68,15 +69,15 @@ std::variant<LcmUrl, std::string> parse_lcm_url(std::string_view url) {
     const std::string_view value = eq == std::string_view::npos ? std::string_view() : option.substr(eq + 1);
     if (name == "ttl") {
       out.ttl = decimal(value, 0, 255);
-      if (!out.ttl) return hint + "ttl must be a decimal number 0..255";
+      if (!out.ttl) return Error{hint + "ttl must be a decimal number 0..255"};
     } else if (name == "recv_buf_size") {
       out.recv_buf_size = decimal(value, 1, 1u << 30);
-      if (!out.recv_buf_size) return hint + "recv_buf_size must be a decimal number of bytes (at most 1 GiB)";
+      if (!out.recv_buf_size) return Error{hint + "recv_buf_size must be a decimal number of bytes (at most 1 GiB)"};
     } else {
-      return hint + "unknown option '" + shown(name) + "' (ttl and recv_buf_size are supported)";
+      return Error{hint + "unknown option '" + shown(name) + "' (ttl and recv_buf_size are supported)"};
     }
   }
-  if (query != std::string_view::npos && rest.back() == '&') return hint + "empty option after '&'";
+  if (query != std::string_view::npos && rest.back() == '&') return Error{hint + "empty option after '&'"};
   return out;
 }
 

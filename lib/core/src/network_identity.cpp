@@ -15,10 +15,9 @@ std::string network_identity(const SegmentSpec& segment) {
       return "dds:domain=" + std::to_string(segment.dds.domain) +
              (segment.dds.discovery_server.empty() ? "" : ";server=" + segment.dds.discovery_server);
     case SegmentType::lcm: {
-      const auto url = parse_lcm_url(segment.lcm.url);
-      const auto* parsed = std::get_if<LcmUrl>(&url);
-      if (!parsed || parsed->memq) return {};
-      return "lcm:" + parsed->group + ":" + std::to_string(parsed->port);
+      const Result<LcmUrl> url = parse_lcm_url(segment.lcm.url);
+      if (!url || url.value().memq) return {};
+      return "lcm:" + url.value().group + ":" + std::to_string(url.value().port);
     }
   }
   return {};

@@ -42,7 +42,7 @@ namespace cosmic {
 namespace dds_detail {
 
 Status DdsAdapter::start(EventSink& sink) {
-  std::lock_guard control(control_mutex_);
+  LockGuard control(control_mutex_);
   if (started()) {
     return Status::failure(prefix() + "already started");
   }
@@ -79,7 +79,7 @@ Status DdsAdapter::start(EventSink& sink) {
 }
 
 Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
-  std::lock_guard control(control_mutex_);
+  LockGuard control(control_mutex_);
   if (!started()) return not_started(segment_.name);
   // Every other problem concerns one channel, which is refused in both roles (not carried at
   // all); the rest of the segment is configured (SegmentAdapter::configure).
@@ -112,11 +112,10 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
         it->second->home == &home_of(b->spec.cls)) {
       continue;
     }
-    std::string error;
-    if (auto entry = create_endpoint(*b, error, &DdsAdapter::create_writer)) {
-      new_writers.push_back(std::move(entry));
+    if (auto entry = create_endpoint(*b, &DdsAdapter::create_writer)) {
+      new_writers.push_back(std::move(entry).value());
     } else {
-      refuse(*b, error);
+      refuse(*b, entry.error().text);
     }
   }
   for (const auto& [id, b] : want_readers) {
@@ -134,11 +133,10 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
       // its successor cannot be created, the channel is refused and the old reader goes too.
       deactivate(*existing);
     }
-    std::string error;
-    if (auto entry = create_endpoint(*b, error, &DdsAdapter::create_reader)) {
-      new_readers.push_back(std::move(entry));
+    if (auto entry = create_endpoint(*b, &DdsAdapter::create_reader)) {
+      new_readers.push_back(std::move(entry).value());
     } else {
-      refuse(*b, error);
+      refuse(*b, entry.error().text);
     }
   }
   // A channel refused in one role is carried in neither.
@@ -193,18 +191,13 @@ Status DdsAdapter::configure(std::span<const ChannelBinding> bindings) {
 }
 
 template <typename Entry>
-std::unique_ptr<Entry> DdsAdapter::create_endpoint(const ChannelBinding& binding, std::string& error,
-                                                   std::unique_ptr<Entry> (DdsAdapter::*create)(const ChannelBinding&,
-                                                                                                std::string&)) {
+Result<std::unique_ptr<Entry>> DdsAdapter::create_endpoint(
+    const ChannelBinding& binding, Result<std::unique_ptr<Entry>> (DdsAdapter::*create)(const ChannelBinding&)) {
   try {
-    if (Status st = ensure_class_participant(binding.spec.cls); !st.ok) {
-      error = st.error;
-      return nullptr;
-    }
-    return (this->*create)(binding, error);
+    if (Status st = ensure_class_participant(binding.spec.cls); !st.ok) return Error{st.error};
+    return (this->*create)(binding);
   } catch (const std::exception& e) {
-    error = std::string("Fast DDS: ") + e.what();
-    return nullptr;
+    return Error{std::string("Fast DDS: ") + e.what()};
   }
 }
 
@@ -315,7 +308,7 @@ void DdsAdapter::teardown() {
 }
 
 void DdsAdapter::stop() {
-  std::lock_guard control(control_mutex_);
+  LockGuard control(control_mutex_);
   if (!started()) {
     return;
   }

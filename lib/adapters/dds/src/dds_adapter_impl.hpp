@@ -31,6 +31,7 @@
 #include "cosmic/health_cell.hpp"
 #include "cosmic/log_prefix.hpp"
 #include "cosmic/mutex.hpp"
+#include "cosmic/result.hpp"
 #include "cosmic/pi_mutex.hpp"
 #include "cosmic/snapshot_table.hpp"
 #include "cosmic/thread_policy.hpp"
@@ -158,16 +159,15 @@ class DdsAdapter final : public DdsSegmentAdapter {
   Status open_participant(ChannelClass cls, const ThreadPolicy& threads, const std::string& thread_name);
   Status ensure_class_participant(ChannelClass cls);
   void close_participant(ClassParticipant& home);
-  dds::Topic* acquire_topic(ClassParticipant& home, const DdsTopicRef& ref, std::string& error);
+  Result<dds::Topic*> acquire_topic(ClassParticipant& home, const DdsTopicRef& ref);
   void release_topic(ClassParticipant& home, dds::Topic* topic);
-  std::unique_ptr<WriterEntry> create_writer(const ChannelBinding& binding, std::string& error);
-  std::unique_ptr<ReaderEntry> create_reader(const ChannelBinding& binding, std::string& error);
+  Result<std::unique_ptr<WriterEntry>> create_writer(const ChannelBinding& binding);
+  Result<std::unique_ptr<ReaderEntry>> create_reader(const ChannelBinding& binding);
   // The class participant of `binding`, then `create`; every failure (an exception of Fast DDS
-  // included) comes back as nullptr and `error`.
+  // included) comes back as an error.
   template <typename Entry>
-  std::unique_ptr<Entry> create_endpoint(const ChannelBinding& binding, std::string& error,
-                                         std::unique_ptr<Entry> (DdsAdapter::*create)(const ChannelBinding&,
-                                                                                      std::string&));
+  Result<std::unique_ptr<Entry>> create_endpoint(
+      const ChannelBinding& binding, Result<std::unique_ptr<Entry>> (DdsAdapter::*create)(const ChannelBinding&));
   void destroy_writer(WriterEntry& entry);
   void deactivate(ReaderEntry& entry);
   void destroy_reader(std::unique_ptr<ReaderEntry> entry);
@@ -179,7 +179,8 @@ class DdsAdapter final : public DdsSegmentAdapter {
   Logger& log_;
   const std::string prefix_;  // "DDS segment NAME: " (cosmic/log_prefix.hpp)
 
-  std::mutex control_mutex_;
+  // Serialises start/configure/stop (control thread); never taken on a send or receive path.
+  Mutex control_mutex_;
   EventSink* sink_ = nullptr;
   std::array<ClassParticipant, 3> classes_;  // indexed by ChannelClass; entries point into it
   bool log_attached_ = false;

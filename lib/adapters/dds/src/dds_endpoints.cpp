@@ -258,28 +258,23 @@ void DdsAdapter::close_participant(ClassParticipant& home) {
 
 // The participant's topic `ref` (created with its first user), registering a native topic's type
 // as an opaque type the first time the participant meets it. Control thread.
-dds::Topic* DdsAdapter::acquire_topic(ClassParticipant& home, const DdsTopicRef& ref, std::string& error) {
+Result<dds::Topic*> DdsAdapter::acquire_topic(ClassParticipant& home, const DdsTopicRef& ref) {
   auto it = home.topics.find(ref.topic);
   if (it != home.topics.end()) {
     if (it->second.topic->get_type_name() != ref.type) {
-      error = "topic " + ref.topic + " already has type " + it->second.topic->get_type_name() + ", not " + ref.type;
-      return nullptr;
+      return Error{"topic " + ref.topic + " already has type " + it->second.topic->get_type_name() + ", not " +
+                   ref.type};
     }
     ++it->second.users;
     return it->second.topic;
   }
   if (ref.native && !home.participant->find_type(ref.type)) {
     dds::TypeSupport type(new OpaqueType(ref.type));
-    if (type.register_type(home.participant) != ReturnCode_t::RETCODE_OK) {
-      error = "cannot register type " + ref.type;
-      return nullptr;
-    }
+    if (type.register_type(home.participant) != ReturnCode_t::RETCODE_OK)
+      return Error{"cannot register type " + ref.type};
   }
   dds::Topic* topic = home.participant->create_topic(ref.topic, ref.type, dds::TOPIC_QOS_DEFAULT);
-  if (topic == nullptr) {
-    error = "cannot create topic " + ref.topic + " of type " + ref.type;
-    return nullptr;
-  }
+  if (topic == nullptr) return Error{"cannot create topic " + ref.topic + " of type " + ref.type};
   home.topics[ref.topic] = TopicRef{topic, 1};
   return topic;
 }
@@ -296,17 +291,17 @@ void DdsAdapter::release_topic(ClassParticipant& home, dds::Topic* topic) {
   }
 }
 
-std::unique_ptr<WriterEntry> DdsAdapter::create_writer(const ChannelBinding& binding, std::string& error) {
+Result<std::unique_ptr<WriterEntry>> DdsAdapter::create_writer(const ChannelBinding& binding) {
   auto entry = std::make_unique<WriterEntry>(*this, binding.id, binding.spec, shape_of(segment_, binding.spec));
   entry->home = &home_of(binding.spec.cls);
-  entry->topic = acquire_topic(*entry->home, entry->shape.topic, error);
-  if (entry->topic == nullptr) return nullptr;
+  Result<dds::Topic*> topic = acquire_topic(*entry->home, entry->shape.topic);
+  if (!topic) return std::move(topic).error();
+  entry->topic = topic.value();
   entry->writer = entry->home->publisher->create_datawriter(entry->topic, writer_qos(segment_, binding.spec),
                                                             entry.get(), dds::StatusMask::offered_incompatible_qos());
   if (entry->writer == nullptr) {
     release_topic(*entry->home, entry->topic);
-    error = "cannot create a DataWriter on " + entry->shape.topic.topic;
-    return nullptr;
+    return Error{"cannot create a DataWriter on " + entry->shape.topic.topic};
   }
   {
     PiLock sample(entry->sample_mutex);  // nothing sends on it yet; the analysis asks for it all the same
@@ -315,12 +310,13 @@ std::unique_ptr<WriterEntry> DdsAdapter::create_writer(const ChannelBinding& bin
   return entry;
 }
 
-std::unique_ptr<ReaderEntry> DdsAdapter::create_reader(const ChannelBinding& binding, std::string& error) {
+Result<std::unique_ptr<ReaderEntry>> DdsAdapter::create_reader(const ChannelBinding& binding) {
   auto entry = std::make_unique<ReaderEntry>(*this, binding.id, binding.spec, shape_of(segment_, binding.spec));
   entry->home = &home_of(binding.spec.cls);
   entry->own_prefix = entry->home->prefix;
-  entry->topic = acquire_topic(*entry->home, entry->shape.topic, error);
-  if (entry->topic == nullptr) return nullptr;
+  Result<dds::Topic*> topic = acquire_topic(*entry->home, entry->shape.topic);
+  if (!topic) return std::move(topic).error();
+  entry->topic = topic.value();
   {
     PiLock lock(entry->mutex);  // the reader does not exist yet: no callback can race with this
     entry->active = true;
@@ -332,8 +328,7 @@ std::unique_ptr<ReaderEntry> DdsAdapter::create_reader(const ChannelBinding& bin
       entry->home->subscriber->create_datareader(entry->topic, reader_qos(segment_, binding.spec), entry.get(), mask);
   if (entry->reader == nullptr) {
     release_topic(*entry->home, entry->topic);
-    error = "cannot create a DataReader on " + entry->shape.topic.topic;
-    return nullptr;
+    return Error{"cannot create a DataReader on " + entry->shape.topic.topic};
   }
   return entry;
 }

@@ -121,10 +121,9 @@ class LcmAdapter final : public SegmentAdapter {
   Status start(EventSink& sink) override {
     LockGuard control(control_mutex_);
     if (started_) return Status::failure(prefix_ + "already started");
-    const auto parsed = parse_lcm_url(segment_.lcm.url);
-    if (const auto* why = std::get_if<std::string>(&parsed))
-      return fail_start("bad LCM URL " + segment_.lcm.url + ": " + *why);
-    const LcmUrl& url = std::get<LcmUrl>(parsed);
+    const Result<LcmUrl> parsed = parse_lcm_url(segment_.lcm.url);
+    if (!parsed) return fail_start("bad LCM URL " + segment_.lcm.url + ": " + parsed.error().text);
+    const LcmUrl& url = parsed.value();
     if (url.memq) {
       // memq:// is private to one LCM instance: nothing reaches this segment and what it sends
       // reaches no one else. It stays up, with no socket and no thread.
@@ -134,21 +133,21 @@ class LcmAdapter final : public SegmentAdapter {
       set_health(SegmentHealth::up, "");
       return Status{};
     }
-    if (const auto why = transmit_.open(url)) return fail_start(*why);
+    if (Result<void> opened = transmit_.open(url); !opened) return fail_start(std::move(opened).error().text);
     lcm_detail::OpenedSocket rx = lcm_detail::open_receive_socket(url, kDefaultReceiveBuffer);
     if (rx.fd < 0) {
       transmit_.close();
       return fail_start("receive socket on " + segment_.lcm.url + ": " + rx.error);
     }
     // Before the filter: the probe comes from a socket of its own, and this is where liblcm checked.
-    if (const auto why = lcm_detail::self_test(url, rx.fd, kSelfTestTimeout)) {
+    if (Result<void> came_back = lcm_detail::self_test(url, rx.fd, kSelfTestTimeout); !came_back) {
       transmit_.close();
       ::close(rx.fd);
-      return fail_start(*why);
+      return fail_start(std::move(came_back).error().text);
     }
     bool own_dropped = segment_.lcm.own_datagrams == LcmOwnDatagrams::drop;
-    if (const auto why = transmit_.follow_with_filter(rx.fd, segment_.lcm.own_datagrams)) {
-      rx.warnings.push_back("own datagrams are read back in full and skipped here (" + *why + ")");
+    if (const Result<void> followed = transmit_.follow_with_filter(rx.fd, segment_.lcm.own_datagrams); !followed) {
+      rx.warnings.push_back("own datagrams are read back in full and skipped here (" + followed.error().text + ")");
       own_dropped = false;
     }
     for (const auto& warning : rx.warnings) log_.log(LogLevel::warning, prefix_ + warning);
@@ -210,10 +209,11 @@ class LcmAdapter final : public SegmentAdapter {
     // every received channel is refused (and, by the rule above, not sent either).
     bool receives = std::any_of(wanted.begin(), wanted.end(), [](const auto& c) { return c.second.rx; });
     if (receives && started_ && rx_fd_ >= 0) {
-      if (const auto why = join_group()) {
+      if (const Result<void> joined = join_group(); !joined) {
         for (const ChannelBinding* b : plan.accepted()) {
           const auto entry = wanted.find(b->id);
-          if (entry != wanted.end() && entry->second.rx) plan.refuse(*b, "cannot receive on this segment: " + *why);
+          if (entry != wanted.end() && entry->second.rx)
+            plan.refuse(*b, "cannot receive on this segment: " + joined.error().text);
         }
         std::erase_if(wanted, [&](const auto& entry) { return plan.refused(entry.first); });
         receives = false;
@@ -267,8 +267,10 @@ class LcmAdapter final : public SegmentAdapter {
   AdapterStatistics statistics() const override {
     AdapterStatistics s = counters_.snapshot();
     LockGuard lock(own_count_mutex_);
-    if (own_counting_ || own_dropped_before_ > 0)
-      s.own_datagrams_dropped = own_dropped_before_ + (own_counting_ ? transmit_.own_drops() : 0);
+    if (own_counting_ || own_dropped_before_ > 0) {
+      s.transport.push_back(
+          TransportCounter{"own_datagrams_dropped", own_dropped_before_ + (own_counting_ ? transmit_.own_drops() : 0)});
+    }
     return s;
   }
 
@@ -306,24 +308,24 @@ class LcmAdapter final : public SegmentAdapter {
   // The receive socket is a member of the group only while a channel is received here. A segment
   // that only sends leaves it: what it sends no longer loops back to it (nothing to drop or cut,
   // nothing in the host's InErrors) and the group's other traffic never wakes its receive thread.
-  std::optional<std::string> join_group() COSMIC_REQUIRES(control_mutex_) {
-    if (member_) return std::nullopt;
+  Result<void> join_group() COSMIC_REQUIRES(control_mutex_) {
+    if (member_) return {};
     transmit_.count_looped_back(true);  // before the join: the count never falls short
-    if (auto why = lcm_detail::set_group_membership(rx_fd_, *rx_url_, true)) {
+    if (Result<void> joined = lcm_detail::set_group_membership(rx_fd_, *rx_url_, true); !joined) {
       transmit_.count_looped_back(false);
-      return why;
+      return joined;
     }
     member_ = true;
     log_.log(LogLevel::info, prefix_ + "a channel is received here: joined " + rx_url_->group);
-    return std::nullopt;
+    return {};
   }
 
   void leave_group() COSMIC_REQUIRES(control_mutex_) {
     // A socket that receives every group of the host (IP_MULTICAST_ALL could not be turned off)
     // would go on receiving ours while any other program is a member: it stays a member.
     if (!member_ || !may_leave_) return;
-    if (const auto why = lcm_detail::set_group_membership(rx_fd_, *rx_url_, false)) {
-      log_.log(LogLevel::warning, prefix_ + "stays a member of the group (" + *why + ")");
+    if (const Result<void> left = lcm_detail::set_group_membership(rx_fd_, *rx_url_, false); !left) {
+      log_.log(LogLevel::warning, prefix_ + "stays a member of the group (" + left.error().text + ")");
       return;
     }
     transmit_.count_looped_back(false);  // after the leave: the count never falls short

@@ -70,7 +70,8 @@ OpenedSocket open_receive_socket(const LcmUrl& url, std::size_t buffer_bytes) {
   bind_to.sin_addr = group->sin_addr;
   if (::bind(fd, reinterpret_cast<const sockaddr*>(&bind_to), sizeof bind_to) != 0)
     return failed(std::move(out), fd, failed_call(("bind to port " + std::to_string(url.port)).c_str()));
-  if (auto why = set_group_membership(fd, url, true)) return failed(std::move(out), fd, std::move(*why));
+  if (Result<void> joined = set_group_membership(fd, url, true); !joined)
+    return failed(std::move(out), fd, std::move(joined).error().text);
   // Without this, Linux hands the socket every group any socket of the host joined on this port.
   if (set_int(fd, IPPROTO_IP, IP_MULTICAST_ALL, 0) != 0)
     out.warnings.push_back(failed_call("IP_MULTICAST_ALL"));
@@ -85,17 +86,17 @@ OpenedSocket open_receive_socket(const LcmUrl& url, std::size_t buffer_bytes) {
   return out;
 }
 
-std::optional<std::string> set_group_membership(int fd, const LcmUrl& url, bool member) {
+Result<void> set_group_membership(int fd, const LcmUrl& url, bool member) {
   const auto group = group_address(url);
-  if (!group) return "not an IPv4 multicast group: " + url.group;
+  if (!group) return Error{"not an IPv4 multicast group: " + url.group};
   ip_mreq membership{};
   membership.imr_multiaddr = group->sin_addr;
   membership.imr_interface.s_addr = htonl(INADDR_ANY);
   if (::setsockopt(fd, IPPROTO_IP, member ? IP_ADD_MEMBERSHIP : IP_DROP_MEMBERSHIP, &membership, sizeof membership) ==
       0)
-    return std::nullopt;
-  return member ? failed_call(("joining " + url.group + " (check the multicast route)").c_str())
-                : failed_call(("leaving " + url.group).c_str());
+    return {};
+  return Error::from_errno(member ? "joining " + url.group + " (check the multicast route)" : "leaving " + url.group,
+                           errno);
 }
 
 OpenedSocket open_send_socket(const LcmUrl& url) {
@@ -127,10 +128,10 @@ OpenedSocket open_send_socket(const LcmUrl& url) {
 // is accepted whole. Dropping (the default) spares the receive thread a wake-up and a read per
 // datagram sent; a dropped datagram counts in the socket's drops (SO_RXQ_OVFL) and in the host's
 // UDP InErrors, which cutting leaves alone.
-std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> own, LcmOwnDatagrams mode) {
+Result<void> drop_own_datagrams(int fd, std::span<const Endpoint> own, LcmOwnDatagrams mode) {
   constexpr std::uint32_t kSourceAddress = static_cast<std::uint32_t>(SKF_NET_OFF) + 12;
   constexpr std::uint32_t kSourcePort = 0;
-  if (own.empty() || own.size() > 16) return std::string("no endpoints to filter");
+  if (own.empty() || own.size() > 16) return Error{"no endpoints to filter"};
   std::vector<sock_filter> program;
   const std::size_t drop_at = own.size() * 4 + 1;  // the trim: after every check and the accept
   for (const Endpoint& e : own) {
@@ -144,14 +145,15 @@ std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> 
   // Cut: trim to the UDP header (queued, read, skipped). Drop: 0, never queued.
   program.push_back(BPF_STMT(BPF_RET | BPF_K, mode == LcmOwnDatagrams::drop ? 0u : 1u));
   const sock_fprog fprog{static_cast<unsigned short>(program.size()), program.data()};
-  if (::setsockopt(fd, SOL_SOCKET, SO_ATTACH_FILTER, &fprog, sizeof fprog) != 0) return failed_call("SO_ATTACH_FILTER");
-  return std::nullopt;
+  if (::setsockopt(fd, SOL_SOCKET, SO_ATTACH_FILTER, &fprog, sizeof fprog) != 0)
+    return Error::from_errno("SO_ATTACH_FILTER", errno);
+  return {};
 }
 
-std::optional<std::string> self_test(const LcmUrl& url, int fd, std::chrono::milliseconds timeout) {
+Result<void> self_test(const LcmUrl& url, int fd, std::chrono::milliseconds timeout) {
   static constexpr std::string_view kChannel = "LCM_SELF_TEST";
   OpenedSocket probe = open_send_socket(url);
-  if (probe.fd < 0) return "self test: " + probe.error;
+  if (probe.fd < 0) return Error{"self test: " + probe.error};
   // A payload no other sender's message carries: our probe socket's own source.
   std::array<std::uint8_t, 6> token{};
   const std::uint64_t key = probe.local.key();
@@ -159,8 +161,10 @@ std::optional<std::string> self_test(const LcmUrl& url, int fd, std::chrono::mil
   const std::array<std::span<const std::uint8_t>, 1> parts{std::span<const std::uint8_t>(token)};
   const SendFailure sent = send_lcm_message(probe.fd, 0, kChannel, parts);
   ::close(probe.fd);
-  if (sent.failed())
-    return std::string("self test: ") + sent.what + (sent.error ? std::string(": ") + std::strerror(sent.error) : "");
+  if (sent.failed()) {
+    return Error{std::string("self test: ") + sent.what + (sent.error ? ": " + errno_text(sent.error) : ""),
+                 sent.error};
+  }
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   ReceiveBatch batch(8);
   for (;;) {
@@ -170,16 +174,17 @@ std::optional<std::string> self_test(const LcmUrl& url, int fd, std::chrono::mil
     pollfd p{fd, POLLIN, 0};
     if (::poll(&p, 1, static_cast<int>(left.count())) <= 0) continue;
     const int n = batch.receive(fd);
-    if (n < 0) return failed_call("self test: recvmmsg");
+    if (n < 0) return Error::from_errno("self test: recvmmsg", errno);
     for (int i = 0; i < n; ++i) {
       const auto d = parse_lcm_datagram(batch.datagram(static_cast<std::size_t>(i)));
       if (d && !d->fragment && d->channel == kChannel && batch.sender(static_cast<std::size_t>(i)) == probe.local &&
           std::equal(d->data.begin(), d->data.end(), token.begin(), token.end()))
-        return std::nullopt;
+        return {};
     }
   }
-  return "self test: our own message on " + url.group + ":" + std::to_string(url.port) + " did not come back within " +
-         std::to_string(timeout.count()) + " ms (check the multicast route, multicast loopback and the firewall)";
+  return Error{"self test: our own message on " + url.group + ":" + std::to_string(url.port) +
+               " did not come back within " + std::to_string(timeout.count()) +
+               " ms (check the multicast route, multicast loopback and the firewall)"};
 }
 
 ReceiveBatch::ReceiveBatch(std::size_t slots) : slots_(slots), iovecs_(slots), headers_(slots) {

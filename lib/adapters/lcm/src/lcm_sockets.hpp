@@ -24,6 +24,7 @@
 
 #include "cosmic/lcm_udpm.hpp"
 #include "cosmic/lcm_url.hpp"
+#include "cosmic/result.hpp"
 #include "cosmic/model.hpp"
 
 namespace cosmic::lcm_detail {
@@ -60,23 +61,23 @@ OpenedSocket open_send_socket(const LcmUrl& url);
 
 // Joins (`member`) or leaves the URL's group on receive socket `fd`, on the interface the kernel
 // picks for it, as open_receive_socket() joined it. With IP_MULTICAST_ALL off, a socket that left
-// receives nothing of the group, even while other sockets of the host stay members. nullopt when
-// done; otherwise why not (joining and leaving twice fail).
-std::optional<std::string> set_group_membership(int fd, const LcmUrl& url, bool member);
+// receives nothing of the group, even while other sockets of the host stay members. An error says
+// why not (joining and leaving twice fail).
+Result<void> set_group_membership(int fd, const LcmUrl& url, bool member);
 
 // Attaches a socket filter to receive socket `fd` that, in the kernel, cuts every datagram sent
 // from one of `own` (our transmit sockets: multicast loopback hands our own datagrams back to
 // every socket of the group, ours included) down to an empty one, so none of their bytes is
 // copied, or with `mode` drop drops it before it is queued. Replaces a filter attached before.
-// nullopt when attached; otherwise why not. Either way the receive thread still tells them by
-// their source.
-std::optional<std::string> drop_own_datagrams(int fd, std::span<const Endpoint> own, LcmOwnDatagrams mode);
+// An error says why it is not attached. Either way the receive thread still tells them by their
+// source.
+Result<void> drop_own_datagrams(int fd, std::span<const Endpoint> own, LcmOwnDatagrams mode);
 
 // liblcm's start-up check, as it makes it: a message on LCM_SELF_TEST sent from a socket of its
 // own must come back to receive socket `fd` within `timeout`. Whatever else arrives meanwhile is
-// read and dropped (nothing is delivered before the segment is up). nullopt when it came back;
-// otherwise why not (no multicast loopback, a firewall, a route on another interface).
-std::optional<std::string> self_test(const LcmUrl& url, int fd, std::chrono::milliseconds timeout);
+// read and dropped (nothing is delivered before the segment is up). An error when it did not come
+// back says why not (no multicast loopback, a firewall, a route on another interface).
+Result<void> self_test(const LcmUrl& url, int fd, std::chrono::milliseconds timeout);
 
 // One recvmmsg's worth of datagrams, reused from call to call.
 class ReceiveBatch {

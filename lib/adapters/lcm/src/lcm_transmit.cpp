@@ -43,7 +43,7 @@ LcmTransmitter::LcmTransmitter(const std::string& segment_name, Logger& log, Ada
       health_(health),
       receive_failing_(receive_failing) {}
 
-std::optional<std::string> LcmTransmitter::open(const LcmUrl& url) {
+Result<void> LcmTransmitter::open(const LcmUrl& url) {
   url_ = url;
   own_drops_.store(0, std::memory_order_release);
   counting_looped_back_.store(true, std::memory_order_release);
@@ -51,17 +51,17 @@ std::optional<std::string> LcmTransmitter::open(const LcmUrl& url) {
     OpenedSocket tx = open_send_socket(url);
     if (tx.fd < 0) {
       close();
-      return "transmit socket on udpm://" + url.group + ":" + std::to_string(url.port) + ": " + tx.error;
+      return Error{"transmit socket on udpm://" + url.group + ":" + std::to_string(url.port) + ": " + tx.error};
     }
     LockGuard lock(senders_[i].mutex);
     senders_[i].fd = tx.fd;
     senders_[i].failing.store(false, std::memory_order_relaxed);
     own_keys_[i].store(tx.local.key(), std::memory_order_relaxed);
   }
-  return std::nullopt;
+  return {};
 }
 
-std::optional<std::string> LcmTransmitter::follow_with_filter(int receive_fd, LcmOwnDatagrams mode) {
+Result<void> LcmTransmitter::follow_with_filter(int receive_fd, LcmOwnDatagrams mode) {
   {
     LockGuard lock(filter_mutex_);
     receive_fd_ = receive_fd;
@@ -70,18 +70,18 @@ std::optional<std::string> LcmTransmitter::follow_with_filter(int receive_fd, Lc
   return attach_filter();
 }
 
-std::optional<std::string> LcmTransmitter::attach_filter() {
+Result<void> LcmTransmitter::attach_filter() {
   LockGuard lock(filter_mutex_);
-  if (receive_fd_ < 0) return std::nullopt;
+  if (receive_fd_ < 0) return {};
   std::array<Endpoint, 3> own{};
   std::size_t count = 0;
   for (const auto& key : own_keys_)
     if (const std::uint64_t k = key.load(std::memory_order_relaxed); k != 0) own[count++] = endpoint_of(k);
-  if (count == 0) return std::nullopt;
-  auto why = drop_own_datagrams(receive_fd_, std::span(own.data(), count), filter_mode_);
+  if (count == 0) return {};
+  Result<void> attached = drop_own_datagrams(receive_fd_, std::span(own.data(), count), filter_mode_);
   // A filter that could not follow leaves the new source's datagrams to be read and skipped.
-  filter_drops_.store(!why && filter_mode_ == LcmOwnDatagrams::drop, std::memory_order_release);
-  return why;
+  filter_drops_.store(attached.ok() && filter_mode_ == LcmOwnDatagrams::drop, std::memory_order_release);
+  return attached;
 }
 
 void LcmTransmitter::count_looped_back(bool counting) {
@@ -245,8 +245,8 @@ void LcmTransmitter::reopen(ClassSender& sender, std::size_t index, SendLog& lat
   sender.fd = tx.fd;
   own_keys_[index].store(tx.local.key(), std::memory_order_relaxed);
   later.emplace_back(LogLevel::notice, prefix_ + class_name(index) + " transmit socket reopened");
-  if (const auto why = attach_filter())
-    later.emplace_back(LogLevel::warning, prefix_ + "own datagrams read back in full (" + *why + ")");
+  if (const Result<void> attached = attach_filter(); !attached)
+    later.emplace_back(LogLevel::warning, prefix_ + "own datagrams read back in full (" + attached.error().text + ")");
 }
 
 }  // namespace cosmic::lcm_detail

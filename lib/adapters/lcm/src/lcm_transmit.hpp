@@ -43,11 +43,11 @@ class LcmTransmitter {
   LcmTransmitter(const std::string& segment_name, Logger& log, AdapterCounters& counters, HealthCell& health,
                  const std::atomic<bool>& receive_failing);
 
-  // Opens the three sockets; the reason when one fails (none is left open then).
-  std::optional<std::string> open(const LcmUrl& url);
+  // Opens the three sockets, or says why one failed (none is left open then).
+  Result<void> open(const LcmUrl& url);
   // The receive socket whose filter follows our sources (-1: none), cutting or dropping what
-  // they send (`mode`); attaches it now. The reason when the filter cannot be attached.
-  std::optional<std::string> follow_with_filter(int receive_fd, LcmOwnDatagrams mode);
+  // they send (`mode`); attaches it now, or says why the filter cannot be attached.
+  Result<void> follow_with_filter(int receive_fd, LcmOwnDatagrams mode);
   // Datagrams our transmit sockets handed the kernel since open() while the receive socket was a
   // member of the group and its filter dropped our own: each is one drop of that socket's (the
   // segment's own_datagrams_dropped; its overflow count leaves them out). Counted before each
@@ -95,7 +95,7 @@ class LcmTransmitter {
       COSMIC_REQUIRES(sender.mutex);
   void reopen(ClassSender& sender, std::size_t index, SendLog& later) COSMIC_REQUIRES(sender.mutex);
   void write(SendLog& later) noexcept;
-  std::optional<std::string> attach_filter();
+  Result<void> attach_filter();
   // Before `datagrams` leave: counted while they loop back to a filter that drops them.
   void note_sending(std::size_t datagrams);
 

@@ -8,7 +8,8 @@
 #include <optional>
 #include <string>
 #include <string_view>
-#include <variant>
+
+#include "cosmic/result.hpp"
 
 namespace cosmic {
 
@@ -26,6 +27,6 @@ struct LcmUrl {
 // LCM's default, 239.255.76.67:7667) with a multicast
 // group (224.0.0.0/4), a decimal port 1..65535, decimal option values and nothing else. Otherwise
 // the reason (one line; control characters shown as \xNN).
-std::variant<LcmUrl, std::string> parse_lcm_url(std::string_view url);
+Result<LcmUrl> parse_lcm_url(std::string_view url);
 
 }  // namespace cosmic
