@@ -13,10 +13,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   cosmic::fuzz::FuzzInput in(data, size);
   const auto c = cosmic::fuzz::read_can_format_case(in, false);
   cosmic::fuzz::fuzz_can_format(
-      in, c, [](CanBus) { return FamousoFrames(CanReassemblyBounds{4, cosmic::Nanos(1000)}); },
+      in, c,
+      [](CanBus) {
+        return FamousoFrames(CanReassemblyBounds{4, cosmic::Nanos(1000)});
+      },
       [](const CanFrameFormat& format, std::size_t max_event) {
         const std::uint32_t id = 0x1E05123 & ~cosmic::kFamousoFragmentFlag;
-        return CanTxBinding{1,    &format, id, id | cosmic::kFamousoFragmentFlag,
+        return CanTxBinding{1,    &format, id,        id | cosmic::kFamousoFragmentFlag,
                             true, 0x123,   max_event, format.fragments(max_event)};
       });
   cosmic::fuzz::FuzzInput headers(data, size);

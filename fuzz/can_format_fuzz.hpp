@@ -56,8 +56,8 @@ void fuzz_can_format(FuzzInput& in, const CanFormatCase& c, Make make, Tx tx) {
       std::optional<std::vector<std::uint8_t>> decoded;
       for (const canfd_frame& f : frames.out) {
         require(!decoded);  // only the last frame completes the event
-        const auto r = receiver.decode(rx, f.can_id, std::span<const std::uint8_t>(f.data, f.len), c.bus.fd,
-                                       Nanos(now));
+        const auto r =
+            receiver.decode(rx, f.can_id, std::span<const std::uint8_t>(f.data, f.len), c.bus.fd, Nanos(now));
         require(!r.lost && !r.displaced);
         if (r.event) decoded.emplace(r.event->begin(), r.event->end());
       }

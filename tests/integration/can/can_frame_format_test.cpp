@@ -175,8 +175,9 @@ TEST(CanFrameFormat, NoFormatCarriesAnEventsIdentity) {
   CosmicFrames cosmic(kClassic, kBounds);
   FamousoFrames famouso(kBounds);
   NativeFrames native(kClassic);
-  for (const CanFrameFormat* format : {static_cast<const CanFrameFormat*>(&cosmic), static_cast<const CanFrameFormat*>(&famouso),
-                                       static_cast<const CanFrameFormat*>(&native)}) {
+  for (const CanFrameFormat* format :
+       {static_cast<const CanFrameFormat*>(&cosmic), static_cast<const CanFrameFormat*>(&famouso),
+        static_cast<const CanFrameFormat*>(&native)}) {
     EXPECT_EQ(format->identity(), (FormatIdentity{false, false, false, false})) << format->name();
   }
 }

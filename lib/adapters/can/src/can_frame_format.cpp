@@ -108,7 +108,8 @@ void CosmicFrames::expire(Nanos now, const std::function<void(std::uint32_t)>& d
 
 // ------------------------------------------------------------------------------ FAMOUSO
 
-FamousoFrames::FamousoFrames(CanReassemblyBounds bounds) : afp_(famouso::AfpLimits{bounds.max_partials, bounds.timeout}) {}
+FamousoFrames::FamousoFrames(CanReassemblyBounds bounds)
+    : afp_(famouso::AfpLimits{bounds.max_partials, bounds.timeout}) {}
 
 // Admission counts a FAMOUSO event's frames as section 6 does (at least AFP's), so the same bound.
 Result<void> FamousoFrames::check_payload(std::uint64_t payload) const {
@@ -171,8 +172,8 @@ bool NativeFrames::encode(const CanTxBinding& binding, std::span<const std::uint
   return sink.take(std::span(&frame, 1));
 }
 
-CanDecoded NativeFrames::decode(const CanRxBinding& binding, canid_t, std::span<const std::uint8_t> data,
-                                bool fd_frame, Nanos) {
+CanDecoded NativeFrames::decode(const CanRxBinding& binding, canid_t, std::span<const std::uint8_t> data, bool fd_frame,
+                                Nanos) {
   const auto contents =
       can_native::contents(can_native::RxChannel{binding.id, binding.subject, binding.payload}, data, fd_frame);
   if (!contents) return CanDecoded{std::nullopt, true, std::nullopt};
