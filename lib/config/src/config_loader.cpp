@@ -16,6 +16,7 @@
 #include "background_loader.hpp"
 #include "components_loader.hpp"
 #include "native_loader.hpp"
+#include "type_loader.hpp"
 #include "federation_loader.hpp"
 #include "realtime_loader.hpp"
 #include "folded_names.hpp"
@@ -426,9 +427,10 @@ class ConfigParser {
   }
 
   std::optional<ChannelSpec> parse_channel(const YAML::Node& node, const std::string& path) {
-    if (!reader_.check_map(node, path,
-                           {"name", "subject", "class", "period", "max_rate", "reaction_time", "omission_degree",
-                            "temp_validity", "payload", "etag", "encoding", "publishers", "subscribers", "native"})) {
+    if (!reader_.check_map(
+            node, path,
+            {"name", "subject", "class", "period", "max_rate", "reaction_time", "omission_degree", "temp_validity",
+             "payload", "etag", "encoding", "publishers", "subscribers", "native", "type"})) {
       return std::nullopt;
     }
     const std::size_t errors_before = reader_.error_count();
@@ -456,6 +458,7 @@ class ConfigParser {
       c.lcm_encoding = static_cast<LcmEncoding>(
           reader_.choice(node["encoding"], key(path, "encoding"), {"envelope", "raw"}).value_or(0));
     }
+    if (node["type"]) c.type = config_detail::parse_channel_type(reader_, node["type"], key(path, "type"));
     parse_bindings(node, path, c);
     if (node["native"]) {
       config_detail::parse_native(reader_, node["native"], key(path, "native"), config_, c);

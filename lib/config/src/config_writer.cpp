@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "cosmic/config_loader.hpp"
+#include "type_loader.hpp"
 
 namespace cosmic {
 namespace {
@@ -46,6 +47,7 @@ std::string channel_to_yaml(const ChannelSpec& channel) {
     }
     out << YAML::EndMap;
   }
+  if (channel.type) out << YAML::Key << "type" << YAML::Value << config_detail::channel_type_to_yaml(*channel.type);
   out << YAML::EndMap;
   return out.c_str();
 }

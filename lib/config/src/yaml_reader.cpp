@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <set>
@@ -334,6 +335,35 @@ std::optional<double> YamlReader::percent(const YAML::Node& node, const std::str
   const auto text = scalar(node, path, "a percentage such as 70%");
   if (!text) return std::nullopt;
   return report(*this, node, path, parse_percent(*text), "a percentage from 0% to 100%");
+}
+
+std::optional<std::int64_t> YamlReader::signed_int(const YAML::Node& node, const std::string& path) {
+  const char* expected = "a whole number, e.g. -3 or 42";
+  const auto value = scalar(node, path, expected);
+  if (!value) return std::nullopt;
+  std::int64_t parsed = 0;
+  const auto [end, ec] = std::from_chars(value->data(), value->data() + value->size(), parsed);
+  if (ec != std::errc() || end != value->data() + value->size()) {
+    error_at(
+        node, path,
+        quote_value(*value) + (ec == std::errc::result_out_of_range ? " is out of range" : " is not a whole number"),
+        expected);
+    return std::nullopt;
+  }
+  return parsed;
+}
+
+std::optional<double> YamlReader::number(const YAML::Node& node, const std::string& path) {
+  const char* expected = "a decimal number, e.g. 0, -0.5 or 1e3";
+  const auto value = scalar(node, path, expected);
+  if (!value) return std::nullopt;
+  double parsed = 0;
+  const auto [end, ec] = std::from_chars(value->data(), value->data() + value->size(), parsed);
+  if (ec != std::errc() || end != value->data() + value->size() || !std::isfinite(parsed)) {
+    error_at(node, path, quote_value(*value) + " is not a finite decimal number", expected);
+    return std::nullopt;
+  }
+  return parsed;
 }
 
 std::optional<double> YamlReader::frequency(const YAML::Node& node, const std::string& path) {

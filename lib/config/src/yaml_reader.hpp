@@ -53,6 +53,10 @@ class YamlReader {
   std::optional<bool> boolean(const YAML::Node& node, const std::string& path);
   std::optional<std::uint64_t> unsigned_int(const YAML::Node& node, const std::string& path, std::uint64_t min,
                                             std::uint64_t max);
+  // A whole number that may be negative (decimal).
+  std::optional<std::int64_t> signed_int(const YAML::Node& node, const std::string& path);
+  // A finite decimal number: 12, -0.5, 1e-3.
+  std::optional<double> number(const YAML::Node& node, const std::string& path);
   std::optional<Nanos> duration(const YAML::Node& node, const std::string& path, bool allow_zero);
   std::optional<BitRate> bitrate(const YAML::Node& node, const std::string& path);
   std::optional<std::uint64_t> size(const YAML::Node& node, const std::string& path, std::uint64_t max);

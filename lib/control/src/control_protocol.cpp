@@ -277,6 +277,8 @@ Json ControlProtocol::channel_entry(const ChannelReport& verdict, const ChannelS
     char subject[24];
     std::snprintf(subject, sizeof subject, "0x%016llx", static_cast<unsigned long long>(spec->subject));
     entry["subject"] = subject;
+    // The contents' type (cosmic/channel_type.hpp) as text; null: opaque bytes.
+    entry["type"] = spec->type ? Json(describe(*spec->type)) : Json(nullptr);
   }
   if (const auto etag = gateway_.knowledge_base().etag_of(verdict.name)) entry["etag"] = *etag;
   entry["mismatches"] = Json::array();

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "cosmic/channel_type.hpp"
 #include "cosmic/units.hpp"
 
 namespace cosmic {
@@ -157,6 +158,7 @@ struct ChannelSpec {
   std::vector<std::string> publishers;   // P segments
   std::vector<std::string> subscribers;  // S segments
   std::vector<NativeBinding> native;     // at most one per segment, each one of publishers/subscribers
+  std::optional<ChannelType> type;       // the contents' fields (cosmic/channel_type.hpp); none: opaque bytes
   friend bool operator==(const ChannelSpec&, const ChannelSpec&) = default;
 
   const NativeBinding* native_on(const std::string& segment) const;

@@ -1,0 +1,299 @@
+#include "type_loader.hpp"
+
+#include <array>
+#include <charconv>
+#include <map>
+
+namespace cosmic::config_detail {
+namespace {
+
+constexpr const char* kTypeWords =
+    "bool, int8, int16, int32, int64, uint8, uint16, uint32, uint64, float32, float64, enum, string, array, sequence, "
+    "record";
+
+// The keys a field's (or an element's) type may have, beside `type`, by kind.
+const char* keys_of(FieldType::Kind kind) {
+  switch (kind) {
+    case FieldType::Kind::scalar:
+      return "";
+    case FieldType::Kind::enumeration:
+      return "values, underlying";
+    case FieldType::Kind::string:
+      return "max_length";
+    case FieldType::Kind::array:
+      return "length, element";
+    case FieldType::Kind::sequence:
+      return "max_length, element";
+    case FieldType::Kind::record:
+      return "fields";
+  }
+  return "";
+}
+
+std::string number_text(double value) {
+  std::array<char, 32> buffer{};
+  const auto [end, error] = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
+  return error == std::errc() ? std::string(buffer.data(), end) : std::string("0");
+}
+
+class TypeLoader {
+ public:
+  explicit TypeLoader(YamlReader& reader) : reader_(reader) {}
+
+  std::optional<ChannelType> parse(const YAML::Node& node, const std::string& path) {
+    if (!reader_.check_map(node, path, {"fields"})) return std::nullopt;
+    const std::size_t errors_before = reader_.error_count();
+    ChannelType type;
+    if (!has(node, "fields")) {
+      reader_.error_at(node, path, "a type needs its fields", "fields: [{name: NAME, type: float64}, ...]");
+      return std::nullopt;
+    }
+    type.fields = fields(node["fields"], key(path, "fields"), "", 0);
+    if (reader_.error_count() != errors_before) return std::nullopt;
+    // What only the whole type shows (names twice, ranges against kinds, sizes), at its place.
+    for (const TypeProblem& p : check_type(type)) {
+      const auto at = places_.find(p.where);
+      const auto& [place, place_path] = at != places_.end() ? at->second : std::pair{node, path};
+      reader_.error_at(place, place_path, p.what);
+    }
+    if (reader_.error_count() != errors_before) return std::nullopt;
+    return type;
+  }
+
+ private:
+  std::vector<TypeField> fields(const YAML::Node& list, const std::string& path, const std::string& where,
+                                std::size_t depth) {
+    std::vector<TypeField> out;
+    if (!reader_.is_list(list, path)) return out;
+    if (depth >= kMaxTypeDepth) {
+      reader_.error_at(list, path, "nested more than " + std::to_string(kMaxTypeDepth) + " levels deep");
+      return out;
+    }
+    if (list.size() > kMaxRecordFields) {
+      reader_.error_at(list, path,
+                       std::to_string(list.size()) + " fields, at most " + std::to_string(kMaxRecordFields));
+      return out;
+    }
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      if (auto f = field(list[i], indexed(path, i), where, i, depth)) out.push_back(std::move(*f));
+    }
+    return out;
+  }
+
+  // Field `index` of the record at `where` (check_type()'s names for places: "pose.x", or
+  // "pose.fields[1]" where a name does not tell the field apart).
+  std::optional<TypeField> field(const YAML::Node& node, const std::string& path, const std::string& where,
+                                 std::size_t index, std::size_t depth) {
+    if (!reader_.check_map(node, path,
+                           {"name", "type", "unit", "min", "max", "values", "underlying", "max_length", "length",
+                            "element", "fields"})) {
+      return std::nullopt;
+    }
+    TypeField f;
+    if (!has(node, "name")) {
+      reader_.error_at(node, path, "a field needs a name", "name: [A-Za-z][A-Za-z0-9_]*");
+    } else if (auto name = reader_.string(node["name"], key(path, "name"))) {
+      f.name = *name;
+      if (!valid_field_name(f.name)) {
+        reader_.error_at(node["name"], key(path, "name"), "field name '" + f.name + "' is not valid",
+                         "[A-Za-z][A-Za-z0-9_]*, at most 64 characters");
+      }
+    }
+    const std::string prefix = where.empty() ? "" : where + ".";
+    const std::string here = prefix + f.name;
+    places_.emplace(here, std::pair{node, path});
+    places_.emplace(prefix + "fields[" + std::to_string(index) + "]", std::pair{node, path});
+    if (auto type = field_type(node, path, here, depth)) f.type = std::move(*type);
+    if (has(node, "unit")) f.unit = reader_.string(node["unit"], key(path, "unit")).value_or("");
+    if (has(node, "min")) f.minimum = reader_.number(node["min"], key(path, "min"));
+    if (has(node, "max")) f.maximum = reader_.number(node["max"], key(path, "max"));
+    return f;
+  }
+
+  // The type of a field or an element: `node` holds `type` and the kind's keys.
+  std::optional<FieldType> field_type(const YAML::Node& node, const std::string& path, const std::string& where,
+                                      std::size_t depth) {
+    if (!has(node, "type")) {
+      reader_.error_at(node, path, "no type", std::string("type: one of ") + kTypeWords);
+      return std::nullopt;
+    }
+    const auto word = reader_.string(node["type"], key(path, "type"));
+    if (!word) return std::nullopt;
+    FieldType t;
+    if (const auto scalar = scalar_kind(*word)) {
+      t.scalar = *scalar;
+    } else if (*word == "enum") {
+      t.kind = FieldType::Kind::enumeration;
+    } else if (*word == "string") {
+      t.kind = FieldType::Kind::string;
+    } else if (*word == "array") {
+      t.kind = FieldType::Kind::array;
+    } else if (*word == "sequence") {
+      t.kind = FieldType::Kind::sequence;
+    } else if (*word == "record") {
+      t.kind = FieldType::Kind::record;
+    } else {
+      reader_.error_at(node["type"], key(path, "type"), "unknown type '" + *word + "'",
+                       std::string("one of ") + kTypeWords);
+      return std::nullopt;
+    }
+    refuse_foreign_keys(node, path, t.kind);
+    switch (t.kind) {
+      case FieldType::Kind::scalar:
+        break;
+      case FieldType::Kind::enumeration:
+        enumeration(node, path, t);
+        break;
+      case FieldType::Kind::string:
+        t.bound = bound(node, path, "max_length");
+        break;
+      case FieldType::Kind::array:
+      case FieldType::Kind::sequence:
+        t.bound = bound(node, path, t.kind == FieldType::Kind::array ? "length" : "max_length");
+        if (auto e = element(node, path, where, depth)) t.element.push_back(std::move(*e));
+        break;
+      case FieldType::Kind::record:
+        if (!has(node, "fields")) {
+          reader_.error_at(node, path, "a record needs its fields", "fields: [{name: NAME, type: float64}, ...]");
+        } else {
+          t.fields = fields(node["fields"], key(path, "fields"), where, depth + 1);
+        }
+        break;
+    }
+    return t;
+  }
+
+  void refuse_foreign_keys(const YAML::Node& node, const std::string& path, FieldType::Kind kind) {
+    // Whole words: "length" is inside "max_length".
+    const std::string allowed = std::string(", ") + keys_of(kind) + ",";
+    for (const char* k : {"values", "underlying", "max_length", "length", "element", "fields"}) {
+      if (!node[k] || allowed.find(std::string(", ") + k + ",") != std::string::npos) continue;
+      reader_.error_at(node[k], key(path, k), std::string(k) + " does not belong to this type",
+                       *keys_of(kind) ? std::string("for it: ") + keys_of(kind) : std::string("nothing more for it"));
+    }
+  }
+
+  std::uint32_t bound(const YAML::Node& node, const std::string& path, const char* name) {
+    if (!has(node, name)) {
+      reader_.error_at(node, path, std::string("needs ") + name,
+                       std::string(name) + ": 1.." + std::to_string(kMaxTypeBound));
+      return 0;
+    }
+    return static_cast<std::uint32_t>(reader_.unsigned_int(node[name], key(path, name), 1, kMaxTypeBound).value_or(0));
+  }
+
+  void enumeration(const YAML::Node& node, const std::string& path, FieldType& t) {
+    t.scalar = ScalarKind::int32;
+    if (has(node, "underlying")) {
+      const auto word = reader_.string(node["underlying"], key(path, "underlying"));
+      const auto kind = word ? scalar_kind(*word) : std::nullopt;
+      if (word && (!kind || !is_integer(*kind))) {
+        reader_.error_at(node["underlying"], key(path, "underlying"), "'" + *word + "' is not an integer type",
+                         "int8, int16, int32, int64, uint8, uint16, uint32 or uint64");
+      } else if (kind) {
+        t.scalar = *kind;
+      }
+    }
+    const YAML::Node values = node["values"];
+    if (!values || !values.IsMap() || values.size() == 0) {
+      reader_.error_at(values ? values : node, key(path, "values"), "an enumeration needs its named values",
+                       "values: {NAME: 0, OTHER: 1}");
+      return;
+    }
+    for (const auto& entry : values) {
+      const std::string name = entry.first.IsScalar() ? entry.first.Scalar() : std::string();
+      const std::string at = key(key(path, "values"), name);
+      if (auto v = reader_.signed_int(entry.second, at)) t.values.push_back(EnumValue{name, *v});
+    }
+  }
+
+  std::optional<FieldType> element(const YAML::Node& node, const std::string& path, const std::string& where,
+                                   std::size_t depth) {
+    if (!has(node, "element")) {
+      reader_.error_at(node, path, "needs its element type", "element: float64, or element: {type: record, ...}");
+      return std::nullopt;
+    }
+    const YAML::Node e = node["element"];
+    const std::string at = key(path, "element");
+    places_.emplace(where + ".element", std::pair{e, at});
+    if (e.IsScalar()) {  // a scalar's name alone
+      const auto kind = scalar_kind(e.Scalar());
+      if (!kind) {
+        reader_.error_at(e, at, "'" + e.Scalar() + "' is not a scalar type",
+                         "a scalar's name, or a map: {type: record, fields: [...]}");
+        return std::nullopt;
+      }
+      FieldType t;
+      t.scalar = *kind;
+      return t;
+    }
+    if (!reader_.check_map(e, at, {"type", "values", "underlying", "max_length", "length", "element", "fields"}))
+      return std::nullopt;
+    return field_type(e, at, where + ".element", depth + 1);
+  }
+
+  YamlReader& reader_;
+  std::map<std::string, std::pair<YAML::Node, std::string>> places_;  // check_type's "where" -> node, key path
+};
+
+void emit_fields(YAML::Node& list, const std::vector<TypeField>& fields);
+
+YAML::Node type_to_yaml(const FieldType& t) {
+  YAML::Node out;
+  switch (t.kind) {
+    case FieldType::Kind::scalar:
+      out["type"] = std::string(scalar_name(t.scalar));
+      break;
+    case FieldType::Kind::enumeration:
+      out["type"] = "enum";
+      out["underlying"] = std::string(scalar_name(t.scalar));
+      for (const EnumValue& v : t.values) out["values"][v.name] = v.value;
+      break;
+    case FieldType::Kind::string:
+      out["type"] = "string";
+      out["max_length"] = t.bound;
+      break;
+    case FieldType::Kind::array:
+    case FieldType::Kind::sequence:
+      out["type"] = t.kind == FieldType::Kind::array ? "array" : "sequence";
+      out[t.kind == FieldType::Kind::array ? "length" : "max_length"] = t.bound;
+      if (!t.element.empty()) out["element"] = type_to_yaml(t.element[0]);
+      break;
+    case FieldType::Kind::record: {
+      YAML::Node list(YAML::NodeType::Sequence);
+      emit_fields(list, t.fields);
+      out["type"] = "record";
+      out["fields"] = list;
+      break;
+    }
+  }
+  return out;
+}
+
+void emit_fields(YAML::Node& list, const std::vector<TypeField>& fields) {
+  for (const TypeField& f : fields) {
+    YAML::Node entry = type_to_yaml(f.type);
+    entry["name"] = f.name;
+    if (!f.unit.empty()) entry["unit"] = f.unit;
+    // The shortest text that reads back as the same double.
+    if (f.minimum) entry["min"] = number_text(*f.minimum);
+    if (f.maximum) entry["max"] = number_text(*f.maximum);
+    list.push_back(entry);
+  }
+}
+
+}  // namespace
+
+std::optional<ChannelType> parse_channel_type(YamlReader& reader, const YAML::Node& node, const std::string& path) {
+  return TypeLoader(reader).parse(node, path);
+}
+
+YAML::Node channel_type_to_yaml(const ChannelType& type) {
+  YAML::Node list(YAML::NodeType::Sequence);
+  emit_fields(list, type.fields);
+  YAML::Node out;
+  out["fields"] = list;
+  return out;
+}
+
+}  // namespace cosmic::config_detail

@@ -1,0 +1,106 @@
+// The type of a channel's contents (issue 35; the paper's Fig. 7, "Contents"): a record of named
+// fields, each a scalar (bool, signed and unsigned integers of 8 to 64 bits, float32, float64),
+// an enumeration with named values, a bounded string, a fixed array, a bounded sequence or a nested
+// record. A numeric field may carry a unit and a range. Each network's representation of the
+// channel (a DBC frame, an IDL struct in CDR, an LCM type, JSON) is written against this type.
+//
+// Plain values without I/O: the configuration builds them (inline YAML; the type files of DBC, IDL,
+// ROS 2 .msg and LCM come next) and checks them with check_type(); any thread may read them.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace cosmic {
+
+enum class ScalarKind : std::uint8_t {
+  boolean,
+  int8,
+  int16,
+  int32,
+  int64,
+  uint8,
+  uint16,
+  uint32,
+  uint64,
+  float32,
+  float64,
+};
+
+// The YAML and text spelling: "bool", "int8", ..., "float64".
+std::string_view scalar_name(ScalarKind kind);
+std::optional<ScalarKind> scalar_kind(std::string_view name);
+bool is_integer(ScalarKind kind);
+bool is_signed_integer(ScalarKind kind);
+// The values the kind holds: [lowest, highest] (bool: 0..1; floats: their finite range).
+std::pair<double, double> scalar_limits(ScalarKind kind);
+
+struct EnumValue {
+  std::string name;
+  std::int64_t value = 0;
+  friend bool operator==(const EnumValue&, const EnumValue&) = default;
+};
+
+struct TypeField;
+
+struct FieldType {
+  enum class Kind : std::uint8_t { scalar, enumeration, string, array, sequence, record };
+  Kind kind = Kind::scalar;
+  ScalarKind scalar = ScalarKind::float64;  // scalar; an enumeration's underlying integer
+  std::vector<EnumValue> values;            // enumeration: its named values, as declared
+  std::uint32_t bound = 0;                  // string: most bytes; array: its length; sequence: most elements
+  std::vector<FieldType> element;           // array and sequence: exactly one, the element's type
+  std::vector<TypeField> fields;            // record: its fields, in order
+  friend bool operator==(const FieldType&, const FieldType&) = default;
+};
+
+struct TypeField {
+  std::string name;
+  FieldType type;
+  std::string unit;               // a numeric field's (or numeric elements') unit, e.g. "m/s"; empty: none
+  std::optional<double> minimum;  // a numeric field's declared range, within its kind's limits
+  std::optional<double> maximum;
+  friend bool operator==(const TypeField&, const TypeField&) = default;
+};
+
+struct ChannelType {
+  std::vector<TypeField> fields;
+  friend bool operator==(const ChannelType&, const ChannelType&) = default;
+};
+
+// Bounds a type stays within, so a hostile or mistaken file cannot make a type that costs without
+// limit to check, convert or show.
+inline constexpr std::size_t kMaxTypeDepth = 8;                // records and element types nested
+inline constexpr std::size_t kMaxRecordFields = 256;           // fields of one record
+inline constexpr std::uint32_t kMaxTypeBound = 65'536;         // array length, sequence and string bounds
+inline constexpr std::size_t kMaxEnumValues = 1024;            // named values of one enumeration
+inline constexpr std::uint64_t kMaxFlattenedScalars = 65'536;  // scalars of the largest value, arrays expanded
+
+// A field's name, as DDS, ROS 2 and LCM accept it: [A-Za-z][A-Za-z0-9_]*, at most 64 characters.
+bool valid_field_name(std::string_view name);
+
+// What is wrong with a type, one problem per entry, each naming where ("fields[2].element",
+// "pose.x"); empty when the type is sound: names valid and unique per record, enumerations with
+// unique names and values their underlying integer holds, bounds and arrays at least 1 and at most
+// kMaxTypeBound, element types present exactly where needed, units and ranges only on numeric
+// fields, ranges within their kind and not reversed, nesting and size within the bounds above.
+struct TypeProblem {
+  std::string where;
+  std::string what;
+  friend bool operator==(const TypeProblem&, const TypeProblem&) = default;
+};
+std::vector<TypeProblem> check_type(const ChannelType& type);
+
+// Whether the type (or its elements) is a number: an integer, a float, or bool.
+bool is_numeric(const FieldType& type);
+
+// How `cosmicctl channel` and errors show a type: "float64", "uint8[4]", "sequence<int32, 10>",
+// "string<=32>", "enum int32 {OFF=0, ON=1}", "{x: float64, y: float64}".
+std::string describe(const FieldType& type);
+std::string describe(const ChannelType& type);
+
+}  // namespace cosmic

@@ -1,0 +1,225 @@
+// A channel's type (issue 35 item 1): the model's checks and text (cosmic/channel_type.hpp) and the
+// inline `type:` of the YAML: every kind read, every problem located, written back unchanged.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "cosmic/channel_type.hpp"
+#include "cosmic/config_loader.hpp"
+
+namespace cosmic {
+namespace {
+
+FieldType scalar(ScalarKind kind) {
+  FieldType t;
+  t.scalar = kind;
+  return t;
+}
+
+TypeField field(std::string name, FieldType type) { return TypeField{std::move(name), std::move(type), "", {}, {}}; }
+
+std::string problems_text(const std::vector<TypeProblem>& problems) {
+  std::string out;
+  for (const auto& p : problems) out += p.where + ": " + p.what + "\n";
+  return out;
+}
+
+TEST(ChannelType, ScalarNamesAndLimits) {
+  EXPECT_EQ(scalar_kind("uint16"), ScalarKind::uint16);
+  EXPECT_EQ(scalar_kind("float"), std::nullopt);
+  EXPECT_EQ(scalar_name(ScalarKind::boolean), "bool");
+  EXPECT_EQ(scalar_limits(ScalarKind::int8), std::make_pair(-128.0, 127.0));
+  EXPECT_TRUE(is_integer(ScalarKind::uint64));
+  EXPECT_FALSE(is_integer(ScalarKind::float32));
+  EXPECT_TRUE(is_signed_integer(ScalarKind::int16));
+  EXPECT_FALSE(is_signed_integer(ScalarKind::uint16));
+}
+
+TEST(ChannelType, ASoundTypeHasNoProblemAndDescribesItself) {
+  ChannelType type;
+  TypeField distance = field("distance", scalar(ScalarKind::float32));
+  distance.unit = "m";
+  distance.minimum = 0;
+  distance.maximum = 40.5;
+  FieldType state;
+  state.kind = FieldType::Kind::enumeration;
+  state.scalar = ScalarKind::uint8;
+  state.values = {{"OFF", 0}, {"ON", 1}};
+  FieldType ranges;
+  ranges.kind = FieldType::Kind::array;
+  ranges.bound = 4;
+  ranges.element = {scalar(ScalarKind::uint8)};
+  FieldType track;
+  track.kind = FieldType::Kind::sequence;
+  track.bound = 10;
+  FieldType point;
+  point.kind = FieldType::Kind::record;
+  point.fields = {field("x", scalar(ScalarKind::float64)), field("y", scalar(ScalarKind::float64))};
+  track.element = {point};
+  FieldType label;
+  label.kind = FieldType::Kind::string;
+  label.bound = 32;
+  type.fields = {distance, field("state", state), field("ranges", ranges), field("track", track),
+                 field("label", label)};
+  EXPECT_EQ(check_type(type), std::vector<TypeProblem>{});
+  EXPECT_EQ(describe(type),
+            "{distance: float32 [m, 0..40.5], state: enum uint8 {OFF=0, ON=1}, ranges: uint8[4], "
+            "track: sequence<{x: float64, y: float64}, 10>, label: string<=32>}");
+}
+
+TEST(ChannelType, EveryProblemIsNamedWithWhereItIs) {
+  ChannelType type;
+  TypeField reversed = field("speed", scalar(ScalarKind::int8));
+  reversed.minimum = 10;
+  reversed.maximum = -10;
+  TypeField too_wide = field("count", scalar(ScalarKind::uint8));
+  too_wide.maximum = 300;
+  FieldType mode;
+  mode.kind = FieldType::Kind::enumeration;
+  mode.scalar = ScalarKind::uint8;
+  mode.values = {{"A", 1}, {"B", 1}, {"C", 256}};
+  TypeField unit_on_text = field("name", FieldType{FieldType::Kind::string, ScalarKind::float64, {}, 8, {}, {}});
+  unit_on_text.unit = "m";
+  FieldType inner;
+  inner.kind = FieldType::Kind::record;
+  inner.fields = {field("x", scalar(ScalarKind::float64)), field("x", scalar(ScalarKind::float64))};
+  type.fields = {reversed,
+                 too_wide,
+                 field("mode", mode),
+                 unit_on_text,
+                 field("pose", inner),
+                 field("9lives", scalar(ScalarKind::boolean))};
+  const std::string text = problems_text(check_type(type));
+  EXPECT_NE(text.find("speed: min 10 is above max -10"), std::string::npos) << text;
+  EXPECT_NE(text.find("count: max 300 is outside what uint8 holds (0..255)"), std::string::npos) << text;
+  EXPECT_NE(text.find("mode: value 1 named twice"), std::string::npos) << text;
+  EXPECT_NE(text.find("mode: value C = 256 does not fit uint8"), std::string::npos) << text;
+  EXPECT_NE(text.find("name: a unit and a range belong to numeric fields only"), std::string::npos) << text;
+  EXPECT_NE(text.find("pose.fields[1]: field 'x' defined twice"), std::string::npos) << text;
+  EXPECT_NE(text.find("field name '9lives' is not"), std::string::npos) << text;
+}
+
+TEST(ChannelType, NestingAndSizeAreBounded) {
+  FieldType deep = scalar(ScalarKind::uint8);
+  for (std::size_t i = 0; i < kMaxTypeDepth + 1; ++i) {
+    FieldType record;
+    record.kind = FieldType::Kind::record;
+    record.fields = {field("inner", deep)};
+    deep = record;
+  }
+  ChannelType nested{{field("outer", deep)}};
+  EXPECT_NE(problems_text(check_type(nested)).find("nested more than 8 levels deep"), std::string::npos);
+
+  FieldType big;
+  big.kind = FieldType::Kind::array;
+  big.bound = kMaxTypeBound;
+  FieldType row;
+  row.kind = FieldType::Kind::array;
+  row.bound = 2;
+  row.element = {scalar(ScalarKind::uint8)};
+  big.element = {row};
+  ChannelType huge{{field("grid", big)}};
+  EXPECT_NE(problems_text(check_type(huge)).find("more than 65536 scalars"), std::string::npos)
+      << problems_text(check_type(huge));
+}
+
+// ------------------------------------------------------------------------------ YAML
+
+constexpr const char* kHead =
+    "gateway: {name: gw, can_node_id: 1}\n"
+    "segments:\n"
+    "  - {name: lan, type: dds, domain: 0}\n"
+    "  - {name: viz, type: lcm, url: \"udpm://239.255.76.67:7667?ttl=0\"}\n"
+    "channels:\n"
+    "  - name: scan\n"
+    "    subject: 0x10\n"
+    "    class: nrt\n"
+    "    payload: 1KiB\n"
+    "    publishers: [lan]\n"
+    "    subscribers: [viz]\n";
+
+std::string listed_errors(const std::vector<ConfigError>& errors) {
+  std::string out;
+  for (const auto& e : errors) out += e.to_string() + "\n";
+  return out;
+}
+
+TEST(ChannelTypeYaml, EveryKindIsReadAndWrittenBackUnchanged) {
+  const std::string text =
+      std::string(kHead) +
+      "    type:\n"
+      "      fields:\n"
+      "        - {name: distance, type: float32, unit: m, min: 0, max: 40.25}\n"
+      "        - {name: state, type: enum, underlying: uint8, values: {OFF: 0, ON: 1, FAULT: 7}}\n"
+      "        - {name: label, type: string, max_length: 32}\n"
+      "        - {name: ranges, type: array, length: 16, element: float32, unit: m, min: -1e3}\n"
+      "        - name: track\n"
+      "          type: sequence\n"
+      "          max_length: 100\n"
+      "          element: {type: record, fields: [{name: x, type: float64}, {name: y, type: int64}]}\n"
+      "        - {name: pose, type: record, fields: [{name: yaw, type: float64, unit: rad}]}\n"
+      "        - {name: ok, type: bool}\n";
+  const ConfigResult r = parse_config(text, "typed.yaml");
+  ASSERT_TRUE(r.ok()) << listed_errors(r.errors);
+  const ChannelSpec& scan = r.config.channels.at(0);
+  ASSERT_TRUE(scan.type.has_value());
+  EXPECT_EQ(describe(*scan.type),
+            "{distance: float32 [m, 0..40.25], state: enum uint8 {OFF=0, ON=1, FAULT=7}, label: string<=32>, "
+            "ranges: float32[16] [m, -1000..], track: sequence<{x: float64, y: int64}, 100>, "
+            "pose: {yaw: float64 [rad]}, ok: bool}");
+  // What bind and the state file write reads back equal.
+  const ChannelsResult again = parse_channels("[" + channel_to_yaml(scan) + "]", "bind", r.config);
+  ASSERT_TRUE(again.ok()) << listed_errors(again.errors) << channel_to_yaml(scan);
+  ASSERT_EQ(again.channels.size(), 1u);
+  EXPECT_EQ(again.channels[0], scan) << channel_to_yaml(scan);
+}
+
+TEST(ChannelTypeYaml, AChannelWithoutATypeHasNone) {
+  const ConfigResult r = parse_config(kHead, "untyped.yaml");
+  ASSERT_TRUE(r.ok()) << listed_errors(r.errors);
+  EXPECT_FALSE(r.config.channels.at(0).type.has_value());
+}
+
+TEST(ChannelTypeYaml, EveryProblemIsLocatedAtOnce) {
+  const std::string text = std::string(kHead) +
+                           "    type:\n"
+                           "      fields:\n"
+                           "        - {name: a, type: float16}\n"                              // line 14
+                           "        - {name: b, type: uint8, max: 256}\n"                      // line 15
+                           "        - {name: c, type: string}\n"                               // line 16
+                           "        - {name: d, type: array, max_length: 3, element: int8}\n"  // line 17
+                           "        - {name: b, type: bool}\n"                                 // line 18
+                           "        - {type: int8}\n"                                          // line 19
+                           "        - {name: e, type: enum, values: {X: 1.5}}\n";              // line 20
+  const ConfigResult r = parse_config(text, "bad.yaml");
+  ASSERT_FALSE(r.ok());
+  const std::string errors = listed_errors(r.errors);
+  EXPECT_NE(errors.find("bad.yaml:14:27: channels[0].type.fields[0].type: unknown type 'float16'"), std::string::npos)
+      << errors;
+  EXPECT_NE(errors.find("bad.yaml:16:11: channels[0].type.fields[2]: needs max_length"), std::string::npos) << errors;
+  EXPECT_NE(
+      errors.find("bad.yaml:17:46: channels[0].type.fields[3].max_length: max_length does not belong to this type"),
+      std::string::npos)
+      << errors;
+  EXPECT_NE(errors.find("bad.yaml:17:11: channels[0].type.fields[3]: needs length"), std::string::npos) << errors;
+  EXPECT_NE(errors.find("bad.yaml:19:11: channels[0].type.fields[5]: a field needs a name"), std::string::npos)
+      << errors;
+  EXPECT_NE(errors.find("channels[0].type.fields[6].values.X: '1.5' is not a whole number"), std::string::npos)
+      << errors;
+  // Found by the whole-type check once each field reads: only when nothing else is wrong.
+  const std::string fixed = std::string(kHead) +
+                            "    type:\n"
+                            "      fields:\n"
+                            "        - {name: b, type: uint8, max: 256}\n"  // line 14
+                            "        - {name: b, type: bool}\n";            // line 15
+  const ConfigResult r2 = parse_config(fixed, "bad.yaml");
+  const std::string errors2 = listed_errors(r2.errors);
+  EXPECT_NE(errors2.find("bad.yaml:14:11: channels[0].type.fields[0]: max 256 is outside what uint8 holds (0..255)"),
+            std::string::npos)
+      << errors2;
+  EXPECT_NE(errors2.find("bad.yaml:15:11: channels[0].type.fields[1]: field 'b' defined twice"), std::string::npos)
+      << errors2;
+}
+
+}  // namespace
+}  // namespace cosmic
