@@ -162,7 +162,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
 
   for (const auto& component : loaded.config.components) {
-    if (cosmicctl::identifier_collision(loaded.config, component)) continue;
+    if (!cosmicctl::check_identifiers(loaded.config, component).ok()) continue;
     const auto skeleton = cosmicctl::generate_skeleton(loaded.config, component, path, "/usr/lib/cmake/cosmic_client");
     const auto plain =
         cosmicctl::generate_skeleton(loaded.config, component, "model.yaml", "/usr/lib/cmake/cosmic_client");

@@ -250,6 +250,8 @@ void print_runtime(const Json& c) {
 void print_channel(const Json& r) {
   const Json& c = r["channel"];
   print_channels(Json{{"channels", Json::array({c})}});
+  // The contents' fields (a channel without a type carries opaque bytes).
+  if (c.contains("type") && c["type"].is_string()) std::cout << "\ncontents: " << text(c["type"]) << "\n";
   print_runtime(c);
   std::cout << "\nadmission:\n";
   // A channel whose events come through other gateways (federation): their hops first.

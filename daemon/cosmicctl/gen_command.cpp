@@ -68,8 +68,8 @@ int run_gen(const GenOptions& o) {
               << " (one of: " << component_names(loaded.config) << ")\n";
     return kExitUsage;
   }
-  if (const auto collision = identifier_collision(loaded.config, *component)) {
-    std::cerr << o.file << ": " << *collision << "\n";
+  if (const cosmic::Result<void> distinct = check_identifiers(loaded.config, *component); !distinct) {
+    std::cerr << o.file << ": " << distinct.error().text << "\n";
     return kExitConfigError;
   }
   std::error_code ec;

@@ -149,16 +149,16 @@ void add_channel(Pieces& p, const cosmic::ChannelSpec& c, const cosmic::Componen
 
 }  // namespace
 
-std::optional<std::string> identifier_collision(const cosmic::Config& config, const cosmic::ComponentSpec& component) {
+cosmic::Result<void> check_identifiers(const cosmic::Config& config, const cosmic::ComponentSpec& component) {
   std::map<std::string, std::string> owner;  // identifier -> channel name
   for (const cosmic::ChannelSpec* c : used_channels(config, component)) {
     const auto [it, fresh] = owner.emplace(identifier(c->name), c->name);
     if (!fresh && it->second != c->name) {
-      return "channels '" + it->second + "' and '" + c->name + "' of component " + component.name +
-             " both become the C++ identifier " + it->first + "; rename one of them";
+      return cosmic::Error{"channels '" + it->second + "' and '" + c->name + "' of component " + component.name +
+                           " both become the C++ identifier " + it->first + "; rename one of them"};
     }
   }
-  return std::nullopt;
+  return {};
 }
 
 std::string client_segment(const cosmic::SegmentSpec& s, unsigned can_node) {

@@ -16,6 +16,7 @@
 #include <string>
 
 #include "cosmic/model.hpp"
+#include "cosmic/result.hpp"
 
 namespace cosmicctl {
 
@@ -30,7 +31,7 @@ Skeleton generate_skeleton(const cosmic::Config& config, const cosmic::Component
 
 // Why `component`'s skeleton cannot be generated: two of its channels whose names differ only
 // in '-', '.' or '_' would become one C++ identifier (issue 22, item 5). nullopt when none.
-std::optional<std::string> identifier_collision(const cosmic::Config& config, const cosmic::ComponentSpec& component);
+cosmic::Result<void> check_identifiers(const cosmic::Config& config, const cosmic::ComponentSpec& component);
 
 // How a component on `segment` opens it with cosmic_open() (CAN: TxNode `can_node`).
 std::string client_segment(const cosmic::SegmentSpec& segment, unsigned can_node);

@@ -108,26 +108,26 @@ TEST(DdsNames, EnvelopeAndNativeTopicsAreNamedOneWayEverywhere) {
   const ChannelSpec a = channel("a-b", 0x2, ChannelClass::nrt, {"lan"}, {"robot"}, 8);
   const ChannelSpec b = channel("a.b", 0x3, ChannelClass::nrt, {"lan"}, {"robot"}, 8);
   const std::array<const ChannelSpec*, 2> envelope{&a, &b};
-  EXPECT_EQ(dds_topic_collision(envelope, "lan"),
+  EXPECT_EQ(check_dds_topics_distinct(envelope, "lan").error().text,
             "channels 'a-b' and 'a.b' both map to DDS topic cosmic/a_b ('-' and '.' become '_'); rename one of them");
   ChannelSpec d = channel("d", 0x4, ChannelClass::nrt, {"robot"}, {"lan"}, 8);
   d.native.push_back(
       NativeBinding{"robot", std::nullopt, std::nullopt, NativeDdsTopic{"rt/arm", kTwist, DdsRepresentation::xcdr1}});
   const std::array<const ChannelSpec*, 2> native{&c, &d};
-  EXPECT_EQ(dds_topic_collision(native, "robot"),
+  EXPECT_EQ(check_dds_topics_distinct(native, "robot").error().text,
             "channels 'robot.arm-left_2' and 'd' both map to DDS topic rt/arm; rename one of them");
-  EXPECT_EQ(dds_topic_collision(native, "lan"), std::nullopt);
-  EXPECT_EQ(dds_topic_name_problem("rt/ns/cmd_vel"), std::nullopt);
-  EXPECT_TRUE(dds_topic_name_problem(""));
-  EXPECT_TRUE(dds_topic_name_problem("/rt/x"));
-  EXPECT_TRUE(dds_topic_name_problem("rt/x/"));
-  EXPECT_TRUE(dds_topic_name_problem(std::string(kMaxDdsNameLength + 1, 'a')));
-  EXPECT_EQ(dds_type_name_problem("std_msgs::msg::dds_::String_"), std::nullopt);
-  EXPECT_EQ(dds_type_name_problem("_T"), std::nullopt);
-  EXPECT_TRUE(dds_type_name_problem("::T"));
-  EXPECT_TRUE(dds_type_name_problem("T::"));
-  EXPECT_TRUE(dds_type_name_problem("1T"));
-  EXPECT_TRUE(dds_type_name_problem("a:b"));
+  EXPECT_TRUE(check_dds_topics_distinct(native, "lan").ok());
+  EXPECT_TRUE(check_dds_topic_name("rt/ns/cmd_vel").ok());
+  EXPECT_FALSE(check_dds_topic_name("").ok());
+  EXPECT_FALSE(check_dds_topic_name("/rt/x").ok());
+  EXPECT_FALSE(check_dds_topic_name("rt/x/").ok());
+  EXPECT_FALSE(check_dds_topic_name(std::string(kMaxDdsNameLength + 1, 'a')).ok());
+  EXPECT_TRUE(check_dds_type_name("std_msgs::msg::dds_::String_").ok());
+  EXPECT_TRUE(check_dds_type_name("_T").ok());
+  EXPECT_FALSE(check_dds_type_name("::T").ok());
+  EXPECT_FALSE(check_dds_type_name("T::").ok());
+  EXPECT_FALSE(check_dds_type_name("1T").ok());
+  EXPECT_FALSE(check_dds_type_name("a:b").ok());
 }
 
 TEST(DdsEncapsulation, NamesEveryCdrIdentifierAndRefusesTheRest) {

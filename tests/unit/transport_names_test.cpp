@@ -67,13 +67,13 @@ channels: []
 }
 
 TEST(InterfaceNames, QuotesAndControlCharactersAreRefusedWhereTheyAreWritten) {
-  EXPECT_EQ(interface_name_problem("can0"), std::nullopt);
-  EXPECT_EQ(interface_name_problem("eth0.100"), std::nullopt);
-  EXPECT_EQ(interface_name_problem("br-lan"), std::nullopt);
-  EXPECT_TRUE(interface_name_problem(""));
-  EXPECT_TRUE(interface_name_problem(".."));
-  EXPECT_TRUE(interface_name_problem("can0/x"));
-  EXPECT_TRUE(interface_name_problem("sixteen_chars_xx"));
+  EXPECT_TRUE(check_interface_name("can0").ok());
+  EXPECT_TRUE(check_interface_name("eth0.100").ok());
+  EXPECT_TRUE(check_interface_name("br-lan").ok());
+  EXPECT_FALSE(check_interface_name("").ok());
+  EXPECT_FALSE(check_interface_name("..").ok());
+  EXPECT_FALSE(check_interface_name("can0/x").ok());
+  EXPECT_FALSE(check_interface_name("sixteen_chars_xx").ok());
   const ConfigResult r =
       parse_config(std::string(kHead) + R"(  - {name: bus, type: can, interface: "vcan0\"\nint x;", bitrate: 500kbit/s}
   - {name: lan, type: dds, interfaces: [eth0, "lo\"x"]}
@@ -91,13 +91,12 @@ channels: []
 }
 
 TEST(LcmChannelNames, ANulOrControlCharacterIsRefusedBeforeItReachesTheWire) {
-  EXPECT_EQ(transport_name_problem(SegmentType::lcm, "WHEEL_SPEED"), std::nullopt);
-  EXPECT_EQ(transport_name_problem(SegmentType::lcm, "odometry/pose 2"), std::nullopt);  // LCM allows these
-  EXPECT_TRUE(transport_name_problem(SegmentType::lcm, std::string("A\0B", 3)));
-  EXPECT_TRUE(transport_name_problem(SegmentType::lcm, "A\nB"));
-  EXPECT_TRUE(transport_name_problem(SegmentType::lcm, "A\x7f"));
-  EXPECT_EQ(transport_name_problem(SegmentType::dds, std::string("A\0B", 3)),
-            std::nullopt);  // DDS names are checked elsewhere
+  EXPECT_TRUE(check_transport_name(SegmentType::lcm, "WHEEL_SPEED").ok());
+  EXPECT_TRUE(check_transport_name(SegmentType::lcm, "odometry/pose 2").ok());  // LCM allows these
+  EXPECT_FALSE(check_transport_name(SegmentType::lcm, std::string("A\0B", 3)).ok());
+  EXPECT_FALSE(check_transport_name(SegmentType::lcm, "A\nB").ok());
+  EXPECT_FALSE(check_transport_name(SegmentType::lcm, "A\x7f").ok());
+  EXPECT_TRUE(check_transport_name(SegmentType::dds, std::string("A\0B", 3)).ok());  // DDS names are checked elsewhere
   // In a native binding of the configuration, at its place.
   const ConfigResult r = parse_config(std::string(kHead) + R"(  - {name: lan, type: dds}
   - {name: viz, type: lcm}

@@ -250,8 +250,9 @@ class ConfigParser {
     CanSegmentProperties& can = s.can;
     if (require(node, path, "interface", "a network interface such as can0")) {
       if (auto v = reader_.string(node["interface"], key(path, "interface"))) {
-        if (const auto problem = interface_name_problem(*v)) {
-          reader_.error_at(node["interface"], key(path, "interface"), *problem, "a network interface such as can0");
+        if (const Result<void> valid = check_interface_name(*v); !valid) {
+          reader_.error_at(node["interface"], key(path, "interface"), valid.error().text,
+                           "a network interface such as can0");
         }
         can.interface = *v;
       }
@@ -540,10 +541,11 @@ class ConfigParser {
       for (const auto& name : *names) {
         const SegmentSpec* segment = config_.find_segment(name);
         if (!segment) continue;
-        const auto problem = transport_name_problem(segment->type, c.name);
-        if (problem && reported.insert(*problem).second) {
+        const Result<void> carried = check_transport_name(segment->type, c.name);
+        if (!carried && reported.insert(carried.error().text).second) {
           reader_.error_at(node["name"], key(path, "name"),
-                           "segment '" + name + "' cannot carry this channel: " + *problem, "a shorter name");
+                           "segment '" + name + "' cannot carry this channel: " + carried.error().text,
+                           "a shorter name");
         }
       }
     }

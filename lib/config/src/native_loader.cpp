@@ -69,8 +69,8 @@ bool parse_lcm(YamlReader& reader, const YAML::Node& node, const std::string& pa
                     "the LCM channel name, e.g. channel: POSE");
     return false;
   }
-  if (const auto problem = transport_name_problem(SegmentType::lcm, *name)) {
-    reader.error_at(node["channel"], key(path, "channel"), *problem, "a shorter name");
+  if (const Result<void> carried = check_transport_name(SegmentType::lcm, *name); !carried) {
+    reader.error_at(node["channel"], key(path, "channel"), carried.error().text, "a shorter name");
     return false;
   }
   binding.lcm_channel = *name;
@@ -95,8 +95,8 @@ bool parse_dds(YamlReader& reader, const YAML::Node& node, const std::string& pa
   NativeDdsTopic topic;
   bool ok = true;
   if (const auto name = name_at(reader, node, path, "topic", kTopicHint)) {
-    if (const auto problem = dds_topic_name_problem(*name)) {
-      reader.error_at(node["topic"], key(path, "topic"), *problem, kTopicHint);
+    if (const Result<void> valid = check_dds_topic_name(*name); !valid) {
+      reader.error_at(node["topic"], key(path, "topic"), valid.error().text, kTopicHint);
       ok = false;
     }
     topic.topic = *name;
@@ -104,8 +104,8 @@ bool parse_dds(YamlReader& reader, const YAML::Node& node, const std::string& pa
     ok = false;
   }
   if (const auto name = name_at(reader, node, path, "type", kTypeHint)) {
-    if (const auto problem = dds_type_name_problem(*name)) {
-      reader.error_at(node["type"], key(path, "type"), *problem, kTypeHint);
+    if (const Result<void> valid = check_dds_type_name(*name); !valid) {
+      reader.error_at(node["type"], key(path, "type"), valid.error().text, kTypeHint);
       ok = false;
     } else if (*name == kEnvelopeTypeName) {
       reader.error_at(node["type"], key(path, "type"),

@@ -221,20 +221,20 @@ bool ControlServer::refuse_at_fd_limit() {
   return fd >= 0;
 }
 
-std::optional<std::string> ControlServer::admit(const Client& client) const {
-  if (clients_.size() >= options_.max_clients) return "too many control clients; try again later";
-  if (client.privileged) return std::nullopt;
+Result<void> ControlServer::admit(const Client& client) const {
+  if (clients_.size() >= options_.max_clients) return Error{"too many control clients; try again later"};
+  if (client.privileged) return {};
   const std::size_t reserve = std::min(options_.privileged_reserve, options_.max_clients);
   if (clients_.size() >= options_.max_clients - reserve) {
-    return "the remaining control connections are reserved for administrators; try again later";
+    return Error{"the remaining control connections are reserved for administrators; try again later"};
   }
   std::size_t same_uid = 0;
   for (const auto& [fd, other] : clients_) same_uid += (!other.privileged && other.peer.uid == client.peer.uid) ? 1 : 0;
   if (same_uid >= options_.max_clients_per_uid) {
-    return "uid " + std::to_string(client.peer.uid) + " already holds " + std::to_string(same_uid) +
-           " control connections (the limit per user); close one first";
+    return Error{"uid " + std::to_string(client.peer.uid) + " already holds " + std::to_string(same_uid) +
+                 " control connections (the limit per user); close one first"};
   }
-  return std::nullopt;
+  return {};
 }
 
 void ControlServer::add_client(int fd) {
@@ -247,8 +247,8 @@ void ControlServer::add_client(int fd) {
     client.peer = PeerCredentials{-1, static_cast<unsigned>(-1), static_cast<unsigned>(-1)};
   }
   client.privileged = options_.privileged && options_.privileged(client.peer);
-  if (const auto why = admit(client)) {
-    refuse(fd, error_line("busy", *why));
+  if (const Result<void> admitted = admit(client); !admitted) {
+    refuse(fd, error_line("busy", admitted.error().text));
     return;
   }
   client.id = next_client_id_++;

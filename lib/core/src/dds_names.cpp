@@ -66,50 +66,50 @@ std::vector<std::pair<const ChannelSpec*, std::string>> dds_topic_collisions(
   return collisions;
 }
 
-std::optional<std::string> dds_topic_collision(std::span<const ChannelSpec* const> channels,
-                                               const std::string& segment) {
+Result<void> check_dds_topics_distinct(std::span<const ChannelSpec* const> channels, const std::string& segment) {
   auto collisions = dds_topic_collisions(channels, segment);
-  if (collisions.empty()) return std::nullopt;
-  return std::move(collisions.front().second);
+  if (collisions.empty()) return {};
+  return Error{std::move(collisions.front().second)};
 }
 
-std::optional<std::string> dds_topic_name_problem(std::string_view name) {
-  if (auto problem = length_problem("topic", name)) return problem;
-  if (!is_letter(name.front())) return "topic name " + quoted(name) + " does not start with a letter";
+Result<void> check_dds_topic_name(std::string_view name) {
+  if (auto problem = length_problem("topic", name)) return Error{*problem};
+  if (!is_letter(name.front())) return Error{"topic name " + quoted(name) + " does not start with a letter"};
   for (std::size_t i = 0; i < name.size(); ++i) {
     const char c = name[i];
     if (c == '/' && (i + 1 == name.size() || name[i + 1] == '/')) {
-      return "topic name " + quoted(name) + " has an empty part between '/' separators";
+      return Error{"topic name " + quoted(name) + " has an empty part between '/' separators"};
     }
     if (!is_letter(c) && !is_digit(c) && c != '_' && c != '/') {
-      return "topic name " + quoted(name) + " has " + character_text(c) + " at position " + std::to_string(i + 1) +
-             "; only letters, digits, '_' and '/' are accepted";
+      return Error{"topic name " + quoted(name) + " has " + character_text(c) + " at position " +
+                   std::to_string(i + 1) + "; only letters, digits, '_' and '/' are accepted"};
     }
   }
   if (name.substr(0, kEnvelopeTopicPrefix.size()) == kEnvelopeTopicPrefix) {
-    return "topic name " + quoted(name) + " is under " + std::string(kEnvelopeTopicPrefix) +
-           ", which the gateway's envelope channels use";
+    return Error{"topic name " + quoted(name) + " is under " + std::string(kEnvelopeTopicPrefix) +
+                 ", which the gateway's envelope channels use"};
   }
-  return std::nullopt;
+  return {};
 }
 
-std::optional<std::string> dds_type_name_problem(std::string_view name) {
-  if (auto problem = length_problem("type", name)) return problem;
+Result<void> check_dds_type_name(std::string_view name) {
+  if (auto problem = length_problem("type", name)) return Error{*problem};
   std::size_t start = 0;
   for (;;) {
     const std::size_t end = name.find("::", start);
     const std::string_view part =
         name.substr(start, end == std::string_view::npos ? std::string_view::npos : end - start);
     if (part.empty() || !(is_letter(part.front()) || part.front() == '_')) {
-      return "type name " + quoted(name) + " has a part that is not an IDL identifier (parts are joined by '::')";
+      return Error{"type name " + quoted(name) +
+                   " has a part that is not an IDL identifier (parts are joined by '::')"};
     }
     for (const char c : part) {
       if (!is_letter(c) && !is_digit(c) && c != '_') {
-        return "type name " + quoted(name) + " has " + character_text(c) +
-               "; only IDL identifiers (letters, digits, '_') joined by '::' are accepted";
+        return Error{"type name " + quoted(name) + " has " + character_text(c) +
+                     "; only IDL identifiers (letters, digits, '_') joined by '::' are accepted"};
       }
     }
-    if (end == std::string_view::npos) return std::nullopt;
+    if (end == std::string_view::npos) return {};
     start = end + 2;
   }
 }

@@ -66,24 +66,25 @@ std::uint16_t etag_bits(const NativeCanFrame& frame) { return static_cast<std::u
 
 // A native identity another bound channel holds, or an extended native identifier whose etag bits
 // a bound COSMIC channel uses (or the reverse): the reason, or nothing.
-std::optional<std::string> KnowledgeBase::native_clash(const ChannelSpec& channel,
-                                                       std::optional<std::uint16_t> etag) const {
+Result<void> KnowledgeBase::check_native_identities(const ChannelSpec& channel,
+                                                    std::optional<std::uint16_t> etag) const {
   for (const NativeBinding& binding : channel.native) {
     const std::string identity = native_identity(binding);
     if (const auto owner = native_owners_.find({binding.segment, identity}); owner != native_owners_.end()) {
-      return identity + " on segment " + binding.segment + " is already carried by bound channel " + owner->second;
+      return Error{identity + " on segment " + binding.segment + " is already carried by bound channel " +
+                   owner->second};
     }
     if (!binding.can || !binding.can->extended) continue;
     if (const auto owner = static_etag_owner(etags_, etag_bits(*binding.can))) {
-      return "extended identifier " + identity + " reads as etag " + std::to_string(etag_bits(*binding.can)) +
-             " of bound channel " + *owner + " to COSMIC devices";
+      return Error{"extended identifier " + identity + " reads as etag " + std::to_string(etag_bits(*binding.can)) +
+                   " of bound channel " + *owner + " to COSMIC devices"};
     }
   }
   if (const auto owner = etag ? native_etags_.find(*etag) : native_etags_.end(); owner != native_etags_.end()) {
-    return "etag " + std::to_string(*etag) + " is the etag bits of bound channel " + owner->second +
-           "'s native extended identifier";
+    return Error{"etag " + std::to_string(*etag) + " is the etag bits of bound channel " + owner->second +
+                 "'s native extended identifier"};
   }
-  return std::nullopt;
+  return {};
 }
 
 KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel,
@@ -122,8 +123,8 @@ KnowledgeBase::Attempt KnowledgeBase::attempt(const ChannelSpec& channel,
       return a;
     }
   }
-  if (const auto clash = native_clash(channel, channel.etag)) {
-    a.report = rejected_report(channel, *clash);
+  if (const Result<void> distinct = check_native_identities(channel, channel.etag); !distinct) {
+    a.report = rejected_report(channel, distinct.error().text);
     return a;
   }
   a.trial = set_.trial(channel, a.etag.value_or(0));

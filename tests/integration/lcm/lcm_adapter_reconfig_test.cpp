@@ -174,7 +174,7 @@ TEST_F(LcmAdapterTest, ANameBeyondTheTransportLimitIsRefusedForItsChannelAlone) 
   EXPECT_FALSE(status.ok);
   ASSERT_EQ(status.refused.size(), 1u) << status.error;
   EXPECT_EQ(status.refused[0].channel, 2u);
-  EXPECT_EQ(status.refused[0].reason, *transport_name_problem(SegmentType::lcm, too_long));
+  EXPECT_EQ(status.refused[0].reason, check_transport_name(SegmentType::lcm, too_long).error().text);
   EXPECT_NE(status.error.find("at most 63 characters"), std::string::npos) << status.error;
   EXPECT_EQ(adapter->send(outbound(1, Bytes{1})), SendStatus::sent);
   EXPECT_EQ(adapter->send(outbound(3, Bytes{1})), SendStatus::sent);

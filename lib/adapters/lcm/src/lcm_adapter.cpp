@@ -189,8 +189,8 @@ class LcmAdapter final : public SegmentAdapter {
       // A native binding names the LCM channel and carries the contents raw.
       const NativeBinding* native = b->spec.native_on(segment_.name);
       const std::string& name = native && native->lcm_channel ? *native->lcm_channel : b->spec.name;
-      if (const auto problem = binding_problem(*b, name, names)) {
-        plan.refuse(*b, *problem);
+      if (const Result<void> carried = check_binding(*b, name, names); !carried) {
+        plan.refuse(*b, carried.error().text);
         continue;
       }
       names.emplace(name, b->id);
@@ -365,20 +365,20 @@ class LcmAdapter final : public SegmentAdapter {
     replace_table(ChannelTable{table_.current_for_publisher().channels, sink});
   }
 
-  // Why binding `b` under LCM channel `name` cannot be carried, given the names taken so far.
-  std::optional<std::string> binding_problem(const ChannelBinding& b, const std::string& name,
-                                             const std::unordered_map<std::string, ChannelId>& names) const {
-    if (name.empty()) return std::string("the native binding names no LCM channel");
-    if (auto problem = transport_name_problem(SegmentType::lcm, name)) return problem;
+  // Whether binding `b` can be carried under LCM channel `name`, given the names taken so far.
+  Result<void> check_binding(const ChannelBinding& b, const std::string& name,
+                             const std::unordered_map<std::string, ChannelId>& names) const {
+    if (name.empty()) return Error{"the native binding names no LCM channel"};
+    if (Result<void> carried = check_transport_name(SegmentType::lcm, name); !carried) return carried;
     const auto taken = names.find(name);
     if (taken != names.end() && taken->second != b.id) {
-      return "LCM channel '" + name + "' is already bound by channel id " + std::to_string(taken->second);
+      return Error{"LCM channel '" + name + "' is already bound by channel id " + std::to_string(taken->second)};
     }
     const auto same_id = std::find_if(names.begin(), names.end(), [&](const auto& n) { return n.second == b.id; });
     if (same_id != names.end() && same_id->first != name) {
-      return "channel id " + std::to_string(b.id) + " is already bound as LCM channel '" + same_id->first + "'";
+      return Error{"channel id " + std::to_string(b.id) + " is already bound as LCM channel '" + same_id->first + "'"};
     }
-    return std::nullopt;
+    return {};
   }
 
   // The segment's receive thread: waits for datagrams or stop(), then reads all that are queued

@@ -25,6 +25,7 @@
 
 #include "cosmic/control_protocol.hpp"
 #include "cosmic/mutex.hpp"
+#include "cosmic/result.hpp"
 #include "cosmic/thread_annotations.hpp"
 
 namespace cosmic {
@@ -98,7 +99,7 @@ class ControlServer {
     bool in_handler = false;            // a responder called from inside the handler only queues
     bool closing = false;               // close once `out` is written
   };
-  std::optional<std::string> admit(const Client& client) const;
+  Result<void> admit(const Client& client) const;
   void accept_clients();
   bool refuse_at_fd_limit();
   void add_client(int fd);

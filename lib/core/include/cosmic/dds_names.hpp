@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include "cosmic/model.hpp"
+#include "cosmic/result.hpp"
 
 namespace cosmic {
 
@@ -38,21 +39,20 @@ struct DdsTopicRef {
 // envelope topic.
 DdsTopicRef dds_topic_of(const ChannelSpec& channel, const std::string& segment);
 
-// Why two distinct channels among `channels` cannot share the DDS segment `segment` (both
-// map to one topic), or nullopt.
-std::optional<std::string> dds_topic_collision(std::span<const ChannelSpec* const> channels,
-                                               const std::string& segment);
+// Whether the distinct channels among `channels` can share the DDS segment `segment`; the error
+// names two that map to one topic.
+Result<void> check_dds_topics_distinct(std::span<const ChannelSpec* const> channels, const std::string& segment);
 // Every channel among `channels` whose topic on `segment` an earlier, distinct channel already
-// maps to, with the reason (the first of them is what dds_topic_collision() says).
+// maps to, with the reason (the first of them is what check_dds_topics_distinct() says).
 std::vector<std::pair<const ChannelSpec*, std::string>> dds_topic_collisions(
     std::span<const ChannelSpec* const> channels, const std::string& segment);
 
-// Why `name` cannot be a native topic name, or nullopt. Topic names are letters, digits, '_' and
+// Whether `name` can be a native topic name (the error says why not). Topic names are letters, digits, '_' and
 // '/' separators (ROS 2: rt/<name>, possibly namespaced), start with a letter, at most
 // kMaxDdsNameLength characters, and not under kEnvelopeTopicPrefix.
-std::optional<std::string> dds_topic_name_problem(std::string_view name);
-// Why `name` cannot be a type name, or nullopt: IDL identifiers (letters, digits, '_', starting
+Result<void> check_dds_topic_name(std::string_view name);
+// Whether `name` can be a type name (the error says why not): IDL identifiers (letters, digits, '_', starting
 // with a letter or '_') joined by "::", at most kMaxDdsNameLength characters.
-std::optional<std::string> dds_type_name_problem(std::string_view name);
+Result<void> check_dds_type_name(std::string_view name);
 
 }  // namespace cosmic

@@ -27,6 +27,7 @@
 #include "cosmic/can_wire.hpp"
 #include "cosmic/model.hpp"
 #include "cosmic/network_identity.hpp"
+#include "cosmic/result.hpp"
 #include "cosmic/upstream_path.hpp"
 
 namespace cosmic {
@@ -109,7 +110,7 @@ class KnowledgeBase {
   Attempt attempt(const ChannelSpec& channel, std::optional<std::uint16_t> preferred_etag = std::nullopt) const;
   std::optional<std::uint16_t> allocate_etag() const;
   bool needs_etag(const ChannelSpec& channel) const;
-  std::optional<std::string> native_clash(const ChannelSpec& channel, std::optional<std::uint16_t> etag) const;
+  Result<void> check_native_identities(const ChannelSpec& channel, std::optional<std::uint16_t> etag) const;
 
   // The segments as admission sees them: the configured ones plus what other gateways reserve.
   std::vector<SegmentSpec> analysed_segments() const;

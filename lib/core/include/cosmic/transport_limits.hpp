@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "cosmic/model.hpp"
+#include "cosmic/result.hpp"
 
 namespace cosmic {
 
@@ -20,46 +21,47 @@ inline constexpr std::size_t kLcmMaxChannelName = 63;
 // A network interface name (IFNAMSIZ - 1).
 inline constexpr std::size_t kMaxInterfaceName = 15;
 
-// Why a segment of type `type` cannot carry a channel named `channel`, if it cannot.
-inline std::optional<std::string> transport_name_problem(SegmentType type, std::string_view channel) {
-  if (type != SegmentType::lcm) return std::nullopt;
+// Whether a segment of type `type` can carry a channel named `channel` (the error says why not).
+inline Result<void> check_transport_name(SegmentType type, std::string_view channel) {
+  if (type != SegmentType::lcm) return {};
   // A NUL ends the name on the wire (what follows would become payload for other subscribers);
   // control characters would be written into logs. The name itself is not echoed here.
   for (const char c : channel) {
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
       char shown[8];
       std::snprintf(shown, sizeof shown, "0x%02X", static_cast<unsigned char>(c));
-      return std::string("LCM channel names hold no control characters; this one has ") + shown;
+      return Error{std::string("LCM channel names hold no control characters; this one has ") + shown};
     }
   }
   if (channel.size() > kLcmMaxChannelName) {
-    return "LCM channel names have at most " + std::to_string(kLcmMaxChannelName) + " characters, '" +
-           std::string(channel.substr(0, 16)) + "...' has " + std::to_string(channel.size());
+    return Error{"LCM channel names have at most " + std::to_string(kLcmMaxChannelName) + " characters, '" +
+                 std::string(channel.substr(0, 16)) + "...' has " + std::to_string(channel.size())};
   }
-  return std::nullopt;
+  return {};
 }
 
-// Why `name` cannot be a network interface name (CAN `interface`, DDS `interfaces`), if it
-// cannot: 1 to kMaxInterfaceName characters of [A-Za-z0-9_.@-], not "." or "..". Linux refuses
+// Whether `name` can be a network interface name (CAN `interface`, DDS `interfaces`; the error
+// says why not): 1 to kMaxInterfaceName characters of [A-Za-z0-9_.@-], not "." or "..". Linux refuses
 // '/', ':' and white space itself; the rest of what it would take (quotes, control characters)
 // no interface of a real system has, and the gateway copies the name into logs and generated code.
-inline std::optional<std::string> interface_name_problem(std::string_view name) {
-  if (name.empty()) return std::string("empty interface name");
+inline Result<void> check_interface_name(std::string_view name) {
+  if (name.empty()) return Error{std::string("empty interface name")};
   if (name.size() > kMaxInterfaceName) {
-    return "interface name '" + std::string(name.substr(0, 20)) + (name.size() > 20 ? "..." : "") +
-           "' is too long (at most " + std::to_string(kMaxInterfaceName) + " characters)";
+    return Error{"interface name '" + std::string(name.substr(0, 20)) + (name.size() > 20 ? "..." : "") +
+                 "' is too long (at most " + std::to_string(kMaxInterfaceName) + " characters)"};
   }
-  if (name == "." || name == "..") return "'" + std::string(name) + "' is not an interface name";
+  if (name == "." || name == "..") return Error{"'" + std::string(name) + "' is not an interface name"};
   for (const char c : name) {
     const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
                     c == '.' || c == '@' || c == '-';
     if (!ok) {
       char shown[8];
       std::snprintf(shown, sizeof shown, c > ' ' && c < 0x7f ? "'%c'" : "0x%02X", static_cast<unsigned char>(c));
-      return std::string("interface names hold letters, digits, '_', '.', '@' and '-' only; this one has ") + shown;
+      return Error{std::string("interface names hold letters, digits, '_', '.', '@' and '-' only; this one has ") +
+                   shown};
     }
   }
-  return std::nullopt;
+  return {};
 }
 
 }  // namespace cosmic
