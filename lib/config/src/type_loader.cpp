@@ -1,7 +1,6 @@
 #include "type_loader.hpp"
 
 #include <array>
-#include <charconv>
 #include <map>
 
 namespace cosmic::config_detail {
@@ -28,12 +27,6 @@ const char* keys_of(FieldType::Kind kind) {
       return "fields";
   }
   return "";
-}
-
-std::string number_text(double value) {
-  std::array<char, 32> buffer{};
-  const auto [end, error] = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  return error == std::errc() ? std::string(buffer.data(), end) : std::string("0");
 }
 
 class TypeLoader {
@@ -276,8 +269,8 @@ void emit_fields(YAML::Node& list, const std::vector<TypeField>& fields) {
     entry["name"] = f.name;
     if (!f.unit.empty()) entry["unit"] = f.unit;
     // The shortest text that reads back as the same double.
-    if (f.minimum) entry["min"] = number_text(*f.minimum);
-    if (f.maximum) entry["max"] = number_text(*f.maximum);
+    if (f.minimum) entry["min"] = shortest_number_text(*f.minimum);
+    if (f.maximum) entry["max"] = shortest_number_text(*f.maximum);
     list.push_back(entry);
   }
 }

@@ -13,12 +13,7 @@ namespace {
 constexpr std::array<std::string_view, 11> kScalarNames = {"bool",   "int8",   "int16",  "int32",   "int64",  "uint8",
                                                            "uint16", "uint32", "uint64", "float32", "float64"};
 
-// The shortest text that reads back as the same double.
-std::string number_text(double value) {
-  std::array<char, 32> buffer{};
-  const auto [end, error] = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  return error == std::errc() ? std::string(buffer.data(), end) : std::string("?");
-}
+std::string number_text(double value) { return shortest_number_text(value); }
 
 std::string child(const std::string& where, const std::string& name) {
   return where.empty() ? name : where + "." + name;
@@ -212,6 +207,12 @@ bool valid_field_name(std::string_view name) {
   const auto alpha = [](char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z'); };
   if (!alpha(name.front())) return false;
   return std::all_of(name.begin(), name.end(), [&](char c) { return alpha(c) || (c >= '0' && c <= '9') || c == '_'; });
+}
+
+std::string shortest_number_text(double value) {
+  std::array<char, 32> buffer{};
+  const auto [end, error] = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
+  return error == std::errc() ? std::string(buffer.data(), end) : std::string("?");
 }
 
 bool is_numeric(const FieldType& type) { return numeric_kind(type).has_value(); }

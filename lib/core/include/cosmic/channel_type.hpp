@@ -103,4 +103,7 @@ bool is_numeric(const FieldType& type);
 std::string describe(const FieldType& type);
 std::string describe(const ChannelType& type);
 
+// The shortest text that reads back as the same double (ranges in errors, descriptions and YAML).
+std::string shortest_number_text(double value);
+
 }  // namespace cosmic
