@@ -62,6 +62,10 @@ wait_until() {  # wait_until SECONDS WHAT CMD...: polls CMD until it succeeds
   done
 }
 
+# The system interpreter, as the CAN tests use it: a version manager's shim (pyenv) spawns dozens
+# of processes per start, 7 s each time inside the emulated CAN VM.
+python=/usr/bin/python3
+[ -x "$python" ] || python=$(command -v python3) || { echo "speed proof: python3 not found" >&2; exit 2; }
 BODY=${PROOF_BODY:-lcm}
 SC=${PROOF_CONTROLLER_DIR:-$WORK/sc}
 body_segment="lcm:udpm://239.255.76.68:7668?ttl=0"
@@ -85,7 +89,7 @@ fi
 
 # 1. robot.yaml with its own control socket; for lcm the body bus becomes an LCM group
 #    (real-time declared, as the CAN bus would be).
-python3 - "$ROBOT" "$WORK/robot-run.yaml" "$WORK/control.sock" "$BODY" <<'PY'
+"$python" - "$ROBOT" "$WORK/robot-run.yaml" "$WORK/control.sock" "$BODY" <<'PY'
 import re, sys
 text = open(sys.argv[1]).read()
 if sys.argv[4] == "lcm":
@@ -115,6 +119,9 @@ fi
 # 3. cosmicd, the generated component (asking cosmicd for its channels first), the probe.
 "$COSMICD" --config "$WORK/robot-run.yaml" --socket "$WORK/control.sock" --state-file "$WORK/state" 2>"$WORK/cosmicd.log" &
 PIDS+=($!) NAMES+=(cosmicd) LOGS+=("$WORK/cosmicd.log")
+# cosmicd opens its control socket once its segments are up; a sanitized cosmicctl takes seconds
+# to start in the VM, so it asks once the socket is there instead of polling.
+wait_until "$WAIT_S" "cosmicd's control socket" test -S "$WORK/control.sock"
 wait_until "$WAIT_S" "cosmicd" "$COSMICCTL" --socket "$WORK/control.sock" status
 "$SC/build/speed_controller" --check "$WORK/control.sock" >"$WORK/sc.out" 2>&1 &
 PIDS+=($!) NAMES+=(speed_controller) LOGS+=("$WORK/sc.out")
@@ -129,7 +136,7 @@ check_running
 grep -q "forwarded" "$WORK/live.svg" || fail "the live diagram has no counters"
 
 # 4. Measured against promised: actual_speed's end-to-end bound + one controller period + speed's.
-python3 - "$WORK/check.json" "$(tail -1 "$WORK/probe.out")" <<'PY'
+"$python" - "$WORK/check.json" "$(tail -1 "$WORK/probe.out")" <<'PY'
 import json, os, sys
 report = {c["name"]: c for c in json.load(open(sys.argv[1]))["channels"]}
 measured = json.loads(sys.argv[2])
