@@ -32,5 +32,6 @@ std::vector<CommandRunner> add_daemon_commands(CLI::App& app, const GlobalOption
 CommandRunner add_diagram_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_gen_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_top_command(CLI::App& app, const GlobalOptions& options);
+CommandRunner add_types_command(CLI::App& app, const GlobalOptions& options);
 
 }  // namespace cosmicctl

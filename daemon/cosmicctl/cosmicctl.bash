@@ -6,7 +6,7 @@
 # unbind) to the channels of the running gateway (`cosmicctl --json channels`, silent when it
 # cannot be reached). Needs nothing from the bash-completion package.
 
-_cosmicctl_commands="bind calibrate channel channels check diagram gen peers reload segments status top unbind"
+_cosmicctl_commands="bind calibrate channel channels check diagram gen peers reload segments status top types unbind"
 _cosmicctl_global_options="--help --json --socket --version"
 
 # The options of one command (besides the global ones, which may follow it too).
@@ -82,6 +82,11 @@ _cosmicctl() {
       [ -n "$file" ] && return
       compopt -o filenames 2>/dev/null
       mapfile -t COMPREPLY < <(compgen -f -X '!*.yaml' -- "$cur"; compgen -f -X '!*.yml' -- "$cur"; compgen -d -- "$cur")
+      ;;
+    types)
+      [ -n "$file" ] && return
+      compopt -o filenames 2>/dev/null
+      mapfile -t COMPREPLY < <(compgen -f -X '!*.dbc' -- "$cur"; compgen -f -X '!*.DBC' -- "$cur"; compgen -d -- "$cur")
       ;;
     channel | unbind)
       [ -n "$file" ] && return

@@ -1,11 +1,20 @@
 // A channel's type (issue 35 item 1): the model's checks and text (cosmic/channel_type.hpp) and the
-// inline `type:` of the YAML: every kind read, every problem located, written back unchanged.
+// `type:` of the YAML, inline or from a DBC message: every kind read, every problem located (in the
+// DBC file where it is there), written back unchanged.
 #include <gtest/gtest.h>
 
 #include <string>
 
+#include "cosmic/build_paths.hpp"
 #include "cosmic/channel_type.hpp"
 #include "cosmic/config_loader.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 
 namespace cosmic {
 namespace {
@@ -16,7 +25,12 @@ FieldType scalar(ScalarKind kind) {
   return t;
 }
 
-TypeField field(std::string name, FieldType type) { return TypeField{std::move(name), std::move(type), "", {}, {}}; }
+TypeField field(std::string name, FieldType type) {
+  TypeField f;
+  f.name = std::move(name);
+  f.type = std::move(type);
+  return f;
+}
 
 std::string problems_text(const std::vector<TypeProblem>& problems) {
   std::string out;
@@ -107,7 +121,7 @@ TEST(ChannelType, NestingAndSizeAreBounded) {
     record.fields = {field("inner", deep)};
     deep = record;
   }
-  ChannelType nested{{field("outer", deep)}};
+  ChannelType nested{{field("outer", deep)}, {}};
   EXPECT_NE(problems_text(check_type(nested)).find("nested more than 8 levels deep"), std::string::npos);
 
   FieldType big;
@@ -118,7 +132,7 @@ TEST(ChannelType, NestingAndSizeAreBounded) {
   row.bound = 2;
   row.element = {scalar(ScalarKind::uint8)};
   big.element = {row};
-  ChannelType huge{{field("grid", big)}};
+  ChannelType huge{{field("grid", big)}, {}};
   EXPECT_NE(problems_text(check_type(huge)).find("more than 65536 scalars"), std::string::npos)
       << problems_text(check_type(huge));
 }
@@ -219,6 +233,64 @@ TEST(ChannelTypeYaml, EveryProblemIsLocatedAtOnce) {
       << errors2;
   EXPECT_NE(errors2.find("bad.yaml:15:11: channels[0].type.fields[1]: field 'b' defined twice"), std::string::npos)
       << errors2;
+}
+
+TEST(ChannelTypeYaml, ADbcMessageGivesTheFieldsAndIsWrittenBackAsItsSource) {
+  const std::string text = std::string(kHead) + "    type: {dbc: body.dbc, message: WheelSpeeds}\n";
+  const std::string config_path = std::string(build_paths::dbc_dir) + "/typed.yaml";  // anchors body.dbc
+  const ConfigResult r = parse_config(text, config_path);
+  ASSERT_TRUE(r.ok()) << listed_errors(r.errors);
+  const ChannelSpec& scan = r.config.channels.at(0);
+  ASSERT_TRUE(scan.type.has_value());
+  EXPECT_EQ(describe(*scan.type),
+            "{SpeedFL: float64 [km/h, 0..655.35], SpeedFR: float64 [km/h, 0..655.35], SpeedRL: float64 [km/h, "
+            "0..655.35], SpeedRR: float64 [km/h, 0..655.35]}");
+  ASSERT_TRUE(scan.type->source.has_value());
+  EXPECT_EQ(scan.type->source->message, "WheelSpeeds");
+  EXPECT_EQ(scan.type->source->dbc, std::string(build_paths::dbc_dir) + "/body.dbc");
+  EXPECT_NE(std::find(r.included_files.begin(), r.included_files.end(), scan.type->source->dbc),
+            r.included_files.end());
+  const std::string written = channel_to_yaml(scan);
+  EXPECT_NE(written.find("message: WheelSpeeds"), std::string::npos) << written;
+  const ChannelsResult again = parse_channels("[" + written + "]", "bind", r.config);
+  ASSERT_TRUE(again.ok()) << listed_errors(again.errors) << written;
+  EXPECT_EQ(again.channels.at(0), scan) << written;
+}
+
+TEST(ChannelTypeYaml, DbcTypeProblemsAreLocatedInTheYamlOrTheDbcFile) {
+  const auto dir = std::filesystem::temp_directory_path() / ("cosmic-dbc-type-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "bad.dbc") << "BO_ 1 A: 8 X\n SG_ _s : 0|8@1+ (1,0) [0|0] \"\" X\n"
+                                    "BO_ 2 B: 8 X\n SG_ S : 60|8@1+ (1,0) [0|0] \"\" X\n";
+  std::ofstream(dir / "good.dbc") << "BO_ 1 A: 8 X\n SG_ S : 0|8@1+ (1,0) [0|0] \"\" X\n";
+  const auto errors_for = [&](const std::string& type) {
+    return listed_errors(
+        parse_config(std::string(kHead) + "    type: " + type + "\n", (dir / "t.yaml").string()).errors);
+  };
+  const std::string bad = (dir / "bad.dbc").string();
+  // The DBC's own error, at its line; no message is taken from a file with errors.
+  EXPECT_NE(errors_for("{dbc: bad.dbc, message: A}")
+                .find(bad + ":4:2: channels[0].type.dbc: signal 'S' (60|8@1+) "
+                            "does not fit the 8 bytes of message 'B'"),
+            std::string::npos)
+      << errors_for("{dbc: bad.dbc, message: A}");
+  const std::string good = (dir / "good.dbc").string();
+  EXPECT_NE(errors_for("{dbc: good.dbc, message: Z}")
+                .find("t.yaml:12:36: channels[0].type.message: no message 'Z' in " + good),
+            std::string::npos)
+      << errors_for("{dbc: good.dbc, message: Z}");
+  EXPECT_NE(errors_for("{dbc: none.dbc, message: A}").find("channels[0].type.dbc: cannot read DBC file"),
+            std::string::npos);
+  EXPECT_NE(errors_for("{dbc: good.dbc}").find("channels[0].type: a DBC type names its message"), std::string::npos);
+  EXPECT_NE(errors_for("{dbc: good.dbc, message: A, fields: []}").find("channels[0].type.fields"), std::string::npos)
+      << errors_for("{dbc: good.dbc, message: A, fields: []}");
+  std::ofstream(dir / "underscore.dbc") << "BO_ 1 A: 8 X\n SG_ _s : 0|8@1+ (1,0) [0|0] \"\" X\n";
+  EXPECT_NE(errors_for("{dbc: underscore.dbc, message: A}")
+                .find((dir / "underscore.dbc").string() +
+                      ":2:2: channels[0].type.message: signal name '_s' is not a field name"),
+            std::string::npos)
+      << errors_for("{dbc: underscore.dbc, message: A}");
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

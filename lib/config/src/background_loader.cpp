@@ -1,12 +1,6 @@
 #include "background_loader.hpp"
+#include "dbc_file_loader.hpp"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <cstring>
-#include <filesystem>
 #include <map>
 #include <set>
 
@@ -22,33 +16,6 @@ constexpr std::size_t kMaxBackgroundFrames = 20'000;
 
 std::string location(const std::string& file, const YAML::Mark& mark) {
   return file + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1);
-}
-
-// Reads a regular file of at most kDbcMaxTextBytes without ever blocking on a FIFO or a device.
-std::string read_regular_file(const std::string& path, std::string& text) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) return std::strerror(errno);
-  struct stat info {};
-  std::string error;
-  if (::fstat(fd, &info) != 0) {
-    error = std::strerror(errno);
-  } else if (!S_ISREG(info.st_mode)) {
-    error = "not a regular file";
-  } else if (static_cast<std::uint64_t>(info.st_size) > kDbcMaxTextBytes) {
-    error = "larger than " + std::to_string(kDbcMaxTextBytes >> 20) + " MiB";
-  } else {
-    text.resize(static_cast<std::size_t>(info.st_size));
-    std::size_t done = 0;
-    while (done < text.size()) {
-      const ssize_t n = ::read(fd, text.data() + done, text.size() - done);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) break;
-      done += static_cast<std::size_t>(n);
-    }
-    text.resize(done);
-  }
-  ::close(fd);
-  return error;
 }
 
 class BackgroundParser {
@@ -159,22 +126,10 @@ class BackgroundParser {
 
   // `path` is the background map's key path; `where` the dbc: value.
   void load_dbc(const YAML::Node& where, const std::string& path, const std::string& file) {
-    const std::filesystem::path relative(file);
-    const std::string resolved =
-        relative.is_absolute()
-            ? file
-            : (std::filesystem::path(reader_.file()).parent_path() / relative).lexically_normal().string();
-    std::string text;
-    if (const std::string error = read_regular_file(resolved, text); !error.empty()) {
-      reader_.error_at(where, key(path, "dbc"), "cannot read DBC file " + resolved + ": " + error,
-                       "a readable DBC file, relative to this file");
-      return;
-    }
-    included_.push_back(resolved);
-    const DbcFile dbc = parse_dbc(text);
-    for (const DbcError& e : dbc.errors)
-      reader_.error_in(ConfigError{resolved, e.line, e.column, key(path, "dbc"), e.message, ""});
-    if (!dbc.ok()) return;
+    const auto loaded = load_dbc_file(reader_, where, key(path, "dbc"), file, included_);
+    if (!loaded) return;
+    const std::string& resolved = loaded->path;
+    const DbcFile& dbc = loaded->file;
     std::set<std::string> seen;
     for (const DbcMessage& m : dbc.messages) {
       seen.insert(m.name);

@@ -459,7 +459,7 @@ class ConfigParser {
       c.lcm_encoding = static_cast<LcmEncoding>(
           reader_.choice(node["encoding"], key(path, "encoding"), {"envelope", "raw"}).value_or(0));
     }
-    if (node["type"]) c.type = config_detail::parse_channel_type(reader_, node["type"], key(path, "type"));
+    if (node["type"]) c.type = config_detail::parse_channel_type(reader_, node["type"], key(path, "type"), included_);
     parse_bindings(node, path, c);
     if (node["native"]) {
       config_detail::parse_native(reader_, node["native"], key(path, "native"), config_, c);

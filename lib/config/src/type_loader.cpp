@@ -1,7 +1,11 @@
 #include "type_loader.hpp"
 
+#include <algorithm>
 #include <array>
 #include <map>
+
+#include "cosmic/dbc_type.hpp"
+#include "dbc_file_loader.hpp"
 
 namespace cosmic::config_detail {
 namespace {
@@ -31,9 +35,10 @@ const char* keys_of(FieldType::Kind kind) {
 
 class TypeLoader {
  public:
-  explicit TypeLoader(YamlReader& reader) : reader_(reader) {}
+  TypeLoader(YamlReader& reader, std::vector<std::string>& included) : reader_(reader), included_(included) {}
 
   std::optional<ChannelType> parse(const YAML::Node& node, const std::string& path) {
+    if (node.IsMap() && has(node, "dbc")) return from_dbc(node, path);
     if (!reader_.check_map(node, path, {"fields"})) return std::nullopt;
     const std::size_t errors_before = reader_.error_count();
     ChannelType type;
@@ -54,6 +59,42 @@ class TypeLoader {
   }
 
  private:
+  // {dbc: FILE, message: NAME}: the message's signals as fields (cosmic/dbc_type.hpp).
+  std::optional<ChannelType> from_dbc(const YAML::Node& node, const std::string& path) {
+    if (!reader_.check_map(node, path, {"dbc", "message"})) return std::nullopt;
+    const auto file = reader_.string(node["dbc"], key(path, "dbc"));
+    if (!has(node, "message")) {
+      reader_.error_at(node, path, "a DBC type names its message", "message: NAME (a BO_ of the DBC file)");
+      return std::nullopt;
+    }
+    const auto name = reader_.string(node["message"], key(path, "message"));
+    if (!file || !name) return std::nullopt;
+    const auto loaded = load_dbc_file(reader_, node["dbc"], key(path, "dbc"), *file, included_);
+    if (!loaded) return std::nullopt;
+    const auto& messages = loaded->file.messages;
+    const auto message =
+        std::find_if(messages.begin(), messages.end(), [&](const DbcMessage& m) { return m.name == *name; });
+    if (message == messages.end()) {
+      reader_.error_at(node["message"], key(path, "message"),
+                       "no message " + quote_value(*name) + " in " + loaded->path, message_names(messages));
+      return std::nullopt;
+    }
+    DbcChannelType typed = channel_type_from_dbc(*message);
+    for (const DbcError& e : typed.errors)
+      reader_.error_in(ConfigError{loaded->path, e.line, e.column, key(path, "message"), e.message, ""});
+    if (!typed.ok()) return std::nullopt;
+    typed.type.source = TypeSource{loaded->path, message->name};
+    return std::move(typed.type);
+  }
+
+  // "one of A, B, C" (the first few) for an unknown message name.
+  static std::string message_names(const std::vector<DbcMessage>& messages) {
+    if (messages.empty()) return "the file declares no message";
+    std::string out = "one of ";
+    for (std::size_t i = 0; i < messages.size() && i < 8; ++i) out += (i ? ", " : "") + messages[i].name;
+    return messages.size() > 8 ? out + ", ..." : out;
+  }
+
   std::vector<TypeField> fields(const YAML::Node& list, const std::string& path, const std::string& where,
                                 std::size_t depth) {
     std::vector<TypeField> out;
@@ -226,6 +267,7 @@ class TypeLoader {
   }
 
   YamlReader& reader_;
+  std::vector<std::string>& included_;                                // DBC files read
   std::map<std::string, std::pair<YAML::Node, std::string>> places_;  // check_type's "where" -> node, key path
 };
 
@@ -277,11 +319,18 @@ void emit_fields(YAML::Node& list, const std::vector<TypeField>& fields) {
 
 }  // namespace
 
-std::optional<ChannelType> parse_channel_type(YamlReader& reader, const YAML::Node& node, const std::string& path) {
-  return TypeLoader(reader).parse(node, path);
+std::optional<ChannelType> parse_channel_type(YamlReader& reader, const YAML::Node& node, const std::string& path,
+                                              std::vector<std::string>& included) {
+  return TypeLoader(reader, included).parse(node, path);
 }
 
 YAML::Node channel_type_to_yaml(const ChannelType& type) {
+  if (type.source) {
+    YAML::Node out;
+    out["dbc"] = type.source->dbc;
+    out["message"] = type.source->message;
+    return out;
+  }
   YAML::Node list(YAML::NodeType::Sequence);
   emit_fields(list, type.fields);
   YAML::Node out;

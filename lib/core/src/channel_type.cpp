@@ -74,6 +74,7 @@ class TypeChecker {
       }
       field_type(f.type, at, depth);
       unit_and_range(f, at);
+      if (f.present_when) presence(fields, i, at);
     }
   }
 
@@ -131,6 +132,28 @@ class TypeChecker {
         add(where, "value " + v.name + " = " + std::to_string(v.value) + " does not fit " +
                        std::string(scalar_name(type.scalar)));
       }
+    }
+  }
+
+  void presence(const std::vector<TypeField>& fields, std::size_t index, const std::string& where) {
+    const FieldPresence& when = *fields[index].present_when;
+    const auto selector = std::find_if(fields.begin(), fields.begin() + static_cast<std::ptrdiff_t>(index),
+                                       [&](const TypeField& f) { return f.name == when.selector; });
+    if (selector == fields.begin() + static_cast<std::ptrdiff_t>(index)) {
+      add(where, "its selector '" + when.selector + "' is not a field declared before it in the same record");
+      return;
+    }
+    const FieldType& type = selector->type;
+    const bool integral =
+        (type.kind == FieldType::Kind::scalar || type.kind == FieldType::Kind::enumeration) && is_integer(type.scalar);
+    if (!integral || selector->present_when) {
+      add(where, "its selector '" + when.selector + "' is not an always present integer or enumeration field");
+      return;
+    }
+    const auto [lowest, highest] = scalar_limits(type.scalar);
+    if (static_cast<double>(when.value) < lowest || static_cast<double>(when.value) > highest) {
+      add(where, "its selector value " + std::to_string(when.value) + " does not fit " +
+                     std::string(scalar_name(type.scalar)));
     }
   }
 
@@ -260,20 +283,23 @@ std::string describe(const FieldType& type) {
   return "?";
 }
 
+std::string describe(const TypeField& f) {
+  std::string out = f.name + ": " + describe(f.type);
+  if (!f.unit.empty() || f.minimum || f.maximum) {
+    std::string extra = f.unit;
+    if (f.minimum || f.maximum) {
+      extra += (extra.empty() ? "" : ", ") + (f.minimum ? number_text(*f.minimum) : std::string()) + ".." +
+               (f.maximum ? number_text(*f.maximum) : std::string());
+    }
+    out += " [" + extra + "]";
+  }
+  if (f.present_when) out += " when " + f.present_when->selector + "=" + std::to_string(f.present_when->value);
+  return out;
+}
+
 std::string describe(const ChannelType& type) {
   std::string out = "{";
-  for (std::size_t i = 0; i < type.fields.size(); ++i) {
-    const TypeField& f = type.fields[i];
-    out += (i ? ", " : "") + f.name + ": " + describe(f.type);
-    if (!f.unit.empty() || f.minimum || f.maximum) {
-      std::string extra = f.unit;
-      if (f.minimum || f.maximum) {
-        extra += (extra.empty() ? "" : ", ") + (f.minimum ? number_text(*f.minimum) : std::string()) + ".." +
-                 (f.maximum ? number_text(*f.maximum) : std::string());
-      }
-      out += " [" + extra + "]";
-    }
-  }
+  for (std::size_t i = 0; i < type.fields.size(); ++i) out += (i ? ", " : "") + describe(type.fields[i]);
   return out + "}";
 }
 

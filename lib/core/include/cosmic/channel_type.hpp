@@ -58,17 +58,36 @@ struct FieldType {
   friend bool operator==(const FieldType&, const FieldType&) = default;
 };
 
+// A field its record carries only while another field, its selector, holds one value: a DBC
+// message's multiplexed signals (the selector is the multiplexor switch). The selector is an integer
+// or enumeration field declared earlier in the same record that is always present.
+struct FieldPresence {
+  std::string selector;
+  std::int64_t value = 0;
+  friend bool operator==(const FieldPresence&, const FieldPresence&) = default;
+};
+
 struct TypeField {
   std::string name;
   FieldType type;
   std::string unit;               // a numeric field's (or numeric elements') unit, e.g. "m/s"; empty: none
   std::optional<double> minimum;  // a numeric field's declared range, within its kind's limits
   std::optional<double> maximum;
+  std::optional<FieldPresence> present_when;  // none: always present
   friend bool operator==(const TypeField&, const TypeField&) = default;
+};
+
+// Where a type was read from, when not written inline: the configuration writes it back this way
+// (a bind or state file names the DBC message, not its fields).
+struct TypeSource {
+  std::string dbc;      // the DBC file, as resolved against the configuration's directory
+  std::string message;  // the BO_ message's name
+  friend bool operator==(const TypeSource&, const TypeSource&) = default;
 };
 
 struct ChannelType {
   std::vector<TypeField> fields;
+  std::optional<TypeSource> source;  // none: declared inline
   friend bool operator==(const ChannelType&, const ChannelType&) = default;
 };
 
@@ -87,7 +106,9 @@ bool valid_field_name(std::string_view name);
 // "pose.x"); empty when the type is sound: names valid and unique per record, enumerations with
 // unique names and values their underlying integer holds, bounds and arrays at least 1 and at most
 // kMaxTypeBound, element types present exactly where needed, units and ranges only on numeric
-// fields, ranges within their kind and not reversed, nesting and size within the bounds above.
+// fields, ranges within their kind and not reversed, nesting and size within the bounds above, a
+// presence condition's selector an earlier, always present integer or enumeration field of the same
+// record whose kind holds the value.
 struct TypeProblem {
   std::string where;
   std::string what;
@@ -99,8 +120,11 @@ std::vector<TypeProblem> check_type(const ChannelType& type);
 bool is_numeric(const FieldType& type);
 
 // How `cosmicctl channel` and errors show a type: "float64", "uint8[4]", "sequence<int32, 10>",
-// "string<=32>", "enum int32 {OFF=0, ON=1}", "{x: float64, y: float64}".
+// "string<=32>", "enum int32 {OFF=0, ON=1}", "{x: float64, y: float64}", "{mode: uint8, dtc:
+// uint16 when mode=0}".
 std::string describe(const FieldType& type);
+// "distance: float32 [m, 0..40]", "dtc: uint16 when mode=0".
+std::string describe(const TypeField& field);
 std::string describe(const ChannelType& type);
 
 // The shortest text that reads back as the same double (ranges in errors, descriptions and YAML).

@@ -1,0 +1,156 @@
+// `cosmicctl types FILE`: what a type file defines, as a typed channel would see it (issue 35). A
+// DBC file (.dbc): every message with its identifier, length and cycle time, and the fields its
+// signals become (cosmic/dbc_type.hpp) with each signal's layout, or why the message cannot be a
+// channel's type. With --json the same as one JSON document. Offline: reads FILE, nothing else.
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "cosmic/dbc.hpp"
+#include "cosmic/dbc_type.hpp"
+
+namespace cosmicctl {
+namespace {
+
+using Json = nlohmann::json;
+
+struct TypesOptions {
+  std::string file;
+};
+
+// The whole of FILE when it is a regular file of at most kDbcMaxTextBytes; else prints why.
+std::optional<std::string> read_type_file(const std::string& file) {
+  struct stat info {};
+  if (::stat(file.c_str(), &info) != 0) {
+    std::cerr << "cosmicctl types: cannot read " << file << ": " << std::strerror(errno) << "\n";
+    return std::nullopt;
+  }
+  if (!S_ISREG(info.st_mode) || static_cast<std::uint64_t>(info.st_size) > cosmic::kDbcMaxTextBytes) {
+    std::cerr << "cosmicctl types: " << file << " is not a regular file of at most " << (cosmic::kDbcMaxTextBytes >> 20)
+              << " MiB\n";
+    return std::nullopt;
+  }
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in && !in.eof()) {
+    std::cerr << "cosmicctl types: cannot read " << file << "\n";
+    return std::nullopt;
+  }
+  return text.str();
+}
+
+std::string hex_id(const cosmic::DbcMessage& m) {
+  char buffer[16];
+  std::snprintf(buffer, sizeof buffer, m.extended ? "0x%08X" : "0x%03X", m.can_id);
+  return buffer;
+}
+
+// "8|16@1+ (0.01,0)", as SG_ writes it.
+std::string layout(const cosmic::DbcSignal& s) {
+  std::ostringstream out;
+  out << s.start_bit << "|" << s.size << "@" << (s.order == cosmic::DbcByteOrder::big_endian ? "0" : "1")
+      << (s.is_signed ? "-" : "+") << " (" << cosmic::shortest_number_text(s.factor) << ","
+      << cosmic::shortest_number_text(s.offset) << ")";
+  if (s.value_type != cosmic::DbcValueType::integer)
+    out << (s.value_type == cosmic::DbcValueType::float32 ? " float32" : " float64");
+  return out.str();
+}
+
+Json field_json(const cosmic::TypeField& f, const cosmic::DbcSignal& s) {
+  Json out{{"name", f.name}, {"type", cosmic::describe(f.type)}, {"layout", layout(s)}};
+  if (!f.unit.empty()) out["unit"] = f.unit;
+  if (f.minimum) out["min"] = *f.minimum;
+  if (f.maximum) out["max"] = *f.maximum;
+  if (f.present_when) out["present_when"] = {{"selector", f.present_when->selector}, {"value", f.present_when->value}};
+  return out;
+}
+
+Json message_json(const cosmic::DbcMessage& m) {
+  Json out{{"name", m.name},     {"can_id", m.can_id}, {"extended", m.extended},
+           {"length", m.length}, {"line", m.line},     {"cycle_ms", nullptr}};
+  if (m.cycle_time) out["cycle_ms"] = std::chrono::duration<double, std::milli>(*m.cycle_time).count();
+  const cosmic::DbcChannelType typed = cosmic::channel_type_from_dbc(m);
+  if (!typed.ok()) {
+    out["error"] = std::to_string(typed.errors.front().line) + ":" + std::to_string(typed.errors.front().column) +
+                   ": " + typed.errors.front().message;
+    return out;
+  }
+  Json fields = Json::array();
+  for (std::size_t i = 0; i < typed.type.fields.size(); ++i)
+    fields.push_back(field_json(typed.type.fields[i], m.signals[i]));
+  out["fields"] = std::move(fields);
+  return out;
+}
+
+void print_message(const cosmic::DbcMessage& m) {
+  std::cout << m.name << ": id " << hex_id(m) << (m.extended ? " (extended)" : "") << ", " << m.length << " bytes, ";
+  if (m.cycle_time) {
+    std::cout << "every "
+              << cosmic::shortest_number_text(std::chrono::duration<double, std::milli>(*m.cycle_time).count())
+              << " ms\n";
+  } else {
+    std::cout << "on event\n";
+  }
+  const cosmic::DbcChannelType typed = cosmic::channel_type_from_dbc(m);
+  if (!typed.ok()) {
+    for (const auto& e : typed.errors) std::cout << "  not a type: line " << e.line << ": " << e.message << "\n";
+    return;
+  }
+  // One field per signal, in order: the type beside the layout it comes from.
+  for (std::size_t i = 0; i < typed.type.fields.size(); ++i) {
+    std::cout << "  " << cosmic::describe(typed.type.fields[i]) << "   <- " << layout(m.signals[i]) << "\n";
+  }
+}
+
+int run_types(const TypesOptions& o, const GlobalOptions& global) {
+  if (!o.file.ends_with(".dbc") && !o.file.ends_with(".DBC")) {
+    std::cerr << "cosmicctl types: " << o.file << ": not a DBC file (.dbc), the type file this version reads\n";
+    return kExitUsage;
+  }
+  const auto text = read_type_file(o.file);
+  if (!text) return kExitConfigError;
+  const cosmic::DbcFile dbc = cosmic::parse_dbc(*text);
+  if (!dbc.ok()) {
+    for (const auto& e : dbc.errors)
+      std::cerr << o.file << ":" << e.line << ":" << e.column << ": " << e.message << "\n";
+    return kExitConfigError;
+  }
+  if (global.json) {
+    Json types = Json::array();
+    for (const auto& m : dbc.messages) types.push_back(message_json(m));
+    std::cout << Json{{"file", o.file}, {"format", "dbc"}, {"types", std::move(types)}}.dump(2) << "\n";
+    return kExitOk;
+  }
+  std::cout << o.file << ": DBC, " << dbc.messages.size() << " messages\n";
+  for (const auto& m : dbc.messages) print_message(m);
+  return kExitOk;
+}
+
+}  // namespace
+
+CommandRunner add_types_command(CLI::App& app, const GlobalOptions& options) {
+  auto* command = app.add_subcommand(
+      "types",
+      "List the types a DBC file defines: each message's fields as a typed channel (type: {dbc: ...}) sees them");
+  auto o = std::make_shared<TypesOptions>();
+  command->add_option("FILE", o->file, "Type file: a DBC file (.dbc)")->required();
+  return [command, o, &options]() -> int {
+    if (!command->parsed()) return -1;
+    return run_types(*o, options);
+  };
+}
+
+}  // namespace cosmicctl
