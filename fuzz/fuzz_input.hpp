@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <span>
 
@@ -37,9 +38,12 @@ class FuzzInput {
   std::span<const std::uint8_t> rest_;
 };
 
-// A broken invariant is a finding: abort so libFuzzer saves the input.
-inline void require(bool condition) {
-  if (!condition) std::abort();
+// A broken invariant is a finding: say which, and abort so libFuzzer saves the input.
+// (clang-14 with libstdc++ 12 has no std::source_location: the builtins it rests on.)
+inline void require(bool condition, const char* file = __builtin_FILE(), int line = __builtin_LINE()) {
+  if (condition) return;
+  std::fprintf(stderr, "broken invariant at %s:%d\n", file, line);
+  std::abort();
 }
 
 }  // namespace cosmic::fuzz

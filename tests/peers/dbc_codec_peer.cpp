@@ -7,6 +7,12 @@
 //   {"encode": "MESSAGE", "values": {"SIGNAL": physical, ...}}  -> {"data": "HEX"}
 //     (the signals not given are 0 bits; a value the signal cannot hold is {"error": "..."})
 //   {"type": "MESSAGE"}                          -> {"type": "<describe() of the channel type>"}
+// and through the typed channel's representations (cosmic/dbc_frames.hpp, cosmic/json_representation.hpp):
+//   {"json": "MESSAGE", "data": "HEX"}          -> {"json": {the event as JSON}}
+//     (the frame to the compact layout, then JSON)
+//   {"pack": "MESSAGE", "fields": {"FIELD": number, ...}}  -> {"data": "HEX"}
+//     (the fields into the compact layout, an enumeration at its raw value, then the frame; a field
+//      not given is 0; {"error": ...} for a value out of range, which is dropped)
 // Exit status 2 when the DBC file does not read.
 #include <cstdio>
 #include <fstream>
@@ -18,8 +24,11 @@
 #include <nlohmann/json.hpp>
 
 #include "cosmic/dbc.hpp"
+#include "cosmic/compact_layout.hpp"
 #include "cosmic/dbc_codec.hpp"
+#include "cosmic/dbc_frames.hpp"
 #include "cosmic/dbc_type.hpp"
+#include "cosmic/json_representation.hpp"
 
 namespace {
 
@@ -77,13 +86,56 @@ Json encode(const cosmic::DbcMessage& m, const Json& values) {
   return Json{{"data", to_hex(data)}};
 }
 
+Json typed_json(const cosmic::DbcMessage& m, const std::string& hex) {
+  const auto type = cosmic::channel_type_from_dbc(m).type;
+  const auto codec = cosmic::DbcFrameCodec::make(m, type);
+  if (!codec) return Json{{"error", codec.error().text}};
+  std::vector<std::uint8_t> frame = from_hex(hex);
+  frame.resize(m.length);
+  std::vector<std::uint8_t> compact(codec.value().compact_size());
+  if (!codec.value().to_compact(frame, compact)) return Json{{"error", "short frame"}};
+  const cosmic::JsonRepresentation json{cosmic::ChannelType(type)};
+  std::string text(json.max_size(), '\0');
+  const auto size = json.write(compact, std::span<char>(text.data(), text.size()));
+  if (!size) return Json{{"error", "not an event"}};
+  return Json{{"json", Json::parse(text.substr(0, *size))}};
+}
+
+Json typed_pack(const cosmic::DbcMessage& m, const Json& fields) {
+  const auto type = cosmic::channel_type_from_dbc(m).type;
+  const auto codec = cosmic::DbcFrameCodec::make(m, type);
+  const auto layout = cosmic::CompactLayout::of_flat_record(type);
+  if (!codec || !layout) return Json{{"error", "no typed codec"}};
+  std::vector<std::uint8_t> compact(layout.value().size());
+  for (std::size_t i = 0; i < type.fields.size(); ++i) {
+    if (!fields.contains(type.fields[i].name)) continue;
+    const Json& given = fields[type.fields[i].name];
+    const auto& slot = layout.value().slots()[i];
+    cosmic::ScalarValue value;
+    if (slot.kind == cosmic::ScalarKind::float32 || slot.kind == cosmic::ScalarKind::float64) {
+      value.real = given.get<double>();
+    } else if (cosmic::is_signed_integer(slot.kind)) {
+      value.integer = given.get<std::int64_t>();
+    } else {
+      value.unsigned_integer = given.get<std::uint64_t>();
+    }
+    cosmic::write_scalar(slot.kind, value, compact.data() + slot.offset);
+  }
+  std::vector<std::uint8_t> frame(m.length);
+  const auto packed = codec.value().to_frame(compact, frame, cosmic::RangePolicy::drop);
+  if (!packed.sent) return Json{{"error", std::to_string(packed.out_of_range) + " out of range"}};
+  return Json{{"data", to_hex(frame)}};
+}
+
 Json answer(const cosmic::DbcFile& file, const Json& request) {
-  for (const char* verb : {"decode", "encode", "type"}) {
+  for (const char* verb : {"decode", "encode", "type", "json", "pack"}) {
     if (!request.contains(verb)) continue;
     const cosmic::DbcMessage* m = find(file, request[verb].get<std::string>());
     if (m == nullptr) return Json{{"error", "no message " + request[verb].get<std::string>()}};
     if (std::string(verb) == "decode") return decode(*m, request.at("data").get<std::string>());
     if (std::string(verb) == "encode") return encode(*m, request.at("values"));
+    if (std::string(verb) == "json") return typed_json(*m, request.at("data").get<std::string>());
+    if (std::string(verb) == "pack") return typed_pack(*m, request.at("fields"));
     const auto typed = cosmic::channel_type_from_dbc(*m);
     return typed.ok() ? Json{{"type", cosmic::describe(typed.type)}} : Json{{"error", typed.errors.front().message}};
   }

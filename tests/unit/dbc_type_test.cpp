@@ -88,6 +88,13 @@ TEST(DbcType, WhatATypeCannotHoldIsRefusedAtTheSignal) {
       type_errors("BO_ 1 A: 8 X\n SG_ M0 M : 0|8@1+ (1,0) [0|0] \"\" X\n SG_ Sub m1M : 8|8@1+ (1,0) [0|0] \"\" X\n"),
       std::vector<std::string>{"3:2: signal 'Sub' is itself a multiplexor inside a multiplexed frame "
                                "(extended multiplexing), which typed channels do not decode"});
+  EXPECT_EQ(
+      type_errors("BO_ 1 A: 8 X\n SG_ P : 0|12@1+ (1,0) [0|0] \"\" X\n SG_ Q : 15|8@0+ (1,0) [0|0] \"\" X\n"),
+      std::vector<std::string>{"3:2: signal 'Q' shares bits of byte 1 with signal 'P', which the same frame carries"});
+  // Multiplexed by different switch values, they never meet in one frame.
+  EXPECT_TRUE(type_errors("BO_ 1 A: 8 X\n SG_ M M : 0|8@1+ (1,0) [0|0] \"\" X\n SG_ P m0 : 8|16@1+ (1,0) [0|0] \"\" X\n"
+                          " SG_ Q m1 : 8|8@1+ (1,0) [0|0] \"\" X\n")
+                  .empty());
   EXPECT_EQ(type_errors("BO_ 1 A: 8 X\n"),
             std::vector<std::string>{"1:1: message 'A' has no signals to make fields of"});
 }

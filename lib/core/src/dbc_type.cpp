@@ -80,6 +80,47 @@ std::optional<FieldType> whole_number(const DbcSignal& s) {
 
 DbcError at(const DbcSignal& s, std::string message) { return DbcError{s.line, s.column, std::move(message)}; }
 
+using BitMask = std::array<std::uint8_t, 64>;  // the bits of a CAN FD frame's data
+
+BitMask bits_of(const DbcSignal& s) {
+  BitMask mask{};
+  dbc_write_bits(s, ~std::uint64_t{0}, mask);
+  return mask;
+}
+
+bool multiplexed(const DbcSignal& s) {
+  return s.multiplex == DbcMultiplex::multiplexed || s.multiplex == DbcMultiplex::multiplexed_multiplexor;
+}
+
+// Two signals one frame can carry together (not two multiplexed ones of different switch values)
+// must not share a bit: packing one would overwrite the other.
+std::optional<DbcError> overlap(const DbcMessage& message) {
+  std::vector<BitMask> masks;
+  masks.reserve(message.signals.size());
+  for (const DbcSignal& s : message.signals) masks.push_back(bits_of(s));
+  for (std::size_t a = 0; a < masks.size(); ++a) {
+    for (std::size_t b = 0; b < a; ++b) {
+      const DbcSignal& x = message.signals[a];
+      const DbcSignal& y = message.signals[b];
+      if (multiplexed(x) && multiplexed(y) && x.multiplex_value != y.multiplex_value) continue;
+      for (std::size_t i = 0; i < masks[a].size(); ++i) {
+        if ((masks[a][i] & masks[b][i]) == 0) continue;
+        return at(x, "signal " + quote_value(x.name) + " shares bits of byte " + std::to_string(i) + " with signal " +
+                         quote_value(y.name) + ", which the same frame carries");
+      }
+    }
+  }
+  return std::nullopt;
+}
+
+// The switch field's value when its raw value is `raw`: raw for an enumeration (raw values), else
+// raw * factor + offset (whole: channel_type_from_dbc refuses another scaling).
+std::int64_t selector_value(const DbcSignal& selector, std::uint32_t raw) {
+  if (!selector.value_names.empty()) return raw;
+  return static_cast<std::int64_t>(raw) * static_cast<std::int64_t>(selector.factor) +
+         static_cast<std::int64_t>(selector.offset);
+}
+
 }  // namespace
 
 FieldType dbc_field_type(const DbcSignal& s) {
@@ -125,7 +166,18 @@ DbcChannelType channel_type_from_dbc(const DbcMessage& message) {
                                       std::to_string(kMaxRecordFields) + " fields"});
     return out;
   }
+  if (const auto shared = overlap(message)) {
+    out.errors.push_back(*shared);
+    return out;
+  }
   const DbcSignal* selector = dbc_multiplexor(message);
+  if (selector != nullptr && dbc_field_type(*selector).kind == FieldType::Kind::scalar &&
+      !is_integer(dbc_field_type(*selector).scalar) && dbc_field_type(*selector).scalar != ScalarKind::boolean) {
+    out.errors.push_back(at(*selector, "multiplexor switch " + quote_value(selector->name) +
+                                           " has a scaling that is not whole, so its values are not the raw "
+                                           "values its multiplexed signals name"));
+    return out;
+  }
   for (const DbcSignal& s : message.signals) {
     if (!valid_field_name(s.name)) {
       out.errors.push_back(at(s, "signal name " + quote_value(s.name) +
@@ -141,6 +193,9 @@ DbcChannelType channel_type_from_dbc(const DbcMessage& message) {
     TypeField field;
     field.name = s.name;
     field.type = dbc_field_type(s);
+    if (&s == selector && field.type.kind == FieldType::Kind::scalar && field.type.scalar == ScalarKind::boolean) {
+      field.type.scalar = ScalarKind::uint8;  // a one-bit switch: a selector is an integer
+    }
     if (field.type.kind == FieldType::Kind::scalar) {
       field.unit = s.unit;
       if (declares_range(s)) {
@@ -149,7 +204,7 @@ DbcChannelType channel_type_from_dbc(const DbcMessage& message) {
       }
     }
     if (s.multiplex == DbcMultiplex::multiplexed && selector != nullptr) {
-      field.present_when = FieldPresence{selector->name, static_cast<std::int64_t>(s.multiplex_value)};
+      field.present_when = FieldPresence{selector->name, selector_value(*selector, s.multiplex_value)};
     }
     out.type.fields.push_back(std::move(field));
   }

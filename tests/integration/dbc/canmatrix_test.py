@@ -11,6 +11,10 @@ multiplexed, 64-bit, a 64-byte CAN FD frame), with a fixed seed:
      packed by canmatrix (its Frame.encode takes raw values), decoded by cosmic to the physical
      values; the physical values packed by cosmic (which rounds to the nearest raw value) to the same
      bytes, decoded by canmatrix to the same values.
+  3. the same through a typed channel's representations: a frame to the compact layout to JSON
+     gives canmatrix's physical values (an enumeration the identifier of canmatrix's value name,
+     by the rule of docs/yaml-reference.md), and fields packed through the compact layout give
+     canmatrix's bytes.
 Exit status 0 when everything agrees; otherwise each disagreement is printed.
 """
 import json
@@ -97,6 +101,73 @@ def random_values(rng, frame):
     return raws, values
 
 
+def value_identifier(description, value):
+    """cosmic::dbc_value_identifier, written again from its documentation."""
+    name = ""
+    for c in description:
+        if c.isascii() and c.isalnum():
+            name += c
+        elif name and not name.endswith("_"):
+            name += "_"
+    name = name.rstrip("_")
+    if not name:
+        return "v%d" % abs(value)
+    if not name[0].isalpha():
+        name = "v" + name
+    return name[:64].rstrip("_")
+
+
+def whole(number):
+    return float(number) == int(number)
+
+
+def typed_fields(frame, raws):
+    """The fields a typed channel's event holds for these raw values: an enumeration or a bool its
+    raw value, an integer field raw * factor + offset in whole numbers, a float field its physical value."""
+    fields = {}
+    for s in frame.signals:
+        if s.name not in raws:
+            continue
+        raw = raws[s.name]
+        if s.values or s.is_float:
+            fields[s.name] = raw
+        elif whole(s.factor) and whole(s.offset):
+            fields[s.name] = raw * int(s.factor) + int(s.offset)
+        else:
+            fields[s.name] = raw * float(s.factor) + float(s.offset)
+    return fields
+
+
+def check_typed(peer, frame, data, raws, problems):
+    name = frame.name
+    decoded = frame.decode(bytearray(data))
+    event = peer.ask({"json": name, "data": data.hex()})
+    if "error" in event:
+        problems.append("%s %s: no JSON event: %s" % (name, data.hex(), event["error"]))
+        return
+    event = event["json"]
+    if set(event) != set(decoded):
+        problems.append("%s %s: JSON has %s, canmatrix %s" % (name, data.hex(), sorted(event), sorted(decoded)))
+        return
+    for signal_name, signal_value in decoded.items():
+        ours, signal = event[signal_name], signal_value.signal
+        if isinstance(ours, str):
+            expected = value_identifier(signal.values.get(int(signal_value.raw_value), ""), int(signal_value.raw_value))
+            if ours != expected:
+                problems.append("%s %s: %s JSON %r, canmatrix names %r" % (name, data.hex(), signal_name, ours, expected))
+        elif isinstance(ours, bool) or signal.values:
+            if int(ours) != int(signal_value.raw_value):
+                problems.append("%s %s: %s JSON %r, canmatrix raw %r" % (name, data.hex(), signal_name, ours,
+                                                                         signal_value.raw_value))
+        elif not same(ours, signal_value.phys_value):
+            problems.append("%s %s: %s JSON %r, canmatrix %r" % (name, data.hex(), signal_name, ours,
+                                                                 signal_value.phys_value))
+    packed = peer.ask({"pack": name, "fields": typed_fields(frame, raws)})
+    expected = bytes(frame.encode(raws)).hex()
+    if packed.get("data") != expected:
+        problems.append("%s %r: the typed path packs %s, canmatrix %s" % (name, raws, packed, expected))
+
+
 def check_message(peer, frame, rng, problems):
     name = frame.name
     length = int(frame.size)
@@ -123,6 +194,7 @@ def check_message(peer, frame, rng, problems):
         if packed_by_cosmic != packed_by_canmatrix:
             problems.append("%s %r: cosmic packs %s, canmatrix %s" % (name, values, packed_by_cosmic.hex(),
                                                                       packed_by_canmatrix.hex()))
+        check_typed(peer, frame, packed_by_canmatrix, raws, problems)
         decoded_by_cosmic = peer.ask({"decode": name, "data": packed_by_canmatrix.hex()})["values"]
         decoded_by_canmatrix = canmatrix_values(frame, packed_by_cosmic)
         for signal, value in values.items():

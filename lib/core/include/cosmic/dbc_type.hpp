@@ -11,7 +11,8 @@
 //   - a whole factor and offset: the smallest integer that holds every physical value the raw bits
 //     give and the declared range (unsigned where none is negative);
 //   - otherwise float64.
-// VAL_ descriptions become identifiers (dbc_value_identifier).
+// VAL_ descriptions become identifiers (dbc_value_identifier). Refused: two signals the same frame
+// carries (not multiplexed by different switch values) that share a bit.
 #pragma once
 
 #include <cstdint>

@@ -1,0 +1,61 @@
+// A typed channel's hop on a CAN bus in a DBC message's own frame (issue 35, "each hop in its
+// network's own form"): the message's signals packed as the DBC says, converted to and from the
+// compact layout (cosmic/compact_layout.hpp) of the message's type (cosmic/dbc_type.hpp). A unit
+// of its own (its fuzz target: fuzz_dbc_frames).
+//
+// Built once per binding (at bind, on the control thread), then only read: to_compact() and
+// to_frame() run on the forwarding threads, allocate nothing and never throw.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "cosmic/channel_type.hpp"
+#include "cosmic/compact_layout.hpp"
+#include "cosmic/dbc.hpp"
+#include "cosmic/result.hpp"
+
+namespace cosmic {
+
+// What to do with a value the signal's bits cannot hold (issue 35: `on_range`).
+enum class RangePolicy : std::uint8_t { drop, saturate };
+
+class DbcFrameCodec {
+ public:
+  // The codec of `message` for `type`, which must be the message's own type (channel_type_from_dbc);
+  // else why not.
+  static Result<DbcFrameCodec> make(const DbcMessage& message, const ChannelType& type);
+
+  std::size_t frame_length() const { return message_.length; }
+  std::size_t compact_size() const { return layout_.size(); }
+
+  // A received frame's data (at least frame_length() bytes; CAN FD padding beyond is ignored) as
+  // one event in the compact layout (compact_size() bytes): each signal the frame carries at its
+  // physical value (an enumeration at its raw value), the others zero. False, writing nothing, when
+  // the frame is shorter than the message.
+  bool to_compact(std::span<const std::uint8_t> frame, std::span<std::uint8_t> compact) const;
+
+  struct Packed {
+    bool sent = false;               // false: a value out of range under RangePolicy::drop
+    std::uint32_t out_of_range = 0;  // values the signals could not hold (saturated or the reason to drop)
+  };
+  // An event in the compact layout (compact_size() bytes) as the frame's data (frame_length()
+  // bytes; unused bits 0): the present fields packed into their signals.
+  Packed to_frame(std::span<const std::uint8_t> compact, std::span<std::uint8_t> frame, RangePolicy policy) const;
+
+ private:
+  struct FieldCodec {
+    std::size_t signal = 0;  // index in message_.signals, and of the layout's slot
+    bool raw = false;        // an enumeration: the raw value; else the physical one
+    bool whole = false;      // an integer field: raw * factor + offset in whole numbers
+    std::int64_t factor = 1, offset = 0;
+  };
+
+  DbcMessage message_;
+  CompactLayout layout_;
+  std::vector<FieldCodec> fields_;
+};
+
+}  // namespace cosmic
