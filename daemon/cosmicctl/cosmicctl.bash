@@ -86,7 +86,7 @@ _cosmicctl() {
     types)
       [ -n "$file" ] && return
       compopt -o filenames 2>/dev/null
-      mapfile -t COMPREPLY < <(compgen -f -X '!*.dbc' -- "$cur"; compgen -f -X '!*.DBC' -- "$cur"; compgen -d -- "$cur")
+      mapfile -t COMPREPLY < <(compgen -f -X '!*.dbc' -- "$cur"; compgen -f -X '!*.DBC' -- "$cur"; compgen -f -X '!*.lcm' -- "$cur"; compgen -d -- "$cur")
       ;;
     channel | unbind)
       [ -n "$file" ] && return

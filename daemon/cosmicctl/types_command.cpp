@@ -1,9 +1,12 @@
 // `cosmicctl types FILE`: what a type file defines, as a typed channel would see it (issue 35). A
 // DBC file (.dbc): every message with its identifier, length and cycle time, and the fields its
 // signals become (cosmic/dbc_type.hpp) with each signal's layout, or why the message cannot be a
-// channel's type. With --json the same as one JSON document. Offline: reads FILE, nothing else.
+// channel's type. An LCM type file (.lcm): every struct with the fingerprint lcm-gen gives it, its
+// constants and its fields (cosmic/lcm_types.hpp). With --json the same as one JSON document.
+// Offline: reads FILE, nothing else.
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
@@ -20,6 +23,7 @@
 #include "commands.hpp"
 #include "cosmic/dbc.hpp"
 #include "cosmic/dbc_type.hpp"
+#include "cosmic/lcm_types.hpp"
 
 namespace cosmicctl {
 namespace {
@@ -69,6 +73,12 @@ std::string layout(const cosmic::DbcSignal& s) {
   return out.str();
 }
 
+// The signal a field of the message's type comes from (the same name; the switch's field is first).
+const cosmic::DbcSignal& signal_of(const cosmic::DbcMessage& m, const cosmic::TypeField& f) {
+  return *std::find_if(m.signals.begin(), m.signals.end(),
+                       [&](const cosmic::DbcSignal& s) { return s.name == f.name; });
+}
+
 Json field_json(const cosmic::TypeField& f, const cosmic::DbcSignal& s) {
   Json out{{"name", f.name}, {"type", cosmic::describe(f.type)}, {"layout", layout(s)}};
   if (!f.unit.empty()) out["unit"] = f.unit;
@@ -90,7 +100,7 @@ Json message_json(const cosmic::DbcMessage& m) {
   }
   Json fields = Json::array();
   for (std::size_t i = 0; i < typed.type.fields.size(); ++i)
-    fields.push_back(field_json(typed.type.fields[i], m.signals[i]));
+    fields.push_back(field_json(typed.type.fields[i], signal_of(m, typed.type.fields[i])));
   out["fields"] = std::move(fields);
   return out;
 }
@@ -111,17 +121,73 @@ void print_message(const cosmic::DbcMessage& m) {
   }
   // One field per signal, in order: the type beside the layout it comes from.
   for (std::size_t i = 0; i < typed.type.fields.size(); ++i) {
-    std::cout << "  " << cosmic::describe(typed.type.fields[i]) << "   <- " << layout(m.signals[i]) << "\n";
+    std::cout << "  " << cosmic::describe(typed.type.fields[i]) << "   <- "
+              << layout(signal_of(m, typed.type.fields[i])) << "\n";
   }
 }
 
+std::string hex64(std::uint64_t v) {
+  char buffer[24];
+  std::snprintf(buffer, sizeof buffer, "0x%016llx", static_cast<unsigned long long>(v));
+  return buffer;
+}
+
+int run_lcm_types(const TypesOptions& o, const GlobalOptions& global, const std::string& text) {
+  const cosmic::LcmTypeFile file = cosmic::parse_lcm_types(text);
+  if (!file.ok()) {
+    for (const auto& e : file.errors)
+      std::cerr << o.file << ":" << e.line << ":" << e.column << ": " << e.message << "\n";
+    return kExitConfigError;
+  }
+  Json types = Json::array();
+  for (const cosmic::LcmStruct& s : file.structs) {
+    const auto fingerprint = cosmic::lcm_fingerprint(file, s);
+    const cosmic::LcmChannelType typed = cosmic::lcm_channel_type(file, s);
+    Json entry{
+        {"name", s.full_name()}, {"line", s.line}, {"fingerprint", fingerprint ? Json(hex64(*fingerprint)) : Json()}};
+    Json constants = Json::array();
+    for (const auto& c : s.constants) constants.push_back({{"name", c.name}, {"type", c.type}, {"value", c.value}});
+    entry["constants"] = std::move(constants);
+    Json fields = Json::array();
+    for (const auto& f : typed.type.fields) fields.push_back({{"name", f.name}, {"type", cosmic::describe(f.type)}});
+    entry["fields"] = std::move(fields);
+    if (!typed.ok()) {
+      entry["error"] = std::to_string(typed.errors.front().line) + ":" + std::to_string(typed.errors.front().column) +
+                       ": " + typed.errors.front().message;
+    }
+    types.push_back(std::move(entry));
+  }
+  if (global.json) {
+    std::cout << Json{{"file", o.file}, {"format", "lcm"}, {"types", std::move(types)}}.dump(
+                     2, ' ', false, Json::error_handler_t::replace)
+              << "\n";
+    return kExitOk;
+  }
+  std::cout << o.file << ": LCM, " << file.structs.size() << " structs\n";
+  for (const Json& t : types) {
+    std::cout << t["name"].get<std::string>() << ": fingerprint "
+              << (t["fingerprint"].is_null() ? std::string("none") : t["fingerprint"].get<std::string>()) << "\n";
+    for (const Json& c : t["constants"]) {
+      std::cout << "  const " << c["type"].get<std::string>() << " " << c["name"].get<std::string>() << " = "
+                << c["value"].get<std::string>() << "\n";
+    }
+    for (const Json& f : t["fields"])
+      std::cout << "  " << f["name"].get<std::string>() << ": " << f["type"].get<std::string>() << "\n";
+    if (t.contains("error")) std::cout << "  not a type as it stands: line " << t["error"].get<std::string>() << "\n";
+  }
+  return kExitOk;
+}
+
 int run_types(const TypesOptions& o, const GlobalOptions& global) {
-  if (!o.file.ends_with(".dbc") && !o.file.ends_with(".DBC")) {
-    std::cerr << "cosmicctl types: " << o.file << ": not a DBC file (.dbc), the type file this version reads\n";
+  const bool lcm = o.file.ends_with(".lcm");
+  if (!lcm && !o.file.ends_with(".dbc") && !o.file.ends_with(".DBC")) {
+    std::cerr << "cosmicctl types: " << o.file << ": not a DBC file (.dbc) or an LCM type file (.lcm), the type files "
+              << "this version reads\n";
     return kExitUsage;
   }
   const auto text = read_type_file(o.file);
   if (!text) return kExitConfigError;
+  if (lcm) return run_lcm_types(o, global, *text);
   const cosmic::DbcFile dbc = cosmic::parse_dbc(*text);
   if (!dbc.ok()) {
     for (const auto& e : dbc.errors)
@@ -131,7 +197,10 @@ int run_types(const TypesOptions& o, const GlobalOptions& global) {
   if (global.json) {
     Json types = Json::array();
     for (const auto& m : dbc.messages) types.push_back(message_json(m));
-    std::cout << Json{{"file", o.file}, {"format", "dbc"}, {"types", std::move(types)}}.dump(2) << "\n";
+    // A DBC file's units and names may be Windows-1252, not UTF-8: replaced, never a throw.
+    std::cout << Json{{"file", o.file}, {"format", "dbc"}, {"types", std::move(types)}}.dump(
+                     2, ' ', false, Json::error_handler_t::replace)
+              << "\n";
     return kExitOk;
   }
   std::cout << o.file << ": DBC, " << dbc.messages.size() << " messages\n";
@@ -146,7 +215,7 @@ CommandRunner add_types_command(CLI::App& app, const GlobalOptions& options) {
       "types",
       "List the types a DBC file defines: each message's fields as a typed channel (type: {dbc: ...}) sees them");
   auto o = std::make_shared<TypesOptions>();
-  command->add_option("FILE", o->file, "Type file: a DBC file (.dbc)")->required();
+  command->add_option("FILE", o->file, "Type file: a DBC file (.dbc) or an LCM type file (.lcm)")->required();
   return [command, o, &options]() -> int {
     if (!command->parsed()) return -1;
     return run_types(*o, options);

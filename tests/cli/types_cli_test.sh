@@ -50,7 +50,7 @@ json_check mixed_json '
 
 # 4. Bad input: exit 64 for what is not a DBC file, 2 for what does not read, every DBC error located.
 run not_dbc 64 types "$SRC/config/robot.yaml"
-contains not_dbc err "robot.yaml: not a DBC file (.dbc), the type file this version reads"
+contains not_dbc err "robot.yaml: not a DBC file (.dbc) or an LCM type file (.lcm), the type files this version reads"
 run missing 2 types "$WORK/none.dbc"
 contains missing err "cannot read $WORK/none.dbc: No such file or directory"
 mkdir "$WORK/dir.dbc"

@@ -246,9 +246,9 @@ TEST(ChannelTypeYaml, ADbcMessageGivesTheFieldsAndIsWrittenBackAsItsSource) {
             "{SpeedFL: float64 [km/h, 0..655.35], SpeedFR: float64 [km/h, 0..655.35], SpeedRL: float64 [km/h, "
             "0..655.35], SpeedRR: float64 [km/h, 0..655.35]}");
   ASSERT_TRUE(scan.type->source.has_value());
-  EXPECT_EQ(scan.type->source->message, "WheelSpeeds");
-  EXPECT_EQ(scan.type->source->dbc, std::string(build_paths::dbc_dir) + "/body.dbc");
-  EXPECT_NE(std::find(r.included_files.begin(), r.included_files.end(), scan.type->source->dbc),
+  EXPECT_EQ(scan.type->source->name, "WheelSpeeds");
+  EXPECT_EQ(scan.type->source->file, std::string(build_paths::dbc_dir) + "/body.dbc");
+  EXPECT_NE(std::find(r.included_files.begin(), r.included_files.end(), scan.type->source->file),
             r.included_files.end());
   const std::string written = channel_to_yaml(scan);
   EXPECT_NE(written.find("message: WheelSpeeds"), std::string::npos) << written;
@@ -290,6 +290,50 @@ TEST(ChannelTypeYaml, DbcTypeProblemsAreLocatedInTheYamlOrTheDbcFile) {
                       ":2:2: channels[0].type.message: signal name '_s' is not a field name"),
             std::string::npos)
       << errors_for("{dbc: underscore.dbc, message: A}");
+  std::filesystem::remove_all(dir);
+}
+
+TEST(ChannelTypeYaml, AnLcmStructGivesTheFieldsAndIsWrittenBackWithItsBounds) {
+  const auto dir = std::filesystem::temp_directory_path() / ("cosmic-lcm-type-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "scan.lcm") << "package sensors;\nstruct scan_t {\n  int64_t utime;\n  int32_t n;\n"
+                                     "  float ranges[n];\n  string frame;\n}\n";
+  const auto load = [&](const std::string& type) {
+    return parse_config(std::string(kHead) + "    type: " + type + "\n", (dir / "t.yaml").string());
+  };
+  const ConfigResult r = load("{lcm: scan.lcm, name: sensors.scan_t, max_length: {ranges: 1081}}");
+  ASSERT_TRUE(r.ok()) << listed_errors(r.errors);
+  const ChannelSpec& scan = r.config.channels.at(0);
+  ASSERT_TRUE(scan.type.has_value());
+  EXPECT_EQ(describe(*scan.type), "{utime: int64, n: int32, ranges: sequence<float32, 1081>, frame: string<=65536>}");
+  ASSERT_TRUE(scan.type->source.has_value());
+  EXPECT_EQ(scan.type->source->format, TypeSource::Format::lcm);
+  EXPECT_EQ(scan.type->source->name, "sensors.scan_t");
+  const std::string written = channel_to_yaml(scan);
+  const ChannelsResult again = parse_channels("[" + written + "]", "bind", r.config);
+  ASSERT_TRUE(again.ok()) << listed_errors(again.errors) << written;
+  EXPECT_EQ(again.channels.at(0), scan) << written;
+
+  const std::string lcm = (dir / "scan.lcm").string();
+  EXPECT_NE(listed_errors(load("{lcm: scan.lcm, name: scan_t}").errors)
+                .find("t.yaml:12:33: channels[0].type.name: no struct 'scan_t' in " + lcm),
+            std::string::npos)
+      << listed_errors(load("{lcm: scan.lcm, name: scan_t}").errors);
+  EXPECT_NE(
+      listed_errors(load("{lcm: scan.lcm, name: sensors.scan_t, max_length: {frame: 4}}").errors)
+          .find(lcm +
+                ":2:1: channels[0].type.name: max_length names frame, which is not a variable-length array member"),
+      std::string::npos)
+      << listed_errors(load("{lcm: scan.lcm, name: sensors.scan_t, max_length: {frame: 4}}").errors);
+  EXPECT_NE(listed_errors(load("{lcm: scan.lcm, name: sensors.scan_t, max_length: {ranges: 0}}").errors)
+                .find("channels[0].type.max_length.ranges"),
+            std::string::npos);
+  std::ofstream(dir / "broken.lcm") << "struct t { int16_t b[n]; }\n";
+  EXPECT_NE(
+      listed_errors(load("{lcm: broken.lcm, name: t}").errors)
+          .find((dir / "broken.lcm").string() + ":1:20: channels[0].type.lcm: the size of b, 'n', is not an integer"),
+      std::string::npos)
+      << listed_errors(load("{lcm: broken.lcm, name: t}").errors);
   std::filesystem::remove_all(dir);
 }
 

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <string>
 
 namespace cosmic {
@@ -99,6 +100,58 @@ TEST(DbcType, WhatATypeCannotHoldIsRefusedAtTheSignal) {
             std::vector<std::string>{"1:1: message 'A' has no signals to make fields of"});
 }
 
+TEST(DbcType, TheSwitchComesFirstWhereverTheFileDeclaresIt) {
+  const ChannelType type = type_of(R"dbc(BO_ 1 Diag: 8 X
+ SG_ Dtc m0 : 8|16@1+ (1,0) [0|0] "" X
+ SG_ Mode M : 0|8@1+ (1,0) [0|0] "" X
+ SG_ Level m1 : 8|8@1+ (1,0) [0|0] "" X
+)dbc");
+  EXPECT_EQ(describe(type), "{Mode: uint8, Dtc: uint16 when Mode=0, Level: uint8 when Mode=1}");
+  // A one-bit switch is an integer field (a selector), not a bool.
+  EXPECT_EQ(
+      describe(type_of("BO_ 1 A: 8 X\n SG_ P m1 : 8|8@1+ (1,0) [0|0] \"\" X\n SG_ M M : 0|1@1+ (1,0) [0|0] \"\" X\n")),
+      "{M: uint8, P: uint8 when M=1}");
+  // A whole scaling applies to the switch's value too.
+  EXPECT_EQ(
+      describe(type_of("BO_ 1 A: 8 X\n SG_ M M : 0|4@1+ (2,10) [0|0] \"\" X\n SG_ P m3 : 8|8@1+ (1,0) [0|0] \"\" X\n")),
+      "{M: uint8, P: uint8 when M=16}");
+}
+
+TEST(DbcType, SwitchesThatCannotSelectAreRefused) {
+  EXPECT_EQ(type_errors("BO_ 1 A: 8 X\n SG_ M M : 0|4@1- (1,0) [0|0] \"\" X\n SG_ P m1 : 8|8@1+ (1,0) [0|0] \"\" X\n"),
+            std::vector<std::string>{"2:2: multiplexor switch 'M' is signed: the switch's values are the unsigned raw "
+                                     "values its multiplexed signals name"});
+  EXPECT_EQ(
+      type_errors("BO_ 1 A: 8 X\n SG_ M M : 0|4@1+ (0.5,0) [0|0] \"\" X\n SG_ P m1 : 8|8@1+ (1,0) [0|0] \"\" X\n"),
+      std::vector<std::string>{"2:2: multiplexor switch 'M' is not an integer field (an IEEE float, or a scaling "
+                               "that is not whole): the switch's values are the unsigned raw values its "
+                               "multiplexed signals name"});
+  EXPECT_EQ(type_errors("BO_ 1 A: 8 X\n SG_ M M : 0|2@1+ (1,0) [0|0] \"\" X\n SG_ P m4 : 8|8@1+ (1,0) [0|0] \"\" X\n"),
+            std::vector<std::string>{"3:2: signal 'P' is selected by 'M' = 4, which the switch's 2 bits cannot hold"});
+}
+
+TEST(DbcType, SixtyFourBitValuesPickATypeThatHoldsThemExactly) {
+  // Physical 1..2^64 fits no 64-bit integer: float64, never a wrapped uint64.
+  EXPECT_EQ(describe(type_of("BO_ 1 A: 8 X\n SG_ S : 0|64@1+ (1,1) [0|0] \"\" X\n")), "{S: float64}");
+  EXPECT_EQ(describe(type_of("BO_ 1 A: 8 X\n SG_ S : 0|64@1+ (1,0) [0|0] \"\" X\n")), "{S: uint64}");
+  EXPECT_EQ(describe(type_of("BO_ 1 A: 8 X\n SG_ S : 0|64@1- (1,0) [0|0] \"\" X\n")), "{S: int64}");
+  EXPECT_EQ(describe(type_of("BO_ 1 A: 8 X\n SG_ S : 0|64@1- (-1,0) [0|0] \"\" X\n")), "{S: float64}");
+  EXPECT_EQ(describe(type_of("BO_ 1 A: 8 X\n SG_ S : 0|63@1+ (1,0) [0|0] \"\" X\n")), "{S: uint64}");
+  EXPECT_EQ(type_errors("BO_ 1 A: 8 X\n SG_ S : 0|64@1+ (1,0) [0|0] \"\" X\nVAL_ 1 S -1 \"none\" ;\n"),
+            std::vector<std::string>{"2:2: signal 'S': no integer holds both its raw values and the negative values "
+                                     "its value table names"});
+}
+
+TEST(DbcType, EnumerationNamesStayUniqueAndShort) {
+  const ChannelType type =
+      type_of("BO_ 1 A: 8 X\n SG_ S : 0|8@1+ (1,0) [0|0] \"\" X\nVAL_ 1 S 1 \"A\" 2 \"A 3\" 3 \"A\" 4 \"" +
+              std::string(70, 'b') + "\" 5 \"" + std::string(70, 'b') + "\" ;\n");
+  ASSERT_EQ(type.fields.size(), 1u);
+  EXPECT_EQ(describe(type.fields[0].type),
+            "enum uint8 {A=1, A_3=2, A_3_1=3, " + std::string(64, 'b') + "=4, " + std::string(62, 'b') + "_5=5}");
+  EXPECT_TRUE(check_type(type).empty());
+}
+
 TEST(DbcType, ValueIdentifiers) {
   EXPECT_EQ(dbc_value_identifier("Not available", 7), "Not_available");
   EXPECT_EQ(dbc_value_identifier("  --Off--  ", 0), "Off");
@@ -106,6 +159,7 @@ TEST(DbcType, ValueIdentifiers) {
   EXPECT_EQ(dbc_value_identifier("-", -3), "v3");
   EXPECT_EQ(dbc_value_identifier("Zündung ein", 1), "Z_ndung_ein");
   EXPECT_EQ(dbc_value_identifier(std::string(100, 'a'), 1).size(), 64u);
+  EXPECT_EQ(dbc_value_identifier("-", std::numeric_limits<std::int64_t>::min()), "v9223372036854775808");
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
 #include "background_loader.hpp"
-#include "dbc_file_loader.hpp"
+#include "type_file_loader.hpp"
 
 #include <map>
 #include <set>

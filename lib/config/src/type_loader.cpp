@@ -5,7 +5,8 @@
 #include <map>
 
 #include "cosmic/dbc_type.hpp"
-#include "dbc_file_loader.hpp"
+#include "cosmic/lcm_types.hpp"
+#include "type_file_loader.hpp"
 
 namespace cosmic::config_detail {
 namespace {
@@ -39,6 +40,7 @@ class TypeLoader {
 
   std::optional<ChannelType> parse(const YAML::Node& node, const std::string& path) {
     if (node.IsMap() && has(node, "dbc")) return from_dbc(node, path);
+    if (node.IsMap() && has(node, "lcm")) return from_lcm(node, path);
     if (!reader_.check_map(node, path, {"fields"})) return std::nullopt;
     const std::size_t errors_before = reader_.error_count();
     ChannelType type;
@@ -83,7 +85,54 @@ class TypeLoader {
     for (const DbcError& e : typed.errors)
       reader_.error_in(ConfigError{loaded->path, e.line, e.column, key(path, "message"), e.message, ""});
     if (!typed.ok()) return std::nullopt;
-    typed.type.source = TypeSource{loaded->path, message->name};
+    typed.type.source = TypeSource{TypeSource::Format::dbc, loaded->path, message->name, {}};
+    return std::move(typed.type);
+  }
+
+  // {lcm: FILE, name: pkg.type_t, max_length: {MEMBER: N}}: the struct's members as fields
+  // (cosmic/lcm_types.hpp).
+  std::optional<ChannelType> from_lcm(const YAML::Node& node, const std::string& path) {
+    if (!reader_.check_map(node, path, {"lcm", "name", "max_length"})) return std::nullopt;
+    const auto file = reader_.string(node["lcm"], key(path, "lcm"));
+    if (!has(node, "name")) {
+      reader_.error_at(node, path, "an LCM type names its struct", "name: PACKAGE.TYPE (a struct of the file)");
+      return std::nullopt;
+    }
+    const auto name = reader_.string(node["name"], key(path, "name"));
+    std::map<std::string, std::uint32_t> max_length;
+    if (has(node, "max_length") && !node["max_length"].IsMap()) {
+      reader_.error_at(node["max_length"], key(path, "max_length"), "max_length is a map of members to bounds",
+                       "max_length: {ranges: 1081}");
+    } else if (has(node, "max_length")) {
+      for (const auto& entry : node["max_length"]) {
+        const std::string member = entry.first.as<std::string>();
+        const auto bound =
+            reader_.unsigned_int(entry.second, key(key(path, "max_length"), member), 1, kLcmSequenceBound);
+        if (bound) max_length[member] = static_cast<std::uint32_t>(*bound);
+      }
+    }
+    if (!file || !name) return std::nullopt;
+    const auto loaded =
+        load_named_file(reader_, node["lcm"], key(path, "lcm"), *file, included_, kLcmMaxTextBytes, "LCM type file");
+    if (!loaded) return std::nullopt;
+    const LcmTypeFile lcm = parse_lcm_types(loaded->text);
+    for (const LcmError& e : lcm.errors)
+      reader_.error_in(ConfigError{loaded->path, e.line, e.column, key(path, "lcm"), e.message, ""});
+    if (!lcm.ok()) return std::nullopt;
+    const LcmStruct* s = lcm.find(*name);
+    if (s == nullptr) {
+      std::string names;
+      for (std::size_t i = 0; i < lcm.structs.size() && i < 8; ++i)
+        names += (i ? ", " : "") + lcm.structs[i].full_name();
+      reader_.error_at(node["name"], key(path, "name"), "no struct " + quote_value(*name) + " in " + loaded->path,
+                       lcm.structs.empty() ? "the file declares no struct" : "one of " + names);
+      return std::nullopt;
+    }
+    LcmChannelType typed = lcm_channel_type(lcm, *s, max_length);
+    for (const LcmError& e : typed.errors)
+      reader_.error_in(ConfigError{loaded->path, e.line, e.column, key(path, "name"), e.message, ""});
+    if (!typed.ok()) return std::nullopt;
+    typed.type.source = TypeSource{TypeSource::Format::lcm, loaded->path, s->full_name(), max_length};
     return std::move(typed.type);
   }
 
@@ -327,8 +376,10 @@ std::optional<ChannelType> parse_channel_type(YamlReader& reader, const YAML::No
 YAML::Node channel_type_to_yaml(const ChannelType& type) {
   if (type.source) {
     YAML::Node out;
-    out["dbc"] = type.source->dbc;
-    out["message"] = type.source->message;
+    const bool dbc = type.source->format == TypeSource::Format::dbc;
+    out[dbc ? "dbc" : "lcm"] = type.source->file;
+    out[dbc ? "message" : "name"] = type.source->name;
+    for (const auto& [member, bound] : type.source->max_length) out["max_length"][member] = bound;
     return out;
   }
   YAML::Node list(YAML::NodeType::Sequence);

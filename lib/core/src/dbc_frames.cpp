@@ -71,11 +71,15 @@ Result<DbcFrameCodec> DbcFrameCodec::make(const DbcMessage& message, const Chann
   DbcFrameCodec codec;
   codec.message_ = message;
   codec.layout_ = std::move(layout).value();
-  for (std::size_t i = 0; i < message.signals.size(); ++i) {
-    const DbcSignal& s = message.signals[i];
+  for (std::size_t i = 0; i < type.fields.size(); ++i) {
+    // The fields come in the type's order (the multiplexor switch first), the signals in the file's.
+    const auto signal = std::find_if(message.signals.begin(), message.signals.end(),
+                                     [&](const DbcSignal& s) { return s.name == type.fields[i].name; });
+    const DbcSignal& s = *signal;  // the same names: the type is the message's own
     const FieldType& field = type.fields[i].type;
     FieldCodec f;
-    f.signal = i;
+    f.signal = static_cast<std::size_t>(signal - message.signals.begin());
+    f.slot = i;
     f.raw = field.kind == FieldType::Kind::enumeration || field.scalar == ScalarKind::boolean;
     f.whole = !f.raw && is_integer(field.scalar);
     if (f.whole) {
@@ -94,7 +98,7 @@ bool DbcFrameCodec::to_compact(std::span<const std::uint8_t> frame, std::span<st
   for (const FieldCodec& f : fields_) {
     const DbcSignal& s = message_.signals[f.signal];
     if (!dbc_signal_present(message_, s, data)) continue;
-    const CompactLayout::Slot& slot = layout_.slots()[f.signal];
+    const CompactLayout::Slot& slot = layout_.slots()[f.slot];
     const std::uint64_t bits = dbc_read_bits(s, data);
     const Wide raw = s.is_signed ? Wide{dbc_raw_integer(s, bits)} : Wide{bits};
     ScalarValue value;
@@ -117,9 +121,9 @@ DbcFrameCodec::Packed DbcFrameCodec::to_frame(std::span<const std::uint8_t> comp
   const auto data = frame.first(message_.length);
   std::fill(data.begin(), data.end(), std::uint8_t{0});
   for (const FieldCodec& f : fields_) {
-    if (!layout_.present(f.signal, compact)) continue;
+    if (!layout_.present(f.slot, compact)) continue;
     const DbcSignal& s = message_.signals[f.signal];
-    const CompactLayout::Slot& slot = layout_.slots()[f.signal];
+    const CompactLayout::Slot& slot = layout_.slots()[f.slot];
     const ScalarValue value = read_scalar(slot.kind, compact.data() + slot.offset);
     std::optional<std::uint64_t> bits;
     std::uint64_t saturated = 0;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <set>
 #include <utility>
@@ -19,22 +20,34 @@ bool whole(double value) { return std::fabs(value) < kExactIntegers && std::floo
 
 bool declares_range(const DbcSignal& s) { return s.minimum != 0.0 || s.maximum != 0.0; }
 
-// The smallest integer kind holding [lowest, highest]; nullopt beyond 64 bits.
-std::optional<ScalarKind> smallest_integer(double lowest, double highest) {
-  static constexpr std::array kUnsigned{ScalarKind::uint8, ScalarKind::uint16, ScalarKind::uint32, ScalarKind::uint64};
-  static constexpr std::array kSigned{ScalarKind::int8, ScalarKind::int16, ScalarKind::int32, ScalarKind::int64};
-  for (const ScalarKind kind : lowest >= 0.0 ? kUnsigned : kSigned) {
-    const auto [low, high] = scalar_limits(kind);
-    if (lowest >= low && highest <= high) return kind;
+using Wide = __int128;  // exact for every raw value times a whole factor a double holds below 2^53
+
+// The smallest integer kind holding [lowest, highest] exactly; nullopt beyond 64 bits.
+std::optional<ScalarKind> smallest_integer(Wide lowest, Wide highest) {
+  struct Limits {
+    ScalarKind kind;
+    Wide low, high;
+  };
+  static const std::array<Limits, 8> kinds{{
+      {ScalarKind::uint8, 0, 0xFF},
+      {ScalarKind::uint16, 0, 0xFFFF},
+      {ScalarKind::uint32, 0, 0xFFFF'FFFF},
+      {ScalarKind::uint64, 0, Wide{std::numeric_limits<std::uint64_t>::max()}},
+      {ScalarKind::int8, -128, 127},
+      {ScalarKind::int16, -32768, 32767},
+      {ScalarKind::int32, Wide{std::numeric_limits<std::int32_t>::min()}, std::numeric_limits<std::int32_t>::max()},
+      {ScalarKind::int64, Wide{std::numeric_limits<std::int64_t>::min()}, std::numeric_limits<std::int64_t>::max()},
+  }};
+  for (const Limits& k : kinds) {
+    if ((lowest < 0) == (k.low < 0) && lowest >= k.low && highest <= k.high) return k.kind;
   }
   return std::nullopt;
 }
 
-// The raw range of an integer signal as doubles (exact for 64-bit ends up to rounding).
-std::pair<double, double> raw_range(const DbcSignal& s) {
-  if (!s.is_signed) return {0.0, std::ldexp(1.0, static_cast<int>(s.size)) - 1.0};
-  const double half = std::ldexp(1.0, static_cast<int>(s.size) - 1);
-  return {-half, half - 1.0};
+// The raw range of an integer signal, exactly.
+std::pair<Wide, Wide> raw_range(const DbcSignal& s) {
+  if (!s.is_signed) return {0, (Wide{1} << s.size) - 1};
+  return {-(Wide{1} << (s.size - 1)), (Wide{1} << (s.size - 1)) - 1};
 }
 
 FieldType scalar(ScalarKind kind) {
@@ -44,34 +57,49 @@ FieldType scalar(ScalarKind kind) {
   return type;
 }
 
-FieldType enumeration(const DbcSignal& s) {
+std::string magnitude_text(std::int64_t value) {
+  return std::to_string(value < 0 ? 0 - static_cast<std::uint64_t>(value) : static_cast<std::uint64_t>(value));
+}
+
+// The kind for the raw range and every named value; nullopt when none holds them all (an unsigned
+// 64-bit signal naming a negative value).
+std::optional<FieldType> enumeration(const DbcSignal& s) {
   auto [lowest, highest] = raw_range(s);
   for (const DbcValueName& v : s.value_names) {
-    lowest = std::min(lowest, static_cast<double>(v.value));
-    highest = std::max(highest, static_cast<double>(v.value));
+    lowest = std::min(lowest, Wide{v.value});
+    highest = std::max(highest, Wide{v.value});
   }
-  FieldType type = scalar(smallest_integer(lowest, highest).value_or(ScalarKind::int64));
+  const auto kind = smallest_integer(lowest, highest);
+  if (!kind) return std::nullopt;
+  FieldType type = scalar(*kind);
   type.kind = FieldType::Kind::enumeration;
   std::set<std::string> taken;
   for (const DbcValueName& v : s.value_names) {
-    std::string name = dbc_value_identifier(v.name, v.value);
-    if (!taken.insert(name).second) {
-      name += "_" + std::to_string(v.value < 0 ? -v.value : v.value);
-      taken.insert(name);
+    const std::string base = dbc_value_identifier(v.name, v.value);
+    std::string name = base;
+    // A name given twice gets the value (then a counter) appended, cut to stay within 64 characters.
+    for (int again = 0; !taken.insert(name).second; ++again) {
+      const std::string suffix = "_" + magnitude_text(v.value) + (again > 0 ? "_" + std::to_string(again) : "");
+      name = base.substr(0, 64 - suffix.size()) + suffix;
     }
     type.values.push_back(EnumValue{std::move(name), v.value});
   }
   return type;
 }
 
+// A whole factor and offset: the smallest integer holding every physical value and the declared
+// range, computed exactly.
 std::optional<FieldType> whole_number(const DbcSignal& s) {
   if (!whole(s.factor) || !whole(s.offset)) return std::nullopt;
   const auto [raw_low, raw_high] = raw_range(s);
-  double lowest = std::min(raw_low * s.factor + s.offset, raw_high * s.factor + s.offset);
-  double highest = std::max(raw_low * s.factor + s.offset, raw_high * s.factor + s.offset);
+  const auto factor = static_cast<Wide>(static_cast<std::int64_t>(s.factor));
+  const auto offset = static_cast<Wide>(static_cast<std::int64_t>(s.offset));
+  Wide lowest = std::min(raw_low * factor + offset, raw_high * factor + offset);
+  Wide highest = std::max(raw_low * factor + offset, raw_high * factor + offset);
   if (declares_range(s)) {
-    lowest = std::min(lowest, s.minimum);
-    highest = std::max(highest, s.maximum);
+    if (std::fabs(s.minimum) >= kExactIntegers || std::fabs(s.maximum) >= kExactIntegers) return std::nullopt;
+    lowest = std::min(lowest, static_cast<Wide>(std::floor(s.minimum)));
+    highest = std::max(highest, static_cast<Wide>(std::ceil(s.maximum)));
   }
   const auto kind = smallest_integer(lowest, highest);
   if (!kind) return std::nullopt;
@@ -117,8 +145,9 @@ std::optional<DbcError> overlap(const DbcMessage& message) {
 // raw * factor + offset (whole: channel_type_from_dbc refuses another scaling).
 std::int64_t selector_value(const DbcSignal& selector, std::uint32_t raw) {
   if (!selector.value_names.empty()) return raw;
-  return static_cast<std::int64_t>(raw) * static_cast<std::int64_t>(selector.factor) +
-         static_cast<std::int64_t>(selector.offset);
+  // switch_problem() has checked that this fits.
+  return static_cast<std::int64_t>(Wide{raw} * static_cast<std::int64_t>(selector.factor) +
+                                   static_cast<std::int64_t>(selector.offset));
 }
 
 }  // namespace
@@ -127,7 +156,7 @@ FieldType dbc_field_type(const DbcSignal& s) {
   const bool unscaled = s.factor == 1.0 && s.offset == 0.0;
   if (s.value_type == DbcValueType::float32) return scalar(unscaled ? ScalarKind::float32 : ScalarKind::float64);
   if (s.value_type == DbcValueType::float64) return scalar(ScalarKind::float64);
-  if (!s.value_names.empty()) return enumeration(s);
+  if (!s.value_names.empty()) return enumeration(s).value_or(scalar(ScalarKind::float64));
   const bool flag_range = !declares_range(s) || (s.minimum >= 0.0 && s.maximum <= 1.0);
   if (s.size == 1 && !s.is_signed && unscaled && flag_range) return scalar(ScalarKind::boolean);
   return whole_number(s).value_or(scalar(ScalarKind::float64));
@@ -144,7 +173,7 @@ std::string dbc_value_identifier(std::string_view description, std::int64_t valu
     }
   }
   while (!name.empty() && name.back() == '_') name.pop_back();
-  if (name.empty()) return "v" + std::to_string(value < 0 ? -value : value);
+  if (name.empty()) return "v" + magnitude_text(value);
   if (!((name.front() >= 'A' && name.front() <= 'Z') || (name.front() >= 'a' && name.front() <= 'z')))
     name = "v" + name;
   if (name.size() > 64) name.resize(64);
@@ -152,42 +181,89 @@ std::string dbc_value_identifier(std::string_view description, std::int64_t valu
   return name;
 }
 
+namespace {
+
+// What keeps the switch from selecting its signals as typed fields: it must be an unsigned integer
+// field, and every value its signals name must fit its bits and the field.
+std::optional<DbcError> switch_problem(const DbcMessage& message, const DbcSignal& selector) {
+  const FieldType type = dbc_field_type(selector);
+  const bool integral =
+      type.kind == FieldType::Kind::enumeration || type.scalar == ScalarKind::boolean || is_integer(type.scalar);
+  if (selector.is_signed || !integral) {
+    return at(
+        selector,
+        "multiplexor switch " + quote_value(selector.name) + " is " +
+            (selector.is_signed ? "signed" : "not an integer field (an IEEE float, or a scaling that is not whole)") +
+            ": the switch's values are the unsigned raw values its multiplexed signals name");
+  }
+  const Wide raw_high = raw_range(selector).second;
+  for (const DbcSignal& s : message.signals) {
+    if (s.multiplex != DbcMultiplex::multiplexed) continue;
+    const Wide value = Wide{s.multiplex_value} * static_cast<std::int64_t>(selector.factor) +
+                       static_cast<std::int64_t>(selector.offset);
+    if (Wide{s.multiplex_value} > raw_high || value > std::numeric_limits<std::int64_t>::max()) {
+      return at(s, "signal " + quote_value(s.name) + " is selected by " + quote_value(selector.name) + " = " +
+                       std::to_string(s.multiplex_value) + ", which the switch's " + std::to_string(selector.size) +
+                       " bits cannot hold");
+    }
+  }
+  return std::nullopt;
+}
+
+// The switch first (a field's selector comes before it), then the others in the message's order.
+std::vector<const DbcSignal*> field_order(const DbcMessage& message, const DbcSignal* selector) {
+  std::vector<const DbcSignal*> order;
+  if (selector != nullptr) order.push_back(selector);
+  for (const DbcSignal& s : message.signals) {
+    if (&s != selector) order.push_back(&s);
+  }
+  return order;
+}
+
+std::optional<DbcError> field_problem(const DbcSignal& s) {
+  if (!valid_field_name(s.name)) {
+    return at(s, "signal name " + quote_value(s.name) +
+                     " is not a field name ([A-Za-z][A-Za-z0-9_]*, at most 64 characters)");
+  }
+  if (s.multiplex == DbcMultiplex::multiplexed_multiplexor) {
+    return at(s, "signal " + quote_value(s.name) +
+                     " is itself a multiplexor inside a multiplexed frame (extended multiplexing), which typed "
+                     "channels do not decode");
+  }
+  if (!s.value_names.empty() && s.value_type == DbcValueType::integer && !enumeration(s)) {
+    return at(s, "signal " + quote_value(s.name) +
+                     ": no integer holds both its raw values and the negative values "
+                     "its value table names");
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 DbcChannelType channel_type_from_dbc(const DbcMessage& message) {
   DbcChannelType out;
-  if (message.signals.empty()) {
-    out.errors.push_back(DbcError{message.line, message.column,
-                                  "message " + quote_value(message.name) + " has no signals to make fields of"});
+  const auto refuse = [&](DbcError error) {
+    out.errors.push_back(std::move(error));
     return out;
+  };
+  if (message.signals.empty()) {
+    return refuse(
+        {message.line, message.column, "message " + quote_value(message.name) + " has no signals to make fields of"});
   }
   if (message.signals.size() > kMaxRecordFields) {
-    out.errors.push_back(DbcError{message.line, message.column,
-                                  "message " + quote_value(message.name) + " has " +
-                                      std::to_string(message.signals.size()) + " signals; a type has at most " +
-                                      std::to_string(kMaxRecordFields) + " fields"});
-    return out;
+    return refuse({message.line, message.column,
+                   "message " + quote_value(message.name) + " has " + std::to_string(message.signals.size()) +
+                       " signals; a type has at most " + std::to_string(kMaxRecordFields) + " fields"});
   }
-  if (const auto shared = overlap(message)) {
-    out.errors.push_back(*shared);
-    return out;
-  }
+  if (const auto shared = overlap(message)) return refuse(*shared);
   const DbcSignal* selector = dbc_multiplexor(message);
-  if (selector != nullptr && dbc_field_type(*selector).kind == FieldType::Kind::scalar &&
-      !is_integer(dbc_field_type(*selector).scalar) && dbc_field_type(*selector).scalar != ScalarKind::boolean) {
-    out.errors.push_back(at(*selector, "multiplexor switch " + quote_value(selector->name) +
-                                           " has a scaling that is not whole, so its values are not the raw "
-                                           "values its multiplexed signals name"));
-    return out;
+  if (selector != nullptr) {
+    if (const auto problem = switch_problem(message, *selector)) return refuse(*problem);
   }
-  for (const DbcSignal& s : message.signals) {
-    if (!valid_field_name(s.name)) {
-      out.errors.push_back(at(s, "signal name " + quote_value(s.name) +
-                                     " is not a field name ([A-Za-z][A-Za-z0-9_]*, at most 64 characters)"));
-      continue;
-    }
-    if (s.multiplex == DbcMultiplex::multiplexed_multiplexor) {
-      out.errors.push_back(at(s, "signal " + quote_value(s.name) +
-                                     " is itself a multiplexor inside a multiplexed frame (extended multiplexing), "
-                                     "which typed channels do not decode"));
+  for (const DbcSignal* signal : field_order(message, selector)) {
+    const DbcSignal& s = *signal;
+    if (const auto problem = field_problem(s)) {
+      out.errors.push_back(*problem);
       continue;
     }
     TypeField field;

@@ -99,8 +99,10 @@ class JsonWriter {
       : in_(compact), out_(out), selectors_(selectors) {}
 
   bool record(const std::vector<TypeField>& fields) {
-    // The integer value of each field read so far, for the conditional fields that follow.
-    std::array<std::int64_t, kMaxRecordFields> values{};
+    // The integer value of each field read so far, for the conditional fields that follow. Not
+    // zero-filled (a sequence of records would fill 2 KiB per element): an entry is read only for a
+    // selector, an integer field before the field it selects (check_type), which value() has set.
+    std::array<std::int64_t, kMaxRecordFields> values;  // NOLINT(cppcoreguidelines-pro-type-member-init)
     if (!put("{")) return false;
     bool first = true;
     for (std::size_t i = 0; i < fields.size() && i < values.size(); ++i) {

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -78,10 +79,13 @@ struct TypeField {
 };
 
 // Where a type was read from, when not written inline: the configuration writes it back this way
-// (a bind or state file names the DBC message, not its fields).
+// (a bind or state file names the DBC message or the LCM struct, not its fields).
 struct TypeSource {
-  std::string dbc;      // the DBC file, as resolved against the configuration's directory
-  std::string message;  // the BO_ message's name
+  enum class Format : std::uint8_t { dbc, lcm };
+  Format format = Format::dbc;
+  std::string file;  // as resolved against the configuration's directory
+  std::string name;  // the DBC message's name, or the LCM struct's full name (pkg.name_t)
+  std::map<std::string, std::uint32_t> max_length;  // LCM: bounds of variable-length arrays, by member
   friend bool operator==(const TypeSource&, const TypeSource&) = default;
 };
 

@@ -47,7 +47,8 @@ class DbcFrameCodec {
 
  private:
   struct FieldCodec {
-    std::size_t signal = 0;  // index in message_.signals, and of the layout's slot
+    std::size_t signal = 0;  // index in message_.signals
+    std::size_t slot = 0;    // index of the field and of its slot in the compact layout
     bool raw = false;        // an enumeration: the raw value; else the physical one
     bool whole = false;      // an integer field: raw * factor + offset in whole numbers
     std::int64_t factor = 1, offset = 0;

@@ -1,7 +1,8 @@
 // A typed channel's contents from a DBC message (issue 35; `type: {dbc: FILE, message: NAME}`):
-// one field per signal, in the message's order, named as the signal, of the signal's physical type,
-// with its unit and declared range; a value table (VAL_) makes an enumeration of the raw values; a
-// multiplexed signal is present only while the switch selects it. Pure: no I/O; any thread.
+// one field per signal, named as the signal, of the signal's physical type, with its unit and
+// declared range, the multiplexor switch first and the others in the message's order; a value table
+// (VAL_) makes an enumeration of the raw values; a multiplexed signal is present only while the
+// switch selects it. Pure: no I/O; any thread.
 //
 // A signal's field type:
 //   - an IEEE float signal: float32 when it is unscaled (factor 1, offset 0), else float64;

@@ -1,0 +1,78 @@
+// Reading the type files a configuration names (type_file_loader.hpp).
+#include "type_file_loader.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+
+namespace cosmic::config_detail {
+namespace {
+
+// Reads a regular file of at most `max_bytes` without ever blocking on a FIFO or a device.
+std::string read_regular_file(const std::string& path, std::string& text, std::size_t max_bytes) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return std::strerror(errno);
+  struct stat info {};
+  std::string error;
+  if (::fstat(fd, &info) != 0) {
+    error = std::strerror(errno);
+  } else if (!S_ISREG(info.st_mode)) {
+    error = "not a regular file";
+  } else if (static_cast<std::uint64_t>(info.st_size) > max_bytes) {
+    error = "larger than " + std::to_string(max_bytes >> 20) + " MiB";
+  } else {
+    text.resize(static_cast<std::size_t>(info.st_size));
+    std::size_t done = 0;
+    while (done < text.size()) {
+      const ssize_t n = ::read(fd, text.data() + done, text.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) {
+        error = std::strerror(errno);  // an I/O error is not the end of the file
+        break;
+      }
+      if (n == 0) break;
+      done += static_cast<std::size_t>(n);
+    }
+    text.resize(done);
+  }
+  ::close(fd);
+  return error;
+}
+
+}  // namespace
+
+std::optional<LoadedText> load_named_file(YamlReader& reader, const YAML::Node& where, const std::string& key_path,
+                                          const std::string& file, std::vector<std::string>& included,
+                                          std::size_t max_bytes, const std::string& what) {
+  const std::filesystem::path relative(file);
+  const std::string resolved =
+      relative.is_absolute()
+          ? file
+          : (std::filesystem::path(reader.file()).parent_path() / relative).lexically_normal().string();
+  std::string text;
+  if (const std::string error = read_regular_file(resolved, text, max_bytes); !error.empty()) {
+    reader.error_at(where, key_path, "cannot read " + what + " " + resolved + ": " + error,
+                    "a readable " + what + ", relative to this file");
+    return std::nullopt;
+  }
+  included.push_back(resolved);
+  return LoadedText{resolved, std::move(text)};
+}
+
+std::optional<LoadedDbc> load_dbc_file(YamlReader& reader, const YAML::Node& where, const std::string& key_path,
+                                       const std::string& file, std::vector<std::string>& included) {
+  const auto loaded = load_named_file(reader, where, key_path, file, included, kDbcMaxTextBytes, "DBC file");
+  if (!loaded) return std::nullopt;
+  DbcFile dbc = parse_dbc(loaded->text);
+  for (const DbcError& e : dbc.errors)
+    reader.error_in(ConfigError{loaded->path, e.line, e.column, key_path, e.message, ""});
+  if (!dbc.ok()) return std::nullopt;
+  return LoadedDbc{loaded->path, std::move(dbc)};
+}
+
+}  // namespace cosmic::config_detail

@@ -1,0 +1,38 @@
+// Reading the type files a configuration names (a CAN bus's background traffic from a DBC file, a
+// typed channel's `type: {dbc: FILE, ...}` or `{lcm: FILE, ...}`): relative to the configuration's
+// own file, a regular file of bounded size read without blocking on a FIFO or a device, its errors
+// reported located in that file itself. Internal to the config library; runs where the
+// configuration is loaded.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cosmic/dbc.hpp"
+#include "yaml_reader.hpp"
+
+namespace cosmic::config_detail {
+
+struct LoadedText {
+  std::string path;  // as resolved against the configuration's directory
+  std::string text;
+};
+
+// The text of `file` (at most `max_bytes`), or nullopt after reporting why not at `where`; `what`
+// names the kind of file in the message ("DBC file", "LCM type file").
+std::optional<LoadedText> load_named_file(YamlReader& reader, const YAML::Node& where, const std::string& key_path,
+                                          const std::string& file, std::vector<std::string>& included,
+                                          std::size_t max_bytes, const std::string& what);
+
+struct LoadedDbc {
+  std::string path;  // as resolved against the configuration's directory
+  DbcFile file;      // without errors
+};
+
+// `where` is the YAML value that names `file`, `key_path` its key path; every problem goes to
+// `reader`, and the resolved path of a file read to `included` (ConfigResult::included_files).
+std::optional<LoadedDbc> load_dbc_file(YamlReader& reader, const YAML::Node& where, const std::string& key_path,
+                                       const std::string& file, std::vector<std::string>& included);
+
+}  // namespace cosmic::config_detail
