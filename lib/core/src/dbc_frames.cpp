@@ -70,6 +70,9 @@ Result<DbcFrameCodec> DbcFrameCodec::make(const DbcMessage& message, const Chann
   if (!layout) return std::move(layout).error();
   DbcFrameCodec codec;
   codec.message_ = message;
+  if (const DbcSignal* selector = dbc_multiplexor(message)) {
+    codec.switch_ = static_cast<std::size_t>(selector - message.signals.data());
+  }
   codec.layout_ = std::move(layout).value();
   for (std::size_t i = 0; i < type.fields.size(); ++i) {
     // The fields come in the type's order (the multiplexor switch first), the signals in the file's.
@@ -95,9 +98,11 @@ bool DbcFrameCodec::to_compact(std::span<const std::uint8_t> frame, std::span<st
   if (frame.size() < message_.length || compact.size() < layout_.size()) return false;
   const auto data = frame.first(message_.length);
   std::fill_n(compact.begin(), layout_.size(), std::uint8_t{0});
+  // The switch is read once per frame, not once per multiplexed signal (dbc_signal_present).
+  const std::uint64_t selected = switch_ ? dbc_read_bits(message_.signals[*switch_], data) : 0;
   for (const FieldCodec& f : fields_) {
     const DbcSignal& s = message_.signals[f.signal];
-    if (!dbc_signal_present(message_, s, data)) continue;
+    if (s.multiplex == DbcMultiplex::multiplexed && (!switch_ || selected != s.multiplex_value)) continue;
     const CompactLayout::Slot& slot = layout_.slots()[f.slot];
     const std::uint64_t bits = dbc_read_bits(s, data);
     const Wide raw = s.is_signed ? Wide{dbc_raw_integer(s, bits)} : Wide{bits};

@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -55,6 +56,7 @@ class DbcFrameCodec {
   };
 
   DbcMessage message_;
+  std::optional<std::size_t> switch_;  // index of message_'s multiplexor switch, if any (found once, at make)
   CompactLayout layout_;
   std::vector<FieldCodec> fields_;
 };
