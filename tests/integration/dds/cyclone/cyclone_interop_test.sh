@@ -32,7 +32,7 @@ YAML
 
 domain_of() { [ "$1" = left ] && echo 31 || echo 32; }
 
-# check_output FILE COUNT SIZE: the envelopes the Cyclone reader got, each event's payload
+# check_output FILE COUNT SIZE POLICED: the envelopes the Cyclone reader got, each event's payload
 # (q*7+i)&0xff unchanged, events in order without duplicates, origin stamped by the gateway
 # (non-zero), sequences strictly increasing. A reader with DEFAULT QoS is BEST_EFFORT (the DDS
 # default), so the wire may lose a sample the gateway sent (no repair): at most 10% may be
@@ -40,10 +40,11 @@ domain_of() { [ "$1" = left ] && echo 31 || echo 32; }
 check_output() {
   python3 - "$@" <<'PY'
 import json, sys
-path, count, size = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+path, count, size, policed = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
 lines = [json.loads(l) for l in open(path)]
-missing = count - len(lines)
-assert 0 <= missing <= count // 10, f"{len(lines)} envelopes, expected {count} (at most {count // 10} lost)"
+missing = count - policed - len(lines)
+assert 0 <= missing <= count // 10, \
+    f"{len(lines)} envelopes, expected {count} less the {policed} rate-policed (at most {count // 10} lost)"
 qs = []
 for e in lines:
     payload = bytes.fromhex(e["payload"])
@@ -88,14 +89,20 @@ run_channel() {
   # timeout; check_output judges what it got.
   wait "$sub"
   local sub_rc=$?
-  if ! check_output "$WORK/$channel.out" "$count" "$size"; then
+  # Every event taken must leave, except those cosmicd's rate police counted: the writer paces at
+  # twice the declared period (or more), but on a loaded machine events can reach cosmicd bunched by
+  # more than the segment's 1 ms latency bound, and the police then drops them, correctly and counted.
+  local policed
+  policed=$(channel_field gw "$channel" "$from" dropped.rate)
+  [ "$policed" -eq 0 ] || log "note: $channel: cosmicd's rate police dropped $policed bunched arrivals"
+  if ! check_output "$WORK/$channel.out" "$count" "$size" "$policed"; then
     fail "$channel: wrong envelopes (subscriber exit $sub_rc: $(cat "$WORK/$channel.sub.err"))"
     log "--- where the events went (cosmicd's counters of $channel)"
     ctl gw channel "$channel" >&2
     return
   fi
   expect_field gw "$channel" "$from" rx "$count"
-  expect_field gw "$channel" "$to" tx "$count"
+  expect_field gw "$channel" "$to" tx "$((count - policed))"
   passed
 }
 
