@@ -251,7 +251,13 @@ void print_channel(const Json& r) {
   const Json& c = r["channel"];
   print_channels(Json{{"channels", Json::array({c})}});
   // The contents' fields (a channel without a type carries opaque bytes).
-  if (c.contains("type") && c["type"].is_string()) std::cout << "\ncontents: " << text(c["type"]) << "\n";
+  if (c.contains("type") && c["type"].is_string()) {
+    std::cout << "\ncontents: " << text(c["type"]) << "\n";
+    for (const auto& hop : c["segments"]) {
+      if (hop.contains("representation") && hop["representation"].is_string())
+        std::cout << "  on " << text(hop["segment"]) << ": " << text(hop["representation"]) << "\n";
+    }
+  }
   print_runtime(c);
   std::cout << "\nadmission:\n";
   // A channel whose events come through other gateways (federation): their hops first.

@@ -139,7 +139,7 @@ TEST(ChannelType, NestingAndSizeAreBounded) {
 
 // ------------------------------------------------------------------------------ YAML
 
-constexpr const char* kHead =
+constexpr const char* kTypedConfigHead =
     "gateway: {name: gw, can_node_id: 1}\n"
     "segments:\n"
     "  - {name: lan, type: dds, domain: 0}\n"
@@ -148,7 +148,7 @@ constexpr const char* kHead =
     "  - name: scan\n"
     "    subject: 0x10\n"
     "    class: nrt\n"
-    "    payload: 1KiB\n"
+    "    omission_degree: 0\n"  // (a typed channel's payload comes from its hops)
     "    publishers: [lan]\n"
     "    subscribers: [viz]\n";
 
@@ -160,7 +160,7 @@ std::string listed_errors(const std::vector<ConfigError>& errors) {
 
 TEST(ChannelTypeYaml, EveryKindIsReadAndWrittenBackUnchanged) {
   const std::string text =
-      std::string(kHead) +
+      std::string(kTypedConfigHead) +
       "    type:\n"
       "      fields:\n"
       "        - {name: distance, type: float32, unit: m, min: 0, max: 40.25}\n"
@@ -189,13 +189,13 @@ TEST(ChannelTypeYaml, EveryKindIsReadAndWrittenBackUnchanged) {
 }
 
 TEST(ChannelTypeYaml, AChannelWithoutATypeHasNone) {
-  const ConfigResult r = parse_config(kHead, "untyped.yaml");
+  const ConfigResult r = parse_config(kTypedConfigHead, "untyped.yaml");
   ASSERT_TRUE(r.ok()) << listed_errors(r.errors);
   EXPECT_FALSE(r.config.channels.at(0).type.has_value());
 }
 
 TEST(ChannelTypeYaml, EveryProblemIsLocatedAtOnce) {
-  const std::string text = std::string(kHead) +
+  const std::string text = std::string(kTypedConfigHead) +
                            "    type:\n"
                            "      fields:\n"
                            "        - {name: a, type: float16}\n"                              // line 14
@@ -221,7 +221,7 @@ TEST(ChannelTypeYaml, EveryProblemIsLocatedAtOnce) {
   EXPECT_NE(errors.find("channels[0].type.fields[6].values.X: '1.5' is not a whole number"), std::string::npos)
       << errors;
   // Found by the whole-type check once each field reads: only when nothing else is wrong.
-  const std::string fixed = std::string(kHead) +
+  const std::string fixed = std::string(kTypedConfigHead) +
                             "    type:\n"
                             "      fields:\n"
                             "        - {name: b, type: uint8, max: 256}\n"  // line 14
@@ -236,7 +236,7 @@ TEST(ChannelTypeYaml, EveryProblemIsLocatedAtOnce) {
 }
 
 TEST(ChannelTypeYaml, ADbcMessageGivesTheFieldsAndIsWrittenBackAsItsSource) {
-  const std::string text = std::string(kHead) + "    type: {dbc: body.dbc, message: WheelSpeeds}\n";
+  const std::string text = std::string(kTypedConfigHead) + "    type: {dbc: body.dbc, message: WheelSpeeds}\n";
   const std::string config_path = std::string(build_paths::dbc_dir) + "/typed.yaml";  // anchors body.dbc
   const ConfigResult r = parse_config(text, config_path);
   ASSERT_TRUE(r.ok()) << listed_errors(r.errors);
@@ -265,7 +265,7 @@ TEST(ChannelTypeYaml, DbcTypeProblemsAreLocatedInTheYamlOrTheDbcFile) {
   std::ofstream(dir / "good.dbc") << "BO_ 1 A: 8 X\n SG_ S : 0|8@1+ (1,0) [0|0] \"\" X\n";
   const auto errors_for = [&](const std::string& type) {
     return listed_errors(
-        parse_config(std::string(kHead) + "    type: " + type + "\n", (dir / "t.yaml").string()).errors);
+        parse_config(std::string(kTypedConfigHead) + "    type: " + type + "\n", (dir / "t.yaml").string()).errors);
   };
   const std::string bad = (dir / "bad.dbc").string();
   // The DBC's own error, at its line; no message is taken from a file with errors.
@@ -299,7 +299,7 @@ TEST(ChannelTypeYaml, AnLcmStructGivesTheFieldsAndIsWrittenBackWithItsBounds) {
   std::ofstream(dir / "scan.lcm") << "package sensors;\nstruct scan_t {\n  int64_t utime;\n  int32_t n;\n"
                                      "  float ranges[n];\n  string frame;\n}\n";
   const auto load = [&](const std::string& type) {
-    return parse_config(std::string(kHead) + "    type: " + type + "\n", (dir / "t.yaml").string());
+    return parse_config(std::string(kTypedConfigHead) + "    type: " + type + "\n", (dir / "t.yaml").string());
   };
   const ConfigResult r = load("{lcm: scan.lcm, name: sensors.scan_t, max_length: {ranges: 1081}}");
   ASSERT_TRUE(r.ok()) << listed_errors(r.errors);

@@ -16,6 +16,7 @@
 #include "background_loader.hpp"
 #include "components_loader.hpp"
 #include "native_loader.hpp"
+#include "typed_hops_loader.hpp"
 #include "type_loader.hpp"
 #include "federation_loader.hpp"
 #include "realtime_loader.hpp"
@@ -61,6 +62,7 @@ class ConfigParser {
       }
       config_detail::load_components(reader_, *root, config_);
       native_.check_derived(reader_, config_);
+      typed_.check(reader_, config_.channels, config_.segments);
     }
     result.config = std::move(config_);
     result.errors = reader_.take_errors();
@@ -84,6 +86,7 @@ class ConfigParser {
         reader_.error_at(*root, "", "expected channel definitions",
                          "a 'channels:' list, a list of channels or one channel map");
       }
+      typed_.check(reader_, config_.channels, config_.segments);
       if (config_.channels.empty() && reader_.error_count() == 0) {
         reader_.error_at(*root, "channels", "no channel to bind", "at least one channel definition");
       }
@@ -402,6 +405,7 @@ class ConfigParser {
       native_.add(reader_, node["native"], key(path, "native"), *channel,
                   derive_bindings_ && !(node["publishers"] && node["subscribers"]));
     }
+    typed_.add(node, path, *channel);
     config_.channels.push_back(std::move(*channel));
   }
 
@@ -431,7 +435,7 @@ class ConfigParser {
     if (!reader_.check_map(
             node, path,
             {"name", "subject", "class", "period", "max_rate", "reaction_time", "omission_degree", "temp_validity",
-             "payload", "etag", "encoding", "publishers", "subscribers", "native", "type"})) {
+             "payload", "etag", "encoding", "publishers", "subscribers", "native", "type", "on_range"})) {
       return std::nullopt;
     }
     const std::size_t errors_before = reader_.error_count();
@@ -460,6 +464,7 @@ class ConfigParser {
           reader_.choice(node["encoding"], key(path, "encoding"), {"envelope", "raw"}).value_or(0));
     }
     if (node["type"]) c.type = config_detail::parse_channel_type(reader_, node["type"], key(path, "type"), included_);
+    config_detail::parse_on_range(reader_, node, path, c);
     parse_bindings(node, path, c);
     if (node["native"]) {
       config_detail::parse_native(reader_, node["native"], key(path, "native"), config_, c);
@@ -569,6 +574,7 @@ class ConfigParser {
   std::map<std::uint16_t, std::string> etags_;
   std::vector<std::string> included_;  // files read besides the YAML (DBC)
   config_detail::NativeDeclarations native_;
+  config_detail::TypedHopChecks typed_;
 };
 
 }  // namespace

@@ -38,6 +38,8 @@ std::string channel_to_yaml(const ChannelSpec& channel) {
             << binding.can->extended;
       }
       if (binding.lcm_channel) out << YAML::Key << "channel" << YAML::Value << *binding.lcm_channel;
+      if (binding.form != NativeForm::source)
+        out << YAML::Key << "representation" << YAML::Value << to_string(binding.form);
       if (binding.dds) {
         out << YAML::Key << "topic" << YAML::Value << binding.dds->topic << YAML::Key << "type" << YAML::Value
             << binding.dds->type << YAML::Key << "representation" << YAML::Value
@@ -48,6 +50,7 @@ std::string channel_to_yaml(const ChannelSpec& channel) {
     out << YAML::EndMap;
   }
   if (channel.type) out << YAML::Key << "type" << YAML::Value << config_detail::channel_type_to_yaml(*channel.type);
+  if (channel.on_range == RangePolicy::saturate) out << YAML::Key << "on_range" << YAML::Value << "saturate";
   out << YAML::EndMap;
   return out.c_str();
 }

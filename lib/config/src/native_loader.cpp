@@ -10,9 +10,21 @@
 namespace cosmic::config_detail {
 namespace {
 
+// `representation:` of a typed channel's CAN or LCM hop: the first choice is the type source's own
+// form (dbc, lcm), then compact, then json.
+bool parse_form(YamlReader& reader, const YAML::Node& node, const std::string& path,
+                std::initializer_list<const char*> choices, NativeBinding& binding) {
+  if (!node["representation"]) return true;
+  const auto choice = reader.choice(node["representation"], key(path, "representation"), choices);
+  if (!choice) return false;
+  binding.form = *choice == 0 ? NativeForm::source : *choice == 1 ? NativeForm::compact : NativeForm::json;
+  return true;
+}
+
 bool parse_can(YamlReader& reader, const YAML::Node& node, const std::string& path, const SegmentSpec& segment,
                NativeBinding& binding) {
-  if (!reader.check_map(node, path, {"can_id", "extended"})) return false;
+  if (!reader.check_map(node, path, {"can_id", "extended", "representation"})) return false;
+  if (!parse_form(reader, node, path, {"dbc", "compact"}, binding)) return false;
   NativeCanFrame frame;
   if (node["extended"]) {
     const auto extended = reader.boolean(node["extended"], key(path, "extended"));
@@ -56,7 +68,8 @@ bool parse_can(YamlReader& reader, const YAML::Node& node, const std::string& pa
 }
 
 bool parse_lcm(YamlReader& reader, const YAML::Node& node, const std::string& path, NativeBinding& binding) {
-  if (!reader.check_map(node, path, {"channel"})) return false;
+  if (!reader.check_map(node, path, {"channel", "representation"})) return false;
+  if (!parse_form(reader, node, path, {"lcm", "compact", "json"}, binding)) return false;
   if (!node["channel"]) {
     reader.error_at(node, key(path, "channel"), "missing required key 'channel'",
                     "the LCM channel name, e.g. channel: POSE");

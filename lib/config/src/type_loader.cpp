@@ -85,7 +85,7 @@ class TypeLoader {
     for (const DbcError& e : typed.errors)
       reader_.error_in(ConfigError{loaded->path, e.line, e.column, key(path, "message"), e.message, ""});
     if (!typed.ok()) return std::nullopt;
-    typed.type.source = TypeSource{TypeSource::Format::dbc, loaded->path, message->name, {}};
+    typed.type.source = TypeSource{TypeSource::Format::dbc, loaded->path, message->name, {}, *message, {}};
     return std::move(typed.type);
   }
 
@@ -132,7 +132,12 @@ class TypeLoader {
     for (const LcmError& e : typed.errors)
       reader_.error_in(ConfigError{loaded->path, e.line, e.column, key(path, "name"), e.message, ""});
     if (!typed.ok()) return std::nullopt;
-    typed.type.source = TypeSource{TypeSource::Format::lcm, loaded->path, s->full_name(), max_length};
+    typed.type.source = TypeSource{TypeSource::Format::lcm,
+                                   loaded->path,
+                                   s->full_name(),
+                                   max_length,
+                                   {},
+                                   std::make_shared<const LcmTypeFile>(lcm)};
     return std::move(typed.type);
   }
 

@@ -57,9 +57,10 @@ CanHopPlan frame_plan(const SegmentSpec& segment, const ChannelSpec& channel) {
   CanHopPlan plan;
   const std::optional<NativeCanFrame> native = channel.native_can(segment.name);
   const std::uint32_t capacity = max_frame_payload(bus);
-  const bool fits = channel.payload <= capacity || native;
-  plan.frames_per_event = fits ? 1 : fragments_needed(channel.payload, capacity);
-  const auto data_bytes = static_cast<std::uint32_t>(std::min<std::uint64_t>(channel.payload, capacity));
+  const std::uint64_t payload = channel.payload_on(segment.name);
+  const bool fits = payload <= capacity || native;
+  plan.frames_per_event = fits ? 1 : fragments_needed(payload, capacity);
+  const auto data_bytes = static_cast<std::uint32_t>(std::min<std::uint64_t>(payload, capacity));
   plan.frame_bytes = bus.fd ? fd_padded_length(data_bytes) : data_bytes;
   if (native) {
     plan.native = true;
@@ -78,7 +79,7 @@ double hop_load(const SegmentSpec& segment, const ChannelSpec& channel) {
     const CanHopPlan plan = frame_plan(segment, channel);
     return to_seconds(plan.transmission) * plan.frames_per_event / period_s;
   }
-  const double bits = static_cast<double>(channel.payload + kIpOverheadBytes) * 8.0;
+  const double bits = static_cast<double>(channel.payload_on(segment.name) + kIpOverheadBytes) * 8.0;
   return bits / period_s / static_cast<double>(segment.bandwidth.bits_per_second);
 }
 

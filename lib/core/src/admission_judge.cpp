@@ -31,14 +31,14 @@ void add_frame_fit(const ChannelSpec& channel, const SegmentSpec& segment, HopRe
     const std::uint32_t capacity = max_frame_payload(segment.can);
     // A native frame is the event: no fragmentation, whatever the class.
     const bool fragmentable = channel.cls == ChannelClass::nrt && !channel.native_can(segment.name);
-    limit = fragmentable && channel.payload > capacity
+    limit = fragmentable && channel.payload_on(segment.name) > capacity
                 ? static_cast<double>(kMaxFragments * (capacity - kFragmentHeaderBytes))
                 : capacity;
   } else {
     limit = channel.cls == ChannelClass::nrt ? static_cast<double>(kMaxIpEventBytes)
                                              : static_cast<double>(segment.max_message_size - kIpOverheadBytes);
   }
-  const auto value = static_cast<double>(channel.payload);
+  const auto value = static_cast<double>(channel.payload_on(segment.name));
   h.checks.push_back(Check{"frame_fit", value, limit, "B", "<=", value <= limit});
 }
 

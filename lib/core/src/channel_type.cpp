@@ -7,7 +7,17 @@
 #include <limits>
 #include <set>
 
+#include "cosmic/lcm_types.hpp"
+
 namespace cosmic {
+
+bool operator==(const TypeSource& a, const TypeSource& b) {
+  const bool same_lcm =
+      a.lcm_file == b.lcm_file || (a.lcm_file && b.lcm_file && a.lcm_file->structs == b.lcm_file->structs);
+  return a.format == b.format && a.file == b.file && a.name == b.name && a.max_length == b.max_length &&
+         a.dbc_message == b.dbc_message && same_lcm;
+}
+
 namespace {
 
 constexpr std::array<std::string_view, 11> kScalarNames = {"bool",   "int8",   "int16",  "int32",   "int64",  "uint8",

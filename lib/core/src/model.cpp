@@ -34,10 +34,29 @@ const char* to_string(Reliability value) { return value == Reliability::reliable
 
 const char* to_string(DdsRepresentation value) { return value == DdsRepresentation::xcdr2 ? "xcdr2" : "xcdr1"; }
 
+const char* to_string(NativeForm value) {
+  switch (value) {
+    case NativeForm::source:
+      return "source";
+    case NativeForm::compact:
+      return "compact";
+    case NativeForm::json:
+      return "json";
+  }
+  return "?";
+}
+
 std::string native_identity(const NativeBinding& binding) {
   if (binding.can) return can_id_text(binding.can->can_id, binding.can->extended);
   if (binding.dds) return binding.dds->topic;
   return binding.lcm_channel.value_or("");
+}
+
+std::uint64_t ChannelSpec::payload_on(const std::string& segment) const {
+  for (const HopPayload& hop : hop_payloads) {
+    if (hop.segment == segment) return hop.bytes;
+  }
+  return payload;
 }
 
 const NativeBinding* ChannelSpec::native_on(const std::string& segment) const {

@@ -163,7 +163,22 @@ std::int64_t saturating_add(std::int64_t a, std::int64_t b) {
 }
 }  // namespace
 
-std::optional<OutboundEvent> EgressLane::still_wanted(LaneItem& item) noexcept {
+std::optional<std::span<const std::uint8_t>> EgressLane::hop_bytes(LaneItem& item, std::size_t slot) noexcept {
+  ChannelState& channel = *item.channel;
+  const Representation* form = channel.route.subscriber_form(item.hop);
+  if (form == nullptr) return item.payload->bytes();
+  std::vector<std::uint8_t>& out = scratch_[slot];
+  // Grows once per larger representation, never in steady state (the bound is the type's).
+  if (out.size() < form->max_wire_size()) out.resize(form->max_wire_size());
+  const Conversion converted = form->from_compact(item.payload->bytes(), out);
+  if (converted.ok()) return std::span<const std::uint8_t>(out.data(), converted.size);
+  channel.counters[segment_].drop(converted.fault == ConversionFault::out_of_range ? DropReason::out_of_range
+                                                                                   : DropReason::invalid);
+  discard(item);
+  return std::nullopt;
+}
+
+std::optional<OutboundEvent> EgressLane::still_wanted(LaneItem& item, std::size_t slot) noexcept {
   ChannelState& channel = *item.channel;
   if (channel.removed.load(std::memory_order_relaxed) ||
       channel.retired_egress[segment_].load(std::memory_order_relaxed) ||
@@ -181,7 +196,9 @@ std::optional<OutboundEvent> EgressLane::still_wanted(LaneItem& item) noexcept {
     discard(item);
     return std::nullopt;
   }
-  OutboundEvent out{channel.route.id, item.header, item.payload->bytes()};
+  const std::optional<std::span<const std::uint8_t>> bytes = hop_bytes(item, slot);
+  if (!bytes) return std::nullopt;
+  OutboundEvent out{channel.route.id, item.header, *bytes};
   out.header.age_ns = age.count();
   // Counted before the send, taken back if it fails: whoever sees the event on the wire sees the
   // counter already moved.
@@ -211,7 +228,7 @@ void EgressLane::account(LaneItem& item, SendStatus status) noexcept {
 }
 
 void EgressLane::forward(LaneItem& item) noexcept {
-  const std::optional<OutboundEvent> out = still_wanted(item);
+  const std::optional<OutboundEvent> out = still_wanted(item, 0);
   if (!out) return;
   SegmentAdapter* adapter = adapter_.load(std::memory_order_acquire);
   account(item, adapter != nullptr ? adapter->send(*out) : SendStatus::failed);
@@ -224,7 +241,7 @@ void EgressLane::forward_batch(std::span<LaneItem> items) noexcept {
   std::array<std::size_t, kSendBatch> which{};  // index in `items` of each event in `outs`
   std::size_t n = 0;
   for (std::size_t i = 0; i < items.size() && n < kSendBatch; ++i) {
-    if (auto out = still_wanted(items[i])) {
+    if (auto out = still_wanted(items[i], n)) {
       outs[n] = *out;
       which[n++] = i;
     }

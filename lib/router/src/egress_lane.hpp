@@ -9,6 +9,7 @@
 // the router runs without threads (tests).
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <functional>
 #include <optional>
@@ -78,7 +79,12 @@ class EgressLane {
   void hand_over(std::span<LaneItem> items) noexcept;
   // Before a send: the event as it leaves, or nullopt (the item discarded, its drop counted)
   // when it is not to be sent (channel gone, lane reset, expired).
-  std::optional<OutboundEvent> still_wanted(LaneItem& item) noexcept;
+  // A typed channel's event is converted into its hop's representation in scratch_[slot].
+  std::optional<OutboundEvent> still_wanted(LaneItem& item, std::size_t slot) noexcept;
+  // The bytes the hop carries: the compact event in the hop's representation (in scratch_[slot]),
+  // or the payload as it is for an untyped channel; nullopt when the conversion refused it (the
+  // drop counted, the item discarded).
+  std::optional<std::span<const std::uint8_t>> hop_bytes(LaneItem& item, std::size_t slot) noexcept;
   // After a send: counters and residence by the adapter's answer; the item is released.
   void account(LaneItem& item, SendStatus status) noexcept;
   void discard(LaneItem& item) noexcept;
@@ -98,6 +104,11 @@ class EgressLane {
   // them, so a lane blocked inside a send shows its events as queued (the watchdog's stall).
   std::atomic<std::size_t> in_hand_{0};
   std::uint64_t generation_ COSMIC_GUARDED_BY(mutex_) = 0;
+
+  // Where this lane's thread writes typed events in their hop's form, one buffer per event of a
+  // batch (the adapter reads them all in one send_batch); each grows to the largest message it
+  // has held and is then reused. Only the lane's thread (or run_once's caller) touches them.
+  std::array<std::vector<std::uint8_t>, kSendBatch> scratch_;
 
   std::atomic<SegmentAdapter*> adapter_{nullptr};
   std::atomic<std::uint64_t> current_generation_{0};

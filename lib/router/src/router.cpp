@@ -22,7 +22,23 @@ constexpr std::size_t kClassCount = 3;
 const char* const kClassPrefix[kClassCount] = {"hrt:", "srt:", "nrt:"};
 
 std::size_t class_index(ChannelClass cls) { return static_cast<std::size_t>(cls); }
+
+// Where an ingress thread puts a typed event in the compact layout: one buffer per thread that
+// reads a network, grown to the largest event it has converted and then reused, so steady-state
+// forwarding allocates nothing.
+std::span<std::uint8_t> ingress_scratch(std::size_t size) {
+  thread_local std::vector<std::uint8_t> scratch;
+  if (scratch.size() < size) scratch.resize(size);
+  return std::span(scratch.data(), size);
+}
 }  // namespace
+
+const Representation* Route::publisher_form(std::size_t segment) const {
+  for (std::size_t i = 0; i < publishers.size() && i < publisher_forms.size(); ++i) {
+    if (publishers[i] == segment) return publisher_forms[i].get();
+  }
+  return nullptr;
+}
 
 struct Router::Table {
   std::vector<std::shared_ptr<ChannelState>> channels;  // sorted by route id
@@ -171,6 +187,16 @@ void Router::receive(std::size_t segment, const InboundEvent& event) {
   if (const IngressFault fault = ingress_check(checked, channel->route.spec, self_); fault != IngressFault::none) {
     counters.drop(drop_reason(fault));
     return;
+  }
+  // A typed channel's event goes on in the compact layout, whatever form its hop brought it in.
+  if (const Representation* form = channel->route.publisher_form(segment)) {
+    const std::span<std::uint8_t> compact = ingress_scratch(form->max_compact_size());
+    const Conversion converted = form->to_compact(checked.payload, compact);
+    if (!converted.ok()) {
+      counters.drop(DropReason::decode_error);
+      return;
+    }
+    checked.payload = compact.first(converted.size);
   }
   if (!admit(*channel, counters, checked)) return;
   enqueue(channel, checked);

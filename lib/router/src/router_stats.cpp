@@ -24,6 +24,8 @@ const char* to_string(DropReason reason) {
       return "invalid";
     case DropReason::oversize:
       return "oversize";
+    case DropReason::out_of_range:
+      return "out_of_range";
   }
   return "?";
 }

@@ -2,6 +2,7 @@
 
 #include "cosmic/can_buffering.hpp"
 #include "cosmic/channel_changes.hpp"
+#include "cosmic/hop_representation.hpp"
 
 #include <algorithm>
 #include <optional>
@@ -206,9 +207,36 @@ void Gateway::apply_routes() {
       }
     }
     for (const auto& s : channel.subscribers) route.subscribers.push_back(slots_.at(s).index);
+    if (channel.type && !add_representations(route)) continue;
     routes.push_back(std::move(route));
   }
   router_->apply(std::move(routes));
+}
+
+// Each hop's representation of a typed channel. The configuration has checked that every hop can
+// carry the type, so a failure here means the segment changed under the channel: the channel is
+// not routed (its events count as unrouted), never forwarded in a form its hop does not take.
+bool Gateway::add_representations(Route& route) const {
+  const auto form_on = [&](const std::string& name) -> std::shared_ptr<const Representation> {
+    const SegmentSpec* segment = config_.find_segment(name);
+    if (segment == nullptr) return nullptr;
+    Result<std::shared_ptr<const Representation>> made = hop_representation(route.spec, *segment);
+    if (!made) {
+      log_.log(LogLevel::error,
+               "channel " + route.spec.name + " not routed: segment " + name + ": " + made.error().text);
+      return nullptr;
+    }
+    return made.value();
+  };
+  for (const auto& p : route.spec.publishers) {
+    route.publisher_forms.push_back(form_on(p));
+    if (!route.publisher_forms.back()) return false;
+  }
+  for (const auto& s : route.spec.subscribers) {
+    route.subscriber_forms.push_back(form_on(s));
+    if (!route.subscriber_forms.back()) return false;
+  }
+  return true;
 }
 
 BindResult Gateway::bind(const std::vector<ChannelSpec>& channels) {

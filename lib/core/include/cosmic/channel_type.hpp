@@ -10,13 +10,18 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
 
+#include "cosmic/dbc.hpp"
+
 namespace cosmic {
+
+struct LcmTypeFile;  // cosmic/lcm_types.hpp
 
 enum class ScalarKind : std::uint8_t {
   boolean,
@@ -86,8 +91,19 @@ struct TypeSource {
   std::string file;  // as resolved against the configuration's directory
   std::string name;  // the DBC message's name, or the LCM struct's full name (pkg.name_t)
   std::map<std::string, std::uint32_t> max_length;  // LCM: bounds of variable-length arrays, by member
-  friend bool operator==(const TypeSource&, const TypeSource&) = default;
+  // What the source's own representation needs beyond the fields, read with them and compared by
+  // content (a file changed under a reload rebinds the channel): a DBC message's frame layout; the
+  // LCM file's structs (the struct's nested structs and which member counts which array). Shared:
+  // every copy of a channel's spec refers to the one file read.
+  std::optional<DbcMessage> dbc_message;
+  std::shared_ptr<const LcmTypeFile> lcm_file;
+  friend bool operator==(const TypeSource& a, const TypeSource& b);
 };
+
+// What to do with a value a hop's representation cannot hold (a DBC signal too narrow, a scaled
+// value beyond its raw bits; channel key `on_range`): drop the event on that hop and count it
+// (`out_of_range`), or send the nearest value the representation holds.
+enum class RangePolicy : std::uint8_t { drop, saturate };
 
 struct ChannelType {
   std::vector<TypeField> fields;

@@ -51,6 +51,7 @@ struct DbcSignal {
   std::uint32_t multiplex_value = 0;      // multiplexed: the switch value that selects this signal
   std::vector<DbcValueName> value_names;  // VAL_, ordered by value
   int line = 0, column = 0;               // 1-based, of the SG_ keyword
+  friend bool operator==(const DbcSignal&, const DbcSignal&) = default;
 };
 
 struct DbcMessage {
@@ -62,6 +63,7 @@ struct DbcMessage {
       cycle_time;  // GenMsgCycleTime (explicit BA_, else the BA_DEF_DEF_ default); nullopt when none or 0
   std::vector<DbcSignal> signals;  // file order
   int line = 0, column = 0;        // 1-based, of the BO_ keyword
+  friend bool operator==(const DbcMessage&, const DbcMessage&) = default;
 };
 
 // line and column are 1-based; both are 0 for a problem of the whole text (its size) and for the

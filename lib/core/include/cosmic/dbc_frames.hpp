@@ -20,9 +20,6 @@
 
 namespace cosmic {
 
-// What to do with a value the signal's bits cannot hold (issue 35: `on_range`).
-enum class RangePolicy : std::uint8_t { drop, saturate };
-
 class DbcFrameCodec {
  public:
   // The codec of `message` for `type`, which must be the message's own type (channel_type_from_dbc);

@@ -29,6 +29,7 @@ using LcmError = DbcError;
 struct LcmDimension {
   bool variable = false;  // sized by a member of the struct (its name in `size`)
   std::string size;       // the decimal length, or the member's name, as written
+  friend bool operator==(const LcmDimension&, const LcmDimension&) = default;
 };
 
 struct LcmMember {
@@ -36,6 +37,7 @@ struct LcmMember {
   std::string type;  // a primitive's name (int32_t, string, ...) or a struct's full name (pkg.name_t)
   std::vector<LcmDimension> dimensions;
   int line = 0, column = 0;
+  friend bool operator==(const LcmMember&, const LcmMember&) = default;
 };
 
 struct LcmConstant {
@@ -43,6 +45,7 @@ struct LcmConstant {
   std::string type;
   std::string value;  // as written
   int line = 0, column = 0;
+  friend bool operator==(const LcmConstant&, const LcmConstant&) = default;
 };
 
 struct LcmStruct {
@@ -52,6 +55,7 @@ struct LcmStruct {
   std::vector<LcmConstant> constants;
   int line = 0, column = 0;  // of the `struct` keyword
   std::string full_name() const { return package.empty() ? name : package + "." + name; }
+  friend bool operator==(const LcmStruct&, const LcmStruct&) = default;
 };
 
 struct LcmTypeFile {

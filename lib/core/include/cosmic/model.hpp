@@ -133,16 +133,31 @@ struct NativeDdsTopic {
   friend bool operator==(const NativeDdsTopic&, const NativeDdsTopic&) = default;
 };
 
+// How a typed channel's events look on a native CAN or LCM hop (key `representation` under the
+// hop's `native` entry; docs/typed-layout.md): the type source's own form (a DBC message's frame on
+// CAN, the LCM type's encoding on LCM), the compact layout, or JSON (LCM, written for tools only).
+// A native DDS hop carries CDR in the version NativeDdsTopic::representation names.
+enum class NativeForm : std::uint8_t { source, compact, json };
+const char* to_string(NativeForm value);
+
 struct NativeBinding {
   std::string segment;
   std::optional<NativeCanFrame> can;       // CAN segments: the channel is this frame
   std::optional<std::string> lcm_channel;  // LCM segments: raw contents on this LCM channel name
   std::optional<NativeDdsTopic> dds;       // DDS segments: the serialized samples of this topic
+  NativeForm form = NativeForm::source;    // CAN and LCM hops of a typed channel
   friend bool operator==(const NativeBinding&, const NativeBinding&) = default;
 };
 // How errors and reports name a native identity: "0x123", "0x18FF0001", the LCM channel name or
 // the DDS topic name.
 std::string native_identity(const NativeBinding& binding);
+
+// A typed channel's message size on one hop, as its representation says (cosmic/hop_representation.hpp).
+struct HopPayload {
+  std::string segment;
+  std::uint64_t bytes = 0;
+  friend bool operator==(const HopPayload&, const HopPayload&) = default;
+};
 
 struct ChannelSpec {
   std::string name;
@@ -155,11 +170,19 @@ struct ChannelSpec {
   std::uint64_t payload = 8;           // maximum payload bytes
   std::optional<std::uint16_t> etag;   // static CAN etag, otherwise assigned
   LcmEncoding lcm_encoding = LcmEncoding::envelope;
-  std::vector<std::string> publishers;   // P segments
-  std::vector<std::string> subscribers;  // S segments
-  std::vector<NativeBinding> native;     // at most one per segment, each one of publishers/subscribers
-  std::optional<ChannelType> type;       // the contents' fields (cosmic/channel_type.hpp); none: opaque bytes
+  std::vector<std::string> publishers;       // P segments
+  std::vector<std::string> subscribers;      // S segments
+  std::vector<NativeBinding> native;         // at most one per segment, each one of publishers/subscribers
+  std::optional<ChannelType> type;           // the contents' fields (cosmic/channel_type.hpp); none: opaque bytes
+  RangePolicy on_range = RangePolicy::drop;  // a typed channel's values a hop cannot hold
+  // A typed channel: each hop's message size from its representation (derived by the configuration
+  // with `payload`, which is then the largest of them); empty for an untyped channel.
+  std::vector<HopPayload> hop_payloads;
   friend bool operator==(const ChannelSpec&, const ChannelSpec&) = default;
+
+  // The most bytes one event takes on `segment`: its hop's own size where the type gives one, else
+  // `payload`.
+  std::uint64_t payload_on(const std::string& segment) const;
 
   const NativeBinding* native_on(const std::string& segment) const;
   // The native CAN frame of this channel on `segment`, if it has one there.

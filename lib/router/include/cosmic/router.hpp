@@ -28,6 +28,7 @@
 #include "cosmic/steady_clock.hpp"
 #include "cosmic/mutex.hpp"
 #include "cosmic/pi_mutex.hpp"
+#include "cosmic/representation.hpp"
 #include "cosmic/router_stats.hpp"
 #include "cosmic/snapshot_table.hpp"
 #include "cosmic/segment_adapter.hpp"
@@ -47,7 +48,20 @@ struct Route {
   // latency bound of the publisher segments. The rate bucket banks 1 + ceil(this / period)
   // events, so a publisher at its period whose events the network bunches loses none.
   Nanos ingress_jitter{0};
-  friend bool operator==(const Route&, const Route&) = default;
+  // A typed channel's representation on each publisher and subscriber segment, parallel to the
+  // lists (cosmic/hop_representation.hpp); empty for an untyped channel, whose contents cross as
+  // the bytes they came in. Ingress turns a publisher hop's message into the compact layout, each
+  // egress lane the compact event into its hop's form. Derived from `spec`, so not compared.
+  std::vector<std::shared_ptr<const Representation>> publisher_forms{};
+  std::vector<std::shared_ptr<const Representation>> subscriber_forms{};
+  friend bool operator==(const Route& a, const Route& b) {
+    return a.id == b.id && a.spec == b.spec && a.publishers == b.publishers && a.subscribers == b.subscribers &&
+           a.ingress_jitter == b.ingress_jitter;
+  }
+  const Representation* publisher_form(std::size_t segment) const;
+  const Representation* subscriber_form(std::size_t hop) const {
+    return hop < subscriber_forms.size() ? subscriber_forms[hop].get() : nullptr;
+  }
 };
 
 struct RouterLimits {

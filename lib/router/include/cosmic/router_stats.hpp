@@ -27,9 +27,10 @@ enum class DropReason : std::size_t {
   no_route,
   send_failed,
   invalid,
-  oversize
+  oversize,
+  out_of_range  // a typed event's value its hop's representation cannot hold (on_range: drop)
 };
-inline constexpr std::size_t kDropReasonCount = 9;
+inline constexpr std::size_t kDropReasonCount = 10;
 const char* to_string(DropReason reason);
 
 struct SegmentCounters {

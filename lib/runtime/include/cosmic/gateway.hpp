@@ -267,6 +267,7 @@ class Gateway {
   std::map<std::string, std::string> undeclared_interference() const;
   std::string violation_line(const ChannelSpec& spec) const;
   void apply_routes();
+  bool add_representations(Route& route) const;
   ChannelId id_for(const ChannelSpec& spec);
   // A replacement's new definitions take over their channels' ids; returns the entries they
   // replaced, for undo_takeover().

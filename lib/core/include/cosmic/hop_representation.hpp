@@ -1,0 +1,100 @@
+// Which representation each hop of a typed channel takes (issue 35; docs/typed-layout.md), and the
+// forms that need no wire-format unit of their own:
+//   - a hop in the gateway's own format (the envelope on DDS and LCM, the COSMIC identifier layout
+//     on CAN) carries the compact layout;
+//   - a native CAN hop carries the DBC message's frame when the type comes from a DBC file (or the
+//     compact layout with `representation: compact`);
+//   - a native LCM hop carries the LCM type's encoding when the type comes from an LCM file, the
+//     compact layout, or JSON for tools (`representation: json`, written only);
+//   - a native DDS hop carries CDR of the type as an IDL struct, in the version its `representation`
+//     names (xcdr1, xcdr2), and reads either.
+// An untyped channel has no representation: its contents cross as the bytes they came in.
+//
+// Pure: builds objects from the channel's spec, no I/O. Called on the control thread (configuration
+// checks, route tables); the representations it returns are then shared read-only by the
+// forwarding threads.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cosmic/channel_type.hpp"
+#include "cosmic/dbc_frames.hpp"
+#include "cosmic/json_representation.hpp"
+#include "cosmic/model.hpp"
+#include "cosmic/representation.hpp"
+#include "cosmic/result.hpp"
+
+namespace cosmic {
+
+// The compact layout itself: what the gateway's own envelopes and frames carry of a typed event.
+// Reading checks the event (check_compact) and copies it.
+class CompactRepresentation final : public Representation {
+ public:
+  explicit CompactRepresentation(ChannelType type);
+  std::string describe() const override { return "compact"; }
+  std::size_t max_wire_size() const noexcept override { return max_size_; }
+  std::size_t max_compact_size() const noexcept override { return max_size_; }
+  Conversion to_compact(std::span<const std::uint8_t> wire, std::span<std::uint8_t> compact) const noexcept override;
+  Conversion from_compact(std::span<const std::uint8_t> compact, std::span<std::uint8_t> wire) const noexcept override;
+
+ private:
+  ChannelType type_;
+  std::size_t max_size_ = 0;
+};
+
+// A DBC message's frame (cosmic/dbc_frames.hpp) with the channel's range policy.
+class DbcFrameRepresentation final : public Representation {
+ public:
+  DbcFrameRepresentation(DbcFrameCodec codec, std::string name, RangePolicy policy);
+  std::string describe() const override { return name_; }
+  std::size_t max_wire_size() const noexcept override { return codec_.frame_length(); }
+  std::size_t max_compact_size() const noexcept override { return codec_.compact_size(); }
+  Conversion to_compact(std::span<const std::uint8_t> wire, std::span<std::uint8_t> compact) const noexcept override;
+  Conversion from_compact(std::span<const std::uint8_t> compact, std::span<std::uint8_t> wire) const noexcept override;
+
+ private:
+  DbcFrameCodec codec_;
+  std::string name_;
+  RangePolicy policy_;
+};
+
+// JSON text (cosmic/json_representation.hpp), written for tools; never read.
+class JsonHopRepresentation final : public Representation {
+ public:
+  explicit JsonHopRepresentation(ChannelType type);
+  std::string describe() const override { return "JSON"; }
+  std::size_t max_wire_size() const noexcept override { return json_.max_size(); }
+  std::size_t max_compact_size() const noexcept override { return compact_size_; }
+  bool reads() const noexcept override { return false; }
+  Conversion to_compact(std::span<const std::uint8_t> wire, std::span<std::uint8_t> compact) const noexcept override;
+  Conversion from_compact(std::span<const std::uint8_t> compact, std::span<std::uint8_t> wire) const noexcept override;
+
+ private:
+  JsonRepresentation json_;
+  std::size_t compact_size_ = 0;
+};
+
+// The representation of `channel` on `segment` (one of its publishers or subscribers): null for an
+// untyped channel; else the hop's form as set out above, or why the hop cannot carry the type (the
+// error names the segment).
+Result<std::shared_ptr<const Representation>> hop_representation(const ChannelSpec& channel,
+                                                                 const SegmentSpec& segment);
+
+// What every hop of a typed channel takes, by segment (its representation's largest message), and
+// the problems of the hops that cannot carry the type. The configuration sets the channel's payload
+// from it and admission counts each hop at its own size (ChannelSpec::payload_on).
+struct HopProblem {
+  std::string segment;
+  std::string what;
+};
+struct TypedHops {
+  std::vector<HopPayload> payloads;  // one per hop, in publishers-then-subscribers order
+  std::size_t compact_size = 0;      // the most bytes of one event in the compact layout
+  std::vector<HopProblem> problems;
+};
+TypedHops typed_hops(const ChannelSpec& channel, const std::vector<SegmentSpec>& segments);
+
+}  // namespace cosmic

@@ -1,0 +1,347 @@
+// Typed channels through the gateway over in-memory segments (issue 35, "each hop in its network's
+// own form"): a DBC frame taken on a CAN hop leaves as the compact layout on the gateway's own
+// envelope hops and as JSON on a native LCM hop; a compact event leaves a native CAN hop as its DBC
+// frame, a value its signal cannot hold dropped (out_of_range) or saturated; an LCM type's encoding
+// leaves a native DDS hop as XCDR1; what a hop cannot read is counted as decode_error.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+
+#include "cosmic/config_loader.hpp"
+#include "cosmic/gateway.hpp"
+#include "cosmic/lcm_types.hpp"
+#include "cosmic/memory_adapter.hpp"
+
+namespace cosmic {
+namespace {
+
+class TypedTestLogger final : public Logger {
+ public:
+  void log(LogLevel, std::string_view message) override { lines.emplace_back(message); }
+  std::vector<std::string> lines;
+};
+
+// Speed: float64 (raw 16 bits x 0.01), Gear: int8, Valid: bool; Torque: float64 (raw 8 bits x 2.5,
+// 0..637.5 Nm), Mode: uint8.
+constexpr const char* kWheelDbc = R"(VERSION ""
+NS_ :
+BS_:
+BU_: Ecu Gateway
+BO_ 416 WheelSpeed: 4 Ecu
+ SG_ Speed : 0|16@1+ (0.01,0) [0|655.35] "km/h" Gateway
+ SG_ Gear : 16|8@1- (1,0) [-1|6] "" Gateway
+ SG_ Valid : 24|1@1+ (1,0) [0|1] "" Gateway
+BO_ 512 DriveCommand: 2 Gateway
+ SG_ Torque : 0|8@1+ (2.5,0) [0|637.5] "Nm" Ecu
+ SG_ Mode : 8|8@1+ (1,0) [0|255] "" Ecu
+)";
+
+constexpr const char* kPoseLcm = R"(package demo;
+struct pose_t {
+  int64_t stamp;
+  int8_t flags;
+  double xy[2];
+  int16_t n;
+  float ranges[n];
+}
+)";
+
+std::string typed_config(const std::string& on_range) {
+  return R"(
+gateway: {name: gw, can_node_id: 1}
+segments:
+  - {name: body, type: can, interface: can0, bitrate: 500kbit/s}
+  - {name: lan, type: dds, latency_bound: 1ms}
+  - {name: viz, type: lcm, latency_bound: 2ms}
+channels:
+  - name: wheel
+    subject: 0x10
+    class: srt
+    period: 10ms
+    reaction_time: 50ms
+    type: {dbc: wheel.dbc, message: WheelSpeed}
+    publishers: [body]
+    subscribers: [lan, viz]
+    native: {body: {can_id: 0x1A0}, viz: {channel: WHEEL, representation: json}}
+  - name: drive
+    subject: 0x11
+    class: nrt
+    type: {dbc: wheel.dbc, message: DriveCommand}
+    on_range: )" +
+         on_range + R"(
+    publishers: [lan]
+    subscribers: [body]
+    native: {body: {can_id: 0x200}}
+  - name: pose
+    subject: 0x12
+    class: nrt
+    type: {lcm: pose.lcm, name: demo.pose_t, max_length: {ranges: 4}}
+    publishers: [viz]
+    subscribers: [lan]
+    native: {viz: {channel: POSE}, lan: {topic: rt/pose, type: "demo::pose_t"}}
+)";
+}
+
+void put_le(std::vector<std::uint8_t>& out, const void* value, std::size_t size) {
+  const auto* bytes = static_cast<const std::uint8_t*>(value);
+  out.insert(out.end(), bytes, bytes + size);  // this test runs on little-endian hosts only
+}
+void put_be(std::vector<std::uint8_t>& out, std::uint64_t value, std::size_t size) {
+  for (std::size_t i = size; i-- > 0;) out.push_back(static_cast<std::uint8_t>(value >> (8 * i)));
+}
+template <typename T>
+std::uint64_t bits_of(T value) {
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, &value, sizeof value);
+  return bits;
+}
+
+class TypedForwardingTest : public ::testing::Test {
+ protected:
+  TypedForwardingTest()
+      : dir_(std::filesystem::temp_directory_path() /
+             ("cosmic-typed-" + std::to_string(::getpid()) + "-" +
+              ::testing::UnitTest::GetInstance()->current_test_info()->name())),
+        gateway(
+            [this](const SegmentSpec& spec, const GatewayIdentity&, Logger&) -> std::unique_ptr<SegmentAdapter> {
+              auto adapter = std::make_unique<MemoryAdapter>(spec.name);
+              adapters[spec.name] = adapter.get();
+              return adapter;
+            },
+            log, 0x4321) {
+    std::filesystem::create_directories(dir_);
+    std::ofstream(dir_ / "wheel.dbc") << kWheelDbc;
+    std::ofstream(dir_ / "pose.lcm") << kPoseLcm;
+  }
+  ~TypedForwardingTest() override {
+    gateway.stop();
+    std::error_code ignored;
+    std::filesystem::remove_all(dir_, ignored);
+  }
+
+  ConfigResult load(const std::string& text) {
+    std::ofstream(dir_ / "gw.yaml") << text;
+    return parse_config(text, (dir_ / "gw.yaml").string());
+  }
+
+  void start(const std::string& on_range = "drop") {
+    ConfigResult loaded = load(typed_config(on_range));
+    ASSERT_TRUE(loaded.ok()) << (loaded.errors.empty() ? "" : loaded.errors[0].to_string());
+    ASSERT_TRUE(gateway.start(std::move(loaded.config)).applied);
+  }
+
+  // The payload of the `index`-th event sent on `segment`, once it is there.
+  std::vector<std::uint8_t> sent_on(const std::string& segment, std::size_t index) {
+    EXPECT_GT(adapters[segment]->wait_sent(index + 1, std::chrono::seconds(5)), index) << segment;
+    const auto sent = adapters[segment]->sent();
+    return sent.size() > index ? sent[index].payload : std::vector<std::uint8_t>{};
+  }
+
+  std::uint64_t dropped(const std::string& channel, const std::string& segment, DropReason reason) const {
+    for (const auto& c : gateway.channel_stats()) {
+      if (c.name != channel) continue;
+      for (const auto& s : c.segments) {
+        if (s.segment == segment) return s.dropped[static_cast<std::size_t>(reason)];
+      }
+    }
+    return ~std::uint64_t{0};
+  }
+
+  std::filesystem::path dir_;
+  TypedTestLogger log;
+  std::map<std::string, MemoryAdapter*> adapters;
+  Gateway gateway;
+};
+
+TEST_F(TypedForwardingTest, ADbcFrameLeavesAsTheCompactLayoutAndAsJson) {
+  start();
+  // Speed 12.34 km/h (raw 1234), Gear -1, Valid 1.
+  ASSERT_TRUE(adapters["body"]->inject("wheel", {0xD2, 0x04, 0xFF, 0x01}));
+  std::vector<std::uint8_t> compact;
+  const double speed = 12.34;
+  put_le(compact, &speed, 8);
+  compact.push_back(0xFF);
+  compact.push_back(0x01);
+  EXPECT_EQ(sent_on("lan", 0), compact);
+  const std::vector<std::uint8_t> json = sent_on("viz", 0);
+  EXPECT_EQ(std::string(json.begin(), json.end()), R"({"Speed":12.34,"Gear":-1,"Valid":true})");
+}
+
+TEST_F(TypedForwardingTest, AFrameShorterThanItsMessageIsADecodeError) {
+  start();
+  ASSERT_TRUE(adapters["body"]->inject("wheel", {0xD2, 0x04, 0xFF}));
+  ASSERT_TRUE(adapters["body"]->inject("wheel", {0x00, 0x00, 0x00, 0x00}));
+  EXPECT_EQ(sent_on("lan", 0).size(), 10u);  // the sound frame passed; the short one did not
+  EXPECT_EQ(adapters["lan"]->sent().size(), 1u);
+  EXPECT_EQ(dropped("wheel", "body", DropReason::decode_error), 1u);
+}
+
+// The envelope hop brings the compact layout: {Torque: float64, Mode: uint8}.
+std::vector<std::uint8_t> drive_event(double torque, std::uint8_t mode) {
+  std::vector<std::uint8_t> compact;
+  put_le(compact, &torque, 8);
+  compact.push_back(mode);
+  return compact;
+}
+
+TEST_F(TypedForwardingTest, ACompactEventLeavesAsItsDbcFrameAndAValueBeyondItsSignalIsDropped) {
+  start("drop");
+  ASSERT_TRUE(adapters["lan"]->inject("drive", drive_event(100.0, 3)));
+  EXPECT_EQ(sent_on("body", 0), (std::vector<std::uint8_t>{40, 3}));
+  ASSERT_TRUE(adapters["lan"]->inject("drive", drive_event(700.0, 4)));  // raw 280: beyond 8 bits
+  ASSERT_TRUE(adapters["lan"]->inject("drive", drive_event(2.5, 5)));
+  EXPECT_EQ(sent_on("body", 1), (std::vector<std::uint8_t>{1, 5}));
+  EXPECT_EQ(adapters["body"]->sent().size(), 2u);
+  EXPECT_EQ(dropped("drive", "body", DropReason::out_of_range), 1u);
+}
+
+TEST_F(TypedForwardingTest, OnRangeSaturateSendsTheNearestValueTheSignalHolds) {
+  start("saturate");
+  ASSERT_TRUE(adapters["lan"]->inject("drive", drive_event(700.0, 4)));
+  EXPECT_EQ(sent_on("body", 0), (std::vector<std::uint8_t>{255, 4}));
+  EXPECT_EQ(dropped("drive", "body", DropReason::out_of_range), 0u);
+}
+
+TEST_F(TypedForwardingTest, ACompactEventThatIsNotOneOfTheTypeIsADecodeError) {
+  start();
+  ASSERT_TRUE(adapters["lan"]->inject("drive", {1, 2, 3}));
+  ASSERT_TRUE(adapters["lan"]->inject("drive", drive_event(5.0, 1)));
+  EXPECT_EQ(sent_on("body", 0), (std::vector<std::uint8_t>{2, 1}));
+  EXPECT_EQ(dropped("drive", "lan", DropReason::decode_error), 1u);
+}
+
+// demo.pose_t in LCM's encoding (big-endian, the fingerprint first) leaves the native DDS hop as
+// XCDR1 little-endian: stamp int64, flags int8, xy double[2] (aligned to 8), n int16, ranges
+// sequence<float32, 4> (uint32 count, aligned to 4).
+TEST_F(TypedForwardingTest, AnLcmMessageLeavesANativeDdsHopAsXcdr1) {
+  start();
+  const LcmTypeFile file = parse_lcm_types(kPoseLcm);
+  ASSERT_TRUE(file.ok());
+  const std::optional<std::uint64_t> fingerprint = lcm_fingerprint(file, *file.find("demo.pose_t"));
+  ASSERT_TRUE(fingerprint.has_value());
+  std::vector<std::uint8_t> body;
+  put_be(body, 1'700'000'000'000'000'000ULL, 8);
+  body.push_back(0x80);  // flags -128
+  put_be(body, bits_of(1.5), 8);
+  put_be(body, bits_of(-2.25), 8);
+  put_be(body, 2, 2);  // n
+  put_be(body, bits_of(0.5f), 4);
+  put_be(body, bits_of(8.0f), 4);
+  std::vector<std::uint8_t> wrong(8, 0), message;
+  wrong.insert(wrong.end(), body.begin(), body.end());
+  put_be(message, *fingerprint, 8);
+  message.insert(message.end(), body.begin(), body.end());
+  ASSERT_TRUE(adapters["viz"]->inject("pose", wrong));  // another type's fingerprint
+  ASSERT_TRUE(adapters["viz"]->inject("pose", message));
+
+  std::vector<std::uint8_t> cdr{0x00, 0x01, 0x00, 0x00};  // CDR_LE, options 0 (48 bytes: no padding)
+  const std::int64_t stamp = 1'700'000'000'000'000'000LL;
+  put_le(cdr, &stamp, 8);
+  cdr.push_back(0x80);
+  cdr.insert(cdr.end(), 7, 0);  // xy aligns to 8
+  const double xy[2] = {1.5, -2.25};
+  put_le(cdr, xy, 16);
+  const std::int16_t n = 2;
+  put_le(cdr, &n, 2);
+  cdr.insert(cdr.end(), 2, 0);  // the sequence's count aligns to 4
+  const std::uint32_t count = 2;
+  put_le(cdr, &count, 4);
+  const float ranges[2] = {0.5f, 8.0f};
+  put_le(cdr, ranges, 8);
+  EXPECT_EQ(sent_on("lan", 0), cdr);
+  EXPECT_EQ(adapters["lan"]->sent().size(), 1u);
+  EXPECT_EQ(dropped("pose", "viz", DropReason::decode_error), 1u);
+}
+
+// The configuration `channels` (a YAML list) with a CAN segment body and an LCM segment viz,
+// read next to wheel.dbc.
+ConfigResult parse_with_wheel_dbc(const std::string& channels) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("cosmic-typed-config-" + std::to_string(::getpid()) + "-" +
+                                                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "wheel.dbc") << kWheelDbc;
+  const std::string text = R"(
+gateway: {name: gw, can_node_id: 1}
+segments:
+  - {name: body, type: can, interface: can0, bitrate: 500kbit/s}
+  - {name: viz, type: lcm, latency_bound: 2ms}
+channels:
+)" + channels;
+  ConfigResult result = parse_config(text, (dir / "gw.yaml").string());
+  std::filesystem::remove_all(dir);
+  return result;
+}
+
+TEST(TypedConfiguration, HopsThatCannotCarryTheTypeAreRefusedWhereTheyAreDeclared) {
+  const ConfigResult result = parse_with_wheel_dbc(R"(
+  - name: wrong_id
+    subject: 1
+    class: nrt
+    type: {dbc: wheel.dbc, message: WheelSpeed}
+    publishers: [body]
+    subscribers: [viz]
+    native: {body: {can_id: 0x1A1}}
+  - name: json_in
+    subject: 2
+    class: nrt
+    type: {dbc: wheel.dbc, message: WheelSpeed}
+    publishers: [viz]
+    subscribers: [body]
+    native: {viz: {channel: IN, representation: json}, body: {can_id: 0x1A0}}
+  - name: untyped
+    subject: 3
+    class: nrt
+    publishers: [viz]
+    subscribers: [body]
+    native: {viz: {channel: RAW, representation: compact}}
+  - name: small
+    subject: 4
+    class: nrt
+    payload: 4B
+    type: {dbc: wheel.dbc, message: WheelSpeed}
+    publishers: [body]
+    subscribers: [viz]
+)");
+  std::map<std::string, std::string> by_path;
+  for (const ConfigError& e : result.errors) {
+    EXPECT_GT(e.line, 0) << e.to_string();
+    by_path[e.path] = e.message;
+  }
+  ASSERT_EQ(result.errors.size(), 4u) << (result.errors.empty() ? "" : result.errors[0].to_string());
+  EXPECT_NE(
+      by_path["channels[0].native.body"].find("native frame 0x1A1 is not DBC message WheelSpeed's identifier 0x1A0"),
+      std::string::npos);
+  EXPECT_NE(by_path["channels[1].native.viz"].find("JSON is written for tools, not read"), std::string::npos);
+  EXPECT_NE(by_path["channels[2].native.viz.representation"].find("this channel has no type"), std::string::npos);
+  EXPECT_NE(by_path["channels[3].payload"].find("payload 4 B is less than an event of the type takes: 10 B"),
+            std::string::npos);
+}
+
+TEST(TypedConfiguration, ATypedChannelsPayloadAndHopSizesComeFromItsRepresentations) {
+  const ConfigResult result = parse_with_wheel_dbc(R"(
+  - name: wheel
+    subject: 1
+    class: nrt
+    type: {dbc: wheel.dbc, message: WheelSpeed}
+    publishers: [body]
+    subscribers: [viz]
+    native: {body: {can_id: 0x1A0}}
+)");
+  ASSERT_TRUE(result.ok()) << result.errors[0].to_string();
+  const ChannelSpec& wheel = result.config.channels.at(0);
+  EXPECT_EQ(wheel.payload, 10u);            // the compact layout's 8 + 1 + 1, the largest of the hops
+  EXPECT_EQ(wheel.payload_on("body"), 4u);  // the DBC frame
+  EXPECT_EQ(wheel.payload_on("viz"), 10u);  // the envelope's compact event
+  // Written back (a bind or state file) and read again: the same channel.
+  ASSERT_TRUE(wheel.type->source->dbc_message.has_value());
+  EXPECT_EQ(wheel.type->source->dbc_message->name, "WheelSpeed");
+}
+
+}  // namespace
+}  // namespace cosmic
