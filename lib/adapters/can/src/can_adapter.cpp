@@ -136,9 +136,9 @@ CanFrameFormat& CanAdapter::format_of(const CanHopPlan& plan) {
 }
 
 Result<void> CanAdapter::bind_native(const ChannelBinding& b, Table& table) {
-  if (Result<void> fits = native_frames_.check_payload(b.spec.payload); !fits) return fits;
+  if (Result<void> fits = native_frames_.check_payload(b.spec.payload_on(segment_.name)); !fits) return fits;
   const NativeCanFrame frame{b.can->can_id, b.can->extended};
-  const auto payload = static_cast<std::size_t>(b.spec.payload);
+  const auto payload = static_cast<std::size_t>(b.spec.payload_on(segment_.name));
   if (b.role == HopRole::publisher) {
     if (!table.native.add_publisher(frame, can_native::RxChannel{b.id, b.spec.subject, payload})) {
       return Error{"native identifier bound twice as publisher"};
@@ -160,10 +160,10 @@ Result<void> CanAdapter::bind_etag(const ChannelBinding& b, Table& table) {
   if (etag <= kHighestReservedEtag || etag > kMaxEtag)
     return Error{"etag " + std::to_string(etag) + " is reserved or out of range"};
   CanFrameFormat& format = format_of(*b.can);
-  if (Result<void> fits = format.check_payload(b.spec.payload); !fits) return fits;
-  const bool fragmented = format.fragments(b.spec.payload);
+  if (Result<void> fits = format.check_payload(b.spec.payload_on(segment_.name)); !fits) return fits;
+  const bool fragmented = format.fragments(b.spec.payload_on(segment_.name));
   const CanIdentifier id = decode_can_id(b.can->can_id & CAN_EFF_MASK);
-  const auto payload = static_cast<std::size_t>(b.spec.payload);
+  const auto payload = static_cast<std::size_t>(b.spec.payload_on(segment_.name));
   if (b.role == HopRole::publisher) {
     if (!table.rx.emplace(etag, CanRxBinding{b.id, &format, b.spec.subject, payload, fragmented}).second) {
       return Error{"etag " + std::to_string(etag) + " bound twice as publisher"};

@@ -305,7 +305,7 @@ Result<std::unique_ptr<WriterEntry>> DdsAdapter::create_writer(const ChannelBind
   }
   {
     PiLock sample(entry->sample_mutex);  // nothing sends on it yet; the analysis asks for it all the same
-    entry->format->reserve(std::min<std::uint64_t>(binding.spec.payload, segment_.max_message_size));
+    entry->format->reserve(std::min<std::uint64_t>(binding.spec.payload_on(segment_.name), segment_.max_message_size));
   }
   return entry;
 }
@@ -320,7 +320,7 @@ Result<std::unique_ptr<ReaderEntry>> DdsAdapter::create_reader(const ChannelBind
   {
     PiLock lock(entry->mutex);  // the reader does not exist yet: no callback can race with this
     entry->active = true;
-    entry->format->reserve(std::min<std::uint64_t>(binding.spec.payload, segment_.max_message_size));
+    entry->format->reserve(std::min<std::uint64_t>(binding.spec.payload_on(segment_.name), segment_.max_message_size));
   }
   const dds::StatusMask mask = dds::StatusMask::data_available()
                                << dds::StatusMask::requested_incompatible_qos() << dds::StatusMask::sample_lost();

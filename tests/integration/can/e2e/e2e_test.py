@@ -33,12 +33,14 @@ GW_NODE = 9                      # gateway.can_node_id
 DEV = 5                          # TxNode of the device this test plays on the bus
 SUBJ = {"sensor": 0x1000000A1, "command": 0x1000000B2, "bulk_up": 0x1000000C3, "bulk_down": 0x1000000C4,
         "fd_down": 0x1000000D5, "fd_up": 0x1000000D6, "wheel": 0x1000000E1, "lamp": 0x1000000E2,
-        "brake": 0x1000000E3, "relay": 0x1000000D7, "fd_bulk_down": 0x1000000D8}
+        "brake": 0x1000000E3, "relay": 0x1000000D7, "fd_bulk_down": 0x1000000D8, "wheel_speed": 0x1000000F1,
+        "drive": 0x1000000F2}
 ETAG = {"sensor": 16383,         # dynamic: the first etag handed out (section 3)
         "command": 300, "bulk_up": 201, "bulk_down": 202, "fd_down": 501, "fd_up": 502, "relay": 503,
         "fd_bulk_down": 504}
 CHANNELS = ("sensor", "command", "bulk_up", "bulk_down")  # those on segment bus (vcan0) with etags
 NATIVE_CHANNELS = ("wheel", "brake", "lamp")              # native identifiers on segment bus
+TYPED_CHANNELS = ("wheel_speed", "drive")                 # typed, DBC frames on segment bus
 FD_CHANNELS = ("fd_down", "fd_up", "fd_bulk_down")        # those on segment bus_fd (vcan1) alone
 BRIDGED_CHANNELS = ("relay",)                             # bus_fd -> bus
 SEGMENTS = 4
@@ -50,6 +52,8 @@ LAMP_ID = 0x18FF1234             # native, extended (lamp: viz -> bus)
 ENGINE_ID = 0x0C0                # declared background frame of segment bus
 BRAKE_ID = 0x0F0                 # native, standard, HRT (brake: bus -> viz)
 INTRUDER_ID = 0x0A0              # declared nowhere: beats brake's 0x0F0
+WHEEL_SPEED_ID = 0x1A0           # typed: typed.dbc's WheelSpeed (wheel_speed: bus -> viz as JSON)
+DRIVE_ID = 0x200                 # typed: typed.dbc's DriveCommand (drive: viz -> bus)
 MARKER = "7FF#5A"                # 11-bit, no channel's: only cosmicd's census sees it (unexplained)
 
 
@@ -280,17 +284,18 @@ class Scenario:
         subprocess.run(["cangen", IF, *args], check=True)
 
     # --- LCM and DDS peers
-    def lcm_sub(self, name, channel, count=1):
+    def lcm_sub(self, name, channel, count=1, raw=False):
         p = self.spawn(name, [self.t.lcm_peer, "sub", "--url", LCM_URL, "--channel", channel,
-                              "--count", str(count), "--timeout", "90"])
+                              "--count", str(count), "--timeout", "90"] + (["--raw"] if raw else []))
         wait_until("LCM subscriber %s ready" % name, 20,
                    lambda: "READY" in read_text(self.path(name + ".err"))
                    or check(p.poll() is None, "LCM subscriber exited"))
         return self.path(name + ".out")
 
-    def lcm_pub(self, channel, size, count=1):
+    def lcm_pub(self, channel, size, count=1, payload_hex=None):
         subprocess.run([self.t.lcm_peer, "pub", "--url", LCM_URL, "--channel", channel, "--count", str(count),
-                        "--size", str(size), "--subject", str(SUBJ[channel])], check=True)
+                        "--size", str(size), "--subject", str(SUBJ[channel])]
+                       + (["--payload-hex", payload_hex] if payload_hex else []), check=True)
 
     def _matched(self, name):
         return any(e.get("event") == "matched" and e.get("count", 0) >= 1 for e in json_lines(self.path(name + ".err")))
@@ -485,6 +490,42 @@ def scenario_native(s):
     expect_eq("receive errors (background frames are no one's events)", gw.segments(cli=True)["bus"]["adapter"]["receive_errors"],
               errors0)
     s.notes.append("%d background frames meanwhile" % read_text(s.path("engine.out")).count(" %03X#" % ENGINE_ID))
+
+
+def scenario_typed(s):
+    """Typed channels from typed.dbc, checked with python3-canmatrix (not ours): cansend 1A0#...
+    (WheelSpeed) -> cosmicd -> an LCM tool gets JSON with the physical values canmatrix decodes from
+    the frame; an LCM envelope with DriveCommand's compact layout (Torque float64, Mode uint8) ->
+    cosmicd -> candump shows frame 0x200, which canmatrix decodes to the values sent; a value beyond
+    Torque's 8 bits is dropped and counted (out_of_range); cosmicctl channel names each hop's form."""
+    import struct
+    import canmatrix.formats
+    matrix = canmatrix.formats.loadp_flat(os.path.join(HERE, "typed.dbc"))
+    gw = s.t.gw
+    expect_eq("wheel_speed's forms", {h["segment"]: h["representation"] for h in gw.ctl("channel", "wheel_speed")["channel"]["segments"]},
+              {"bus": "DBC frame 0x1A0 WheelSpeed", "viz": "JSON"})
+    lcm = s.lcm_sub("lcm", "WHEEL_SPEED_JSON", raw=True)
+    frame = bytes([0xD2, 0x04, 0xFF, 0x01])
+    cansend("%03X#%s" % (WHEEL_SPEED_ID, frame.hex().upper()))
+    message = wait_until("the JSON of WheelSpeed on LCM", 20, lambda: next(iter(json_lines(lcm)), None))
+    got = json.loads(bytes.fromhex(message["payload"]).decode())
+    decoded = matrix.frame_by_id(canmatrix.ArbitrationId(WHEEL_SPEED_ID)).decode(bytearray(frame))
+    expected = {name: float(v.phys_value) for name, v in decoded.items()}
+    expect_eq("WheelSpeed's fields as JSON", list(got), ["Speed", "Gear", "Valid"])
+    expect_eq("WheelSpeed's values (canmatrix: %r)" % expected,
+              {k: float(v) for k, v in got.items()}, expected)
+    s.candump("dump", "%03X:7FF" % DRIVE_ID)
+    s.lcm_pub("drive", 9, payload_hex=(struct.pack("<d", 100.0) + bytes([3])).hex())
+    s.lcm_pub("drive", 9, payload_hex=(struct.pack("<d", 700.0) + bytes([4])).hex())  # raw 280 > 255
+    s.lcm_pub("drive", 9, payload_hex=(struct.pack("<d", 2.5) + bytes([5])).hex())
+    drive_frames = lambda: [f for f in canlog.read_frames(s.path("dump.out")) if not f.eff and f.id == DRIVE_ID]
+    wait_until("two DriveCommand frames on the bus", 20, lambda: len(drive_frames()) >= 2)
+    drive = matrix.frame_by_id(canmatrix.ArbitrationId(DRIVE_ID))
+    values = [{n: float(v.phys_value) for n, v in drive.decode(bytearray(f.data)).items()} for f in drive_frames()]
+    expect_eq("DriveCommand frames decoded by canmatrix", values,
+              [{"Torque": 100.0, "Mode": 3.0}, {"Torque": 2.5, "Mode": 5.0}])
+    wait_until("the value beyond Torque's signal counted", 10,
+               lambda: gw.hop("drive", "bus")["dropped"]["out_of_range"] == 1)
 
 
 def scenario_unexplained(s):
@@ -815,7 +856,7 @@ def scenario_link_down_up(s):
         st = gw.status(cli=True)
         expect_eq("cosmicctl status: segments up", st["segments"]["up"], SEGMENTS - 1)
         expect_eq("cosmicctl status: channels degraded", st["channels"]["degraded"],
-                  len(CHANNELS) + len(NATIVE_CHANNELS) + len(BRIDGED_CHANNELS))
+                  len(CHANNELS) + len(NATIVE_CHANNELS) + len(TYPED_CHANNELS) + len(BRIDGED_CHANNELS))
         # An event for the bus while it is down: counted as not sent, nothing breaks.
 
         def not_sent():
@@ -848,7 +889,7 @@ def scenario_link_down_up(s):
 
 
 SCENARIOS = [scenario_etags, scenario_get_etag, scenario_can_to_ip, scenario_ip_to_can, scenario_fragments_up,
-             scenario_fragments_down, scenario_can_fd, scenario_fd_fragments_down, scenario_native, scenario_unexplained, scenario_garbage, scenario_overflow, scenario_burst, scenario_error_frames,
+             scenario_fragments_down, scenario_can_fd, scenario_fd_fragments_down, scenario_native, scenario_typed, scenario_unexplained, scenario_garbage, scenario_overflow, scenario_burst, scenario_error_frames,
              scenario_link_down_up]
 
 
