@@ -146,7 +146,11 @@ void check_representation(const DdsEndpointQos& writer, const DdsEndpointQos& re
   // (Cyclone DDS allows only XCDR2 for those); ours is final, the likely root cause.
   const auto& remote_ids = say.local_is_writer() ? accepted : std::vector{offered};
   const bool remote_xcdr2_only = remote_ids.size() == 1 && remote_ids.front() == DdsDataRepresentationId::xcdr2;
-  if (remote_xcdr2_only && local.extensibility == DdsTypeExtensibility::final_kind) {
+  if (say.local_is_writer() && !local.unannounced.empty()) {
+    rule += "; cosmicd's writer writes " + representations_text(local.unannounced) +
+            ", but its DDS library (Fast DDS before 2.13, eProsima/Fast-DDS#3935) does not announce it, so "
+            "peers take it for XCDR1: a reader that also accepts XCDR1 matches and gets the samples";
+  } else if (remote_xcdr2_only && local.extensibility == DdsTypeExtensibility::final_kind) {
     rule += "; XCDR2 only suggests its type is appendable or mutable, this one is final";
   }
   say.add(DdsMatchPolicy::data_representation, "data representation", to_string(offered),

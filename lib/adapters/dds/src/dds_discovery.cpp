@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <sstream>
+#include <utility>
+
+#include <fastrtps/config.h>
 
 #include <fastrtps/types/TypeObject.h>
 
@@ -200,6 +203,13 @@ DdsEndpointQos local_writer_qos(const DdsTopicRef& topic, const dds::DataWriterQ
                      qos.ownership(), qos.destination_order(), qos.representation()});
   // The adapter's Publisher has the default QoS (docs/dds-mapping.md, Entities).
   fill_group(out, dds::PUBLISHER_QOS_DEFAULT.presentation(), dds::PUBLISHER_QOS_DEFAULT.partition());
+#if FASTRTPS_VERSION_MAJOR == 2 && FASTRTPS_VERSION_MINOR < 13
+  // What goes on the wire is what the far side matches against: Fast DDS before 2.13 leaves a
+  // writer's data representation out of its announcement (eProsima/Fast-DDS#3935), which peers
+  // read as XCDR1.
+  out.unannounced = std::exchange(out.representations, {});
+  if (out.unannounced.size() == 1 && out.unannounced.front() == DdsDataRepresentationId::xcdr1) out.unannounced.clear();
+#endif
   return out;
 }
 

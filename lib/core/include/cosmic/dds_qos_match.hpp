@@ -48,6 +48,9 @@ struct DdsEndpointQos {
   // A writer offers its first entry; a reader accepts any entry. Empty: XCDR1 (XTypes 1.3
   // section 7.6.3.1.1, the value an endpoint that does not send the policy has).
   std::vector<DdsDataRepresentationId> representations;
+  // The local writer's configured representations that its DDS library does not announce (Fast
+  // DDS before 2.13 sends none: eProsima/Fast-DDS#3935), so peers take it for XCDR1; empty else.
+  std::vector<DdsDataRepresentationId> unannounced;
   // From the announced type object, when there is one (unknown otherwise: most peers announce
   // only a TypeInformation hash, which does not say it).
   DdsTypeExtensibility extensibility = DdsTypeExtensibility::unknown;

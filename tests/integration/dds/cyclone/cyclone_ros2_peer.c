@@ -8,6 +8,8 @@
  *   cosmic-cyclone-ros2-peer pub --domain D --topic T --count K [--period-ms P]
  *                                [--wait-readers N] [--timeout-s S] [--gate stdin]
  *   cosmic-cyclone-ros2-peer sub --domain D --topic T --count K [--timeout-s S]
+ *   (either, --representation xcdr2: the endpoint asks for XCDR2 alone instead of XCDR1, so it
+ *    matches only a peer that writes or reads XCDR2; --representation both: XCDR1 and XCDR2)
  *
  * pub: waits until its writer matched N readers (default 1; publication_matched, with a
  * deadline), prints MATCHED on stderr, then, with --gate stdin, waits for one line on stdin (or
@@ -51,6 +53,8 @@ struct options {
   long wait_readers;
   long timeout_s;
   bool gate;
+  bool xcdr2;
+  bool both;
 };
 
 static bool parse(int argc, char** argv, struct options* o) {
@@ -79,6 +83,9 @@ static bool parse(int argc, char** argv, struct options* o) {
       ok = parse_long(value, &o->timeout_s);
     else if (strcmp(key, "--gate") == 0)
       ok = o->gate = strcmp(value, "stdin") == 0;
+    else if (strcmp(key, "--representation") == 0)
+      ok = (o->xcdr2 = strcmp(value, "xcdr2") == 0) || (o->both = strcmp(value, "both") == 0) ||
+           strcmp(value, "xcdr1") == 0;
     else
       ok = false;
     if (!ok) return false;
@@ -89,14 +96,16 @@ static bool parse(int argc, char** argv, struct options* o) {
          o->period_ms >= 0 && o->wait_readers >= 0 && o->timeout_s > 0;
 }
 
-/* ROS 2's default QoS profile (rmw_qos_profile_default) as rmw_cyclonedds maps it, XCDR1. */
-static dds_qos_t* ros2_default_qos(void) {
+/* ROS 2's default QoS profile (rmw_qos_profile_default) as rmw_cyclonedds maps it, XCDR1 (or
+ * what --representation asks for). */
+static dds_qos_t* ros2_default_qos(const struct options* o) {
   dds_qos_t* qos = dds_create_qos();
   dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
   dds_qset_durability(qos, DDS_DURABILITY_VOLATILE);
   dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);
-  const dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
-  dds_qset_data_representation(qos, 1, &xcdr1);
+  const dds_data_representation_id_t ids[2] = {o->xcdr2 ? DDS_DATA_REPRESENTATION_XCDR2 : DDS_DATA_REPRESENTATION_XCDR1,
+                                               DDS_DATA_REPRESENTATION_XCDR2};
+  dds_qset_data_representation(qos, o->both ? 2 : 1, ids);
   return qos;
 }
 
@@ -153,7 +162,7 @@ static const char* representation_name(dds_entity_t writer) {
 }
 
 static int run_pub(dds_entity_t participant, dds_entity_t topic, const struct options* o) {
-  dds_qos_t* qos = ros2_default_qos();
+  dds_qos_t* qos = ros2_default_qos(o);
   dds_entity_t writer = dds_create_writer(participant, topic, qos, NULL);
   dds_delete_qos(qos);
   if (writer < 0) {
@@ -221,7 +230,7 @@ static bool print_sample(struct ddsi_serdata* sd) {
 
 static int run_sub(dds_entity_t participant, dds_entity_t topic, const struct options* o) {
   const dds_time_t deadline = dds_time() + DDS_SECS(o->timeout_s);
-  dds_qos_t* qos = ros2_default_qos();
+  dds_qos_t* qos = ros2_default_qos(o);
   dds_entity_t reader = dds_create_reader(participant, topic, qos, NULL);
   dds_delete_qos(qos);
   if (reader < 0) {
@@ -269,8 +278,8 @@ int main(int argc, char** argv) {
   if (!parse(argc, argv, &o)) {
     fprintf(stderr,
             "usage: %s pub --domain D --topic T --count K [--period-ms P] [--wait-readers N] "
-            "[--timeout-s S] [--gate stdin]\n"
-            "       %s sub --domain D --topic T --count K [--timeout-s S]\n",
+            "[--timeout-s S] [--gate stdin] [--representation xcdr1|xcdr2|both]\n"
+            "       %s sub --domain D --topic T --count K [--timeout-s S] [--representation xcdr1|xcdr2|both]\n",
             argv[0], argv[0]);
     return 2;
   }

@@ -68,6 +68,21 @@ channels:
     native:
       left: {topic: rt/teleop, type: "$TWIST"}
       viz: {channel: TELEOP}
+  # Typed (issue 35): the same Twist as fields, so cosmicd converts rather than carries bytes: the
+  # Cyclone writer's XCDR1 samples leave for a reader that takes XCDR2 alone, and as JSON on LCM.
+  - name: twist_typed
+    subject: 0x305
+    class: nrt
+    type:
+      fields:
+        - {name: linear, type: record, fields: [{name: x, type: float64}, {name: y, type: float64}, {name: z, type: float64}]}
+        - {name: angular, type: record, fields: [{name: x, type: float64}, {name: y, type: float64}, {name: z, type: float64}]}
+    publishers: [left]
+    subscribers: [right, viz]
+    native:
+      left: {topic: rt/twist_typed, type: "$TWIST"}
+      right: {topic: rt/twist_typed, type: "$TWIST", representation: xcdr2}
+      viz: {channel: TWIST_JSON, representation: json}
   - name: from_lcm
     subject: 0x304
     class: nrt
@@ -256,14 +271,91 @@ PY
   passed
 }
 
+# twist_typed: Cyclone ROS 2 writer (left, XCDR1) -> cosmicd (writing XCDR2 on right) -> a Cyclone
+# reader that takes XCDR1 and XCDR2 (right) and LCM channel TWIST_JSON. The reader must decode every
+# sample to the values written, each serialized as XCDR2 (CDR2_LE 00 07 00 00, the six doubles: no
+# padding at 4-byte alignment): cosmicd transcodes. The LCM tool must get each as JSON with the
+# exact values. (A reader that asks for XCDR2 alone does not match: Fast DDS 2.9 does not announce
+# its writer's representation, eProsima/Fast-DDS#3935; cosmicd reports that peer as a conflict.)
+run_typed() {
+  local count=10
+  scenario "twist_typed: ROS 2 writer (XCDR1, domain 35) -> cosmicd -> XCDR2 to a ROS 2 reader (domain 36) and JSON on LCM"
+  "$ROS2_PEER" sub --domain 36 --topic rt/twist_typed --count "$count" --timeout-s 60 --representation both \
+    >"$WORK/typed.out" 2>"$WORK/typed.sub.err" &
+  local sub=$!
+  PIDS+=("$sub")
+  "$LCM_PEER" sub --url "$LCM_URL" --channel TWIST_JSON --count "$count" --timeout 60 --raw \
+    >"$WORK/typed_json.out" 2>"$WORK/typed_json.err" &
+  local lcm=$!
+  PIDS+=("$lcm")
+  wait_until 30 "twist_typed: LCM subscriber ready" stderr_has "$WORK/typed_json.err" READY || return
+  wait_until 30 "twist_typed: the reader matched cosmicd's writer" stderr_has "$WORK/typed.sub.err" MATCHED || return
+  wait_until 30 "twist_typed: cosmicd's writer matched the reader" field_at_least gw twist_typed right matched 1 || return
+  mkfifo "$WORK/typed.go"
+  "$ROS2_PEER" pub --domain 35 --topic rt/twist_typed --count "$count" --period-ms 10 --wait-readers 1 --timeout-s 60 \
+    --gate stdin <"$WORK/typed.go" >"$WORK/typed.pub.out" 2>"$WORK/typed.pub.err" &
+  local pub=$! go
+  PIDS+=("$pub")
+  exec {go}>"$WORK/typed.go"
+  wait_until 30 "twist_typed: cosmicd's reader matched the Cyclone writer" field_at_least gw twist_typed left matched 1 || { exec {go}>&-; return; }
+  wait_until 30 "twist_typed: Cyclone writer matched" stderr_has "$WORK/typed.pub.err" MATCHED || { exec {go}>&-; return; }
+  echo go >&"$go"
+  exec {go}>&-
+  wait "$pub" || fail "twist_typed: Cyclone publisher failed: $(cat "$WORK/typed.pub.err")"
+  wait "$sub" || fail "twist_typed: XCDR2 reader: $(cat "$WORK/typed.sub.err")"
+  wait "$lcm" || fail "twist_typed: LCM subscriber: $(cat "$WORK/typed_json.err")"
+  python3 - "$WORK/typed.out" "$WORK/typed_json.out" "$count" >&2 <<'PY' || fail "twist_typed: wrong samples or JSON"
+import json, struct, sys
+samples = [json.loads(l) for l in open(sys.argv[1]) if l.strip()]
+texts = [json.loads(l) for l in open(sys.argv[2]) if l.strip()]
+count = int(sys.argv[3])
+assert len(samples) == count, f"{len(samples)} XCDR2 samples, expected {count}"
+assert len(texts) == count, f"{len(texts)} JSON messages, expected {count}"
+for i, (s, t) in enumerate(zip(samples, texts), 1):
+    linear, angular = [float(i), i + 0.5, -float(i)], [0.25 * i, -0.125, 1000.0 + i]
+    assert s["linear"] == linear and s["angular"] == angular, f"sample {i}: {s}"
+    expected = bytes([0x00, 0x07, 0x00, 0x00]) + struct.pack("<6d", *linear, *angular)
+    assert bytes.fromhex(s["cdr"]) == expected, f"sample {i}: serialized {s['cdr']}, expected {expected.hex()}"
+    got = json.loads(bytes.fromhex(t["payload"]).decode())
+    want = {"linear": dict(zip("xyz", linear)), "angular": dict(zip("xyz", angular))}
+    assert got == want and list(got) == ["linear", "angular"], f"JSON {i}: {got}, expected {want}"
+print(f"checked: {count} Twists written in XCDR1 reached the reader as XCDR2 and the LCM tool as JSON, values exact")
+PY
+  expect_field gw twist_typed right tx "$count"
+  passed
+}
+
+# A reader of twist_typed that asks for XCDR2 alone: Cyclone does not match it with cosmicd's
+# writer, which Fast DDS 2.9 announces as XCDR1 (eProsima/Fast-DDS#3935) although it writes XCDR2,
+# and cosmicd must say so: a data_representation conflict on right naming the library's limit.
+xcdr2_only_conflict() {
+  python3 -c '
+import json, sys
+hop = next(s for s in json.load(sys.stdin)["channel"]["segments"] if s["segment"] == "right")
+found = [c for c in hop["peer_conflicts"] if c["peer"] == "reader" and c["policy"] == "data_representation"]
+sys.exit(0 if found and "Fast-DDS#3935" in found[0]["reason"] else 1)' < <(ctl gw --json channel twist_typed)
+}
+run_typed_xcdr2_only() {
+  scenario "twist_typed: a reader asking for XCDR2 alone -> cosmicd reports why it does not match"
+  "$ROS2_PEER" sub --domain 36 --topic rt/twist_typed --count 1 --timeout-s 30 --representation xcdr2 \
+    >"$WORK/typed_x2.out" 2>"$WORK/typed_x2.err" &
+  local sub=$!
+  PIDS+=("$sub")
+  wait_until 30 "twist_typed: cosmicd reports the XCDR2-only reader's conflict" xcdr2_only_conflict || return
+  kill "$sub" 2>/dev/null
+  passed
+}
+
 start_daemon gw "$WORK/gw.yaml" || { tail -20 "$WORK/gw.log" >&2; exit 1; }
 # Every channel admitted and bound (a rejection would leave the test meaningless).
-[ "$(channel_count gw)" -eq 4 ] || fail "expected 4 bound channels, got $(channel_count gw)"
+[ "$(channel_count gw)" -eq 5 ] || fail "expected 5 bound channels, got $(channel_count gw)"
 
 run_channel cmd_vel rt/cmd_vel left right "$COUNT"
 run_channel odom_twist rt/odom_twist right left "$COUNT"
 run_to_lcm
 run_from_lcm
+run_typed
+run_typed_xcdr2_only
 
 if grep -q "incompatible QoS" "$WORK/gw.log"; then
   fail "cosmicd refused a Cyclone endpoint: $(grep "incompatible QoS" "$WORK/gw.log" | head -3)"
