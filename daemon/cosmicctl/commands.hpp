@@ -30,6 +30,7 @@ CommandRunner add_check_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_calibrate_command(CLI::App& app, const GlobalOptions& options);
 std::vector<CommandRunner> add_daemon_commands(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_diagram_command(CLI::App& app, const GlobalOptions& options);
+CommandRunner add_echo_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_gen_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_top_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_types_command(CLI::App& app, const GlobalOptions& options);

@@ -3,10 +3,10 @@
 # tests/cli/man_completion_test.sh fails when a command or option is missing here or no longer
 # exists. Values: FILE arguments complete to YAML files, --output to directories, --format to its
 # choices, --component to the components: of the FILE on the line, channel NAMEs (channel,
-# unbind) to the channels of the running gateway (`cosmicctl --json channels`, silent when it
+# unbind, echo) to the channels of the running gateway (`cosmicctl --json channels`, silent when it
 # cannot be reached). Needs nothing from the bash-completion package.
 
-_cosmicctl_commands="bind calibrate channel channels check diagram gen peers reload segments status top types unbind"
+_cosmicctl_commands="bind calibrate channel channels check diagram echo gen peers reload segments status top types unbind"
 _cosmicctl_global_options="--help --json --socket --version"
 
 # The options of one command (besides the global ones, which may follow it too).
@@ -15,6 +15,7 @@ _cosmicctl_command_options() {
     bind) echo "--replace --match-timeout" ;;
     calibrate) echo "--seconds --rate" ;;
     diagram) echo "--format --detail" ;;
+    echo) echo "--count --interval --timeout" ;;
     gen) echo "--component --output" ;;
     top) echo "--interval --iterations" ;;
   esac
@@ -88,7 +89,7 @@ _cosmicctl() {
       compopt -o filenames 2>/dev/null
       mapfile -t COMPREPLY < <(compgen -f -X '!*.dbc' -- "$cur"; compgen -f -X '!*.DBC' -- "$cur"; compgen -f -X '!*.lcm' -- "$cur"; compgen -d -- "$cur")
       ;;
-    channel | unbind)
+    channel | unbind | echo)
       [ -n "$file" ] && return
       local names
       names=$(cosmicctl "${socket[@]}" --json channels 2>/dev/null | grep -o '"name": *"[^"]*"' | sed 's/.*"\([^"]*\)"$/\1/')

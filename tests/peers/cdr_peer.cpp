@@ -9,6 +9,8 @@
 //                            (from_compact) as the very same bytes. One line per sample on stdout.
 //   cosmic-cdr-peer encode   sample K of each variant (final XCDR1, final XCDR2, appendable XCDR2)
 //                            as from_compact writes it, one such line each, for the Cyclone peer.
+//   cosmic-cdr-peer idl-...  the type read from an IDL file instead (cdr_peer_idl.cpp), for the
+//                            cross-check of the IDL reader against idlc (tests/integration/idl_types).
 //
 // Exit 0: every sample agreed (decode) or was written (encode); 1: one did not; 2: bad arguments.
 #include <bit>
@@ -222,10 +224,13 @@ int encode() {
 
 }  // namespace
 
+int idl_main(int argc, char** argv);  // cdr_peer_idl.cpp
+
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]).starts_with("idl-")) return idl_main(argc, argv);
   const std::string mode = argc == 2 ? argv[1] : "";
   if (mode == "decode") return decode();
   if (mode == "encode") return encode();
-  std::fprintf(stderr, "usage: cosmic-cdr-peer decode|encode\n");
+  std::fprintf(stderr, "usage: cosmic-cdr-peer decode|encode|idl-check|idl-type|idl-samples|idl-decode ...\n");
   return 2;
 }

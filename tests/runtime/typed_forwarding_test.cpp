@@ -10,9 +10,12 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <string>
 
+#include "cosmic/channel_tap.hpp"
 #include "cosmic/config_loader.hpp"
+#include "cosmic/control_protocol.hpp"
 #include "cosmic/gateway.hpp"
 #include "cosmic/lcm_types.hpp"
 #include "cosmic/memory_adapter.hpp"
@@ -341,6 +344,59 @@ TEST(TypedConfiguration, ATypedChannelsPayloadAndHopSizesComeFromItsRepresentati
   // Written back (a bind or state file) and read again: the same channel.
   ASSERT_TRUE(wheel.type->source->dbc_message.has_value());
   EXPECT_EQ(wheel.type->source->dbc_message->name, "WheelSpeed");
+}
+
+// cosmicctl echo's requests: a tap on a typed channel shows each admitted event's fields, decoded.
+TEST_F(TypedForwardingTest, EchoShowsATypedChannelsEventsDecoded) {
+  start();
+  ControlProtocol control(
+      gateway, [] { return ConfigResult{}; }, AccessPolicy{}, log);
+  const PeerCredentials peer{};
+  const auto ask = [&](const nlohmann::json& request) {
+    return nlohmann::json::parse(control.handle(request.dump(), peer));
+  };
+  const nlohmann::json opened = ask({{"command", "echo_open"}, {"name", "wheel"}});
+  ASSERT_TRUE(opened["ok"].get<bool>()) << opened.dump();
+  EXPECT_EQ(opened["type"], "{Speed: float64 [km/h, 0..655.35], Gear: int8 [-1..6], Valid: bool [0..1]}");
+  ASSERT_TRUE(adapters["body"]->inject("wheel", {0xD2, 0x04, 0xFF, 0x01}));
+  ASSERT_EQ(sent_on("lan", 0).size(), 10u);  // admitted (and tapped) before it was queued
+  const nlohmann::json read = ask({{"command", "echo_read"}, {"tap", opened["tap"]}});
+  ASSERT_TRUE(read["ok"].get<bool>()) << read.dump();
+  ASSERT_EQ(read["events"].size(), 1u) << read.dump();
+  EXPECT_EQ(read["events"][0]["contents"], nlohmann::json::parse(R"({"Speed":12.34,"Gear":-1,"Valid":true})"));
+  EXPECT_EQ(read["events"][0]["sequence"], 1);  // as the gateway numbered it for its subscribers
+  EXPECT_EQ(read["events"][0]["origin"], 0x4321);
+  EXPECT_EQ(read["missed"], 0);
+  EXPECT_TRUE(ask({{"command", "echo_close"}, {"tap", opened["tap"]}})["ok"].get<bool>());
+  const nlohmann::json after = ask({{"command", "echo_read"}, {"tap", opened["tap"]}});
+  EXPECT_EQ(after["error"]["code"], "not_found");
+  EXPECT_EQ(ask({{"command", "echo_open"}, {"name", "nothing"}})["error"]["code"], "not_found");
+  EXPECT_EQ(ask({{"command", "echo_read"}})["error"]["code"], "not_found");
+}
+
+// The tap is bounded: a full one counts what it could not take, and forwarding goes on.
+TEST(ChannelTap, AFullTapCountsWhatItMissedAndAClosedOneTakesNothing) {
+  TapBoard board;
+  const EventHeader header{};
+  const std::vector<std::uint8_t> bytes{1, 2, 3};
+  board.offer(7, header, Nanos(0), bytes);  // no tap open: nothing to do
+  const std::optional<std::uint32_t> tap = board.open(7, 3);
+  ASSERT_TRUE(tap.has_value());
+  for (std::size_t i = 0; i < TapBoard::kSlotsPerTap + 5; ++i) board.offer(7, header, Nanos(0), bytes);
+  board.offer(8, header, Nanos(0), bytes);                            // another channel's
+  board.offer(7, header, Nanos(0), std::vector<std::uint8_t>(4, 0));  // larger than the slots
+  std::optional<TapRead> read = board.read(*tap);
+  ASSERT_TRUE(read.has_value());
+  EXPECT_EQ(read->events.size(), TapBoard::kSlotsPerTap);
+  EXPECT_EQ(read->missed, 6u);
+  EXPECT_EQ(read->events[0].payload, bytes);
+  board.close(*tap);
+  EXPECT_EQ(board.open_taps(), 0u);
+  EXPECT_FALSE(board.read(*tap).has_value());
+  std::vector<std::uint32_t> ids;
+  for (std::size_t i = 0; i < TapBoard::kMaxTaps; ++i) ids.push_back(board.open(1, 8).value_or(0));
+  EXPECT_FALSE(board.open(1, 8).has_value());  // every tap in use
+  EXPECT_EQ(std::set<std::uint32_t>(ids.begin(), ids.end()).size(), TapBoard::kMaxTaps);
 }
 
 }  // namespace

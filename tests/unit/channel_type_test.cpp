@@ -293,6 +293,49 @@ TEST(ChannelTypeYaml, DbcTypeProblemsAreLocatedInTheYamlOrTheDbcFile) {
   std::filesystem::remove_all(dir);
 }
 
+// ROS 2 types (issue 35): a .msg message and an IDL struct as rosidl lays them out, their
+// dependencies found under the root FILE lies in (ROOT/pkg/msg/Name.*) or on type_path; an error in
+// a dependency is located in that file; the source is written back with the resolved type_path.
+TEST(ChannelTypeYaml, RosMessagesAndIdlStructsGiveTheFieldsWithTheirDependencies) {
+  const auto dir = std::filesystem::temp_directory_path() / ("cosmic-ros-type-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "ros" / "geometry_msgs" / "msg");
+  std::filesystem::create_directories(dir / "extra" / "geometry_msgs" / "msg");
+  std::ofstream(dir / "ros" / "geometry_msgs" / "msg" / "Twist.msg")
+      << "# This expresses velocity in free space.\nVector3  linear\nVector3  angular\n";
+  std::ofstream(dir / "extra" / "geometry_msgs" / "msg" / "Vector3.msg") << "float64 x\nfloat64 y\nfloat64 z\n";
+  std::ofstream(dir / "ros" / "geometry_msgs" / "msg" / "Twist.idl")
+      << "#include \"geometry_msgs/msg/Vector3.idl\"\nmodule geometry_msgs { module msg {\n"
+         "  struct Twist { geometry_msgs::msg::Vector3 linear; geometry_msgs::msg::Vector3 angular; };\n}; };\n";
+  std::ofstream(dir / "ros" / "geometry_msgs" / "msg" / "Vector3.idl")
+      << "module geometry_msgs { module msg {\n  struct Vector3 { double x; double y; double z; };\n}; };\n";
+  const auto load = [&](const std::string& type) {
+    std::ofstream(dir / "t.yaml") << std::string(kTypedConfigHead) + "    type: " + type + "\n";
+    return parse_config(std::string(kTypedConfigHead) + "    type: " + type + "\n", (dir / "t.yaml").string());
+  };
+  const std::string twist =
+      "{linear: {x: float64, y: float64, z: float64}, angular: {x: float64, y: float64, z: float64}}";
+  const ConfigResult msg =
+      load("{msg: ros/geometry_msgs/msg/Twist.msg, name: geometry_msgs/msg/Twist, type_path: [extra]}");
+  ASSERT_TRUE(msg.ok()) << listed_errors(msg.errors);
+  EXPECT_EQ(describe(*msg.config.channels[0].type), twist);
+  EXPECT_EQ(msg.config.channels[0].type->source->type_path, std::vector<std::string>{(dir / "extra").string()});
+  const ConfigResult idl = load("{idl: ros/geometry_msgs/msg/Twist.idl, name: \"geometry_msgs::msg::Twist\"}");
+  ASSERT_TRUE(idl.ok()) << listed_errors(idl.errors);
+  EXPECT_EQ(describe(*idl.config.channels[0].type), twist);
+  // Without type_path, Vector3.msg is nowhere: the error names it.
+  const ConfigResult missing = load("{msg: ros/geometry_msgs/msg/Twist.msg, name: geometry_msgs/msg/Twist}");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(listed_errors(missing.errors).find("Vector3"), std::string::npos) << listed_errors(missing.errors);
+  // An error in an included IDL file is located in it.
+  std::ofstream(dir / "ros" / "geometry_msgs" / "msg" / "Vector3.idl")
+      << "module geometry_msgs { module msg {\n  struct Vector3 { double x; wchar y; };\n}; };\n";
+  const ConfigResult bad = load("{idl: ros/geometry_msgs/msg/Twist.idl, name: \"geometry_msgs::msg::Twist\"}");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(listed_errors(bad.errors).find("geometry_msgs/msg/Vector3.idl:2:"), std::string::npos)
+      << listed_errors(bad.errors);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(ChannelTypeYaml, AnLcmStructGivesTheFieldsAndIsWrittenBackWithItsBounds) {
   const auto dir = std::filesystem::temp_directory_path() / ("cosmic-lcm-type-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);

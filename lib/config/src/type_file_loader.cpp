@@ -11,9 +11,7 @@
 #include <filesystem>
 
 namespace cosmic::config_detail {
-namespace {
 
-// Reads a regular file of at most `max_bytes` without ever blocking on a FIFO or a device.
 std::string read_regular_file(const std::string& path, std::string& text, std::size_t max_bytes) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) return std::strerror(errno);
@@ -43,8 +41,6 @@ std::string read_regular_file(const std::string& path, std::string& text, std::s
   ::close(fd);
   return error;
 }
-
-}  // namespace
 
 std::optional<LoadedText> load_named_file(YamlReader& reader, const YAML::Node& where, const std::string& key_path,
                                           const std::string& file, std::vector<std::string>& included,

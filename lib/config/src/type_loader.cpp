@@ -6,6 +6,7 @@
 
 #include "cosmic/dbc_type.hpp"
 #include "cosmic/lcm_types.hpp"
+#include "ros_type_loader.hpp"
 #include "type_file_loader.hpp"
 
 namespace cosmic::config_detail {
@@ -41,6 +42,8 @@ class TypeLoader {
   std::optional<ChannelType> parse(const YAML::Node& node, const std::string& path) {
     if (node.IsMap() && has(node, "dbc")) return from_dbc(node, path);
     if (node.IsMap() && has(node, "lcm")) return from_lcm(node, path);
+    if (node.IsMap() && has(node, "idl")) return load_idl_type(reader_, node, path, included_);
+    if (node.IsMap() && has(node, "msg")) return load_msg_type(reader_, node, path, included_);
     if (!reader_.check_map(node, path, {"fields"})) return std::nullopt;
     const std::size_t errors_before = reader_.error_count();
     ChannelType type;
@@ -100,17 +103,7 @@ class TypeLoader {
     }
     const auto name = reader_.string(node["name"], key(path, "name"));
     std::map<std::string, std::uint32_t> max_length;
-    if (has(node, "max_length") && !node["max_length"].IsMap()) {
-      reader_.error_at(node["max_length"], key(path, "max_length"), "max_length is a map of members to bounds",
-                       "max_length: {ranges: 1081}");
-    } else if (has(node, "max_length")) {
-      for (const auto& entry : node["max_length"]) {
-        const std::string member = entry.first.as<std::string>();
-        const auto bound =
-            reader_.unsigned_int(entry.second, key(key(path, "max_length"), member), 1, kLcmSequenceBound);
-        if (bound) max_length[member] = static_cast<std::uint32_t>(*bound);
-      }
-    }
+    if (has(node, "max_length")) max_length = parse_max_length(reader_, node["max_length"], key(path, "max_length"));
     if (!file || !name) return std::nullopt;
     const auto loaded =
         load_named_file(reader_, node["lcm"], key(path, "lcm"), *file, included_, kLcmMaxTextBytes, "LCM type file");
@@ -381,10 +374,12 @@ std::optional<ChannelType> parse_channel_type(YamlReader& reader, const YAML::No
 YAML::Node channel_type_to_yaml(const ChannelType& type) {
   if (type.source) {
     YAML::Node out;
+    static constexpr const char* kFormatKey[] = {"dbc", "lcm", "idl", "msg"};
     const bool dbc = type.source->format == TypeSource::Format::dbc;
-    out[dbc ? "dbc" : "lcm"] = type.source->file;
+    out[kFormatKey[static_cast<std::size_t>(type.source->format)]] = type.source->file;
     out[dbc ? "message" : "name"] = type.source->name;
     for (const auto& [member, bound] : type.source->max_length) out["max_length"][member] = bound;
+    for (const std::string& dir : type.source->type_path) out["type_path"].push_back(dir);
     return out;
   }
   YAML::Node list(YAML::NodeType::Sequence);

@@ -9,6 +9,7 @@
 #include "cosmic/report.hpp"
 
 #include "bind_answer.hpp"
+#include "echo_taps.hpp"
 
 namespace cosmic {
 namespace {
@@ -53,7 +54,10 @@ ControlProtocol::ControlProtocol(Gateway& gateway, std::function<ConfigResult()>
       log_(log),
       on_change_(std::move(on_change)),
       offload_(std::move(offload)),
-      started_(std::chrono::steady_clock::now()) {}
+      started_(std::chrono::steady_clock::now()),
+      echo_(std::make_unique<control_detail::EchoTaps>(gateway)) {}
+
+ControlProtocol::~ControlProtocol() = default;
 
 bool ControlProtocol::is_mutating(std::string_view command) {
   return command == "bind" || command == "replace" || command == "unbind" || command == "reload";
@@ -115,9 +119,14 @@ ControlProtocol::Answer ControlProtocol::dispatch(const Json& request, const Pee
   if (command == "segments") return segments();
   if (command == "channels") return channels();
   if (command == "channel") return channel(request);
+  const auto now = std::chrono::steady_clock::now();
+  echo_->expire(now);
+  if (command == "echo_open") return echo_->open(request, now);
+  if (command == "echo_read") return echo_->read(request, now);
+  if (command == "echo_close") return echo_->close(request);
   if (mutating) return mutate(command, request, peer, later);
   if (const auto reader = readers_.find(command); reader != readers_.end()) return reader->second();
-  std::string known = "status, segments, channels, channel";
+  std::string known = "status, segments, channels, channel, echo_open, echo_read, echo_close";
   for (const auto& [name, answer] : readers_) known += ", " + name;
   return failure("unknown_command",
                  "unknown command '" + printable(command) + "' (" + known + ", bind, replace, unbind, reload)");

@@ -108,8 +108,9 @@ Made lcm_encoding_on(const ChannelSpec& channel) {
 }
 
 Made cdr_on(const ChannelSpec& channel, const NativeDdsTopic& topic) {
-  Result<CdrRepresentation> cdr =
-      CdrRepresentation::make(*channel.type, topic.representation, CdrExtensibility::final_type);
+  const bool appendable = channel.type->source && channel.type->source->appendable;
+  Result<CdrRepresentation> cdr = CdrRepresentation::make(
+      *channel.type, topic.representation, appendable ? CdrExtensibility::appendable : CdrExtensibility::final_type);
   if (!cdr) return hop_error(cdr.error().text);
   return std::shared_ptr<const Representation>(std::make_shared<CdrRepresentation>(std::move(cdr).value()));
 }

@@ -14,8 +14,6 @@
 namespace cosmic {
 namespace {
 
-constexpr std::size_t kMaxReportedErrors = 100;
-
 enum class Kind { identifier, number, punct, end };
 
 struct Token {
@@ -144,7 +142,7 @@ class Parser {
   }
 
   void error(int line, int column, std::string message) {
-    if (file_.errors.size() < kMaxReportedErrors) {
+    if (file_.errors.size() < kMaxReportedTextErrors) {
       file_.errors.push_back(LcmError{line, column, std::move(message)});
     } else {
       ++unreported_;

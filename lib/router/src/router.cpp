@@ -227,7 +227,6 @@ bool Router::admit(ChannelState& channel, SegmentCounters& counters, const Inbou
 // Copies the payload once and queues the event on the lane of each subscriber segment.
 void Router::enqueue(const std::shared_ptr<ChannelState>& channel, const InboundEvent& event) {
   const Route& route = channel->route;
-  if (route.subscribers.empty()) return;
   EventHeader header = event.header;
   header.hop_count = static_cast<std::uint8_t>(header.hop_count + 1);
   if (header.origin == 0) {
@@ -236,6 +235,9 @@ void Router::enqueue(const std::shared_ptr<ChannelState>& channel, const Inbound
     header.sequence = channel->next_sequence.fetch_add(1, std::memory_order_relaxed) + 1;
     header.created_ns = wall_clock_ns() - header.age_ns;
   }
+  // A tap sees the event as it leaves (cosmicctl echo): one atomic load while none is open.
+  taps_.offer(route.id, header, event.received_at, event.payload);
+  if (route.subscribers.empty()) return;
   const auto fanout = static_cast<std::uint32_t>(route.subscribers.size());
   PayloadBuffer* buffer = pool_->acquire(event.payload, fanout);
   if (buffer == nullptr) {

@@ -170,4 +170,24 @@ std::vector<SegmentInfo> Gateway::segments() const {
   return out;
 }
 
+Result<std::uint32_t> Gateway::open_tap(const std::string& channel) {
+  const ChannelSpec* spec = kb_->find_bound(channel);
+  const auto id = channel_ids_.find(channel);
+  if (spec == nullptr || id == channel_ids_.end() || !router_) return Error{"no bound channel " + channel};
+  const std::optional<std::uint32_t> tap = router_->taps().open(id->second.second, spec->payload);
+  if (!tap) {
+    return Error{"every tap is in use (" + std::to_string(TapBoard::kMaxTaps) + " at once): close an echo first"};
+  }
+  return *tap;
+}
+
+std::optional<TapRead> Gateway::read_tap(std::uint32_t tap) {
+  if (!router_) return std::nullopt;
+  return router_->taps().read(tap);
+}
+
+void Gateway::close_tap(std::uint32_t tap) {
+  if (router_) router_->taps().close(tap);
+}
+
 }  // namespace cosmic

@@ -12,7 +12,8 @@ out on B and C is received by this script's own sockets. Checked:
   - every message leaves on B as one JSON object with exactly the sent values (floats as the double
     they are exactly), the fields in the struct's order;
   - a message of another fingerprint and one cut short are dropped and counted as decode_error;
-  - `cosmicctl channel pose` names each hop's representation.
+  - `cosmicctl channel pose` names each hop's representation;
+  - `cosmicctl echo pose --json` prints the first events with their decoded fields.
 """
 import json
 import os
@@ -148,6 +149,16 @@ def run(sock_path, pose_t, point_t):
     json_sock, out_sock = receiver(PORT_JSON), receiver(PORT_OUT)
     send = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
     send.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)
+    # cosmicctl echo: the first events the gateway takes in, decoded (the malformed two are not
+    # taken in, so the tap starts with message 0). It says on stderr when its tap is open.
+    echo_err_path = os.path.join(os.path.dirname(sock_path), "echo.err")
+    echo_err_file = open(echo_err_path, "w")
+    echo = subprocess.Popen([COSMICCTL, "--socket", sock_path, "--json", "echo", "pose", "--count", "5", "--timeout",
+                             "30"], stdout=subprocess.PIPE, stderr=echo_err_file, text=True)
+    deadline = time.monotonic() + 20
+    while "echo pose:" not in open(echo_err_path).read() and echo.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    check("echo pose:" in open(echo_err_path).read(), "cosmicctl echo did not open its tap")
     messages = [sample(pose_t, point_t, i, rng) for i in range(COUNT)]
     encoded = [m.encode() for m in messages]
     # Two that are not pose_t: another fingerprint, and a message cut short.
@@ -169,6 +180,13 @@ def run(sock_path, pose_t, point_t):
         check(list(got) == ["stamp", "flags", "position", "frame", "covariance", "n", "ranges", "valid"],
               f"POSE_JSON message {i}: fields {list(got)}")
         check(got == as_json_values(m), f"POSE_JSON message {i}: {got} != {as_json_values(m)}")
+    echo_out, _ = echo.communicate(timeout=40)
+    check(echo.returncode == 0, f"cosmicctl echo exited {echo.returncode}: {open(echo_err_path).read()}")
+    echoed = [json.loads(line) for line in echo_out.splitlines() if line.strip()]
+    check(len(echoed) == 5, f"cosmicctl echo printed {len(echoed)} events, expected 5")
+    for i, event in enumerate(echoed):
+        check(event.get("channel") == "pose" and event.get("contents") == as_json_values(messages[i]),
+              f"cosmicctl echo event {i}: {event}")
     answer = json.loads(ctl(sock_path, "--json", "channel", "pose").stdout)
     hops = {s["segment"]: s for s in answer["channel"]["segments"]}
     check(hops["a"]["dropped"]["decode_error"] == 2, f"decode_error on a: {hops['a']['dropped']['decode_error']}, expected 2")

@@ -57,12 +57,19 @@ inline constexpr double kMaxMatchTimeoutS = 60.0;
 // Characters of a client-chosen text (command, channel name) quoted in a log line.
 inline constexpr std::size_t kMaxLoggedText = 64;
 
+namespace control_detail {
+class EchoTaps;
+}
+
 class ControlProtocol {
  public:
   // `reload_source` re-reads the daemon's configuration file (on the worker thread when
   // `offload` is given). Without `offload`, admission runs inline on the calling thread.
   ControlProtocol(Gateway& gateway, std::function<ConfigResult()> reload_source, AccessPolicy policy, Logger& log,
                   ChangeObserver on_change = {}, Offload offload = {});
+  ~ControlProtocol();  // closes the taps echo opened
+  ControlProtocol(const ControlProtocol&) = delete;
+  ControlProtocol& operator=(const ControlProtocol&) = delete;
 
   // The answer line now, or nullopt when a bind or reload runs off the control thread: `later`
   // then gets the answer. While one runs, every bind, unbind and reload is answered `busy`.
@@ -129,6 +136,7 @@ class ControlProtocol {
   DenialLog denials_;               // which denials are logged (a burst is summarised)
   std::map<std::string, std::function<Json()>> readers_;  // add_reader()
   BindGate gate_;
+  std::unique_ptr<control_detail::EchoTaps> echo_;  // echo_open, echo_read, echo_close
 };
 
 }  // namespace cosmic

@@ -86,17 +86,24 @@ struct TypeField {
 // Where a type was read from, when not written inline: the configuration writes it back this way
 // (a bind or state file names the DBC message or the LCM struct, not its fields).
 struct TypeSource {
-  enum class Format : std::uint8_t { dbc, lcm };
+  enum class Format : std::uint8_t { dbc, lcm, idl, msg };
   Format format = Format::dbc;
   std::string file;  // as resolved against the configuration's directory
-  std::string name;  // the DBC message's name, or the LCM struct's full name (pkg.name_t)
-  std::map<std::string, std::uint32_t> max_length;  // LCM: bounds of variable-length arrays, by member
+  // The DBC message's name, the LCM struct's full name (pkg.name_t), the IDL struct's scoped name
+  // (pkg::msg::Name) or the ROS 2 message's (pkg/msg/Name).
+  std::string name;
+  // LCM: bounds of variable-length arrays, by member; IDL, .msg: of strings and sequences, by path.
+  std::map<std::string, std::uint32_t> max_length;
   // What the source's own representation needs beyond the fields, read with them and compared by
   // content (a file changed under a reload rebinds the channel): a DBC message's frame layout; the
   // LCM file's structs (the struct's nested structs and which member counts which array). Shared:
   // every copy of a channel's spec refers to the one file read.
   std::optional<DbcMessage> dbc_message;
   std::shared_ptr<const LcmTypeFile> lcm_file;
+  // IDL and .msg: where included files and referenced messages are looked for (as given, resolved),
+  // and whether the IDL struct is @appendable (its CDR hops then write XCDR2 with DHEADERs).
+  std::vector<std::string> type_path{};
+  bool appendable = false;
   friend bool operator==(const TypeSource& a, const TypeSource& b);
 };
 

@@ -68,6 +68,10 @@ struct DbcMessage {
 
 // line and column are 1-based; both are 0 for a problem of the whole text (its size) and for the
 // closing line that counts the errors left unreported.
+// How many problems a reader of a text file (DBC, LCM, IDL, .msg) reports at most; one closing line
+// then counts the rest.
+inline constexpr std::size_t kMaxReportedTextErrors = 100;
+
 struct DbcError {
   int line = 0;
   int column = 0;

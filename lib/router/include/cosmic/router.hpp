@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "cosmic/channel_tap.hpp"
 #include "cosmic/event.hpp"
 #include "cosmic/log.hpp"
 #include "cosmic/model.hpp"
@@ -126,6 +127,8 @@ class Router {
   void set_residence_bound(Nanos bound);
   // What lane threads could not get of their ThreadPolicy since the last call (control thread).
   std::vector<std::string> take_thread_problems() COSMIC_EXCLUDES(problems_mutex_);
+  // Taps on channels' admitted events (cosmicctl echo; cosmic/channel_tap.hpp). Control thread.
+  TapBoard& taps() { return taps_; }
 
  private:
   struct Table;
@@ -158,6 +161,7 @@ class Router {
   std::unique_ptr<LaneContext> lane_context_;
   std::vector<std::unique_ptr<EgressLane>> lanes_;  // segment * 3 + class
 
+  TapBoard taps_;
   Mutex problems_mutex_;
   std::vector<std::string> thread_problems_ COSMIC_GUARDED_BY(problems_mutex_);
 };

@@ -232,6 +232,12 @@ class Gateway {
   // transport does not report (see SegmentAdapter::peer_qos_conflicts).
   std::vector<PeerQosConflict> peer_qos_conflicts(const std::string& segment, const std::string& channel) const;
 
+  // Taps on a bound channel's admitted events (cosmicctl echo; cosmic/channel_tap.hpp): a tap on
+  // the channel as it is bound now (a replacement's events go to a new tap), or why not.
+  Result<std::uint32_t> open_tap(const std::string& channel);
+  std::optional<TapRead> read_tap(std::uint32_t tap);
+  void close_tap(std::uint32_t tap);
+
  private:
   struct SegmentSlot {
     std::size_t index = 0;

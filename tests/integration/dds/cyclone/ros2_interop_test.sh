@@ -29,6 +29,7 @@ trap 'cleanup; rm -rf "$WORK"' EXIT
 export CYCLONEDDS_URI='<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface name="lo" multicast="true"/></Interfaces></General></Domain></CycloneDDS>'
 
 TWIST=geometry_msgs::msg::dds_::Twist_
+HERE=$(cd "$(dirname "$0")" && pwd)
 COUNT=50
 
 cat >"$WORK/gw.yaml" <<YAML
@@ -68,15 +69,13 @@ channels:
     native:
       left: {topic: rt/teleop, type: "$TWIST"}
       viz: {channel: TELEOP}
-  # Typed (issue 35): the same Twist as fields, so cosmicd converts rather than carries bytes: the
-  # Cyclone writer's XCDR1 samples leave for a reader that takes XCDR2 alone, and as JSON on LCM.
+  # Typed (issue 35): the Twist read from the IDL file the Cyclone peers are generated from, so
+  # cosmicd converts rather than carries bytes: the Cyclone writer's XCDR1 samples leave as XCDR2,
+  # and as JSON on LCM.
   - name: twist_typed
     subject: 0x305
     class: nrt
-    type:
-      fields:
-        - {name: linear, type: record, fields: [{name: x, type: float64}, {name: y, type: float64}, {name: z, type: float64}]}
-        - {name: angular, type: record, fields: [{name: x, type: float64}, {name: y, type: float64}, {name: z, type: float64}]}
+    type: {idl: "$HERE/ros2_twist.idl", name: "geometry_msgs::msg::dds_::Twist_"}  # what idlc compiled for the peer
     publishers: [left]
     subscribers: [right, viz]
     native:
