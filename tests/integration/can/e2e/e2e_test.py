@@ -607,10 +607,12 @@ def scenario_garbage(s):
     # cosmicd's socket is classic CAN and filters 29-bit frames of its publisher etags + GET_ETAG.
     bound = {ETAG["sensor"], ETAG["bulk_up"], ETAG_GET}
     passing = [f for f in frames if f.eff and f.fd_flags is None and (f.id & 0x3FFF) in bound]
-    # ... and the native standard identifiers of wheel and brake (exact match, data frames only).
-    wheel = [f for f in frames if not f.eff and f.fd_flags is None and not f.rtr and f.id == WHEEL_ID]
-    brake = [f for f in frames if not f.eff and f.fd_flags is None and not f.rtr and f.id == BRAKE_ID]
-    passing += wheel + brake
+    # ... and the native standard identifiers of the channels published on the bus: wheel, brake and
+    # the typed wheel_speed (exact match, data frames only); random 11-bit frames hit them by chance.
+    def native(can_id):
+        return [f for f in frames if not f.eff and f.fd_flags is None and not f.rtr and f.id == can_id]
+    wheel = native(WHEEL_ID)
+    passing += wheel + native(BRAKE_ID) + native(WHEEL_SPEED_ID)
     sensor = [f for f in passing if (f.id & 0x3FFF) == ETAG["sensor"]]
     sensor_bad = [f for f in sensor if f.rtr or len(f.data) > 4]  # remote, or longer than payload 4 B
     get_bad = [f for f in passing if (f.id & 0x3FFF) == ETAG_GET and (f.rtr or len(f.data) != 8)]
