@@ -3,7 +3,9 @@
 // classic or a 64-byte frame) and a received frame of the input's bytes. Every frame becomes an event
 // that check_compact() accepts and JSON writes; the event packs into a frame (saturating) that reads
 // back to a frame packed the same way: the second trip changes nothing. Dropping refuses exactly
-// the events saturating had to clamp.
+// the events saturating had to clamp. End-to-end protection (cosmic/e2e_protection.hpp) on two of the
+// signals, where they can carry it: a protected frame checks intact with its counter, and one flipped
+// bit anywhere in the message is caught.
 #include <array>
 #include <cstdint>
 #include <string>
@@ -13,6 +15,7 @@
 #include "cosmic/dbc_codec.hpp"
 #include "cosmic/dbc_frames.hpp"
 #include "cosmic/dbc_type.hpp"
+#include "cosmic/e2e_protection.hpp"
 #include "cosmic/json_representation.hpp"
 #include "fuzz_input.hpp"
 
@@ -58,6 +61,27 @@ cosmic::DbcSignal make_signal(FuzzInput& in, std::size_t index, std::uint32_t le
   return s;
 }
 
+void check_e2e(FuzzInput& in, const cosmic::DbcMessage& message, std::vector<std::uint8_t> frame) {
+  const std::size_t n = message.signals.size();
+  if (n < 2) return;
+  const auto& counter = message.signals[in.byte() % n].name;
+  const auto& crc = message.signals[in.byte() % n].name;
+  const auto data_id = static_cast<std::uint16_t>(in.byte() << 8 | in.byte());
+  const auto mode = static_cast<cosmic::E2eDataIdMode>(in.byte() % 3);
+  const auto e2e = cosmic::E2eProtection::make(message, cosmic::E2eSpec{counter, crc, data_id, mode});
+  if (!e2e.ok()) return;
+  std::uint64_t sequence = 0;
+  for (std::uint8_t b : in.bytes(8)) sequence = sequence << 8 | b;
+  e2e.value().protect(frame, sequence);
+  const cosmic::E2eReading reading = e2e.value().check(frame);
+  require(reading.intact && reading.counter == sequence % e2e.value().counter_modulus());
+  // alt: a flipped counter bit also changes which data ID byte the CRC covers, two changes at once.
+  if (mode == cosmic::E2eDataIdMode::alt) return;
+  const std::size_t bit = static_cast<std::size_t>(in.byte() << 8 | in.byte()) % (message.length * 8);
+  frame[bit / 8] = static_cast<std::uint8_t>(frame[bit / 8] ^ (1u << (bit % 8)));
+  require(!e2e.value().check(frame).intact);
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -100,5 +124,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // Dropping sends nothing exactly when saturating had to clamp.
   std::vector<std::uint8_t> dropped(message.length);
   require(codec.value().to_frame(event, dropped, cosmic::RangePolicy::drop).sent == (packed.out_of_range == 0));
+  check_e2e(in, message, once);
   return 0;
 }

@@ -200,6 +200,16 @@ std::string drops_text(const Json& dropped) {
   return out.empty() ? "-" : out;
 }
 
+// The DROPPED column: the gateway's drops on the hop, then the events a protected hop's end-to-end
+// counter shows missing before they reached it (not drops of this gateway, so named apart).
+std::string hop_losses_text(const Json& segment) {
+  std::string out = drops_text(segment["dropped"]);
+  const std::uint64_t omitted = segment.value("omitted", std::uint64_t{0});
+  if (omitted == 0) return out;
+  return (out == "-" ? "" : out + " ") + "omitted=" + std::to_string(omitted) + " (" +
+         std::to_string(segment.value("omission_excess", std::uint64_t{0})) + " gaps beyond omission_degree)";
+}
+
 void print_channels(const Json& r) {
   std::cout << pad_column("CHANNEL", 16) << pad_column("CLASS", 6) << pad_column("VERDICT", 9)
             << pad_column("RUNTIME", 9) << pad_column("ETAG", 6) << pad_column("SEGMENT", 12) << pad_column("ROLE", 4)
@@ -215,7 +225,7 @@ void print_channels(const Json& r) {
                 << pad_column(first && c.contains("etag") ? text(c["etag"]) : "", 6)
                 << pad_column(text(s["segment"]), 12) << pad_column(s["role"] == "publisher" ? "P" : "S", 4)
                 << pad_column(text(s["rx"]), 9) << pad_column(text(s["tx"]), 9)
-                << pad_column(first ? residence : "", 19) << drops_text(s["dropped"]) << "\n";
+                << pad_column(first ? residence : "", 19) << hop_losses_text(s) << "\n";
       first = false;
     }
     for (const auto& reason : c["reasons"]) std::cout << "    - " << text(reason) << "\n";

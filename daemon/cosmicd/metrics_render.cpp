@@ -238,6 +238,12 @@ void render_hop_counters(Exposition& out, const std::vector<HopView>& hops) {
       out.sample(labels, h.counters ? h.counters->dropped[r] : 0);
     }
   }
+  out.family("cosmic_channel_omitted_events", MetricType::counter,
+             "Events the publisher sent that never arrived on this segment, by the gaps in its end-to-end counter.");
+  for (const auto& h : hops) out.sample(hop_labels(h), h.counters ? h.counters->omitted : 0);
+  out.family("cosmic_channel_omission_excess", MetricType::counter,
+             "Gaps in the end-to-end counter on this segment longer than the channel's omission degree.");
+  for (const auto& h : hops) out.sample(hop_labels(h), h.counters ? h.counters->omission_excess : 0);
 }
 
 // Egress hops (subscriber segments) carry the measured residence.

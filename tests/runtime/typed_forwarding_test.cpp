@@ -5,6 +5,7 @@
 // leaves a native DDS hop as XCDR1; what a hop cannot read is counted as decode_error.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <filesystem>
@@ -42,6 +43,14 @@ BO_ 416 WheelSpeed: 4 Ecu
 BO_ 512 DriveCommand: 2 Gateway
  SG_ Torque : 0|8@1+ (2.5,0) [0|637.5] "Nm" Ecu
  SG_ Mode : 8|8@1+ (1,0) [0|255] "" Ecu
+BO_ 432 BrakeStatus: 4 Ecu
+ SG_ Crc : 0|8@1+ (1,0) [0|255] "" Gateway
+ SG_ Counter : 8|4@1+ (1,0) [0|14] "" Gateway
+ SG_ Pressure : 16|16@1+ (1,0) [0|65535] "bar" Gateway
+BO_ 433 BrakeCommand: 4 Gateway
+ SG_ Crc : 0|8@1+ (1,0) [0|255] "" Ecu
+ SG_ Counter : 8|4@1+ (1,0) [0|14] "" Ecu
+ SG_ Pressure : 16|16@1+ (1,0) [0|65535] "bar" Ecu
 )";
 
 constexpr const char* kPoseLcm = R"(package demo;
@@ -87,6 +96,21 @@ channels:
     publishers: [viz]
     subscribers: [lan]
     native: {viz: {channel: POSE}, lan: {topic: rt/pose, type: "demo::pose_t"}}
+  - name: brake
+    subject: 0x13
+    class: nrt
+    omission_degree: 1
+    type: {dbc: wheel.dbc, message: BrakeStatus, e2e: {counter: Counter, crc: Crc, data_id: 0x0123}}
+    publishers: [body]
+    subscribers: [lan]
+    native: {body: {can_id: 0x1B0}}
+  - name: brake_command
+    subject: 0x14
+    class: nrt
+    type: {dbc: wheel.dbc, message: BrakeCommand, e2e: {counter: Counter, crc: Crc, data_id: 0x0124, data_id_mode: low}}
+    publishers: [lan]
+    subscribers: [body]
+    native: {body: {can_id: 0x1B1}}
 )";
 }
 
@@ -153,6 +177,16 @@ class TypedForwardingTest : public ::testing::Test {
       }
     }
     return ~std::uint64_t{0};
+  }
+
+  const SegmentCountersSnapshot* hop(const std::vector<ChannelStatsSnapshot>& stats, const std::string& channel,
+                                     const std::string& segment) const {
+    for (const auto& c : stats) {
+      for (const auto& s : c.segments) {
+        if (c.name == channel && s.segment == segment) return &s;
+      }
+    }
+    return nullptr;
   }
 
   std::filesystem::path dir_;
@@ -397,6 +431,64 @@ TEST(ChannelTap, AFullTapCountsWhatItMissedAndAClosedOneTakesNothing) {
   for (std::size_t i = 0; i < TapBoard::kMaxTaps; ++i) ids.push_back(board.open(1, 8).value_or(0));
   EXPECT_FALSE(board.open(1, 8).has_value());  // every tap in use
   EXPECT_EQ(std::set<std::uint32_t>(ids.begin(), ids.end()).size(), TapBoard::kMaxTaps);
+}
+
+// BrakeStatus with its E2E counter and CRC (profile 1, data ID 0x0123, both bytes): the CRCs below
+// are python3-crcmod's (mkCrcFun(0x11D, initCrc=0, xorOut=0)) over 23 01, the counter byte and the
+// pressure, not this code's.
+std::vector<std::uint8_t> brake_frame(std::uint8_t crc, std::uint8_t counter, std::uint16_t pressure) {
+  return {crc, counter, static_cast<std::uint8_t>(pressure & 0xFF), static_cast<std::uint8_t>(pressure >> 8)};
+}
+
+TEST_F(TypedForwardingTest, AnE2eFrameIsCheckedAndItsCounterGapsCountAgainstTheOmissionDegree) {
+  start();
+  const auto inject = [&](std::vector<std::uint8_t> frame) { ASSERT_TRUE(adapters["body"]->inject("brake", frame)); };
+  inject(brake_frame(0x50, 0, 100));  // counter 0
+  inject(brake_frame(0x93, 1, 101));  // 1
+  inject(brake_frame(0x08, 3, 103));  // 3: counter 2 never came (1 omitted, within the degree)
+  inject(brake_frame(0x08, 3, 103));  // 3 again: a repeat
+  inject(brake_frame(0x20, 4, 104));  // a wrong CRC (0x21 is right)
+  inject(brake_frame(0x79, 7, 107));  // 7: 4, 5 and 6 missing (the corrupt 4 never counted as received)
+  // The type leaves the counter and CRC out: the lan hop gets Pressure alone (uint16, the compact layout).
+  for (std::size_t i = 0; i < 4; ++i) {
+    const std::uint16_t expected[] = {100, 101, 103, 107};
+    EXPECT_EQ(sent_on("lan", i), (std::vector<std::uint8_t>{static_cast<std::uint8_t>(expected[i] & 0xFF),
+                                                            static_cast<std::uint8_t>(expected[i] >> 8)}))
+        << i;
+  }
+  const auto stats = gateway.channel_stats();
+  const SegmentCountersSnapshot* body = hop(stats, "brake", "body");
+  ASSERT_NE(body, nullptr);
+  EXPECT_EQ(body->rx, 6u);
+  EXPECT_EQ(body->dropped[static_cast<std::size_t>(DropReason::duplicate)], 1u);
+  EXPECT_EQ(body->dropped[static_cast<std::size_t>(DropReason::corrupt)], 1u);
+  EXPECT_EQ(body->omitted, 4u);
+  EXPECT_EQ(body->omission_excess, 1u);  // the gap of 3 is beyond omission_degree 1; the gap of 1 is not
+  // A gap beyond the omission degree turns the channel violated (an NRT channel too), with the numbers.
+  gateway.refresh_runtime(Nanos(1'000'000'000));
+  for (const auto& c : gateway.channel_stats()) {
+    if (c.name == "brake") {
+      EXPECT_EQ(c.runtime_state, RuntimeState::violated);
+    }
+  }
+  const bool logged = std::any_of(log.lines.begin(), log.lines.end(), [](const std::string& line) {
+    return line.find(
+               "channel brake violated its omission degree 1: hop body: 1 gaps in the end-to-end counter "
+               "longer than that, 4 events missing in all;") != std::string::npos;
+  });
+  EXPECT_TRUE(logged);
+}
+
+TEST_F(TypedForwardingTest, AnE2eFrameLeavesWithItsOwnCounterAndCrc) {
+  start();
+  for (std::uint16_t pressure : {500, 501, 502}) {
+    ASSERT_TRUE(adapters["lan"]->inject(
+        "brake_command", {static_cast<std::uint8_t>(pressure & 0xFF), static_cast<std::uint8_t>(pressure >> 8)}));
+  }
+  // data_id_mode low: crcmod over 24, the counter byte and the pressure.
+  EXPECT_EQ(sent_on("body", 0), (std::vector<std::uint8_t>{0xD6, 0, 0xF4, 0x01}));
+  EXPECT_EQ(sent_on("body", 1), (std::vector<std::uint8_t>{0x15, 1, 0xF5, 0x01}));
+  EXPECT_EQ(sent_on("body", 2), (std::vector<std::uint8_t>{0x4D, 2, 0xF6, 0x01}));
 }
 
 }  // namespace

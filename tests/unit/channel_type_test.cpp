@@ -293,6 +293,49 @@ TEST(ChannelTypeYaml, DbcTypeProblemsAreLocatedInTheYamlOrTheDbcFile) {
   std::filesystem::remove_all(dir);
 }
 
+// End-to-end protection on a DBC type (cosmic/e2e_protection.hpp): the counter and CRC are not
+// fields, the protection is written back with the source, and what cannot be protected is located
+// at the e2e key with the reason.
+TEST(ChannelTypeYaml, AnE2eDbcTypeLeavesItsCounterAndCrcOutAndIsWrittenBack) {
+  const auto dir = std::filesystem::temp_directory_path() / ("cosmic-e2e-type-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "brake.dbc") << "BO_ 432 Brake: 4 X\n SG_ Crc : 0|8@1+ (1,0) [0|0] \"\" X\n"
+                                      " SG_ Counter : 8|4@1+ (1,0) [0|0] \"\" X\n"
+                                      " SG_ Pressure : 16|16@1+ (1,0) [0|0] \"bar\" X\n";
+  const auto parsed = [&](const std::string& type) {
+    return parse_config(std::string(kTypedConfigHead) + "    type: " + type + "\n", (dir / "t.yaml").string());
+  };
+  const ConfigResult r =
+      parsed("{dbc: brake.dbc, message: Brake, e2e: {counter: Counter, crc: Crc, data_id: 0x123, data_id_mode: alt}}");
+  ASSERT_TRUE(r.ok()) << listed_errors(r.errors);
+  const ChannelSpec& brake = r.config.channels.at(0);
+  EXPECT_EQ(describe(*brake.type), "{Pressure: uint16 [bar]}");
+  ASSERT_TRUE(brake.type->source->e2e.has_value());
+  EXPECT_EQ(*brake.type->source->e2e, (E2eSpec{"Counter", "Crc", 0x123, E2eDataIdMode::alt}));
+  EXPECT_EQ(brake.type->source->dbc_message->signals.size(), 3u);  // the frame keeps them
+  const std::string written = channel_to_yaml(brake);
+  const ChannelsResult again = parse_channels("[" + written + "]", "bind", r.config);
+  ASSERT_TRUE(again.ok()) << listed_errors(again.errors) << written;
+  EXPECT_EQ(again.channels.at(0), brake) << written;
+
+  const auto errors_for = [&](const std::string& type) { return listed_errors(parsed(type).errors); };
+  const std::string wrong =
+      errors_for("{dbc: brake.dbc, message: Brake, e2e: {counter: Counter, crc: Pressure, data_id: 1}}");
+  EXPECT_NE(wrong.find("t.yaml:12:49: channels[0].type.e2e: the CRC signal Pressure does not fill one whole byte of "
+                       "the frame (16 bits at start bit 16); CRC-8 needs one byte of its own"),
+            std::string::npos)
+      << wrong;
+  const std::string missing = errors_for("{dbc: brake.dbc, message: Brake, e2e: {counter: Counter}}");
+  EXPECT_NE(missing.find("channels[0].type.e2e: end-to-end protection needs its crc"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("channels[0].type.e2e: end-to-end protection needs its data_id"), std::string::npos)
+      << missing;
+  const std::string range = errors_for(
+      "{dbc: brake.dbc, message: Brake, e2e: {counter: Counter, crc: Crc, data_id: 0x10000, data_id_mode: nibble}}");
+  EXPECT_NE(range.find("channels[0].type.e2e.data_id: '0x10000' is out of range"), std::string::npos) << range;
+  EXPECT_NE(range.find("channels[0].type.e2e.data_id_mode: "), std::string::npos) << range;
+  std::filesystem::remove_all(dir);
+}
+
 // ROS 2 types (issue 35): a .msg message and an IDL struct as rosidl lays them out, their
 // dependencies found under the root FILE lies in (ROOT/pkg/msg/Name.*) or on type_path; an error in
 // a dependency is located in that file; the source is written back with the resolved type_path.

@@ -66,7 +66,7 @@ class TypeLoader {
  private:
   // {dbc: FILE, message: NAME}: the message's signals as fields (cosmic/dbc_type.hpp).
   std::optional<ChannelType> from_dbc(const YAML::Node& node, const std::string& path) {
-    if (!reader_.check_map(node, path, {"dbc", "message"})) return std::nullopt;
+    if (!reader_.check_map(node, path, {"dbc", "message", "e2e"})) return std::nullopt;
     const auto file = reader_.string(node["dbc"], key(path, "dbc"));
     if (!has(node, "message")) {
       reader_.error_at(node, path, "a DBC type names its message", "message: NAME (a BO_ of the DBC file)");
@@ -84,12 +84,45 @@ class TypeLoader {
                        "no message " + quote_value(*name) + " in " + loaded->path, message_names(messages));
       return std::nullopt;
     }
-    DbcChannelType typed = channel_type_from_dbc(*message);
+    std::optional<E2eSpec> e2e;
+    if (has(node, "e2e")) {
+      e2e = e2e_of(node["e2e"], key(path, "e2e"), *message);
+      if (!e2e) return std::nullopt;
+    }
+    DbcChannelType typed = channel_type_from_dbc(e2e ? e2e_payload_message(*message, *e2e) : *message);
     for (const DbcError& e : typed.errors)
       reader_.error_in(ConfigError{loaded->path, e.line, e.column, key(path, "message"), e.message, ""});
     if (!typed.ok()) return std::nullopt;
     typed.type.source = TypeSource{TypeSource::Format::dbc, loaded->path, message->name, {}, *message, {}};
+    typed.type.source->e2e = e2e;
     return std::move(typed.type);
+  }
+
+  // e2e: {counter: SIG, crc: SIG, data_id: N, data_id_mode: both|low|alt} (cosmic/e2e_protection.hpp),
+  // checked against the message.
+  std::optional<E2eSpec> e2e_of(const YAML::Node& node, const std::string& path, const DbcMessage& message) {
+    if (!reader_.check_map(node, path, {"counter", "crc", "data_id", "data_id_mode"})) return std::nullopt;
+    const std::size_t errors_before = reader_.error_count();
+    for (const char* needed : {"counter", "crc", "data_id"}) {
+      if (!has(node, needed))
+        reader_.error_at(node, path, std::string("end-to-end protection needs its ") + needed,
+                         "e2e: {counter: SIGNAL, crc: SIGNAL, data_id: 0..0xFFFF}");
+    }
+    if (reader_.error_count() != errors_before) return std::nullopt;
+    E2eSpec spec;
+    const auto counter = reader_.string(node["counter"], key(path, "counter"));
+    const auto crc = reader_.string(node["crc"], key(path, "crc"));
+    const auto data_id = reader_.unsigned_int(node["data_id"], key(path, "data_id"), 0, 0xFFFF);
+    std::optional<std::size_t> mode = 0;
+    if (has(node, "data_id_mode"))
+      mode = reader_.choice(node["data_id_mode"], key(path, "data_id_mode"), {"both", "low", "alt"});
+    if (!counter || !crc || !data_id || !mode) return std::nullopt;
+    spec = E2eSpec{*counter, *crc, static_cast<std::uint16_t>(*data_id), static_cast<E2eDataIdMode>(*mode)};
+    if (Result<E2eProtection> checked = E2eProtection::make(message, spec); !checked) {
+      reader_.error_at(node, path, checked.error().text);
+      return std::nullopt;
+    }
+    return spec;
   }
 
   // {lcm: FILE, name: pkg.type_t, max_length: {MEMBER: N}}: the struct's members as fields
@@ -378,6 +411,12 @@ YAML::Node channel_type_to_yaml(const ChannelType& type) {
     const bool dbc = type.source->format == TypeSource::Format::dbc;
     out[kFormatKey[static_cast<std::size_t>(type.source->format)]] = type.source->file;
     out[dbc ? "message" : "name"] = type.source->name;
+    if (const auto& e2e = type.source->e2e) {
+      out["e2e"]["counter"] = e2e->counter;
+      out["e2e"]["crc"] = e2e->crc;
+      out["e2e"]["data_id"] = e2e->data_id;
+      out["e2e"]["data_id_mode"] = to_string(e2e->data_id_mode);
+    }
     for (const auto& [member, bound] : type.source->max_length) out["max_length"][member] = bound;
     for (const std::string& dir : type.source->type_path) out["type_path"].push_back(dir);
     return out;

@@ -323,6 +323,8 @@ Json ControlProtocol::channel_entry(const ChannelReport& verdict, const ChannelS
     }
     seg["representation"] = hop_representation_text(spec, gateway_.config(), hop.segment);
     for (std::size_t r = 0; r < kDropReasonCount; ++r) seg["dropped"][to_string(static_cast<DropReason>(r))] = 0;
+    seg["omitted"] = 0;
+    seg["omission_excess"] = 0;
     if (stats) {
       for (const auto& counters : stats->segments) {
         if (counters.segment != hop.segment) continue;
@@ -331,6 +333,8 @@ Json ControlProtocol::channel_entry(const ChannelReport& verdict, const ChannelS
         for (std::size_t r = 0; r < kDropReasonCount; ++r) {
           seg["dropped"][to_string(static_cast<DropReason>(r))] = counters.dropped[r];
         }
+        seg["omitted"] = counters.omitted;
+        seg["omission_excess"] = counters.omission_excess;
         if (counters.egress && hop.role == HopRole::subscriber) seg["runtime"] = hop_runtime(hop, *counters.egress);
       }
     }

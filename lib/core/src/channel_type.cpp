@@ -15,7 +15,8 @@ bool operator==(const TypeSource& a, const TypeSource& b) {
   const bool same_lcm =
       a.lcm_file == b.lcm_file || (a.lcm_file && b.lcm_file && a.lcm_file->structs == b.lcm_file->structs);
   return a.format == b.format && a.file == b.file && a.name == b.name && a.max_length == b.max_length &&
-         a.dbc_message == b.dbc_message && same_lcm && a.type_path == b.type_path && a.appendable == b.appendable;
+         a.dbc_message == b.dbc_message && same_lcm && a.type_path == b.type_path && a.appendable == b.appendable &&
+         a.e2e == b.e2e;
 }
 
 namespace {

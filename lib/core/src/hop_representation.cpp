@@ -30,8 +30,9 @@ Conversion CompactRepresentation::from_compact(std::span<const std::uint8_t> com
   return {compact.size(), ConversionFault::none, 0};
 }
 
-DbcFrameRepresentation::DbcFrameRepresentation(DbcFrameCodec codec, std::string name, RangePolicy policy)
-    : codec_(std::move(codec)), name_(std::move(name)), policy_(policy) {}
+DbcFrameRepresentation::DbcFrameRepresentation(DbcFrameCodec codec, std::string name, RangePolicy policy,
+                                               std::optional<E2eProtection> e2e)
+    : codec_(std::move(codec)), name_(std::move(name)), policy_(policy), e2e_(std::move(e2e)) {}
 
 Conversion DbcFrameRepresentation::to_compact(std::span<const std::uint8_t> wire,
                                               std::span<std::uint8_t> compact) const noexcept {
@@ -84,11 +85,19 @@ Made dbc_frame_on(const ChannelSpec& channel, const NativeCanFrame& frame) {
     return hop_error("native frame " + can_id_text(frame.can_id, frame.extended) + " is not DBC message " +
                      message.name + "'s identifier " + can_id_text(message.can_id, message.extended));
   }
-  Result<DbcFrameCodec> codec = DbcFrameCodec::make(message, type);
+  const std::optional<E2eSpec>& e2e_spec = type.source->e2e;
+  Result<DbcFrameCodec> codec = DbcFrameCodec::make(e2e_spec ? e2e_payload_message(message, *e2e_spec) : message, type);
   if (!codec) return hop_error(codec.error().text);
-  const std::string name = "DBC frame " + can_id_text(message.can_id, message.extended) + " " + message.name;
+  std::optional<E2eProtection> e2e;
+  if (e2e_spec) {
+    Result<E2eProtection> made = E2eProtection::make(message, *e2e_spec);
+    if (!made) return hop_error("end-to-end protection: " + made.error().text);
+    e2e = std::move(made).value();
+  }
+  std::string name = "DBC frame " + can_id_text(message.can_id, message.extended) + " " + message.name;
+  if (e2e) name += " with E2E (counter " + e2e_spec->counter + ", CRC " + e2e_spec->crc + ")";
   return std::shared_ptr<const Representation>(
-      std::make_shared<DbcFrameRepresentation>(std::move(codec).value(), name, channel.on_range));
+      std::make_shared<DbcFrameRepresentation>(std::move(codec).value(), name, channel.on_range, std::move(e2e)));
 }
 
 Made lcm_encoding_on(const ChannelSpec& channel) {

@@ -23,7 +23,9 @@ struct ChannelState {
                policing_depth(route.spec.period.value_or(Nanos(0)), route.ingress_jitter, burst)),
         counters(segment_count),
         egress(route.subscribers.size()),
-        retired_egress(segment_count) {}
+        retired_egress(segment_count),
+        e2e_last(segment_count),
+        e2e_next(route.subscribers.size()) {}
 
   const Route route;
   PiMutex policy_mutex;  // guards bucket, dedup and loop_guard (ingress threads of several segments)
@@ -41,6 +43,12 @@ struct ChannelState {
   // already queued still go to the subscriber segments the new route keeps, not to the others
   // (indexed by segment slot).
   std::vector<std::atomic<bool>> retired_egress;
+  // End-to-end counters of the hops whose form carries them (Representation::e2e()): the last
+  // counter each publisher segment brought, plus one (0: none yet; indexed by segment slot; its
+  // ingress thread), and the next one each subscriber hop writes (parallel to route.subscribers;
+  // its lane thread).
+  std::vector<std::atomic<std::uint64_t>> e2e_last;
+  std::vector<std::atomic<std::uint64_t>> e2e_next;
 };
 
 }  // namespace cosmic

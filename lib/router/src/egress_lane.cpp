@@ -5,6 +5,8 @@
 #include <optional>
 #include <limits>
 
+#include "cosmic/e2e_protection.hpp"
+
 namespace cosmic {
 
 EgressLane::EgressLane(LaneContext& context, std::size_t segment, std::size_t byte_budget)
@@ -171,7 +173,14 @@ std::optional<std::span<const std::uint8_t>> EgressLane::hop_bytes(LaneItem& ite
   // Grows once per larger representation, never in steady state (the bound is the type's).
   if (out.size() < form->max_wire_size()) out.resize(form->max_wire_size());
   const Conversion converted = form->from_compact(item.payload->bytes(), out);
-  if (converted.ok()) return std::span<const std::uint8_t>(out.data(), converted.size);
+  if (converted.ok()) {
+    const std::span<std::uint8_t> message(out.data(), converted.size);
+    // The hop's own counter: one more for every event converted for it, so a receiver counts as
+    // missing exactly the events this hop lost after here.
+    if (const E2eProtection* e2e = form->e2e())
+      e2e->protect(message, channel.e2e_next[item.hop].fetch_add(1, std::memory_order_relaxed));
+    return message;
+  }
   channel.counters[segment_].drop(converted.fault == ConversionFault::out_of_range ? DropReason::out_of_range
                                                                                    : DropReason::invalid);
   discard(item);

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "channel_state.hpp"
+#include "cosmic/e2e_protection.hpp"
 #include "cosmic/ingress_check.hpp"
 #include "egress_lane.hpp"
 #include "payload_pool.hpp"
@@ -190,6 +191,8 @@ void Router::receive(std::size_t segment, const InboundEvent& event) {
   }
   // A typed channel's event goes on in the compact layout, whatever form its hop brought it in.
   if (const Representation* form = channel->route.publisher_form(segment)) {
+    if (const E2eProtection* e2e = form->e2e(); e2e != nullptr && !e2e_admit(*channel, segment, *e2e, checked.payload))
+      return;
     const std::span<std::uint8_t> compact = ingress_scratch(form->max_compact_size());
     const Conversion converted = form->to_compact(checked.payload, compact);
     if (!converted.ok()) {
@@ -200,6 +203,36 @@ void Router::receive(std::size_t segment, const InboundEvent& event) {
   }
   if (!admit(*channel, counters, checked)) return;
   enqueue(channel, checked);
+}
+
+// A protected frame's CRC and counter (cosmic/e2e_protection.hpp): a corrupt frame and a repeated
+// one go no further; a gap in the counter is counted against the channel's omission degree.
+bool Router::e2e_admit(ChannelState& channel, std::size_t segment, const E2eProtection& e2e,
+                       std::span<const std::uint8_t> frame) {
+  SegmentCounters& counters = channel.counters[segment];
+  if (frame.size() < e2e.frame_length()) {
+    counters.drop(DropReason::decode_error);
+    return false;
+  }
+  const E2eReading reading = e2e.check(frame);
+  if (!reading.intact) {
+    counters.drop(DropReason::corrupt);
+    return false;
+  }
+  const std::uint64_t previous = channel.e2e_last[segment].exchange(reading.counter + std::uint64_t{1});
+  const E2eStep step =
+      e2e_step(previous == 0 ? std::nullopt : std::optional<std::uint32_t>(static_cast<std::uint32_t>(previous - 1)),
+               reading.counter, e2e.counter_modulus());
+  if (step.repeated) {
+    counters.drop(DropReason::duplicate);
+    return false;
+  }
+  if (step.omitted > 0) {
+    counters.omitted.fetch_add(step.omitted, std::memory_order_relaxed);
+    if (step.omitted > channel.route.spec.omission_degree)
+      counters.omission_excess.fetch_add(1, std::memory_order_relaxed);
+  }
+  return true;
 }
 
 // Duplicate, validity and rate policies; counts what it refuses.
@@ -321,7 +354,8 @@ HopRuntimeSnapshot hop_snapshot(const EgressStats& stats) {
 }
 
 SegmentCountersSnapshot counters_snapshot(const std::string& name, const SegmentCounters& c) {
-  SegmentCountersSnapshot seg{name, c.rx.load(), c.tx.load(), {}, std::nullopt};
+  SegmentCountersSnapshot seg{name,        c.rx.load(), c.tx.load(), {}, c.omitted.load(), c.omission_excess.load(),
+                              std::nullopt};
   for (std::size_t r = 0; r < kDropReasonCount; ++r) seg.dropped[r] = c.dropped[r].load();
   return seg;
 }
@@ -337,7 +371,11 @@ std::vector<ChannelMisses> Router::misses() const {
       residence += hop.residence_miss.load(std::memory_order_relaxed);
       deadline += hop.deadline_miss.load(std::memory_order_relaxed);
     }
-    if (residence + deadline > 0) out.push_back(ChannelMisses{state->route.spec.name, residence, deadline});
+    std::uint64_t omission_excess = 0;
+    for (const std::size_t s : state->route.publishers)
+      omission_excess += state->counters[s].omission_excess.load(std::memory_order_relaxed);
+    if (residence + deadline + omission_excess > 0)
+      out.push_back(ChannelMisses{state->route.spec.name, residence, deadline, omission_excess});
   }
   return out;
 }

@@ -26,6 +26,8 @@ const char* to_string(DropReason reason) {
       return "oversize";
     case DropReason::out_of_range:
       return "out_of_range";
+    case DropReason::corrupt:
+      return "corrupt";
   }
   return "?";
 }

@@ -68,21 +68,26 @@ void Gateway::refresh_runtime(Nanos now) {
   runtime_ = std::move(next);
 }
 
-// One channel: a new miss of an HRT hop starts (or extends) a violation episode; a clean
-// interval ends it. SRT and NRT channels count misses but keep their state (they were promised
-// no bound).
+// One channel: a new miss of an HRT hop, or a gap in an end-to-end counter longer than the
+// channel's omission degree (any class: every class declares its omission degree), starts (or
+// extends) a violation episode; a clean interval ends it. SRT and NRT channels count timing misses
+// but keep their state (they were promised no bound).
 void Gateway::judge(const ChannelMisses& counted, const ChannelSpec& spec, RuntimeTrack& track, Nanos now,
                     const std::string* foreign) {
   const std::uint64_t misses = counted.residence_miss + counted.deadline_miss;
-  const bool missed = misses > track.misses || foreign;
+  const bool late = spec.cls == ChannelClass::hrt && (misses > track.misses || foreign);
+  const bool omitted = counted.omission_excess > track.omission_excess;
+  const bool missed = late || omitted;
+  if (misses > track.misses || foreign || omitted) track.last_miss = now;
   track.misses = misses;
-  if (missed) track.last_miss = now;
-  if (spec.cls != ChannelClass::hrt) return;
+  track.omission_excess = counted.omission_excess;
   if (missed && track.state == RuntimeState::bound) {
     track.state = RuntimeState::violated;
     ++track.violations;
-    log_.log(LogLevel::warning,
-             foreign ? "channel " + spec.name + " violated its admitted bounds: " + *foreign : violation_line(spec));
+    std::string line = !late     ? omission_line(spec)
+                       : foreign ? "channel " + spec.name + " violated its admitted bounds: " + *foreign
+                                 : violation_line(spec);
+    log_.log(LogLevel::warning, line);
   } else if (!missed && track.state == RuntimeState::violated &&
              now - track.last_miss >= config_.gateway.clean_interval) {
     track.state = RuntimeState::bound;
@@ -102,6 +107,22 @@ std::string Gateway::violation_line(const ChannelSpec& spec) const {
               format_duration(config_.gateway.residence_bound) + " (" + std::to_string(seg.egress->residence_miss) +
               " misses), " + std::to_string(seg.egress->deadline_miss) + " events older than reaction_time " +
               (spec.reaction_time ? format_duration(*spec.reaction_time) : std::string("-")) + ";";
+    }
+  }
+  return line;
+}
+
+// The gaps behind an omission violation, hop by hop.
+std::string Gateway::omission_line(const ChannelSpec& spec) const {
+  std::string line =
+      "channel " + spec.name + " violated its omission degree " + std::to_string(spec.omission_degree) + ":";
+  for (const auto& stats : router_->snapshot()) {
+    if (stats.name != spec.name) continue;
+    for (const auto& seg : stats.segments) {
+      if (seg.omission_excess == 0) continue;
+      line += " hop " + seg.segment + ": " + std::to_string(seg.omission_excess) +
+              " gaps in the end-to-end counter longer than that, " + std::to_string(seg.omitted) +
+              " events missing in all;";
     }
   }
   return line;

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "cosmic/dbc.hpp"
+#include "cosmic/e2e_protection.hpp"
 
 namespace cosmic {
 
@@ -104,6 +105,9 @@ struct TypeSource {
   // and whether the IDL struct is @appendable (its CDR hops then write XCDR2 with DHEADERs).
   std::vector<std::string> type_path{};
   bool appendable = false;
+  // DBC: the message's end-to-end protection (cosmic/e2e_protection.hpp); its counter and CRC
+  // signals are then not fields of the type, dbc_message keeps them.
+  std::optional<E2eSpec> e2e{};
   friend bool operator==(const TypeSource& a, const TypeSource& b);
 };
 

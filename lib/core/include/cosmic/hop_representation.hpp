@@ -17,11 +17,13 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "cosmic/channel_type.hpp"
 #include "cosmic/dbc_frames.hpp"
+#include "cosmic/e2e_protection.hpp"
 #include "cosmic/json_representation.hpp"
 #include "cosmic/model.hpp"
 #include "cosmic/representation.hpp"
@@ -45,11 +47,14 @@ class CompactRepresentation final : public Representation {
   std::size_t max_size_ = 0;
 };
 
-// A DBC message's frame (cosmic/dbc_frames.hpp) with the channel's range policy.
+// A DBC message's frame (cosmic/dbc_frames.hpp) with the channel's range policy, and its
+// end-to-end protection where the type declares one (the codec then packs the other signals).
 class DbcFrameRepresentation final : public Representation {
  public:
-  DbcFrameRepresentation(DbcFrameCodec codec, std::string name, RangePolicy policy);
+  DbcFrameRepresentation(DbcFrameCodec codec, std::string name, RangePolicy policy,
+                         std::optional<E2eProtection> e2e = std::nullopt);
   std::string describe() const override { return name_; }
+  const E2eProtection* e2e() const noexcept override { return e2e_ ? &*e2e_ : nullptr; }
   std::size_t max_wire_size() const noexcept override { return codec_.frame_length(); }
   std::size_t max_compact_size() const noexcept override { return codec_.compact_size(); }
   Conversion to_compact(std::span<const std::uint8_t> wire, std::span<std::uint8_t> compact) const noexcept override;
@@ -59,6 +64,7 @@ class DbcFrameRepresentation final : public Representation {
   DbcFrameCodec codec_;
   std::string name_;
   RangePolicy policy_;
+  std::optional<E2eProtection> e2e_;
 };
 
 // JSON text (cosmic/json_representation.hpp), written for tools; never read.

@@ -17,6 +17,8 @@
 
 namespace cosmic {
 
+class E2eProtection;
+
 // Why a conversion produced nothing.
 enum class ConversionFault : std::uint8_t {
   none,
@@ -45,6 +47,10 @@ class Representation {
   // Whether the hop can bring events in (a DBC frame, LCM, CDR, compact: yes; JSON: written for
   // tools only, never read).
   virtual bool reads() const noexcept { return true; }
+  // The end-to-end protection the hop's messages carry (a DBC message's counter and CRC;
+  // cosmic/e2e_protection.hpp), or null. The router checks it on what the hop brings in, before
+  // to_compact(), and writes it on what from_compact() made, with the counters it keeps per hop.
+  virtual const E2eProtection* e2e() const noexcept { return nullptr; }
 
   // One received message of the hop as one event in the compact layout, into `compact` (at least
   // max_compact_size() bytes).

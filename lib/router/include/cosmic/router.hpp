@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -81,6 +82,7 @@ struct RouterLimits {
 
 using SteadyClock = Nanos (*)();
 
+class E2eProtection;
 class EgressLane;
 struct ChannelState;
 class PayloadPool;
@@ -137,6 +139,8 @@ class Router {
   void receive(std::size_t segment, const InboundEvent& event);
   void problem(std::size_t segment, ChannelId channel, InboundProblem what);
   bool admit(ChannelState& channel, SegmentCounters& counters, const InboundEvent& event);
+  bool e2e_admit(ChannelState& channel, std::size_t segment, const E2eProtection& e2e,
+                 std::span<const std::uint8_t> frame);
   void enqueue(const std::shared_ptr<ChannelState>& channel, const InboundEvent& event);
   std::shared_ptr<ChannelState> find(ChannelId id) const;
   EgressLane& lane(std::size_t segment, ChannelClass cls);

@@ -17,7 +17,8 @@ namespace cosmic {
 // the transport could not take it; duplicate: seen before or a loop copy; decode_error: the
 // bytes were not an event; no_route: not bound for that direction; send_failed: the transport
 // refused it; invalid: a header field out of range (negative or absurd age, foreign subject,
-// our own origin); oversize: larger than the channel's admitted payload.
+// our own origin); oversize: larger than the channel's admitted payload; corrupt: a frame whose
+// end-to-end CRC or counter value is wrong (cosmic/e2e_protection.hpp).
 enum class DropReason : std::size_t {
   expired,
   rate,
@@ -28,15 +29,20 @@ enum class DropReason : std::size_t {
   send_failed,
   invalid,
   oversize,
-  out_of_range  // a typed event's value its hop's representation cannot hold (on_range: drop)
+  out_of_range,  // a typed event's value its hop's representation cannot hold (on_range: drop)
+  corrupt
 };
-inline constexpr std::size_t kDropReasonCount = 10;
+inline constexpr std::size_t kDropReasonCount = 11;
 const char* to_string(DropReason reason);
 
 struct SegmentCounters {
   std::atomic<std::uint64_t> rx{0};
   std::atomic<std::uint64_t> tx{0};
   std::array<std::atomic<std::uint64_t>, kDropReasonCount> dropped{};
+  // A hop with end-to-end protection: events its publisher sent that never arrived (gaps in the
+  // counter), and the gaps longer than the channel's omission_degree.
+  std::atomic<std::uint64_t> omitted{0};
+  std::atomic<std::uint64_t> omission_excess{0};
   void drop(DropReason reason) { dropped[static_cast<std::size_t>(reason)].fetch_add(1, std::memory_order_relaxed); }
 };
 
@@ -89,6 +95,8 @@ struct SegmentCountersSnapshot {
   std::uint64_t rx = 0;
   std::uint64_t tx = 0;
   std::array<std::uint64_t, kDropReasonCount> dropped{};
+  std::uint64_t omitted = 0;
+  std::uint64_t omission_excess = 0;
   std::optional<HopRuntimeSnapshot> egress;  // set on the channel's subscriber segments
 };
 
@@ -104,6 +112,7 @@ struct ChannelMisses {
   std::string name;
   std::uint64_t residence_miss = 0;
   std::uint64_t deadline_miss = 0;
+  std::uint64_t omission_excess = 0;  // over its publisher hops (SegmentCounters)
 };
 
 struct ChannelStatsSnapshot {

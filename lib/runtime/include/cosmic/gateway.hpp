@@ -252,7 +252,8 @@ class Gateway {
 
   struct RuntimeTrack {
     RuntimeState state = RuntimeState::bound;
-    std::uint64_t misses = 0;  // residence + deadline misses seen at the last refresh
+    std::uint64_t misses = 0;           // residence + deadline misses seen at the last refresh
+    std::uint64_t omission_excess = 0;  // gaps beyond the omission degree seen at the last refresh
     Nanos last_miss{0};
     std::uint64_t violations = 0;
   };
@@ -272,6 +273,7 @@ class Gateway {
   // HRT channels that frames unknown to admission beat on a CAN bus: name -> reason.
   std::map<std::string, std::string> undeclared_interference() const;
   std::string violation_line(const ChannelSpec& spec) const;
+  std::string omission_line(const ChannelSpec& spec) const;
   void apply_routes();
   bool add_representations(Route& route) const;
   ChannelId id_for(const ChannelSpec& spec);

@@ -34,13 +34,13 @@ DEV = 5                          # TxNode of the device this test plays on the b
 SUBJ = {"sensor": 0x1000000A1, "command": 0x1000000B2, "bulk_up": 0x1000000C3, "bulk_down": 0x1000000C4,
         "fd_down": 0x1000000D5, "fd_up": 0x1000000D6, "wheel": 0x1000000E1, "lamp": 0x1000000E2,
         "brake": 0x1000000E3, "relay": 0x1000000D7, "fd_bulk_down": 0x1000000D8, "wheel_speed": 0x1000000F1,
-        "drive": 0x1000000F2}
+        "drive": 0x1000000F2, "brake_status": 0x1000000F3, "brake_command": 0x1000000F4}
 ETAG = {"sensor": 16383,         # dynamic: the first etag handed out (section 3)
         "command": 300, "bulk_up": 201, "bulk_down": 202, "fd_down": 501, "fd_up": 502, "relay": 503,
         "fd_bulk_down": 504}
 CHANNELS = ("sensor", "command", "bulk_up", "bulk_down")  # those on segment bus (vcan0) with etags
 NATIVE_CHANNELS = ("wheel", "brake", "lamp")              # native identifiers on segment bus
-TYPED_CHANNELS = ("wheel_speed", "drive")                 # typed, DBC frames on segment bus
+TYPED_CHANNELS = ("wheel_speed", "drive", "brake_status", "brake_command")  # typed, DBC frames on segment bus
 FD_CHANNELS = ("fd_down", "fd_up", "fd_bulk_down")        # those on segment bus_fd (vcan1) alone
 BRIDGED_CHANNELS = ("relay",)                             # bus_fd -> bus
 SEGMENTS = 4
@@ -54,6 +54,8 @@ BRAKE_ID = 0x0F0                 # native, standard, HRT (brake: bus -> viz)
 INTRUDER_ID = 0x0A0              # declared nowhere: beats brake's 0x0F0
 WHEEL_SPEED_ID = 0x1A0           # typed: typed.dbc's WheelSpeed (wheel_speed: bus -> viz as JSON)
 DRIVE_ID = 0x200                 # typed: typed.dbc's DriveCommand (drive: viz -> bus)
+BRAKE_STATUS_ID = 0x1B0          # typed, E2E: typed.dbc's BrakeStatus (brake_status: bus -> viz as JSON)
+BRAKE_COMMAND_ID = 0x210         # typed, E2E: typed.dbc's BrakeCommand (brake_command: viz -> bus)
 MARKER = "7FF#5A"                # 11-bit, no channel's: only cosmicd's census sees it (unexplained)
 
 
@@ -528,6 +530,51 @@ def scenario_typed(s):
                lambda: gw.hop("drive", "bus")["dropped"]["out_of_range"] == 1)
 
 
+def scenario_e2e(s):
+    """End-to-end protection (AUTOSAR E2E profile 1), checked with python3-crcmod (not ours): frames
+    of BrakeStatus whose CRC crcmod computed pass as JSON with the counter and CRC left out; a wrong
+    CRC is dropped (corrupt), a repeated counter is a duplicate, gaps in the counter are counted as
+    omitted and the one beyond omission_degree 1 turns the channel violated, logged with the
+    numbers; BrakeCommand frames cosmicd sends carry counters 0, 1, 2 and the CRC crcmod computes."""
+    import struct
+    import crcmod
+    crc8 = crcmod.mkCrcFun(0x11D, initCrc=0, rev=False, xorOut=0)  # profile 1: start 0, no final XOR
+    gw = s.t.gw
+
+    def protected(data_id, counter, raw):
+        body = bytes([counter]) + struct.pack("<H", raw)
+        return bytes([crc8(struct.pack("<H", data_id) + body)]) + body
+    expect_eq("brake_status's forms", {h["segment"]: h["representation"]
+                                       for h in gw.ctl("channel", "brake_status")["channel"]["segments"]},
+              {"bus": "DBC frame 0x1B0 BrakeStatus with E2E (counter Counter, CRC Crc)", "viz": "JSON"})
+    lcm = s.lcm_sub("lcm", "BRAKE_STATUS_JSON", count=4, raw=True)
+    bad = bytearray(protected(0x01B0, 4, 1004))
+    bad[0] ^= 0x01
+    for frame in (protected(0x01B0, 0, 1000), protected(0x01B0, 1, 1001), protected(0x01B0, 3, 1003),
+                  protected(0x01B0, 3, 1003), bytes(bad), protected(0x01B0, 7, 1007)):
+        cansend("%03X#%s" % (BRAKE_STATUS_ID, frame.hex().upper()))
+    wait_until("six BrakeStatus frames counted", 20, lambda: gw.hop("brake_status", "bus")["rx"] == 6)
+    events = wait_until("four BrakeStatus events as JSON", 20, lambda: json_lines(lcm) if len(json_lines(lcm)) >= 4 else None)
+    got = [json.loads(bytes.fromhex(e["payload"]).decode()) for e in events]
+    expect_eq("BrakeStatus as JSON (counter and CRC are not contents)", got,
+              [{"Pressure": raw * 0.1} for raw in (1000, 1001, 1003, 1007)])
+    hop = gw.hop("brake_status", "bus")
+    expect_eq("corrupt, duplicate", (hop["dropped"]["corrupt"], hop["dropped"]["duplicate"]), (1, 1))
+    expect_eq("omitted (2; 4, 5, 6), gaps beyond omission_degree 1", (hop["omitted"], hop["omission_excess"]), (4, 1))
+    wait_until("brake_status violated", 20, lambda: gw.channels()["brake_status"]["runtime_state"] == "violated")
+    lines = [l for l in read_text(gw.log).splitlines() if "channel brake_status violated" in l]
+    expect_eq("the violation's line", [l.split(" warning ")[-1] for l in lines],
+              ["channel brake_status violated its omission degree 1: hop bus: 1 gaps in the end-to-end counter "
+               "longer than that, 4 events missing in all;"])
+    s.candump("dump", "%03X:7FF" % BRAKE_COMMAND_ID)
+    for raw in (500, 501, 502):
+        s.lcm_pub("brake_command", 8, payload_hex=struct.pack("<d", raw / 10).hex())
+    frames = lambda: [f for f in canlog.read_frames(s.path("dump.out")) if not f.eff and f.id == BRAKE_COMMAND_ID]
+    wait_until("three BrakeCommand frames on the bus", 20, lambda: len(frames()) >= 3)
+    expect_eq("BrakeCommand frames: crcmod's CRC, counters 0, 1, 2", [bytes(f.data) for f in frames()],
+              [protected(0x0210, c, raw) for c, raw in ((0, 500), (1, 501), (2, 502))])
+
+
 def scenario_unexplained(s):
     """Frames nothing explains: cosmicctl segments counts them by identifier with their rate (the
     declared background frame and the bound channels' frames are not counted); one that beats the
@@ -608,11 +655,12 @@ def scenario_garbage(s):
     bound = {ETAG["sensor"], ETAG["bulk_up"], ETAG_GET}
     passing = [f for f in frames if f.eff and f.fd_flags is None and (f.id & 0x3FFF) in bound]
     # ... and the native standard identifiers of the channels published on the bus: wheel, brake and
-    # the typed wheel_speed (exact match, data frames only); random 11-bit frames hit them by chance.
+    # the typed wheel_speed and brake_status (exact match, data frames only); random 11-bit frames
+    # hit them by chance.
     def native(can_id):
         return [f for f in frames if not f.eff and f.fd_flags is None and not f.rtr and f.id == can_id]
     wheel = native(WHEEL_ID)
-    passing += wheel + native(BRAKE_ID) + native(WHEEL_SPEED_ID)
+    passing += wheel + native(BRAKE_ID) + native(WHEEL_SPEED_ID) + native(BRAKE_STATUS_ID)
     sensor = [f for f in passing if (f.id & 0x3FFF) == ETAG["sensor"]]
     sensor_bad = [f for f in sensor if f.rtr or len(f.data) > 4]  # remote, or longer than payload 4 B
     get_bad = [f for f in passing if (f.id & 0x3FFF) == ETAG_GET and (f.rtr or len(f.data) != 8)]
@@ -891,7 +939,7 @@ def scenario_link_down_up(s):
 
 
 SCENARIOS = [scenario_etags, scenario_get_etag, scenario_can_to_ip, scenario_ip_to_can, scenario_fragments_up,
-             scenario_fragments_down, scenario_can_fd, scenario_fd_fragments_down, scenario_native, scenario_typed, scenario_unexplained, scenario_garbage, scenario_overflow, scenario_burst, scenario_error_frames,
+             scenario_fragments_down, scenario_can_fd, scenario_fd_fragments_down, scenario_native, scenario_typed, scenario_e2e, scenario_unexplained, scenario_garbage, scenario_overflow, scenario_burst, scenario_error_frames,
              scenario_link_down_up]
 
 
