@@ -18,6 +18,7 @@
 #include "cosmic/config_loader.hpp"
 #include "cosmic/control_protocol.hpp"
 #include "cosmic/gateway.hpp"
+#include "cosmic/hop_representation.hpp"
 #include "cosmic/lcm_types.hpp"
 #include "cosmic/memory_adapter.hpp"
 
@@ -53,6 +54,17 @@ BO_ 433 BrakeCommand: 4 Gateway
  SG_ Pressure : 16|16@1+ (1,0) [0|65535] "bar" Ecu
 )";
 
+// The signal gateway's far side (another bus's DBC): VehicleSpeed carries wheel's Speed (12 bits x
+// 0.2), Gear (as GearPos, 4 bits signed) and Valid.
+constexpr const char* kChassisDbc = R"(VERSION ""
+BO_ 768 VehicleSpeed: 3 Gateway
+ SG_ VehicleSpeed : 0|12@1+ (0.2,0) [0|819] "km/h" Cluster
+ SG_ GearPos : 12|4@1- (1,0) [-1|6] "" Cluster
+ SG_ Valid : 16|1@1+ (1,0) [0|1] "" Cluster
+BO_ 769 NarrowSpeed: 1 Gateway
+ SG_ Speed : 0|8@1+ (0.2,0) [0|51] "km/h" Cluster
+)";
+
 constexpr const char* kPoseLcm = R"(package demo;
 struct pose_t {
   int64_t stamp;
@@ -70,6 +82,7 @@ segments:
   - {name: body, type: can, interface: can0, bitrate: 500kbit/s}
   - {name: lan, type: dds, latency_bound: 1ms}
   - {name: viz, type: lcm, latency_bound: 2ms}
+  - {name: chassis, type: can, interface: can1, bitrate: 500kbit/s}
 channels:
   - name: wheel
     subject: 0x10
@@ -78,8 +91,11 @@ channels:
     reaction_time: 50ms
     type: {dbc: wheel.dbc, message: WheelSpeed}
     publishers: [body]
-    subscribers: [lan, viz]
-    native: {body: {can_id: 0x1A0}, viz: {channel: WHEEL, representation: json}}
+    subscribers: [lan, viz, chassis]
+    native:
+      body: {can_id: 0x1A0}
+      viz: {channel: WHEEL, representation: json}
+      chassis: {dbc: chassis.dbc, message: VehicleSpeed, map: {Speed: VehicleSpeed, Gear: GearPos}}
   - name: drive
     subject: 0x11
     class: nrt
@@ -144,6 +160,7 @@ class TypedForwardingTest : public ::testing::Test {
     std::filesystem::create_directories(dir_);
     std::ofstream(dir_ / "wheel.dbc") << kWheelDbc;
     std::ofstream(dir_ / "pose.lcm") << kPoseLcm;
+    std::ofstream(dir_ / "chassis.dbc") << kChassisDbc;
   }
   ~TypedForwardingTest() override {
     gateway.stop();
@@ -489,6 +506,47 @@ TEST_F(TypedForwardingTest, AnE2eFrameLeavesWithItsOwnCounterAndCrc) {
   EXPECT_EQ(sent_on("body", 0), (std::vector<std::uint8_t>{0xD6, 0, 0xF4, 0x01}));
   EXPECT_EQ(sent_on("body", 1), (std::vector<std::uint8_t>{0x15, 1, 0xF5, 0x01}));
   EXPECT_EQ(sent_on("body", 2), (std::vector<std::uint8_t>{0x4D, 2, 0xF6, 0x01}));
+}
+
+// The signal gateway (AUTOSAR COM's, CAN to CAN): WheelSpeed's fields re-packed into the chassis
+// bus's VehicleSpeed by name and by `map`; python3-canmatrix decodes 3E F0 01 with chassis.dbc as
+// VehicleSpeed 12.4 km/h, GearPos -1, Valid 1 (Speed 12.34 to the signal's 0.2 km/h step).
+TEST_F(TypedForwardingTest, ADbcFrameIsRepackedIntoAnotherBussMessage) {
+  start();
+  ASSERT_TRUE(adapters["body"]->inject("wheel", {0xD2, 0x04, 0xFF, 0x01}));
+  EXPECT_EQ(sent_on("chassis", 0), (std::vector<std::uint8_t>{0x3E, 0xF0, 0x01}));
+  // Admission counts the chassis hop at VehicleSpeed's 3 bytes; cosmicctl channel names its form.
+  const ChannelSpec* wheel = gateway.config().find_channel("wheel");
+  ASSERT_NE(wheel, nullptr);
+  EXPECT_EQ(wheel->payload_on("chassis"), 3u);
+  const auto form = hop_representation(*wheel, *gateway.config().find_segment("chassis"));
+  ASSERT_TRUE(form.ok());
+  EXPECT_EQ(form.value()->describe(), "DBC frame 0x300 VehicleSpeed of chassis.dbc");
+}
+
+TEST_F(TypedForwardingTest, ASignalTooNarrowForTheFieldIsRefusedNamingIt) {
+  std::string text = typed_config("drop");
+  const std::string mapped =
+      "chassis: {dbc: chassis.dbc, message: VehicleSpeed, map: {Speed: VehicleSpeed, Gear: GearPos}}";
+  text.replace(text.find(mapped), mapped.size(), "chassis: {dbc: chassis.dbc, message: NarrowSpeed}");
+  const ConfigResult narrow = load(text);
+  ASSERT_FALSE(narrow.ok());
+  std::string errors;
+  for (const auto& e : narrow.errors) errors += e.to_string() + "\n";
+  EXPECT_NE(errors.find("channels[0].native.chassis: message NarrowSpeed: signal Speed holds 0..51, narrower than "
+                        "field Speed's range 0..655.35"),
+            std::string::npos)
+      << errors;
+  text = typed_config("drop");
+  text.replace(text.find(mapped), mapped.size(), "chassis: {dbc: chassis.dbc, message: VehicleSpeed}");
+  const ConfigResult unmapped = load(text);
+  ASSERT_FALSE(unmapped.ok());
+  errors.clear();
+  for (const auto& e : unmapped.errors) errors += e.to_string() + "\n";
+  EXPECT_NE(errors.find("field Speed has no signal Speed in message VehicleSpeed (map: {Speed: SIGNAL} names the one "
+                        "that carries it)"),
+            std::string::npos)
+      << errors;
 }
 
 }  // namespace

@@ -151,7 +151,7 @@ TEST(NativeCanAdmission, TheIdentifierIsTheFramesPriorityAndOneFrameIsTheEvent) 
 // A native channel delays the gateway's other frames exactly as a background frame of the same
 // identifier, length and period does: the analysis knows no difference.
 TEST(NativeCanAdmission, ANativeChannelWeighsLikeTheSameBackgroundFrame) {
-  for (const NativeCanFrame frame :
+  for (const NativeCanFrame& frame :
        {NativeCanFrame{0x020, false}, NativeCanFrame{0x600, false}, NativeCanFrame{0x00FF1234, true}}) {
     Config with_native = native_bus();
     with_native.channels = {channel("speed", 0x51, ChannelClass::srt, {"lan"}, {"body"}),

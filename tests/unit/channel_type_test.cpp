@@ -336,6 +336,55 @@ TEST(ChannelTypeYaml, AnE2eDbcTypeLeavesItsCounterAndCrcOutAndIsWrittenBack) {
   std::filesystem::remove_all(dir);
 }
 
+// The signal gateway's native entry (native: {BUS: {dbc, message, map, e2e}}): the identifier is
+// the message's, and what does not belong there is refused at its key.
+TEST(ChannelTypeYaml, ASignalGatewayEntryTakesItsIdentifierFromTheMessage) {
+  const auto dir = std::filesystem::temp_directory_path() / ("cosmic-gw-type-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "a.dbc") << "BO_ 416 A: 2 X\n SG_ S : 0|8@1+ (1,0) [0|200] \"\" X\n";
+  std::ofstream(dir / "b.dbc") << "BO_ 768 B: 1 X\n SG_ S : 0|8@1+ (1,0) [0|0] \"\" X\n";
+  const std::string head =
+      "gateway: {name: gw, can_node_id: 1}\n"
+      "segments:\n"
+      "  - {name: body, type: can, interface: can0, bitrate: 500kbit/s}\n"
+      "  - {name: chassis, type: can, interface: can1, bitrate: 500kbit/s}\n"
+      "channels:\n"
+      "  - name: s\n"
+      "    subject: 0x10\n"
+      "    class: nrt\n"
+      "    publishers: [body]\n"
+      "    subscribers: [chassis]\n";
+  const auto parsed = [&](const std::string& rest) { return parse_config(head + rest, (dir / "t.yaml").string()); };
+  const ConfigResult ok = parsed(
+      "    type: {dbc: a.dbc, message: A}\n"
+      "    native: {body: {can_id: 0x1A0}, chassis: {dbc: b.dbc, message: B}}\n");
+  ASSERT_TRUE(ok.ok()) << listed_errors(ok.errors);
+  const NativeBinding* chassis = ok.config.channels.at(0).native_on("chassis");
+  ASSERT_NE(chassis, nullptr);
+  EXPECT_EQ(chassis->can->can_id, 0x300u);
+  EXPECT_EQ(ok.config.channels.at(0).payload_on("chassis"), 1u);
+  const std::string wrong_id =
+      listed_errors(parsed("    type: {dbc: a.dbc, message: A}\n"
+                           "    native: {body: {can_id: 0x1A0}, chassis: {dbc: b.dbc, message: B, can_id: 0x301}}\n")
+                        .errors);
+  EXPECT_NE(wrong_id.find("channels[0].native.chassis.can_id: 0x301 is not message B's identifier 0x300"),
+            std::string::npos)
+      << wrong_id;
+  const std::string untyped = listed_errors(parsed("    native: {chassis: {dbc: b.dbc, message: B}}\n").errors);
+  EXPECT_NE(untyped.find("channels[0].native.chassis.dbc: a DBC message on a native hop carries a typed channel's "
+                         "fields, and this channel has no type"),
+            std::string::npos)
+      << untyped;
+  const std::string stray =
+      listed_errors(parsed("    type: {dbc: a.dbc, message: A}\n"
+                           "    native: {body: {can_id: 0x1A0}, chassis: {can_id: 0x300, map: {S: S}}}\n")
+                        .errors);
+  EXPECT_NE(stray.find("channels[0].native.chassis.map: map belongs to a frame given as a DBC message"),
+            std::string::npos)
+      << stray;
+  std::filesystem::remove_all(dir);
+}
+
 // ROS 2 types (issue 35): a .msg message and an IDL struct as rosidl lays them out, their
 // dependencies found under the root FILE lies in (ROOT/pkg/msg/Name.*) or on type_path; an error in
 // a dependency is located in that file; the source is written back with the resolved type_path.

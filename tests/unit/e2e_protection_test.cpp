@@ -11,6 +11,8 @@
 #include "cosmic/dbc.hpp"
 #include "cosmic/e2e_protection.hpp"
 
+#include "dbc_test_support.hpp"
+
 namespace cosmic {
 namespace {
 
@@ -43,12 +45,7 @@ BO_ 435 Tiny: 1 Ecu
 
 const DbcMessage& e2e_message(const std::string& name) {
   static const DbcFile file = parse_dbc(kE2eDbc);
-  EXPECT_TRUE(file.ok()) << (file.errors.empty() ? "" : file.errors[0].message);
-  for (const auto& m : file.messages) {
-    if (m.name == name) return m;
-  }
-  ADD_FAILURE() << "no message " << name;
-  return file.messages.front();
+  return test::message_named(file, name);
 }
 
 E2eProtection brake_protection(E2eDataIdMode mode = E2eDataIdMode::both, std::uint16_t data_id = 0x0123) {

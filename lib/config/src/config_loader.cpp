@@ -467,7 +467,7 @@ class ConfigParser {
     config_detail::parse_on_range(reader_, node, path, c);
     parse_bindings(node, path, c);
     if (node["native"]) {
-      config_detail::parse_native(reader_, node["native"], key(path, "native"), config_, c);
+      config_detail::parse_native(reader_, node["native"], key(path, "native"), config_, c, included_);
       // With components, the lists are derived later (check_derived_native_segments).
       if (!derive_bindings_ || (node["publishers"] && node["subscribers"])) {
         config_detail::check_native_segments(reader_, node["native"], key(path, "native"), c);

@@ -6,6 +6,7 @@
 #include "cosmic/can_wire.hpp"
 #include "cosmic/dds_names.hpp"
 #include "cosmic/transport_limits.hpp"
+#include "type_file_loader.hpp"
 
 namespace cosmic::config_detail {
 namespace {
@@ -21,11 +22,98 @@ bool parse_form(YamlReader& reader, const YAML::Node& node, const std::string& p
   return true;
 }
 
+bool check_can_frame(YamlReader& reader, const YAML::Node& node, const std::string& path, const SegmentSpec& segment,
+                     const NativeCanFrame& frame, NativeBinding& binding);
+
+// `map: {FIELD: SIGNAL}`: which signal carries a field, where the names differ.
+std::optional<std::map<std::string, std::string>> parse_field_map(YamlReader& reader, const YAML::Node& node,
+                                                                  const std::string& path) {
+  if (!node.IsMap()) {
+    reader.error_at(node, path, "expected a map of the channel's fields to the message's signals",
+                    "map: {Speed: VehicleSpeed}");
+    return std::nullopt;
+  }
+  std::map<std::string, std::string> map;
+  for (const auto& entry : node) {
+    const auto signal = reader.string(entry.second, key(path, entry.first.Scalar()));
+    if (!signal) return std::nullopt;
+    map[entry.first.Scalar()] = *signal;
+  }
+  return map;
+}
+
+// `native: {BUS: {dbc: FILE, message: NAME, map: {...}, e2e: {...}}}`: the signal gateway's frame,
+// its identifier the message's (a can_id given must be it).
+bool parse_can_message(YamlReader& reader, const YAML::Node& node, const std::string& path,
+                       std::vector<std::string>& included, NativeCanFrame& frame) {
+  if (!node["message"]) {
+    reader.error_at(node, key(path, "message"), "missing required key 'message'",
+                    "the DBC message the frame is, e.g. message: VehicleSpeed");
+    return false;
+  }
+  const auto file = reader.string(node["dbc"], key(path, "dbc"));
+  const auto name = reader.string(node["message"], key(path, "message"));
+  if (!file || !name) return false;
+  const auto loaded = load_dbc_file(reader, node["dbc"], key(path, "dbc"), *file, included);
+  if (!loaded) return false;
+  const auto& messages = loaded->file.messages;
+  const auto message =
+      std::find_if(messages.begin(), messages.end(), [&](const DbcMessage& m) { return m.name == *name; });
+  if (message == messages.end()) {
+    reader.error_at(node["message"], key(path, "message"), "no message " + quote_value(*name) + " in " + loaded->path);
+    return false;
+  }
+  frame.dbc_message = *message;
+  frame.dbc_file = loaded->path;
+  frame.can_id = message->can_id;
+  frame.extended = message->extended;
+  if (node["map"]) {
+    auto map = parse_field_map(reader, node["map"], key(path, "map"));
+    if (!map) return false;
+    frame.field_map = std::move(*map);
+  }
+  if (node["e2e"]) {
+    frame.e2e = parse_e2e(reader, node["e2e"], key(path, "e2e"), *message);
+    if (!frame.e2e) return false;
+  }
+  if (node["can_id"]) {
+    const auto id = reader.unsigned_int(node["can_id"], key(path, "can_id"), 0, kExtendedIdMax);
+    if (!id) return false;
+    if (*id != frame.can_id) {
+      reader.error_at(node["can_id"], key(path, "can_id"),
+                      can_id_text(static_cast<std::uint32_t>(*id), frame.extended) + " is not message " +
+                          message->name + "'s identifier " + can_id_text(frame.can_id, frame.extended),
+                      "leave out can_id: the message gives it");
+      return false;
+    }
+  }
+  if (node["extended"] || node["representation"]) {
+    const char* which = node["extended"] ? "extended" : "representation";
+    reader.error_at(node[which], key(path, which), std::string(which) + " comes from the DBC message",
+                    "leave it out beside dbc and message");
+    return false;
+  }
+  return true;
+}
+
 bool parse_can(YamlReader& reader, const YAML::Node& node, const std::string& path, const SegmentSpec& segment,
-               NativeBinding& binding) {
-  if (!reader.check_map(node, path, {"can_id", "extended", "representation"})) return false;
-  if (!parse_form(reader, node, path, {"dbc", "compact"}, binding)) return false;
+               std::vector<std::string>& included, NativeBinding& binding) {
+  if (!reader.check_map(node, path, {"can_id", "extended", "representation", "dbc", "message", "map", "e2e"}))
+    return false;
   NativeCanFrame frame;
+  if (node["dbc"]) {
+    if (!parse_can_message(reader, node, path, included, frame)) return false;
+    return check_can_frame(reader, node, path, segment, frame, binding);
+  }
+  for (const char* only : {"message", "map", "e2e"}) {
+    if (node[only]) {
+      reader.error_at(
+          node[only], key(path, only), std::string(only) + " belongs to a frame given as a DBC message",
+          "dbc: FILE, message: NAME beside it (the signal gateway), or the channel's type: {dbc, message, e2e}");
+      return false;
+    }
+  }
+  if (!parse_form(reader, node, path, {"dbc", "compact"}, binding)) return false;
   if (node["extended"]) {
     const auto extended = reader.boolean(node["extended"], key(path, "extended"));
     if (!extended) return false;
@@ -40,11 +128,19 @@ bool parse_can(YamlReader& reader, const YAML::Node& node, const std::string& pa
       reader.unsigned_int(node["can_id"], key(path, "can_id"), 0, frame.extended ? kExtendedIdMax : kStandardIdMax);
   if (!id) return false;
   frame.can_id = static_cast<std::uint32_t>(*id);
+  return check_can_frame(reader, node, path, segment, frame, binding);
+}
+
+// What every native CAN frame must be: not an etag of the binding protocols, not declared background.
+bool check_can_frame(YamlReader& reader, const YAML::Node& node, const std::string& path, const SegmentSpec& segment,
+                     const NativeCanFrame& frame, NativeBinding& binding) {
+  const YAML::Node& where = node["can_id"] ? node["can_id"] : node["message"] ? node["message"] : node;
+  const std::string where_path = node["can_id"] ? key(path, "can_id") : node["message"] ? key(path, "message") : path;
   // COSMIC and FAMOUSO devices read an extended identifier's low 14 bits as an etag: one of the
   // binding protocols' etags would be taken for a protocol message by every such device.
   const auto etag = static_cast<std::uint16_t>(frame.can_id & kEtagMask);
   if (frame.extended && etag <= kHighestReservedEtag) {
-    reader.error_at(node["can_id"], key(path, "can_id"),
+    reader.error_at(where, where_path,
                     "extended identifier " + can_id_text(frame.can_id, true) + " has etag bits " +
                         std::to_string(etag) + ", which the binding protocols use (0.." +
                         std::to_string(kHighestReservedEtag) + ")",
@@ -57,7 +153,7 @@ bool parse_can(YamlReader& reader, const YAML::Node& node, const std::string& pa
     return f.can_id == frame.can_id && f.extended == frame.extended;
   });
   if (declared != background.end()) {
-    reader.error_at(node["can_id"], key(path, "can_id"),
+    reader.error_at(where, where_path,
                     can_id_text(frame.can_id, frame.extended) + " is declared as background frame " + declared->name +
                         " (" + declared->origin + ") of segment " + segment.name,
                     "a frame is either background traffic or a channel: remove it from the background");
@@ -161,7 +257,7 @@ bool parse_dds(YamlReader& reader, const YAML::Node& node, const std::string& pa
 }  // namespace
 
 void parse_native(YamlReader& reader, const YAML::Node& node, const std::string& path, const Config& config,
-                  ChannelSpec& channel) {
+                  ChannelSpec& channel, std::vector<std::string>& included) {
   if (!node.IsMap()) {
     reader.error_at(
         node, path, "expected a map of segment names to native identities",
@@ -184,7 +280,7 @@ void parse_native(YamlReader& reader, const YAML::Node& node, const std::string&
     bool ok = false;
     switch (segment->type) {
       case SegmentType::can:
-        ok = parse_can(reader, entry.second, entry_path, *segment, binding);
+        ok = parse_can(reader, entry.second, entry_path, *segment, included, binding);
         break;
       case SegmentType::lcm:
         ok = parse_lcm(reader, entry.second, entry_path, binding);

@@ -16,8 +16,10 @@ namespace cosmic::config_detail {
 
 // Reads `node` (the channel's `native` map) into `channel.native`, checking each entry against the
 // segment's type and background declarations in `config`. Problems go to `reader` at their location.
+// A native CAN frame given as a DBC message (the signal gateway) reads that file: its resolved path
+// goes to `included`.
 void parse_native(YamlReader& reader, const YAML::Node& node, const std::string& path, const Config& config,
-                  ChannelSpec& channel);
+                  ChannelSpec& channel, std::vector<std::string>& included);
 
 // Once the channel's publishers and subscribers are final (given or derived from components):
 // every native entry names one of them. `node` is the channel's `native` map.

@@ -1,6 +1,8 @@
 // Reading the type files a configuration names (type_file_loader.hpp).
 #include "type_file_loader.hpp"
 
+#include "cosmic/e2e_protection.hpp"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -69,6 +71,34 @@ std::optional<LoadedDbc> load_dbc_file(YamlReader& reader, const YAML::Node& whe
     reader.error_in(ConfigError{loaded->path, e.line, e.column, key_path, e.message, ""});
   if (!dbc.ok()) return std::nullopt;
   return LoadedDbc{loaded->path, std::move(dbc)};
+}
+
+// e2e: {counter: SIG, crc: SIG, data_id: N, data_id_mode: both|low|alt} (cosmic/e2e_protection.hpp),
+// checked against the message.
+std::optional<E2eSpec> parse_e2e(YamlReader& reader, const YAML::Node& node, const std::string& path,
+                                 const DbcMessage& message) {
+  if (!reader.check_map(node, path, {"counter", "crc", "data_id", "data_id_mode"})) return std::nullopt;
+  const std::size_t errors_before = reader.error_count();
+  for (const char* needed : {"counter", "crc", "data_id"}) {
+    if (!has(node, needed))
+      reader.error_at(node, path, std::string("end-to-end protection needs its ") + needed,
+                      "e2e: {counter: SIGNAL, crc: SIGNAL, data_id: 0..0xFFFF}");
+  }
+  if (reader.error_count() != errors_before) return std::nullopt;
+  E2eSpec spec;
+  const auto counter = reader.string(node["counter"], key(path, "counter"));
+  const auto crc = reader.string(node["crc"], key(path, "crc"));
+  const auto data_id = reader.unsigned_int(node["data_id"], key(path, "data_id"), 0, 0xFFFF);
+  std::optional<std::size_t> mode = 0;
+  if (has(node, "data_id_mode"))
+    mode = reader.choice(node["data_id_mode"], key(path, "data_id_mode"), {"both", "low", "alt"});
+  if (!counter || !crc || !data_id || !mode) return std::nullopt;
+  spec = E2eSpec{*counter, *crc, static_cast<std::uint16_t>(*data_id), static_cast<E2eDataIdMode>(*mode)};
+  if (Result<E2eProtection> checked = E2eProtection::make(message, spec); !checked) {
+    reader.error_at(node, path, checked.error().text);
+    return std::nullopt;
+  }
+  return spec;
 }
 
 }  // namespace cosmic::config_detail

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cosmic/dbc.hpp"
+#include "cosmic/e2e_protection.hpp"
 #include "yaml_reader.hpp"
 
 namespace cosmic::config_detail {
@@ -38,5 +39,10 @@ struct LoadedDbc {
 // `reader`, and the resolved path of a file read to `included` (ConfigResult::included_files).
 std::optional<LoadedDbc> load_dbc_file(YamlReader& reader, const YAML::Node& where, const std::string& key_path,
                                        const std::string& file, std::vector<std::string>& included);
+
+// A DBC message's end-to-end protection: `e2e: {counter: SIG, crc: SIG, data_id: N, data_id_mode:
+// both|low|alt}` (cosmic/e2e_protection.hpp), checked against `message`; nullopt after reporting.
+std::optional<E2eSpec> parse_e2e(YamlReader& reader, const YAML::Node& node, const std::string& path,
+                                 const DbcMessage& message);
 
 }  // namespace cosmic::config_detail

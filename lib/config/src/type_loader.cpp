@@ -86,7 +86,7 @@ class TypeLoader {
     }
     std::optional<E2eSpec> e2e;
     if (has(node, "e2e")) {
-      e2e = e2e_of(node["e2e"], key(path, "e2e"), *message);
+      e2e = parse_e2e(reader_, node["e2e"], key(path, "e2e"), *message);
       if (!e2e) return std::nullopt;
     }
     DbcChannelType typed = channel_type_from_dbc(e2e ? e2e_payload_message(*message, *e2e) : *message);
@@ -96,33 +96,6 @@ class TypeLoader {
     typed.type.source = TypeSource{TypeSource::Format::dbc, loaded->path, message->name, {}, *message, {}};
     typed.type.source->e2e = e2e;
     return std::move(typed.type);
-  }
-
-  // e2e: {counter: SIG, crc: SIG, data_id: N, data_id_mode: both|low|alt} (cosmic/e2e_protection.hpp),
-  // checked against the message.
-  std::optional<E2eSpec> e2e_of(const YAML::Node& node, const std::string& path, const DbcMessage& message) {
-    if (!reader_.check_map(node, path, {"counter", "crc", "data_id", "data_id_mode"})) return std::nullopt;
-    const std::size_t errors_before = reader_.error_count();
-    for (const char* needed : {"counter", "crc", "data_id"}) {
-      if (!has(node, needed))
-        reader_.error_at(node, path, std::string("end-to-end protection needs its ") + needed,
-                         "e2e: {counter: SIGNAL, crc: SIGNAL, data_id: 0..0xFFFF}");
-    }
-    if (reader_.error_count() != errors_before) return std::nullopt;
-    E2eSpec spec;
-    const auto counter = reader_.string(node["counter"], key(path, "counter"));
-    const auto crc = reader_.string(node["crc"], key(path, "crc"));
-    const auto data_id = reader_.unsigned_int(node["data_id"], key(path, "data_id"), 0, 0xFFFF);
-    std::optional<std::size_t> mode = 0;
-    if (has(node, "data_id_mode"))
-      mode = reader_.choice(node["data_id_mode"], key(path, "data_id_mode"), {"both", "low", "alt"});
-    if (!counter || !crc || !data_id || !mode) return std::nullopt;
-    spec = E2eSpec{*counter, *crc, static_cast<std::uint16_t>(*data_id), static_cast<E2eDataIdMode>(*mode)};
-    if (Result<E2eProtection> checked = E2eProtection::make(message, spec); !checked) {
-      reader_.error_at(node, path, checked.error().text);
-      return std::nullopt;
-    }
-    return spec;
   }
 
   // {lcm: FILE, name: pkg.type_t, max_length: {MEMBER: N}}: the struct's members as fields

@@ -41,6 +41,13 @@ void TypedHopChecks::check_one(YamlReader& reader, const Declared& declared, Cha
   const YAML::Node& node = declared.node;
   if (!channel.type) {
     for (const NativeBinding& native : channel.native) {
+      if (native.can && native.can->dbc_message) {
+        const auto [where, at] = hop_location(node, declared.path, native.segment);
+        reader.error_at(where["dbc"], key(at, "dbc"),
+                        "a DBC message on a native hop carries a typed channel's fields, and this channel has no type",
+                        "a type: for the channel (e.g. type: {dbc: FILE, message: NAME}), or can_id: alone");
+        continue;
+      }
       if (native.form == NativeForm::source) continue;
       const auto [where, at] = hop_location(node, declared.path, native.segment);
       reader.error_at(where["representation"], key(at, "representation"),

@@ -78,18 +78,115 @@ Result<DbcFrameCodec> DbcFrameCodec::make(const DbcMessage& message, const Chann
     // The fields come in the type's order (the multiplexor switch first), the signals in the file's.
     const auto signal = std::find_if(message.signals.begin(), message.signals.end(),
                                      [&](const DbcSignal& s) { return s.name == type.fields[i].name; });
-    const DbcSignal& s = *signal;  // the same names: the type is the message's own
-    const FieldType& field = type.fields[i].type;
-    FieldCodec f;
-    f.signal = static_cast<std::size_t>(signal - message.signals.begin());
-    f.slot = i;
-    f.raw = field.kind == FieldType::Kind::enumeration || field.scalar == ScalarKind::boolean;
-    f.whole = !f.raw && is_integer(field.scalar);
+    // The same names: the type is the message's own, so every field fits its signal.
+    Result<FieldCodec> f =
+        field_codec(*signal, static_cast<std::size_t>(signal - message.signals.begin()), type.fields[i], i, false);
+    if (!f) return std::move(f).error();
+    codec.fields_.push_back(f.value());
+  }
+  return codec;
+}
+
+namespace {
+
+bool is_whole(double v) { return std::isfinite(v) && std::trunc(v) == v && std::fabs(v) < 9.0e15; }
+
+std::string number(double v) { return shortest_number_text(v); }
+
+// Why `signal` cannot hold the declared range or the values of `field`, or empty.
+std::string too_narrow(const DbcSignal& signal, const TypeField& field, bool raw) {
+  if (signal.value_type != DbcValueType::integer) return {};
+  const double low = static_cast<double>(raw_low(signal)), high = static_cast<double>(raw_high(signal));
+  if (raw) {
+    for (const EnumValue& v : field.type.values) {
+      if (static_cast<double>(v.value) < low || static_cast<double>(v.value) > high) {
+        return "signal " + signal.name + " holds raw values " + number(low) + ".." + number(high) + ", not field " +
+               field.name + "'s value " + v.name + " = " + std::to_string(v.value);
+      }
+    }
+    return {};
+  }
+  const double a = low * signal.factor + signal.offset, b = high * signal.factor + signal.offset;
+  const double lowest = std::min(a, b), highest = std::max(a, b);
+  const bool narrow = (field.minimum && *field.minimum < lowest) || (field.maximum && *field.maximum > highest);
+  if (!narrow) return {};
+  return "signal " + signal.name + " holds " + number(lowest) + ".." + number(highest) + ", narrower than field " +
+         field.name + "'s range " + (field.minimum ? number(*field.minimum) : "") + ".." +
+         (field.maximum ? number(*field.maximum) : "");
+}
+
+}  // namespace
+
+Result<DbcFrameCodec::FieldCodec> DbcFrameCodec::field_codec(const DbcSignal& s, std::size_t signal_index,
+                                                             const TypeField& field, std::size_t slot, bool mapped) {
+  const FieldType& type = field.type;
+  if (type.kind != FieldType::Kind::scalar && type.kind != FieldType::Kind::enumeration) {
+    return Error{"field " + field.name + " is not a number: a DBC signal carries one number"};
+  }
+  FieldCodec f;
+  f.signal = signal_index;
+  f.slot = slot;
+  f.raw = type.kind == FieldType::Kind::enumeration || type.scalar == ScalarKind::boolean;
+  f.whole = !f.raw && is_integer(type.scalar);
+  // The message's own type fits by construction (dbc_field_type); its declared range may be wider
+  // than the raw bits, as DBC files often declare.
+  if (!mapped) {
     if (f.whole) {
-      f.factor = static_cast<std::int64_t>(s.factor);  // whole by dbc_field_type's rule
+      f.factor = static_cast<std::int64_t>(s.factor);
       f.offset = static_cast<std::int64_t>(s.offset);
     }
-    codec.fields_.push_back(f);
+    return f;
+  }
+  if ((f.raw || f.whole) && s.value_type != DbcValueType::integer) {
+    return Error{"field " + field.name + " is an integer, and signal " + s.name + " an IEEE float"};
+  }
+  if (f.whole) {
+    if (!is_whole(s.factor) || !is_whole(s.offset) || s.factor == 0) {
+      return Error{"field " + field.name + " is an integer, and signal " + s.name + "'s scaling (" + number(s.factor) +
+                   ", " + number(s.offset) + ") is not whole"};
+    }
+    f.factor = static_cast<std::int64_t>(s.factor);
+    f.offset = static_cast<std::int64_t>(s.offset);
+  }
+  if (const std::string why = too_narrow(s, field, f.raw); !why.empty()) return Error{why};
+  return f;
+}
+
+Result<DbcFrameCodec> DbcFrameCodec::make_mapped(const DbcMessage& message, const ChannelType& type,
+                                                 const std::map<std::string, std::string>& field_map) {
+  if (dbc_multiplexor(message) != nullptr) {
+    return Error{"message " + message.name +
+                 " is multiplexed: the signal gateway re-packs messages without"
+                 " multiplexing"};
+  }
+  for (const auto& [field, signal] : field_map) {
+    if (std::none_of(type.fields.begin(), type.fields.end(), [&](const TypeField& f) { return f.name == field; }))
+      return Error{"map names field " + field + ", which the channel's type does not have"};
+  }
+  auto layout = CompactLayout::of_flat_record(type);
+  if (!layout) return std::move(layout).error();
+  DbcFrameCodec codec;
+  codec.message_ = message;
+  codec.layout_ = std::move(layout).value();
+  std::map<std::size_t, std::string> taken;  // signal index -> the field it carries
+  for (std::size_t i = 0; i < type.fields.size(); ++i) {
+    const TypeField& field = type.fields[i];
+    const auto mapped = field_map.find(field.name);
+    const std::string& name = mapped != field_map.end() ? mapped->second : field.name;
+    const auto signal = std::find_if(message.signals.begin(), message.signals.end(),
+                                     [&](const DbcSignal& s) { return s.name == name; });
+    if (signal == message.signals.end()) {
+      return Error{
+          "field " + field.name + " has no signal " + name + " in message " + message.name +
+          (mapped != field_map.end() ? "" : " (map: {" + field.name + ": SIGNAL} names the one that carries it)")};
+    }
+    const auto index = static_cast<std::size_t>(signal - message.signals.begin());
+    if (const auto [other, fresh] = taken.emplace(index, field.name); !fresh) {
+      return Error{"fields " + other->second + " and " + field.name + " are both mapped to signal " + name};
+    }
+    Result<FieldCodec> f = field_codec(*signal, index, field, i, true);
+    if (!f) return Error{"message " + message.name + ": " + f.error().text};
+    codec.fields_.push_back(f.value());
   }
   return codec;
 }

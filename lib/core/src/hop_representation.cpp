@@ -72,7 +72,36 @@ using Made = Result<std::shared_ptr<const Representation>>;
 
 Error hop_error(const std::string& why) { return Error{why, 0, kNoChannel}; }
 
+// The frame's end-to-end protection, if declared; why not.
+Result<std::optional<E2eProtection>> protection_of(const DbcMessage& message, const std::optional<E2eSpec>& spec) {
+  if (!spec) return std::optional<E2eProtection>();
+  Result<E2eProtection> made = E2eProtection::make(message, *spec);
+  if (!made) return hop_error("end-to-end protection: " + made.error().text);
+  return std::optional<E2eProtection>(std::move(made).value());
+}
+
+std::string frame_name(const DbcMessage& message, const std::optional<E2eSpec>& e2e) {
+  std::string name = "DBC frame " + can_id_text(message.can_id, message.extended) + " " + message.name;
+  if (e2e) name += " with E2E (counter " + e2e->counter + ", CRC " + e2e->crc + ")";
+  return name;
+}
+
+// The signal gateway: the channel's fields re-packed into another DBC message's signals.
+Made mapped_frame_on(const ChannelSpec& channel, const NativeCanFrame& frame) {
+  const DbcMessage& message = *frame.dbc_message;
+  const DbcMessage payload = frame.e2e ? e2e_payload_message(message, *frame.e2e) : message;
+  Result<DbcFrameCodec> codec = DbcFrameCodec::make_mapped(payload, *channel.type, frame.field_map);
+  if (!codec) return hop_error(codec.error().text);
+  Result<std::optional<E2eProtection>> e2e = protection_of(message, frame.e2e);
+  if (!e2e) return e2e.error();
+  return std::shared_ptr<const Representation>(std::make_shared<DbcFrameRepresentation>(
+      std::move(codec).value(),
+      frame_name(message, frame.e2e) + " of " + frame.dbc_file.substr(frame.dbc_file.rfind('/') + 1), channel.on_range,
+      std::move(e2e).value()));
+}
+
 Made dbc_frame_on(const ChannelSpec& channel, const NativeCanFrame& frame) {
+  if (frame.dbc_message) return mapped_frame_on(channel, frame);
   const ChannelType& type = *channel.type;
   if (!type.source || type.source->format != TypeSource::Format::dbc || !type.source->dbc_message) {
     return hop_error(
@@ -88,16 +117,10 @@ Made dbc_frame_on(const ChannelSpec& channel, const NativeCanFrame& frame) {
   const std::optional<E2eSpec>& e2e_spec = type.source->e2e;
   Result<DbcFrameCodec> codec = DbcFrameCodec::make(e2e_spec ? e2e_payload_message(message, *e2e_spec) : message, type);
   if (!codec) return hop_error(codec.error().text);
-  std::optional<E2eProtection> e2e;
-  if (e2e_spec) {
-    Result<E2eProtection> made = E2eProtection::make(message, *e2e_spec);
-    if (!made) return hop_error("end-to-end protection: " + made.error().text);
-    e2e = std::move(made).value();
-  }
-  std::string name = "DBC frame " + can_id_text(message.can_id, message.extended) + " " + message.name;
-  if (e2e) name += " with E2E (counter " + e2e_spec->counter + ", CRC " + e2e_spec->crc + ")";
-  return std::shared_ptr<const Representation>(
-      std::make_shared<DbcFrameRepresentation>(std::move(codec).value(), name, channel.on_range, std::move(e2e)));
+  Result<std::optional<E2eProtection>> e2e = protection_of(message, e2e_spec);
+  if (!e2e) return e2e.error();
+  return std::shared_ptr<const Representation>(std::make_shared<DbcFrameRepresentation>(
+      std::move(codec).value(), frame_name(message, e2e_spec), channel.on_range, std::move(e2e).value()));
 }
 
 Made lcm_encoding_on(const ChannelSpec& channel) {

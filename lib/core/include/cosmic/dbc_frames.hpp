@@ -9,8 +9,10 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "cosmic/channel_type.hpp"
@@ -25,6 +27,15 @@ class DbcFrameCodec {
   // The codec of `message` for `type`, which must be the message's own type (channel_type_from_dbc);
   // else why not.
   static Result<DbcFrameCodec> make(const DbcMessage& message, const ChannelType& type);
+  // The signal gateway's codec (issue 35: a typed channel from one DBC message re-packed into another
+  // message, AUTOSAR COM's signal gateway): `type` is any flat record (usually another message's
+  // type), each field carried by the signal of `message` of its name, or the one `field_map` names
+  // for it (field -> signal). Else why not, naming the field: a field without a signal, a map entry
+  // of no field or signal, two fields in one signal, an integer field in a signal whose scaling is
+  // not whole, a signal too narrow for the field's declared range or enumeration values, a
+  // multiplexed message. The message's other signals are sent as 0.
+  static Result<DbcFrameCodec> make_mapped(const DbcMessage& message, const ChannelType& type,
+                                           const std::map<std::string, std::string>& field_map);
 
   std::size_t frame_length() const { return message_.length; }
   std::size_t compact_size() const { return layout_.size(); }
@@ -51,6 +62,11 @@ class DbcFrameCodec {
     bool whole = false;      // an integer field: raw * factor + offset in whole numbers
     std::int64_t factor = 1, offset = 0;
   };
+
+  // The codec of `field` (slot `slot`) in `signal`; when `mapped` (the field is not the signal's
+  // own), why not when the field cannot go there.
+  static Result<FieldCodec> field_codec(const DbcSignal& signal, std::size_t signal_index, const TypeField& field,
+                                        std::size_t slot, bool mapped);
 
   DbcMessage message_;
   std::optional<std::size_t> switch_;  // index of message_'s multiplexor switch, if any (found once, at make)

@@ -7,6 +7,7 @@
 #include <array>
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -117,6 +118,14 @@ struct SegmentSpec {
 struct NativeCanFrame {
   std::uint32_t can_id = 0;  // 11 or 29 bits, without flags; the frame's data bytes are the contents
   bool extended = false;
+  // A typed channel's signal-gateway hop (`native: {BUS: {dbc: FILE, message: NAME}}`): the frame is
+  // this DBC message, not the type's own, its signals carrying the type's fields by name or as
+  // field_map renames them (field -> signal); can_id and extended are the message's. Optionally
+  // protected end to end. Compared by content: a changed file rebinds the channel.
+  std::optional<DbcMessage> dbc_message{};
+  std::string dbc_file{};
+  std::map<std::string, std::string> field_map{};
+  std::optional<E2eSpec> e2e{};
   friend bool operator==(const NativeCanFrame&, const NativeCanFrame&) = default;
 };
 

@@ -1,0 +1,107 @@
+// The signal gateway's codec (issue 35; DbcFrameCodec::make_mapped, cosmic/dbc_frames.hpp): a typed
+// channel's fields packed into another DBC message's signals by name and by map, and everything it
+// refuses, each reason naming the field.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "cosmic/compact_layout.hpp"
+#include "cosmic/dbc_frames.hpp"
+#include "cosmic/dbc_type.hpp"
+
+#include "dbc_test_support.hpp"
+
+namespace cosmic {
+namespace {
+
+constexpr std::string_view kGatewayDbc = R"dbc(BO_ 416 Wheel: 4 Ecu
+ SG_ Speed : 0|16@1+ (0.01,0) [0|655.35] "km/h" Gateway
+ SG_ Gear : 16|8@1- (1,0) [-1|6] "" Gateway
+ SG_ State : 24|2@1+ (1,0) [0|3] "" Gateway
+BO_ 768 Cluster: 4 Gateway
+ SG_ ClusterSpeed : 0|12@1+ (0.2,0) [0|0] "km/h" Dash
+ SG_ Gear : 12|4@1- (1,0) [0|0] "" Dash
+ SG_ State : 16|2@1+ (1,0) [0|0] "" Dash
+BO_ 769 Muxed: 4 Gateway
+ SG_ Mode M : 0|8@1+ (1,0) [0|0] "" Dash
+ SG_ Speed m0 : 8|16@1+ (0.01,0) [0|0] "" Dash
+BO_ 770 Odd: 4 Gateway
+ SG_ Speed : 0|16@1+ (0.01,0) [0|0] "" Dash
+ SG_ Gear : 16|8@1- (0.5,0) [0|0] "" Dash
+ SG_ State : 24|1@1+ (1,0) [0|0] "" Dash
+ SG_ Float : 0|32@1+ (1,0) [0|0] "" Dash
+VAL_ 416 State 0 "Off" 1 "On" 3 "Fault" ;
+SIG_VALTYPE_ 770 Float : 1;
+)dbc";
+
+const DbcMessage& gateway_message(const std::string& name) {
+  static const DbcFile file = parse_dbc(kGatewayDbc);
+  return test::message_named(file, name);
+}
+
+ChannelType wheel_type() { return channel_type_from_dbc(gateway_message("Wheel")).type; }
+
+std::string refusal(const std::string& message, const std::map<std::string, std::string>& map) {
+  const Result<DbcFrameCodec> codec = DbcFrameCodec::make_mapped(gateway_message(message), wheel_type(), map);
+  return codec.ok() ? "accepted" : codec.error().text;
+}
+
+TEST(DbcSignalGateway, FieldsGoIntoTheSignalsOfTheirNameOrTheirMap) {
+  const ChannelType type = wheel_type();
+  const Result<DbcFrameCodec> codec =
+      DbcFrameCodec::make_mapped(gateway_message("Cluster"), type, {{"Speed", "ClusterSpeed"}});
+  ASSERT_TRUE(codec.ok()) << codec.error().text;
+  const Result<DbcFrameCodec> own = DbcFrameCodec::make(gateway_message("Wheel"), type);
+  ASSERT_TRUE(own.ok());
+  // Speed 100.00 km/h (raw 10000), Gear -1, State Fault (3).
+  const std::vector<std::uint8_t> wheel = {0x10, 0x27, 0xFF, 0x03};
+  std::vector<std::uint8_t> event(own.value().compact_size());
+  ASSERT_TRUE(own.value().to_compact(wheel, event));
+  std::vector<std::uint8_t> cluster(4);
+  const DbcFrameCodec::Packed packed = codec.value().to_frame(event, cluster, RangePolicy::drop);
+  ASSERT_TRUE(packed.sent);
+  // ClusterSpeed 500 (100 / 0.2) in bits 0-11, Gear -1 (0xF) in 12-15, State 3 in 16-17.
+  EXPECT_EQ(cluster, (std::vector<std::uint8_t>{0xF4, 0xF1, 0x03, 0x00}));
+  // And back: the cluster's frame as the channel's event.
+  std::vector<std::uint8_t> again(own.value().compact_size());
+  ASSERT_TRUE(codec.value().to_compact(cluster, again));
+  EXPECT_EQ(again, event);
+}
+
+TEST(DbcSignalGateway, WhatCannotBeCarriedIsRefusedNamingTheField) {
+  EXPECT_EQ(refusal("Cluster", {}),
+            "field Speed has no signal Speed in message Cluster (map: {Speed: SIGNAL} names "
+            "the one that carries it)");
+  EXPECT_EQ(refusal("Cluster", {{"Speed", "Nothing"}}), "field Speed has no signal Nothing in message Cluster");
+  EXPECT_EQ(refusal("Cluster", {{"Speed", "ClusterSpeed"}, {"Torque", "Gear"}}),
+            "map names field Torque, which the channel's type does not have");
+  EXPECT_EQ(refusal("Cluster", {{"Speed", "ClusterSpeed"}, {"State", "Gear"}}),
+            "fields Gear and State are both mapped to signal Gear");
+  EXPECT_EQ(refusal("Muxed", {}),
+            "message Muxed is multiplexed: the signal gateway re-packs messages without "
+            "multiplexing");
+  EXPECT_EQ(refusal("Odd", {}),
+            "message Odd: field Gear is an integer, and signal Gear's scaling (0.5, 0) is not whole");
+  EXPECT_EQ(refusal("Odd", {{"Gear", "Float"}}),
+            "message Odd: field Gear is an integer, and signal Float an IEEE float");
+  EXPECT_EQ(refusal("Odd", {{"Speed", "Gear"}, {"Gear", "Float"}}),
+            "message Odd: signal Gear holds -64..63.5, narrower than field Speed's range 0..655.35");
+  EXPECT_EQ(refusal("Odd", {{"Gear", "Gear"}, {"Speed", "Float"}, {"State", "State"}}),
+            "message Odd: field Gear is an integer, and signal Gear's scaling (0.5, 0) is not whole");
+}
+
+TEST(DbcSignalGateway, AnEnumerationNeedsEveryValueInItsSignal) {
+  const Result<DbcFrameCodec> codec = DbcFrameCodec::make_mapped(
+      gateway_message("Odd"), wheel_type(), {{"Speed", "Float"}, {"Gear", "Gear"}, {"State", "State"}});
+  EXPECT_FALSE(codec.ok());
+  ChannelType type = wheel_type();
+  type.fields.erase(type.fields.begin() + 1);  // Gear
+  const Result<DbcFrameCodec> one_bit = DbcFrameCodec::make_mapped(gateway_message("Odd"), type, {{"Speed", "Float"}});
+  ASSERT_FALSE(one_bit.ok());
+  EXPECT_EQ(one_bit.error().text, "message Odd: signal State holds raw values 0..1, not field State's value Fault = 3");
+}
+
+}  // namespace
+}  // namespace cosmic
