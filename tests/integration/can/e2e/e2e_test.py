@@ -54,6 +54,7 @@ BRAKE_ID = 0x0F0                 # native, standard, HRT (brake: bus -> viz)
 INTRUDER_ID = 0x0A0              # declared nowhere: beats brake's 0x0F0
 WHEEL_SPEED_ID = 0x1A0           # typed: typed.dbc's WheelSpeed (wheel_speed: bus -> viz as JSON)
 DRIVE_ID = 0x200                 # typed: typed.dbc's DriveCommand (drive: viz -> bus)
+CLUSTER_SPEED_ID = 0x1A8         # typed: typed.dbc's ClusterSpeed on bus_fd (wheel_speed re-packed)
 BRAKE_STATUS_ID = 0x1B0          # typed, E2E: typed.dbc's BrakeStatus (brake_status: bus -> viz as JSON)
 BRAKE_COMMAND_ID = 0x210         # typed, E2E: typed.dbc's BrakeCommand (brake_command: viz -> bus)
 MARKER = "7FF#5A"                # 11-bit, no channel's: only cosmicd's census sees it (unexplained)
@@ -497,7 +498,8 @@ def scenario_native(s):
 def scenario_typed(s):
     """Typed channels from typed.dbc, checked with python3-canmatrix (not ours): cansend 1A0#...
     (WheelSpeed) -> cosmicd -> an LCM tool gets JSON with the physical values canmatrix decodes from
-    the frame; an LCM envelope with DriveCommand's compact layout (Torque float64, Mode uint8) ->
+    the frame, and vcan1 gets ClusterSpeed 0x1A8 (the signal gateway), which canmatrix decodes to
+    the same values at its signals' steps; an LCM envelope with DriveCommand's compact layout (Torque float64, Mode uint8) ->
     cosmicd -> candump shows frame 0x200, which canmatrix decodes to the values sent; a value beyond
     Torque's 8 bits is dropped and counted (out_of_range); cosmicctl channel names each hop's form."""
     import struct
@@ -505,8 +507,10 @@ def scenario_typed(s):
     matrix = canmatrix.formats.loadp_flat(os.path.join(HERE, "typed.dbc"))
     gw = s.t.gw
     expect_eq("wheel_speed's forms", {h["segment"]: h["representation"] for h in gw.ctl("channel", "wheel_speed")["channel"]["segments"]},
-              {"bus": "DBC frame 0x1A0 WheelSpeed", "viz": "JSON"})
+              {"bus": "DBC frame 0x1A0 WheelSpeed", "viz": "JSON",
+               "bus_fd": "DBC frame 0x1A8 ClusterSpeed of typed.dbc"})
     lcm = s.lcm_sub("lcm", "WHEEL_SPEED_JSON", raw=True)
+    s.candump("cluster", "%03X:7FF" % CLUSTER_SPEED_ID, iface=IF_FD)
     frame = bytes([0xD2, 0x04, 0xFF, 0x01])
     cansend("%03X#%s" % (WHEEL_SPEED_ID, frame.hex().upper()))
     message = wait_until("the JSON of WheelSpeed on LCM", 20, lambda: next(iter(json_lines(lcm)), None))
@@ -516,6 +520,13 @@ def scenario_typed(s):
     expect_eq("WheelSpeed's fields as JSON", list(got), ["Speed", "Gear", "Valid"])
     expect_eq("WheelSpeed's values (canmatrix: %r)" % expected,
               {k: float(v) for k, v in got.items()}, expected)
+    cluster = lambda: [f for f in canlog.read_frames(s.path("cluster.out")) if not f.eff and f.id == CLUSTER_SPEED_ID]
+    wait_until("ClusterSpeed on vcan1", 20, lambda: cluster())
+    decoded = matrix.frame_by_id(canmatrix.ArbitrationId(CLUSTER_SPEED_ID)).decode(bytearray(cluster()[0].data))
+    repacked = {name: float(v.phys_value) for name, v in decoded.items()}
+    check(abs(repacked["VehicleSpeed"] - round(expected["Speed"] / 0.2) * 0.2) < 1e-9 and
+          repacked["GearPos"] == expected["Gear"] and repacked["Valid"] == expected["Valid"],
+          "ClusterSpeed decoded by canmatrix %r carries WheelSpeed's %r" % (repacked, expected))
     s.candump("dump", "%03X:7FF" % DRIVE_ID)
     s.lcm_pub("drive", 9, payload_hex=(struct.pack("<d", 100.0) + bytes([3])).hex())
     s.lcm_pub("drive", 9, payload_hex=(struct.pack("<d", 700.0) + bytes([4])).hex())  # raw 280 > 255
