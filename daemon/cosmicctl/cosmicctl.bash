@@ -18,6 +18,7 @@ _cosmicctl_command_options() {
     echo) echo "--count --interval --timeout" ;;
     gen) echo "--component --output" ;;
     top) echo "--interval --iterations" ;;
+    types) echo "--type-path --name" ;;
   esac
 }
 
@@ -87,7 +88,8 @@ _cosmicctl() {
     types)
       [ -n "$file" ] && return
       compopt -o filenames 2>/dev/null
-      mapfile -t COMPREPLY < <(compgen -f -X '!*.dbc' -- "$cur"; compgen -f -X '!*.DBC' -- "$cur"; compgen -f -X '!*.lcm' -- "$cur"; compgen -d -- "$cur")
+      mapfile -t COMPREPLY < <(compgen -f -X '!*.dbc' -- "$cur"; compgen -f -X '!*.DBC' -- "$cur"; compgen -f -X '!*.lcm' -- "$cur"
+        compgen -f -X '!*.idl' -- "$cur"; compgen -f -X '!*.msg' -- "$cur"; compgen -d -- "$cur")
       ;;
     channel | unbind | echo)
       [ -n "$file" ] && return

@@ -2,7 +2,8 @@
 // DBC file (.dbc): every message with its identifier, length and cycle time, and the fields its
 // signals become (cosmic/dbc_type.hpp) with each signal's layout, or why the message cannot be a
 // channel's type. An LCM type file (.lcm): every struct with the fingerprint lcm-gen gives it, its
-// constants and its fields (cosmic/lcm_types.hpp). With --json the same as one JSON document.
+// constants and its fields (cosmic/lcm_types.hpp). An IDL file or a ROS 2 message: types_ros.hpp.
+// With --json the same as one JSON document.
 // Offline: reads FILE, nothing else.
 #include <sys/stat.h>
 
@@ -17,6 +18,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -24,6 +26,7 @@
 #include "cosmic/dbc.hpp"
 #include "cosmic/dbc_type.hpp"
 #include "cosmic/lcm_types.hpp"
+#include "types_ros.hpp"
 
 namespace cosmicctl {
 namespace {
@@ -32,6 +35,8 @@ using Json = nlohmann::json;
 
 struct TypesOptions {
   std::string file;
+  std::vector<std::string> type_path;  // IDL includes and .msg dependencies
+  std::string name;                    // .msg: pkg/msg/Name when FILE's place does not say
 };
 
 // The whole of FILE when it is a regular file of at most kDbcMaxTextBytes; else prints why.
@@ -180,14 +185,24 @@ int run_lcm_types(const TypesOptions& o, const GlobalOptions& global, const std:
 
 int run_types(const TypesOptions& o, const GlobalOptions& global) {
   const bool lcm = o.file.ends_with(".lcm");
-  if (!lcm && !o.file.ends_with(".dbc") && !o.file.ends_with(".DBC")) {
-    std::cerr << "cosmicctl types: " << o.file << ": not a DBC file (.dbc) or an LCM type file (.lcm), the type files "
-              << "this version reads\n";
+  const bool idl = o.file.ends_with(".idl");
+  const bool msg = o.file.ends_with(".msg");
+  if (!lcm && !idl && !msg && !o.file.ends_with(".dbc") && !o.file.ends_with(".DBC")) {
+    std::cerr << "cosmicctl types: " << o.file << ": not a DBC file (.dbc), an LCM type file (.lcm), an IDL file "
+              << "(.idl) or a ROS 2 message (.msg), the type files this version reads\n";
+    return kExitUsage;
+  }
+  if (!msg && !o.name.empty()) {
+    std::cerr << "cosmicctl types: --name names a .msg file's message; " << o.file << " says its own names\n";
     return kExitUsage;
   }
   const auto text = read_type_file(o.file);
   if (!text) return kExitConfigError;
   if (lcm) return run_lcm_types(o, global, *text);
+  if (idl || msg) {
+    const RosTypesRequest request{o.file, *text, o.type_path, o.name};
+    return idl ? run_idl_types(request, global) : run_msg_types(request, global);
+  }
   const cosmic::DbcFile dbc = cosmic::parse_dbc(*text);
   if (!dbc.ok()) {
     for (const auto& e : dbc.errors)
@@ -213,9 +228,17 @@ int run_types(const TypesOptions& o, const GlobalOptions& global) {
 CommandRunner add_types_command(CLI::App& app, const GlobalOptions& options) {
   auto* command = app.add_subcommand(
       "types",
-      "List the types a DBC file defines: each message's fields as a typed channel (type: {dbc: ...}) sees them");
+      "List the types a DBC, LCM, IDL or ROS 2 .msg file defines, as a typed channel (type: {dbc|lcm|idl|msg: ...}) "
+      "sees them");
   auto o = std::make_shared<TypesOptions>();
-  command->add_option("FILE", o->file, "Type file: a DBC file (.dbc) or an LCM type file (.lcm)")->required();
+  command
+      ->add_option(
+          "FILE", o->file,
+          "Type file: a DBC file (.dbc), an LCM type file (.lcm), an IDL file (.idl) or a ROS 2 message (.msg)")
+      ->required();
+  command->add_option("--type-path", o->type_path,
+                      "Where included IDL files and referenced messages are found (DIR/pkg/msg/Name.*; repeatable)");
+  command->add_option("--name", o->name, "A .msg file's message, PKG/msg/NAME, when its place does not say");
   return [command, o, &options]() -> int {
     if (!command->parsed()) return -1;
     return run_types(*o, options);

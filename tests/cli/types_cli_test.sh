@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# `cosmicctl types FILE` end to end (issue 35): what a DBC file's messages become as typed channels,
+# `cosmicctl types FILE` end to end (issue 35): what a DBC file's messages (and a ROS 2 message's, an
+# IDL file's structs) become as typed channels,
 # in text and in the --json shape, and every bad input refused with its exit status and a clear
 # message (a file that is not a DBC file, one that does not exist, a directory, a DBC with errors).
 # Usage: types_cli_test.sh PATH_TO_cosmicctl PROJECT_SOURCE_DIR
@@ -50,7 +51,7 @@ json_check mixed_json '
 
 # 4. Bad input: exit 64 for what is not a DBC file, 2 for what does not read, every DBC error located.
 run not_dbc 64 types "$SRC/config/robot.yaml"
-contains not_dbc err "robot.yaml: not a DBC file (.dbc) or an LCM type file (.lcm), the type files this version reads"
+contains not_dbc err "robot.yaml: not a DBC file (.dbc), an LCM type file (.lcm), an IDL file (.idl) or a ROS 2 message (.msg), the type files this version reads"
 run missing 2 types "$WORK/none.dbc"
 contains missing err "cannot read $WORK/none.dbc: No such file or directory"
 mkdir "$WORK/dir.dbc"
@@ -61,5 +62,42 @@ run broken 2 types "$WORK/broken.dbc"
 contains broken err "$WORK/broken.dbc:2:2: signal 'S' (9|8@1+) does not fit the 2 bytes of message 'A'"
 contains broken err "$WORK/broken.dbc:3:6: VAL_ names message id 7 (0x7), which no BO_ declares"
 run no_file 64 types
+
+# 5. ROS 2 messages and IDL files: the fields a typed channel gets, their dependencies found under
+# the root the file lies in (ROOT/pkg/msg/Name.*) or on --type-path, as the configuration finds them.
+MSG=$SRC/tests/integration/msg_types/type_path
+run twist 0 types "$MSG/geometry_msgs/msg/Twist.msg"
+contains twist out "Twist.msg: ROS 2 message geometry_msgs/msg/Twist, 2 messages read"
+contains twist out "  linear: {x: float64, y: float64, z: float64}"
+contains twist out "  angular: {x: float64, y: float64, z: float64}"
+run twist_json 0 --json types "$MSG/geometry_msgs/msg/Twist.msg"
+json_check twist_json '
+  d["format"] == "msg" and d["types"][0]["name"] == "geometry_msgs/msg/Twist"
+  [f["name"] for f in d["types"][0]["fields"]] == ["linear", "angular"]
+  [m["name"] for m in d["messages"]] == ["geometry_msgs/msg/Twist", "geometry_msgs/msg/Vector3"]
+'
+cp "$MSG/geometry_msgs/msg/Twist.msg" "$WORK/Twist.msg"
+run msg_placeless 64 types "$WORK/Twist.msg"
+contains msg_placeless err "a .msg file's package comes from its place, ROOT/PKG/msg/NAME.msg; give --name PKG/msg/NAME"
+run msg_named 0 types "$WORK/Twist.msg" --name geometry_msgs/msg/Twist --type-path "$MSG"
+contains msg_named out "  linear: {x: float64, y: float64, z: float64}"
+run msg_missing 2 types "$WORK/Twist.msg" --name geometry_msgs/msg/Twist
+contains msg_missing err "Vector3"
+IDL=$SRC/tests/integration/idl_types/idl/good
+run header 0 types "$IDL/std_msgs/msg/Header.idl"
+contains header out "Header.idl: IDL, 2 structs, 1 included files"
+contains header out "std_msgs::msg::Header (final)"
+contains header out "  stamp: {sec: int32, nanosec: uint32}"
+contains header out "  frame_id: string<=65536>"
+contains header out "builtin_interfaces::msg::Time (final), from "
+run header_json 0 --json types "$IDL/std_msgs/msg/Header.idl"
+json_check header_json '
+  d["format"] == "idl" and [t["name"] for t in d["types"]] == ["builtin_interfaces::msg::Time", "std_msgs::msg::Header"]
+  d["read"][0].endswith("builtin_interfaces/msg/Time.idl")
+'
+run idl_broken 2 types "$SRC/tests/integration/idl_types/idl/bad/syntax.idl"
+contains idl_broken err "syntax.idl:"
+run idl_name 64 types "$IDL/std_msgs/msg/Header.idl" --name std_msgs/msg/Header
+contains idl_name err "--name names a .msg file's message"
 
 finish "cosmicctl types"

@@ -4,35 +4,13 @@
 
 #include "cosmic/idl_types.hpp"
 #include "cosmic/msg_types.hpp"
+#include "cosmic/ros_type_files.hpp"
 #include "type_file_loader.hpp"
 
 namespace cosmic::config_detail {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Where referenced files are looked for, in order: the type_path entries, FILE's own directory, and ROOT when FILE is
-// ROOT/pkg/msg/Name.*.
-std::vector<fs::path> search_roots(const std::string& file, const std::vector<std::string>& type_path) {
-  std::vector<fs::path> roots(type_path.begin(), type_path.end());  // resolved by read_type_map
-  const fs::path own = fs::path(file).parent_path();
-  roots.push_back(own);
-  if (own.filename() == "msg" && own.has_parent_path()) roots.push_back(own.parent_path().parent_path());
-  return roots;
-}
-
-// The text of the first of `roots`/`relative` that reads, its path added to `included`.
-std::optional<std::string> find_text(const std::vector<fs::path>& roots, const fs::path& relative,
-                                     std::size_t max_bytes, std::vector<std::string>& included) {
-  for (const fs::path& root : roots) {
-    const std::string candidate = (root / relative).lexically_normal().string();
-    std::string text;
-    if (!read_regular_file(candidate, text, max_bytes).empty()) continue;
-    included.push_back(candidate);
-    return text;
-  }
-  return std::nullopt;
-}
 
 struct TypeMap {
   std::string file, name;
@@ -89,9 +67,9 @@ std::optional<ChannelType> load_idl_type(YamlReader& reader, const YAML::Node& n
   const auto loaded =
       load_named_file(reader, node["idl"], key(path, "idl"), map->file, included, kIdlMaxTextBytes, "IDL file");
   if (!loaded) return std::nullopt;
-  const std::vector<fs::path> roots = search_roots(loaded->path, map->type_path);
+  const std::vector<std::string> roots = ros_type_roots(loaded->path, map->type_path);
   const IdlTypeFile idl = parse_idl_types(loaded->text, [&](std::string_view include) {
-    return find_text(roots, fs::path(std::string(include)), kIdlMaxTextBytes, included);
+    return read_from_roots(roots, std::string(include), kIdlMaxTextBytes, included);
   });
   // An error in an included file is located there: its name as written, found on the roots.
   for (const IdlError& e : idl.errors) {
@@ -137,12 +115,12 @@ std::optional<ChannelType> load_msg_type(YamlReader& reader, const YAML::Node& n
   const auto loaded =
       load_named_file(reader, node["msg"], key(path, "msg"), map->file, included, kMsgMaxTextBytes, ".msg file");
   if (!loaded) return std::nullopt;
-  const std::vector<fs::path> roots = search_roots(loaded->path, map->type_path);
+  const std::vector<std::string> roots = ros_type_roots(loaded->path, map->type_path);
   std::map<std::string, std::string> paths{{name->full(), loaded->path}};  // pkg/msg/Name -> file, for errors
   const MsgLoader load = [&](const std::string& package, const std::string& message) -> std::optional<std::string> {
     if (package == name->package && message == name->name) return loaded->text;
     const fs::path relative = fs::path(package) / "msg" / (message + ".msg");
-    std::optional<std::string> text = find_text(roots, relative, kMsgMaxTextBytes, included);
+    std::optional<std::string> text = read_from_roots(roots, relative.string(), kMsgMaxTextBytes, included);
     if (text) paths[package + "/msg/" + message] = included.back();
     return text;
   };
@@ -159,3 +137,29 @@ std::optional<ChannelType> load_msg_type(YamlReader& reader, const YAML::Node& n
 }
 
 }  // namespace cosmic::config_detail
+
+namespace cosmic {
+
+std::vector<std::string> ros_type_roots(const std::string& file, const std::vector<std::string>& type_path) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> roots(type_path.begin(), type_path.end());
+  const fs::path own = fs::path(file).parent_path();
+  roots.push_back(own.string());
+  if (own.filename() == "msg" && own.has_parent_path()) roots.push_back(own.parent_path().parent_path().string());
+  return roots;
+}
+
+std::optional<std::string> read_from_roots(const std::vector<std::string>& roots, const std::string& relative,
+                                           std::size_t max_bytes, std::vector<std::string>& read) {
+  namespace fs = std::filesystem;
+  for (const std::string& root : roots) {
+    const std::string candidate = (fs::path(root) / relative).lexically_normal().string();
+    std::string text;
+    if (!config_detail::read_regular_file(candidate, text, max_bytes).empty()) continue;
+    read.push_back(candidate);
+    return text;
+  }
+  return std::nullopt;
+}
+
+}  // namespace cosmic
