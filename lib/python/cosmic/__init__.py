@@ -41,9 +41,10 @@ from ._errors import (
     UnboundError,
 )
 from ._native import Channel, Event, check_channel, parse_duration_ns
+from ._typed import ChannelType
 
 __all__ = [
-    "Channel", "ChannelDesc", "Client", "ClosedError", "Error", "Event", "InvalidError", "NotReadyError", "PUBLISH",
+    "Channel", "ChannelDesc", "ChannelType", "Client", "ClosedError", "Error", "Event", "InvalidError", "NotReadyError", "PUBLISH",
     "Role", "SUBSCRIBE", "TooLargeError", "TransportError", "UnavailableError", "UnboundError", "check_channel",
     "load_channel", "parse_duration_ns", "OK", "E_INVALID", "E_TRANSPORT", "E_AGAIN", "E_TOO_LARGE",
     "E_UNBOUND", "E_UNAVAILABLE", "E_TIMEOUT",
@@ -119,6 +120,9 @@ class ChannelDesc:
     temp_validity: Optional[float] = None
     omission_degree: int = 0
     payload: int = 8
+    # A typed channel's fields (its events in the compact layout: decode(), encode(), decode_batch());
+    # None for opaque bytes.
+    type: Optional[ChannelType] = None
 
 
 def load_channel(yaml_file: str, name: str) -> ChannelDesc:
@@ -128,7 +132,8 @@ def load_channel(yaml_file: str, name: str) -> ChannelDesc:
     return ChannelDesc(
         name=d["name"], subject=d["subject"], cls=d["cls"], period=_seconds(d["period_ns"]),
         reaction_time=_seconds(d["reaction_time_ns"]), temp_validity=_seconds(d["temp_validity_ns"]),
-        omission_degree=d["omission_degree"], payload=d["payload"])
+        omission_degree=d["omission_degree"], payload=d["payload"],
+        type=None if d["type"] is None else ChannelType(d["type"]))
 
 
 class Client(_native.Client):

@@ -3,6 +3,7 @@
 #include <pybind11/stl.h>
 
 #include "binding.hpp"
+#include "cosmic/channel_type.hpp"
 #include "cosmic/config_loader.hpp"
 #include "cosmic/units.hpp"
 
@@ -12,6 +13,46 @@ namespace {
 py::object nanos_or_none(const std::optional<Nanos>& value) {
   if (!value) return py::none();
   return py::int_(value->count());
+}
+
+py::object number_or_none(const std::optional<double>& value) {
+  if (!value) return py::none();
+  return py::float_(*value);
+}
+
+py::list fields_desc(const std::vector<TypeField>& fields);
+
+// A field's type as cosmic._typed reads it: {"kind", "scalar", "bound", "values", "element", "fields"}.
+py::dict field_type_desc(const FieldType& type) {
+  static constexpr const char* kKinds[] = {"scalar", "enum", "string", "array", "sequence", "record"};
+  FieldType scalar;
+  scalar.scalar = type.scalar;
+  py::dict values;
+  for (const EnumValue& v : type.values) values[py::str(v.name)] = v.value;
+  py::dict d;
+  d["kind"] = kKinds[static_cast<std::size_t>(type.kind)];
+  d["scalar"] = describe(scalar);  // "float64", "uint8", ...: also an enumeration's integer
+  d["bound"] = type.bound;
+  d["values"] = values;
+  d["element"] = type.element.empty() ? py::object(py::none()) : py::object(field_type_desc(type.element.front()));
+  d["fields"] = fields_desc(type.fields);
+  return d;
+}
+
+py::list fields_desc(const std::vector<TypeField>& fields) {
+  py::list out;
+  for (const TypeField& f : fields) {
+    py::dict d;
+    d["name"] = f.name;
+    d["type"] = field_type_desc(f.type);
+    d["unit"] = f.unit;
+    d["min"] = number_or_none(f.minimum);
+    d["max"] = number_or_none(f.maximum);
+    d["present_when"] = f.present_when ? py::object(py::make_tuple(f.present_when->selector, f.present_when->value))
+                                       : py::object(py::none());
+    out.append(d);
+  }
+  return out;
 }
 
 // One channel of a gateway configuration, as cosmicd reads it (parse_config: the whole file is
@@ -44,6 +85,8 @@ py::dict load_channel(const std::string& path, const std::string& name) {
   d["temp_validity_ns"] = nanos_or_none(spec->temp_validity);
   d["omission_degree"] = spec->omission_degree;
   d["payload"] = spec->payload;
+  // A typed channel's fields (cosmic._typed.ChannelType reads them); None: opaque bytes.
+  d["type"] = spec->type ? py::object(fields_desc(spec->type->fields)) : py::object(py::none());
   return d;
 }
 
