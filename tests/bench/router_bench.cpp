@@ -17,14 +17,26 @@
 //                                 segment as fast as it can (flood=1); counters: HRT residence
 //                                 p50/p99/p99.9/max in microseconds (from the router's own
 //                                 histogram) and the NRT events dropped as queue_full.
+//   BM_TypedConversion/stage      a typed channel's conversions (issue 35) on one event of a
+//                                 10-signal DBC message (8-byte frame): stage 0 the frame into the
+//                                 compact layout (the ingress side), 1 the compact event into XCDR2
+//                                 of the message's struct (a ROS 2-style DDS hop's egress side), 2
+//                                 both.
+//   BM_TypedDispatch/B            BM_OnEventDispatch's path for that typed channel: the frame comes
+//                                 in on a DBC hop and leaves as XCDR2, both conversions included.
 // items_per_second is events per second; ns/event = 1e9 / items_per_second.
 #include <benchmark/benchmark.h>
 
 #include <atomic>
 #include <chrono>
+#include <memory>
+#include <string_view>
 #include <thread>
 #include <vector>
 
+#include "cosmic/cdr_representation.hpp"
+#include "cosmic/dbc_type.hpp"
+#include "cosmic/hop_representation.hpp"
 #include "cosmic/memory_adapter.hpp"
 #include "cosmic/router.hpp"
 
@@ -64,8 +76,40 @@ RouterLimits limits_for(bool threaded) {
   return limits;
 }
 
+// The typed channel of BM_TypedConversion and BM_TypedDispatch: a wheel-speed ECU's 10 signals
+// (four scaled speeds as float64, gear, mode, two flags, a counter, a scaled temperature).
+constexpr std::string_view kTypedDbc = R"(BO_ 416 WheelSpeeds: 8 Ecu
+ SG_ SpeedFL : 0|12@1+ (0.1,0) [0|409.5] "km/h" Gw
+ SG_ SpeedFR : 12|12@1+ (0.1,0) [0|409.5] "km/h" Gw
+ SG_ SpeedRL : 24|12@1+ (0.1,0) [0|409.5] "km/h" Gw
+ SG_ SpeedRR : 36|12@1+ (0.1,0) [0|409.5] "km/h" Gw
+ SG_ Gear : 48|4@1- (1,0) [-1|6] "" Gw
+ SG_ Mode : 52|2@1+ (1,0) [0|3] "" Gw
+ SG_ Valid : 54|1@1+ (1,0) [0|1] "" Gw
+ SG_ Brake : 55|1@1+ (1,0) [0|1] "" Gw
+ SG_ Counter : 56|4@1+ (1,0) [0|15] "" Gw
+ SG_ Temp : 60|4@1+ (5,-20) [-20|55] "degC" Gw
+)";
+
+struct TypedForms {
+  TypedForms() {
+    const DbcFile file = parse_dbc(kTypedDbc);
+    const DbcMessage& message = file.messages.at(0);
+    type = channel_type_from_dbc(message).type;
+    frame = std::make_shared<DbcFrameRepresentation>(DbcFrameCodec::make(message, type).value(), "DBC frame",
+                                                     RangePolicy::drop);
+    cdr = std::make_shared<CdrRepresentation>(
+        CdrRepresentation::make(type, DdsRepresentation::xcdr2, CdrExtensibility::final_type).value());
+  }
+  ChannelType type;
+  std::shared_ptr<const Representation> frame;
+  std::shared_ptr<const Representation> cdr;
+  std::vector<std::uint8_t> wheel_frame = {0x15, 0x36, 0x41, 0x2B, 0x9A, 0x07, 0xF1, 0x93};
+};
+
 struct Bench {
-  explicit Bench(bool threaded = false) : router(GatewayIdentity{0xAAAA, "bench"}, 2, limits_for(threaded)) {
+  explicit Bench(bool threaded = false, const TypedForms* typed = nullptr)
+      : router(GatewayIdentity{0xAAAA, "bench"}, 2, limits_for(threaded)) {
     ChannelSpec spec;
     spec.name = "bench";
     spec.subject = 0x100;
@@ -82,7 +126,13 @@ struct Bench {
     const ChannelBinding sub{kChannel, spec, HopRole::subscriber, std::nullopt};
     in.configure(std::span<const ChannelBinding>(&pub, 1));
     out.configure(std::span<const ChannelBinding>(&sub, 1));
-    router.apply({Route{kChannel, spec, {0}, {1}}});
+    Route route{kChannel, spec, {0}, {1}};
+    if (typed != nullptr) {
+      route.spec.type = typed->type;
+      route.publisher_forms = {typed->frame};
+      route.subscriber_forms = {typed->cdr};
+    }
+    router.apply({route});
   }
   MemoryAdapter in{"in"};
   CountingAdapter out;
@@ -196,6 +246,38 @@ void BM_HrtResidence(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_HrtResidence)->Arg(0)->Arg(1)->ArgName("flood")->Iterations(5)->Unit(benchmark::kMillisecond);
+
+void BM_TypedConversion(benchmark::State& state) {
+  const TypedForms f;
+  std::vector<std::uint8_t> compact(f.frame->max_compact_size());
+  std::vector<std::uint8_t> wire(f.cdr->max_wire_size());
+  const std::int64_t stage = state.range(0);
+  if (!f.frame->to_compact(f.wheel_frame, compact).ok()) state.SkipWithError("the frame did not convert");
+  for (auto _ : state) {
+    if (stage != 1) benchmark::DoNotOptimize(f.frame->to_compact(f.wheel_frame, compact));
+    if (stage != 0) benchmark::DoNotOptimize(f.cdr->from_compact(compact, wire));
+    benchmark::ClobberMemory();
+  }
+  if (!f.cdr->from_compact(compact, wire).ok()) state.SkipWithError("the event did not convert");
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()));
+}
+BENCHMARK(BM_TypedConversion)->Arg(0)->Arg(1)->Arg(2)->ArgName("stage");
+
+void BM_TypedDispatch(benchmark::State& state) {
+  const TypedForms f;
+  Bench b(false, &f);
+  const auto batch = static_cast<std::size_t>(state.range(0));
+  EventHeader header{};
+  header.subject = 0x100;
+  for (auto _ : state) {
+    for (std::size_t i = 0; i < batch; ++i)
+      b.router.inbox(0).on_event(InboundEvent{kChannel, header, f.wheel_frame, steady_now()});
+    benchmark::DoNotOptimize(b.router.run_once(batch));
+  }
+  if (b.out.sent() != state.iterations() * batch) state.SkipWithError("events were lost");
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * batch));
+}
+BENCHMARK(BM_TypedDispatch)->Arg(1)->Arg(64)->ArgName("batch");
 
 }  // namespace
 
