@@ -16,6 +16,7 @@
 #include "cosmic/cdr_representation.hpp"
 #include "cosmic/compact_layout.hpp"
 #include "fuzz_input.hpp"
+#include "fuzz_types.hpp"
 
 using cosmic::fuzz::FuzzInput;
 using cosmic::fuzz::require;
@@ -28,50 +29,7 @@ constexpr cosmic::ScalarKind kEnumKinds[] = {cosmic::ScalarKind::int8, cosmic::S
                                              cosmic::ScalarKind::int32, cosmic::ScalarKind::uint32,
                                              cosmic::ScalarKind::int64};
 
-cosmic::FieldType make_type(FuzzInput& in, int depth);
-
-std::vector<cosmic::TypeField> make_fields(FuzzInput& in, int depth) {
-  std::vector<cosmic::TypeField> fields;
-  const int count = 1 + in.byte() % 5;
-  for (int i = 0; i < count; ++i) {
-    cosmic::TypeField f;
-    f.name = "f" + std::to_string(i);
-    f.type = make_type(in, depth + 1);
-    fields.push_back(std::move(f));
-  }
-  return fields;
-}
-
-cosmic::FieldType make_type(FuzzInput& in, int depth) {
-  cosmic::FieldType t;
-  const std::uint8_t kind = depth >= 3 ? in.byte() % 2 : in.byte() % 6;
-  t.scalar = static_cast<cosmic::ScalarKind>(in.byte() % 11);
-  switch (kind) {
-    case 0:
-      t.kind = cosmic::FieldType::Kind::scalar;
-      break;
-    case 1:
-      t.kind = cosmic::FieldType::Kind::enumeration;
-      t.scalar = kEnumKinds[in.byte() % std::size(kEnumKinds)];
-      t.values = {{"A", 0}, {"B", 1 + in.byte() % 3}};
-      break;
-    case 2:
-      t.kind = cosmic::FieldType::Kind::string;
-      t.bound = 1 + in.byte() % 16;
-      break;
-    case 3:
-    case 4:
-      t.kind = kind == 3 ? cosmic::FieldType::Kind::array : cosmic::FieldType::Kind::sequence;
-      t.bound = 1 + in.byte() % 4;
-      t.element = {make_type(in, depth + 1)};
-      break;
-    default:
-      t.kind = cosmic::FieldType::Kind::record;
-      t.fields = make_fields(in, depth);
-      break;
-  }
-  return t;
-}
+constexpr cosmic::fuzz::TypeShapes kShapes{kEnumKinds, false};
 
 std::span<const std::uint8_t> first(const Bytes& bytes, std::size_t size) {
   return std::span<const std::uint8_t>(bytes).first(size);
@@ -109,7 +67,7 @@ const cosmic::CdrRepresentation& writer_like(std::span<const std::uint8_t> wire,
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   FuzzInput in(data, size);
   cosmic::ChannelType type;
-  type.fields = make_fields(in, 0);
+  type.fields = cosmic::fuzz::make_fields(in, 0, kShapes);
   if (!cosmic::check_type(type).empty()) return 0;
   std::vector<cosmic::CdrRepresentation> all;
   for (const auto& [version, extensibility] :

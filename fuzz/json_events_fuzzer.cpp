@@ -13,62 +13,16 @@
 #include "cosmic/compact_layout.hpp"
 #include "cosmic/json_representation.hpp"
 #include "fuzz_input.hpp"
+#include "fuzz_types.hpp"
 
 using cosmic::fuzz::FuzzInput;
 using cosmic::fuzz::require;
 
 namespace {
 
-cosmic::FieldType make_type(FuzzInput& in, int depth);
-
-std::vector<cosmic::TypeField> make_fields(FuzzInput& in, int depth) {
-  std::vector<cosmic::TypeField> fields;
-  const int count = 1 + in.byte() % 5;
-  for (int i = 0; i < count; ++i) {
-    cosmic::TypeField f;
-    f.name = "f" + std::to_string(i);
-    f.type = make_type(in, depth + 1);
-    // A conditional field on the first field when that is an integer.
-    const auto& first = fields.empty() ? f.type : fields.front().type;
-    const bool integral =
-        (first.kind == cosmic::FieldType::Kind::scalar || first.kind == cosmic::FieldType::Kind::enumeration) &&
-        cosmic::is_integer(first.scalar);
-    if (i > 0 && integral && (in.byte() & 3) == 0) f.present_when = cosmic::FieldPresence{"f0", in.byte() % 3};
-    fields.push_back(std::move(f));
-  }
-  return fields;
-}
-
-cosmic::FieldType make_type(FuzzInput& in, int depth) {
-  cosmic::FieldType t;
-  const std::uint8_t kind = depth >= 3 ? in.byte() % 2 : in.byte() % 6;
-  t.scalar = static_cast<cosmic::ScalarKind>(in.byte() % 11);
-  switch (kind) {
-    case 0:
-      t.kind = cosmic::FieldType::Kind::scalar;
-      break;
-    case 1:
-      t.kind = cosmic::FieldType::Kind::enumeration;
-      t.scalar = (in.byte() & 1) != 0 ? cosmic::ScalarKind::int8 : cosmic::ScalarKind::uint16;
-      t.values = {{"A", 0}, {"B", 1 + in.byte() % 3}};
-      break;
-    case 2:
-      t.kind = cosmic::FieldType::Kind::string;
-      t.bound = 1 + in.byte() % 16;
-      break;
-    case 3:
-    case 4:
-      t.kind = kind == 3 ? cosmic::FieldType::Kind::array : cosmic::FieldType::Kind::sequence;
-      t.bound = 1 + in.byte() % 4;
-      t.element = {make_type(in, depth + 1)};
-      break;
-    default:
-      t.kind = cosmic::FieldType::Kind::record;
-      t.fields = make_fields(in, depth);
-      break;
-  }
-  return t;
-}
+// An enumeration's integer: odd bytes int8, even uint16.
+constexpr cosmic::ScalarKind kEnumKinds[] = {cosmic::ScalarKind::uint16, cosmic::ScalarKind::int8};
+constexpr cosmic::fuzz::TypeShapes kShapes{kEnumKinds, true};
 
 bool names_are_the_types(const nlohmann::json& value, const std::vector<cosmic::TypeField>& fields) {
   if (!value.is_object()) return false;
@@ -87,7 +41,7 @@ bool names_are_the_types(const nlohmann::json& value, const std::vector<cosmic::
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   FuzzInput in(data, size);
   cosmic::ChannelType type;
-  type.fields = make_fields(in, 0);
+  type.fields = cosmic::fuzz::make_fields(in, 0, kShapes);
   if (!cosmic::check_type(type).empty()) return 0;
   const auto bytes = in.bytes(cosmic::max_compact_size(type) + 8);
   const cosmic::JsonRepresentation json{cosmic::ChannelType(type)};

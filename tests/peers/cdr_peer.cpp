@@ -21,11 +21,13 @@
 #include <string>
 #include <vector>
 
+#include "peer_hex.hpp"
 #include "cosmic/cdr_representation.hpp"
 
 namespace {
 
 using Bytes = std::vector<std::uint8_t>;
+namespace peer = cosmic::peer;
 using cosmic::FieldType;
 using cosmic::ScalarKind;
 
@@ -149,23 +151,6 @@ cosmic::CdrRepresentation representation(const std::string& extensibility, const
   return std::move(made).value();
 }
 
-std::string hex(const Bytes& bytes) {
-  std::string out;
-  char two[3];
-  for (const std::uint8_t b : bytes) {
-    std::snprintf(two, sizeof two, "%02x", b);
-    out += two;
-  }
-  return out;
-}
-
-Bytes unhex(const std::string& text) {
-  Bytes out;
-  for (std::size_t i = 0; i + 1 < text.size(); i += 2)
-    out.push_back(static_cast<std::uint8_t>(std::stoi(text.substr(i, 2), nullptr, 16)));
-  return out;
-}
-
 Bytes written(const cosmic::CdrRepresentation& cdr, const Bytes& event) {
   Bytes wire(cdr.max_wire_size());
   const cosmic::Conversion c = cdr.from_compact(event, wire);
@@ -183,10 +168,10 @@ std::string disagreement(const std::string& extensibility, const std::string& ve
     const cosmic::Conversion c = cdr.to_compact(wire, event);
     event.resize(c.size);
     if (!c.ok()) return std::string("refused (fault ") + std::to_string(static_cast<int>(c.fault)) + ")";
-    if (event != want) return "read other values: " + hex(event) + " instead of " + hex(want);
+    if (event != want) return "read other values: " + peer::hex(event) + " instead of " + peer::hex(want);
   }
   const Bytes ours = written(representation(extensibility, version), want);
-  if (little_endian && ours != wire) return "we write " + hex(ours);
+  if (little_endian && ours != wire) return "we write " + peer::hex(ours);
   return "";
 }
 
@@ -201,7 +186,7 @@ int decode() {
       std::fprintf(stderr, "cdr-peer: bad line: %s\n", line.c_str());
       return 2;
     }
-    const std::string why = disagreement(extensibility, version, order == "le", k, unhex(text));
+    const std::string why = disagreement(extensibility, version, order == "le", k, peer::unhex(text));
     std::printf("%s %d %s %s %s %s\n", why.empty() ? "ok" : "FAIL", k, extensibility.c_str(), version.c_str(),
                 order.c_str(), why.c_str());
     failures += why.empty() ? 0 : 1;
@@ -216,7 +201,7 @@ int encode() {
     for (int k = 0; k < kSamples; ++k) {
       const Bytes wire = written(cdr, sample_event(k));
       if (wire.empty()) return 1;
-      std::printf("%d %s %s le %s\n", k, v.extensibility, v.version, hex(wire).c_str());
+      std::printf("%d %s %s le %s\n", k, v.extensibility, v.version, peer::hex(wire).c_str());
     }
   }
   return 0;

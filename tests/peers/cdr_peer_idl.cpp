@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include "peer_hex.hpp"
 #include "cosmic/cdr_representation.hpp"
 #include "cosmic/compact_layout.hpp"
 #include "cosmic/idl_types.hpp"
@@ -38,6 +39,7 @@
 namespace {
 
 using Bytes = std::vector<std::uint8_t>;
+namespace peer = cosmic::peer;
 using cosmic::FieldType;
 using cosmic::ScalarKind;
 
@@ -223,23 +225,6 @@ class SampleMaker {
   std::string text_;
 };
 
-std::string idl_hex(const Bytes& bytes) {
-  std::string out;
-  char two[3];
-  for (const std::uint8_t b : bytes) {
-    std::snprintf(two, sizeof two, "%02x", b);
-    out += two;
-  }
-  return out;
-}
-
-Bytes idl_unhex(const std::string& text) {
-  Bytes out;
-  for (std::size_t i = 0; i + 1 < text.size(); i += 2)
-    out.push_back(static_cast<std::uint8_t>(std::stoi(text.substr(i, 2), nullptr, 16)));
-  return out;
-}
-
 std::optional<cosmic::CdrRepresentation> representation(const cosmic::IdlChannelType& typed,
                                                         const std::string& version) {
   auto made = cosmic::CdrRepresentation::make(
@@ -266,7 +251,7 @@ int samples(const cosmic::IdlChannelType& typed, const std::string& version, int
       return 1;
     }
     wire.resize(c.size);
-    std::printf("%d %s %s %s\n", k, version.c_str(), idl_hex(wire).c_str(), sample.text().c_str());
+    std::printf("%d %s %s %s\n", k, version.c_str(), peer::hex(wire).c_str(), sample.text().c_str());
   }
   return 0;
 }
@@ -281,11 +266,12 @@ std::string disagreement(const cosmic::IdlChannelType& typed, const std::string&
   const cosmic::Conversion read = cdr->to_compact(wire, event);
   if (!read.ok()) return "refused (fault " + std::to_string(static_cast<int>(read.fault)) + ")";
   event.resize(read.size);
-  if (event != sample.event()) return "read other values: " + idl_hex(event) + " instead of " + idl_hex(sample.event());
+  if (event != sample.event())
+    return "read other values: " + peer::hex(event) + " instead of " + peer::hex(sample.event());
   Bytes ours(cdr->max_wire_size());
   const cosmic::Conversion write = cdr->from_compact(sample.event(), ours);
   ours.resize(write.ok() ? write.size : 0);
-  if (ours != wire) return "we write " + idl_hex(ours);
+  if (ours != wire) return "we write " + peer::hex(ours);
   return "";
 }
 
@@ -300,7 +286,7 @@ int decode(const cosmic::IdlChannelType& typed) {
       std::fprintf(stderr, "cdr-peer: bad line: %s\n", line.c_str());
       return 2;
     }
-    const std::string why = disagreement(typed, version, k, idl_unhex(text));
+    const std::string why = disagreement(typed, version, k, peer::unhex(text));
     std::printf("%s %d %s %s\n", why.empty() ? "ok" : "FAIL", k, version.c_str(), why.c_str());
     failures += why.empty() ? 0 : 1;
     ++count;

@@ -4,7 +4,6 @@
 
 #include "cosmic/can_background.hpp"
 #include "cosmic/federation.hpp"
-#include "cosmic/hop_representation.hpp"
 #include "cosmic/json_nesting.hpp"
 #include "cosmic/report.hpp"
 
@@ -258,15 +257,6 @@ std::string incompatible_text(const HopReport& hop, std::uint64_t count) {
          " refused for incompatible QoS (not matched; the log names the policy)";
 }
 
-// A typed channel's form on the hop ("DBC frame 0x1A0 WheelSpeed", "compact", "JSON", "XCDR1");
-// null for an untyped channel, whose contents cross as the bytes they came in.
-Json hop_representation_text(const ChannelSpec* spec, const Config& config, const std::string& segment_name) {
-  const SegmentSpec* segment = config.find_segment(segment_name);
-  if (spec == nullptr || !spec->type || segment == nullptr) return nullptr;
-  const Result<std::shared_ptr<const Representation>> made = hop_representation(*spec, *segment);
-  return made ? Json(made.value()->describe()) : Json(nullptr);
-}
-
 // A remote endpoint that the far side refuses (or neither side accepts), with the rule.
 std::string peer_conflict_text(const HopReport& hop, const PeerQosConflict& c) {
   return "remote " + c.peer + " " + c.id + " of " + c.topic + " on " + hop.segment + ": " + c.policy + ": " + c.reason;
@@ -321,7 +311,10 @@ Json ControlProtocol::channel_entry(const ChannelReport& verdict, const ChannelS
     } else {
       seg["peer_conflicts"] = nullptr;
     }
-    seg["representation"] = hop_representation_text(spec, gateway_.config(), hop.segment);
+    // A typed channel's form on the hop as routed; null for an untyped channel (its contents cross
+    // as the bytes they came in).
+    const std::optional<std::string> form = gateway_.hop_form(verdict.name, hop.segment);
+    seg["representation"] = form ? Json(*form) : Json(nullptr);
     for (std::size_t r = 0; r < kDropReasonCount; ++r) seg["dropped"][to_string(static_cast<DropReason>(r))] = 0;
     seg["omitted"] = 0;
     seg["omission_excess"] = 0;

@@ -198,6 +198,7 @@ Gateway::VerdictCounts Gateway::verdict_counts() const {
 
 void Gateway::apply_routes() {
   std::vector<Route> routes;
+  hop_forms_.clear();
   for (const auto& channel : kb_->bound_channels()) {
     Route route{id_for(channel), channel, {}, {}};
     for (const auto& p : channel.publishers) {
@@ -216,7 +217,7 @@ void Gateway::apply_routes() {
 // Each hop's representation of a typed channel. The configuration has checked that every hop can
 // carry the type, so a failure here means the segment changed under the channel: the channel is
 // not routed (its events count as unrouted), never forwarded in a form its hop does not take.
-bool Gateway::add_representations(Route& route) const {
+bool Gateway::add_representations(Route& route) {
   const auto form_on = [&](const std::string& name) -> std::shared_ptr<const Representation> {
     const SegmentSpec* segment = config_.find_segment(name);
     if (segment == nullptr) return nullptr;
@@ -236,7 +237,19 @@ bool Gateway::add_representations(Route& route) const {
     route.subscriber_forms.push_back(form_on(s));
     if (!route.subscriber_forms.back()) return false;
   }
+  auto& forms = hop_forms_[route.spec.name];
+  for (std::size_t i = 0; i < route.spec.publishers.size(); ++i)
+    forms[route.spec.publishers[i]] = route.publisher_forms[i]->describe();
+  for (std::size_t i = 0; i < route.spec.subscribers.size(); ++i)
+    forms[route.spec.subscribers[i]] = route.subscriber_forms[i]->describe();
   return true;
+}
+
+std::optional<std::string> Gateway::hop_form(const std::string& channel, const std::string& segment) const {
+  const auto forms = hop_forms_.find(channel);
+  if (forms == hop_forms_.end()) return std::nullopt;
+  const auto form = forms->second.find(segment);
+  return form == forms->second.end() ? std::nullopt : std::optional<std::string>(form->second);
 }
 
 BindResult Gateway::bind(const std::vector<ChannelSpec>& channels) {

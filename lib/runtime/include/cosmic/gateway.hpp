@@ -205,6 +205,9 @@ class Gateway {
   std::set<std::string> violated_channel_names() const;
   // What the forwarding threads could not get of gateway.realtime since the last call.
   std::vector<std::string> take_thread_problems();
+  // The form a routed typed channel's events take on `segment` ("DBC frame 0x1A0 WheelSpeed",
+  // "compact", "JSON", "XCDR1"); nullopt for an untyped or unrouted channel. Control thread.
+  std::optional<std::string> hop_form(const std::string& channel, const std::string& segment) const;
 
   const GatewayIdentity& identity() const { return identity_; }
   const Config& config() const { return config_; }
@@ -275,7 +278,7 @@ class Gateway {
   std::string violation_line(const ChannelSpec& spec) const;
   std::string omission_line(const ChannelSpec& spec) const;
   void apply_routes();
-  bool add_representations(Route& route) const;
+  bool add_representations(Route& route);
   ChannelId id_for(const ChannelSpec& spec);
   // A replacement's new definitions take over their channels' ids; returns the entries they
   // replaced, for undo_takeover().
@@ -292,8 +295,11 @@ class Gateway {
   std::unique_ptr<KnowledgeBase> kb_;
   std::unique_ptr<Router> router_;
   std::map<std::string, RuntimeTrack> runtime_;  // by channel name
-  Refusals refused_;                             // after the last configure_adapters()
-  std::map<std::string, SegmentSlot> slots_;     // by segment name
+  // What each routed typed channel's hops carry (Representation::describe()), as apply_routes() built
+  // them: channel -> segment -> form.
+  std::map<std::string, std::map<std::string, std::string>> hop_forms_;
+  Refusals refused_;                          // after the last configure_adapters()
+  std::map<std::string, SegmentSlot> slots_;  // by segment name
   std::map<std::string, std::pair<ChannelSpec, ChannelId>> channel_ids_;
   ChannelId next_channel_id_ = 1;
   std::uint64_t generation_ = 0;
