@@ -7,6 +7,7 @@
 
 #include "cosmic/build_paths.hpp"
 #include "cosmic/channel_type.hpp"
+#include "cosmic/hop_representation.hpp"
 #include "cosmic/config_loader.hpp"
 
 #include <unistd.h>
@@ -382,6 +383,27 @@ TEST(ChannelTypeYaml, ASignalGatewayEntryTakesItsIdentifierFromTheMessage) {
   EXPECT_NE(stray.find("channels[0].native.chassis.map: map belongs to a frame given as a DBC message"),
             std::string::npos)
       << stray;
+  // The far message protected end to end: its counter and CRC are the gateway's to write.
+  std::ofstream(dir / "c.dbc") << "BO_ 769 C: 3 X\n SG_ Crc : 0|8@1+ (1,0) [0|0] \"\" X\n"
+                                  " SG_ Cnt : 8|4@1+ (1,0) [0|0] \"\" X\n SG_ S : 16|8@1+ (1,0) [0|0] \"\" X\n";
+  const ConfigResult protected_far = parsed(
+      "    type: {dbc: a.dbc, message: A}\n"
+      "    native: {body: {can_id: 0x1A0}, chassis: {dbc: c.dbc, message: C, e2e: {counter: Cnt, crc: Crc, data_id: "
+      "5}}}\n");
+  ASSERT_TRUE(protected_far.ok()) << listed_errors(protected_far.errors);
+  const ChannelSpec& channel = protected_far.config.channels.at(0);
+  EXPECT_EQ(channel.payload_on("chassis"), 3u);
+  const auto form = hop_representation(channel, *protected_far.config.find_segment("chassis"));
+  ASSERT_TRUE(form.ok()) << form.error().text;
+  EXPECT_EQ(form.value()->describe(), "DBC frame 0x301 C with E2E (counter Cnt, CRC Crc) of c.dbc");
+  ASSERT_NE(form.value()->e2e(), nullptr);
+  const std::string bad_e2e = listed_errors(parsed("    type: {dbc: a.dbc, message: A}\n"
+                                                   "    native: {body: {can_id: 0x1A0}, chassis: {dbc: c.dbc, message: "
+                                                   "C, e2e: {counter: S, crc: Cnt, data_id: 5}}}\n")
+                                                .errors);
+  EXPECT_NE(bad_e2e.find("channels[0].native.chassis.e2e: the CRC signal Cnt does not fill one whole byte"),
+            std::string::npos)
+      << bad_e2e;
   std::filesystem::remove_all(dir);
 }
 
