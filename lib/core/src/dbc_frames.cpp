@@ -159,7 +159,8 @@ Result<DbcFrameCodec> DbcFrameCodec::make_mapped(const DbcMessage& message, cons
                  " is multiplexed: the signal gateway re-packs messages without"
                  " multiplexing"};
   }
-  for (const auto& [field, signal] : field_map) {
+  for (const auto& entry : field_map) {
+    const std::string& field = entry.first;  // not a structured binding: clang 14 cannot capture one
     if (std::none_of(type.fields.begin(), type.fields.end(), [&](const TypeField& f) { return f.name == field; }))
       return Error{"map names field " + field + ", which the channel's type does not have"};
   }
