@@ -483,11 +483,10 @@ TEST_F(TypedForwardingTest, AnE2eFrameIsCheckedAndItsCounterGapsCountAgainstTheO
   EXPECT_EQ(body->omission_excess, 1u);  // the gap of 3 is beyond omission_degree 1; the gap of 1 is not
   // A gap beyond the omission degree turns the channel violated (an NRT channel too), with the numbers.
   gateway.refresh_runtime(Nanos(1'000'000'000));
-  for (const auto& c : gateway.channel_stats()) {
-    if (c.name == "brake") {
-      EXPECT_EQ(c.runtime_state, RuntimeState::violated);
-    }
-  }
+  const auto after = gateway.channel_stats();
+  const auto brake = std::find_if(after.begin(), after.end(), [](const auto& c) { return c.name == "brake"; });
+  ASSERT_NE(brake, after.end());
+  EXPECT_EQ(brake->runtime_state, RuntimeState::violated);
   const bool logged = std::any_of(log.lines.begin(), log.lines.end(), [](const std::string& line) {
     return line.find(
                "channel brake violated its omission degree 1: hop body: 1 gaps in the end-to-end counter "
