@@ -1,75 +1,14 @@
 #include "gen_skeleton.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <cstdio>
 
+#include "gen_names.hpp"
+#include "gen_struct.hpp"
 #include "gen_templates.hpp"
 
 namespace cosmicctl {
 namespace {
-
-// A C++ identifier from a model name ([A-Za-z0-9_.-]).
-std::string identifier(const std::string& name) {
-  std::string out;
-  for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-  if (out.empty() || std::isdigit(static_cast<unsigned char>(out[0]))) out = "c_" + out;
-  return out;
-}
-
-std::string camel(const std::string& name) {
-  std::string out;
-  bool up = true;
-  for (char c : identifier(name)) {
-    if (c == '_') {
-      up = true;
-      continue;
-    }
-    out += up ? static_cast<char>(std::toupper(static_cast<unsigned char>(c))) : c;
-    up = false;
-  }
-  return out.empty() ? "Component" : out;
-}
-
-// Text for a `//` or `#` comment: control characters (a newline would end the comment and let the
-// rest become code) shown as '?'.
-std::string comment_text(const std::string& text) {
-  std::string out = text;
-  for (char& c : out) {
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
-  }
-  return out;
-}
-
-// The body of a C++ string literal: '\\' and '"' escaped, anything not printable ASCII as a
-// three-digit octal escape (a hex escape would swallow the hex digits after it).
-std::string literal_text(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    const auto byte = static_cast<unsigned char>(c);
-    if (c == '\\' || c == '"') {
-      out += '\\';
-      out += c;
-    } else if (byte < 0x20 || byte >= 0x7f) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\%03o", static_cast<unsigned>(byte));
-      out += escaped;
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
-
-// Every {{KEY}} of `text` replaced by its value.
-std::string fill(std::string text, const std::map<std::string, std::string>& values) {
-  for (const auto& [key, value] : values) {
-    const std::string mark = "{{" + key + "}}";
-    for (auto at = text.find(mark); at != std::string::npos; at = text.find(mark, at + value.size()))
-      text.replace(at, mark.size(), value);
-  }
-  return text;
-}
 
 std::string ns(const std::optional<cosmic::Nanos>& d) { return d ? std::to_string(d->count()) : "0"; }
 
@@ -117,34 +56,81 @@ std::vector<const cosmic::ChannelSpec*> used_channels(const cosmic::Config& conf
 struct Pieces {
   std::string descs, all, members, handler_decls, period_decls, publish_decls, announce, subscribe, periods,
       logic_handlers, logic_periods;
+  // Typed channels (gen_struct.hpp): their headers, the decoding and encoding around the handlers.
+  std::string type_includes, typed_decls, typed_members, typed_definitions;
+  std::map<std::string, std::string> type_headers;  // file name -> content
 };
 
+// A typed channel's subscriber: the client's bytes decoded into the channel's struct for
+// refresh_CHANNEL(); its logic handler takes the struct.
+void add_typed_subscriber(Pieces& p, const cosmic::ChannelSpec& c, const std::string& cls) {
+  const std::string id = identifier(c.name);
+  const std::string event = type_namespace(c) + "::Event";
+  p.handler_decls += "  void refresh_" + id + "(const " + event + "& event);  // " + c.name + ", decoded\n";
+  p.typed_decls += "  void receive_" + id + "(std::span<const std::uint8_t> bytes);\n";
+  p.typed_members += "  " + event + " " + id + "_event_;  // decoded into again and again: its buffers stay\n";
+  p.subscribe += "  subscribe(" + id + "_, &" + cls + "::receive_" + id + ");\n";
+  p.typed_definitions +=
+      fill(kTypedReceiveTemplate, {{"CLASS", cls}, {"ID", id}, {"CHANNEL", c.name}, {"NS", type_namespace(c)}});
+  p.logic_handlers +=
+      fill(kLogicTypedHandlerTemplate, {{"CLASS", cls}, {"ID", id}, {"CHANNEL", c.name}, {"EVENT", event}});
+}
+
+// A typed channel's publisher: publish_CHANNEL(struct) encodes, beside publish_CHANNEL(bytes).
+void add_typed_publisher(Pieces& p, const cosmic::ChannelSpec& c, const std::string& cls) {
+  const std::string id = identifier(c.name);
+  p.publish_decls += "  // The event encoded (" + type_header_name(c) +
+                     "); COSMIC_E_INVALID when it does not encode.\n  int publish_" + id + "(const " +
+                     type_namespace(c) + "::Event& event);\n";
+  p.typed_definitions +=
+      fill(kTypedPublishTemplate, {{"CLASS", cls}, {"ID", id}, {"CHANNEL", c.name}, {"NS", type_namespace(c)}});
+}
+
 void add_channel(Pieces& p, const cosmic::ChannelSpec& c, const cosmic::ComponentSpec& component,
-                 const std::string& cls) {
+                 const std::string& cls, const std::string& model_file) {
   const std::string id = identifier(c.name);
   p.descs += channel_desc(c, component);
   p.all += std::string(p.all.empty() ? "" : ", ") + "&" + id;
   p.members += "  cosmic::client::Channel& " + id + "_;\n";
   p.announce += ",\n      " + id + "_(client_->announce(channels::" + id + "))";
+  if (c.type) {
+    p.type_includes += "#include \"" + type_header_name(c) + "\"\n";
+    p.type_headers[type_header_name(c)] = generate_type_header(c, model_file);
+  }
   if (has(component.subscribes, c.name)) {
-    p.handler_decls += "  void refresh_" + id + "(std::span<const std::uint8_t> event);  // " + c.name + "\n";
-    p.subscribe += "  subscribe(" + id + "_, &" + cls + "::refresh_" + id + ");\n";
-    p.logic_handlers += fill(kLogicHandlerTemplate, {{"CLASS", cls}, {"ID", id}, {"CHANNEL", c.name}});
+    if (c.type) {
+      add_typed_subscriber(p, c, cls);
+    } else {
+      p.handler_decls += "  void refresh_" + id + "(std::span<const std::uint8_t> event);  // " + c.name + "\n";
+      p.subscribe += "  subscribe(" + id + "_, &" + cls + "::refresh_" + id + ");\n";
+      p.logic_handlers += fill(kLogicHandlerTemplate, {{"CLASS", cls}, {"ID", id}, {"CHANNEL", c.name}});
+    }
   }
   if (has(component.publishes, c.name)) {
     p.publish_decls +=
         "  int publish_" + id + "(std::span<const std::uint8_t> event) { return " + id + "_.publish(event); }\n";
+    if (c.type) add_typed_publisher(p, c, cls);
     if (c.period) {
       p.period_decls += "  void " + id + "_period();  // every " + cosmic::format_duration(*c.period) + "\n";
       p.periods += "      {std::chrono::nanoseconds(" + std::to_string(c.period->count()) + "), &" + cls + "::" + id +
                    "_period},\n";
-      p.logic_periods += fill(kLogicPeriodTemplate, {{"CLASS", cls},
-                                                     {"COMPONENT", component.name},
-                                                     {"ID", id},
-                                                     {"CHANNEL", c.name},
-                                                     {"PERIOD", cosmic::format_duration(*c.period)}});
+      p.logic_periods +=
+          fill(kLogicPeriodTemplate, {{"CLASS", cls},
+                                      {"COMPONENT", component.name},
+                                      {"ID", id},
+                                      {"CHANNEL", c.name},
+                                      {"WHAT", c.type ? "a " + type_namespace(c) + "::Event" : std::string("bytes")},
+                                      {"PERIOD", cosmic::format_duration(*c.period)}});
     }
   }
+}
+
+// What a component with typed channels has besides: the count of the events refused.
+void add_refusals(Pieces& p, const std::string& component, const std::string& cls) {
+  if (p.type_headers.empty()) return;
+  p.typed_decls += kTypedRefusedDecl;
+  p.typed_members += "  std::atomic<std::uint64_t> refused_events_{0};\n";
+  p.typed_definitions += fill(kTypedRefusedTemplate, {{"CLASS", cls}, {"COMPONENT", component}});
 }
 
 }  // namespace
@@ -179,7 +165,8 @@ Skeleton generate_skeleton(const cosmic::Config& config, const cosmic::Component
   const std::string cls = camel(component.name);
   const std::string file = identifier(component.name);
   Pieces p;
-  for (const auto* c : used_channels(config, component)) add_channel(p, *c, component, cls);
+  for (const auto* c : used_channels(config, component)) add_channel(p, *c, component, cls, model_file);
+  add_refusals(p, component.name, cls);
   // A CAN component needs a TxNode of its own: one after the gateway's, by component position.
   const auto position = static_cast<unsigned>(&component - config.components.data());
   const unsigned node = (config.gateway.can_node_id + 1 + position) % 128;
@@ -203,7 +190,11 @@ Skeleton generate_skeleton(const cosmic::Config& config, const cosmic::Component
       {"SUBSCRIBE", p.subscribe},
       {"PERIODS", p.periods},
       {"LOGIC_HANDLERS", p.logic_handlers},
-      {"LOGIC_PERIODS", p.logic_periods}};
+      {"LOGIC_PERIODS", p.logic_periods},
+      {"TYPE_INCLUDES", p.type_includes},
+      {"TYPED_DECLS", p.typed_decls},
+      {"TYPED_MEMBERS", p.typed_members},
+      {"TYPED_DEFINITIONS", p.typed_definitions}};
   Skeleton out;
   out.files["CMakeLists.txt"] = fill(kCMakeTemplate, values);
   out.files["channels.hpp"] = fill(kChannelsTemplate, values);
@@ -212,6 +203,8 @@ Skeleton generate_skeleton(const cosmic::Config& config, const cosmic::Component
   out.files["main.cpp"] = fill(kMainTemplate, values);
   out.logic_file = file + "_logic.cpp";
   out.files[out.logic_file] = fill(kLogicTemplate, values);
+  for (const auto& [name, text] : p.type_headers) out.files[name] = text;
+  if (!p.type_headers.empty()) out.files["compact.hpp"] = compact_header();
   return out;
 }
 

@@ -22,6 +22,8 @@ for h in refresh_actual_speed refresh_command refresh_obstacle speed_period; do
   grep -q "void $h(" "$WORK/sc/speed_controller.hpp" || fail "no handler $h"
 done
 grep -q "refresh_speed\|actual_speed_period" "$WORK/sc/speed_controller.hpp" && fail "a handler for a channel in the wrong direction"
+# No typed channel, no struct headers (gen_typed_test.sh has the typed ones).
+[ -e "$WORK/sc/compact.hpp" ] && fail "compact.hpp for a component without typed channels"
 
 # The logic file is the user's: a second run keeps it.
 echo "// mine" >>"$WORK/sc/speed_controller_logic.cpp"
