@@ -3,6 +3,7 @@
 // refuses, each reason naming the field.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <map>
 #include <string>
 #include <vector>
@@ -87,9 +88,34 @@ TEST(DbcSignalGateway, WhatCannotBeCarriedIsRefusedNamingTheField) {
   EXPECT_EQ(refusal("Odd", {{"Gear", "Float"}}),
             "message Odd: field Gear is an integer, and signal Float an IEEE float");
   EXPECT_EQ(refusal("Odd", {{"Speed", "Gear"}, {"Gear", "Float"}}),
-            "message Odd: signal Gear holds -64..63.5, narrower than field Speed's range 0..655.35");
+            "message Odd: field Gear is an integer, and signal Float an IEEE float");
   EXPECT_EQ(refusal("Odd", {{"Gear", "Gear"}, {"Speed", "Float"}, {"State", "State"}}),
             "message Odd: field Gear is an integer, and signal Gear's scaling (0.5, 0) is not whole");
+}
+
+// A narrower signal is no refusal of the codec: the hop decides (refused under on_range: drop,
+// saturated and degraded otherwise; cosmic/hop_representation.hpp), so the codec names it.
+TEST(DbcSignalGateway, ASignalNarrowerThanItsFieldsRangeIsNamedAndItsValuesSaturate) {
+  ChannelType speed_only = wheel_type();
+  speed_only.fields.resize(1);  // Speed: float64, 0..655.35 km/h
+  const Result<DbcFrameCodec> codec =
+      DbcFrameCodec::make_mapped(gateway_message("Odd"), speed_only, {{"Speed", "Gear"}});
+  ASSERT_TRUE(codec.ok()) << codec.error().text;
+  EXPECT_EQ(codec.value().narrowed(),
+            (std::vector<std::string>{"signal Gear holds -64..63.5, narrower than field Speed's range 0..655.35"}));
+  const double speed = 100.0;
+  std::vector<std::uint8_t> event(codec.value().compact_size());
+  std::memcpy(event.data(), &speed, sizeof speed);
+  std::vector<std::uint8_t> odd(4);
+  EXPECT_FALSE(codec.value().to_frame(event, odd, RangePolicy::drop).sent);
+  const DbcFrameCodec::Packed saturated = codec.value().to_frame(event, odd, RangePolicy::saturate);
+  ASSERT_TRUE(saturated.sent);
+  EXPECT_EQ(saturated.out_of_range, 1u);
+  EXPECT_EQ(odd, (std::vector<std::uint8_t>{0x00, 0x00, 0x7F, 0x00}));  // Gear at 63.5 (raw 127)
+  const Result<DbcFrameCodec> wide =
+      DbcFrameCodec::make_mapped(gateway_message("Cluster"), speed_only, {{"Speed", "ClusterSpeed"}});
+  ASSERT_TRUE(wide.ok());
+  EXPECT_TRUE(wide.value().narrowed().empty());
 }
 
 TEST(DbcSignalGateway, AnEnumerationNeedsEveryValueInItsSignal) {

@@ -56,14 +56,10 @@ void TypedHopChecks::check_one(YamlReader& reader, const Declared& declared, Cha
     }
     return;
   }
+  // A hop that cannot carry the type is admission's to judge (check "representation"): the
+  // configuration stays loadable and the other channels run.
   const TypedHops hops = typed_hops(channel, segments);
-  for (const HopProblem& problem : hops.problems) {
-    const auto [where, at] = hop_location(node, declared.path, problem.segment);
-    reader.error_at(where, at, problem.what, "a representation that carries the type (docs/typed-layout.md)");
-  }
-  if (!hops.problems.empty()) return;
-  std::uint64_t largest = hops.compact_size;
-  for (const HopPayload& hop : hops.payloads) largest = std::max(largest, hop.bytes);
+  const std::uint64_t largest = hops.largest();
   channel.hop_payloads = hops.payloads;
   if (!has(node, "payload")) {
     channel.payload = largest;

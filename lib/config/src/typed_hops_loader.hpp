@@ -1,7 +1,8 @@
 // A typed channel's hops in the configuration (issue 35): the channel key `on_range`, and, once a
 // document's channels and their publishers and subscribers are final, each hop's representation
-// (cosmic/hop_representation.hpp) checked against the type, the hop sizes and the channel's payload
-// derived from them. Internal to the config library.
+// (cosmic/hop_representation.hpp) with the hop sizes and the channel's payload derived from them.
+// Whether each hop can carry the type is admission's question (a bound, degraded or rejected
+// verdict with the reason on that hop), not the configuration's. Internal to the config library.
 #pragma once
 
 #include <string>
@@ -19,10 +20,10 @@ class TypedHopChecks {
  public:
   // Remembers where channel `channel` was declared (its map `node` at `path`).
   void add(const YAML::Node& node, const std::string& path, const ChannelSpec& channel);
-  // For every channel added: a typed channel's hops each carry its type in their representation (a
-  // problem is reported at the hop's `native` entry, else at `type`); its hop sizes are set, and its
-  // payload becomes the largest of them unless `payload` was given (then it must hold each). An
-  // untyped channel may not choose a representation.
+  // For every channel added: a typed channel's hops (ChannelSpec::hop_payloads: each one's form
+  // and size, or why it cannot carry the type) are set, and its payload becomes the largest of the
+  // hops that fit unless `payload` was given (then it must hold each). An untyped channel may not
+  // choose a representation (reported at the hop's `native` entry).
   void check(YamlReader& reader, std::vector<ChannelSpec>& channels, const std::vector<SegmentSpec>& segments) const;
 
  private:

@@ -120,7 +120,7 @@ const ChannelReport* AdmissionReport::find(const std::string& name) const {
 }
 
 Verdict consequence_of(const std::string& check, ChannelClass cls) {
-  if (cls == ChannelClass::hrt || check == "frame_fit") return Verdict::rejected;
+  if (cls == ChannelClass::hrt || check == "frame_fit" || check == "representation") return Verdict::rejected;
   return Verdict::degraded;
 }
 
@@ -344,7 +344,7 @@ ChannelReport AdmissionSet::report_of(const ChannelSpec& spec, const ChannelData
   report.cls = spec.cls;
   for (const HopPlace& p : data.places) {
     const SegmentSpec& segment = segment_specs_[p.segment];
-    HopReport h{segment.name, p.role, std::nullopt, std::nullopt, std::nullopt, {}, {}};
+    HopReport h{segment.name, p.role, std::nullopt, std::nullopt, std::nullopt, {}, {}, {}};
     if (segment.type == SegmentType::can) {
       CanHopPlan plan = can ? can->plans[p.segment][p.position] : segments_[p.segment].plans[p.position];
       if (diverged && p.role == HopRole::subscriber) plan.response_time = std::nullopt;

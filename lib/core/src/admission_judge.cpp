@@ -53,8 +53,25 @@ std::string background_text(const HopReport& h) {
   return text;
 }
 
-std::string failure_text(const Check& check, const HopReport& h, const SegmentSpec& segment) {
+// A typed channel's hop: can its representation carry the type, and all of each field's range?
+void add_representation_checks(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) {
+  const HopPayload* hop = channel.hop_on(segment.name);
+  if (!channel.type || hop == nullptr) return;
+  h.representation = hop->form;
+  const bool fits = hop->unfit.empty();
+  h.checks.push_back(Check{"representation", fits ? 1.0 : 0.0, 1.0, "bool", ">=", fits});
+  if (fits && !hop->narrowed.empty()) h.checks.push_back(Check{"range", 0.0, 1.0, "bool", ">=", false});
+}
+
+std::string failure_text(const Check& check, const HopReport& h, const SegmentSpec& segment,
+                         const ChannelSpec& channel) {
   const std::string on = " on " + h.segment;
+  if (check.check == "representation") {
+    return h.segment + " cannot carry the channel's type: " + channel.hop_on(h.segment)->unfit;
+  }
+  if (check.check == "range") {
+    return h.segment + " (" + h.representation + ") saturates values: " + channel.hop_on(h.segment)->narrowed;
+  }
   if (check.check == "frame_fit") {
     const bool native = h.can && h.can->native;
     return "payload " + std::to_string(static_cast<long long>(check.value)) + " B > " +
@@ -96,7 +113,7 @@ void Judge::judge(const ChannelSpec& channel, ChannelReport& report) const {
     const SegmentSpec& segment = segment_named(segments_, h.segment);
     add_hop_checks(channel, segment, h);
     for (const Check& check : h.checks) {
-      if (!check.ok) worsen(consequence_of(check.check, channel.cls), failure_text(check, h, segment));
+      if (!check.ok) worsen(consequence_of(check.check, channel.cls), failure_text(check, h, segment, channel));
     }
   }
   EndToEnd& e2e = report.end_to_end;
@@ -118,6 +135,7 @@ void Judge::judge(const ChannelSpec& channel, ChannelReport& report) const {
 }
 
 void Judge::add_hop_checks(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) const {
+  add_representation_checks(channel, segment, h);
   add_frame_fit(channel, segment, h);
   if (channel.period) {
     const double load = loads_[static_cast<std::size_t>(&segment - segments_.data())];

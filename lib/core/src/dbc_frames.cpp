@@ -148,7 +148,10 @@ Result<DbcFrameCodec::FieldCodec> DbcFrameCodec::field_codec(const DbcSignal& s,
     f.factor = static_cast<std::int64_t>(s.factor);
     f.offset = static_cast<std::int64_t>(s.offset);
   }
-  if (const std::string why = too_narrow(s, field, f.raw); !why.empty()) return Error{why};
+  // An enumeration's value the signal cannot hold would arrive as another value: never carried.
+  if (f.raw) {
+    if (const std::string why = too_narrow(s, field, true); !why.empty()) return Error{why};
+  }
   return f;
 }
 
@@ -187,6 +190,9 @@ Result<DbcFrameCodec> DbcFrameCodec::make_mapped(const DbcMessage& message, cons
     }
     Result<FieldCodec> f = field_codec(*signal, index, field, i, true);
     if (!f) return Error{"message " + message.name + ": " + f.error().text};
+    if (!f.value().raw) {
+      if (std::string why = too_narrow(*signal, field, false); !why.empty()) codec.narrowed_.push_back(std::move(why));
+    }
     codec.fields_.push_back(f.value());
   }
   return codec;

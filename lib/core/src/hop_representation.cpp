@@ -30,9 +30,19 @@ Conversion CompactRepresentation::from_compact(std::span<const std::uint8_t> com
   return {compact.size(), ConversionFault::none, 0};
 }
 
+namespace {
+std::string semicolon_list(const std::vector<std::string>& parts) {
+  std::string text;
+  for (const std::string& part : parts) text += (text.empty() ? "" : "; ") + part;
+  return text;
+}
+}  // namespace
+
 DbcFrameRepresentation::DbcFrameRepresentation(DbcFrameCodec codec, std::string name, RangePolicy policy,
                                                std::optional<E2eProtection> e2e)
     : codec_(std::move(codec)), name_(std::move(name)), policy_(policy), e2e_(std::move(e2e)) {}
+
+std::string DbcFrameRepresentation::narrowed() const { return semicolon_list(codec_.narrowed()); }
 
 Conversion DbcFrameRepresentation::to_compact(std::span<const std::uint8_t> wire,
                                               std::span<std::uint8_t> compact) const noexcept {
@@ -92,6 +102,12 @@ Made mapped_frame_on(const ChannelSpec& channel, const NativeCanFrame& frame) {
   const DbcMessage payload = frame.e2e ? e2e_payload_message(message, *frame.e2e) : message;
   Result<DbcFrameCodec> codec = DbcFrameCodec::make_mapped(payload, *channel.type, frame.field_map);
   if (!codec) return hop_error(codec.error().text);
+  // Events inside the field's range that the signal cannot hold would be lost: refused, unless
+  // the channel chose to saturate them (admission then degrades it, naming the fields).
+  if (!codec.value().narrowed().empty() && channel.on_range == RangePolicy::drop) {
+    return hop_error("message " + message.name + ": " + semicolon_list(codec.value().narrowed()) +
+                     "; its events beyond would be dropped (on_range: saturate sends them at the signal's limit)");
+  }
   Result<std::optional<E2eProtection>> e2e = protection_of(message, frame.e2e);
   if (!e2e) return e2e.error();
   return std::shared_ptr<const Representation>(std::make_shared<DbcFrameRepresentation>(
@@ -183,6 +199,12 @@ Made hop_representation(const ChannelSpec& channel, const SegmentSpec& segment) 
   return made;
 }
 
+std::uint64_t TypedHops::largest() const {
+  std::uint64_t most = compact_size;
+  for (const HopPayload& hop : payloads) most = std::max(most, hop.bytes);
+  return most;
+}
+
 TypedHops typed_hops(const ChannelSpec& channel, const std::vector<SegmentSpec>& segments) {
   TypedHops hops;
   if (!channel.type) return hops;
@@ -195,11 +217,17 @@ TypedHops typed_hops(const ChannelSpec& channel, const std::vector<SegmentSpec>&
                                       [&](const HopPayload& h) { return h.segment == name; });
     if (already != hops.payloads.end()) return;
     Made made = hop_representation(channel, *segment);
-    if (!made) {
-      hops.problems.push_back(HopProblem{name, made.error().text});
-      return;
+    HopPayload hop;
+    hop.segment = name;
+    if (made) {
+      const Representation& form = *made.value();
+      hop.bytes = form.max_wire_size();
+      hop.form = form.describe();
+      hop.narrowed = form.narrowed();
+    } else {
+      hop.unfit = made.error().text;
     }
-    hops.payloads.push_back(HopPayload{name, made.value()->max_wire_size()});
+    hops.payloads.push_back(std::move(hop));
   };
   for (const std::string& name : channel.publishers) visit(name);
   for (const std::string& name : channel.subscribers) visit(name);

@@ -53,10 +53,14 @@ std::string native_identity(const NativeBinding& binding) {
 }
 
 std::uint64_t ChannelSpec::payload_on(const std::string& segment) const {
-  for (const HopPayload& hop : hop_payloads) {
-    if (hop.segment == segment) return hop.bytes;
-  }
-  return payload;
+  const HopPayload* hop = hop_on(segment);
+  return hop != nullptr && hop->unfit.empty() ? hop->bytes : payload;
+}
+
+const HopPayload* ChannelSpec::hop_on(const std::string& segment) const {
+  const auto it =
+      std::find_if(hop_payloads.begin(), hop_payloads.end(), [&](const HopPayload& h) { return h.segment == segment; });
+  return it == hop_payloads.end() ? nullptr : &*it;
 }
 
 const NativeBinding* ChannelSpec::native_on(const std::string& segment) const {

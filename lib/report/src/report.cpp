@@ -54,6 +54,7 @@ nlohmann::json to_json(const HopReport& hop) {
         {"topic", hop.dds->topic}, {"type", hop.dds->type}, {"layout", hop.dds->native ? "native" : "envelope"}};
     if (hop.dds->native) out["dds"]["representation"] = to_string(hop.dds->representation);
   }
+  if (!hop.representation.empty()) out["representation"] = hop.representation;
   out["checks"] = nlohmann::json::array();
   for (const auto& check : hop.checks) out["checks"].push_back(to_json(check));
   if (!hop.background.empty()) {
@@ -230,6 +231,7 @@ std::string render_channel_text(const ChannelReport& channel) {
           << hop.can->frames_per_event;
     }
     if (hop.dds) out << "  topic " << hop.dds->topic << " type " << hop.dds->type;
+    if (!hop.representation.empty()) out << "  as " << hop.representation;
     out << "\n";
     for (const auto& check : hop.checks) {
       out << "    " << (check.ok ? "ok   " : "FAIL ") << pad_column(check.check, 14) << check_value_text(check) << " "

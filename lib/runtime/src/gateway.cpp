@@ -214,9 +214,10 @@ void Gateway::apply_routes() {
   router_->apply(std::move(routes));
 }
 
-// Each hop's representation of a typed channel. The configuration has checked that every hop can
-// carry the type, so a failure here means the segment changed under the channel: the channel is
-// not routed (its events count as unrouted), never forwarded in a form its hop does not take.
+// Each hop's representation of a typed channel. Admission has rejected a channel with a hop that
+// cannot carry the type (check "representation"), so a failure here means the segment changed
+// under the channel: the channel is not routed (its events count as unrouted), never forwarded in
+// a form its hop does not take.
 bool Gateway::add_representations(Route& route) {
   const auto form_on = [&](const std::string& name) -> std::shared_ptr<const Representation> {
     const SegmentSpec* segment = config_.find_segment(name);

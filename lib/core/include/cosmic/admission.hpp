@@ -36,7 +36,7 @@ const char* to_string(HopRole value);
 // One criterion's number against its limit. `relation` is how value must compare to limit
 // ("<=", "<", ">="); ok says whether it does.
 struct Check {
-  std::string check;  // frame_fit, utilization, response_time, latency, omission, realtime
+  std::string check;  // frame_fit, utilization, response_time, latency, omission, realtime, representation, range
   double value = 0;
   double limit = 0;
   std::string unit;  // "s", "B", "ratio", "events", "bool"
@@ -83,6 +83,9 @@ struct HopReport {
   std::vector<Check> checks;
   // CAN hops whose response time misses the reaction time: the background frames delaying it most.
   std::vector<BackgroundDelay> background;
+  // A typed channel's hop: the form its events take there ("DBC frame 0x1A0 WheelSpeed", "XCDR2",
+  // "compact"; ChannelSpec::hop_payloads), empty when the hop cannot carry the type.
+  std::string representation;
 };
 
 // A hop of a channel's path on another gateway of the federation (cosmic/upstream_path.hpp).
@@ -123,7 +126,9 @@ struct ChannelReport {
 };
 
 // How a failing criterion ("frame_fit", "latency", ...) affects the verdict of a channel of `cls`:
-// rejected for HRT channels and for a frame that does not fit, degraded otherwise.
+// rejected for HRT channels, for a frame that does not fit and for a hop whose representation
+// cannot carry the channel's type ("representation"), degraded otherwise (e.g. "range": the hop
+// saturates values of a field's declared range).
 Verdict consequence_of(const std::string& check, ChannelClass cls);
 
 // A rejection of `channel` for one reason, before any hop is judged (already bound, not bound

@@ -32,10 +32,16 @@ class DbcFrameCodec {
   // type), each field carried by the signal of `message` of its name, or the one `field_map` names
   // for it (field -> signal). Else why not, naming the field: a field without a signal, a map entry
   // of no field or signal, two fields in one signal, an integer field in a signal whose scaling is
-  // not whole, a signal too narrow for the field's declared range or enumeration values, a
-  // multiplexed message. The message's other signals are sent as 0.
+  // not whole, a signal too narrow for an enumeration's values, a multiplexed message. A signal
+  // narrower than its field's declared range is no refusal here: narrowed() names it, and the hop
+  // decides (cosmic/hop_representation.hpp: refused under on_range: drop, saturated otherwise).
+  // The message's other signals are sent as 0.
   static Result<DbcFrameCodec> make_mapped(const DbcMessage& message, const ChannelType& type,
                                            const std::map<std::string, std::string>& field_map);
+
+  // The signal gateway's fields whose declared range their signal holds only in part ("signal
+  // Speed holds 0..655.35, narrower than field speed's range 0..1000"); empty for make()'s codecs.
+  const std::vector<std::string>& narrowed() const { return narrowed_; }
 
   std::size_t frame_length() const { return message_.length; }
   std::size_t compact_size() const { return layout_.size(); }
@@ -72,6 +78,7 @@ class DbcFrameCodec {
   std::optional<std::size_t> switch_;  // index of message_'s multiplexor switch, if any (found once, at make)
   CompactLayout layout_;
   std::vector<FieldCodec> fields_;
+  std::vector<std::string> narrowed_;
 };
 
 }  // namespace cosmic

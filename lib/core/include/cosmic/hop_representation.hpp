@@ -55,6 +55,7 @@ class DbcFrameRepresentation final : public Representation {
                          std::optional<E2eProtection> e2e = std::nullopt);
   std::string describe() const override { return name_; }
   const E2eProtection* e2e() const noexcept override { return e2e_ ? &*e2e_ : nullptr; }
+  std::string narrowed() const override;
   std::size_t max_wire_size() const noexcept override { return codec_.frame_length(); }
   std::size_t max_compact_size() const noexcept override { return codec_.compact_size(); }
   Conversion to_compact(std::span<const std::uint8_t> wire, std::span<std::uint8_t> compact) const noexcept override;
@@ -89,17 +90,15 @@ class JsonHopRepresentation final : public Representation {
 Result<std::shared_ptr<const Representation>> hop_representation(const ChannelSpec& channel,
                                                                  const SegmentSpec& segment);
 
-// What every hop of a typed channel takes, by segment (its representation's largest message), and
-// the problems of the hops that cannot carry the type. The configuration sets the channel's payload
-// from it and admission counts each hop at its own size (ChannelSpec::payload_on).
-struct HopProblem {
-  std::string segment;
-  std::string what;
-};
+// What every hop of a typed channel takes, by segment: its representation's largest message and
+// name, or why the hop cannot carry the type, and what it narrows (HopPayload). The configuration
+// sets the channel's payload from the hops that fit (ChannelSpec::hop_payloads); admission counts
+// each hop at its own size (ChannelSpec::payload_on) and judges the unfit and narrowed ones.
 struct TypedHops {
   std::vector<HopPayload> payloads;  // one per hop, in publishers-then-subscribers order
   std::size_t compact_size = 0;      // the most bytes of one event in the compact layout
-  std::vector<HopProblem> problems;
+  // The largest message of the hops that fit, at least compact_size.
+  std::uint64_t largest() const;
 };
 TypedHops typed_hops(const ChannelSpec& channel, const std::vector<SegmentSpec>& segments);
 

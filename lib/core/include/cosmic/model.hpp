@@ -161,10 +161,16 @@ struct NativeBinding {
 // the DDS topic name.
 std::string native_identity(const NativeBinding& binding);
 
-// A typed channel's message size on one hop, as its representation says (cosmic/hop_representation.hpp).
+// A typed channel's hop as its representation says (cosmic/hop_representation.hpp): the most bytes
+// of one message, the form's name, and what the form cannot carry of the type. Admission judges
+// these: an unfit hop rejects the channel (check "representation"), a narrowed one degrades it
+// (check "range"; an HRT channel is rejected).
 struct HopPayload {
   std::string segment;
   std::uint64_t bytes = 0;
+  std::string form;      // "DBC frame 0x1A0 WheelSpeed", "XCDR2", "compact"; empty when unfit
+  std::string unfit;     // why the hop cannot carry the type (bytes is then 0); empty: it can
+  std::string narrowed;  // the fields whose declared range the form holds only in part (saturated)
   friend bool operator==(const HopPayload&, const HopPayload&) = default;
 };
 
@@ -192,6 +198,8 @@ struct ChannelSpec {
   // The most bytes one event takes on `segment`: its hop's own size where the type gives one, else
   // `payload`.
   std::uint64_t payload_on(const std::string& segment) const;
+  // A typed channel's hop on `segment` (hop_payloads), if the configuration derived one.
+  const HopPayload* hop_on(const std::string& segment) const;
 
   const NativeBinding* native_on(const std::string& segment) const;
   // The native CAN frame of this channel on `segment`, if it has one there.

@@ -51,6 +51,10 @@ class Representation {
   // cosmic/e2e_protection.hpp), or null. The router checks it on what the hop brings in, before
   // to_compact(), and writes it on what from_compact() made, with the counters it keeps per hop.
   virtual const E2eProtection* e2e() const noexcept { return nullptr; }
+  // The fields whose declared range the form holds only in part, its values beyond saturated at
+  // the form's limit (a signal gateway's narrower signal under on_range: saturate), or empty.
+  // Admission degrades the channel with it (check "range").
+  virtual std::string narrowed() const { return {}; }
 
   // One received message of the hop as one event in the compact layout, into `compact` (at least
   // max_compact_size() bytes).
