@@ -197,6 +197,19 @@ TEST_F(TypedForwardingTest, AnHrtChannelThatWouldSaturateIsRejected) {
   EXPECT_NE(reasons_of(*wheel).find(kNarrowed), std::string::npos) << reasons_of(*wheel);
 }
 
+// One channel requested, nothing changed, rejected for its chassis hop's too narrow Speed signal.
+void expect_rejected_on_chassis(const BindResult& result) {
+  EXPECT_FALSE(result.applied);
+  ASSERT_EQ(result.channels.size(), 1u);
+  EXPECT_EQ(result.channels[0].verdict, Verdict::rejected);
+  EXPECT_NE(reasons_of(result.channels[0])
+                .find(std::string("chassis cannot carry the channel's type: message "
+                                  "NarrowSpeed: ") +
+                      kNarrowed),
+            std::string::npos)
+      << reasons_of(result.channels[0]);
+}
+
 TEST_F(TypedForwardingTest, BindAndReplaceRejectAHopThatCannotCarryTheTypeAndChangeNothing) {
   start();
   const std::string file = (dir_ / "bind.yaml").string();
@@ -211,11 +224,7 @@ TEST_F(TypedForwardingTest, BindAndReplaceRejectAHopThatCannotCarryTheTypeAndCha
 )",
                                         file, gateway.config());
   ASSERT_TRUE(extra.ok()) << extra.errors[0].to_string();
-  const BindResult bound = gateway.bind(extra.channels);
-  EXPECT_FALSE(bound.applied);
-  ASSERT_EQ(bound.channels.size(), 1u);
-  EXPECT_EQ(bound.channels[0].verdict, Verdict::rejected);
-  EXPECT_NE(reasons_of(bound.channels[0]).find(kNarrowed), std::string::npos) << reasons_of(bound.channels[0]);
+  expect_rejected_on_chassis(gateway.bind(extra.channels));
 
   ChannelsResult replacement = parse_channels(R"(
 - name: wheel
@@ -230,12 +239,7 @@ TEST_F(TypedForwardingTest, BindAndReplaceRejectAHopThatCannotCarryTheTypeAndCha
 )",
                                               file, gateway.config());
   ASSERT_TRUE(replacement.ok()) << replacement.errors[0].to_string();
-  const BindResult replaced = gateway.replace(replacement.channels);
-  EXPECT_FALSE(replaced.applied);
-  ASSERT_EQ(replaced.channels.size(), 1u);
-  EXPECT_EQ(replaced.channels[0].verdict, Verdict::rejected);
-  EXPECT_NE(reasons_of(replaced.channels[0]).find("chassis cannot carry the channel's type"), std::string::npos)
-      << reasons_of(replaced.channels[0]);
+  expect_rejected_on_chassis(gateway.replace(replacement.channels));
 
   // The running wheel is as it was: its frame still leaves chassis as VehicleSpeed (12.34 km/h is
   // raw 62 of 0.2; Gear -1 in 4 bits; Valid).

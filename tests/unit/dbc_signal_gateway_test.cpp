@@ -74,7 +74,7 @@ TEST(DbcSignalGateway, FieldsGoIntoTheSignalsOfTheirNameOrTheirMap) {
 TEST(DbcSignalGateway, WhatCannotBeCarriedIsRefusedNamingTheField) {
   EXPECT_EQ(refusal("Cluster", {}),
             "field Speed has no signal Speed in message Cluster (map: {Speed: SIGNAL} names "
-            "the one that carries it)");
+            "the one that carries it, omit: [Speed] leaves it out)");
   EXPECT_EQ(refusal("Cluster", {{"Speed", "Nothing"}}), "field Speed has no signal Nothing in message Cluster");
   EXPECT_EQ(refusal("Cluster", {{"Speed", "ClusterSpeed"}, {"Torque", "Gear"}}),
             "map names field Torque, which the channel's type does not have");
@@ -91,6 +91,58 @@ TEST(DbcSignalGateway, WhatCannotBeCarriedIsRefusedNamingTheField) {
             "message Odd: field Gear is an integer, and signal Float an IEEE float");
   EXPECT_EQ(refusal("Odd", {{"Gear", "Gear"}, {"Speed", "Float"}, {"State", "State"}}),
             "message Odd: field Gear is an integer, and signal Gear's scaling (0.5, 0) is not whole");
+}
+
+// A ROS 2 Twist: {linear: {x, y, z}, angular: {x, y, z}}, float64 each.
+ChannelType twist_type() {
+  TypeField number{"x", FieldType{}, "", std::nullopt, std::nullopt, std::nullopt};
+  FieldType vector3;
+  vector3.kind = FieldType::Kind::record;
+  for (const char* axis : {"x", "y", "z"}) {
+    number.name = axis;
+    vector3.fields.push_back(number);
+  }
+  ChannelType twist;
+  twist.fields.push_back(TypeField{"linear", vector3, "", std::nullopt, std::nullopt, std::nullopt});
+  twist.fields.push_back(TypeField{"angular", vector3, "", std::nullopt, std::nullopt, std::nullopt});
+  return twist;
+}
+
+constexpr std::string_view kDriveDbc = R"dbc(BO_ 528 DriveCommand: 4 Gateway
+ SG_ Speed : 0|16@1- (0.001,0) [-32.768|32.767] "m/s" Drive
+ SG_ YawRate : 16|16@1- (0.001,0) [-32.768|32.767] "rad/s" Drive
+)dbc";
+
+// A nested record's numbers map by their paths, and `omit` leaves the others out: a Twist command
+// becomes a drive ECU's frame and back.
+TEST(DbcSignalGateway, ANestedRecordsNumbersMapByTheirPathsAndOmittedOnesStayOut) {
+  static const DbcFile file = parse_dbc(kDriveDbc);
+  const DbcMessage& drive = test::message_named(file, "DriveCommand");
+  const std::vector<std::string> omitted = {"linear.y", "linear.z", "angular.x", "angular.y"};
+  const Result<DbcFrameCodec> codec =
+      DbcFrameCodec::make_mapped(drive, twist_type(), {{"linear.x", "Speed"}, {"angular.z", "YawRate"}}, omitted);
+  ASSERT_TRUE(codec.ok()) << codec.error().text;
+  ASSERT_EQ(codec.value().compact_size(), 48u);
+  const double twist[6] = {1.5, 7.0, 7.0, 7.0, 7.0, -0.25};  // linear.x 1.5 m/s, angular.z -0.25 rad/s
+  std::vector<std::uint8_t> event(48);
+  std::memcpy(event.data(), twist, sizeof twist);
+  std::vector<std::uint8_t> frame(4);
+  ASSERT_TRUE(codec.value().to_frame(event, frame, RangePolicy::drop).sent);
+  EXPECT_EQ(frame, (std::vector<std::uint8_t>{0xDC, 0x05, 0x06, 0xFF}));  // raw 1500, raw -250
+  std::vector<std::uint8_t> back(48);
+  ASSERT_TRUE(codec.value().to_compact(frame, back));
+  double values[6];
+  std::memcpy(values, back.data(), sizeof values);
+  EXPECT_EQ(std::vector<double>(values, values + 6), (std::vector<double>{1.5, 0, 0, 0, 0, -0.25}));
+
+  EXPECT_EQ(
+      DbcFrameCodec::make_mapped(drive, twist_type(), {{"linear.x", "Speed"}, {"angular.z", "YawRate"}}).error().text,
+      "field linear.y has no signal linear.y in message DriveCommand (map: {linear.y: SIGNAL} names the one "
+      "that carries it, omit: [linear.y] leaves it out)");
+  EXPECT_EQ(DbcFrameCodec::make_mapped(drive, twist_type(), {{"linear.x", "Speed"}}, {"linear.x"}).error().text,
+            "field linear.x is both mapped and omitted");
+  EXPECT_EQ(DbcFrameCodec::make_mapped(drive, twist_type(), {}, {"linear.w"}).error().text,
+            "omit names field linear.w, which the channel's type does not have");
 }
 
 // A narrower signal is no refusal of the codec: the hop decides (refused under on_range: drop,

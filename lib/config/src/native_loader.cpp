@@ -42,7 +42,7 @@ std::optional<std::map<std::string, std::string>> parse_field_map(YamlReader& re
   return map;
 }
 
-// `native: {BUS: {dbc: FILE, message: NAME, map: {...}, e2e: {...}}}`: the signal gateway's frame,
+// `native: {BUS: {dbc: FILE, message: NAME, map: {...}, omit: [...], e2e: {...}}}`: the signal gateway's frame,
 // its identifier the message's (a can_id given must be it).
 bool parse_can_message(YamlReader& reader, const YAML::Node& node, const std::string& path,
                        std::vector<std::string>& included, NativeCanFrame& frame) {
@@ -72,6 +72,11 @@ bool parse_can_message(YamlReader& reader, const YAML::Node& node, const std::st
     if (!map) return false;
     frame.field_map = std::move(*map);
   }
+  if (node["omit"]) {
+    auto omitted = reader.string_list(node["omit"], key(path, "omit"));
+    if (!omitted) return false;
+    frame.omitted_fields = std::move(*omitted);
+  }
   if (node["e2e"]) {
     frame.e2e = parse_e2e(reader, node["e2e"], key(path, "e2e"), *message);
     if (!frame.e2e) return false;
@@ -98,14 +103,14 @@ bool parse_can_message(YamlReader& reader, const YAML::Node& node, const std::st
 
 bool parse_can(YamlReader& reader, const YAML::Node& node, const std::string& path, const SegmentSpec& segment,
                std::vector<std::string>& included, NativeBinding& binding) {
-  if (!reader.check_map(node, path, {"can_id", "extended", "representation", "dbc", "message", "map", "e2e"}))
+  if (!reader.check_map(node, path, {"can_id", "extended", "representation", "dbc", "message", "map", "omit", "e2e"}))
     return false;
   NativeCanFrame frame;
   if (node["dbc"]) {
     if (!parse_can_message(reader, node, path, included, frame)) return false;
     return check_can_frame(reader, node, path, segment, frame, binding);
   }
-  for (const char* only : {"message", "map", "e2e"}) {
+  for (const char* only : {"message", "map", "omit", "e2e"}) {
     if (node[only]) {
       reader.error_at(
           node[only], key(path, only), std::string(only) + " belongs to a frame given as a DBC message",

@@ -155,34 +155,66 @@ Result<DbcFrameCodec::FieldCodec> DbcFrameCodec::field_codec(const DbcSignal& s,
   return f;
 }
 
+namespace {
+
+// `type` with its nested records' fields lifted to the top as PATH.FIELD ("linear.x"), in order:
+// the same compact layout (a record is its fields), one name per scalar.
+void lift_leaves(const std::vector<TypeField>& fields, const std::string& prefix, std::vector<TypeField>& out) {
+  for (const TypeField& field : fields) {
+    if (field.type.kind == FieldType::Kind::record) {
+      lift_leaves(field.type.fields, prefix + field.name + ".", out);
+      continue;
+    }
+    TypeField leaf = field;
+    leaf.name = prefix + field.name;
+    if (leaf.present_when && !prefix.empty()) leaf.present_when->selector = prefix + leaf.present_when->selector;
+    out.push_back(std::move(leaf));
+  }
+}
+
+bool has_leaf(const ChannelType& leaves, const std::string& name) {
+  return std::any_of(leaves.fields.begin(), leaves.fields.end(), [&](const TypeField& f) { return f.name == name; });
+}
+
+}  // namespace
+
 Result<DbcFrameCodec> DbcFrameCodec::make_mapped(const DbcMessage& message, const ChannelType& type,
-                                                 const std::map<std::string, std::string>& field_map) {
+                                                 const std::map<std::string, std::string>& field_map,
+                                                 const std::vector<std::string>& omitted) {
   if (dbc_multiplexor(message) != nullptr) {
     return Error{"message " + message.name +
                  " is multiplexed: the signal gateway re-packs messages without"
                  " multiplexing"};
   }
+  ChannelType leaves;
+  lift_leaves(type.fields, "", leaves.fields);
   for (const auto& entry : field_map) {
-    const std::string& field = entry.first;  // not a structured binding: clang 14 cannot capture one
-    if (std::none_of(type.fields.begin(), type.fields.end(), [&](const TypeField& f) { return f.name == field; }))
-      return Error{"map names field " + field + ", which the channel's type does not have"};
+    if (!has_leaf(leaves, entry.first))
+      return Error{"map names field " + entry.first + ", which the channel's type does not have"};
   }
-  auto layout = CompactLayout::of_flat_record(type);
+  for (const std::string& name : omitted) {
+    if (!has_leaf(leaves, name)) return Error{"omit names field " + name + ", which the channel's type does not have"};
+    if (field_map.count(name) != 0) return Error{"field " + name + " is both mapped and omitted"};
+  }
+  auto layout = CompactLayout::of_flat_record(leaves);
   if (!layout) return std::move(layout).error();
   DbcFrameCodec codec;
   codec.message_ = message;
   codec.layout_ = std::move(layout).value();
   std::map<std::size_t, std::string> taken;  // signal index -> the field it carries
-  for (std::size_t i = 0; i < type.fields.size(); ++i) {
-    const TypeField& field = type.fields[i];
+  for (std::size_t i = 0; i < leaves.fields.size(); ++i) {
+    const TypeField& field = leaves.fields[i];
+    if (std::find(omitted.begin(), omitted.end(), field.name) != omitted.end()) continue;
     const auto mapped = field_map.find(field.name);
     const std::string& name = mapped != field_map.end() ? mapped->second : field.name;
     const auto signal = std::find_if(message.signals.begin(), message.signals.end(),
                                      [&](const DbcSignal& s) { return s.name == name; });
     if (signal == message.signals.end()) {
-      return Error{
-          "field " + field.name + " has no signal " + name + " in message " + message.name +
-          (mapped != field_map.end() ? "" : " (map: {" + field.name + ": SIGNAL} names the one that carries it)")};
+      return Error{"field " + field.name + " has no signal " + name + " in message " + message.name +
+                   (mapped != field_map.end()
+                        ? ""
+                        : " (map: {" + field.name + ": SIGNAL} names the one that carries it, omit: [" + field.name +
+                              "] leaves it out)")};
     }
     const auto index = static_cast<std::size_t>(signal - message.signals.begin());
     if (const auto [other, fresh] = taken.emplace(index, field.name); !fresh) {

@@ -100,7 +100,8 @@ std::string frame_name(const DbcMessage& message, const std::optional<E2eSpec>& 
 Made mapped_frame_on(const ChannelSpec& channel, const NativeCanFrame& frame) {
   const DbcMessage& message = *frame.dbc_message;
   const DbcMessage payload = frame.e2e ? e2e_payload_message(message, *frame.e2e) : message;
-  Result<DbcFrameCodec> codec = DbcFrameCodec::make_mapped(payload, *channel.type, frame.field_map);
+  Result<DbcFrameCodec> codec =
+      DbcFrameCodec::make_mapped(payload, *channel.type, frame.field_map, frame.omitted_fields);
   if (!codec) return hop_error(codec.error().text);
   // Events inside the field's range that the signal cannot hold would be lost: refused, unless
   // the channel chose to saturate them (admission then degrades it, naming the fields).

@@ -2,7 +2,7 @@
 # End-to-end tests of the CAN segment through the real daemon: can-utils on vcan0 <-> cosmicd <->
 # cosmic-lcm-peer (LCM) and cosmic-dds-peer (Fast DDS), all on this machine (ctest: can.e2e).
 #
-#   scripts/can-vm -- bash tests/integration/can/e2e_test.sh COSMICD COSMICCTL DDS_PEER LCM_PEER
+#   scripts/can-vm -- bash tests/integration/can/e2e_test.sh COSMICD COSMICCTL DDS_PEER LCM_PEER [CYCLONE_ROS2_PEER]
 #
 # Needs root, vcan0 and vcan1 up (scripts/can-vm provides them, in a VM when the host has no
 # AF_CAN); vcan1 is switched to CAN FD (mtu 72) if it is not.
@@ -22,6 +22,12 @@
 #                   counted
 #   native          native identifiers with can-utils while cangen runs a declared background
 #                   frame: cansend 123#... -> LCM and DDS; LCM -> candump 18FF1234#...; no etag
+#   typed           DBC-typed channels checked with python3-canmatrix: a WheelSpeed frame -> JSON on
+#                   LCM and the re-packed ClusterSpeed on vcan1; DriveCommand's compact event -> 0x200
+#   ros2            a ROS 2 node (Cyclone DDS, idlc's Twist): WheelVelocity frames -> Twists on
+#                   rt/wheel_twist; Twists on rt/cmd_vel -> DriveTwist frames, decoded by canmatrix
+#                   (needs CYCLONE_ROS2_PEER)
+#   e2e             AUTOSAR E2E profile 1 counters and CRCs, checked with python3-crcmod
 #   unexplained     frames nothing explains are listed by cosmicctl segments (id, rate); one that
 #                   beats the HRT channel brake's identifier turns brake violated, logged once
 #   garbage         cangen (random 29-bit, 11-bit, mixed FD/remote, aimed at the bound etags,
@@ -43,8 +49,8 @@
 # match); no fixed sleeps. CAN_E2E_KEEP=1 keeps the work directory under /tmp.
 set -euo pipefail
 
-if [ $# -ne 4 ]; then
-  echo "usage: $0 COSMICD COSMICCTL DDS_PEER LCM_PEER   (as root with vcan0: scripts/can-vm)" >&2
+if [ $# -ne 4 ] && [ $# -ne 5 ]; then
+  echo "usage: $0 COSMICD COSMICCTL DDS_PEER LCM_PEER [CYCLONE_ROS2_PEER]   (as root with vcan0: scripts/can-vm)" >&2
   exit 64
 fi
 for f in "$@"; do

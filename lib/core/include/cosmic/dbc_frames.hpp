@@ -28,16 +28,20 @@ class DbcFrameCodec {
   // else why not.
   static Result<DbcFrameCodec> make(const DbcMessage& message, const ChannelType& type);
   // The signal gateway's codec (issue 35: a typed channel from one DBC message re-packed into another
-  // message, AUTOSAR COM's signal gateway): `type` is any flat record (usually another message's
-  // type), each field carried by the signal of `message` of its name, or the one `field_map` names
-  // for it (field -> signal). Else why not, naming the field: a field without a signal, a map entry
-  // of no field or signal, two fields in one signal, an integer field in a signal whose scaling is
+  // message, AUTOSAR COM's signal gateway): `type` is a record of numbers and nested records of
+  // numbers (another message's type, a ROS 2 Twist), each number (named by its path, "linear.x")
+  // carried by the signal of `message` of its name, or the one `field_map` names for it (field ->
+  // signal), unless `omitted` lists it (not carried: sent as nothing, received as 0). Else why not,
+  // naming the field: a field without a signal, a map or omit entry of no field, a field both mapped
+  // and omitted, a signal that is not the message's, two fields in one signal, an array, string or
+  // sequence, an integer field in a signal whose scaling is
   // not whole, a signal too narrow for an enumeration's values, a multiplexed message. A signal
   // narrower than its field's declared range is no refusal here: narrowed() names it, and the hop
   // decides (cosmic/hop_representation.hpp: refused under on_range: drop, saturated otherwise).
   // The message's other signals are sent as 0.
   static Result<DbcFrameCodec> make_mapped(const DbcMessage& message, const ChannelType& type,
-                                           const std::map<std::string, std::string>& field_map);
+                                           const std::map<std::string, std::string>& field_map,
+                                           const std::vector<std::string>& omitted = {});
 
   // The signal gateway's fields whose declared range their signal holds only in part ("signal
   // Speed holds 0..655.35, narrower than field speed's range 0..1000"); empty for make()'s codecs.

@@ -120,11 +120,13 @@ struct NativeCanFrame {
   bool extended = false;
   // A typed channel's signal-gateway hop (`native: {BUS: {dbc: FILE, message: NAME}}`): the frame is
   // this DBC message, not the type's own, its signals carrying the type's fields by name or as
-  // field_map renames them (field -> signal); can_id and extended are the message's. Optionally
+  // field_map renames them (field -> signal; a nested record's field by its path, linear.x), but for
+  // omitted_fields; can_id and extended are the message's. Optionally
   // protected end to end. Compared by content: a changed file rebinds the channel.
   std::optional<DbcMessage> dbc_message{};
   std::string dbc_file{};
   std::map<std::string, std::string> field_map{};
+  std::vector<std::string> omitted_fields{};  // `omit`: the type's fields this message does not carry
   std::optional<E2eSpec> e2e{};
   friend bool operator==(const NativeCanFrame&, const NativeCanFrame&) = default;
 };

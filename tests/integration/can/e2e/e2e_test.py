@@ -34,13 +34,15 @@ DEV = 5                          # TxNode of the device this test plays on the b
 SUBJ = {"sensor": 0x1000000A1, "command": 0x1000000B2, "bulk_up": 0x1000000C3, "bulk_down": 0x1000000C4,
         "fd_down": 0x1000000D5, "fd_up": 0x1000000D6, "wheel": 0x1000000E1, "lamp": 0x1000000E2,
         "brake": 0x1000000E3, "relay": 0x1000000D7, "fd_bulk_down": 0x1000000D8, "wheel_speed": 0x1000000F1,
-        "drive": 0x1000000F2, "brake_status": 0x1000000F3, "brake_command": 0x1000000F4}
+        "drive": 0x1000000F2, "brake_status": 0x1000000F3, "brake_command": 0x1000000F4,
+        "wheel_twist": 0x1000000F5, "cmd_vel": 0x1000000F6}
 ETAG = {"sensor": 16383,         # dynamic: the first etag handed out (section 3)
         "command": 300, "bulk_up": 201, "bulk_down": 202, "fd_down": 501, "fd_up": 502, "relay": 503,
         "fd_bulk_down": 504}
 CHANNELS = ("sensor", "command", "bulk_up", "bulk_down")  # those on segment bus (vcan0) with etags
 NATIVE_CHANNELS = ("wheel", "brake", "lamp")              # native identifiers on segment bus
-TYPED_CHANNELS = ("wheel_speed", "drive", "brake_status", "brake_command")  # typed, DBC frames on segment bus
+TYPED_CHANNELS = ("wheel_speed", "drive", "brake_status", "brake_command", "wheel_twist",
+                  "cmd_vel")  # typed, DBC frames on segment bus
 FD_CHANNELS = ("fd_down", "fd_up", "fd_bulk_down")        # those on segment bus_fd (vcan1) alone
 BRIDGED_CHANNELS = ("relay",)                             # bus_fd -> bus
 SEGMENTS = 4
@@ -57,6 +59,11 @@ DRIVE_ID = 0x200                 # typed: typed.dbc's DriveCommand (drive: viz -
 CLUSTER_SPEED_ID = 0x1A8         # typed: typed.dbc's ClusterSpeed on bus_fd (wheel_speed re-packed)
 BRAKE_STATUS_ID = 0x1B0          # typed, E2E: typed.dbc's BrakeStatus (brake_status: bus -> viz as JSON)
 BRAKE_COMMAND_ID = 0x210         # typed, E2E: typed.dbc's BrakeCommand (brake_command: viz -> bus)
+WHEEL_VELOCITY_ID = 0x1A1        # typed: typed.dbc's WheelVelocity (wheel_twist: bus -> a ROS 2 Twist)
+DRIVE_TWIST_ID = 0x220           # typed: typed.dbc's DriveTwist (cmd_vel: a ROS 2 Twist -> bus)
+# Eclipse Cyclone DDS (the ROS 2 node's stack) on loopback, multicast on.
+CYCLONE_URI = ('<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface name="lo" multicast="true"/>'
+               '</Interfaces></General></Domain></CycloneDDS>')
 MARKER = "7FF#5A"                # 11-bit, no channel's: only cosmicd's census sees it (unexplained)
 
 
@@ -232,10 +239,10 @@ class Scenario:
     def path(self, name):
         return os.path.join(self.dir, name)
 
-    def spawn(self, name, argv, stdin=subprocess.DEVNULL):
+    def spawn(self, name, argv, stdin=subprocess.DEVNULL, env=None):
         out = open(self.path(name + ".out"), "wb")
         err = open(self.path(name + ".err"), "wb")
-        p = subprocess.Popen(argv, stdout=out, stderr=err, stdin=stdin)
+        p = subprocess.Popen(argv, stdout=out, stderr=err, stdin=stdin, env=env)
         out.close()
         err.close()
         self.procs.append(p)
@@ -541,6 +548,57 @@ def scenario_typed(s):
                lambda: gw.hop("drive", "bus")["dropped"]["out_of_range"] == 1)
 
 
+def scenario_ros2(s):
+    """A ROS 2 node (Eclipse Cyclone DDS with idlc's geometry_msgs Twist: not ours) and DBC ECUs
+    (python3-canmatrix: not ours). cansend WheelVelocity 0x1A1 frames -> cosmicd -> the Cyclone
+    subscriber on rt/wheel_twist receives Twists whose linear.x and angular.z are the physical
+    values canmatrix decodes from each frame, the four omitted members 0; the Cyclone publisher's
+    Twists on rt/cmd_vel -> cosmicd -> candump: DriveTwist 0x220 frames that canmatrix decodes to
+    each Twist's linear.x and angular.z."""
+    import canmatrix.formats
+    if s.t.cyclone_peer is None:
+        raise Fail("no Cyclone DDS peer (cosmic-cyclone-ros2-peer) was given")
+    matrix = canmatrix.formats.loadp_flat(os.path.join(HERE, "typed.dbc"))
+    gw = s.t.gw
+    env = dict(os.environ, CYCLONEDDS_URI=CYCLONE_URI)
+    expect_eq("wheel_twist's forms", {h["segment"]: h["representation"] for h in gw.ctl("channel", "wheel_twist")["channel"]["segments"]},
+              {"bus": "DBC frame 0x1A1 WheelVelocity of typed.dbc", "lan": "XCDR1"})
+    sub = s.spawn("twist_sub", [s.t.cyclone_peer, "sub", "--domain", DOMAIN, "--topic", "rt/wheel_twist",
+                                "--count", "3", "--timeout-s", "90"], env=env)
+    wait_until("the ROS 2 node matched cosmicd's writer of rt/wheel_twist", 60,
+               lambda: "MATCHED" in read_text(s.path("twist_sub.err")) and
+               (gw.hop("wheel_twist", "lan")["matched"] or 0) >= 1, interval=0.2)
+    frames = [bytes.fromhex("7D000CFE"), bytes.fromhex("D4FEE803"), bytes.fromhex("FF7F0080")]
+    for frame in frames:
+        cansend("%03X#%s" % (WHEEL_VELOCITY_ID, frame.hex().upper()))
+    wait_until("3 Twists at the ROS 2 node", 60, lambda: sub.poll() is not None or len(json_lines(s.path("twist_sub.out"))) >= 3)
+    twists = json_lines(s.path("twist_sub.out"))
+    velocity = matrix.frame_by_id(canmatrix.ArbitrationId(WHEEL_VELOCITY_ID))
+    for frame, twist in zip(frames, twists):
+        decoded = {n: float(v.phys_value) for n, v in velocity.decode(bytearray(frame)).items()}
+        check(abs(twist["linear"][0] - decoded["Speed"]) < 1e-9 and abs(twist["angular"][2] - decoded["YawRate"]) < 1e-9
+              and twist["linear"][1:] == [0, 0] and twist["angular"][:2] == [0, 0],
+              "Twist %r carries WheelVelocity %s as canmatrix decodes it: %r" % (twist, frame.hex(), decoded))
+    expect_eq("Twists received", len(twists), 3)
+
+    s.candump("drive", "%03X:7FF" % DRIVE_TWIST_ID)
+    pub = s.spawn("twist_pub", [s.t.cyclone_peer, "pub", "--domain", DOMAIN, "--topic", "rt/cmd_vel", "--count", "3",
+                                "--period-ms", "20", "--wait-readers", "1", "--timeout-s", "90", "--gate", "stdin"],
+                  stdin=subprocess.PIPE, env=env)
+    wait_until("cosmicd's reader of rt/cmd_vel and the ROS 2 node's writer matched", 60,
+               lambda: "MATCHED" in read_text(s.path("twist_pub.err")) and
+               (gw.hop("cmd_vel", "lan")["matched"] or 0) >= 1, interval=0.2)
+    pub.stdin.write(b"go\n")
+    pub.stdin.close()
+    drive_frames = lambda: [f for f in canlog.read_frames(s.path("drive.out")) if not f.eff and f.id == DRIVE_TWIST_ID]
+    wait_until("3 DriveTwist frames on the bus", 60, lambda: len(drive_frames()) >= 3)
+    drive = matrix.frame_by_id(canmatrix.ArbitrationId(DRIVE_TWIST_ID))
+    values = [{n: float(v.phys_value) for n, v in drive.decode(bytearray(f.data)).items()} for f in drive_frames()]
+    # The peer's Twist i (1..3): linear = (i, i + 0.5, -i), angular = (0.25 i, -0.125, 1000 + i).
+    expect_eq("DriveTwist frames decoded by canmatrix", values,
+              [{"Speed": float(i), "YawRate": 1000.0 + i} for i in (1, 2, 3)])
+
+
 def scenario_e2e(s):
     """End-to-end protection (AUTOSAR E2E profile 1), checked with python3-crcmod (not ours): frames
     of BrakeStatus whose CRC crcmod computed pass as JSON with the counter and CRC left out; a wrong
@@ -666,12 +724,12 @@ def scenario_garbage(s):
     bound = {ETAG["sensor"], ETAG["bulk_up"], ETAG_GET}
     passing = [f for f in frames if f.eff and f.fd_flags is None and (f.id & 0x3FFF) in bound]
     # ... and the native standard identifiers of the channels published on the bus: wheel, brake and
-    # the typed wheel_speed and brake_status (exact match, data frames only); random 11-bit frames
+    # the typed wheel_speed, brake_status and wheel_twist (exact match, data frames only); random 11-bit frames
     # hit them by chance.
     def native(can_id):
         return [f for f in frames if not f.eff and f.fd_flags is None and not f.rtr and f.id == can_id]
     wheel = native(WHEEL_ID)
-    passing += wheel + native(BRAKE_ID) + native(WHEEL_SPEED_ID) + native(BRAKE_STATUS_ID)
+    passing += wheel + native(BRAKE_ID) + native(WHEEL_SPEED_ID) + native(BRAKE_STATUS_ID) + native(WHEEL_VELOCITY_ID)
     sensor = [f for f in passing if (f.id & 0x3FFF) == ETAG["sensor"]]
     sensor_bad = [f for f in sensor if f.rtr or len(f.data) > 4]  # remote, or longer than payload 4 B
     get_bad = [f for f in passing if (f.id & 0x3FFF) == ETAG_GET and (f.rtr or len(f.data) != 8)]
@@ -950,17 +1008,17 @@ def scenario_link_down_up(s):
 
 
 SCENARIOS = [scenario_etags, scenario_get_etag, scenario_can_to_ip, scenario_ip_to_can, scenario_fragments_up,
-             scenario_fragments_down, scenario_can_fd, scenario_fd_fragments_down, scenario_native, scenario_typed, scenario_e2e, scenario_unexplained, scenario_garbage, scenario_overflow, scenario_burst, scenario_error_frames,
+             scenario_fragments_down, scenario_can_fd, scenario_fd_fragments_down, scenario_native, scenario_typed, scenario_ros2, scenario_e2e, scenario_unexplained, scenario_garbage, scenario_overflow, scenario_burst, scenario_error_frames,
              scenario_link_down_up]
 
 
 # ---------------------------------------------------------------------------------- driver
 
 class Test:
-    def __init__(self, cosmicd, cosmicctl, dds_peer, lcm_peer):
+    def __init__(self, cosmicd, cosmicctl, dds_peer, lcm_peer, cyclone_peer=None):
         self.work = tempfile.mkdtemp(prefix="cosmic-can-e2e.", dir="/tmp")
         self.gw = Gateway(cosmicd, cosmicctl, self.work)
-        self.dds_peer, self.lcm_peer = dds_peer, lcm_peer
+        self.dds_peer, self.lcm_peer, self.cyclone_peer = dds_peer, lcm_peer, cyclone_peer
         self.gateway_id = None
 
     def tail(self, path, n, prefix="  | "):
@@ -1046,8 +1104,8 @@ class Test:
 
 
 def main(argv):
-    if len(argv) != 5:
-        print("usage: e2e_test.py COSMICD COSMICCTL DDS_PEER LCM_PEER", file=sys.stderr)
+    if len(argv) not in (5, 6):
+        print("usage: e2e_test.py COSMICD COSMICCTL DDS_PEER LCM_PEER [CYCLONE_ROS2_PEER]", file=sys.stderr)
         return 64
     test = Test(*argv[1:])
     try:
