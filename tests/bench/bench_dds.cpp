@@ -40,6 +40,12 @@ using eprosima::fastrtps::types::ReturnCode_t;
 constexpr std::uint8_t kCdrLe[4] = {0x00, 0x01, 0x00, 0x00};
 constexpr std::size_t kHeader = sizeof kCdrLe;
 
+// A sample that starts with the CDR_LE (XCDR1) encapsulation header: 00 01, options 00 0x where the
+// low two bits count the padding after the body (a typed hop's struct, 63 bytes, announces 1).
+bool cdr_le_sample(const std::vector<std::uint8_t>& bytes) {
+  return bytes.size() >= kHeader && std::memcmp(bytes.data(), kCdrLe, 3) == 0 && (bytes[3] & 0xFC) == 0;
+}
+
 // A native topic's sample: the serialized bytes, encapsulation header included.
 struct RawSample {
   std::vector<std::uint8_t> bytes;
@@ -151,7 +157,7 @@ class ReaderListener : public fdds::DataReaderListener {
       const std::int64_t now = mono_ns();
       if (!native_) {
         recorder.record(env_.payload().data(), env_.payload().size(), now);
-      } else if (raw_.bytes.size() < kHeader || std::memcmp(raw_.bytes.data(), kCdrLe, kHeader) != 0) {
+      } else if (!cdr_le_sample(raw_.bytes)) {
         recorder.record(raw_.bytes.data(), 0, now);  // not what the publisher wrote: malformed
       } else {
         recorder.record(raw_.bytes.data() + kHeader, raw_.bytes.size() - kHeader, now);

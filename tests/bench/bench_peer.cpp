@@ -3,6 +3,7 @@
 // DDS -> DDS) and the paths through cosmicd, so the only difference between them is the gateway.
 //
 //   cosmic-bench-peer lcm-pub --url U --channel C --count N --size B [--rate HZ] [--warmup W] [--max-rate HZ]
+//                             [--zero-fill]
 //                             [--envelope]
 //   cosmic-bench-peer lcm-sub --url U --channel C --count N [--timeout S] [--idle S] [--envelope]
 //                             [--dump FILE]
@@ -14,7 +15,7 @@
 //
 // Payload of every event (size >= 16): bytes 0..7 = CLOCK_MONOTONIC ns when the publisher hands
 // it to its library (little-endian), bytes 8..11 = index (measured events 1..N, warm-up events
-// 0x80000000 | k, little-endian), the rest (index + i) & 0xff. The stamp travels in the payload,
+// 0x80000000 | k, little-endian), the rest (index + i) & 0xff (0 with --zero-fill). The stamp travels in the payload,
 // which the gateway forwards unchanged, so one-way latency = receive time - stamp on every path
 // (all processes of one host read the same CLOCK_MONOTONIC). LCM events are the bare payload
 // (cosmicd channel encoding raw) unless --envelope; DDS events are cosmic::Envelope with origin 0
@@ -97,7 +98,8 @@ std::uint64_t get_le(const std::uint8_t* p, int bytes) {
 }
 
 void fill(std::vector<std::uint8_t>& payload, std::uint32_t index) {
-  for (std::size_t i = 16; i < payload.size(); ++i) payload[i] = static_cast<std::uint8_t>((index + i) & 0xff);
+  for (std::size_t i = 16; i < payload.size(); ++i)
+    payload[i] = g_zero_fill ? std::uint8_t{0} : static_cast<std::uint8_t>((index + i) & 0xff);
   put_le(payload.data() + 8, index, 4);
   put_le(payload.data() + 12, 0, 4);
 }
@@ -340,6 +342,7 @@ int main(int argc, char** argv) {
   lp->add_option("--rate", lo.rate, "events/s (0: as fast as possible)");
   lp->add_option("--max-rate", lo.max_rate, "the channel's max_rate: catch up after a stall no faster than this");
   lp->add_option("--warmup", lo.warmup, "warm-up events");
+  lp->add_flag("--zero-fill", g_zero_fill, "bytes 16.. are 0 (a typed channel's compact event), not the index pattern");
   CLI::App* ls = app.add_subcommand("lcm-sub", "receive on LCM");
   lcm_common(ls);
   ls->add_option("--timeout", lo.timeout, "seconds");

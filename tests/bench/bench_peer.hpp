@@ -23,6 +23,9 @@ inline std::atomic<bool> g_stop{false};
 // Set by a publisher whose transport stopped taking events (dds-pub: no write succeeded for
 // --stall seconds): the run ends early and says so.
 inline bool g_stalled = false;
+// --zero-fill: bytes 16.. of every payload are 0, not the index pattern, so that a typed channel's
+// compact event (scripts/bench's typed path) holds valid values (zero numbers, false bools).
+inline bool g_zero_fill = false;
 
 std::int64_t mono_ns();
 void sleep_until_ns(std::int64_t t);
