@@ -74,6 +74,7 @@ TEST(TypedAdmission, AHopThatCannotCarryTheTypeRejectsTheChannelWithTheReasonOnT
   - name: wrong_id
     subject: 1
     class: nrt
+    omission_degree: 1
     type: {dbc: wheel.dbc, message: WheelSpeed}
     publishers: [body]
     subscribers: [viz]
@@ -108,6 +109,8 @@ TEST(TypedAdmission, AHopThatCannotCarryTheTypeRejectsTheChannelWithTheReasonOnT
   ASSERT_NE(unfit, nullptr);
   EXPECT_FALSE(unfit->ok);
   EXPECT_TRUE(check_of(*hop_of(*wrong_id, "viz"), "representation")->ok);  // the reason is on its hop only
+  EXPECT_EQ(check_of(*hop_of(*wrong_id, "body"), "frame_fit"), nullptr);   // no size to judge there
+  EXPECT_EQ(wrong_id->reasons.size(), 1u) << reasons_of(*wrong_id);
   EXPECT_EQ(hop_of(*wrong_id, "viz")->representation, "compact");
   EXPECT_EQ(hop_of(*wrong_id, "body")->representation, "");
 

@@ -136,7 +136,9 @@ void Judge::judge(const ChannelSpec& channel, ChannelReport& report) const {
 
 void Judge::add_hop_checks(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) const {
   add_representation_checks(channel, segment, h);
-  add_frame_fit(channel, segment, h);
+  // A hop that cannot carry the type has no message size: its frame is not judged.
+  const HopPayload* hop = channel.type ? channel.hop_on(segment.name) : nullptr;
+  if (hop == nullptr || hop->unfit.empty()) add_frame_fit(channel, segment, h);
   if (channel.period) {
     const double load = loads_[static_cast<std::size_t>(&segment - segments_.data())];
     h.checks.push_back(
