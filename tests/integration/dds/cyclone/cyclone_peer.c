@@ -11,11 +11,10 @@
  * drops what arrives before it matched the writer), then writes N envelopes with origin 0 (a
  * native source), envelope sequence 1..N, payload byte i of event q = (q * 7 + i) mod 256, one
  * every P ms (default 10), and waits for the acknowledgements of reliable readers.
- * sub: prints MATCHED on stderr once its reader matched a writer, then one JSON line per
- * envelope on stdout: {"origin":O,"sequence":Q,"hop_count":H,"subject":S,"payload":"hex"};
- * exits 0 after N envelopes, 1 on timeout (default 30 s).
- * Exit 2: bad arguments; 3: DDS entity creation failed.
- * Network: Cyclone DDS reads CYCLONEDDS_URI as usual (the tests enable multicast on loopback).
+ * sub (default QoS, history KEEP_ALL: see run_sub): prints MATCHED on stderr once its reader matched a writer, then one
+ * JSON line per envelope on stdout: {"origin":O,"sequence":Q,"hop_count":H,"subject":S,"payload":"hex"}; exits 0 after
+ * N envelopes, 1 on timeout (default 30 s). Exit 2: bad arguments; 3: DDS entity creation failed. Network: Cyclone DDS
+ * reads CYCLONEDDS_URI as usual (the tests enable multicast on loopback).
  */
 #include <inttypes.h>
 #include <stdio.h>
@@ -138,7 +137,14 @@ static void print_envelope(const cosmic_Envelope* env) {
 }
 
 static int run_sub(dds_entity_t participant, dds_entity_t topic, const struct options* o) {
-  dds_entity_t reader = dds_create_reader(participant, topic, NULL, NULL); /* default QoS */
+  /* Default QoS but for the history, KEEP_ALL instead of KEEP_LAST 1: history is the reader's own
+   * (no part of matching), and with depth 1 a loaded host that delays this process overwrites a
+   * sample in the reader's cache before it is taken, a loss the test would blame on the wire. The
+   * wire stays BEST_EFFORT, as by default. */
+  dds_qos_t* qos = dds_create_qos();
+  dds_qset_history(qos, DDS_HISTORY_KEEP_ALL, 0);
+  dds_entity_t reader = dds_create_reader(participant, topic, qos, NULL);
+  dds_delete_qos(qos);
   if (reader < 0) return 3;
   if (!wait_matched(participant, reader, DDS_SUBSCRIPTION_MATCHED_STATUS, reader_matched, DDS_SECS(o->timeout_s))) {
     fprintf(stderr, "no writer matched\n");
