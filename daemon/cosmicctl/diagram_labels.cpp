@@ -83,7 +83,7 @@ std::string cell(const std::string& text, const std::string& attributes = "") {
   return "<TD" + attributes + ">" + html_text(text) + "</TD>";
 }
 
-std::string fill(const char* colour) { return std::string(" BGCOLOR=\"") + colour + "\""; }
+std::string background_attribute(const char* colour) { return std::string(" BGCOLOR=\"") + colour + "\""; }
 
 // A violated channel's table gets a thick red frame, so it stands out among fifty at a glance.
 std::string table_open(const ChannelStatus& status) {
@@ -98,7 +98,7 @@ std::string name_cell(const cosmic::ChannelSpec& c) {
 std::string verdict_cell(const ChannelStatus& status) {
   const std::string verdict = shown_verdict(status);
   const std::string text = status.violated ? "<B>VIOLATED</B>" : html_text(verdict);
-  return std::string("<TD") + fill(verdict_colour(verdict)) + ">" + text + "</TD>";
+  return std::string("<TD") + background_attribute(verdict_colour(verdict)) + ">" + text + "</TD>";
 }
 
 // One row: name, class, verdict, the bound (its number only: the tooltip says what it is) and,
@@ -119,7 +119,7 @@ std::string table_label(const cosmic::ChannelSpec& c, const ChannelStatus& statu
   label += row(cell(upper(cosmic::to_string(c.cls))));
   for (const auto& q : qos_list(c)) label += row(cell(q));
   label += row(verdict_cell(status));
-  const std::string verdict_fill = fill(verdict_colour(shown_verdict(status)));
+  const std::string verdict_fill = background_attribute(verdict_colour(shown_verdict(status)));
   if (const std::string bound = end_to_end_text(status); !bound.empty()) label += row(cell(bound, verdict_fill));
   for (const auto& line : status.counters) label += row(cell(line, verdict_fill));
   for (const auto& note : status.notes) label += row(cell(note, verdict_fill));
