@@ -53,10 +53,10 @@ std::string background_text(const HopReport& h) {
   return text;
 }
 
-// A typed channel's hop: can its representation carry the type, and all of each field's range?
-void add_representation_checks(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) {
-  const HopPayload* hop = channel.hop_on(segment.name);
-  if (!channel.type || hop == nullptr) return;
+// A typed channel's hop (null: untyped): can its representation carry the type, and all of each
+// field's range?
+void add_representation_checks(const HopPayload* hop, HopReport& h) {
+  if (hop == nullptr) return;
   h.representation = hop->form;
   const bool fits = hop->unfit.empty();
   h.checks.push_back(Check{"representation", fits ? 1.0 : 0.0, 1.0, "bool", ">=", fits});
@@ -135,9 +135,9 @@ void Judge::judge(const ChannelSpec& channel, ChannelReport& report) const {
 }
 
 void Judge::add_hop_checks(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) const {
-  add_representation_checks(channel, segment, h);
-  // A hop that cannot carry the type has no message size: its frame is not judged.
   const HopPayload* hop = channel.type ? channel.hop_on(segment.name) : nullptr;
+  add_representation_checks(hop, h);
+  // A hop that cannot carry the type has no message size: its frame is not judged.
   if (hop == nullptr || hop->unfit.empty()) add_frame_fit(channel, segment, h);
   if (channel.period) {
     const double load = loads_[static_cast<std::size_t>(&segment - segments_.data())];
