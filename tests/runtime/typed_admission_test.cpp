@@ -188,8 +188,13 @@ TEST_F(TypedForwardingTest, ASignalTooNarrowForTheRangeDegradesASaturatingChanne
 }
 
 TEST_F(TypedForwardingTest, AnHrtChannelThatWouldSaturateIsRejected) {
+  // wheel as HRT between the two buses only: nothing but the saturating hop can reject it.
   std::string text = narrow_config("saturate");
   text.replace(text.find("class: srt"), 10, "class: hrt");
+  const std::string subscribers = "subscribers: [lan, viz, chassis]";
+  text.replace(text.find(subscribers), subscribers.size(), "subscribers: [chassis]");
+  const std::string json_hop = "      viz: {channel: WHEEL, representation: json}\n";
+  text.erase(text.find(json_hop), json_hop.size());
   ConfigResult loaded = load(text);
   ASSERT_TRUE(loaded.ok()) << loaded.errors[0].to_string();
   const Evaluation evaluation =
@@ -197,6 +202,7 @@ TEST_F(TypedForwardingTest, AnHrtChannelThatWouldSaturateIsRejected) {
   const ChannelReport* wheel = report_of(evaluation.channels, "wheel");
   ASSERT_NE(wheel, nullptr);
   EXPECT_EQ(wheel->verdict, Verdict::rejected);
+  ASSERT_EQ(wheel->reasons.size(), 1u) << reasons_of(*wheel);
   EXPECT_NE(reasons_of(*wheel).find(kNarrowed), std::string::npos) << reasons_of(*wheel);
 }
 
