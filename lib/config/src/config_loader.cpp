@@ -2,6 +2,7 @@
 
 #include <variant>
 
+#include "cosmic/lcm_auth_layout.hpp"
 #include "cosmic/lcm_url.hpp"
 #include "cosmic/transport_limits.hpp"
 
@@ -21,6 +22,7 @@
 #include "federation_loader.hpp"
 #include "realtime_loader.hpp"
 #include "folded_names.hpp"
+#include "key_file_loader.hpp"
 #include "listen_address.hpp"
 #include "segment_overlap.hpp"
 #include "yaml_reader.hpp"
@@ -221,7 +223,7 @@ class ConfigParser {
           {"name",          "type",        "interface",       "profile",          "bitrate",    "fd",
            "data_bitrate",  "errors",      "max_utilization", "background",       "domain",     "latency_bound",
            "bandwidth",     "reliability", "realtime",        "max_message_size", "interfaces", "discovery_server",
-           "shared_memory", "url",         "network",         "own_datagrams"});
+           "shared_memory", "url",         "network",         "own_datagrams",    "auth"});
       return std::nullopt;
     }
     s.type = static_cast<SegmentType>(*type);
@@ -373,7 +375,7 @@ class ConfigParser {
   void parse_lcm(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
     reader_.check_map(node, path,
                       {"name", "type", "url", "latency_bound", "bandwidth", "realtime", "max_message_size",
-                       "max_utilization", "network", "own_datagrams"});
+                       "max_utilization", "network", "own_datagrams", "auth"});
     s.reliability = Reliability::best_effort;
     parse_ip_common(node, path, s);
     if (has(node, "url")) {
@@ -390,6 +392,25 @@ class ConfigParser {
       s.lcm.own_datagrams = static_cast<LcmOwnDatagrams>(
           reader_.choice(node["own_datagrams"], key(path, "own_datagrams"), {"cut", "drop"}).value_or(0));
     }
+    if (has(node, "auth")) parse_lcm_auth(node["auth"], key(path, "auth"), s);
+  }
+
+  // auth: {key_file: FILE, window: DURATION} (cosmic/lcm_auth.hpp).
+  void parse_lcm_auth(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
+    if (!reader_.check_map(node, path, {"key_file", "window"})) return;
+    LcmAuthSpec auth;
+    if (require(node, path, "key_file", "a key file: openssl rand -hex 32 > FILE; chmod 600 FILE")) {
+      auto loaded = config_detail::load_key_file(reader_, node["key_file"], key(path, "key_file"), included_,
+                                                 kLcmAuthMinKeyBytes, kLcmAuthMaxKeyBytes);
+      if (loaded) {
+        auth.key_file = loaded->path;
+        auth.key = std::move(loaded->key);
+      }
+    }
+    if (has(node, "window")) {
+      if (auto v = reader_.duration(node["window"], key(path, "window"), false)) auth.window = *v;
+    }
+    s.lcm.auth = std::move(auth);
   }
 
   void parse_channel_list(const YAML::Node& node, const std::string& path) {

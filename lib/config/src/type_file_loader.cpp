@@ -14,7 +14,8 @@
 
 namespace cosmic::config_detail {
 
-std::string read_regular_file(const std::string& path, std::string& text, std::size_t max_bytes) {
+std::string read_regular_file(const std::string& path, std::string& text, std::size_t max_bytes,
+                              std::string (*refuse_mode)(unsigned mode)) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) return std::strerror(errno);
   struct stat info {};
@@ -23,8 +24,11 @@ std::string read_regular_file(const std::string& path, std::string& text, std::s
     error = std::strerror(errno);
   } else if (!S_ISREG(info.st_mode)) {
     error = "not a regular file";
+  } else if (refuse_mode != nullptr && !(error = refuse_mode(info.st_mode)).empty()) {
+    // refused for its permissions
   } else if (static_cast<std::uint64_t>(info.st_size) > max_bytes) {
-    error = "larger than " + std::to_string(max_bytes >> 20) + " MiB";
+    error = max_bytes >= (1u << 20) ? "larger than " + std::to_string(max_bytes >> 20) + " MiB"
+                                    : "larger than " + std::to_string(max_bytes) + " bytes";
   } else {
     text.resize(static_cast<std::size_t>(info.st_size));
     std::size_t done = 0;

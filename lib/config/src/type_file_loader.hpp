@@ -16,8 +16,10 @@
 namespace cosmic::config_detail {
 
 // Reads a regular file of at most `max_bytes` into `text` without ever blocking on a FIFO or a
-// device; why not, or an empty string.
-std::string read_regular_file(const std::string& path, std::string& text, std::size_t max_bytes);
+// device; why not, or an empty string. `refuse_mode`, where given, says why a file of that
+// st_mode must not be read (empty: it may).
+std::string read_regular_file(const std::string& path, std::string& text, std::size_t max_bytes,
+                              std::string (*refuse_mode)(unsigned mode) = nullptr);
 
 struct LoadedText {
   std::string path;  // as resolved against the configuration's directory

@@ -1,5 +1,7 @@
 #include "cosmic/admission.hpp"
 
+#include "cosmic/lcm_auth_layout.hpp"
+
 #include "cosmic/dds_names.hpp"
 
 #include <algorithm>
@@ -79,11 +81,20 @@ double hop_load(const SegmentSpec& segment, const ChannelSpec& channel) {
     const CanHopPlan plan = frame_plan(segment, channel);
     return to_seconds(plan.transmission) * plan.frames_per_event / period_s;
   }
-  const double bits = static_cast<double>(channel.payload_on(segment.name) + kIpOverheadBytes) * 8.0;
+  const auto security = hop_security(segment, channel);
+  const double bits =
+      static_cast<double>(channel.payload_on(segment.name) + kIpOverheadBytes + (security ? security->bytes : 0)) * 8.0;
   return bits / period_s / static_cast<double>(segment.bandwidth.bits_per_second);
 }
 
 }  // namespace
+
+std::optional<HopSecurity> hop_security(const SegmentSpec& segment, const ChannelSpec& channel) {
+  if (segment.type == SegmentType::lcm && segment.lcm.auth)
+    return HopSecurity{"HMAC-SHA256 trailer", static_cast<std::uint32_t>(kLcmAuthTrailerSize)};
+  (void)channel;  // SecOC (per CAN hop of a channel) comes with its own key
+  return std::nullopt;
+}
 
 const char* to_string(Verdict value) {
   switch (value) {
@@ -120,7 +131,8 @@ const ChannelReport* AdmissionReport::find(const std::string& name) const {
 }
 
 Verdict consequence_of(const std::string& check, ChannelClass cls) {
-  if (cls == ChannelClass::hrt || check == "frame_fit" || check == "representation") return Verdict::rejected;
+  if (cls == ChannelClass::hrt || check == "frame_fit" || check == "representation" || check == "authentication")
+    return Verdict::rejected;
   return Verdict::degraded;
 }
 

@@ -38,7 +38,8 @@ void add_frame_fit(const ChannelSpec& channel, const SegmentSpec& segment, HopRe
     limit = channel.cls == ChannelClass::nrt ? static_cast<double>(kMaxIpEventBytes)
                                              : static_cast<double>(segment.max_message_size - kIpOverheadBytes);
   }
-  const auto value = static_cast<double>(channel.payload_on(segment.name));
+  // What authentication adds takes room of the message like the payload.
+  const auto value = static_cast<double>(channel.payload_on(segment.name) + (h.security ? h.security->bytes : 0));
   h.checks.push_back(Check{"frame_fit", value, limit, "B", "<=", value <= limit});
 }
 
@@ -63,9 +64,22 @@ void add_representation_checks(const HopPayload* hop, HopReport& h) {
   if (fits && !hop->narrowed.empty()) h.checks.push_back(Check{"range", 0.0, 1.0, "bool", ">=", false});
 }
 
+// An authenticated hop: what it adds, and whether the channel's messages can carry it there (a raw
+// LCM message has no room for the trailer: nothing in it tells the tag from the contents).
+void add_security_checks(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) {
+  h.security = hop_security(segment, channel);
+  if (!h.security || segment.type != SegmentType::lcm) return;
+  const bool carried = channel.native_on(segment.name) == nullptr && channel.lcm_encoding != LcmEncoding::raw;
+  h.checks.push_back(Check{"authentication", carried ? 1.0 : 0.0, 1.0, "bool", ">=", carried});
+}
+
 std::string failure_text(const Check& check, const HopReport& h, const SegmentSpec& segment,
                          const ChannelSpec& channel) {
   const std::string on = " on " + h.segment;
+  if (check.check == "authentication") {
+    return "raw LCM messages" + on +
+           " cannot carry the authentication trailer the segment requires (auth): use encoding: envelope";
+  }
   if (check.check == "representation") {
     return h.segment + " cannot carry the channel's type: " + channel.hop_on(h.segment)->unfit;
   }
@@ -137,6 +151,7 @@ void Judge::judge(const ChannelSpec& channel, ChannelReport& report) const {
 void Judge::add_hop_checks(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) const {
   const HopPayload* hop = channel.type ? channel.hop_on(segment.name) : nullptr;
   add_representation_checks(hop, h);
+  add_security_checks(channel, segment, h);
   // A hop that cannot carry the type has no message size: its frame is not judged.
   if (hop == nullptr || hop->unfit.empty()) add_frame_fit(channel, segment, h);
   if (channel.period) {

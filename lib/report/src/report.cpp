@@ -55,6 +55,7 @@ nlohmann::json to_json(const HopReport& hop) {
     if (hop.dds->native) out["dds"]["representation"] = to_string(hop.dds->representation);
   }
   if (!hop.representation.empty()) out["representation"] = hop.representation;
+  if (hop.security) out["security"] = {{"scheme", hop.security->scheme}, {"bytes", hop.security->bytes}};
   out["checks"] = nlohmann::json::array();
   for (const auto& check : hop.checks) out["checks"].push_back(to_json(check));
   if (!hop.background.empty()) {
@@ -232,6 +233,7 @@ std::string render_channel_text(const ChannelReport& channel) {
     }
     if (hop.dds) out << "  topic " << hop.dds->topic << " type " << hop.dds->type;
     if (!hop.representation.empty()) out << "  as " << hop.representation;
+    if (hop.security) out << "  signed " << hop.security->scheme << " +" << hop.security->bytes << " B";
     out << "\n";
     for (const auto& check : hop.checks) {
       out << "    " << (check.ok ? "ok   " : "FAIL ") << pad_column(check.check, 14) << check_value_text(check) << " "

@@ -292,6 +292,21 @@ void Router::enqueue(const std::shared_ptr<ChannelState>& channel, const Inbound
   if (!queued) channel->forwarded.fetch_sub(1, std::memory_order_relaxed);
 }
 
+namespace {
+DropReason drop_reason_of(InboundProblem what) {
+  switch (what) {
+    case InboundProblem::decode_error:
+      return DropReason::decode_error;
+    case InboundProblem::unauthenticated:
+      return DropReason::unauthenticated;
+    case InboundProblem::replayed:
+      return DropReason::replayed;
+    default:
+      return DropReason::no_route;
+  }
+}
+}  // namespace
+
 void Router::problem(std::size_t segment, ChannelId channel_id, InboundProblem what) {
   if (what == InboundProblem::own_echo) return;  // our own publication seen again: expected, not a loss
   const auto channel = channel_id == kNoChannel ? nullptr : find(channel_id);
@@ -299,8 +314,7 @@ void Router::problem(std::size_t segment, ChannelId channel_id, InboundProblem w
     unrouted_[segment].fetch_add(1, std::memory_order_relaxed);
     return;
   }
-  channel->counters[segment].drop(what == InboundProblem::decode_error ? DropReason::decode_error
-                                                                       : DropReason::no_route);
+  channel->counters[segment].drop(drop_reason_of(what));
 }
 
 std::size_t Router::run_once(std::size_t budget) {

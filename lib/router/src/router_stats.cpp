@@ -28,6 +28,10 @@ const char* to_string(DropReason reason) {
       return "out_of_range";
     case DropReason::corrupt:
       return "corrupt";
+    case DropReason::unauthenticated:
+      return "unauthenticated";
+    case DropReason::replayed:
+      return "replayed";
   }
   return "?";
 }

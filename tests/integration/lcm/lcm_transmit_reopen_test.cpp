@@ -52,7 +52,7 @@ int shell(const std::string& command) { return std::system((command + " 2>&1").c
 
 // A transmitter with what it reports to, and one raw 16-byte event of channel 1 (`name`) to send.
 struct TransmitRig {
-  explicit TransmitRig(const std::string& name) : transmitter(name, log, counters, health, receive_failing) {
+  explicit TransmitRig(const std::string& name) : transmitter(name, nullptr, log, counters, health, receive_failing) {
     channel.id = 1;
     channel.name = name;
     channel.format = make_lcm_message_format(LcmEncoding::raw);

@@ -23,6 +23,10 @@
 // the default) or cuts them down to nothing, which the receive thread then skips by that source.
 // The receive socket is a member of the group only while a channel is received here (join_group,
 // leave_group), so a segment that only sends gets none of them back.
+// On a segment with `auth` (cosmic/lcm_auth.hpp) the transmitter signs every message and the
+// receive thread checks every message of a received channel before its format reads it: one
+// without a valid trailer is counted as unauthenticated, one sent before or outside the window as
+// replayed, each a drop of its channel (docs/security.md); raw channels cannot be bound here.
 // The EventSink is called while the receive thread reads the table: it must hand the event on
 // (the router queues it) and not call back into this adapter's configure() or stop(), which
 // would wait for that reading to end.
@@ -51,6 +55,7 @@
 #include "cosmic/arrival_clock.hpp"
 #include "cosmic/binding_plan.hpp"
 #include "cosmic/health_cell.hpp"
+#include "cosmic/lcm_auth.hpp"
 #include "cosmic/lcm_reassembly.hpp"
 #include "cosmic/lcm_udpm.hpp"
 #include "cosmic/lcm_url.hpp"
@@ -80,6 +85,8 @@ constexpr std::chrono::milliseconds kSelfTestTimeout{2000};
 // The receive socket's buffer unless the URL names one (recv_buf_size): about 5,000 small
 // datagrams or 60 of 64 KiB, what liblcm's queues held before (4,096 messages).
 constexpr std::size_t kDefaultReceiveBuffer = 4u << 20;
+// At most one line per kind of refused message (unauthenticated, replayed) in this time.
+constexpr Nanos kRefusalLogPause = std::chrono::seconds(10);
 
 struct StringHash {
   using is_transparent = void;
@@ -109,9 +116,12 @@ class LcmAdapter final : public SegmentAdapter {
       : segment_(segment),
         log_(log),
         prefix_(segment_log_prefix(SegmentType::lcm, segment.name)),
-        transmit_(segment.name, log, counters_, health_, receive_failing_),
-        // An envelope's payload may be max_message_size bytes: the message is its header longer.
-        reassembler_(segment.max_message_size + kLcmEnvelopeHeaderSize) {}
+        transmit_(segment.name, segment_.lcm.auth ? &*segment_.lcm.auth : nullptr, log, counters_, health_,
+                  receive_failing_),
+        // An envelope's payload may be max_message_size bytes: the message is its header longer,
+        // and its authentication trailer.
+        reassembler_(segment.max_message_size + kLcmEnvelopeHeaderSize + (segment.lcm.auth ? kLcmAuthTrailerSize : 0)) {
+  }
 
   ~LcmAdapter() override { stop(); }
 
@@ -132,6 +142,12 @@ class LcmAdapter final : public SegmentAdapter {
       started_ = true;
       set_health(SegmentHealth::up, "");
       return Status{};
+    }
+    if (segment_.lcm.auth) {
+      Result<LcmAuthVerifier> verifier =
+          LcmAuthVerifier::make(segment_.lcm.auth->key.bytes(), segment_.lcm.auth->window);
+      if (!verifier) return fail_start("cannot check authentication: " + verifier.error().text);
+      verifier_.emplace(std::move(verifier).value());  // before the receive thread that uses it starts
     }
     if (Result<void> opened = transmit_.open(url); !opened) return fail_start(std::move(opened).error().text);
     lcm_detail::OpenedSocket rx = lcm_detail::open_receive_socket(url, kDefaultReceiveBuffer);
@@ -271,6 +287,10 @@ class LcmAdapter final : public SegmentAdapter {
       s.transport.push_back(
           TransportCounter{"own_datagrams_dropped", own_dropped_before_ + (own_counting_ ? transmit_.own_drops() : 0)});
     }
+    if (segment_.lcm.auth) {
+      s.transport.push_back(TransportCounter{"unauthenticated", unauthenticated_.load(std::memory_order_relaxed)});
+      s.transport.push_back(TransportCounter{"replayed", replayed_.load(std::memory_order_relaxed)});
+    }
     return s;
   }
 
@@ -370,6 +390,8 @@ class LcmAdapter final : public SegmentAdapter {
                              const std::unordered_map<std::string, ChannelId>& names) const {
     if (name.empty()) return Error{"the native binding names no LCM channel"};
     if (Result<void> carried = check_transport_name(SegmentType::lcm, name); !carried) return carried;
+    if (segment_.lcm.auth && (b.spec.native_on(segment_.name) != nullptr || b.spec.lcm_encoding == LcmEncoding::raw))
+      return Error{"a raw LCM message cannot carry the authentication trailer this segment requires (auth)"};
     const auto taken = names.find(name);
     if (taken != names.end() && taken->second != b.id) {
       return Error{"LCM channel '" + name + "' is already bound by channel id " + std::to_string(taken->second)};
@@ -468,7 +490,7 @@ class LcmAdapter final : public SegmentAdapter {
       if (arrival == 0) arrival = realtime_now;
       const Nanos received_at = steady_arrival(arrival, Nanos(steady), realtime_now);
       if (!parsed->fragment) {
-        deliver(table, parsed->channel, parsed->data, received_at, arrival);
+        deliver(table, from, parsed->channel, parsed->data, received_at, arrival);
         continue;
       }
       reassemble(table, from, *parsed, received_at, arrival);
@@ -495,7 +517,7 @@ class LcmAdapter final : public SegmentAdapter {
         reassembler_.abandoned() - abandoned_before + (outcome == LcmReassembler::Outcome::refused);
     if (lost != 0) counters_.receive_errors.fetch_add(lost, std::memory_order_relaxed);
     if (outcome == LcmReassembler::Outcome::complete)
-      deliver(table, reassembler_.channel(), reassembler_.payload(), received_at, arrival);
+      deliver(table, from, reassembler_.channel(), reassembler_.payload(), received_at, arrival);
   }
 
   static bool receives(const ChannelTable& table, std::string_view name) {
@@ -504,12 +526,20 @@ class LcmAdapter final : public SegmentAdapter {
   }
 
   // One whole message of LCM channel `name`, from the receive thread's reading of `table`.
-  void deliver(const ChannelTable& table, std::string_view name, std::span<const std::uint8_t> bytes, Nanos received_at,
-               std::int64_t arrival_realtime_ns) {
+  void deliver(const ChannelTable& table, Endpoint from, std::string_view name, std::span<const std::uint8_t> bytes,
+               Nanos received_at, std::int64_t arrival_realtime_ns) {
     const auto it = table.channels->by_name.find(name);
     if (it == table.channels->by_name.end() || !it->second->rx) return;  // not bound for reception here
     const Channel& channel = *it->second;
     counters_.received.fetch_add(1, std::memory_order_relaxed);
+    if (verifier_) {
+      const LcmAuthCheck checked = verifier_->check(name, bytes, arrival_realtime_ns);
+      if (checked.verdict != LcmAuthVerdict::authentic) {
+        refuse(table, channel, from, checked, Nanos(received_at));
+        return;
+      }
+      bytes = bytes.first(checked.message_size);
+    }
     InboundEvent event;
     event.channel = channel.id;
     event.received_at = received_at;
@@ -522,6 +552,26 @@ class LcmAdapter final : public SegmentAdapter {
       return;
     }
     table.sink->on_event(event);
+  }
+
+  // A message that failed its authentication check: counted for the segment and as a drop of its
+  // channel; the first of each kind, and then one every kRefusalLogPause at most, is logged with
+  // where it came from (an attack or a misconfigured peer leaves a trace, not a flood of lines).
+  void refuse(const ChannelTable& table, const Channel& channel, Endpoint from, const LcmAuthCheck& checked,
+              Nanos now) {
+    const bool unauthenticated = checked.verdict == LcmAuthVerdict::unauthenticated;
+    (unauthenticated ? unauthenticated_ : replayed_).fetch_add(1, std::memory_order_relaxed);
+    table.sink->on_problem(channel.id, unauthenticated ? InboundProblem::unauthenticated : InboundProblem::replayed);
+    Nanos& last = unauthenticated ? last_unauthenticated_log_ : last_replayed_log_;
+    if (last != Nanos::min() && now - last < kRefusalLogPause) return;
+    last = now;
+    std::string why = unauthenticated ? "no valid authentication tag"
+                                      : "sent before, or " + std::to_string(checked.skew_ns / 1'000'000) +
+                                            " ms from this host's clock (window " +
+                                            std::to_string(segment_.lcm.auth->window.count() / 1'000'000) + " ms)";
+    log_.log(LogLevel::warning, prefix_ + "dropped a message of channel " + channel.name + " from " + from.text() +
+                                    ": " + why + " (counted as " + to_string(checked.verdict) +
+                                    "; at most one such line every 10 s)");
   }
 
   // memq://: nothing to send on, and nothing lost by it.
@@ -552,8 +602,13 @@ class LcmAdapter final : public SegmentAdapter {
   SnapshotTable<ChannelTable> table_;
 
   lcm_detail::LcmTransmitter transmit_;
-  // Receive thread only.
+  // Receive thread only (set by start() before the thread starts).
   LcmReassembler reassembler_;
+  std::optional<LcmAuthVerifier> verifier_;  // on a segment with auth
+  Nanos last_unauthenticated_log_ = Nanos::min();
+  Nanos last_replayed_log_ = Nanos::min();
+  std::atomic<std::uint64_t> unauthenticated_{0};
+  std::atomic<std::uint64_t> replayed_{0};
   std::uint32_t overflow_seen_ = 0;     // drops less own drops, modulo 2^32, at the last report
   std::int64_t overflow_total_ = 0;     // ... followed without wrapping
   std::int64_t overflow_reported_ = 0;  // what overflow_drops got from this socket so far

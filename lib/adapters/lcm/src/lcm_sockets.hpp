@@ -34,6 +34,11 @@ struct Endpoint {
   std::uint32_t address = 0;
   std::uint16_t port = 0;
   std::uint64_t key() const { return (std::uint64_t{address} << 16) | port; }
+  // "A.B.C.D:PORT", for log lines.
+  std::string text() const {
+    return std::to_string(address >> 24) + "." + std::to_string(address >> 16 & 255) + "." +
+           std::to_string(address >> 8 & 255) + "." + std::to_string(address & 255) + ":" + std::to_string(port);
+  }
   friend bool operator==(const Endpoint&, const Endpoint&) = default;
 };
 
@@ -131,7 +136,7 @@ SendFailure send_lcm_message(int fd, std::uint32_t sequence, std::string_view ch
 class SendBatch {
  public:
   static constexpr std::size_t kCapacity = 32;
-  static constexpr std::size_t kMaxParts = 2;
+  static constexpr std::size_t kMaxParts = 3;  // a header, the contents, an authentication trailer
 
   // False when the batch is full or the message needs fragments (send it alone then).
   bool add(std::uint32_t sequence, std::string_view channel, std::span<const std::span<const std::uint8_t>> parts);

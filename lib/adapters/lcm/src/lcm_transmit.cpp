@@ -2,6 +2,7 @@
 
 #include "cosmic/result.hpp"
 
+#include <sys/random.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,7 +14,7 @@
 
 namespace cosmic::lcm_detail {
 
-static_assert(kLcmMessageParts == SendBatch::kMaxParts, "a format's message fits one batch entry");
+static_assert(kLcmMessageParts + 1 == SendBatch::kMaxParts, "a format's message and its trailer fit one batch entry");
 
 namespace {
 
@@ -33,11 +34,29 @@ const char* class_name(std::size_t index) {
   return index < 3 ? kNames[index] : "?";
 }
 
+// A signer with a sender number of its own, drawn from the kernel's random source: a restarted
+// gateway's sequence numbers from 1 are a new sender's, never taken for replays.
+Result<LcmAuthSigner> make_signer(const LcmAuthSpec& auth) {
+  std::uint64_t sender = 0;
+  while (sender == 0) {
+    const ssize_t n = ::getrandom(&sender, sizeof sender, 0);
+    if (n < 0 && errno == EINTR) continue;
+    if (n != static_cast<ssize_t>(sizeof sender)) return Error::from_errno("getrandom", errno);
+  }
+  return LcmAuthSigner::make(auth.key.bytes(), sender);
+}
+
+std::int64_t wall_clock_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
 }  // namespace
 
-LcmTransmitter::LcmTransmitter(const std::string& segment_name, Logger& log, AdapterCounters& counters,
-                               HealthCell& health, const std::atomic<bool>& receive_failing)
+LcmTransmitter::LcmTransmitter(const std::string& segment_name, const LcmAuthSpec* auth, Logger& log,
+                               AdapterCounters& counters, HealthCell& health, const std::atomic<bool>& receive_failing)
     : prefix_(segment_log_prefix(SegmentType::lcm, segment_name)),
+      auth_(auth),
       log_(log),
       counters_(counters),
       health_(health),
@@ -54,6 +73,15 @@ Result<void> LcmTransmitter::open(const LcmUrl& url) {
       return Error{"transmit socket on udpm://" + url.group + ":" + std::to_string(url.port) + ": " + tx.error};
     }
     LockGuard lock(senders_[i].mutex);
+    if (auth_ != nullptr) {
+      Result<LcmAuthSigner> signer = make_signer(*auth_);
+      if (!signer) {
+        ::close(tx.fd);
+        close();
+        return Error{"cannot sign what it sends: " + signer.error().text};
+      }
+      senders_[i].signer.emplace(std::move(signer).value());
+    }
     senders_[i].fd = tx.fd;
     senders_[i].failing.store(false, std::memory_order_relaxed);
     own_keys_[i].store(tx.local.key(), std::memory_order_relaxed);
@@ -101,6 +129,7 @@ void LcmTransmitter::close() {
   for (std::size_t i = 0; i < senders_.size(); ++i) {
     LockGuard lock(senders_[i].mutex);  // waits for a send in flight
     if (senders_[i].fd >= 0) ::close(std::exchange(senders_[i].fd, -1));
+    senders_[i].signer.reset();
     own_keys_[i].store(0, std::memory_order_relaxed);
   }
   url_.reset();
@@ -182,9 +211,10 @@ void LcmTransmitter::note_sending(std::size_t datagrams) {
 SendStatus LcmTransmitter::send_one(ClassSender& sender, const Channel& channel, const OutboundEvent& event,
                                     SendLog& later) {
   if (sender.fd < 0) return failed(sender, channel, SendFailure{0, "no transmit socket"}, later);
-  LcmMessageParts parts{};
-  const std::size_t count = channel.format->encode(event, sender.envelope_headers[0], parts);
-  if (count == 0) return failed(sender, channel, SendFailure{0, "payload too large"}, later);
+  WireParts parts{};
+  const char* refusal = nullptr;
+  const std::size_t count = wire_parts(sender, 0, channel, event, parts, refusal);
+  if (count == 0) return failed(sender, channel, SendFailure{0, refusal}, later);
   std::size_t payload_size = 0;
   for (std::size_t k = 0; k < count; ++k) payload_size += parts[k].size();
   if (const auto plan = plan_lcm_message(channel.name.size(), payload_size))
@@ -196,11 +226,31 @@ SendStatus LcmTransmitter::send_one(ClassSender& sender, const Channel& channel,
 bool LcmTransmitter::stage(ClassSender& sender, const Channel& channel, const OutboundEvent& event) {
   const std::size_t slot = sender.batch.size();
   if (slot >= SendBatch::kCapacity || sender.fd < 0) return false;
-  LcmMessageParts parts{};
-  const std::size_t count = channel.format->encode(event, sender.envelope_headers[slot], parts);
+  WireParts parts{};
+  const char* refusal = nullptr;
+  // A message refused here goes to send_one(), which says why.
+  const std::size_t count = wire_parts(sender, slot, channel, event, parts, refusal);
   if (count == 0 || !sender.batch.add(sender.sequence, channel.name, std::span(parts.data(), count))) return false;
   ++sender.sequence;
   return true;
+}
+
+std::size_t LcmTransmitter::wire_parts(ClassSender& sender, std::size_t slot, const Channel& channel,
+                                       const OutboundEvent& event, WireParts& wire, const char*& refusal) {
+  LcmMessageParts parts{};
+  const std::size_t count = channel.format->encode(event, sender.envelope_headers[slot], parts);
+  if (count == 0) {
+    refusal = "payload too large";
+    return 0;
+  }
+  std::copy_n(parts.begin(), count, wire.begin());
+  if (!sender.signer) return count;
+  if (!sender.signer->sign(channel.name, std::span(parts.data(), count), wall_clock_ns(), sender.trailers[slot])) {
+    refusal = "cannot compute its authentication tag";
+    return 0;
+  }
+  wire[count] = sender.trailers[slot];
+  return count + 1;
 }
 
 SendStatus LcmTransmitter::sent(ClassSender& sender) {

@@ -10,6 +10,9 @@
 // address went away (the interface renumbered: EADDRNOTAVAIL, EINVAL, ENETUNREACH, ENODEV) is
 // reopened by the lane that meets the failure, at most once a second per class, and the receive
 // socket's filter follows the new source. While a class cannot send, the segment is degraded.
+// On a segment with `auth` each class's socket is a sender of its own to the receivers' replay
+// windows: its signer (cosmic/lcm_auth.hpp), a random sender number drawn at open(), appends
+// the authentication trailer to every message under the class's mutex.
 #pragma once
 
 #include <array>
@@ -24,6 +27,7 @@
 
 #include "cosmic/adapter_counters.hpp"
 #include "cosmic/health_cell.hpp"
+#include "cosmic/lcm_auth.hpp"
 #include "cosmic/lcm_url.hpp"
 #include "cosmic/lcm_wire.hpp"
 #include "cosmic/log.hpp"
@@ -40,8 +44,9 @@ namespace cosmic::lcm_detail {
 class LcmTransmitter {
  public:
   // `receive_failing` is the receive side's own trouble: a transmit recovery does not clear it.
-  LcmTransmitter(const std::string& segment_name, Logger& log, AdapterCounters& counters, HealthCell& health,
-                 const std::atomic<bool>& receive_failing);
+  // `auth`: the segment's authentication (null: none); it outlives the transmitter.
+  LcmTransmitter(const std::string& segment_name, const LcmAuthSpec* auth, Logger& log, AdapterCounters& counters,
+                 HealthCell& health, const std::atomic<bool>& receive_failing);
 
   // Opens the three sockets, or says why one failed (none is left open then).
   Result<void> open(const LcmUrl& url);
@@ -83,10 +88,18 @@ class LcmTransmitter {
     std::array<std::array<std::uint8_t, kLcmEnvelopeHeaderSize>, SendBatch::kCapacity> envelope_headers
         COSMIC_GUARDED_BY(mutex){};
     SendBatch batch COSMIC_GUARDED_BY(mutex);
+    // On a segment with auth: the signer, and the trailers of the messages in flight.
+    std::optional<LcmAuthSigner> signer COSMIC_GUARDED_BY(mutex);
+    std::array<LcmAuthTrailer, SendBatch::kCapacity> trailers COSMIC_GUARDED_BY(mutex){};
     std::chrono::steady_clock::time_point last_reopen COSMIC_GUARDED_BY(mutex){};
     std::atomic<bool> failing{false};  // a run of failures is logged once
   };
 
+  using WireParts = std::array<std::span<const std::uint8_t>, SendBatch::kMaxParts>;
+  // The parts of `event`'s message as it goes on the wire, batch slot `slot`'s buffers holding its
+  // header and trailer: their count, or 0 with why not in `refusal`.
+  std::size_t wire_parts(ClassSender& sender, std::size_t slot, const Channel& channel, const OutboundEvent& event,
+                         WireParts& wire, const char*& refusal) COSMIC_REQUIRES(sender.mutex);
   SendStatus send_one(ClassSender& sender, const Channel& channel, const OutboundEvent& event, SendLog& later)
       COSMIC_REQUIRES(sender.mutex);
   bool stage(ClassSender& sender, const Channel& channel, const OutboundEvent& event) COSMIC_REQUIRES(sender.mutex);
@@ -100,6 +113,7 @@ class LcmTransmitter {
   void note_sending(std::size_t datagrams);
 
   const std::string prefix_;  // "LCM segment NAME: " (cosmic/log_prefix.hpp)
+  const LcmAuthSpec* const auth_;
   Logger& log_;
   AdapterCounters& counters_;
   HealthCell& health_;

@@ -74,6 +74,14 @@ inline std::uint32_t arbitration_key(const CanHopPlan& plan) {
   return arbitration_key(plan.can_id, plan.extended ? CanIdFormat::extended29 : CanIdFormat::standard11);
 }
 
+// What authentication adds on a hop (docs/security.md): the scheme and the bytes it adds to each
+// message (LCM) or frame (CAN), which the hop's size and load checks count.
+struct HopSecurity {
+  std::string scheme;       // "HMAC-SHA256 trailer"
+  std::uint32_t bytes = 0;  // added to each message or frame
+  friend bool operator==(const HopSecurity&, const HopSecurity&) = default;
+};
+
 struct HopReport {
   std::string segment;
   HopRole role = HopRole::publisher;
@@ -86,6 +94,7 @@ struct HopReport {
   // A typed channel's hop: the form its events take there ("DBC frame 0x1A0 WheelSpeed", "XCDR2",
   // "compact"; ChannelSpec::hop_payloads), empty when the hop cannot carry the type.
   std::string representation;
+  std::optional<HopSecurity> security{};  // none where the hop is not authenticated
 };
 
 // A hop of a channel's path on another gateway of the federation (cosmic/upstream_path.hpp).
@@ -158,6 +167,10 @@ using EtagMap = std::map<std::string, std::uint16_t>;
 // Bytes an event occupies on an IP segment beyond its payload (envelope + transport headers):
 // used for bandwidth and message-size checks.
 inline constexpr std::uint64_t kIpOverheadBytes = 96;
+
+// What authentication adds to each of `channel`'s messages or frames on `segment`; nullopt where
+// the hop is not authenticated (an LCM segment without auth, ...).
+std::optional<HopSecurity> hop_security(const SegmentSpec& segment, const ChannelSpec& channel);
 
 struct Evaluation {
   std::vector<ChannelReport> channels;  // same order as the input

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cosmic/channel_type.hpp"
+#include "cosmic/secret_key.hpp"
 #include "cosmic/units.hpp"
 
 namespace cosmic {
@@ -84,9 +85,21 @@ struct DdsSegmentProperties {
 // no counter touched, at the price of a read and a wake-up of the receive thread per datagram sent).
 enum class LcmOwnDatagrams { cut, drop };
 
+// An LCM segment's authentication (segment key `auth`; cosmic/lcm_auth.hpp, docs/security.md):
+// every envelope sent carries an HMAC-SHA256 trailer under `key`, and a received one without a
+// valid trailer, or signed more than `window` away from this host's clock, or sent before, is
+// dropped and counted.
+struct LcmAuthSpec {
+  std::string key_file;  // as resolved against the configuration's directory
+  SecretKey key;
+  Nanos window = std::chrono::seconds(1);
+  friend bool operator==(const LcmAuthSpec&, const LcmAuthSpec&) = default;
+};
+
 struct LcmSegmentProperties {
   std::string url = "udpm://239.255.76.67:7667?ttl=0";
   LcmOwnDatagrams own_datagrams = LcmOwnDatagrams::drop;
+  std::optional<LcmAuthSpec> auth{};
   friend bool operator==(const LcmSegmentProperties&, const LcmSegmentProperties&) = default;
 };
 

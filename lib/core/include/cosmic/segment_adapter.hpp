@@ -45,7 +45,9 @@ struct ChannelBinding {
 };
 
 // Why an inbound message could not become an event.
-enum class InboundProblem { decode_error, unknown_channel, own_echo };
+// unauthenticated, replayed: a message of an authenticated hop (docs/security.md) whose tag is not
+// valid, or that was sent before or outside the freshness window.
+enum class InboundProblem { decode_error, unknown_channel, own_echo, unauthenticated, replayed };
 
 // Implemented by the router, one per segment. Called from adapter threads; never blocks long:
 // the router does its ingress work on the calling thread and hands the event to the egress

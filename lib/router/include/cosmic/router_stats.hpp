@@ -30,9 +30,11 @@ enum class DropReason : std::size_t {
   invalid,
   oversize,
   out_of_range,  // a typed event's value its hop's representation cannot hold (on_range: drop)
-  corrupt
+  corrupt,
+  unauthenticated,  // an authenticated hop's message without a valid tag (docs/security.md)
+  replayed          // ... with a valid tag, sent before or outside the freshness window
 };
-inline constexpr std::size_t kDropReasonCount = 11;
+inline constexpr std::size_t kDropReasonCount = 13;
 const char* to_string(DropReason reason);
 
 struct SegmentCounters {

@@ -1,0 +1,59 @@
+// Reading key files (key_file_loader.hpp).
+#include "key_file_loader.hpp"
+
+#include <algorithm>
+#include <filesystem>
+
+#include "type_file_loader.hpp"
+
+namespace cosmic::config_detail {
+namespace {
+
+constexpr std::size_t kMaxKeyFileBytes = 4096;  // a key of 64 bytes is 128 digits; room for white space
+
+std::string refuse_open_key_file(unsigned mode) {
+  const Result<void> private_file = check_key_file_mode(mode);
+  return private_file ? std::string() : private_file.error().text;
+}
+
+void wipe(std::string& text) {
+  volatile char* p = text.data();
+  for (std::size_t i = 0; i < text.size(); ++i) p[i] = 0;
+}
+
+}  // namespace
+
+std::optional<LoadedKey> load_key_file(YamlReader& reader, const YAML::Node& node, const std::string& path,
+                                       std::vector<std::string>& included, std::size_t min_bytes,
+                                       std::size_t max_bytes) {
+  const auto file = reader.string(node, path);
+  if (!file) return std::nullopt;
+  const std::filesystem::path relative(*file);
+  const std::string resolved =
+      relative.is_absolute()
+          ? *file
+          : (std::filesystem::path(reader.file()).parent_path() / relative).lexically_normal().string();
+  const std::size_t suggested = std::clamp<std::size_t>(32, min_bytes, max_bytes);
+  const std::string valid = "a file only its owner may read, holding " + std::to_string(min_bytes) + " to " +
+                            std::to_string(max_bytes) + " bytes as hexadecimal digits (openssl rand -hex " +
+                            std::to_string(suggested) + " > FILE; chmod 600 FILE)";
+  std::string text;
+  // Read in place (never longer than this): no copy of the key is left behind in freed memory.
+  text.reserve(kMaxKeyFileBytes);
+  if (const std::string error = read_regular_file(resolved, text, kMaxKeyFileBytes, refuse_open_key_file);
+      !error.empty()) {
+    wipe(text);
+    reader.error_at(node, path, "cannot use key file " + resolved + ": " + error, valid);
+    return std::nullopt;
+  }
+  Result<SecretKey> key = parse_key_text(text, min_bytes, max_bytes);
+  wipe(text);
+  if (!key) {
+    reader.error_at(node, path, "key file " + resolved + " holds no key: " + key.error().text, valid);
+    return std::nullopt;
+  }
+  included.push_back(resolved);
+  return LoadedKey{resolved, std::move(key).value()};
+}
+
+}  // namespace cosmic::config_detail

@@ -1,0 +1,28 @@
+// Reading the key files a configuration names (an LCM segment's `auth: {key_file}`, issue 36):
+// relative to the configuration's own file, a regular file only its owner may read or write,
+// holding the key as hexadecimal digits (cosmic/secret_key.hpp). Every problem is reported at
+// the `key_file` value, never quoting the file's content. Internal to the config library.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cosmic/secret_key.hpp"
+#include "yaml_reader.hpp"
+
+namespace cosmic::config_detail {
+
+struct LoadedKey {
+  std::string path;  // as resolved against the configuration's directory
+  SecretKey key;
+};
+
+// The key in the file `node` names (key path `path`), of `min_bytes` to `max_bytes` bytes; its
+// resolved path goes to `included`. Nullopt after reporting why not.
+std::optional<LoadedKey> load_key_file(YamlReader& reader, const YAML::Node& node, const std::string& path,
+                                       std::vector<std::string>& included, std::size_t min_bytes,
+                                       std::size_t max_bytes);
+
+}  // namespace cosmic::config_detail
