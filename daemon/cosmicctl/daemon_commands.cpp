@@ -153,6 +153,14 @@ void print_segments(const Json& r) {
               << " own datagrams dropped by its receive filter (each also counted in the host's UDP InErrors; "
                  "own_datagrams: cut avoids it)\n";
   }
+  // Authenticated segments: what was refused, by kind.
+  for (const auto& s : r["segments"]) {
+    const Json& refused = s["adapter"].value("unauthenticated", Json());
+    if (!refused.is_number_unsigned()) continue;
+    if (std::exchange(first_note, false)) std::cout << "\n";
+    std::cout << text(s["name"]) << ": authenticated; dropped " << text(refused) << " unauthenticated, "
+              << text(s["adapter"].value("replayed", Json(0))) << " replayed\n";
+  }
 }
 
 // Seconds as a short age: "0.4s ago", "12s ago".

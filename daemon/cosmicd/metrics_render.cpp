@@ -146,6 +146,15 @@ void render_segment_counters(Exposition& out, const MetricsSnapshot& s) {
              "each is one in the host's UDP InErrors.");
   for (const auto& seg : s.segments)
     if (const auto own = seg.adapter.transport_counter("own_datagrams_dropped")) out.sample(segment_labels(seg), *own);
+  out.family("cosmic_segment_unauthenticated", MetricType::counter,
+             "Messages of an authenticated segment (LCM auth) dropped for want of a valid authentication tag.");
+  for (const auto& seg : s.segments)
+    if (const auto n = seg.adapter.transport_counter("unauthenticated")) out.sample(segment_labels(seg), *n);
+  out.family("cosmic_segment_replayed", MetricType::counter,
+             "Messages of an authenticated segment (LCM auth) with a valid tag dropped as sent before, or signed "
+             "outside the freshness window.");
+  for (const auto& seg : s.segments)
+    if (const auto n = seg.adapter.transport_counter("replayed")) out.sample(segment_labels(seg), *n);
 }
 
 void render_channel_state(Exposition& out, const MetricsSnapshot& s) {

@@ -2,10 +2,12 @@
 // namespace), polling with cosmic_get_event, waiting until a channel is carried (cosmic_wait_ready),
 // the refusals of bad input, and the control query.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <atomic>
 #include <chrono>
 #include <cstring>
+#include <fstream>
 #include <functional>
 #include <string>
 #include <thread>
@@ -373,3 +375,78 @@ TEST(Client, CheckChannelWithoutAGateway) {
 }
 
 }  // namespace
+
+// Components on an authenticated LCM segment (docs/security.md): the key named in the segment's
+// query is the client's; a component with it is heard, one without it never is.
+namespace client_auth {
+
+std::string write_client_key(const std::string& name, const std::string& hex, unsigned mode) {
+  const std::string path = testing::TempDir() + name;
+  std::ofstream(path) << hex << "\n";
+  ::chmod(path.c_str(), mode);
+  return path;
+}
+
+int poll_one(cosmic_channel* in, std::int32_t& value) {
+  cosmic_event_info info{};
+  return cosmic_get_event(in, &info, &value, sizeof value);
+}
+
+}  // namespace client_auth
+
+TEST(Client, OnAnAuthenticatedLcmSegmentOnlyHoldersOfTheKeyAreHeard) {
+  const std::string key = client_auth::write_client_key(
+      "client_auth.key", "00112233445566778899aabbccddeeff00112233445566778899aabbccddeeff", 0600);
+  const std::string other = client_auth::write_client_key(
+      "client_other.key", "ffeeddccbbaa99887766554433221100ffeeddccbbaa99887766554433221100", 0600);
+  const std::string url = "lcm:udpm://239.255.76.67:7942?ttl=0";
+  Client sub((url + "&key_file=" + key + "&window=500ms").c_str());
+  Client signer((url + "&key_file=" + key).c_str());
+  Client stranger((url + "&key_file=" + other).c_str());
+  Client plain(url.c_str());
+  for (const Client* c : {&sub, &signer, &stranger, &plain}) ASSERT_NE(c->handle, nullptr) << c->error;
+  const auto in_desc = with_roles(kSpeed, COSMIC_SUBSCRIBE);
+  cosmic_channel* in = cosmic_announce(sub.handle, &in_desc, 1000);
+  ASSERT_NE(in, nullptr) << cosmic_last_error(sub.handle);
+  cosmic_channel* forged = cosmic_announce(stranger.handle, &kSpeed, 1000);
+  cosmic_channel* unsigned_out = cosmic_announce(plain.handle, &kSpeed, 1000);
+  cosmic_channel* out = cosmic_announce(signer.handle, &kSpeed, 1000);
+  ASSERT_NE(forged, nullptr);
+  ASSERT_NE(unsigned_out, nullptr);
+  ASSERT_NE(out, nullptr);
+  // The others publish first, then the holder of the key: the first event polled must be its own.
+  const std::int32_t bad = -1;
+  const std::int32_t good = 700;
+  std::int32_t got = 0;
+  int rc = COSMIC_E_AGAIN;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (rc == COSMIC_E_AGAIN && std::chrono::steady_clock::now() < deadline) {
+    cosmic_publish(forged, &bad, sizeof bad);
+    cosmic_publish(unsigned_out, &bad, sizeof bad);
+    cosmic_publish(out, &good, sizeof good);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    rc = client_auth::poll_one(in, got);
+  }
+  ASSERT_EQ(rc, COSMIC_OK) << "no event within 20 s";
+  EXPECT_EQ(got, good);
+  while (client_auth::poll_one(in, got) == COSMIC_OK) EXPECT_EQ(got, good) << "an event without the key got through";
+}
+
+TEST(Client, RefusesKeyFilesItCannotUseWithTheReason) {
+  const std::string open_key = client_auth::write_client_key(
+      "client_open.key", "00112233445566778899aabbccddeeff00112233445566778899aabbccddeeff", 0644);
+  const std::string base = "lcm:udpm://239.255.76.67:7943?ttl=0";
+  const struct {
+    std::string segment;
+    std::string reason;
+  } cases[] = {
+      {base + "&key_file=" + open_key, "group or others may read or write it"},
+      {base + "&key_file=/nonexistent/lan.key", "cannot use key file /nonexistent/lan.key"},
+      {base + "&window=1s", "window= needs key_file="},
+  };
+  for (const auto& c : cases) {
+    Client client(c.segment.c_str());
+    EXPECT_EQ(client.handle, nullptr) << c.segment;
+    EXPECT_NE(std::string(client.error).find(c.reason), std::string::npos) << client.error;
+  }
+}

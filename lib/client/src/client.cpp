@@ -16,6 +16,8 @@
 
 #include "control_query.hpp"
 #include "cosmic/can_wire.hpp"
+#include "cosmic/key_file.hpp"
+#include "cosmic/lcm_auth_layout.hpp"
 #include "cosmic/mutex.hpp"
 #include "cosmic/thread_annotations.hpp"
 #include "transport.hpp"
@@ -92,7 +94,48 @@ struct cosmic_client final : Delivery {
 
 namespace {
 
-// "dds:0?reliability=best_effort", "lcm:udpm://...", "can:vcan0?node=5".
+// An authenticated LCM segment (docs/security.md): `key_file=PATH` and `window=DURATION` in the
+// URL's query are the client's, not LCM's; they are taken out of spec.lcm.url and the key is read.
+// Why not, or an empty string.
+std::string take_lcm_auth(cosmic::SegmentSpec& spec) {
+  std::string& url = spec.lcm.url;
+  const auto query = url.find('?');
+  if (query == std::string::npos) return {};
+  std::string kept;
+  std::optional<std::string> key_file;
+  std::optional<std::string> window;
+  std::size_t from = query + 1;
+  while (from <= url.size()) {
+    const std::size_t end = std::min(url.find('&', from), url.size());
+    const std::string item = url.substr(from, end - from);
+    if (item.rfind("key_file=", 0) == 0) {
+      key_file = item.substr(9);
+    } else if (item.rfind("window=", 0) == 0) {
+      window = item.substr(7);
+    } else {
+      kept += (kept.empty() ? "" : "&") + item;
+    }
+    from = end + 1;
+  }
+  if (!key_file && !window) return {};
+  if (!key_file) return "window= needs key_file= (the segment's key) beside it";
+  url = url.substr(0, query) + (kept.empty() ? "" : "?" + kept);
+  cosmic::LcmAuthSpec auth;
+  auth.key_file = *key_file;
+  if (window) {
+    const auto parsed = cosmic::parse_duration(*window);
+    if (!parsed.value || *parsed.value <= cosmic::Nanos::zero())
+      return "window=" + *window + " is no duration longer than 0 (e.g. 500ms)";
+    auth.window = *parsed.value;
+  }
+  auto key = cosmic::read_key_file(*key_file, cosmic::kLcmAuthMinKeyBytes, cosmic::kLcmAuthMaxKeyBytes);
+  if (!key) return key.error().text;
+  auth.key = std::move(key).value();
+  spec.lcm.auth = std::move(auth);
+  return {};
+}
+
+// "dds:0?reliability=best_effort", "lcm:udpm://...[?...&key_file=PATH]", "can:vcan0?node=5".
 std::unique_ptr<Transport> transport_for(const std::string& segment, std::string& error) {
   const auto colon = segment.find(':');
   const std::string kind = segment.substr(0, colon);
@@ -116,6 +159,8 @@ std::unique_ptr<Transport> transport_for(const std::string& segment, std::string
     spec.type = cosmic::SegmentType::lcm;
     spec.reliability = cosmic::Reliability::best_effort;
     spec.lcm.url = rest;
+    error = take_lcm_auth(spec);
+    if (!error.empty()) return nullptr;
     // A component sends at its own modest rate: its own looped-back messages are cut and skipped
     // rather than dropped, which would count each in the host's UDP InErrors (docs/components.md).
     spec.lcm.own_datagrams = cosmic::LcmOwnDatagrams::cut;

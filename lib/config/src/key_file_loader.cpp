@@ -4,9 +4,10 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "cosmic/key_file.hpp"
 #include "type_file_loader.hpp"
 
-namespace cosmic::config_detail {
+namespace cosmic {
 namespace {
 
 constexpr std::size_t kMaxKeyFileBytes = 4096;  // a key of 64 bytes is 128 digits; room for white space
@@ -16,12 +17,31 @@ std::string refuse_open_key_file(unsigned mode) {
   return private_file ? std::string() : private_file.error().text;
 }
 
-void wipe(std::string& text) {
+void wipe_key_text(std::string& text) {
   volatile char* p = text.data();
   for (std::size_t i = 0; i < text.size(); ++i) p[i] = 0;
 }
 
 }  // namespace
+
+Result<SecretKey> read_key_file(const std::string& path, std::size_t min_bytes, std::size_t max_bytes) {
+  std::string text;
+  // Read in place (never longer than this): no copy of the key is left behind in freed memory.
+  text.reserve(kMaxKeyFileBytes);
+  const std::string error = config_detail::read_regular_file(path, text, kMaxKeyFileBytes, refuse_open_key_file);
+  if (!error.empty()) {
+    wipe_key_text(text);
+    return Error{"cannot use key file " + path + ": " + error};
+  }
+  Result<SecretKey> key = parse_key_text(text, min_bytes, max_bytes);
+  wipe_key_text(text);
+  if (!key) return Error{"key file " + path + " holds no key: " + key.error().text};
+  return key;
+}
+
+}  // namespace cosmic
+
+namespace cosmic::config_detail {
 
 std::optional<LoadedKey> load_key_file(YamlReader& reader, const YAML::Node& node, const std::string& path,
                                        std::vector<std::string>& included, std::size_t min_bytes,
@@ -33,23 +53,13 @@ std::optional<LoadedKey> load_key_file(YamlReader& reader, const YAML::Node& nod
       relative.is_absolute()
           ? *file
           : (std::filesystem::path(reader.file()).parent_path() / relative).lexically_normal().string();
-  const std::size_t suggested = std::clamp<std::size_t>(32, min_bytes, max_bytes);
-  const std::string valid = "a file only its owner may read, holding " + std::to_string(min_bytes) + " to " +
-                            std::to_string(max_bytes) + " bytes as hexadecimal digits (openssl rand -hex " +
-                            std::to_string(suggested) + " > FILE; chmod 600 FILE)";
-  std::string text;
-  // Read in place (never longer than this): no copy of the key is left behind in freed memory.
-  text.reserve(kMaxKeyFileBytes);
-  if (const std::string error = read_regular_file(resolved, text, kMaxKeyFileBytes, refuse_open_key_file);
-      !error.empty()) {
-    wipe(text);
-    reader.error_at(node, path, "cannot use key file " + resolved + ": " + error, valid);
-    return std::nullopt;
-  }
-  Result<SecretKey> key = parse_key_text(text, min_bytes, max_bytes);
-  wipe(text);
+  Result<SecretKey> key = read_key_file(resolved, min_bytes, max_bytes);
   if (!key) {
-    reader.error_at(node, path, "key file " + resolved + " holds no key: " + key.error().text, valid);
+    const std::size_t suggested = std::clamp<std::size_t>(32, min_bytes, max_bytes);
+    reader.error_at(node, path, key.error().text,
+                    "a file only its owner may read, holding " + std::to_string(min_bytes) + " to " +
+                        std::to_string(max_bytes) + " bytes as hexadecimal digits (openssl rand -hex " +
+                        std::to_string(suggested) + " > FILE; chmod 600 FILE)");
     return std::nullopt;
   }
   included.push_back(resolved);
