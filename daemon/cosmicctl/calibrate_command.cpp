@@ -1,12 +1,18 @@
 // `cosmicctl calibrate [FILE]`: measures this machine's residence (the gateway's forwarding plane
 // under FILE's gateway.realtime) and says whether FILE's gateway.residence_bound covers its p99.9.
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "commands.hpp"
 #include "cosmic/config_loader.hpp"
 #include "cosmic/report.hpp"
+#include "cosmic/auth_timing.hpp"
+#include "cosmic/lcm_wire.hpp"
 #include "cosmic/residence_calibration.hpp"
 
 namespace cosmicctl {
@@ -61,6 +67,67 @@ void render_text(const cosmic::CalibrationResult& result, std::ostream& out) {
   for (const auto& problem : result.thread_problems) out << "realtime: could not get " << problem << "\n";
 }
 
+// One authenticated LCM segment's figure: its largest message, and what signing or checking it costs.
+struct SegmentAuthTiming {
+  std::string segment;
+  std::optional<cosmic::Nanos> configured;  // auth.cost
+  cosmic::AuthTiming timing;
+  bool covered() const { return configured && *configured >= timing.p999; }
+};
+
+// The authenticated segments of `config`, each timed with its largest envelope (the channels' hops there).
+std::vector<SegmentAuthTiming> time_authentication(const cosmic::Config& config) {
+  constexpr std::size_t kRuns = 20000;
+  std::vector<SegmentAuthTiming> out;
+  for (const auto& segment : config.segments) {
+    if (segment.type != cosmic::SegmentType::lcm || !segment.lcm.auth) continue;
+    std::uint64_t largest = 0;
+    for (const auto& channel : config.channels) {
+      const bool here =
+          std::find(channel.publishers.begin(), channel.publishers.end(), segment.name) != channel.publishers.end() ||
+          std::find(channel.subscribers.begin(), channel.subscribers.end(), segment.name) != channel.subscribers.end();
+      if (here) largest = std::max(largest, channel.payload_on(segment.name));
+    }
+    const std::size_t message = static_cast<std::size_t>(largest) + cosmic::kLcmEnvelopeHeaderSize;
+    out.push_back({segment.name, segment.lcm.auth->cost, cosmic::time_lcm_auth(message, kRuns)});
+  }
+  return out;
+}
+
+void render_auth_text(const std::vector<SegmentAuthTiming>& timings, std::ostream& out) {
+  if (timings.empty()) return;
+  char line[200];
+  std::snprintf(line, sizeof line, "\n%-16s %9s %10s %10s %10s %10s  %s\n", "authentication", "message", "p50", "p99",
+                "p99.9", "max", "auth.cost");
+  out << line;
+  for (const auto& t : timings) {
+    std::snprintf(line, sizeof line, "%-16s %7zu B %10s %10s %10s %10s  %s\n", t.segment.c_str(),
+                  t.timing.message_bytes, cosmic::format_duration(t.timing.p50).c_str(),
+                  cosmic::format_duration(t.timing.p99).c_str(), cosmic::format_duration(t.timing.p999).c_str(),
+                  cosmic::format_duration(t.timing.max).c_str(),
+                  !t.configured ? "not set: admission does not count it"
+                  : t.covered() ? ("covers p99.9 (" + cosmic::format_duration(*t.configured) + ")").c_str()
+                                : ("BELOW p99.9 (" + cosmic::format_duration(*t.configured) + ")").c_str());
+    out << line;
+  }
+}
+
+nlohmann::json auth_json(const std::vector<SegmentAuthTiming>& timings) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& t : timings) {
+    out.push_back({{"segment", t.segment},
+                   {"message_bytes", t.timing.message_bytes},
+                   {"runs", t.timing.runs},
+                   {"p50_us", micros(t.timing.p50)},
+                   {"p99_us", micros(t.timing.p99)},
+                   {"p999_us", micros(t.timing.p999)},
+                   {"max_us", micros(t.timing.max)},
+                   {"configured_cost_us", t.configured ? nlohmann::json(micros(*t.configured)) : nlohmann::json()},
+                   {"cost_covers_p999", t.covered()}});
+  }
+  return out;
+}
+
 }  // namespace
 
 CommandRunner add_calibrate_command(CLI::App& app, const GlobalOptions& options) {
@@ -78,6 +145,7 @@ CommandRunner add_calibrate_command(CLI::App& app, const GlobalOptions& options)
   return [command, args, &options]() -> int {
     if (!command->parsed()) return -1;
     cosmic::GatewaySpec gateway;
+    std::vector<SegmentAuthTiming> authentication;
     if (!args->file.empty()) {
       const auto loaded = cosmic::load_config_file(args->file);
       if (!loaded.ok()) {
@@ -86,20 +154,33 @@ CommandRunner add_calibrate_command(CLI::App& app, const GlobalOptions& options)
         return kExitConfigError;
       }
       gateway = loaded.config.gateway;
+      authentication = time_authentication(loaded.config);
     }
     cosmic::CalibrationOptions calibration;
     calibration.phase_duration = cosmic::Nanos(static_cast<std::int64_t>(args->seconds * 1e9));
     calibration.hrt_rate_hz = args->rate_hz;
     const auto result = cosmic::calibrate_residence(gateway, calibration);
+    const bool costs_covered = std::all_of(authentication.begin(), authentication.end(),
+                                           [](const SegmentAuthTiming& t) { return !t.configured || t.covered(); });
     if (options.json) {
-      std::cout << to_json(result).dump(2) << "\n";
+      nlohmann::json json = to_json(result);
+      json["authentication"] = auth_json(authentication);
+      std::cout << json.dump(2) << "\n";
     } else {
       render_text(result, std::cout);
       std::cout << "residence_bound " << cosmic::format_duration(result.residence_bound)
                 << (result.bound_covers_p999() ? " covers" : " is BELOW") << " this machine's residence p99.9 "
                 << cosmic::format_duration(result.worst_p999) << "\n";
+      render_auth_text(authentication, std::cout);
     }
-    if (result.bound_covers_p999()) return kExitOk;
+    for (const auto& t : authentication) {
+      if (t.configured && !t.covered())
+        std::cerr << "warning: segment " << t.segment << ": auth.cost " << cosmic::format_duration(*t.configured)
+                  << " is below the p99.9 measured here (" << cosmic::format_duration(t.timing.p999)
+                  << "): raise it, or admission promises latencies this machine does not hold\n";
+    }
+    if (result.bound_covers_p999() && costs_covered) return kExitOk;
+    if (result.bound_covers_p999()) return kExitRejected;
     std::cerr << "warning: gateway.residence_bound " << cosmic::format_duration(result.residence_bound)
               << " is below the residence p99.9 measured here (" << cosmic::format_duration(result.worst_p999)
               << "): HRT channels will be reported violated; raise residence_bound, configure gateway.realtime, "

@@ -56,7 +56,32 @@ assert d["bound_covers_p999"] is False
 assert all(p["residence_miss"] == p["hrt_sent"] > 0 for p in d["phases"]), d["phases"]
 ' "$WORK/tight_json.out" || fail "tight_json: every HRT event should miss a 1 ns bound"
 
-# 3. Bad input: a usage error or a located configuration error, nothing measured.
+# 3. An authenticated LCM segment (docs/security.md): its cryptography timed with the largest
+# envelope of its channels, and compared with auth.cost: 1 ns is below any, 60 s above any.
+with_auth() {  # with_auth FILE COST: the loose robot with its viz segment authenticated at COST
+  sed "s|^    url: udpm://239.255.76.67:7667?ttl=0|&\n    auth: {key_file: viz.key, cost: $2}|" "$WORK/loose.yaml" >"$1"
+  grep -q "auth: {key_file: viz.key, cost: $2}" "$1" || fail "could not authenticate viz in $1"
+}
+(umask 077 && openssl rand -hex 32 >"$WORK/viz.key")
+with_auth "$WORK/auth_loose.yaml" 60s
+with_auth "$WORK/auth_tight.yaml" 1ns
+run auth_json 0 calibrate "$WORK/auth_loose.yaml" --seconds 0.3 --rate 500 --json
+python3 - "$WORK/auth_json.out" <<'PY' || fail "auth_json: the authentication figures"
+import json, sys
+d = json.load(open(sys.argv[1]))
+auth = d["authentication"]
+assert [a["segment"] for a in auth] == ["viz"], auth
+a = auth[0]
+assert a["message_bytes"] > 49 and a["runs"] == 20000, a          # an envelope's header and more
+assert 0 < a["p50_us"] <= a["p99_us"] <= a["p999_us"] <= a["max_us"], a
+assert a["configured_cost_us"] == 60e6 and a["cost_covers_p999"] is True, a
+PY
+run auth_tight 1 calibrate "$WORK/auth_tight.yaml" --seconds 0.3 --rate 500
+contains auth_tight out "authentication"
+contains auth_tight out "BELOW p99.9 (1 ns)"
+contains auth_tight err "warning: segment viz: auth.cost 1 ns is below the p99.9 measured here"
+
+# 4. Bad input: a usage error or a located configuration error, nothing measured.
 run bad_rate 64 calibrate --rate 0
 run bad_seconds 64 calibrate --seconds -1
 run missing_file 64 calibrate "$WORK/nope.yaml"

@@ -10,6 +10,7 @@
 
 #include "cosmic/admission.hpp"
 #include "cosmic/config_loader.hpp"
+#include "cosmic/report.hpp"
 
 namespace cosmic {
 namespace {
@@ -138,6 +139,24 @@ TEST_F(LcmAuthConfig, AdmissionCountsTheTrailerOnTheAuthenticatedHop) {
   };
   const double bandwidth = static_cast<double>(result.config.find_segment("lan")->bandwidth.bits_per_second);
   EXPECT_NEAR(load_of("lan"), (16 + 96 + 40) * 8 / 0.010 / bandwidth, 1e-12);
+}
+
+TEST_F(LcmAuthConfig, TheCalibratedCostIsPartOfTheHopsLatencyAndShown) {
+  key_file("lan.key", kKey32, 0600);
+  const ConfigResult result = load("{key_file: lan.key, cost: 40ms}");
+  ASSERT_TRUE(result.errors.empty()) << result.errors.front().to_string();
+  EXPECT_EQ(result.config.find_segment("lan")->lcm.auth->cost, std::chrono::milliseconds(40));
+  const Evaluation e = evaluate(result.config.gateway, result.config.segments, result.config.channels, {});
+  const ChannelReport& r = e.channels.front();
+  const HopReport& lan = r.hops.front().segment == "lan" ? r.hops.front() : r.hops.back();
+  ASSERT_TRUE(lan.security && lan.security->time);
+  EXPECT_EQ(*lan.security->time, std::chrono::milliseconds(40));
+  // The segment's latency_bound (10 ms by default) and the 40 ms: 50 ms, and the channel's 50 ms
+  // reaction time is missed once the gateway's residence is added; SRT degrades.
+  EXPECT_EQ(lan.latency, std::chrono::milliseconds(50));
+  EXPECT_EQ(r.verdict, Verdict::degraded);
+  const std::string text = render_channel_text(r);
+  EXPECT_NE(text.find("signed HMAC-SHA256 trailer +40 B 40 ms"), std::string::npos) << text;
 }
 
 TEST_F(LcmAuthConfig, ARawChannelOnAnAuthenticatedSegmentIsRejectedWithTheReason) {

@@ -397,7 +397,7 @@ class ConfigParser {
 
   // auth: {key_file: FILE, window: DURATION} (cosmic/lcm_auth.hpp).
   void parse_lcm_auth(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
-    if (!reader_.check_map(node, path, {"key_file", "window"})) return;
+    if (!reader_.check_map(node, path, {"key_file", "window", "cost"})) return;
     LcmAuthSpec auth;
     if (require(node, path, "key_file", "a key file: openssl rand -hex 32 > FILE; chmod 600 FILE")) {
       auto loaded = config_detail::load_key_file(reader_, node["key_file"], key(path, "key_file"), included_,
@@ -409,6 +409,9 @@ class ConfigParser {
     }
     if (has(node, "window")) {
       if (auto v = reader_.duration(node["window"], key(path, "window"), false)) auth.window = *v;
+    }
+    if (has(node, "cost")) {
+      if (auto v = reader_.duration(node["cost"], key(path, "cost"), true)) auth.cost = *v;
     }
     s.lcm.auth = std::move(auth);
   }

@@ -91,9 +91,14 @@ double hop_load(const SegmentSpec& segment, const ChannelSpec& channel) {
 
 std::optional<HopSecurity> hop_security(const SegmentSpec& segment, const ChannelSpec& channel) {
   if (segment.type == SegmentType::lcm && segment.lcm.auth)
-    return HopSecurity{"HMAC-SHA256 trailer", static_cast<std::uint32_t>(kLcmAuthTrailerSize)};
+    return HopSecurity{"HMAC-SHA256 trailer", static_cast<std::uint32_t>(kLcmAuthTrailerSize), segment.lcm.auth->cost};
   (void)channel;  // SecOC (per CAN hop of a channel) comes with its own key
   return std::nullopt;
+}
+
+Nanos ip_hop_latency(const SegmentSpec& segment) {
+  const bool costed = segment.type == SegmentType::lcm && segment.lcm.auth && segment.lcm.auth->cost;
+  return segment.latency_bound + (costed ? *segment.lcm.auth->cost : Nanos(0));
 }
 
 const char* to_string(Verdict value) {
@@ -277,7 +282,7 @@ bool AdmissionSet::update_jitters(CanSide& side, const Trial* newcomer) const {
         if (p.role != HopRole::publisher) continue;
         const std::optional<Nanos> latency = segment_specs_[p.segment].type == SegmentType::can
                                                  ? side.plans[p.segment][p.position].response_time
-                                                 : std::optional<Nanos>(segment_specs_[p.segment].latency_bound);
+                                                 : std::optional<Nanos>(ip_hop_latency(segment_specs_[p.segment]));
         upstream = upstream && latency ? std::optional<Nanos>(std::max(*upstream, *latency)) : std::nullopt;
       }
       const Nanos jitter =
@@ -364,7 +369,7 @@ ChannelReport AdmissionSet::report_of(const ChannelSpec& spec, const ChannelData
       h.background = background_delaying(segment, segments_[p.segment].background, spec, plan);
       h.can = plan;
     } else {
-      h.latency = segment.latency_bound;
+      h.latency = ip_hop_latency(segment);
       if (segment.type == SegmentType::dds) h.dds = dds_topic_of(spec, segment.name);
     }
     report.hops.push_back(std::move(h));

@@ -107,7 +107,9 @@ std::string failure_text(const Check& check, const HopReport& h, const SegmentSp
            background_text(h);
   }
   if (check.check == "latency") {
-    return "latency_bound " + format_seconds(check.value) + " > reaction_time " + format_seconds(check.limit) + on;
+    const bool costed = h.security && h.security->time;
+    return (costed ? "latency_bound + authentication " : "latency_bound ") + format_seconds(check.value) +
+           " > reaction_time " + format_seconds(check.limit) + on;
   }
   if (check.check == "omission") {
     return "omission_degree " + std::to_string(static_cast<long long>(check.value)) + " < " +

@@ -55,7 +55,10 @@ nlohmann::json to_json(const HopReport& hop) {
     if (hop.dds->native) out["dds"]["representation"] = to_string(hop.dds->representation);
   }
   if (!hop.representation.empty()) out["representation"] = hop.representation;
-  if (hop.security) out["security"] = {{"scheme", hop.security->scheme}, {"bytes", hop.security->bytes}};
+  if (hop.security) {
+    out["security"] = {{"scheme", hop.security->scheme}, {"bytes", hop.security->bytes}};
+    out["security"]["time_s"] = hop.security->time ? nlohmann::json(to_seconds(*hop.security->time)) : nlohmann::json();
+  }
   out["checks"] = nlohmann::json::array();
   for (const auto& check : hop.checks) out["checks"].push_back(to_json(check));
   if (!hop.background.empty()) {
@@ -233,7 +236,10 @@ std::string render_channel_text(const ChannelReport& channel) {
     }
     if (hop.dds) out << "  topic " << hop.dds->topic << " type " << hop.dds->type;
     if (!hop.representation.empty()) out << "  as " << hop.representation;
-    if (hop.security) out << "  signed " << hop.security->scheme << " +" << hop.security->bytes << " B";
+    if (hop.security) {
+      out << "  signed " << hop.security->scheme << " +" << hop.security->bytes << " B";
+      if (hop.security->time) out << " " << format_duration(*hop.security->time);
+    }
     out << "\n";
     for (const auto& check : hop.checks) {
       out << "    " << (check.ok ? "ok   " : "FAIL ") << pad_column(check.check, 14) << check_value_text(check) << " "

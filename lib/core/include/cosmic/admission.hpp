@@ -79,6 +79,9 @@ inline std::uint32_t arbitration_key(const CanHopPlan& plan) {
 struct HopSecurity {
   std::string scheme;       // "HMAC-SHA256 trailer"
   std::uint32_t bytes = 0;  // added to each message or frame
+  // What its cryptography adds to the hop's latency, as measured (`cosmicctl calibrate`) and
+  // configured; none when not configured (then not counted).
+  std::optional<Nanos> time{};
   friend bool operator==(const HopSecurity&, const HopSecurity&) = default;
 };
 
@@ -171,6 +174,9 @@ inline constexpr std::uint64_t kIpOverheadBytes = 96;
 // What authentication adds to each of `channel`'s messages or frames on `segment`; nullopt where
 // the hop is not authenticated (an LCM segment without auth, ...).
 std::optional<HopSecurity> hop_security(const SegmentSpec& segment, const ChannelSpec& channel);
+// The latency an IP segment's hop promises: the segment's latency_bound, and what its
+// authentication's cryptography costs where that is configured.
+Nanos ip_hop_latency(const SegmentSpec& segment);
 
 struct Evaluation {
   std::vector<ChannelReport> channels;  // same order as the input

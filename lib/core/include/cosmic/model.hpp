@@ -93,6 +93,9 @@ struct LcmAuthSpec {
   std::string key_file;  // as resolved against the configuration's directory
   SecretKey key;
   Nanos window = std::chrono::seconds(1);
+  // What signing or checking one message costs on this machine, worst case (`auth.cost`, as
+  // `cosmicctl calibrate` measures it): admission adds it to the hop's latency. None: not counted.
+  std::optional<Nanos> cost{};
   friend bool operator==(const LcmAuthSpec&, const LcmAuthSpec&) = default;
 };
 
