@@ -307,6 +307,11 @@ void print_channel(const Json& r) {
     }
     if (hop.contains("dds"))
       std::cout << "  topic " << text(hop["dds"]["topic"]) << " type " << text(hop["dds"]["type"]);
+    if (hop.contains("security")) {
+      const Json& security = hop["security"];
+      std::cout << "  signed " << text(security["scheme"]) << " +" << text(security["bytes"]) << " B";
+      if (security["time_s"].is_number()) std::cout << " " << micros(security["time_s"].get<double>());
+    }
     std::cout << "\n";
     for (const auto& check : hop["checks"]) {
       std::cout << "    " << (check["ok"].get<bool>() ? "ok   " : "FAIL ") << pad_column(text(check["check"]), 14)
