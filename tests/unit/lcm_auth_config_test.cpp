@@ -101,6 +101,22 @@ TEST_F(LcmAuthConfig, KeyFilesThatCannotBeUsedAreRefusedAtTheKey) {
   }
 }
 
+TEST_F(LcmAuthConfig, KeysAcceptedDuringAKeyChangeAreReadAndCheckedLikeTheKey) {
+  key_file("lan.key", kKey32, 0600);
+  key_file("next.key", "ff" + kKey32.substr(2), 0600);
+  key_file("open.key", kKey32, 0604);
+  const ConfigResult result = load("{key_file: lan.key, accept_key_files: [next.key]}");
+  ASSERT_TRUE(result.errors.empty()) << result.errors.front().to_string();
+  const LcmAuthSpec& auth = *result.config.find_segment("lan")->lcm.auth;
+  ASSERT_EQ(auth.accepted.size(), 1u);
+  EXPECT_EQ(auth.accepted.front().bytes()[0], 0xff);
+  EXPECT_EQ(auth.accepted_files.front(), (dir_ / "next.key").string());
+  const ConfigResult open = load("{key_file: lan.key, accept_key_files: [next.key, open.key]}");
+  ASSERT_EQ(open.errors.size(), 1u);
+  EXPECT_EQ(open.errors.front().path, "segments[1].auth.accept_key_files[1]");
+  EXPECT_NE(open.errors.front().message.find("group or others may read or write it"), std::string::npos);
+}
+
 TEST_F(LcmAuthConfig, AuthNeedsAKeyFileAndALongerWindowThanZero) {
   const ConfigResult no_key = load("{window: 1s}");
   ASSERT_EQ(no_key.errors.size(), 1u);

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -106,6 +108,58 @@ TEST(LcmAuth, OutsideTheTimeWindowIsAReplayEvenForANewReceiver) {
   EXPECT_EQ(pair.verifier.check("obstacle", edge, kNow).verdict, LcmAuthVerdict::authentic);
 }
 
+// A holder of the key picks sent_ns freely: the extremes are refused, never an overflow (UBSan).
+TEST(LcmAuth, SigningTimesAtTheEndsOfTheClockAreOutsideTheWindow) {
+  LcmAuthPair pair;
+  for (const std::int64_t sent : {std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::int64_t>::max(),
+                                  std::int64_t{0}, std::int64_t{-1}}) {
+    const LcmAuthCheck checked =
+        pair.verifier.check("obstacle", signed_message(pair.signer, "obstacle", kBody, sent), kNow);
+    EXPECT_EQ(checked.verdict, LcmAuthVerdict::replayed) << sent;
+  }
+  EXPECT_EQ(
+      pair.verifier.check("obstacle", signed_message(pair.signer, "obstacle", kBody, kNow + 500'000'000), kNow).verdict,
+      LcmAuthVerdict::authentic);  // the window's far edge is inside
+}
+
+// Another holder of the key writes under a sender's number with a huge sequence: that sender's
+// next messages count as replayed, but only until its entry expires, not for good.
+TEST(LcmAuth, ASenderNumberPushedUpByAnotherHolderRecoversAfterTheWindow) {
+  LcmAuthPair pair;
+  ASSERT_EQ(pair.verifier.check("obstacle", signed_message(pair.signer, "obstacle", kBody), kNow).verdict,
+            LcmAuthVerdict::authentic);
+  // The same sender number, sequence 2^64 - 1: a hand-made trailer, as a holder of the key could.
+  auto mac = MessageAuth::make(MacAlgorithm::hmac_sha256, auth_test_key(1)).value();
+  std::vector<std::uint8_t> head{0x11, 0x22, 0x33, 0x44, 0x55, 0x66, 0x77, 0x88, 0xff, 0xff, 0xff, 0xff,
+                                 0xff, 0xff, 0xff, 0xff, 0,    0,    0,    0,    0,    0,    0,    0};
+  for (int i = 0; i < 8; ++i)
+    head[16 + i] = static_cast<std::uint8_t>(static_cast<std::uint64_t>(kNow) >> (56 - 8 * i));
+  const std::uint8_t length = 8;
+  MacBytes tag{};
+  ASSERT_TRUE(mac.compute({std::span(&length, 1), std::span(reinterpret_cast<const std::uint8_t*>("obstacle"), 8),
+                           std::span(kBody), std::span(head)},
+                          tag));
+  std::vector<std::uint8_t> pushed = kBody;
+  pushed.insert(pushed.end(), head.begin(), head.end());
+  pushed.insert(pushed.end(), tag.begin(), tag.begin() + 16);
+  ASSERT_EQ(pair.verifier.check("obstacle", pushed, kNow).verdict, LcmAuthVerdict::authentic);
+  EXPECT_EQ(pair.verifier.check("obstacle", signed_message(pair.signer, "obstacle", kBody), kNow).verdict,
+            LcmAuthVerdict::replayed);
+  const std::int64_t later = kNow + 600'000'000;  // past the window after the pushed message
+  EXPECT_EQ(pair.verifier.check("obstacle", signed_message(pair.signer, "obstacle", kBody, later), later).verdict,
+            LcmAuthVerdict::authentic);
+}
+
+TEST(LcmAuth, ACrowdedTableSaysSo) {
+  LcmAuthPair pair;
+  for (std::uint64_t id = 1; id <= LcmAuthVerifier::kMaxSenders; ++id) {
+    auto signer = LcmAuthSigner::make(auth_test_key(1), id).value();
+    ASSERT_FALSE(pair.verifier.check("obstacle", signed_message(signer, "obstacle", kBody), kNow).crowded);
+  }
+  auto one_more = LcmAuthSigner::make(auth_test_key(1), 100000).value();
+  EXPECT_TRUE(pair.verifier.check("obstacle", signed_message(one_more, "obstacle", kBody), kNow).crowded);
+}
+
 TEST(LcmAuth, ReorderedWithinTheWindowIsTakenBelowItIsNot) {
   LcmAuthPair pair;
   std::vector<std::vector<std::uint8_t>> sent;
@@ -140,6 +194,25 @@ TEST(LcmAuth, SendersAreForgottenAfterTheWindowAndBounded) {
             LcmAuthVerdict::authentic);
 }
 
+// A key change: receivers accept the new key beside the old before senders sign with it, and the
+// old beside the new until every sender changed over; a key in neither list still counts for nothing.
+TEST(LcmAuth, DuringAKeyChangeTagsOfEitherKeyCount) {
+  const auto old_key = auth_test_key(1);
+  const auto new_key = auth_test_key(2);
+  const std::span<const std::uint8_t> both[] = {old_key, new_key};
+  auto verifier = LcmAuthVerifier::make(both, 500ms).value();
+  auto old_signer = LcmAuthSigner::make(old_key, 1).value();
+  auto new_signer = LcmAuthSigner::make(new_key, 2).value();
+  auto stranger = LcmAuthSigner::make(auth_test_key(3), 3).value();
+  EXPECT_EQ(verifier.check("obstacle", signed_message(old_signer, "obstacle", kBody), kNow).verdict,
+            LcmAuthVerdict::authentic);
+  EXPECT_EQ(verifier.check("obstacle", signed_message(new_signer, "obstacle", kBody), kNow).verdict,
+            LcmAuthVerdict::authentic);
+  EXPECT_EQ(verifier.check("obstacle", signed_message(stranger, "obstacle", kBody), kNow).verdict,
+            LcmAuthVerdict::unauthenticated);
+  EXPECT_FALSE(LcmAuthVerifier::make(std::span<const std::span<const std::uint8_t>>{}, 500ms));
+}
+
 TEST(LcmAuth, KeysAndWindowsAreChecked) {
   EXPECT_FALSE(LcmAuthSigner::make(std::vector<std::uint8_t>(8, 1), 1));
   EXPECT_EQ(LcmAuthVerifier::make(auth_test_key(1), 0ms).error().text, "the replay window must be longer than 0");
@@ -162,18 +235,23 @@ TEST(ReplayWindow, EachNumberOnceAndNothingBelowTheWindow) {
   EXPECT_EQ(window.highest(), 1000u);
 }
 
-TEST(ReplayWindow, ShiftsKeepEveryMarkInPlace) {
-  // Against a plain set of what was accepted, over shifts of every size within the window.
-  ReplayWindow window;
-  std::vector<std::uint64_t> accepted;
-  std::uint64_t next = 1;
-  for (std::uint64_t step = 1; step < 300; step += 7) {
-    next += step;
-    ASSERT_TRUE(window.accept(next));
-    accepted.push_back(next);
-    for (const std::uint64_t a : accepted) {
-      if (next - a < ReplayWindow::kWidth) {
-        EXPECT_FALSE(window.accept(a)) << a << " after " << next;
+TEST(ReplayWindow, ShiftsKeepEveryMarkInPlaceAndAddNone) {
+  // Against a plain set of what was accepted, over shifts of many sizes within the window: after
+  // each, every accepted number within the window is refused and every other one is still new
+  // (tried on a copy, so the window itself is not changed).
+  for (const std::uint64_t stride : {7u, 11u}) {
+    ReplayWindow window;
+    std::vector<std::uint64_t> accepted;
+    std::uint64_t next = 1;
+    for (std::uint64_t step = 1; step < 300; step += stride) {
+      next += step;
+      ASSERT_TRUE(window.accept(next));
+      accepted.push_back(next);
+      for (std::uint64_t behind = 0; behind < ReplayWindow::kWidth && behind < next; ++behind) {
+        const std::uint64_t number = next - behind;
+        const bool taken = std::find(accepted.begin(), accepted.end(), number) != accepted.end();
+        ReplayWindow copy = window;
+        EXPECT_EQ(copy.accept(number), !taken) << number << " after " << next;
       }
     }
   }

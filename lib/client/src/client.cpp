@@ -94,9 +94,9 @@ struct cosmic_client final : Delivery {
 
 namespace {
 
-// An authenticated LCM segment (docs/security.md): `key_file=PATH` and `window=DURATION` in the
-// URL's query are the client's, not LCM's; they are taken out of spec.lcm.url and the key is read.
-// Why not, or an empty string.
+// An authenticated LCM segment (docs/security.md): `key_file=PATH`, `window=DURATION` and
+// `accept_key_file=PATH` (repeatable) in the URL's query are the client's, not LCM's; they are taken out of
+// spec.lcm.url and the key is read. Why not, or an empty string.
 std::string take_lcm_auth(cosmic::SegmentSpec& spec) {
   std::string& url = spec.lcm.url;
   const auto query = url.find('?');
@@ -104,21 +104,28 @@ std::string take_lcm_auth(cosmic::SegmentSpec& spec) {
   std::string kept;
   std::optional<std::string> key_file;
   std::optional<std::string> window;
+  std::vector<std::string> accepted;
   std::size_t from = query + 1;
   while (from <= url.size()) {
     const std::size_t end = std::min(url.find('&', from), url.size());
     const std::string item = url.substr(from, end - from);
     if (item.rfind("key_file=", 0) == 0) {
+      if (key_file) return "key_file= is given twice";
       key_file = item.substr(9);
+      if (key_file->empty()) return "key_file= names no file";
     } else if (item.rfind("window=", 0) == 0) {
+      if (window) return "window= is given twice";
       window = item.substr(7);
+    } else if (item.rfind("accept_key_file=", 0) == 0) {
+      accepted.push_back(item.substr(16));
     } else {
       kept += (kept.empty() ? "" : "&") + item;
     }
     from = end + 1;
   }
-  if (!key_file && !window) return {};
-  if (!key_file) return "window= needs key_file= (the segment's key) beside it";
+  if (!key_file && !window && accepted.empty()) return {};
+  if (!key_file) return "window= and accept_key_file= need key_file= (the segment's key) beside them";
+  if (url.rfind("memq://", 0) == 0) return "memq:// reaches no other program: there is nothing to authenticate";
   url = url.substr(0, query) + (kept.empty() ? "" : "?" + kept);
   cosmic::LcmAuthSpec auth;
   auth.key_file = *key_file;
@@ -131,6 +138,12 @@ std::string take_lcm_auth(cosmic::SegmentSpec& spec) {
   auto key = cosmic::read_key_file(*key_file, cosmic::kLcmAuthMinKeyBytes, cosmic::kLcmAuthMaxKeyBytes);
   if (!key) return key.error().text;
   auth.key = std::move(key).value();
+  for (const std::string& file : accepted) {
+    auto extra = cosmic::read_key_file(file, cosmic::kLcmAuthMinKeyBytes, cosmic::kLcmAuthMaxKeyBytes);
+    if (!extra) return extra.error().text;
+    auth.accepted_files.push_back(file);
+    auth.accepted.push_back(std::move(extra).value());
+  }
   spec.lcm.auth = std::move(auth);
   return {};
 }

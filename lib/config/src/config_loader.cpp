@@ -397,7 +397,7 @@ class ConfigParser {
 
   // auth: {key_file: FILE, window: DURATION} (cosmic/lcm_auth.hpp).
   void parse_lcm_auth(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
-    if (!reader_.check_map(node, path, {"key_file", "window", "cost"})) return;
+    if (!reader_.check_map(node, path, {"key_file", "accept_key_files", "window", "cost"})) return;
     LcmAuthSpec auth;
     if (require(node, path, "key_file", "a key file: openssl rand -hex 32 > FILE; chmod 600 FILE")) {
       auto loaded = config_detail::load_key_file(reader_, node["key_file"], key(path, "key_file"), included_,
@@ -405,6 +405,16 @@ class ConfigParser {
       if (loaded) {
         auth.key_file = loaded->path;
         auth.key = std::move(loaded->key);
+      }
+    }
+    if (has(node, "accept_key_files") && reader_.is_list(node["accept_key_files"], key(path, "accept_key_files"))) {
+      const YAML::Node& files = node["accept_key_files"];
+      for (std::size_t i = 0; i < files.size(); ++i) {
+        auto loaded = config_detail::load_key_file(reader_, files[i], indexed(key(path, "accept_key_files"), i),
+                                                   included_, kLcmAuthMinKeyBytes, kLcmAuthMaxKeyBytes);
+        if (!loaded) continue;
+        auth.accepted_files.push_back(loaded->path);
+        auth.accepted.push_back(std::move(loaded->key));
       }
     }
     if (has(node, "window")) {

@@ -1,6 +1,8 @@
 // Reading key files (key_file_loader.hpp).
 #include "key_file_loader.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <filesystem>
 
@@ -12,8 +14,13 @@ namespace {
 
 constexpr std::size_t kMaxKeyFileBytes = 4096;  // a key of 64 bytes is 128 digits; room for white space
 
-std::string refuse_open_key_file(unsigned mode) {
-  const Result<void> private_file = check_key_file_mode(mode);
+// Only its owner may read or write it, and the owner is this process's user or root: another user
+// could change the key under us.
+std::string refuse_open_key_file(const struct stat& status) {
+  if (status.st_uid != ::geteuid() && status.st_uid != 0)
+    return "owned by user " + std::to_string(status.st_uid) + ", neither this process's user (" +
+           std::to_string(::geteuid()) + ") nor root";
+  const Result<void> private_file = check_key_file_mode(status.st_mode);
   return private_file ? std::string() : private_file.error().text;
 }
 

@@ -15,7 +15,7 @@
 namespace cosmic::config_detail {
 
 std::string read_regular_file(const std::string& path, std::string& text, std::size_t max_bytes,
-                              std::string (*refuse_mode)(unsigned mode)) {
+                              std::string (*refuse)(const struct stat& status)) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) return std::strerror(errno);
   struct stat info {};
@@ -24,7 +24,7 @@ std::string read_regular_file(const std::string& path, std::string& text, std::s
     error = std::strerror(errno);
   } else if (!S_ISREG(info.st_mode)) {
     error = "not a regular file";
-  } else if (refuse_mode != nullptr && !(error = refuse_mode(info.st_mode)).empty()) {
+  } else if (refuse != nullptr && !(error = refuse(info)).empty()) {
     // refused for its permissions
   } else if (static_cast<std::uint64_t>(info.st_size) > max_bytes) {
     error = max_bytes >= (1u << 20) ? "larger than " + std::to_string(max_bytes >> 20) + " MiB"

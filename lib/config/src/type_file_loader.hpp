@@ -5,6 +5,8 @@
 // configuration is loaded.
 #pragma once
 
+#include <sys/stat.h>
+
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,10 +18,10 @@
 namespace cosmic::config_detail {
 
 // Reads a regular file of at most `max_bytes` into `text` without ever blocking on a FIFO or a
-// device; why not, or an empty string. `refuse_mode`, where given, says why a file of that
-// st_mode must not be read (empty: it may).
+// device; why not, or an empty string. `refuse`, where given, says why a file of that status
+// (owner, permissions) must not be read (empty: it may).
 std::string read_regular_file(const std::string& path, std::string& text, std::size_t max_bytes,
-                              std::string (*refuse_mode)(unsigned mode) = nullptr);
+                              std::string (*refuse)(const struct stat& status) = nullptr);
 
 struct LoadedText {
   std::string path;  // as resolved against the configuration's directory

@@ -46,7 +46,15 @@ void SecretKey::wipe() noexcept {
 
 Result<SecretKey> parse_key_text(std::string_view text, std::size_t min_bytes, std::size_t max_bytes) {
   std::vector<std::uint8_t> bytes;
-  bytes.reserve(max_bytes);
+  bytes.reserve(max_bytes);  // never reallocated: no copy of key bytes is left behind
+  // Whatever is decoded of a text refused is wiped too.
+  struct WipeOnReturn {
+    std::vector<std::uint8_t>& bytes;
+    ~WipeOnReturn() {
+      volatile std::uint8_t* p = bytes.data();
+      for (std::size_t i = 0; i < bytes.size(); ++i) p[i] = 0;
+    }
+  } wipe_on_return{bytes};
   int high = -1;
   std::size_t position = 0;
   for (const char c : text) {
@@ -68,11 +76,10 @@ Result<SecretKey> parse_key_text(std::string_view text, std::size_t min_bytes, s
   }
   if (high >= 0) return Error{"an odd number of hexadecimal digits"};
   if (bytes.size() < min_bytes) {
-    SecretKey discard(std::move(bytes));
-    return Error{std::to_string(discard.size()) + " bytes of key, fewer than " + std::to_string(min_bytes) +
+    return Error{std::to_string(bytes.size()) + " bytes of key, fewer than " + std::to_string(min_bytes) +
                  " (openssl rand -hex " + std::to_string(min_bytes) + " writes one)"};
   }
-  return SecretKey(std::move(bytes));
+  return SecretKey(std::vector<std::uint8_t>(bytes));  // a copy: `bytes` is wiped on the way out
 }
 
 Result<void> check_key_file_mode(unsigned mode) {

@@ -204,7 +204,7 @@ void Gateway::apply_routes() {
     for (const auto& p : channel.publishers) {
       route.publishers.push_back(slots_.at(p).index);
       if (const SegmentSpec* segment = config_.find_segment(p)) {
-        route.ingress_jitter = std::max(route.ingress_jitter, segment->latency_bound);
+        route.ingress_jitter = std::max(route.ingress_jitter, ip_hop_latency(*segment));
       }
     }
     for (const auto& s : channel.subscribers) route.subscribers.push_back(slots_.at(s).index);

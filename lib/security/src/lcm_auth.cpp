@@ -1,6 +1,7 @@
 #include "cosmic/lcm_auth.hpp"
 
 #include <algorithm>
+#include <limits>
 
 namespace cosmic {
 namespace {
@@ -68,15 +69,38 @@ bool LcmAuthSigner::sign(std::string_view channel, std::span<const std::span<con
   return true;
 }
 
-LcmAuthVerifier::LcmAuthVerifier(MessageAuth mac, Nanos window) : mac_(std::move(mac)), window_ns_(window.count()) {
+LcmAuthVerifier::LcmAuthVerifier(std::vector<MessageAuth> macs, Nanos window)
+    : macs_(std::move(macs)), window_ns_(window.count()) {
   senders_.reserve(kMaxSenders);
 }
 
 Result<LcmAuthVerifier> LcmAuthVerifier::make(std::span<const std::uint8_t> key, Nanos window) {
+  const std::span<const std::uint8_t> keys[] = {key};
+  return make(keys, window);
+}
+
+Result<LcmAuthVerifier> LcmAuthVerifier::make(std::span<const std::span<const std::uint8_t>> keys, Nanos window) {
   if (window <= Nanos::zero()) return Error{"the replay window must be longer than 0"};
-  Result<MessageAuth> mac = MessageAuth::make(MacAlgorithm::hmac_sha256, key);
-  if (!mac) return std::move(mac).error();
-  return LcmAuthVerifier(std::move(mac).value(), window);
+  if (keys.empty()) return Error{"no key to check tags with"};
+  std::vector<MessageAuth> macs;
+  for (const auto& key : keys) {
+    Result<MessageAuth> mac = MessageAuth::make(MacAlgorithm::hmac_sha256, key);
+    if (!mac) return std::move(mac).error();
+    macs.push_back(std::move(mac).value());
+  }
+  return LcmAuthVerifier(std::move(macs), window);
+}
+
+bool LcmAuthVerifier::authentic_tag(std::string_view channel, std::span<const std::uint8_t> body,
+                                    const std::uint8_t* trailer) noexcept {
+  const std::span<const std::uint8_t> tag(trailer + kSignedTrailerBytes, kLcmAuthTagSize);
+  for (MessageAuth& mac : macs_) {
+    MacBytes computed{};
+    if (lcm_auth_tag(mac, channel, std::span(&body, 1), std::span(trailer, kSignedTrailerBytes), computed) &&
+        tags_equal(computed, tag, kLcmAuthTagSize))
+      return true;
+  }
+  return false;
 }
 
 LcmAuthCheck LcmAuthVerifier::check(std::string_view channel, std::span<const std::uint8_t> message,
@@ -86,38 +110,47 @@ LcmAuthCheck LcmAuthVerifier::check(std::string_view channel, std::span<const st
   const std::size_t size = message.size() - kLcmAuthTrailerSize;
   const std::uint8_t* trailer = message.data() + size;
   out.sender = get_be64(trailer);
-  const std::span<const std::uint8_t> body = message.first(size);
-  MacBytes tag{};
-  if (!lcm_auth_tag(mac_, channel, std::span(&body, 1), std::span(trailer, kSignedTrailerBytes), tag) ||
-      !tags_equal(tag, std::span(trailer + kSignedTrailerBytes, kLcmAuthTagSize), kLcmAuthTagSize))
-    return out;
+  if (!authentic_tag(channel, message.first(size), trailer)) return out;
   const auto sent_ns = static_cast<std::int64_t>(get_be64(trailer + 16));
-  out.skew_ns = sent_ns - now_ns;
+  // A key holder chooses sent_ns freely: the difference saturates instead of overflowing.
+  if (__builtin_sub_overflow(sent_ns, now_ns, &out.skew_ns))
+    out.skew_ns = sent_ns < 0 ? std::numeric_limits<std::int64_t>::min() : std::numeric_limits<std::int64_t>::max();
   out.verdict = LcmAuthVerdict::replayed;
   // Outside the window either way: recorded long ago, or from a clock too far ahead.
   if (out.skew_ns < -window_ns_ || out.skew_ns > window_ns_) return out;
-  Sender* sender = find_or_add(out.sender, now_ns);
-  if (sender == nullptr || !sender->window.accept(get_be64(trailer + 8))) return out;
+  // Senders expire against the latest clock reading: a clock stepped back must not make an expired
+  // sender's old messages look fresh to a forgotten window.
+  latest_now_ns_ = std::max(latest_now_ns_, now_ns);
+  Sender* sender = find_or_add(out.sender);
+  if (sender == nullptr) {
+    out.crowded = true;
+    return out;
+  }
+  if (!sender->window.accept(get_be64(trailer + 8))) return out;
   sender->last_sent_ns = std::max(sender->last_sent_ns, sent_ns);
   out.verdict = LcmAuthVerdict::authentic;
   out.message_size = size;
   return out;
 }
 
-LcmAuthVerifier::Sender* LcmAuthVerifier::find_or_add(std::uint64_t id, std::int64_t now_ns) noexcept {
+LcmAuthVerifier::Sender* LcmAuthVerifier::find_or_add(std::uint64_t id) noexcept {
+  // Whatever a sender sent before latest - window is refused by its time alone: once its newest
+  // message is that old, its window may go (another sender's entry, or a fresh one for itself, so
+  // that a number pushed up by another holder of the key does not silence it for good).
+  const std::int64_t horizon = latest_now_ns_ - window_ns_;
   Sender* expired = nullptr;
   for (Sender& s : senders_) {
-    if (s.id == id) return &s;
-    // Whatever it sent before now - window is refused by its time alone: its window may go.
-    if (expired == nullptr && s.last_sent_ns < now_ns - window_ns_) expired = &s;
+    if (s.id == id) {
+      if (s.last_sent_ns < horizon) s = Sender{id, horizon, {}};
+      return &s;
+    }
+    if (expired == nullptr && s.last_sent_ns < horizon) expired = &s;
   }
   if (expired == nullptr) {
     if (senders_.size() == kMaxSenders) return nullptr;
     expired = &senders_.emplace_back();  // within the reserved capacity: no allocation
   }
-  *expired = Sender{};
-  expired->id = id;
-  expired->last_sent_ns = now_ns - window_ns_;
+  *expired = Sender{id, horizon, {}};
   return expired;
 }
 

@@ -75,7 +75,11 @@ std::string openssl_hmac(const Bytes& key, const Bytes& input, const std::string
 class LcmAuthAdapterTest : public LcmAdapterTest {
  protected:
   std::unique_ptr<SegmentAdapter> make_authenticated(int port, const Bytes& key, Nanos window = 1s) {
-    segment_.lcm.auth = LcmAuthSpec{"test.key", SecretKey(key), window};
+    LcmAuthSpec auth;
+    auth.key_file = "test.key";
+    auth.key = SecretKey(key);
+    auth.window = window;
+    segment_.lcm.auth = std::move(auth);
     return make(port);
   }
 };

@@ -144,8 +144,9 @@ class LcmAdapter final : public SegmentAdapter {
       return Status{};
     }
     if (segment_.lcm.auth) {
-      Result<LcmAuthVerifier> verifier =
-          LcmAuthVerifier::make(segment_.lcm.auth->key.bytes(), segment_.lcm.auth->window);
+      std::vector<std::span<const std::uint8_t>> keys{segment_.lcm.auth->key.bytes()};
+      for (const SecretKey& accepted : segment_.lcm.auth->accepted) keys.push_back(accepted.bytes());
+      Result<LcmAuthVerifier> verifier = LcmAuthVerifier::make(keys, segment_.lcm.auth->window);
       if (!verifier) return fail_start("cannot check authentication: " + verifier.error().text);
       verifier_.emplace(std::move(verifier).value());  // before the receive thread that uses it starts
     }
@@ -565,10 +566,12 @@ class LcmAdapter final : public SegmentAdapter {
     Nanos& last = unauthenticated ? last_unauthenticated_log_ : last_replayed_log_;
     if (last != Nanos::min() && now - last < kRefusalLogPause) return;
     last = now;
-    std::string why = unauthenticated ? "no valid authentication tag"
-                                      : "sent before, or " + std::to_string(checked.skew_ns / 1'000'000) +
-                                            " ms from this host's clock (window " +
-                                            std::to_string(segment_.lcm.auth->window.count() / 1'000'000) + " ms)";
+    const std::string window = std::to_string(segment_.lcm.auth->window.count() / 1'000'000) + " ms";
+    std::string why = unauthenticated   ? "no valid authentication tag"
+                      : checked.crowded ? "more than " + std::to_string(LcmAuthVerifier::kMaxSenders) +
+                                              " senders within the window (" + window + ")"
+                                        : "sent before, or " + std::to_string(checked.skew_ns / 1'000'000) +
+                                              " ms from this host's clock (window " + window + ")";
     log_.log(LogLevel::warning, prefix_ + "dropped a message of channel " + channel.name + " from " + from.text() +
                                     ": " + why + " (counted as " + to_string(checked.verdict) +
                                     "; at most one such line every 10 s)");

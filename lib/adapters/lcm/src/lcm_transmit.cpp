@@ -41,7 +41,8 @@ Result<LcmAuthSigner> make_signer(const LcmAuthSpec& auth) {
   while (sender == 0) {
     const ssize_t n = ::getrandom(&sender, sizeof sender, 0);
     if (n < 0 && errno == EINTR) continue;
-    if (n != static_cast<ssize_t>(sizeof sender)) return Error::from_errno("getrandom", errno);
+    if (n < 0) return Error::from_errno("getrandom", errno);
+    if (n != static_cast<ssize_t>(sizeof sender)) return Error{"getrandom: a short read"};
   }
   return LcmAuthSigner::make(auth.key.bytes(), sender);
 }
@@ -72,16 +73,18 @@ Result<void> LcmTransmitter::open(const LcmUrl& url) {
       close();
       return Error{"transmit socket on udpm://" + url.group + ":" + std::to_string(url.port) + ": " + tx.error};
     }
-    LockGuard lock(senders_[i].mutex);
-    if (auth_ != nullptr) {
-      Result<LcmAuthSigner> signer = make_signer(*auth_);
-      if (!signer) {
+    std::optional<LcmAuthSigner> signer;
+    if (auth_ != nullptr) {  // made before the sender's mutex is taken: close() takes it
+      Result<LcmAuthSigner> made = make_signer(*auth_);
+      if (!made) {
         ::close(tx.fd);
         close();
-        return Error{"cannot sign what it sends: " + signer.error().text};
+        return Error{"cannot sign what it sends: " + made.error().text};
       }
-      senders_[i].signer.emplace(std::move(signer).value());
+      signer.emplace(std::move(made).value());
     }
+    LockGuard lock(senders_[i].mutex);
+    senders_[i].signer = std::move(signer);
     senders_[i].fd = tx.fd;
     senders_[i].failing.store(false, std::memory_order_relaxed);
     own_keys_[i].store(tx.local.key(), std::memory_order_relaxed);

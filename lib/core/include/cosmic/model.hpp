@@ -92,6 +92,10 @@ enum class LcmOwnDatagrams { cut, drop };
 struct LcmAuthSpec {
   std::string key_file;  // as resolved against the configuration's directory
   SecretKey key;
+  // Keys whose tags are accepted besides `key`'s (`accept_key_files`: a key change in progress);
+  // only `key` signs.
+  std::vector<std::string> accepted_files{};
+  std::vector<SecretKey> accepted{};
   Nanos window = std::chrono::seconds(1);
   // What signing or checking one message costs on this machine, worst case (`auth.cost`, as
   // `cosmicctl calibrate` measures it): admission adds it to the hop's latency. None: not counted.

@@ -17,7 +17,10 @@
 // `window` of the receiver's clock (else: replayed; so a recorded datagram is refused once the
 // window has passed, even by a receiver that restarted since), and its sender's sequence number was
 // not taken before (ReplayWindow; else: replayed). Senders are forgotten once their last
-// datagram is older than the window; at most kMaxSenders are remembered at a time.
+// datagram is older than the window (against the latest clock reading seen); at most kMaxSenders
+// are remembered at a time. Every holder of the key is trusted alike: one can also write under
+// another's sender number and so make that sender's next messages (for up to one window after its
+// last) count as replayed; give writers that must not interfere with each other different keys.
 //
 // Threads: a signer belongs to one transmit socket (its class's mutex), a verifier to the segment's
 // receive thread. sign()/check() never throw; no allocation but OpenSSL's own (message_auth.hpp).
@@ -26,6 +29,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -69,7 +73,8 @@ struct LcmAuthCheck {
   LcmAuthVerdict verdict = LcmAuthVerdict::unauthenticated;
   std::size_t message_size = 0;  // the bytes before the trailer (authentic only)
   std::uint64_t sender = 0;      // the trailer's sender (0 when the message is too short for one)
-  std::int64_t skew_ns = 0;      // sent_ns less the receiver's clock (authentic tag only)
+  std::int64_t skew_ns = 0;      // sent_ns less the receiver's clock, saturated (authentic tag only)
+  bool crowded = false;          // replayed because kMaxSenders other senders are active in the window
 };
 
 class LcmAuthVerifier {
@@ -77,6 +82,9 @@ class LcmAuthVerifier {
   static constexpr std::size_t kMaxSenders = 256;
 
   static Result<LcmAuthVerifier> make(std::span<const std::uint8_t> key, Nanos window);
+  // Tags made with any of `keys` count (a key change: the new key accepted before it signs, the old
+  // one still accepted while senders change over); the first is tried first.
+  static Result<LcmAuthVerifier> make(std::span<const std::span<const std::uint8_t>> keys, Nanos window);
 
   // One received message of LCM channel `channel`, trailer included, at the receiver's wall clock
   // `now_ns`. Only an authentic message moves its sender's window.
@@ -88,12 +96,16 @@ class LcmAuthVerifier {
     std::int64_t last_sent_ns = 0;  // of its newest authentic message
     ReplayWindow window;
   };
-  LcmAuthVerifier(MessageAuth mac, Nanos window);
-  // The sender's entry, a new one in place of one that expired; null when all are in use.
-  Sender* find_or_add(std::uint64_t id, std::int64_t now_ns) noexcept;
+  LcmAuthVerifier(std::vector<MessageAuth> macs, Nanos window);
+  bool authentic_tag(std::string_view channel, std::span<const std::uint8_t> body,
+                     const std::uint8_t* trailer) noexcept;
+  // The sender's entry (emptied when it expired), a new one in place of one that expired; null when
+  // all are in use.
+  Sender* find_or_add(std::uint64_t id) noexcept;
 
-  MessageAuth mac_;
+  std::vector<MessageAuth> macs_;  // one per accepted key, never empty
   std::int64_t window_ns_;
+  std::int64_t latest_now_ns_ = std::numeric_limits<std::int64_t>::min() / 2;  // the latest clock reading
   std::vector<Sender> senders_;  // kMaxSenders reserved by make(): never grows past them
 };
 
