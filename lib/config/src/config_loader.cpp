@@ -21,6 +21,7 @@
 #include "type_loader.hpp"
 #include "federation_loader.hpp"
 #include "realtime_loader.hpp"
+#include "dds_security_loader.hpp"
 #include "folded_names.hpp"
 #include "key_file_loader.hpp"
 #include "listen_address.hpp"
@@ -223,7 +224,7 @@ class ConfigParser {
           {"name",          "type",        "interface",       "profile",          "bitrate",    "fd",
            "data_bitrate",  "errors",      "max_utilization", "background",       "domain",     "latency_bound",
            "bandwidth",     "reliability", "realtime",        "max_message_size", "interfaces", "discovery_server",
-           "shared_memory", "url",         "network",         "own_datagrams",    "auth"});
+           "shared_memory", "url",         "network",         "own_datagrams",    "auth",       "security"});
       return std::nullopt;
     }
     s.type = static_cast<SegmentType>(*type);
@@ -336,7 +337,7 @@ class ConfigParser {
     reader_.check_map(
         node, path,
         {"name", "type", "domain", "latency_bound", "bandwidth", "reliability", "realtime", "max_message_size",
-         "interfaces", "discovery_server", "shared_memory", "max_utilization", "network"});
+         "interfaces", "discovery_server", "shared_memory", "max_utilization", "network", "security"});
     parse_ip_common(node, path, s);
     if (has(node, "domain")) {
       if (auto v = reader_.unsigned_int(node["domain"], key(path, "domain"), 0, 232))
@@ -361,6 +362,8 @@ class ConfigParser {
       }
     }
     if (has(node, "shared_memory")) parse_shared_memory(node["shared_memory"], key(path, "shared_memory"), s);
+    if (has(node, "security"))
+      s.dds.security = config_detail::parse_dds_security(reader_, node["security"], key(path, "security"), included_);
   }
 
   // `shared_memory: [srt, nrt]`: the classes whose participant also uses Fast DDS's shared memory.

@@ -14,16 +14,6 @@ namespace {
 
 constexpr std::size_t kMaxKeyFileBytes = 4096;  // a key of 64 bytes is 128 digits; room for white space
 
-// Only its owner may read or write it, and the owner is this process's user or root: another user
-// could change the key under us.
-std::string refuse_open_key_file(const struct stat& status) {
-  if (status.st_uid != ::geteuid() && status.st_uid != 0)
-    return "owned by user " + std::to_string(status.st_uid) + ", neither this process's user (" +
-           std::to_string(::geteuid()) + ") nor root";
-  const Result<void> private_file = check_key_file_mode(status.st_mode);
-  return private_file ? std::string() : private_file.error().text;
-}
-
 void wipe_key_text(std::string& text) {
   volatile char* p = text.data();
   for (std::size_t i = 0; i < text.size(); ++i) p[i] = 0;
@@ -35,7 +25,8 @@ Result<SecretKey> read_key_file(const std::string& path, std::size_t min_bytes, 
   std::string text;
   // Read in place (never longer than this): no copy of the key is left behind in freed memory.
   text.reserve(kMaxKeyFileBytes);
-  const std::string error = config_detail::read_regular_file(path, text, kMaxKeyFileBytes, refuse_open_key_file);
+  const std::string error =
+      config_detail::read_regular_file(path, text, kMaxKeyFileBytes, config_detail::refuse_unless_private);
   if (!error.empty()) {
     wipe_key_text(text);
     return Error{"cannot use key file " + path + ": " + error};
@@ -49,6 +40,14 @@ Result<SecretKey> read_key_file(const std::string& path, std::size_t min_bytes, 
 }  // namespace cosmic
 
 namespace cosmic::config_detail {
+
+std::string refuse_unless_private(const struct stat& status) {
+  if (status.st_uid != ::geteuid() && status.st_uid != 0)
+    return "owned by user " + std::to_string(status.st_uid) + ", neither this process's user (" +
+           std::to_string(::geteuid()) + ") nor root";
+  const Result<void> private_file = check_key_file_mode(status.st_mode);
+  return private_file ? std::string() : private_file.error().text;
+}
 
 std::optional<LoadedKey> load_key_file(YamlReader& reader, const YAML::Node& node, const std::string& path,
                                        std::vector<std::string>& included, std::size_t min_bytes,

@@ -4,6 +4,8 @@
 // the `key_file` value, never quoting the file's content. Internal to the config library.
 #pragma once
 
+#include <sys/stat.h>
+
 #include <cstddef>
 #include <optional>
 #include <string>
@@ -13,6 +15,10 @@
 #include "yaml_reader.hpp"
 
 namespace cosmic::config_detail {
+
+// Why a file of this status must not hold secrets: group or others may read or write it, or it
+// belongs to another user than this process's or root (who could change it under us). Empty: fine.
+std::string refuse_unless_private(const struct stat& status);
 
 struct LoadedKey {
   std::string path;  // as resolved against the configuration's directory

@@ -187,6 +187,22 @@ Status allow_interfaces(const std::vector<std::string>& interfaces,
   }
   return Status::success();
 }
+// DDS Security through Fast DDS's builtin plugins (docs/security.md): authentication (PKI-DH),
+// access control (Access-Permissions) and cryptography (AES-GCM-GMAC), the files as file:// URIs.
+void add_security(const DdsSecuritySpec& security, dds::DomainParticipantQos& qos) {
+  auto& properties = qos.properties().properties();
+  auto file = [](const std::string& path) { return "file://" + path; };
+  properties.emplace_back("dds.sec.auth.plugin", "builtin.PKI-DH");
+  properties.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_ca", file(security.identity_ca));
+  properties.emplace_back("dds.sec.auth.builtin.PKI-DH.identity_certificate", file(security.certificate));
+  properties.emplace_back("dds.sec.auth.builtin.PKI-DH.private_key", file(security.private_key));
+  properties.emplace_back("dds.sec.access.plugin", "builtin.Access-Permissions");
+  properties.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions_ca", file(security.permissions_ca));
+  properties.emplace_back("dds.sec.access.builtin.Access-Permissions.governance", file(security.governance));
+  properties.emplace_back("dds.sec.access.builtin.Access-Permissions.permissions", file(security.permissions));
+  properties.emplace_back("dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC");
+}
+
 }  // namespace
 
 Status participant_qos(const SegmentSpec& segment, const std::string& participant_name, bool shared_memory,
@@ -196,6 +212,7 @@ Status participant_qos(const SegmentSpec& segment, const std::string& participan
   // Fast DDS >= 2.10 stops matching this participant's own readers and writers; 2.9 ignores
   // the property and the adapter filters by GUID prefix on reception.
   qos.properties().properties().emplace_back("fastdds.ignore_local_endpoints", "true");
+  if (segment.dds.security) add_security(*segment.dds.security, qos);
 
   if (!segment.dds.interfaces.empty() || !shared_memory) {
     auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();

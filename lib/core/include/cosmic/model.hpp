@@ -67,6 +67,22 @@ struct CanSegmentProperties {
   friend bool operator==(const CanSegmentProperties&, const CanSegmentProperties&) = default;
 };
 
+// DDS Security on a DDS segment (segment key `security`, docs/security.md): every participant of
+// the segment authenticates with this identity (PKI-DH), is held to the signed governance and
+// permissions (Access-Permissions) and protects what they say (AES-GCM-GMAC), through Fast DDS's
+// builtin plugins. Paths are absolute; the loader has checked the files (cosmic/dds_security_files.hpp).
+struct DdsSecuritySpec {
+  std::string identity_ca;
+  std::string certificate;
+  std::string private_key;
+  std::string permissions_ca;
+  std::string governance;
+  std::string permissions;
+  std::string subject;             // the certificate's subject ("/O=cosmic/CN=gateway-a")
+  std::uint64_t content_hash = 0;  // of the six files' bytes: a reload sees a file changed in place
+  friend bool operator==(const DdsSecuritySpec&, const DdsSecuritySpec&) = default;
+};
+
 struct DdsSegmentProperties {
   std::uint32_t domain = 0;
   std::vector<std::string> interfaces;  // allow-list of IPv4 addresses or interface names
@@ -75,6 +91,7 @@ struct DdsSegmentProperties {
   // transport to peers on this host (segment key `shared_memory`). Off for HRT by default: under
   // load the shared-memory path held HRT samples back for milliseconds, UDP did not (docs/yaml-reference.md).
   std::array<bool, 3> shared_memory{false, true, true};
+  std::optional<DdsSecuritySpec> security{};
   friend bool operator==(const DdsSegmentProperties&, const DdsSegmentProperties&) = default;
 };
 

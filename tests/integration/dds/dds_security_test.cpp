@@ -1,0 +1,94 @@
+// DDS Security on a DDS segment (issue 36, item 1; docs/security.md) over real Fast DDS in a network
+// namespace, with a test PKI the openssl command line makes here (tests/support/make_test_pki.sh):
+// two gateways' adapters, each with its own identity, authenticate and exchange a channel both
+// ways; a participant without security (cosmic-dds-peer, plain Fast DDS) on the same domain never
+// receives a sample of it.
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "cosmic/build_paths.hpp"
+#include "dds_adapter_fixture.hpp"
+
+namespace cosmic::dds_test {
+namespace {
+
+class DdsSecurityTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    pki_ = std::filesystem::path(testing::TempDir()) / ("dds_security_" + std::to_string(::getpid()));
+    const std::string command =
+        std::string(cosmic::build_paths::source_dir) + "/tests/support/make_test_pki.sh " + pki_.string();
+    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  }
+  static void TearDownTestSuite() { std::filesystem::remove_all(pki_); }
+
+  static SegmentSpec secure_segment(std::uint32_t domain, const std::string& identity) {
+    SegmentSpec s = dds_segment(domain);
+    DdsSecuritySpec security;
+    security.identity_ca = (pki_ / "identity_ca.pem").string();
+    security.certificate = (pki_ / (identity + "_cert.pem")).string();
+    security.private_key = (pki_ / (identity + "_key.pem")).string();
+    security.permissions_ca = (pki_ / "permissions_ca.pem").string();
+    security.governance = (pki_ / "governance.p7s").string();
+    security.permissions = (pki_ / "permissions.p7s").string();
+    security.subject = "/O=cosmic/CN=" + identity;
+    s.dds.security = security;
+    return s;
+  }
+
+  static std::filesystem::path pki_;
+};
+
+std::filesystem::path DdsSecurityTest::pki_;
+
+TEST_F(DdsSecurityTest, AuthenticatedGatewaysExchangeAndAPlainParticipantReceivesNothing) {
+  constexpr std::uint32_t kDomain = 61;
+  Fixture a(secure_segment(kDomain, "gateway-a"), 0xA1);
+  Fixture b(secure_segment(kDomain, "gateway-b"), 0xB2);
+  ASSERT_TRUE(a.adapter->start(a.sink).ok);
+  ASSERT_TRUE(b.adapter->start(b.sink).ok);
+  // obstacle: a sends, b receives; drive: b sends, a receives.
+  ASSERT_TRUE(a.adapter
+                  ->configure(std::vector<ChannelBinding>{binding(1, "obstacle", HopRole::subscriber),
+                                                          binding(2, "drive", HopRole::publisher)})
+                  .ok);
+  ASSERT_TRUE(b.adapter
+                  ->configure(std::vector<ChannelBinding>{binding(1, "obstacle", HopRole::publisher),
+                                                          binding(2, "drive", HopRole::subscriber)})
+                  .ok);
+  // A plain Fast DDS participant on the same domain and topic, waiting for one sample.
+  test::Child plain(
+      peer({"sub", "--domain", std::to_string(kDomain), "--channel", "obstacle", "--count", "1", "--timeout", "6"}));
+  // The handshake (PKI-DH) comes first; a failed one is retried every second.
+  ASSERT_TRUE(a.matched(1, HopRole::subscriber)) << "gateway-a's writer never matched gateway-b's reader";
+  ASSERT_TRUE(b.matched(2, HopRole::subscriber)) << "gateway-b's writer never matched gateway-a's reader";
+  std::vector<std::uint8_t> storage;
+  std::uint32_t q = 0;
+  ASSERT_TRUE(test::eventually(
+      [&] {
+        a.adapter->send(outbound(1, ++q, storage, 0xA1));
+        return b.sink.count_on(1) >= 3;
+      },
+      kWait));
+  ASSERT_TRUE(test::eventually(
+      [&] {
+        b.adapter->send(outbound(2, ++q, storage, 0xB2));
+        return a.sink.count_on(2) >= 3;
+      },
+      kWait));
+  const auto received = b.sink.events_on(1);
+  EXPECT_EQ(received.front().payload.size(), 16u);
+  EXPECT_EQ(received.front().header.origin, 0xA1u);
+  // The plain participant gave up without a sample (exit 1 on its timeout), though obstacles flowed.
+  const auto plain_exit = plain.wait_exit(std::chrono::seconds(20));
+  ASSERT_TRUE(plain_exit.has_value());
+  EXPECT_EQ(*plain_exit, 1) << "a participant without security received an authenticated gateway's sample";
+  EXPECT_TRUE(plain.out_lines().empty());
+  a.adapter->stop();
+  b.adapter->stop();
+}
+
+}  // namespace
+}  // namespace cosmic::dds_test

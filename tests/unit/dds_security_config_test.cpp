@@ -1,0 +1,109 @@
+// A DDS segment's `security:` (docs/security.md): the six files checked at load against a test PKI
+// the openssl command line makes here (tests/support/make_test_pki.sh), each refusal located at
+// its key with the reason OpenSSL gives, where Fast DDS would only say that it cannot create the
+// participant.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include "cosmic/build_paths.hpp"
+#include "cosmic/config_loader.hpp"
+
+namespace cosmic {
+namespace {
+
+class DdsSecurityConfig : public testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    pki_ = std::filesystem::path(testing::TempDir()) / ("dds_security_pki_" + std::to_string(::getpid()));
+    const std::string command =
+        std::string(build_paths::source_dir) + "/tests/support/make_test_pki.sh " + pki_.string();
+    ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  }
+  static void TearDownTestSuite() { std::filesystem::remove_all(pki_); }
+
+  // The segment's security with `files` in place of the defaults (gateway-a's identity).
+  ConfigResult load(const std::map<std::string, std::string>& files) {
+    std::map<std::string, std::string> keys{
+        {"identity_ca", "identity_ca.pem"},   {"certificate", "gateway-a_cert.pem"},
+        {"private_key", "gateway-a_key.pem"}, {"permissions_ca", "permissions_ca.pem"},
+        {"governance", "governance.p7s"},     {"permissions", "permissions.p7s"}};
+    for (const auto& [k, v] : files) {
+      if (v.empty()) {
+        keys.erase(k);
+      } else {
+        keys[k] = v;
+      }
+    }
+    std::string security;
+    for (const auto& [k, v] : keys) security += (security.empty() ? "" : ", ") + k + ": " + v;
+    const std::string text =
+        "segments:\n"
+        "  - name: lan\n"
+        "    type: dds\n"
+        "    domain: 4\n"
+        "    security: {" +
+        security +
+        "}\n"
+        "channels: []\n";
+    return parse_config(text, (pki_ / "gateway.yaml").string());
+  }
+
+  // The one error of `result`, which must be at security.KEY and say `fragment`.
+  void expect_refused(const ConfigResult& result, const std::string& key, const std::string& fragment) {
+    ASSERT_EQ(result.errors.size(), 1u) << (result.errors.empty() ? "" : result.errors.back().to_string());
+    EXPECT_EQ(result.errors.front().path, "segments[0].security." + key);
+    EXPECT_EQ(result.errors.front().line, 5);
+    EXPECT_NE(result.errors.front().message.find(fragment), std::string::npos) << result.errors.front().to_string();
+  }
+
+  static std::filesystem::path pki_;
+};
+
+std::filesystem::path DdsSecurityConfig::pki_;
+
+TEST_F(DdsSecurityConfig, AValidIdentityAndSignedDocumentsLoad) {
+  const ConfigResult result = load({});
+  ASSERT_TRUE(result.errors.empty()) << result.errors.front().to_string();
+  const auto& security = result.config.find_segment("lan")->dds.security;
+  ASSERT_TRUE(security);
+  EXPECT_EQ(security->subject, "/O=cosmic/CN=gateway-a");
+  EXPECT_EQ(security->certificate, (pki_ / "gateway-a_cert.pem").string());
+  EXPECT_EQ(security->governance, (pki_ / "governance.p7s").string());
+  EXPECT_NE(security->content_hash, 0u);
+}
+
+TEST_F(DdsSecurityConfig, APrivateKeyOthersMayReadIsRefused) {
+  expect_refused(load({{"private_key", "open_key.pem"}}), "private_key", "group or others may read or write it");
+}
+
+TEST_F(DdsSecurityConfig, AnExpiredCertificateIsRefused) {
+  expect_refused(load({{"certificate", "expired.pem"}, {"private_key", "gateway-b_key.pem"}}), "certificate",
+                 "certificate has expired");
+}
+
+TEST_F(DdsSecurityConfig, ACertificateOfAnotherCaIsRefused) {
+  expect_refused(load({{"identity_ca", "rogue_ca.pem"}}), "certificate", "unable to get local issuer certificate");
+}
+
+TEST_F(DdsSecurityConfig, AKeyThatIsNotTheCertificatesIsRefused) {
+  expect_refused(load({{"private_key", "gateway-b_key.pem"}}), "private_key", "is not the key of the certificate");
+}
+
+TEST_F(DdsSecurityConfig, UnsignedOrForeignSignedDocumentsAreRefused) {
+  expect_refused(load({{"governance", "governance_unsigned.xml"}}), "governance", "is not an S/MIME signed document");
+  expect_refused(load({{"permissions", "permissions_rogue.p7s"}}), "permissions",
+                 "does not verify against the permissions CA");
+}
+
+TEST_F(DdsSecurityConfig, EveryFileIsNeededAndMissingOnesAreNamed) {
+  expect_refused(load({{"permissions", ""}}), "permissions", "missing key 'permissions'");
+  expect_refused(load({{"governance", "nowhere.p7s"}}), "governance", "No such file or directory");
+}
+
+}  // namespace
+}  // namespace cosmic
