@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # make_test_pki.sh DIR: a DDS Security test PKI made with the openssl command line (never checked in):
-# an identity CA and a permissions CA (ECDSA P-256), identities gateway-a and gateway-b
+# an identity CA and a permissions CA (ECDSA P-256), identities gateway-a, gateway-b and gateway-c
 # ("/O=cosmic/CN=gateway-X", keys 0600), governance (everything ENCRYPT, as Fast DDS 2.9 and Cyclone
-# DDS both handle it) and permissions granting both gateways every topic of domains 0-230, signed
-# S/MIME with -text as the DDS Security specification and Fast DDS want them. Material for the
+# DDS both handle it) and permissions granting gateway-a and gateway-b every topic of domains 0-230
+# and gateway-c every topic to subscribe but only cosmic/telemetry to publish, signed S/MIME with -text as the DDS Security specification and Fast DDS want them. Material for the
 # refusals too: expired.pem (a gateway-b certificate valid 2020-2021), open_key.pem (0644),
 # governance_unsigned.xml, permissions_rogue.p7s (signed by another CA), rogue_ca.pem.
 set -euo pipefail
@@ -22,7 +22,7 @@ ca identity_ca "/O=cosmic/CN=cosmic test identity CA" keyCertSign,cRLSign
 ca permissions_ca "/O=cosmic/CN=cosmic test permissions CA" keyCertSign,cRLSign,digitalSignature
 ca rogue_ca "/O=cosmic/CN=cosmic test permissions CA" keyCertSign,cRLSign,digitalSignature
 printf 'basicConstraints=critical,CA:FALSE\nkeyUsage=critical,digitalSignature,keyAgreement\n' >leaf.cnf
-for name in gateway-a gateway-b; do
+for name in gateway-a gateway-b gateway-c; do
   quiet openssl ecparam -name prime256v1 -genkey -noout -out "${name}_key.pem"
   quiet openssl req -new -key "${name}_key.pem" -subj "/O=cosmic/CN=$name" -out "$name.csr"
   quiet openssl x509 -req -in "$name.csr" -CA identity_ca.pem -CAkey identity_ca_key.pem -CAcreateserial -sha256 \
@@ -102,6 +102,18 @@ XML
   echo '  <permissions>'
   grant gateway-a
   grant gateway-b
+  cat <<XML
+    <grant name="gateway-c">
+      <subject_name>CN=gateway-c,O=cosmic</subject_name>
+      <validity><not_before>2020-01-01T00:00:00</not_before><not_after>2100-01-01T00:00:00</not_after></validity>
+      <allow_rule>
+        <domains><id_range><min>0</min><max>230</max></id_range></domains>
+        <publish><topics><topic>cosmic/telemetry</topic></topics></publish>
+        <subscribe><topics><topic>*</topic></topics></subscribe>
+      </allow_rule>
+      <default>DENY</default>
+    </grant>
+XML
   echo '  </permissions>'
   echo '</dds>'
 } >permissions.xml

@@ -2,7 +2,7 @@
 // namespace, with a test PKI the openssl command line makes here (tests/support/make_test_pki.sh):
 // two gateways' adapters, each with its own identity, authenticate and exchange a channel both
 // ways; a participant without security (cosmic-dds-peer, plain Fast DDS) on the same domain never
-// receives a sample of it.
+// receives a sample of it; an authenticated gateway cannot publish a topic its permissions do not grant.
 #include <unistd.h>
 
 #include <cstdlib>
@@ -88,6 +88,24 @@ TEST_F(DdsSecurityTest, AuthenticatedGatewaysExchangeAndAPlainParticipantReceive
   EXPECT_TRUE(plain.out_lines().empty());
   a.adapter->stop();
   b.adapter->stop();
+}
+
+// gateway-c is authenticated, but its permissions grant it only cosmic/telemetry to publish: a
+// channel it would send on any other topic is refused at bind with the reason, the others bind.
+TEST_F(DdsSecurityTest, AnAuthenticatedGatewayCannotPublishWhatItsPermissionsDoNotGrant) {
+  Fixture c(secure_segment(62, "gateway-c"), 0xC3);
+  ASSERT_TRUE(c.adapter->start(c.sink).ok);
+  const Status status = c.adapter->configure(std::vector<ChannelBinding>{binding(1, "obstacle", HopRole::subscriber),
+                                                                         binding(2, "telemetry", HopRole::subscriber),
+                                                                         binding(3, "drive", HopRole::publisher)});
+  ASSERT_FALSE(status.ok);
+  EXPECT_NE(status.error.find("cannot create a DataWriter on cosmic/obstacle (a secure segment: do the permissions "
+                              "grant /O=cosmic/CN=gateway-c to publish it?)"),
+            std::string::npos)
+      << status.error;
+  EXPECT_EQ(status.error.find("telemetry"), std::string::npos) << status.error;
+  EXPECT_EQ(status.error.find("drive"), std::string::npos) << status.error;
+  c.adapter->stop();
 }
 
 }  // namespace

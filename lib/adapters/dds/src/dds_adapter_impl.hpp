@@ -163,6 +163,8 @@ class DdsAdapter final : public DdsSegmentAdapter {
   void release_topic(ClassParticipant& home, dds::Topic* topic);
   Result<std::unique_ptr<WriterEntry>> create_writer(const ChannelBinding& binding);
   Result<std::unique_ptr<ReaderEntry>> create_reader(const ChannelBinding& binding);
+  // " (a secure segment: do the permissions grant SUBJECT to ACTION it?)", or nothing without security.
+  std::string permission_hint(const char* action) const;
   // The class participant of `binding`, then `create`; every failure (an exception of Fast DDS
   // included) comes back as an error.
   template <typename Entry>

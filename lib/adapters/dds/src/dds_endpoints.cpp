@@ -301,13 +301,21 @@ Result<std::unique_ptr<WriterEntry>> DdsAdapter::create_writer(const ChannelBind
                                                             entry.get(), dds::StatusMask::offered_incompatible_qos());
   if (entry->writer == nullptr) {
     release_topic(*entry->home, entry->topic);
-    return Error{"cannot create a DataWriter on " + entry->shape.topic.topic};
+    return Error{"cannot create a DataWriter on " + entry->shape.topic.topic + permission_hint("publish")};
   }
   {
     PiLock sample(entry->sample_mutex);  // nothing sends on it yet; the analysis asks for it all the same
     entry->format->reserve(std::min<std::uint64_t>(binding.spec.payload_on(segment_.name), segment_.max_message_size));
   }
   return entry;
+}
+
+// On a secure segment the usual reason a DataWriter or DataReader is refused: the signed permissions
+// do not grant this identity the topic (Fast DDS logs it, but does not say so to its caller).
+std::string DdsAdapter::permission_hint(const char* action) const {
+  if (!segment_.dds.security) return {};
+  return std::string(" (a secure segment: do the permissions grant ") + segment_.dds.security->subject + " to " +
+         action + " it?)";
 }
 
 Result<std::unique_ptr<ReaderEntry>> DdsAdapter::create_reader(const ChannelBinding& binding) {
@@ -328,7 +336,7 @@ Result<std::unique_ptr<ReaderEntry>> DdsAdapter::create_reader(const ChannelBind
       entry->home->subscriber->create_datareader(entry->topic, reader_qos(segment_, binding.spec), entry.get(), mask);
   if (entry->reader == nullptr) {
     release_topic(*entry->home, entry->topic);
-    return Error{"cannot create a DataReader on " + entry->shape.topic.topic};
+    return Error{"cannot create a DataReader on " + entry->shape.topic.topic + permission_hint("subscribe")};
   }
   return entry;
 }
