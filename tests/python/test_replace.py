@@ -149,6 +149,12 @@ def steady_figures(events: list[tuple[str, int, float, float]]) -> dict:
             "max_gap_ms": round(max(gaps), 1), "latency_max_ms": round(max(e[3] - e[2] for e in events) * 1e3, 1)}
 
 
+def steady_rate_drops(g: OwnGateway) -> int:
+    """The `rate` drops of feed's events from steady under the current route (cosmicctl channel)."""
+    channel = json.loads(g.ctl("--json", "channel", "feed").stdout)["channel"]
+    return sum(seg["dropped"].get("rate", 0) for seg in channel["segments"] if seg["segment"] == "steady")
+
+
 def test_a_replacement_under_traffic_keeps_the_subscriber_that_stays(own_gateway):
     g = own_gateway
     with cosmic.Client(f"lcm:{STEADY_URL}") as steady_c, cosmic.Client(f"lcm:{WIRE_URL}") as wire_c, \
@@ -160,6 +166,10 @@ def test_a_replacement_under_traffic_keeps_the_subscriber_that_stays(own_gateway
             wait_until(lambda: received.of("s") and received.of("w"), 30, "the gateway's DDS writer on out matched")
             time.sleep(0.5)
             start = received.of("s")[-1][1]
+            # Rate policing drops of steady's events, per route (a replacement starts the channel's
+            # counters afresh): what a publisher bunching beyond its latency bound on a loaded
+            # machine loses by its own doing, told apart from what the gateway loses.
+            policed = [-steady_rate_drops(g)]
 
             # A replacement admission rejects (HRT over segments without a real-time guarantee):
             # nothing changes, traffic goes on as before.
@@ -171,6 +181,7 @@ def test_a_replacement_under_traffic_keeps_the_subscriber_that_stays(own_gateway
             assert unbound.returncode != 0 and "no bound channel named 'fed' to replace" in unbound.stderr, unbound.stderr
             time.sleep(0.3)
 
+            policed.append(steady_rate_drops(g))
             first_switch = time.monotonic()
             to_sim, took_to_sim = g.replace(feed_yaml("steady", "sim"), "to-sim.yaml")
             assert to_sim.returncode == 0, to_sim.stdout + to_sim.stderr
@@ -182,6 +193,7 @@ def test_a_replacement_under_traffic_keeps_the_subscriber_that_stays(own_gateway
             wait_until(lambda: any(e[3] > switched_to_sim for e in received.of("d")), 15, "events from sim after the switch")
             time.sleep(0.5)
 
+            policed.append(steady_rate_drops(g))
             second_switch = time.monotonic()
             to_wire, took_to_wire = g.replace(feed_yaml("steady", "wire"), "to-wire.yaml")
             assert to_wire.returncode == 0, to_wire.stdout + to_wire.stderr
@@ -192,6 +204,7 @@ def test_a_replacement_under_traffic_keeps_the_subscriber_that_stays(own_gateway
             sources.stop()
         time.sleep(0.3)  # the last events in flight
 
+        policed.append(steady_rate_drops(g))
         steady = [e for e in received.of("s") if e[1] >= start]
         figures = steady_figures(steady)
         to_sim_figures = switch_figures(received.of("wd"), "w", "d", (first_switch - 0.3, second_switch))
@@ -205,8 +218,13 @@ def test_a_replacement_under_traffic_keeps_the_subscriber_that_stays(own_gateway
               f"\n  wire (LCM) -> sim (DDS), `cosmicctl bind --replace` took {took_to_sim * 1e3:.0f} ms: {to_sim_figures}"
               f"\n  sim (DDS) -> wire (LCM), `cosmicctl bind --replace` took {took_to_wire * 1e3:.0f} ms: {to_wire_figures}")
         # The promise: a subscriber that stays misses nothing of a publisher that stays, across a
-        # rejected replacement and two switches (figures["first"] is before all three).
-        assert figures["lost"] == 0 and figures["twice"] == 0, figures
+        # rejected replacement and two switches (figures["first"] is before all three), but what the
+        # gateway's rate policing dropped of a publisher that bunched its events beyond its latency
+        # bound (counted as `rate`, printed here).
+        policed_total = sum(policed)
+        print(f"  steady's events dropped by rate policing (publisher beyond its contract): {policed_total}")
+        assert figures["twice"] == 0, figures
+        assert figures["lost"] <= policed_total, (figures, policed)
         assert figures["last"] > to_wire_figures["first_after"]
         # The switched source's pause is what was in flight on the hop removed, not DDS discovery
         # (seconds on a loaded machine before the switch was made before break, issue 40).
