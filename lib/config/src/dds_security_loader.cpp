@@ -30,7 +30,12 @@ std::optional<DdsSecuritySpec> parse_dds_security(YamlReader& reader, const YAML
   const std::size_t errors_before = reader.error_count();
   SecurityFile files[] = {{"identity_ca", {}, {}},    {"certificate", {}, {}}, {"private_key", {}, {}},
                           {"permissions_ca", {}, {}}, {"governance", {}, {}},  {"permissions", {}, {}}};
-  const std::filesystem::path base = std::filesystem::absolute(reader.file()).parent_path();
+  // Fast DDS takes file:// URIs of absolute paths. Without a file name (a text parsed on its own),
+  // relative paths are the working directory's.
+  std::error_code failed;
+  std::filesystem::path base = reader.file().empty() ? std::filesystem::current_path(failed)
+                                                     : std::filesystem::absolute(reader.file(), failed).parent_path();
+  if (failed) base = std::filesystem::path("/");
   for (SecurityFile& f : files) {
     const std::string at = key(path, f.key);
     if (!has(node, f.key)) {
@@ -57,11 +62,18 @@ std::optional<DdsSecuritySpec> parse_dds_security(YamlReader& reader, const YAML
     reader.error_at(node[f.key], key(path, f.key), f.path + ": " + e.text);
   };
   std::string subject;
+  // A CA file that holds no certificate is reported once, at its key: what depends on it is not checked.
   if (identity_ca.read) {
-    if (auto ok = check_ca_certificate(identity_ca.text); !ok) report(identity_ca, ok.error());
+    if (auto ok = check_ca_certificate(identity_ca.text); !ok) {
+      report(identity_ca, ok.error());
+      identity_ca.read = false;
+    }
   }
   if (permissions_ca.read) {
-    if (auto ok = check_ca_certificate(permissions_ca.text); !ok) report(permissions_ca, ok.error());
+    if (auto ok = check_ca_certificate(permissions_ca.text); !ok) {
+      report(permissions_ca, ok.error());
+      permissions_ca.read = false;
+    }
   }
   if (identity_ca.read && certificate.read) {
     auto checked = check_identity_certificate(identity_ca.text, certificate.text);
