@@ -2,7 +2,6 @@
 
 #include <variant>
 
-#include "cosmic/lcm_auth_layout.hpp"
 #include "cosmic/lcm_url.hpp"
 #include "cosmic/transport_limits.hpp"
 
@@ -395,38 +394,8 @@ class ConfigParser {
       s.lcm.own_datagrams = static_cast<LcmOwnDatagrams>(
           reader_.choice(node["own_datagrams"], key(path, "own_datagrams"), {"cut", "drop"}).value_or(0));
     }
-    if (has(node, "auth")) parse_lcm_auth(node["auth"], key(path, "auth"), s);
-  }
-
-  // auth: {key_file: FILE, window: DURATION} (cosmic/lcm_auth.hpp).
-  void parse_lcm_auth(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
-    if (!reader_.check_map(node, path, {"key_file", "accept_key_files", "window", "cost"})) return;
-    LcmAuthSpec auth;
-    if (require(node, path, "key_file", "a key file: openssl rand -hex 32 > FILE; chmod 600 FILE")) {
-      auto loaded = config_detail::load_key_file(reader_, node["key_file"], key(path, "key_file"), included_,
-                                                 kLcmAuthMinKeyBytes, kLcmAuthMaxKeyBytes);
-      if (loaded) {
-        auth.key_file = loaded->path;
-        auth.key = std::move(loaded->key);
-      }
-    }
-    if (has(node, "accept_key_files") && reader_.is_list(node["accept_key_files"], key(path, "accept_key_files"))) {
-      const YAML::Node& files = node["accept_key_files"];
-      for (std::size_t i = 0; i < files.size(); ++i) {
-        auto loaded = config_detail::load_key_file(reader_, files[i], indexed(key(path, "accept_key_files"), i),
-                                                   included_, kLcmAuthMinKeyBytes, kLcmAuthMaxKeyBytes);
-        if (!loaded) continue;
-        auth.accepted_files.push_back(loaded->path);
-        auth.accepted.push_back(std::move(loaded->key));
-      }
-    }
-    if (has(node, "window")) {
-      if (auto v = reader_.duration(node["window"], key(path, "window"), false)) auth.window = *v;
-    }
-    if (has(node, "cost")) {
-      if (auto v = reader_.duration(node["cost"], key(path, "cost"), true)) auth.cost = *v;
-    }
-    s.lcm.auth = std::move(auth);
+    if (has(node, "auth"))
+      s.lcm.auth = config_detail::parse_lcm_auth(reader_, node["auth"], key(path, "auth"), included_);
   }
 
   void parse_channel_list(const YAML::Node& node, const std::string& path) {

@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "cosmic/key_file.hpp"
+#include "cosmic/lcm_auth_layout.hpp"
 #include "type_file_loader.hpp"
 
 namespace cosmic {
@@ -70,6 +71,39 @@ std::optional<LoadedKey> load_key_file(YamlReader& reader, const YAML::Node& nod
   }
   included.push_back(resolved);
   return LoadedKey{resolved, std::move(key).value()};
+}
+
+LcmAuthSpec parse_lcm_auth(YamlReader& reader, const YAML::Node& node, const std::string& path,
+                           std::vector<std::string>& included) {
+  LcmAuthSpec auth;
+  if (!reader.check_map(node, path, {"key_file", "accept_key_files", "window", "cost"})) return auth;
+  if (has(node, "key_file")) {
+    if (auto loaded = load_key_file(reader, node["key_file"], key(path, "key_file"), included, kLcmAuthMinKeyBytes,
+                                    kLcmAuthMaxKeyBytes)) {
+      auth.key_file = loaded->path;
+      auth.key = std::move(loaded->key);
+    }
+  } else if (!node["key_file"]) {  // present without a value: check_map reports it
+    reader.error_at(node, key(path, "key_file"), "missing required key 'key_file'",
+                    "a key file: openssl rand -hex 32 > FILE; chmod 600 FILE");
+  }
+  if (has(node, "accept_key_files") && reader.is_list(node["accept_key_files"], key(path, "accept_key_files"))) {
+    const YAML::Node& files = node["accept_key_files"];
+    for (std::size_t i = 0; i < files.size(); ++i) {
+      auto loaded = load_key_file(reader, files[i], indexed(key(path, "accept_key_files"), i), included,
+                                  kLcmAuthMinKeyBytes, kLcmAuthMaxKeyBytes);
+      if (!loaded) continue;
+      auth.accepted_files.push_back(loaded->path);
+      auth.accepted.push_back(std::move(loaded->key));
+    }
+  }
+  if (has(node, "window")) {
+    if (auto v = reader.duration(node["window"], key(path, "window"), false)) auth.window = *v;
+  }
+  if (has(node, "cost")) {
+    if (auto v = reader.duration(node["cost"], key(path, "cost"), true)) auth.cost = *v;
+  }
+  return auth;
 }
 
 }  // namespace cosmic::config_detail

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "cosmic/model.hpp"
 #include "cosmic/secret_key.hpp"
 #include "yaml_reader.hpp"
 
@@ -30,5 +31,10 @@ struct LoadedKey {
 std::optional<LoadedKey> load_key_file(YamlReader& reader, const YAML::Node& node, const std::string& path,
                                        std::vector<std::string>& included, std::size_t min_bytes,
                                        std::size_t max_bytes);
+
+// An LCM segment's `auth: {key_file, accept_key_files, window, cost}` (cosmic/lcm_auth.hpp), every
+// problem reported at its key; the key files read go to `included`.
+LcmAuthSpec parse_lcm_auth(YamlReader& reader, const YAML::Node& node, const std::string& path,
+                           std::vector<std::string>& included);
 
 }  // namespace cosmic::config_detail

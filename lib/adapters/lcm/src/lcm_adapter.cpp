@@ -23,10 +23,8 @@
 // the default) or cuts them down to nothing, which the receive thread then skips by that source.
 // The receive socket is a member of the group only while a channel is received here (join_group,
 // leave_group), so a segment that only sends gets none of them back.
-// On a segment with `auth` (cosmic/lcm_auth.hpp) the transmitter signs every message and the
-// receive thread checks every message of a received channel before its format reads it: one
-// without a valid trailer is counted as unauthenticated, one sent before or outside the window as
-// replayed, each a drop of its channel (docs/security.md); raw channels cannot be bound here.
+// With `auth` (cosmic/lcm_auth.hpp) the transmitter signs each message, the receive thread checks
+// each one received before its format reads it (lcm_auth_refusals.hpp: what it refuses).
 // The EventSink is called while the receive thread reads the table: it must hand the event on
 // (the router queues it) and not call back into this adapter's configure() or stop(), which
 // would wait for that reading to end.
@@ -69,6 +67,7 @@
 #include "cosmic/thread_annotations.hpp"
 #include "cosmic/thread_policy.hpp"
 #include "cosmic/transport_limits.hpp"
+#include "lcm_auth_refusals.hpp"
 #include "lcm_channel.hpp"
 #include "lcm_sockets.hpp"
 #include "lcm_transmit.hpp"
@@ -85,8 +84,6 @@ constexpr std::chrono::milliseconds kSelfTestTimeout{2000};
 // The receive socket's buffer unless the URL names one (recv_buf_size): about 5,000 small
 // datagrams or 60 of 64 KiB, what liblcm's queues held before (4,096 messages).
 constexpr std::size_t kDefaultReceiveBuffer = 4u << 20;
-// At most one line per kind of refused message (unauthenticated, replayed) in this time.
-constexpr Nanos kRefusalLogPause = std::chrono::seconds(10);
 
 struct StringHash {
   using is_transparent = void;
@@ -120,8 +117,8 @@ class LcmAdapter final : public SegmentAdapter {
                   receive_failing_),
         // An envelope's payload may be max_message_size bytes: the message is its header longer,
         // and its authentication trailer.
-        reassembler_(segment.max_message_size + kLcmEnvelopeHeaderSize + (segment.lcm.auth ? kLcmAuthTrailerSize : 0)) {
-  }
+        reassembler_(segment.max_message_size + kLcmEnvelopeHeaderSize + (segment.lcm.auth ? kLcmAuthTrailerSize : 0)),
+        refusals_(prefix_, segment.lcm.auth ? segment.lcm.auth->window : Nanos(0), log) {}
 
   ~LcmAdapter() override { stop(); }
 
@@ -144,9 +141,7 @@ class LcmAdapter final : public SegmentAdapter {
       return Status{};
     }
     if (segment_.lcm.auth) {
-      std::vector<std::span<const std::uint8_t>> keys{segment_.lcm.auth->key.bytes()};
-      for (const SecretKey& accepted : segment_.lcm.auth->accepted) keys.push_back(accepted.bytes());
-      Result<LcmAuthVerifier> verifier = LcmAuthVerifier::make(keys, segment_.lcm.auth->window);
+      Result<LcmAuthVerifier> verifier = lcm_detail::make_verifier(*segment_.lcm.auth);
       if (!verifier) return fail_start("cannot check authentication: " + verifier.error().text);
       verifier_.emplace(std::move(verifier).value());  // before the receive thread that uses it starts
     }
@@ -289,8 +284,7 @@ class LcmAdapter final : public SegmentAdapter {
           TransportCounter{"own_datagrams_dropped", own_dropped_before_ + (own_counting_ ? transmit_.own_drops() : 0)});
     }
     if (segment_.lcm.auth) {
-      s.transport.push_back(TransportCounter{"unauthenticated", unauthenticated_.load(std::memory_order_relaxed)});
-      s.transport.push_back(TransportCounter{"replayed", replayed_.load(std::memory_order_relaxed)});
+      refusals_.report(s);
     }
     return s;
   }
@@ -536,7 +530,7 @@ class LcmAdapter final : public SegmentAdapter {
     if (verifier_) {
       const LcmAuthCheck checked = verifier_->check(name, bytes, arrival_realtime_ns);
       if (checked.verdict != LcmAuthVerdict::authentic) {
-        refuse(table, channel, from, checked, Nanos(received_at));
+        table.sink->on_problem(channel.id, refusals_.refuse(channel.name, from.text(), checked, received_at));
         return;
       }
       bytes = bytes.first(checked.message_size);
@@ -553,28 +547,6 @@ class LcmAdapter final : public SegmentAdapter {
       return;
     }
     table.sink->on_event(event);
-  }
-
-  // A message that failed its authentication check: counted for the segment and as a drop of its
-  // channel; the first of each kind, and then one every kRefusalLogPause at most, is logged with
-  // where it came from (an attack or a misconfigured peer leaves a trace, not a flood of lines).
-  void refuse(const ChannelTable& table, const Channel& channel, Endpoint from, const LcmAuthCheck& checked,
-              Nanos now) {
-    const bool unauthenticated = checked.verdict == LcmAuthVerdict::unauthenticated;
-    (unauthenticated ? unauthenticated_ : replayed_).fetch_add(1, std::memory_order_relaxed);
-    table.sink->on_problem(channel.id, unauthenticated ? InboundProblem::unauthenticated : InboundProblem::replayed);
-    Nanos& last = unauthenticated ? last_unauthenticated_log_ : last_replayed_log_;
-    if (last != Nanos::min() && now - last < kRefusalLogPause) return;
-    last = now;
-    const std::string window = std::to_string(segment_.lcm.auth->window.count() / 1'000'000) + " ms";
-    std::string why = unauthenticated   ? "no valid authentication tag"
-                      : checked.crowded ? "more than " + std::to_string(LcmAuthVerifier::kMaxSenders) +
-                                              " senders within the window (" + window + ")"
-                                        : "sent before, or " + std::to_string(checked.skew_ns / 1'000'000) +
-                                              " ms from this host's clock (window " + window + ")";
-    log_.log(LogLevel::warning, prefix_ + "dropped a message of channel " + channel.name + " from " + from.text() +
-                                    ": " + why + " (counted as " + to_string(checked.verdict) +
-                                    "; at most one such line every 10 s)");
   }
 
   // memq://: nothing to send on, and nothing lost by it.
@@ -608,13 +580,10 @@ class LcmAdapter final : public SegmentAdapter {
   // Receive thread only (set by start() before the thread starts).
   LcmReassembler reassembler_;
   std::optional<LcmAuthVerifier> verifier_;  // on a segment with auth
-  Nanos last_unauthenticated_log_ = Nanos::min();
-  Nanos last_replayed_log_ = Nanos::min();
-  std::atomic<std::uint64_t> unauthenticated_{0};
-  std::atomic<std::uint64_t> replayed_{0};
-  std::uint32_t overflow_seen_ = 0;     // drops less own drops, modulo 2^32, at the last report
-  std::int64_t overflow_total_ = 0;     // ... followed without wrapping
-  std::int64_t overflow_reported_ = 0;  // what overflow_drops got from this socket so far
+  lcm_detail::LcmAuthRefusals refusals_;     // what it refused
+  std::uint32_t overflow_seen_ = 0;          // drops less own drops, modulo 2^32, at the last report
+  std::int64_t overflow_total_ = 0;          // ... followed without wrapping
+  std::int64_t overflow_reported_ = 0;       // what overflow_drops got from this socket so far
 
   mutable Mutex own_count_mutex_;  // statistics() from any thread; start()/stop() write
   bool own_counting_ COSMIC_GUARDED_BY(own_count_mutex_) = false;
