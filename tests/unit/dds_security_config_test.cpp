@@ -50,6 +50,7 @@ class DdsSecurityConfig : public testing::Test {
         security +
         "}\n"
         "channels: []\n";
+    security_line_ = "    security: {" + security + "}";
     return parse_config(text, (pki_ / "gateway.yaml").string());
   }
 
@@ -58,10 +59,16 @@ class DdsSecurityConfig : public testing::Test {
     ASSERT_EQ(result.errors.size(), 1u) << (result.errors.empty() ? "" : result.errors.back().to_string());
     EXPECT_EQ(result.errors.front().path, "segments[0].security." + key);
     EXPECT_EQ(result.errors.front().line, 5);
+    // All six keys stand on that line: the column tells which one (its value's, or the map's when missing).
+    const auto at = security_line_.find(key + ": ");
+    const int column = at == std::string::npos ? static_cast<int>(security_line_.find('{')) + 1
+                                               : static_cast<int>(at + key.size() + 2) + 1;
+    EXPECT_EQ(result.errors.front().column, column) << result.errors.front().to_string();
     EXPECT_NE(result.errors.front().message.find(fragment), std::string::npos) << result.errors.front().to_string();
   }
 
   static std::filesystem::path pki_;
+  std::string security_line_;  // the YAML line of the last load()'s security map
 };
 
 std::filesystem::path DdsSecurityConfig::pki_;
