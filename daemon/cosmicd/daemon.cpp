@@ -10,6 +10,8 @@
 #include <csignal>
 #include <cstring>
 #include <cstdlib>
+#include <filesystem>
+#include <filesystem>
 #include <random>
 
 #include "adapter_factory.hpp"
@@ -80,7 +82,11 @@ class Daemon {
       : options_(options),
         log_(parse_level(options.log_level)),
         state_file_(options.state_file.empty() ? default_state_file() : options.state_file),
-        gateway_(make_adapter, log_, random_gateway_id()),
+        gateway_(
+            [this](const cosmic::SegmentSpec& segment, const cosmic::GatewayIdentity& self, cosmic::Logger& log) {
+              return make_adapter(segment, self, log, std::filesystem::path(state_file_).parent_path().string());
+            },
+            log_, random_gateway_id()),
         federation_(gateway_, log_, cosmic::make_dds_federation_link) {}
 
   int run() {

@@ -16,6 +16,7 @@
 #include "background_loader.hpp"
 #include "components_loader.hpp"
 #include "native_loader.hpp"
+#include "secoc_loader.hpp"
 #include "typed_hops_loader.hpp"
 #include "type_loader.hpp"
 #include "federation_loader.hpp"
@@ -64,6 +65,7 @@ class ConfigParser {
       }
       config_detail::load_components(reader_, *root, config_);
       native_.check_derived(reader_, config_);
+      secoc_.check_derived(reader_, config_);
       typed_.check(reader_, config_.channels, config_.segments);
     }
     result.config = std::move(config_);
@@ -411,6 +413,9 @@ class ConfigParser {
       native_.add(reader_, node["native"], key(path, "native"), *channel,
                   derive_bindings_ && !(node["publishers"] && node["subscribers"]));
     }
+    if (node["secoc"])
+      secoc_.add(reader_, node["secoc"], key(path, "secoc"), *channel,
+                 derive_bindings_ && !(node["publishers"] && node["subscribers"]));
     typed_.add(node, path, *channel);
     config_.channels.push_back(std::move(*channel));
   }
@@ -441,7 +446,7 @@ class ConfigParser {
     if (!reader_.check_map(
             node, path,
             {"name", "subject", "class", "period", "max_rate", "reaction_time", "omission_degree", "temp_validity",
-             "payload", "etag", "encoding", "publishers", "subscribers", "native", "type", "on_range"})) {
+             "payload", "etag", "encoding", "publishers", "subscribers", "native", "type", "on_range", "secoc"})) {
       return std::nullopt;
     }
     const std::size_t errors_before = reader_.error_count();
@@ -479,6 +484,7 @@ class ConfigParser {
         config_detail::check_native_segments(reader_, node["native"], key(path, "native"), c);
       }
     }
+    if (node["secoc"]) config_detail::parse_secoc(reader_, node["secoc"], key(path, "secoc"), config_, c, included_);
     check_transport_limits(node, path, c);
     if (reader_.error_count() != errors_before) return std::nullopt;
     return c;
@@ -580,6 +586,7 @@ class ConfigParser {
   std::map<std::uint16_t, std::string> etags_;
   std::vector<std::string> included_;  // files read besides the YAML (DBC)
   config_detail::NativeDeclarations native_;
+  config_detail::SecocDeclarations secoc_;
   config_detail::TypedHopChecks typed_;
 };
 

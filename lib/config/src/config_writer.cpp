@@ -8,6 +8,22 @@
 namespace cosmic {
 namespace {
 std::string nanos(Nanos value) { return std::to_string(value.count()) + "ns"; }
+
+// The key file's resolved path, never the key.
+void write_secoc(YAML::Emitter& out, const ChannelSpec& channel) {
+  if (channel.secoc.empty()) return;
+  out << YAML::Key << "secoc" << YAML::Value << YAML::BeginMap;
+  for (const SecocSpec& spec : channel.secoc) {
+    out << YAML::Key << spec.segment << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "key_file" << YAML::Value << spec.key_file;
+    out << YAML::Key << "mac_bits" << YAML::Value << spec.mac_bits;
+    out << YAML::Key << "freshness_bits" << YAML::Value << spec.freshness_bits;
+    if (spec.data_id) out << YAML::Key << "data_id" << YAML::Value << *spec.data_id;
+    if (spec.cost) out << YAML::Key << "cost" << YAML::Value << nanos(*spec.cost);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndMap;
+}
 }  // namespace
 
 std::string channel_to_yaml(const ChannelSpec& channel) {
@@ -51,6 +67,7 @@ std::string channel_to_yaml(const ChannelSpec& channel) {
   }
   if (channel.type) out << YAML::Key << "type" << YAML::Value << config_detail::channel_type_to_yaml(*channel.type);
   if (channel.on_range == RangePolicy::saturate) out << YAML::Key << "on_range" << YAML::Value << "saturate";
+  write_secoc(out, channel);
   out << YAML::EndMap;
   return out.c_str();
 }

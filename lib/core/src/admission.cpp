@@ -59,8 +59,11 @@ CanHopPlan frame_plan(const SegmentSpec& segment, const ChannelSpec& channel) {
   CanHopPlan plan;
   const std::optional<NativeCanFrame> native = channel.native_can(segment.name);
   const std::uint32_t capacity = max_frame_payload(bus);
-  const std::uint64_t payload = channel.payload_on(segment.name);
-  const bool fits = payload <= capacity || native;
+  // A SecOC hop's frame carries the truncated freshness and MAC behind the data: never fragmented
+  // (admission's frame_fit refuses what does not fit one frame).
+  const SecocSpec* secoc = channel.secoc_on(segment.name);
+  const std::uint64_t payload = channel.payload_on(segment.name) + (secoc ? secoc->overhead_bytes() : 0);
+  const bool fits = payload <= capacity || native || secoc;
   plan.frames_per_event = fits ? 1 : fragments_needed(payload, capacity);
   const auto data_bytes = static_cast<std::uint32_t>(std::min<std::uint64_t>(payload, capacity));
   plan.frame_bytes = bus.fd ? fd_padded_length(data_bytes) : data_bytes;
@@ -92,8 +95,16 @@ double hop_load(const SegmentSpec& segment, const ChannelSpec& channel) {
 std::optional<HopSecurity> hop_security(const SegmentSpec& segment, const ChannelSpec& channel) {
   if (segment.type == SegmentType::lcm && segment.lcm.auth)
     return HopSecurity{"HMAC-SHA256 trailer", static_cast<std::uint32_t>(kLcmAuthTrailerSize), segment.lcm.auth->cost};
-  (void)channel;  // SecOC (per CAN hop of a channel) comes with its own key
-  return std::nullopt;
+  const SecocSpec* secoc = segment.type == SegmentType::can ? channel.secoc_on(segment.name) : nullptr;
+  if (secoc == nullptr) return std::nullopt;
+  return HopSecurity{"SecOC AES-128-CMAC " + std::to_string(secoc->mac_bits) + "-bit MAC, " +
+                         std::to_string(secoc->freshness_bits) + "-bit freshness",
+                     secoc->overhead_bytes(), secoc->cost};
+}
+
+Nanos can_hop_security_cost(const SegmentSpec& segment, const ChannelSpec& channel) {
+  const SecocSpec* secoc = segment.type == SegmentType::can ? channel.secoc_on(segment.name) : nullptr;
+  return secoc && secoc->cost ? *secoc->cost : Nanos(0);
 }
 
 Nanos ip_hop_latency(const SegmentSpec& segment) {
@@ -280,9 +291,12 @@ bool AdmissionSet::update_jitters(CanSide& side, const Trial* newcomer) const {
       std::optional<Nanos> upstream = Nanos(0);
       for (const HopPlace& p : m.data->places) {
         if (p.role != HopRole::publisher) continue;
-        const std::optional<Nanos> latency = segment_specs_[p.segment].type == SegmentType::can
-                                                 ? side.plans[p.segment][p.position].response_time
-                                                 : std::optional<Nanos>(ip_hop_latency(segment_specs_[p.segment]));
+        const SegmentSpec& publisher = segment_specs_[p.segment];
+        std::optional<Nanos> latency = std::optional<Nanos>(ip_hop_latency(publisher));
+        if (publisher.type == SegmentType::can) {
+          latency = side.plans[p.segment][p.position].response_time;
+          if (latency) *latency += can_hop_security_cost(publisher, *m.spec);
+        }
         upstream = upstream && latency ? std::optional<Nanos>(std::max(*upstream, *latency)) : std::nullopt;
       }
       const Nanos jitter =
@@ -365,7 +379,9 @@ ChannelReport AdmissionSet::report_of(const ChannelSpec& spec, const ChannelData
     if (segment.type == SegmentType::can) {
       CanHopPlan plan = can ? can->plans[p.segment][p.position] : segments_[p.segment].plans[p.position];
       if (diverged && p.role == HopRole::subscriber) plan.response_time = std::nullopt;
+      // SecOC's cryptography: checking a received frame, or protecting one before its release.
       h.latency = plan.response_time;
+      if (h.latency) *h.latency += can_hop_security_cost(segment, spec);
       h.background = background_delaying(segment, segments_[p.segment].background, spec, plan);
       h.can = plan;
     } else {

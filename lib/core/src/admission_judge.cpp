@@ -30,7 +30,8 @@ void add_frame_fit(const ChannelSpec& channel, const SegmentSpec& segment, HopRe
   if (segment.type == SegmentType::can) {
     const std::uint32_t capacity = max_frame_payload(segment.can);
     // A native frame is the event: no fragmentation, whatever the class.
-    const bool fragmentable = channel.cls == ChannelClass::nrt && !channel.native_can(segment.name);
+    const bool fragmentable =
+        channel.cls == ChannelClass::nrt && !channel.native_can(segment.name) && !channel.secoc_on(segment.name);
     limit = fragmentable && channel.payload_on(segment.name) > capacity
                 ? static_cast<double>(kMaxFragments * (capacity - kFragmentHeaderBytes))
                 : capacity;
@@ -68,14 +69,22 @@ void add_representation_checks(const HopPayload* hop, HopReport& h) {
 // LCM message has no room for the trailer: nothing in it tells the tag from the contents).
 void add_security_checks(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) {
   h.security = hop_security(segment, channel);
-  if (!h.security || segment.type != SegmentType::lcm) return;
-  const bool carried = channel.native_on(segment.name) == nullptr && channel.lcm_encoding != LcmEncoding::raw;
+  if (!h.security) return;
+  // SecOC: this project's layout and native identifiers; FAMOUSO's layout has no room for it.
+  const bool carried = segment.type == SegmentType::can
+                           ? segment.can.profile == CanProfile::cosmic || channel.native_can(segment.name)
+                           : channel.native_on(segment.name) == nullptr && channel.lcm_encoding != LcmEncoding::raw;
   h.checks.push_back(Check{"authentication", carried ? 1.0 : 0.0, 1.0, "bool", ">=", carried});
 }
 
 std::string failure_text(const Check& check, const HopReport& h, const SegmentSpec& segment,
                          const ChannelSpec& channel) {
   const std::string on = " on " + h.segment;
+  if (check.check == "authentication" && segment.type == SegmentType::can) {
+    return "SecOC" + on +
+           " needs this project's frame layout or a native identifier: FAMOUSO's frames (profile: famouso) cannot "
+           "carry it";
+  }
   if (check.check == "authentication") {
     return "raw LCM messages" + on +
            " cannot carry the authentication trailer the segment requires (auth): use encoding: envelope";
@@ -88,7 +97,13 @@ std::string failure_text(const Check& check, const HopReport& h, const SegmentSp
   }
   if (check.check == "frame_fit") {
     const bool native = h.can && h.can->native;
-    return "payload " + std::to_string(static_cast<long long>(check.value)) + " B > " +
+    // What security adds is named apart: "payload 6 B + SecOC 4 B > frame 8 B".
+    const std::uint32_t added = h.security ? h.security->bytes : 0;
+    const std::string what = added == 0 ? std::to_string(static_cast<long long>(check.value)) + " B"
+                                        : std::to_string(static_cast<long long>(check.value) - added) + " B + " +
+                                              (segment.type == SegmentType::can ? "SecOC " : "trailer ") +
+                                              std::to_string(added) + " B";
+    return "payload " + what + " > " +
            (native                             ? "native frame "
             : segment.type == SegmentType::can ? "frame "
                                                : "message ") +
@@ -103,8 +118,9 @@ std::string failure_text(const Check& check, const HopReport& h, const SegmentSp
            " > max_utilization " + format_percent(check.limit) + on;
   }
   if (check.check == "response_time") {
-    return "R = " + format_seconds(check.value) + " > reaction_time " + format_seconds(check.limit) + on +
-           background_text(h);
+    const bool costed = h.security && h.security->time;
+    return "R " + std::string(costed ? "+ SecOC " : "") + "= " + format_seconds(check.value) + " > reaction_time " +
+           format_seconds(check.limit) + on + background_text(h);
   }
   if (check.check == "latency") {
     const bool costed = h.security && h.security->time;

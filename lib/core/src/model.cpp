@@ -68,6 +68,11 @@ const NativeBinding* ChannelSpec::native_on(const std::string& segment) const {
   return it == native.end() ? nullptr : &*it;
 }
 
+const SecocSpec* ChannelSpec::secoc_on(const std::string& segment) const {
+  const auto it = std::find_if(secoc.begin(), secoc.end(), [&](const SecocSpec& s) { return s.segment == segment; });
+  return it == secoc.end() ? nullptr : &*it;
+}
+
 std::optional<NativeCanFrame> ChannelSpec::native_can(const std::string& segment) const {
   const NativeBinding* binding = native_on(segment);
   return binding ? binding->can : std::nullopt;

@@ -32,6 +32,7 @@ void CanAdapter::stop() {
   if (!started_) return;
   receiver_.stop();
   close_socket();
+  secoc_freshness_.stop();  // the lanes have stopped sending: the last values persist
   {
     PiLock lock(io_mutex_);
     table_ = std::make_shared<Table>();  // stop() forgets the bindings (SegmentAdapter's lifecycle)
@@ -66,31 +67,34 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
   BindingPlan plan(bindings);
   std::shared_ptr<Table> table = plan_table(plan);
   Status status = plan.status();
-
-  PiLock lock(io_mutex_);
-  if (sock_ >= 0 && ::setsockopt(sock_, SOL_CAN_RAW, CAN_RAW_FILTER, table->filters.data(),
-                                 static_cast<socklen_t>(table->filters.size() * sizeof(can_filter))) != 0) {
-    // The kernel keeps the old filters, so the old table stays: the whole segment failed.
-    const std::string error = "CAN_RAW_FILTER: " + errno_text(errno) + "; the previous channels stay";
-    log_.log(LogLevel::error, prefix_ + error);
-    return Status::failure(error);
+  // The leases of new SecOC senders, persisted before their first frame (file I/O: outside io_mutex_).
+  secoc_freshness_.persist_now();
+  {
+    PiLock lock(io_mutex_);
+    if (sock_ >= 0 && ::setsockopt(sock_, SOL_CAN_RAW, CAN_RAW_FILTER, table->filters.data(),
+                                   static_cast<socklen_t>(table->filters.size() * sizeof(can_filter))) != 0) {
+      // The kernel keeps the old filters, so the old table stays: the whole segment failed.
+      const std::string error = "CAN_RAW_FILTER: " + errno_text(errno) + "; the previous channels stay";
+      log_.log(LogLevel::error, prefix_ + error);
+      return Status::failure(error);
+    }
+    backlog_.set_capacity(table->backlog_frames);
+    for (auto it = tx_sequence_.begin(); it != tx_sequence_.end();) {
+      const bool bound =
+          std::any_of(table->tx.begin(), table->tx.end(), [&](const auto& t) { return t.second.etag == it->first; });
+      it = bound ? std::next(it) : tx_sequence_.erase(it);
+    }
+    // FAMOUSO nodes ask once and wait: requests for subjects bound only now are answered now.
+    std::erase_if(pending_requests_, [&](const can_binding::GetEtagRequest& r) COSMIC_REQUIRES(io_mutex_) {
+      const auto found = table->etag_of.find(r.subject);
+      if (found == table->etag_of.end()) return false;
+      queue_supply_etag(r.requester, found->second, r.subject, *table);
+      return true;
+    });
+    table_ = std::move(table);
+    generation_.fetch_add(1, std::memory_order_release);
+    if (!answers_.empty()) wake();
   }
-  backlog_.set_capacity(table->backlog_frames);
-  for (auto it = tx_sequence_.begin(); it != tx_sequence_.end();) {
-    const bool bound =
-        std::any_of(table->tx.begin(), table->tx.end(), [&](const auto& t) { return t.second.etag == it->first; });
-    it = bound ? std::next(it) : tx_sequence_.erase(it);
-  }
-  // FAMOUSO nodes ask once and wait: requests for subjects bound only now are answered now.
-  std::erase_if(pending_requests_, [&](const can_binding::GetEtagRequest& r) COSMIC_REQUIRES(io_mutex_) {
-    const auto found = table->etag_of.find(r.subject);
-    if (found == table->etag_of.end()) return false;
-    queue_supply_etag(r.requester, found->second, r.subject, *table);
-    return true;
-  });
-  table_ = std::move(table);
-  generation_.fetch_add(1, std::memory_order_release);
-  if (!answers_.empty()) wake();
   if (!status.ok) log_.log(LogLevel::error, prefix_ + status.error);
   return status;
 }
@@ -139,12 +143,16 @@ Result<void> CanAdapter::bind_native(const ChannelBinding& b, Table& table) {
   if (Result<void> fits = native_frames_.check_payload(b.spec.payload_on(segment_.name)); !fits) return fits;
   const NativeCanFrame frame{b.can->can_id, b.can->extended};
   const auto payload = static_cast<std::size_t>(b.spec.payload_on(segment_.name));
+  const canid_t identifier = frame.can_id | (frame.extended ? CAN_EFF_FLAG : 0);
+  auto secoc = bind_secoc(b, identifier);
+  if (!secoc) return secoc.error();
   if (b.role == HopRole::publisher) {
-    if (!table.native.add_publisher(frame, can_native::RxChannel{b.id, b.spec.subject, payload})) {
+    if (!table.native.add_publisher(frame, can_native::RxChannel{b.id, b.spec.subject, payload, secoc.value().rx})) {
       return Error{"native identifier bound twice as publisher"};
     }
   } else {
-    table.tx[b.id] = CanTxBinding{b.id, &native_frames_, frame.can_id, frame.can_id, frame.extended, 0, payload, false};
+    table.tx[b.id] = CanTxBinding{b.id, &native_frames_, frame.can_id, frame.can_id,    frame.extended,
+                                  0,    payload,         false,        secoc.value().tx};
     table.native.add_subscriber(frame);
   }
   return {};
@@ -164,8 +172,15 @@ Result<void> CanAdapter::bind_etag(const ChannelBinding& b, Table& table) {
   const bool fragmented = format.fragments(b.spec.payload_on(segment_.name));
   const CanIdentifier id = decode_can_id(b.can->can_id & CAN_EFF_MASK);
   const auto payload = static_cast<std::size_t>(b.spec.payload_on(segment_.name));
+  // A publisher hop's plan names the nodes' identifier; the data ID then comes from each frame's.
+  auto secoc = bind_secoc(b, (b.can->can_id & CAN_EFF_MASK) | CAN_EFF_FLAG);
+  if (!secoc) return secoc.error();
+  if (secoc.value().tx || secoc.value().rx) {
+    if (b.can->profile == CanProfile::famouso) return Error{"SecOC needs this project's layout, not FAMOUSO's"};
+  }
   if (b.role == HopRole::publisher) {
-    if (!table.rx.emplace(etag, CanRxBinding{b.id, &format, b.spec.subject, payload, fragmented}).second) {
+    if (!table.rx.emplace(etag, CanRxBinding{b.id, &format, b.spec.subject, payload, fragmented, secoc.value().rx})
+             .second) {
       return Error{"etag " + std::to_string(etag) + " bound twice as publisher"};
     }
   } else {
@@ -180,7 +195,8 @@ Result<void> CanAdapter::bind_etag(const ChannelBinding& b, Table& table) {
                           true,
                           etag,
                           payload,
-                          fragmented};
+                          fragmented,
+                          secoc.value().tx};
     table.tx[b.id] = tx;
     table.tx_etags.insert(etag);
     if (fragmented) table.backlog_frames = std::max(table.backlog_frames, 2 * format.frame_count(tx, payload));
@@ -272,6 +288,10 @@ AdapterStatistics CanAdapter::statistics() const {
   s.overflow_drops = overflow_closed_.load() + overflow_socket_.load() + overflow_controller_.load();
   s.backlog = backlog_size_.load();
   s.transport.push_back(TransportCounter{"binding_requests_over_limit", refused_requests_.load()});
+  if (secoc_bound_.load(std::memory_order_relaxed)) {
+    s.transport.push_back(TransportCounter{"unauthenticated", secoc_unauthenticated_.load()});
+    s.transport.push_back(TransportCounter{"replayed", secoc_replayed_.load()});
+  }
   s.unexplained = census_.snapshot(steady_now());
   s.unexplained_others = census_.others();
   return s;
@@ -281,9 +301,10 @@ AdapterStatistics CanAdapter::statistics() const {
 
 namespace cosmic {
 
-std::unique_ptr<SegmentAdapter> make_can_adapter(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log) {
+std::unique_ptr<SegmentAdapter> make_can_adapter(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log,
+                                                 CanAdapterOptions options) {
   (void)self;  // CAN frames carry no envelope: the gateway is known by its TxNode
-  return std::make_unique<can_detail::CanAdapter>(segment, log);
+  return std::make_unique<can_detail::CanAdapter>(segment, log, std::move(options.secoc_state_file));
 }
 
 }  // namespace cosmic

@@ -56,6 +56,7 @@
 #include "bus_census.hpp"
 #include "native_frames.hpp"
 #include "receive_buffer.hpp"
+#include "secoc_freshness.hpp"
 #include "cosmic/can_adapter.hpp"
 
 namespace cosmic::can_detail {
@@ -117,7 +118,7 @@ using TxSocketRef = std::shared_ptr<const TxSocket>;
 
 class CanAdapter final : public SegmentAdapter {
  public:
-  CanAdapter(const SegmentSpec& segment, Logger& log)
+  CanAdapter(const SegmentSpec& segment, Logger& log, std::string secoc_state_file)
       : segment_(segment),
         log_(log),
         prefix_(segment_log_prefix(SegmentType::can, segment.name)),
@@ -131,7 +132,8 @@ class CanAdapter final : public SegmentAdapter {
         ccp_(segment.can.profile == CanProfile::famouso ? std::optional<famouso::CcpBroker>(std::in_place)
                                                         : std::nullopt),
         table_(std::make_shared<const Table>()),
-        answers_(answer_gap(segment.can)) {}
+        answers_(answer_gap(segment.can)),
+        secoc_freshness_(std::move(secoc_state_file), prefix_, "fv:" + segment.name, log) {}
 
   ~CanAdapter() override { stop(); }
 
@@ -205,6 +207,20 @@ class CanAdapter final : public SegmentAdapter {
   // point at the adapter's formats, through which the receive thread decodes.
   Result<void> bind_native(const ChannelBinding& b, Table& table);
   Result<void> bind_etag(const ChannelBinding& b, Table& table);
+  // configure(): the binding's SecOC state (none without `secoc` on this segment), or why it cannot
+  // be carried. `identifier`: the frames' (with CAN_EFF_FLAG when extended).
+  struct SecocStreams {
+    std::shared_ptr<SecocTx> tx;
+    std::shared_ptr<SecocRx> rx;
+  };
+  Result<SecocStreams> bind_secoc(const ChannelBinding& b, canid_t identifier);
+  // The secured PDU of an event of a SecOC hop in `out`, or the event as it is without SecOC; an
+  // empty span when it cannot be protected (counted). Any lane.
+  std::span<const std::uint8_t> secure(const CanTxBinding& binding, std::span<const std::uint8_t> payload,
+                                       std::span<std::uint8_t> out);
+  // A frame of a SecOC hop: its authentic data, or nothing (counted as unauthenticated or replayed).
+  std::optional<std::span<const std::uint8_t>> authenticate(const CanRxBinding& binding, canid_t can_id,
+                                                            std::span<const std::uint8_t> data, bool fd_frame);
 
   // --- health
   void set_link(Link link, std::string detail);
@@ -310,6 +326,12 @@ class CanAdapter final : public SegmentAdapter {
   std::atomic<std::uint64_t> overflow_controller_{0};
   std::atomic<std::uint64_t> backlog_size_{0};
   can_census::BusCensus census_;
+
+  // SecOC (secoc_freshness.hpp): the counters of the hops' senders and receivers, persisted.
+  SecocFreshness secoc_freshness_;
+  std::atomic<bool> secoc_bound_{false};  // a SecOC hop was bound: statistics show its counters
+  std::atomic<std::uint64_t> secoc_unauthenticated_{0};
+  std::atomic<std::uint64_t> secoc_replayed_{0};
 };
 
 }  // namespace cosmic::can_detail

@@ -21,6 +21,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -34,6 +35,8 @@
 namespace cosmic::can_detail {
 
 class CanFrameFormat;
+class SecocTx;
+class SecocRx;
 
 // Frames one submit hands the kernel at most (one sendmmsg).
 inline constexpr std::size_t kFramesPerSubmit = 16;
@@ -48,6 +51,7 @@ struct CanTxBinding {
   std::uint16_t etag = 0;                  // none for native
   std::size_t payload = 0;                 // the channel's largest event
   bool fragmented = false;                 // cosmic: every event goes as numbered fragments
+  std::shared_ptr<SecocTx> secoc{};        // the hop's SecOC (secoc_streams.hpp): frames are protected
 };
 
 // A channel the gateway receives from the bus (bound as publisher).
@@ -57,6 +61,7 @@ struct CanRxBinding {
   std::uint64_t subject = 0;
   std::size_t payload = 0;
   bool fragmented = false;
+  std::shared_ptr<SecocRx> secoc{};  // the hop's SecOC (secoc_streams.hpp): frames are verified first
 };
 
 // Takes an event's frames in order, at most kFramesPerSubmit at a time (the transport's submit).

@@ -18,8 +18,8 @@ void CanAdapter::handle_frame(const canfd_frame& frame, bool fd_frame, Nanos now
   const Table& table = *rx_table_;
   // Native identifiers first: an extended one may have any bits in the etag field.
   if (const can_native::RxChannel* native = table.native.find(frame.can_id)) {
-    receive(CanRxBinding{native->id, &native_frames_, native->subject, native->payload, false}, frame.can_id,
-            std::span<const std::uint8_t>(frame.data, len), fd_frame, now);
+    receive(CanRxBinding{native->id, &native_frames_, native->subject, native->payload, false, native->secoc},
+            frame.can_id, std::span<const std::uint8_t>(frame.data, len), fd_frame, now);
     return;
   }
   if (table.native.is_background(frame.can_id)) return;  // another device's declared frame
@@ -54,7 +54,9 @@ void CanAdapter::handle_frame(const canfd_frame& frame, bool fd_frame, Nanos now
 
 void CanAdapter::receive(const CanRxBinding& binding, canid_t can_id, std::span<const std::uint8_t> data, bool fd_frame,
                          Nanos now) {
-  const CanDecoded decoded = binding.format->decode(binding, can_id, data, fd_frame, now);
+  const std::optional<std::span<const std::uint8_t>> authentic = authenticate(binding, can_id, data, fd_frame);
+  if (!authentic) return;
+  const CanDecoded decoded = binding.format->decode(binding, can_id, *authentic, fd_frame, now);
   reassembly_losses(binding.id, decoded.displaced, decoded.lost);
   if (decoded.event) deliver(binding, *decoded.event, now);
 }

@@ -240,6 +240,9 @@ SendStatus CanAdapter::send(const OutboundEvent& event) {
     }
     const CanTxBinding& binding = *found;
     const bool fd = segment_.can.fd;
+    std::array<std::uint8_t, CANFD_MAX_DLEN> secured;
+    const std::span<const std::uint8_t> payload = secure(binding, event.payload, secured);
+    if (binding.secoc && payload.empty()) return SendStatus::failed;
     // The first refused batch ends the event: no frame the kernel did not take counts as sent.
     WriteResult refused = WriteResult::written;
     // Batch by batch to submit(): one system call each.
@@ -248,7 +251,7 @@ SendStatus CanAdapter::send(const OutboundEvent& event) {
       if (r == WriteResult::failed || r == WriteResult::full) refused = r;
       return refused == WriteResult::written;
     });
-    if (binding.format->encode(binding, event.payload, sequence, sink)) return SendStatus::sent;
+    if (binding.format->encode(binding, payload, sequence, sink)) return SendStatus::sent;
     // One frame refused: as the kernel or the backlog answered; part of a fragmented event: lost.
     return frames == 1 ? to_send_status(refused) : SendStatus::failed;
   } catch (...) {
@@ -278,7 +281,7 @@ void CanAdapter::send_batch(std::span<const OutboundEvent> events, std::span<Sen
         table = table_;
         for (; i < events.size() && i < results.size() && count < kWriteBatch; ++i) {
           const CanTxBinding* binding = single_frame_binding(*table, events[i]);
-          if (binding == nullptr) break;
+          if (binding == nullptr || binding->secoc) break;  // send() protects and counts SecOC frames
           frames[count++] = binding->format->single_frame(*binding, events[i].payload);
         }
       }

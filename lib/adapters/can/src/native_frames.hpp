@@ -12,6 +12,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <unordered_map>
@@ -21,6 +22,10 @@
 #include "cosmic/event.hpp"
 #include "cosmic/model.hpp"
 
+namespace cosmic::can_detail {
+class SecocRx;
+}
+
 namespace cosmic::can_native {
 
 // The identifier as the socket reports it: CAN_EFF_FLAG set for an extended identifier.
@@ -29,7 +34,8 @@ canid_t socket_id(const NativeCanFrame& frame);
 struct RxChannel {
   ChannelId id = kNoChannel;
   std::uint64_t subject = 0;
-  std::size_t payload = 0;  // the channel's largest event
+  std::size_t payload = 0;                       // the channel's largest event
+  std::shared_ptr<can_detail::SecocRx> secoc{};  // the hop's SecOC, if any
 };
 
 class FrameTable {

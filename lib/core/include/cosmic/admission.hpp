@@ -174,6 +174,8 @@ inline constexpr std::uint64_t kIpOverheadBytes = 96;
 // What authentication adds to each of `channel`'s messages or frames on `segment`; nullopt where
 // the hop is not authenticated (an LCM segment without auth, ...).
 std::optional<HopSecurity> hop_security(const SegmentSpec& segment, const ChannelSpec& channel);
+// What a CAN hop's SecOC adds to its latency (its `cost`); zero without SecOC or cost.
+Nanos can_hop_security_cost(const SegmentSpec& segment, const ChannelSpec& channel);
 // The latency an IP segment's hop promises: the segment's latency_bound, and what its
 // authentication's cryptography costs where that is configured.
 Nanos ip_hop_latency(const SegmentSpec& segment);

@@ -213,6 +213,28 @@ struct HopPayload {
   friend bool operator==(const HopPayload&, const HopPayload&) = default;
 };
 
+// SecOC on one CAN hop of a channel (channel key `secoc: {SEGMENT: {...}}`, issue 36 item 4;
+// docs/security.md): each frame of the channel on that segment carries, after its data, the low
+// `freshness_bits` of a 64-bit freshness counter and the first `mac_bits` of an AES-128-CMAC over
+// (data ID, data, complete freshness) - AUTOSAR's secured I-PDU (cosmic/secoc.hpp). The gateway
+// protects what it sends there and drops (and counts) what it receives that is not authentic or
+// is replayed.
+struct SecocSpec {
+  std::string segment;
+  std::string key_file;  // as resolved against the configuration's directory
+  SecretKey key;         // 16 bytes (AES-128)
+  std::uint32_t mac_bits = 24;
+  std::uint32_t freshness_bits = 8;
+  // The MAC input's data ID; none: derived from each frame's identifier (the TxNode and etag of
+  // this project's layout, the native identifier), so a frame cannot pass for another sender's.
+  std::optional<std::uint32_t> data_id{};
+  // What protecting or checking one frame costs on this machine at worst (`cosmicctl calibrate`):
+  // admission adds it to the hop's latency. None: not counted.
+  std::optional<Nanos> cost{};
+  std::uint32_t overhead_bytes() const { return (mac_bits + freshness_bits) / 8; }
+  friend bool operator==(const SecocSpec&, const SecocSpec&) = default;
+};
+
 struct ChannelSpec {
   std::string name;
   std::uint64_t subject = 0;
@@ -232,6 +254,7 @@ struct ChannelSpec {
   // A typed channel: each hop's message size from its representation (derived by the configuration
   // with `payload`, which is then the largest of them); empty for an untyped channel.
   std::vector<HopPayload> hop_payloads;
+  std::vector<SecocSpec> secoc;  // at most one per segment, each a CAN segment among publishers/subscribers
   friend bool operator==(const ChannelSpec&, const ChannelSpec&) = default;
 
   // The most bytes one event takes on `segment`: its hop's own size where the type gives one, else
@@ -241,6 +264,8 @@ struct ChannelSpec {
   const HopPayload* hop_on(const std::string& segment) const;
 
   const NativeBinding* native_on(const std::string& segment) const;
+  // The SecOC protection of this channel's frames on `segment`, if it has one there.
+  const SecocSpec* secoc_on(const std::string& segment) const;
   // The native CAN frame of this channel on `segment`, if it has one there.
   std::optional<NativeCanFrame> native_can(const std::string& segment) const;
   // The native DDS topic of this channel on `segment`, if it has one there.

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 
 #include "cosmic/log.hpp"
 #include "cosmic/model.hpp"
@@ -13,7 +14,14 @@
 
 namespace cosmic {
 
+struct CanAdapterOptions {
+  // Where the SecOC freshness counters of the segment's channels persist across restarts
+  // (docs/security.md); empty: not persisted (tests), and senders are not held to a lease.
+  std::string secoc_state_file;
+};
+
 // Never null. start() succeeds even when the interface is down or missing (health says so).
-std::unique_ptr<SegmentAdapter> make_can_adapter(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log);
+std::unique_ptr<SegmentAdapter> make_can_adapter(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log,
+                                                 CanAdapterOptions options = {});
 
 }  // namespace cosmic
