@@ -175,6 +175,8 @@ bool SecocFreshness::persist(bool force) {
   std::map<std::shared_ptr<SecocTx>, std::uint64_t> renewed;
   {
     LockGuard lock(mutex_);
+    // Never over a file that was not read, or could not be: it may hold counters still needed.
+    if (!loaded_ || !load_error_.empty()) return false;
     // Streams of channels no longer bound keep their values: a channel bound again continues.
     for (const auto& [key, value] : file_senders_) senders[key] = value;
     for (const auto& [key, value] : file_receivers_) receivers[key] = value;
