@@ -2,8 +2,13 @@
 # make_test_pki.sh DIR: a DDS Security test PKI made with the openssl command line (never checked in):
 # an identity CA and a permissions CA (ECDSA P-256), identities gateway-a, gateway-b and gateway-c
 # ("/O=cosmic/CN=gateway-X", keys 0600), governance (everything ENCRYPT, as Fast DDS 2.9 and Cyclone
-# DDS both handle it) and permissions granting gateway-a and gateway-b every topic of domains 0-230
-# and gateway-c every topic to subscribe but only cosmic/telemetry to publish, signed S/MIME with -text as the DDS Security specification and Fast DDS want them. Material for the
+# DDS both handle it) and permissions granting gateway-a and gateway-b every topic of domains 0-230,
+# gateway-c every topic to subscribe but only cosmic/telemetry to publish, and monitor every topic
+# to subscribe and none to publish, signed S/MIME with -text as the DDS Security specification and Fast DDS want them.
+# Under PKI-DH a participant's GUID prefix follows from its certificate's subject (bit 0 set, then
+# the first 47 bits of SHA-256 over the subject's DER encoding): gateway-a b3.18, gateway-b ce.c4,
+# gateway-c e0.f5, monitor a0.fa. It matters to Cyclone DDS peers, which complete a handshake with
+# Fast DDS only when they start it, that is when their prefix is the lower (docs/security.md). Material for the
 # refusals too: expired.pem (a gateway-b certificate valid 2020-2021), open_key.pem (0644),
 # governance_unsigned.xml, permissions_rogue.p7s (signed by another CA), rogue_ca.pem.
 set -euo pipefail
@@ -22,7 +27,7 @@ ca identity_ca "/O=cosmic/CN=cosmic test identity CA" keyCertSign,cRLSign
 ca permissions_ca "/O=cosmic/CN=cosmic test permissions CA" keyCertSign,cRLSign,digitalSignature
 ca rogue_ca "/O=cosmic/CN=cosmic test permissions CA" keyCertSign,cRLSign,digitalSignature
 printf 'basicConstraints=critical,CA:FALSE\nkeyUsage=critical,digitalSignature,keyAgreement\n' >leaf.cnf
-for name in gateway-a gateway-b gateway-c; do
+for name in gateway-a gateway-b gateway-c monitor; do
   quiet openssl ecparam -name prime256v1 -genkey -noout -out "${name}_key.pem"
   quiet openssl req -new -key "${name}_key.pem" -subj "/O=cosmic/CN=$name" -out "$name.csr"
   quiet openssl x509 -req -in "$name.csr" -CA identity_ca.pem -CAkey identity_ca_key.pem -CAcreateserial -sha256 \
@@ -109,6 +114,15 @@ XML
       <allow_rule>
         <domains><id_range><min>0</min><max>230</max></id_range></domains>
         <publish><topics><topic>cosmic/telemetry</topic></topics></publish>
+        <subscribe><topics><topic>*</topic></topics></subscribe>
+      </allow_rule>
+      <default>DENY</default>
+    </grant>
+    <grant name="monitor">
+      <subject_name>CN=monitor,O=cosmic</subject_name>
+      <validity><not_before>2020-01-01T00:00:00</not_before><not_after>2100-01-01T00:00:00</not_after></validity>
+      <allow_rule>
+        <domains><id_range><min>0</min><max>230</max></id_range></domains>
         <subscribe><topics><topic>*</topic></topics></subscribe>
       </allow_rule>
       <default>DENY</default>
