@@ -81,6 +81,33 @@ contains auth_tight out "authentication"
 contains auth_tight out "BELOW p99.9 (1 ns)"
 contains auth_tight err "warning: segment viz: auth.cost 1 ns is below the p99.9 measured here"
 
+# 3b. A channel's SecOC hop on CAN: its frames' data (the payload) protected and verified, compared
+# with the hop's secoc.cost.
+(umask 077 && openssl rand -hex 16 >"$WORK/bus.key")
+cat >"$WORK/secoc.yaml" <<'YAML'
+gateway: {residence_bound: 60s}
+segments:
+  - {name: bus, type: can, interface: vcan0, bitrate: 500kbit/s}
+  - {name: dds, type: dds, domain: 3}
+channels:
+  - {name: brake, subject: 0x10, class: srt, period: 10ms, reaction_time: 20ms, payload: 4B,
+     publishers: [dds], subscribers: [bus], secoc: {bus: {key_file: bus.key, cost: 1ns}}}
+YAML
+run secoc_json 1 calibrate "$WORK/secoc.yaml" --seconds 0.3 --rate 500 --json
+python3 - "$WORK/secoc_json.out" <<'PY' || fail "secoc_json: the SecOC figures"
+import json, sys
+d = json.load(open(sys.argv[1]))
+[a] = d["authentication"]
+assert a["segment"] == "bus" and a["channel"] == "brake" and a["scheme"] == "SecOC AES-128-CMAC", a
+assert a["message_bytes"] == 4 and a["runs"] == 20000, a
+assert 0 < a["p50_us"] <= a["p99_us"] <= a["p999_us"] <= a["max_us"], a
+assert a["configured_cost_us"] == 0.001 and a["cost_covers_p999"] is False, a
+PY
+contains secoc_json err "warning: channel brake on bus: secoc.cost 1 ns is below the p99.9 measured here"
+run secoc_text 1 calibrate "$WORK/secoc.yaml" --seconds 0.3 --rate 500
+contains secoc_text out "brake@bus"
+contains secoc_text out "BELOW p99.9 (1 ns)"
+
 # 4. Bad input: a usage error or a located configuration error, nothing measured.
 run bad_rate 64 calibrate --rate 0
 run bad_seconds 64 calibrate --seconds -1
