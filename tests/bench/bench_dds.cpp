@@ -26,6 +26,7 @@
 #include <cosmic_dds_idl/EnvelopePubSubTypes.h>
 
 #include "bench_peer.hpp"
+#include "cosmic/dds_security_qos.hpp"
 
 namespace cosmic_bench {
 namespace {
@@ -84,7 +85,8 @@ class RawType final : public fdds::TopicDataType {
   bool getKey(void*, rtps::InstanceHandle_t*, bool) override { return false; }
 };
 
-struct Participant {
+class Participant {
+ public:
   fdds::DomainParticipant* participant = nullptr;
   fdds::Topic* topic = nullptr;
   ~Participant() {
@@ -93,20 +95,34 @@ struct Participant {
       fdds::DomainParticipantFactory::get_instance()->delete_participant(participant);
     }
   }
-  // `native_type` empty: the topic carries cosmic::Envelope; otherwise RawType of that name.
-  bool open(unsigned domain, const std::string& topic_name, const std::string& native_type, std::uint64_t size) {
+  // o.native_type empty: the topic carries cosmic::Envelope; otherwise RawType of that name. With
+  // o.identity, a secure participant with the same plugins and properties as cosmicd's.
+  bool open(const DdsOptions& o) {
     fdds::DomainParticipantQos qos = fdds::PARTICIPANT_QOS_DEFAULT;
     qos.name("cosmic-bench-peer");
-    participant =
-        fdds::DomainParticipantFactory::get_instance()->create_participant(static_cast<fdds::DomainId_t>(domain), qos);
+    if (!o.identity.empty()) cosmic::add_dds_security(security_spec(o), qos);
+    participant = fdds::DomainParticipantFactory::get_instance()->create_participant(
+        static_cast<fdds::DomainId_t>(o.domain), qos);
     if (participant == nullptr) return false;
     fdds::TypeSupport type(
-        native_type.empty()
+        o.native_type.empty()
             ? static_cast<fdds::TopicDataType*>(new cosmic::EnvelopePubSubType())
-            : new RawType(native_type, static_cast<std::uint32_t>(std::max<std::uint64_t>(size + kHeader, 512))));
+            : new RawType(o.native_type, static_cast<std::uint32_t>(std::max<std::uint64_t>(o.size + kHeader, 512))));
     type.register_type(participant);
-    topic = participant->create_topic(topic_name, type.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
+    topic = participant->create_topic(o.topic, type.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
     return topic != nullptr;
+  }
+
+ private:
+  static cosmic::DdsSecuritySpec security_spec(const DdsOptions& o) {
+    cosmic::DdsSecuritySpec spec;
+    spec.identity_ca = o.pki + "/identity_ca.pem";
+    spec.certificate = o.pki + "/" + o.identity + "_cert.pem";
+    spec.private_key = o.pki + "/" + o.identity + "_key.pem";
+    spec.permissions_ca = o.pki + "/permissions_ca.pem";
+    spec.governance = o.governance.empty() ? o.pki + "/governance.p7s" : o.governance;
+    spec.permissions = o.pki + "/permissions.p7s";
+    return spec;
   }
 };
 
@@ -180,7 +196,7 @@ class ReaderListener : public fdds::DataReaderListener {
 int dds_pub(const DdsOptions& o) {
   Participant p;
   const bool native = !o.native_type.empty();
-  if (!p.open(o.domain, o.topic, o.native_type, o.size)) {
+  if (!p.open(o)) {
     err_line("cannot create the DDS participant/topic");
     return 3;
   }
@@ -270,7 +286,7 @@ int dds_pub(const DdsOptions& o) {
 
 int dds_sub(const DdsOptions& o) {
   Participant p;
-  if (!p.open(o.domain, o.topic, o.native_type, o.size)) {
+  if (!p.open(o)) {
     err_line("cannot create the DDS participant/topic");
     return 3;
   }

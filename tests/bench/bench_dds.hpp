@@ -13,6 +13,13 @@ struct DdsOptions {
   unsigned domain = 0;
   std::string topic;
   std::string native_type;  // empty: cosmic::Envelope; otherwise the raw type announced as this name
+  // A secure participant (DDS Security, docs/security.md) when `identity` is set: the PKI in
+  // `pki` laid out as tests/support/make_test_pki.sh makes it (identity_ca.pem, IDENTITY_cert.pem,
+  // IDENTITY_key.pem, permissions_ca.pem, permissions.p7s), governed by `governance` (default
+  // PKI/governance.p7s).
+  std::string pki;
+  std::string identity;
+  std::string governance;
   std::uint64_t count = 0;
   std::uint64_t size = 64;
   double rate = 0;

@@ -9,9 +9,9 @@
 //                             [--dump FILE]
 //   cosmic-bench-peer dds-pub --domain D --topic T --count N --size B [--rate HZ] [--warmup W]
 //                             [--max-rate HZ] [--keep-last DEPTH] [--wait-go] [--match-timeout S] [--stall S]
-//                             [--native TYPE]
+//                             [--native TYPE] [--pki DIR --identity NAME [--governance FILE]]
 //   cosmic-bench-peer dds-sub --domain D --topic T --count N [--timeout S] [--idle S] [--dump FILE]
-//                             [--native TYPE]
+//                             [--native TYPE] [--pki DIR --identity NAME [--governance FILE]]
 //
 // Payload of every event (size >= 16): bytes 0..7 = CLOCK_MONOTONIC ns when the publisher hands
 // it to its library (little-endian), bytes 8..11 = index (measured events 1..N, warm-up events
@@ -23,7 +23,10 @@
 // a raw type announced as TYPE (a cosmicd native topic): the bytes written are a CDR
 // encapsulation header 00 01 00 00 (CDR_LE, XCDR1) followed by the B-byte payload, so the stamp
 // sits at bytes 4..11 of the sample (the receiver skips the header, and counts a sample without
-// exactly that header as malformed). The Fast DDS side is bench_dds.cpp.
+// exactly that header as malformed). With --identity NAME the DDS participant is a secure one
+// (DDS Security with the builtin plugins, as cosmicd's on a segment with `security:`): identity
+// NAME of the PKI in DIR (tests/support/make_test_pki.sh's layout), governed by FILE (default
+// DIR/governance.p7s). The Fast DDS side is bench_dds.cpp.
 //
 // Publishers first send W warm-up events (default 200, paced at min(rate, 5000)/s; they let
 // discovery settle and warm caches and are ignored by the receiver), pause 200 ms, then the N
@@ -335,6 +338,12 @@ int main(int argc, char** argv) {
     c->add_option("--count", dd.count, "measured events")->required();
     c->add_option("--native", dd.native_type,
                   "type name of a native topic: samples are 00 01 00 00 + payload instead of cosmic::Envelope");
+    c->add_option("--pki", dd.pki, "DDS Security: the PKI's directory (tests/support/make_test_pki.sh)");
+    auto* identity =
+        c->add_option("--identity", dd.identity, "DDS Security: a secure participant as NAME (NAME_cert.pem)");
+    identity->needs(c->get_option("--pki"));
+    c->add_option("--governance", dd.governance, "DDS Security: the signed governance (default PKI/governance.p7s)")
+        ->needs(identity);
   };
   CLI::App* lp = app.add_subcommand("lcm-pub", "publish on LCM");
   lcm_common(lp);

@@ -17,6 +17,7 @@
 #include <fastrtps/utils/IPLocator.h>
 
 #include "cosmic/dds_adapter.hpp"
+#include "cosmic/dds_security_qos.hpp"
 
 namespace cosmic::dds_detail {
 
@@ -255,3 +256,11 @@ Status participant_qos(const SegmentSpec& segment, const std::string& participan
 }
 
 }  // namespace cosmic::dds_detail
+
+namespace cosmic {
+
+void add_dds_security(const DdsSecuritySpec& security, eprosima::fastdds::dds::DomainParticipantQos& qos) {
+  dds_detail::add_security(security, qos);
+}
+
+}  // namespace cosmic
