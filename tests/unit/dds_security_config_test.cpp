@@ -112,5 +112,48 @@ TEST_F(DdsSecurityConfig, EveryFileIsNeededAndMissingOnesAreNamed) {
   expect_refused(load({{"governance", "nowhere.p7s"}}), "governance", "No such file or directory");
 }
 
+// Material made here with the openssl command line, in the test PKI's directory; false when it failed.
+bool in_pki(const std::filesystem::path& pki, const std::string& commands) {
+  const std::string command = "cd " + pki.string() + " && (" + commands + ") >/dev/null 2>&1";
+  return std::system(command.c_str()) == 0;
+}
+
+TEST_F(DdsSecurityConfig, ACertificateNotYetValidIsRefused) {
+  ASSERT_TRUE(in_pki(pki_,
+                     "openssl req -new -key gateway-a_key.pem -subj /O=cosmic/CN=gateway-a -out future.csr && "
+                     "openssl ca -batch -config ca.cnf -extensions leaf -cert identity_ca.pem -keyfile "
+                     "identity_ca_key.pem -startdate 20990101000000Z -enddate 21000101000000Z -in future.csr "
+                     "-out future.pem -notext"));
+  expect_refused(load({{"certificate", "future.pem"}}), "certificate", "certificate is not yet valid");
+}
+
+TEST_F(DdsSecurityConfig, AnEncryptedPrivateKeyIsRefused) {
+  ASSERT_TRUE(in_pki(pki_,
+                     "openssl pkey -in gateway-a_key.pem -aes256 -passout pass:secret -out encrypted_key.pem && "
+                     "chmod 600 encrypted_key.pem"));
+  expect_refused(load({{"private_key", "encrypted_key.pem"}}), "private_key", "holds no unencrypted PEM private key");
+}
+
+TEST_F(DdsSecurityConfig, AnEmptyCaFileIsRefusedAtItsKeyOnce) {
+  ASSERT_TRUE(in_pki(pki_, ": > empty_ca.pem"));
+  expect_refused(load({{"identity_ca", "empty_ca.pem"}}), "identity_ca", "holds no PEM certificate");
+  expect_refused(load({{"permissions_ca", "empty_ca.pem"}}), "permissions_ca", "holds no PEM certificate");
+}
+
+TEST_F(DdsSecurityConfig, ARevokedCertificateIsRefusedWhenTheCaFileCarriesItsList) {
+  // The identity CA file with a revocation list naming gateway-a's certificate, as Fast DDS reads it.
+  ASSERT_TRUE(in_pki(pki_,
+                     "openssl ca -config ca.cnf -cert identity_ca.pem -keyfile identity_ca_key.pem "
+                     "-revoke gateway-a_cert.pem && "
+                     "openssl ca -gencrl -crldays 30 -config ca.cnf -cert identity_ca.pem -keyfile identity_ca_key.pem "
+                     "-out revoked.crl && cat identity_ca.pem revoked.crl > identity_ca_crl.pem"));
+  expect_refused(load({{"identity_ca", "identity_ca_crl.pem"}}), "certificate", "certificate revoked");
+  // gateway-b's certificate is not on the list: the same CA file accepts it.
+  const ConfigResult b = load({{"identity_ca", "identity_ca_crl.pem"},
+                               {"certificate", "gateway-b_cert.pem"},
+                               {"private_key", "gateway-b_key.pem"}});
+  EXPECT_TRUE(b.errors.empty()) << b.errors.front().to_string();
+}
+
 }  // namespace
 }  // namespace cosmic
