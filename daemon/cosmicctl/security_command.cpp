@@ -82,7 +82,7 @@ std::variant<std::vector<cosmic::DdsSegmentIdentity>, Failure> identities_of(con
   return identities;
 }
 
-// Both documents of each secure segment, and the segment's permissions CA (by document path).
+// A document to write, and the permissions CAs of the segments that will read it.
 struct Target {
   std::string path;                          // where the configuration expects the signed document
   std::string kind;                          // "governance" or "permissions"
@@ -91,7 +91,7 @@ struct Target {
   std::vector<std::string> permissions_cas;  // of the segments that read it
 };
 
-std::string joined(const std::vector<std::string>& items, const char* separator) {
+std::string separated(const std::vector<std::string>& items, const char* separator) {
   std::string out;
   for (const auto& item : items) out += (out.empty() ? "" : separator) + item;
   return out;
@@ -102,8 +102,8 @@ std::string grant_summary(const cosmic::DdsGrant& grant) {
                     grant.validity.not_after + "\n";
   for (const auto& rule : grant.rules) {
     out += "    domain " + std::to_string(rule.domain) + " (" + rule.segment + "): publish " +
-           (rule.publish.empty() ? "nothing" : joined(rule.publish, ", ")) + "; subscribe " +
-           (rule.subscribe.empty() ? "nothing" : joined(rule.subscribe, ", ")) + "\n";
+           (rule.publish.empty() ? "nothing" : separated(rule.publish, ", ")) + "; subscribe " +
+           (rule.subscribe.empty() ? "nothing" : separated(rule.subscribe, ", ")) + "\n";
   }
   return out;
 }
@@ -117,7 +117,7 @@ std::vector<Target> targets_of(const cosmic::Config& config, const cosmic::DdsAc
     targets.push_back({d.path,
                        "governance",
                        d.xml,
-                       "governance " + d.path + ": domain " + joined(domains, ", ") + ", protection " +
+                       "governance " + d.path + ": domain " + separated(domains, ", ") + ", protection " +
                            cosmic::to_string(protection) + "\n",
                        {}});
   }
@@ -159,6 +159,15 @@ std::string xml_path_of(const std::string& signed_path) {
   return (p7s ? signed_path.substr(0, signed_path.size() - suffix.size()) : signed_path) + ".xml";
 }
 
+// Zeroes a secret's bytes when it goes: the CA's key is in memory only to sign.
+struct WipedOnExit {
+  std::string& text;
+  ~WipedOnExit() {
+    volatile char* p = text.data();
+    for (std::size_t i = 0; i < text.size(); ++i) p[i] = 0;
+  }
+};
+
 // Every document signed with the CA, and each checked against the permissions CA of every segment
 // that reads it (a CA the segments do not trust would make documents no participant loads).
 std::optional<Failure> sign_all(std::vector<Target>& targets, const std::string& ca_path, const std::string& key_path) {
@@ -166,6 +175,7 @@ std::optional<Failure> sign_all(std::vector<Target>& targets, const std::string&
   if (!ca) return Failure{"--sign-with: " + ca.error().text, kExitUsage};
   auto key = cosmic::read_private_file(key_path, kMaxPemBytes);
   if (!key) return Failure{"--sign-with: CA key: " + key.error().text, kExitUsage};
+  const WipedOnExit wipe_key{key.value()};
   for (Target& t : targets) {
     auto signed_text = cosmic::smime_sign_text(t.xml, ca.value(), key.value());
     if (!signed_text) return Failure{"--sign-with: " + signed_text.error().text, kExitUsage};
@@ -180,7 +190,6 @@ std::optional<Failure> sign_all(std::vector<Target>& targets, const std::string&
     }
     t.xml = std::move(signed_text).value();
   }
-  for (auto& c : key.value()) c = '\0';  // the key's bytes are not kept
   return std::nullopt;
 }
 
