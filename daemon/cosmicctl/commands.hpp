@@ -1,7 +1,7 @@
 // cosmicctl subcommands. Each registers itself on the CLI11 app and runs when selected.
-// Exit codes: 0 success, 1 a channel was rejected or the daemon refused, 2 configuration
-// errors, 64 usage errors, 69 daemon unreachable, 75 the daemon is busy (try again), 77 permission
-// denied.
+// Exit codes: 0 success, 1 a channel was rejected, the daemon refused or a file could not be
+// written, 2 configuration errors, 64 usage errors, 69 daemon unreachable, 75 the daemon is busy
+// (try again), 77 permission denied.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -32,6 +32,7 @@ std::vector<CommandRunner> add_daemon_commands(CLI::App& app, const GlobalOption
 CommandRunner add_diagram_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_echo_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_gen_command(CLI::App& app, const GlobalOptions& options);
+CommandRunner add_security_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_top_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_types_command(CLI::App& app, const GlobalOptions& options);
 

@@ -1,12 +1,13 @@
 # bash completion for cosmicctl (installed as /usr/share/bash-completion/completions/cosmicctl).
 # Commands and options are those `cosmicctl --help` and `cosmicctl COMMAND --help` list:
 # tests/cli/man_completion_test.sh fails when a command or option is missing here or no longer
-# exists. Values: FILE arguments complete to YAML files, --output to directories, --format to its
-# choices, --component to the components: of the FILE on the line, channel NAMEs (channel,
+# exists (`security` has the subcommand `permissions`, whose options follow it). Values: FILE
+# arguments complete to YAML files, --output to directories, --format and --protection to their
+# choices, --sign-with to two files, --component to the components: of the FILE on the line, channel NAMEs (channel,
 # unbind, echo) to the channels of the running gateway (`cosmicctl --json channels`, silent when it
 # cannot be reached). Needs nothing from the bash-completion package.
 
-_cosmicctl_commands="bind calibrate channel channels check diagram echo gen peers reload segments status top types unbind"
+_cosmicctl_commands="bind calibrate channel channels check diagram echo gen peers reload security segments status top types unbind"
 _cosmicctl_global_options="--help --json --socket --version"
 
 # The options of one command (besides the global ones, which may follow it too).
@@ -17,6 +18,7 @@ _cosmicctl_command_options() {
     diagram) echo "--format --detail" ;;
     echo) echo "--count --interval --timeout" ;;
     gen) echo "--component --output" ;;
+    security) [ "$2" = permissions ] && echo "--sign-with --protection --valid-days" ;;
     top) echo "--interval --iterations" ;;
     types) echo "--type-path --name" ;;
   esac
@@ -31,18 +33,22 @@ _cosmicctl_components() {
 
 _cosmicctl() {
   local cur=${COMP_WORDS[COMP_CWORD]} prev=${COMP_WORDS[COMP_CWORD - 1]}
-  local command="" socket=() file="" i word
+  local command="" socket=() file="" more="" i word
   for ((i = 1; i < COMP_CWORD; i++)); do
     word=${COMP_WORDS[i]}
     case $word in
       --socket) socket=(--socket "${COMP_WORDS[i + 1]}"); ((i++)) ;;
-      --format | --component | --output | --interval | --iterations | --seconds | --rate | --match-timeout) ((i++)) ;;
+      --format | --component | --output | --interval | --iterations | --seconds | --rate | --match-timeout | \
+        --protection | --valid-days) ((i++)) ;;
+      --sign-with) ((i += 2)) ;;
       -*) ;;
       *)
         if [ -z "$command" ]; then
           command=$word
         elif [ -z "$file" ]; then
           file=$word
+        else
+          more=$word
         fi
         ;;
     esac
@@ -60,12 +66,21 @@ _cosmicctl() {
     --format)
       mapfile -t COMPREPLY < <(compgen -W "svg dot" -- "$cur")
       return ;;
+    --protection)
+      mapfile -t COMPREPLY < <(compgen -W "encrypt sign none" -- "$cur")
+      return ;;
     --component)
       mapfile -t COMPREPLY < <(compgen -W "$(_cosmicctl_components "$file")" -- "$cur")
       return ;;
-    --interval | --iterations | --seconds | --rate)
+    --interval | --iterations | --seconds | --rate | --valid-days)
       return ;;
   esac
+  # --sign-with CA_CERT CA_KEY: both are PEM files.
+  if [ "$prev" = --sign-with ] || [ "${COMP_WORDS[COMP_CWORD - 2]:-}" = --sign-with ]; then
+    compopt -o filenames 2>/dev/null
+    mapfile -t COMPREPLY < <(compgen -f -- "$cur")
+    return
+  fi
 
   if [ -z "$command" ]; then
     if [[ $cur == -* ]]; then
@@ -76,7 +91,7 @@ _cosmicctl() {
     return
   fi
   if [[ $cur == -* ]]; then
-    mapfile -t COMPREPLY < <(compgen -W "$(_cosmicctl_command_options "$command") --help --json --socket" -- "$cur")
+    mapfile -t COMPREPLY < <(compgen -W "$(_cosmicctl_command_options "$command" "$file") --help --json --socket" -- "$cur")
     return
   fi
   case $command in
@@ -90,6 +105,15 @@ _cosmicctl() {
       compopt -o filenames 2>/dev/null
       mapfile -t COMPREPLY < <(compgen -f -X '!*.dbc' -- "$cur"; compgen -f -X '!*.DBC' -- "$cur"; compgen -f -X '!*.lcm' -- "$cur"
         compgen -f -X '!*.idl' -- "$cur"; compgen -f -X '!*.msg' -- "$cur"; compgen -d -- "$cur")
+      ;;
+    security)
+      # security permissions FILE
+      if [ -z "$file" ]; then
+        mapfile -t COMPREPLY < <(compgen -W "permissions" -- "$cur")
+      elif [ "$file" = permissions ] && [ -z "$more" ]; then
+        compopt -o filenames 2>/dev/null
+        mapfile -t COMPREPLY < <(compgen -f -X '!*.yaml' -- "$cur"; compgen -f -X '!*.yml' -- "$cur"; compgen -d -- "$cur")
+      fi
       ;;
     channel | unbind | echo)
       [ -n "$file" ] && return

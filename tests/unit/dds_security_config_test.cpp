@@ -27,7 +27,7 @@ class DdsSecurityConfig : public testing::Test {
   static void TearDownTestSuite() { std::filesystem::remove_all(pki_); }
 
   // The segment's security with `files` in place of the defaults (gateway-a's identity).
-  ConfigResult load(const std::map<std::string, std::string>& files) {
+  ConfigResult load(const std::map<std::string, std::string>& files, const LoadOptions& options = {}) {
     std::map<std::string, std::string> keys{
         {"identity_ca", "identity_ca.pem"},   {"certificate", "gateway-a_cert.pem"},
         {"private_key", "gateway-a_key.pem"}, {"permissions_ca", "permissions_ca.pem"},
@@ -51,7 +51,7 @@ class DdsSecurityConfig : public testing::Test {
         "}\n"
         "channels: []\n";
     security_line_ = "    security: {" + security + "}";
-    return parse_config(text, (pki_ / "gateway.yaml").string());
+    return parse_config(text, (pki_ / "gateway.yaml").string(), options);
   }
 
   // The one error of `result`, which must be at security.KEY and say `fragment`.
@@ -153,6 +153,61 @@ TEST_F(DdsSecurityConfig, ARevokedCertificateIsRefusedWhenTheCaFileCarriesItsLis
                                {"certificate", "gateway-b_cert.pem"},
                                {"private_key", "gateway-b_key.pem"}});
   EXPECT_TRUE(b.errors.empty()) << b.errors.front().to_string();
+}
+
+// `cosmicctl security permissions` loads the configuration before the documents it writes exist:
+// their paths are resolved, nothing else is let off.
+TEST_F(DdsSecurityConfig, PendingDocumentsNeedNotExistButEverythingElseIsChecked) {
+  LoadOptions pending;
+  pending.security_documents_pending = true;
+  const std::map<std::string, std::string> absent{{"governance", "out/governance.p7s"},
+                                                  {"permissions", "out/permissions.p7s"}};
+  const ConfigResult result = load(absent, pending);
+  ASSERT_TRUE(result.errors.empty()) << result.errors.front().to_string();
+  const auto& security = result.config.find_segment("lan")->dds.security;
+  ASSERT_TRUE(security);
+  EXPECT_EQ(security->governance, (pki_ / "out/governance.p7s").string());
+  EXPECT_EQ(security->permissions, (pki_ / "out/permissions.p7s").string());
+  EXPECT_EQ(security->subject, "/O=cosmic/CN=gateway-a");
+  expect_refused(load({{"governance", "out/governance.p7s"}}), "governance", "No such file or directory");
+  auto open_key = absent;
+  open_key["private_key"] = "open_key.pem";
+  expect_refused(load(open_key, pending), "private_key", "group or others may read or write it");
+  expect_refused(load({{"permissions", ""}}, pending), "permissions", "missing key 'permissions'");
+}
+
+// A component's `subject` (its certificate's, RFC 2253) names it in the permissions; only DDS
+// Security authenticates participants by subject.
+TEST(ComponentSubject, IsReadOnADdsSegmentAndRefusedElsewhere) {
+  const std::string segments =
+      "segments:\n"
+      "  - {name: lan, type: dds, domain: 4}\n"
+      "  - {name: viz, type: lcm}\n"
+      "channels:\n"
+      "  - {name: obstacle, subject: 0x10, class: nrt, publishers: [lan], subscribers: [viz]}\n"
+      "components:\n";
+  const ConfigResult ok = parse_config(segments +
+                                           "  - {name: detector, segment: lan, publishes: [obstacle], subject: "
+                                           "\"CN=detector,O=cosmic\"}\n"
+                                           "  - {name: viewer, segment: viz, subscribes: [obstacle]}\n",
+                                       "components.yaml");
+  ASSERT_TRUE(ok.errors.empty()) << ok.errors.front().to_string();
+  EXPECT_EQ(ok.config.components[0].subject, "CN=detector,O=cosmic");
+  EXPECT_EQ(ok.config.components[1].subject, "");
+  const ConfigResult on_lcm =
+      parse_config(segments +
+                       "  - {name: detector, segment: lan, publishes: [obstacle]}\n"
+                       "  - {name: viewer, segment: viz, subscribes: [obstacle], subject: \"CN=viewer\"}\n",
+                   "components.yaml");
+  ASSERT_EQ(on_lcm.errors.size(), 1u);
+  EXPECT_EQ(on_lcm.errors[0].path, "components[1].subject");
+  EXPECT_EQ(on_lcm.errors[0].line, 8);
+  EXPECT_NE(on_lcm.errors[0].message.find("lcm segment 'viz'"), std::string::npos) << on_lcm.errors[0].to_string();
+  const ConfigResult not_a_name = parse_config(
+      segments + "  - {name: detector, segment: lan, publishes: [obstacle], subject: detector}\n", "components.yaml");
+  ASSERT_EQ(not_a_name.errors.size(), 1u);
+  EXPECT_EQ(not_a_name.errors[0].path, "components[0].subject");
+  EXPECT_NE(not_a_name.errors[0].message.find("is not a distinguished name"), std::string::npos);
 }
 
 }  // namespace

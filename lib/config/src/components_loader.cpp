@@ -62,12 +62,13 @@ class ComponentsLoader {
   };
 
   void read_component(const YAML::Node& node, const std::string& path) {
-    if (!reader_.check_map(node, path, {"name", "segment", "publishes", "subscribes"})) return;
+    if (!reader_.check_map(node, path, {"name", "segment", "publishes", "subscribes", "subject"})) return;
     const std::size_t errors_before = reader_.error_count();
     ComponentSpec c;
     if (require(node, path, "name", "a component name"))
       c.name = reader_.name(node["name"], path + ".name").value_or("");
     if (require(node, path, "segment", "the name of the segment the component lives on")) read_segment(node, path, c);
+    if (present(node, "subject")) read_subject(node, path, c);
     read_list(node, path, "publishes", c.publishes);
     read_list(node, path, "subscribes", c.subscribes);
     if (!present(node, "publishes") && !present(node, "subscribes")) {
@@ -103,6 +104,28 @@ class ComponentsLoader {
       return;
     }
     c.segment = *name;
+  }
+
+  // The subject of the component's DDS Security certificate (RFC 2253, "CN=detector,O=cosmic"): only
+  // a DDS segment authenticates participants by it.
+  void read_subject(const YAML::Node& node, const std::string& path, ComponentSpec& c) {
+    const std::string p = path + ".subject";
+    const auto subject = reader_.string(node["subject"], p);
+    if (!subject) return;
+    if (subject->find('=') == std::string::npos) {
+      reader_.error_at(node["subject"], p, "'" + *subject + "' is not a distinguished name",
+                       "the subject of the component's certificate in RFC 2253 form, e.g. CN=detector,O=cosmic");
+      return;
+    }
+    const SegmentSpec* segment = config_.find_segment(c.segment);
+    if (segment != nullptr && segment->type != SegmentType::dds) {
+      reader_.error_at(node["subject"], p,
+                       "component on " + std::string(to_string(segment->type)) + " segment '" + c.segment +
+                           "': only DDS Security authenticates a participant by its subject",
+                       "remove subject, or place the component on a DDS segment");
+      return;
+    }
+    c.subject = *subject;
   }
 
   void read_list(const YAML::Node& node, const std::string& path, const char* role, std::vector<std::string>& out) {

@@ -21,11 +21,11 @@ ConfigResult unreadable(const std::string& path, const std::string& error) {
 }
 }  // namespace
 
-ConfigResult load_config_file(const std::string& path) {
+ConfigResult load_config_file(const std::string& path, const LoadOptions& options) {
   std::string text;
   if (const std::string error = config_detail::read_yaml_file(path, text); !error.empty())
     return unreadable(path, error);
-  return parse_config(text, path);
+  return parse_config(text, path, options);
 }
 
 ConfigResult ConfigFileLoader::load(const std::string& path) {

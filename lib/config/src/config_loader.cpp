@@ -44,7 +44,7 @@ constexpr std::uint64_t kFdMaxDataBitrate = 8'000'000;
 
 class ConfigParser {
  public:
-  explicit ConfigParser(std::string file) : reader_(std::move(file)) {}
+  explicit ConfigParser(std::string file, LoadOptions options = {}) : reader_(std::move(file)), options_(options) {}
 
   ConfigResult parse_document(std::string_view text) {
     ConfigResult result;
@@ -364,7 +364,8 @@ class ConfigParser {
     }
     if (has(node, "shared_memory")) parse_shared_memory(node["shared_memory"], key(path, "shared_memory"), s);
     if (has(node, "security"))
-      s.dds.security = config_detail::parse_dds_security(reader_, node["security"], key(path, "security"), included_);
+      s.dds.security = config_detail::parse_dds_security(reader_, node["security"], key(path, "security"), included_,
+                                                         options_.security_documents_pending);
   }
 
   // `shared_memory: [srt, nrt]`: the classes whose participant also uses Fast DDS's shared memory.
@@ -577,6 +578,7 @@ class ConfigParser {
   static constexpr std::uint64_t kIpMinMessage = kIpOverheadBytes;
 
   YamlReader reader_;
+  LoadOptions options_;
   Config config_;
   bool derive_bindings_ = false;  // the document has components: P/S lists may be left out
   std::set<std::string> segment_names_;
@@ -592,8 +594,8 @@ class ConfigParser {
 
 }  // namespace
 
-ConfigResult parse_config(std::string_view text, const std::string& file_name) {
-  return ConfigParser(file_name).parse_document(text);
+ConfigResult parse_config(std::string_view text, const std::string& file_name, const LoadOptions& options) {
+  return ConfigParser(file_name, options).parse_document(text);
 }
 
 ChannelsResult parse_channels(std::string_view text, const std::string& file_name, const Config& running) {

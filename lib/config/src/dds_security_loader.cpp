@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <string_view>
 
 #include "cosmic/dds_security_files.hpp"
 #include "key_file_loader.hpp"
@@ -23,7 +24,7 @@ struct SecurityFile {
 }  // namespace
 
 std::optional<DdsSecuritySpec> parse_dds_security(YamlReader& reader, const YAML::Node& node, const std::string& path,
-                                                  std::vector<std::string>& included) {
+                                                  std::vector<std::string>& included, bool documents_pending) {
   if (!reader.check_map(node, path,
                         {"identity_ca", "certificate", "private_key", "permissions_ca", "governance", "permissions"}))
     return std::nullopt;
@@ -46,7 +47,9 @@ std::optional<DdsSecuritySpec> parse_dds_security(YamlReader& reader, const YAML
     const auto name = reader.string(node[f.key], at);
     if (!name) continue;
     f.path = (base / *name).lexically_normal().string();
-    const bool is_key = std::string(f.key) == "private_key";
+    const std::string_view which = f.key;
+    if (documents_pending && (which == "governance" || which == "permissions")) continue;
+    const bool is_key = which == "private_key";
     const std::string error =
         read_regular_file(f.path, f.text, kMaxSecurityFileBytes, is_key ? refuse_unless_private : nullptr);
     if (!error.empty()) {

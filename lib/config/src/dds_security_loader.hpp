@@ -14,7 +14,9 @@
 namespace cosmic::config_detail {
 
 // The segment's security, or nullopt after reporting every problem; the files read go to `included`.
+// With `documents_pending` the governance and permissions files are not read (they are about to be
+// written, LoadOptions): only their paths are resolved.
 std::optional<DdsSecuritySpec> parse_dds_security(YamlReader& reader, const YAML::Node& node, const std::string& path,
-                                                  std::vector<std::string>& included);
+                                                  std::vector<std::string>& included, bool documents_pending = false);
 
 }  // namespace cosmic::config_detail

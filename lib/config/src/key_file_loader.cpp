@@ -38,6 +38,17 @@ Result<SecretKey> read_key_file(const std::string& path, std::size_t min_bytes, 
   return key;
 }
 
+Result<std::string> read_private_file(const std::string& path, std::size_t max_bytes) {
+  std::string text;
+  const std::string error =
+      config_detail::read_regular_file(path, text, max_bytes, config_detail::refuse_unless_private);
+  if (!error.empty()) {
+    wipe_key_text(text);
+    return Error{"cannot use " + path + ": " + error};
+  }
+  return text;
+}
+
 }  // namespace cosmic
 
 namespace cosmic::config_detail {

@@ -1,62 +1,20 @@
 #include "cosmic/dds_security_files.hpp"
 
-#include <openssl/bio.h>
-#include <openssl/err.h>
-#include <openssl/evp.h>
-#include <openssl/pem.h>
-#include <openssl/pkcs7.h>
-#include <openssl/x509.h>
-#include <openssl/x509_vfy.h>
-
-#include <memory>
-#include <vector>
+#include "openssl_handles.hpp"
 
 namespace cosmic {
+using security_detail::Bio;
+using security_detail::Certificate;
+using security_detail::certificates_of;
+using security_detail::memory_of;
+using security_detail::openssl_reason;
+using security_detail::Pkcs7;
+using security_detail::private_key_of;
+using security_detail::PrivateKey;
+using security_detail::StoreContextFree;
+using security_detail::StoreFree;
+
 namespace {
-
-struct BioFree {
-  void operator()(BIO* b) const noexcept { BIO_free(b); }
-};
-struct X509Free {
-  void operator()(X509* x) const noexcept { X509_free(x); }
-};
-struct StoreFree {
-  void operator()(X509_STORE* s) const noexcept { X509_STORE_free(s); }
-};
-struct StoreContextFree {
-  void operator()(X509_STORE_CTX* c) const noexcept { X509_STORE_CTX_free(c); }
-};
-struct KeyFree {
-  void operator()(EVP_PKEY* k) const noexcept { EVP_PKEY_free(k); }
-};
-struct Pkcs7Free {
-  void operator()(PKCS7* p) const noexcept { PKCS7_free(p); }
-};
-using Bio = std::unique_ptr<BIO, BioFree>;
-using Certificate = std::unique_ptr<X509, X509Free>;
-
-// OpenSSL's reason for the last failure, and the queue emptied.
-std::string openssl_reason() {
-  const unsigned long code = ERR_peek_last_error();
-  ERR_clear_error();
-  if (code == 0) return "unknown reason";
-  const char* reason = ERR_reason_error_string(code);
-  return reason != nullptr ? reason : "unknown reason";
-}
-
-Bio memory_of(const std::string& text) { return Bio(BIO_new_mem_buf(text.data(), static_cast<int>(text.size()))); }
-
-std::vector<Certificate> certificates_of(const std::string& pem) {
-  std::vector<Certificate> out;
-  Bio bio = memory_of(pem);
-  while (bio) {
-    X509* certificate = PEM_read_bio_X509(bio.get(), nullptr, nullptr, nullptr);
-    if (certificate == nullptr) break;
-    out.emplace_back(certificate);
-  }
-  ERR_clear_error();  // the end of the text reads as an error
-  return out;
-}
 
 // The certificate revocation lists a CA file carries besides its certificates (Fast DDS reads them
 // from the identity CA file and then checks revocation).
@@ -119,10 +77,7 @@ Result<std::string> check_identity_certificate(const std::string& ca_pem, const 
 }
 
 Result<void> check_private_key(const std::string& key_pem, const std::string& certificate_pem) {
-  Bio bio = memory_of(key_pem);
-  // No password callback: an encrypted key fails here, as Fast DDS's PKI-DH would fail without one.
-  char no_password[] = "";
-  std::unique_ptr<EVP_PKEY, KeyFree> key(PEM_read_bio_PrivateKey(bio.get(), nullptr, nullptr, no_password));
+  const PrivateKey key = private_key_of(key_pem);
   if (!key) return Error{"holds no unencrypted PEM private key (" + openssl_reason() + ")"};
   auto certificates = certificates_of(certificate_pem);
   if (certificates.empty()) return {};  // the certificate's own error is reported at its key
@@ -138,7 +93,7 @@ Result<void> check_signed_document(const std::string& ca_pem, const std::string&
   if (authorities.empty()) return Error{"the permissions CA file holds no PEM certificate"};
   Bio bio = memory_of(document);
   BIO* content = nullptr;
-  std::unique_ptr<PKCS7, Pkcs7Free> signed_data(SMIME_read_PKCS7(bio.get(), &content));
+  Pkcs7 signed_data(SMIME_read_PKCS7(bio.get(), &content));
   const Bio content_owner(content);
   if (!signed_data) {
     return Error{"is not an S/MIME signed document (" + openssl_reason() +

@@ -17,6 +17,7 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
+#include "cosmic/dds_names.hpp"
 #include "cosmic_dds_idl/FederationPubSubTypes.h"
 #include "dds_qos.hpp"
 
@@ -26,7 +27,7 @@ namespace {
 namespace dds = eprosima::fastdds::dds;
 using eprosima::fastrtps::types::ReturnCode_t;
 
-constexpr const char* kTopic = "cosmic/federation";
+constexpr const char* kTopic = kFederationTopicName;
 // Messages queued between two take() calls; beyond it a flood is dropped and counted.
 constexpr std::size_t kMaxQueued = 4096;
 

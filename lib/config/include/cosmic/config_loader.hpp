@@ -34,11 +34,19 @@ struct ChannelsResult {
   bool ok() const { return errors.empty(); }
 };
 
+// What a load leaves out of its checks.
+struct LoadOptions {
+  // The DDS Security documents (a secure segment's `governance` and `permissions`) are about to be
+  // written (`cosmicctl security permissions`): their paths are resolved but the files are neither
+  // required to exist nor read nor checked. Everything else, the other four files included, is.
+  bool security_documents_pending = false;
+};
+
 // Parses a whole gateway configuration. `file_name` labels the errors and anchors the relative
 // paths the document names (a CAN segment's background dbc: FILE), which are read.
-ConfigResult parse_config(std::string_view text, const std::string& file_name);
+ConfigResult parse_config(std::string_view text, const std::string& file_name, const LoadOptions& options = {});
 // Reads and parses a file; an unreadable file is one error at 0:0.
-ConfigResult load_config_file(const std::string& path);
+ConfigResult load_config_file(const std::string& path, const LoadOptions& options = {});
 
 // load_config_file() for a file that is read again and again (cosmicd's reloads): a file whose
 // bytes are those of the last valid document it loaded from that path is not parsed again, its

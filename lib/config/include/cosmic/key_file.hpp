@@ -18,4 +18,9 @@ namespace cosmic {
 // the file's content.
 Result<SecretKey> read_key_file(const std::string& path, std::size_t min_bytes, std::size_t max_bytes);
 
+// The bytes of `path`, a regular file of at most `max_bytes` that only its owner may read or write
+// and that this process's user (or root) owns, as a PEM private key's file must be (a CA's key that
+// `cosmicctl security permissions --sign-with` signs with); else why not ("cannot use PATH: ...").
+Result<std::string> read_private_file(const std::string& path, std::size_t max_bytes);
+
 }  // namespace cosmic

@@ -19,6 +19,9 @@ namespace cosmic {
 inline constexpr const char* kEnvelopeTypeName = "cosmic::Envelope";
 // Topic names starting with this are the envelope channels'; a native topic may not use it.
 inline constexpr std::string_view kEnvelopeTopicPrefix = "cosmic/";
+// The topic on which gateways announce themselves to each other (docs/federation.md), on the
+// federation's segment.
+inline constexpr const char* kFederationTopicName = "cosmic/federation";
 // Longest native topic or type name accepted (Fast DDS and Cyclone both take far longer names;
 // this bounds what a configuration can make the gateway announce in discovery).
 inline constexpr std::size_t kMaxDdsNameLength = 255;

@@ -348,6 +348,9 @@ struct ComponentSpec {
   std::string segment;
   std::vector<std::string> publishes;   // channel names
   std::vector<std::string> subscribes;  // channel names
+  // The subject of the component's DDS Security certificate in RFC 2253 form ("CN=detector,O=cosmic"),
+  // for its grant in the permissions `cosmicctl security permissions` writes; empty: none declared.
+  std::string subject{};
   friend bool operator==(const ComponentSpec&, const ComponentSpec&) = default;
 };
 
