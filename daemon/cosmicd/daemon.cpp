@@ -11,7 +11,6 @@
 #include <cstring>
 #include <cstdlib>
 #include <filesystem>
-#include <filesystem>
 #include <random>
 
 #include "adapter_factory.hpp"

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "cosmic/build_paths.hpp"
+#include "cosmic/admission.hpp"
 #include "cosmic/config_loader.hpp"
 
 namespace cosmic {
@@ -208,6 +209,52 @@ TEST(ComponentSubject, IsReadOnADdsSegmentAndRefusedElsewhere) {
   ASSERT_EQ(not_a_name.errors.size(), 1u);
   EXPECT_EQ(not_a_name.errors[0].path, "components[0].subject");
   EXPECT_NE(not_a_name.errors[0].message.find("is not a distinguished name"), std::string::npos);
+}
+
+// What DDS Security adds on a hop (docs/security.md): the transformations' bytes at most in the
+// frame fit and the load, and the configured cost in the hop's latency.
+TEST_F(DdsSecurityConfig, AdmissionCountsWhatSecurityAddsToEachSample) {
+  const auto with = [&](const std::string& cost) {
+    const std::string text =
+        "segments:\n"
+        "  - {name: lan, type: dds, domain: 4, realtime: true, latency_bound: 1ms}\n"
+        "  - name: secure\n"
+        "    type: dds\n"
+        "    domain: 5\n"
+        "    realtime: true\n"
+        "    latency_bound: 1ms\n"
+        "    security: {identity_ca: identity_ca.pem, certificate: gateway-a_cert.pem, private_key: "
+        "gateway-a_key.pem,\n"
+        "               permissions_ca: permissions_ca.pem, governance: governance.p7s, permissions: permissions.p7s" +
+        cost +
+        "}\n"
+        "channels:\n"
+        "  - {name: obstacle, subject: 0x10, class: hrt, period: 10ms, reaction_time: 4ms, payload: 64B,\n"
+        "     publishers: [lan], subscribers: [secure]}\n";
+    return parse_config(text, (pki_ / "gateway.yaml").string());
+  };
+  const ConfigResult plain = with("");
+  ASSERT_TRUE(plain.errors.empty()) << plain.errors.front().to_string();
+  EXPECT_FALSE(plain.config.find_segment("secure")->dds.security->cost);
+  const Evaluation e = evaluate(plain.config.gateway, plain.config.segments, plain.config.channels, {});
+  const ChannelReport& r = e.channels.front();
+  const HopReport& secure = r.hops.back();
+  ASSERT_EQ(secure.segment, "secure");
+  ASSERT_TRUE(secure.security);
+  EXPECT_EQ(secure.security->scheme, "DDS Security AES-GCM-GMAC");
+  EXPECT_EQ(secure.security->bytes, 156u);
+  EXPECT_FALSE(r.hops.front().security);
+  EXPECT_EQ(secure.latency, std::chrono::milliseconds(1));
+  // 1 ms + residence + 1 ms within 4 ms: bound. With 3 ms of cryptography on the secure hop: not.
+  EXPECT_EQ(r.verdict, Verdict::bound);
+  const ConfigResult costed = with(", cost: 3ms");
+  ASSERT_TRUE(costed.errors.empty()) << costed.errors.front().to_string();
+  const Evaluation c = evaluate(costed.config.gateway, costed.config.segments, costed.config.channels, {});
+  EXPECT_EQ(c.channels.front().hops.back().latency, std::chrono::milliseconds(4));
+  EXPECT_EQ(c.channels.front().verdict, Verdict::rejected);
+  const ConfigResult bad = with(", cost: soon");
+  ASSERT_EQ(bad.errors.size(), 1u);
+  EXPECT_EQ(bad.errors.front().path, "segments[1].security.cost");
 }
 
 }  // namespace

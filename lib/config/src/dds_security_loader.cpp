@@ -25,8 +25,9 @@ struct SecurityFile {
 
 std::optional<DdsSecuritySpec> parse_dds_security(YamlReader& reader, const YAML::Node& node, const std::string& path,
                                                   std::vector<std::string>& included, bool documents_pending) {
-  if (!reader.check_map(node, path,
-                        {"identity_ca", "certificate", "private_key", "permissions_ca", "governance", "permissions"}))
+  if (!reader.check_map(
+          node, path,
+          {"identity_ca", "certificate", "private_key", "permissions_ca", "governance", "permissions", "cost"}))
     return std::nullopt;
   const std::size_t errors_before = reader.error_count();
   SecurityFile files[] = {{"identity_ca", {}, {}},    {"certificate", {}, {}}, {"private_key", {}, {}},
@@ -99,9 +100,18 @@ std::optional<DdsSecuritySpec> parse_dds_security(YamlReader& reader, const YAML
     volatile char* p = f.text.data();
     for (std::size_t i = 0; i < f.text.size(); ++i) p[i] = 0;
   }
+  std::optional<Nanos> cost;
+  if (has(node, "cost")) cost = reader.duration(node["cost"], key(path, "cost"), true);
   if (reader.error_count() != errors_before) return std::nullopt;
-  return DdsSecuritySpec{identity_ca.path, certificate.path, private_key.path, permissions_ca.path,
-                         governance.path,  permissions.path, subject,          hash};
+  return DdsSecuritySpec{identity_ca.path,
+                         certificate.path,
+                         private_key.path,
+                         permissions_ca.path,
+                         governance.path,
+                         permissions.path,
+                         subject,
+                         hash,
+                         cost};
 }
 
 }  // namespace cosmic::config_detail

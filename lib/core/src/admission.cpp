@@ -95,6 +95,10 @@ double hop_load(const SegmentSpec& segment, const ChannelSpec& channel) {
 std::optional<HopSecurity> hop_security(const SegmentSpec& segment, const ChannelSpec& channel) {
   if (segment.type == SegmentType::lcm && segment.lcm.auth)
     return HopSecurity{"HMAC-SHA256 trailer", static_cast<std::uint32_t>(kLcmAuthTrailerSize), segment.lcm.auth->cost};
+  if (segment.type == SegmentType::dds && segment.dds.security) {
+    return HopSecurity{"DDS Security AES-GCM-GMAC", static_cast<std::uint32_t>(kDdsSecurityMaxOverheadBytes),
+                       segment.dds.security->cost};
+  }
   const SecocSpec* secoc = segment.type == SegmentType::can ? channel.secoc_on(segment.name) : nullptr;
   if (secoc == nullptr) return std::nullopt;
   return HopSecurity{"SecOC AES-128-CMAC " + std::to_string(secoc->mac_bits) + "-bit MAC, " +
@@ -108,6 +112,8 @@ Nanos can_hop_security_cost(const SegmentSpec& segment, const ChannelSpec& chann
 }
 
 Nanos ip_hop_latency(const SegmentSpec& segment) {
+  if (segment.type == SegmentType::dds && segment.dds.security && segment.dds.security->cost)
+    return segment.latency_bound + *segment.dds.security->cost;
   const bool costed = segment.type == SegmentType::lcm && segment.lcm.auth && segment.lcm.auth->cost;
   return segment.latency_bound + (costed ? *segment.lcm.auth->cost : Nanos(0));
 }

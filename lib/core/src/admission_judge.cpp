@@ -69,7 +69,8 @@ void add_representation_checks(const HopPayload* hop, HopReport& h) {
 // LCM message has no room for the trailer: nothing in it tells the tag from the contents).
 void add_security_checks(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) {
   h.security = hop_security(segment, channel);
-  if (!h.security) return;
+  // DDS Security protects every sample of the participant, native topics too: nothing to check.
+  if (!h.security || segment.type == SegmentType::dds) return;
   // SecOC: this project's layout and native identifiers; FAMOUSO's layout has no room for it.
   const bool carried = segment.type == SegmentType::can
                            ? segment.can.profile == CanProfile::cosmic || channel.native_can(segment.name)
@@ -101,7 +102,9 @@ std::string failure_text(const Check& check, const HopReport& h, const SegmentSp
     const std::uint32_t added = h.security ? h.security->bytes : 0;
     const std::string what = added == 0 ? std::to_string(static_cast<long long>(check.value)) + " B"
                                         : std::to_string(static_cast<long long>(check.value) - added) + " B + " +
-                                              (segment.type == SegmentType::can ? "SecOC " : "trailer ") +
+                                              (segment.type == SegmentType::can   ? "SecOC "
+                                               : segment.type == SegmentType::dds ? "DDS Security "
+                                                                                  : "trailer ") +
                                               std::to_string(added) + " B";
     return "payload " + what + " > " +
            (native                             ? "native frame "

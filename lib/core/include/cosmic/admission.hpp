@@ -74,8 +74,15 @@ inline std::uint32_t arbitration_key(const CanHopPlan& plan) {
   return arbitration_key(plan.can_id, plan.extended ? CanIdFormat::extended29 : CanIdFormat::standard11);
 }
 
+// What DDS Security's AES-GCM-GMAC transformations add to one sample at most (DDS Security 1.1,
+// section 9.5.3): the payload's (CryptoHeader 20 B, the body's length 4 B, CryptoFooter 20 B), the
+// submessage's (SEC_PREFIX 24 B, SEC_BODY header and length 8 B, SEC_POSTFIX 24 B) and the RTPS
+// message's (SRTPS_PREFIX 24 B, SEC_BODY 8 B, SRTPS_POSTFIX 24 B), with no receiver-specific MACs.
+// A governance that protects less adds less; admission counts the bound.
+inline constexpr std::size_t kDdsSecurityMaxOverheadBytes = 44 + 56 + 56;
+
 // What authentication adds on a hop (docs/security.md): the scheme and the bytes it adds to each
-// message (LCM) or frame (CAN), which the hop's size and load checks count.
+// message (LCM, DDS) or frame (CAN), which the hop's size and load checks count.
 struct HopSecurity {
   std::string scheme;       // "HMAC-SHA256 trailer"
   std::uint32_t bytes = 0;  // added to each message or frame
