@@ -43,7 +43,7 @@ void FederationMember::follow_configuration() {
   segment_ = wanted;
   start_error_.clear();
   if (!segment) return;
-  auto link = factory_(*segment, gateway_.identity(), spec.lease, log_);
+  auto link = factory_(*segment, gateway_.identity(), spec, log_);
   if (const std::string error = link->start(); !error.empty()) {
     start_error_ = error;
     log_.log(cosmic::LogLevel::error, "federation: cannot join over segment " + spec.segment + ": " + error +

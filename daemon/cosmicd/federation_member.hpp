@@ -19,7 +19,8 @@
 namespace cosmicd {
 
 using FederationLinkFactory = std::function<std::unique_ptr<cosmic::FederationLink>(
-    const cosmic::SegmentSpec& segment, const cosmic::GatewayIdentity& self, cosmic::Nanos lease, cosmic::Logger& log)>;
+    const cosmic::SegmentSpec& segment, const cosmic::GatewayIdentity& self, const cosmic::FederationSpec& federation,
+    cosmic::Logger& log)>;
 
 struct FederationSnapshot {
   bool enabled = false;
