@@ -153,11 +153,17 @@ void print_segments(const Json& r) {
               << " own datagrams dropped by its receive filter (each also counted in the host's UDP InErrors; "
                  "own_datagrams: cut avoids it)\n";
   }
-  // Authenticated segments: what was refused, by kind.
+  // Authenticated segments: what was refused, by kind (LCM: messages; DDS: participants).
   for (const auto& s : r["segments"]) {
     const Json& refused = s["adapter"].value("unauthenticated", Json());
     if (!refused.is_number_unsigned()) continue;
     if (std::exchange(first_note, false)) std::cout << "\n";
+    if (text(s["type"]) == "dds") {
+      const std::string last = s["adapter"].value("last_unauthenticated", "");
+      std::cout << text(s["name"]) << ": secure; refused " << text(refused) << " unauthenticated participants"
+                << (last.empty() ? std::string() : " (last " + last + ")") << "\n";
+      continue;
+    }
     std::cout << text(s["name"]) << ": authenticated; dropped " << text(refused) << " unauthenticated, "
               << text(s["adapter"].value("replayed", Json(0))) << " replayed\n";
   }
@@ -179,7 +185,7 @@ void print_peers(const Json& r) {
     return;
   }
   std::cout << "federation over segment " << text(f["segment"]) << ", lease " << f["lease_s"].get<double>() << "s\n";
-  std::cout << pad_column("GATEWAY", 16) << pad_column("ID", 18) << pad_column("STATE", 7)
+  std::cout << pad_column("GATEWAY", 16) << pad_column("ID", 18) << pad_column("STATE", 7) << pad_column("SUBJECT", 24)
             << pad_column("ANNOUNCED", 11) << pad_column("CHANNELS", 9) << "SEGMENTS\n";
   for (const auto& p : r["peers"]) {
     std::string segments;
@@ -188,9 +194,12 @@ void print_peers(const Json& r) {
       segments += (segments.empty() ? "" : ", ") + text(s["name"]) + (network.empty() ? "" : " [" + network + "]") +
                   " " + format_percent(s["load"].get<double>());
     }
+    // The subject its authentication proved; "-" on a federation segment without security.
+    const Json& subject = p.value("subject", Json());
+    const std::string subject_text = subject.is_string() && !subject.get<std::string>().empty() ? text(subject) : "-";
     std::cout << pad_column(text(p["name"]), 16) << pad_column(text(p["id"]), 18) << pad_column(text(p["state"]), 7)
-              << pad_column(age_text(p["last_heard_s"].get<double>()), 11) << pad_column(text(p["channels"]), 9)
-              << segments << "\n";
+              << pad_column(subject_text, 24) << pad_column(age_text(p["last_heard_s"].get<double>()), 11)
+              << pad_column(text(p["channels"]), 9) << segments << "\n";
   }
   const Json& c = r["counters"];
   if (c["refused"].get<std::uint64_t>() > 0 || c["dropped"].get<std::uint64_t>() > 0) {

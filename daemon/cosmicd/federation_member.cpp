@@ -5,6 +5,8 @@ namespace {
 
 // Lost and left peers stay listed this many leases, then are forgotten.
 constexpr int kForgetAfterLeases = 20;
+// Writers refused by the link that are each logged once; beyond, their refusals are logged as others are.
+constexpr std::size_t kMaxRefusedWritersLogged = 1024;
 
 double seconds_between(cosmic::Nanos from, cosmic::Nanos to) {
   return std::chrono::duration<double>(to - from).count();
@@ -43,7 +45,7 @@ void FederationMember::follow_configuration() {
   segment_ = wanted;
   start_error_.clear();
   if (!segment) return;
-  auto link = factory_(*segment, gateway_.identity(), spec.lease, log_);
+  auto link = factory_(*segment, gateway_.identity(), spec, log_);
   if (const std::string error = link->start(); !error.empty()) {
     start_error_ = error;
     log_.log(cosmic::LogLevel::error, "federation: cannot join over segment " + spec.segment + ": " + error +
@@ -101,6 +103,15 @@ void FederationMember::hear(cosmic::Nanos now) {
   std::string refusal;
   for (const cosmic::FederationMessage& message : link_->take()) {
     changed |= view_->apply(message, now, &refusal);
+    // A gateway the link refuses (authenticated, not listed) is logged once, with its subject.
+    if (!message.refusal.empty() && refused_writers_logged_.size() < kMaxRefusedWritersLogged) {
+      if (refused_writers_logged_.insert(message.source).second) {
+        log_.log(cosmic::LogLevel::warning, "federation: ignoring gateway " + cosmic::gateway_id_text(message.key) +
+                                                ": " + message.refusal +
+                                                "; its announcements are refused and counted (logged once)");
+      }
+      continue;
+    }
     // A hostile or broken peer may repeat itself: the first refusals are logged, then every 1000th.
     if (!refusal.empty() && (refusals_logged_++ < 10 || refusals_logged_ % 1000 == 0)) {
       log_.log(cosmic::LogLevel::warning, "federation: refused an announcement: " + refusal + " (" +
@@ -183,6 +194,7 @@ nlohmann::json FederationMember::peers_json(cosmic::Nanos now) const {
     peers.push_back({{"id", p.id},
                      {"name", p.name},
                      {"state", p.state},
+                     {"subject", s.secure ? nlohmann::json(p.subject) : nlohmann::json()},
                      {"last_heard_s", p.last_heard_age_seconds},
                      {"revision", p.revision},
                      {"channels", p.channels}});
@@ -205,6 +217,7 @@ nlohmann::json FederationMember::peers_json(cosmic::Nanos now) const {
           {"federation",
            {{"enabled", s.enabled},
             {"segment", s.segment},
+            {"secure", s.secure},
             {"lease_s", std::chrono::duration<double>(spec_.lease).count()},
             {"error", start_error_}}},
           {"peers", peers},
@@ -225,9 +238,10 @@ FederationSnapshot FederationMember::snapshot(cosmic::Nanos now) const {
   FederationSnapshot s;
   s.enabled = link_ != nullptr;
   s.segment = spec_.segment;
+  s.secure = segment_.dds.security.has_value();
   if (!view_) return s;
   for (const auto& [id, peer] : view_->peers()) {
-    s.peers.push_back({cosmic::gateway_id_text(id), peer.announcement.name, cosmic::to_string(peer.state),
+    s.peers.push_back({cosmic::gateway_id_text(id), peer.announcement.name, cosmic::to_string(peer.state), peer.subject,
                        seconds_between(peer.last_heard, now), peer.announcement.revision,
                        peer.announcement.channels.size()});
   }

@@ -1,7 +1,8 @@
 // This gateway as a member of a federation (gateway.federation, docs/federation.md): follows the
 // configuration (joins, rejoins on a changed segment or lease, leaves), announces the gateway's
 // state when it changes, applies what the other gateways announce to the gateway's admission
-// (Gateway::set_peer_reservations) and logs who joined, left or was lost.
+// (Gateway::set_peer_reservations) and logs who joined, left or was lost, and (once per writer) an
+// authenticated gateway that gateway.federation.peers does not list.
 //
 // Threads: the control thread only (tick() from the daemon's loop, peers_json() from the control
 // protocol, snapshot() for /metrics); the link's own threads only queue messages for it.
@@ -19,15 +20,18 @@
 namespace cosmicd {
 
 using FederationLinkFactory = std::function<std::unique_ptr<cosmic::FederationLink>(
-    const cosmic::SegmentSpec& segment, const cosmic::GatewayIdentity& self, cosmic::Nanos lease, cosmic::Logger& log)>;
+    const cosmic::SegmentSpec& segment, const cosmic::GatewayIdentity& self, const cosmic::FederationSpec& federation,
+    cosmic::Logger& log)>;
 
 struct FederationSnapshot {
   bool enabled = false;
   std::string segment;
+  bool secure = false;  // the federation segment has DDS Security
   struct Peer {
     std::string id;
     std::string name;
     std::string state;
+    std::string subject;  // authenticated (secure segment), else empty
     double last_heard_age_seconds = 0;
     std::uint64_t revision = 0;
     std::size_t channels = 0;
@@ -87,6 +91,8 @@ class FederationMember {
   };
   std::optional<Claim> claim_;
   std::uint64_t refusals_logged_ = 0;
+  // Writers whose announcements the link refuses (an unlisted gateway): each logged once.
+  std::set<std::string> refused_writers_logged_;
 };
 
 }  // namespace cosmicd

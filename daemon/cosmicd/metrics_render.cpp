@@ -147,12 +147,21 @@ void render_segment_counters(Exposition& out, const MetricsSnapshot& s) {
   for (const auto& seg : s.segments)
     if (const auto own = seg.adapter.transport_counter("own_datagrams_dropped")) out.sample(segment_labels(seg), *own);
   out.family("cosmic_segment_unauthenticated", MetricType::counter,
-             "Messages of an authenticated segment (LCM auth) dropped for want of a valid authentication tag.");
-  for (const auto& seg : s.segments)
+             "Messages of an authenticated segment (LCM auth) or frames of a CAN segment's SecOC hops dropped for "
+             "want of a valid authentication tag.");
+  for (const auto& seg : s.segments) {
+    if (seg.spec.type == cosmic::SegmentType::dds) continue;  // participants, counted below
     if (const auto n = seg.adapter.transport_counter("unauthenticated")) out.sample(segment_labels(seg), *n);
+  }
+  out.family("cosmic_segment_unauthenticated_participants", MetricType::counter,
+             "Remote participants a secure DDS segment (security) refused authentication, each counted once.");
+  for (const auto& seg : s.segments) {
+    if (seg.spec.type != cosmic::SegmentType::dds) continue;
+    if (const auto n = seg.adapter.transport_counter("unauthenticated")) out.sample(segment_labels(seg), *n);
+  }
   out.family("cosmic_segment_replayed", MetricType::counter,
              "Messages of an authenticated segment (LCM auth) with a valid tag dropped as sent before, or signed "
-             "outside the freshness window.");
+             "outside the freshness window; frames of SecOC hops authentic once and sent again.");
   for (const auto& seg : s.segments)
     if (const auto n = seg.adapter.transport_counter("replayed")) out.sample(segment_labels(seg), *n);
 }

@@ -44,8 +44,10 @@ int main(int argc, char** argv) {
   segment.type = cosmic::SegmentType::dds;
   segment.dds.domain = domain;
   StderrLogger log;
-  auto link = cosmic::make_dds_federation_link(segment, cosmic::GatewayIdentity{1, "federation-peer"},
-                                               cosmic::Nanos(1'000'000'000), log);
+  cosmic::FederationSpec federation;
+  federation.segment = segment.name;
+  federation.lease = cosmic::Nanos(1'000'000'000);
+  auto link = cosmic::make_dds_federation_link(segment, cosmic::GatewayIdentity{1, "federation-peer"}, federation, log);
   if (const std::string error = link->start(); !error.empty()) {
     std::cerr << "cosmic-federation-peer: " << error << "\n";
     return 1;

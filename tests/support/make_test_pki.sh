@@ -3,7 +3,8 @@
 # an identity CA and a permissions CA (ECDSA P-256), identities gateway-a, gateway-b and gateway-c
 # ("/O=cosmic/CN=gateway-X", keys 0600), governance (everything ENCRYPT, as Fast DDS 2.9 and Cyclone
 # DDS both handle it) and permissions granting gateway-a and gateway-b every topic of domains 0-230,
-# gateway-c every topic to subscribe but only cosmic/telemetry to publish, and monitor every topic
+# gateway-c every topic to subscribe but only cosmic/telemetry and cosmic/federation to publish (it
+# may join a federation; whether its gateways list it is theirs to say), and monitor every topic
 # to subscribe and none to publish, signed S/MIME with -text as the DDS Security specification and Fast DDS want them.
 # Under PKI-DH a participant's GUID prefix follows from its certificate's subject (bit 0 set, then
 # the first 47 bits of SHA-256 over the subject's DER encoding): gateway-a b3.18, gateway-b ce.c4,
@@ -113,7 +114,7 @@ XML
       <validity><not_before>2020-01-01T00:00:00</not_before><not_after>2100-01-01T00:00:00</not_after></validity>
       <allow_rule>
         <domains><id_range><min>0</min><max>230</max></id_range></domains>
-        <publish><topics><topic>cosmic/telemetry</topic></topics></publish>
+        <publish><topics><topic>cosmic/telemetry</topic><topic>cosmic/federation</topic></topics></publish>
         <subscribe><topics><topic>*</topic></topics></subscribe>
       </allow_rule>
       <default>DENY</default>

@@ -28,7 +28,8 @@ class DdsSecurityConfig : public testing::Test {
   static void TearDownTestSuite() { std::filesystem::remove_all(pki_); }
 
   // The segment's security with `files` in place of the defaults (gateway-a's identity).
-  ConfigResult load(const std::map<std::string, std::string>& files, const LoadOptions& options = {}) {
+  ConfigResult load(const std::map<std::string, std::string>& files, const LoadOptions& options = {},
+                    const std::string& gateway = "") {
     std::map<std::string, std::string> keys{
         {"identity_ca", "identity_ca.pem"},   {"certificate", "gateway-a_cert.pem"},
         {"private_key", "gateway-a_key.pem"}, {"permissions_ca", "permissions_ca.pem"},
@@ -42,15 +43,15 @@ class DdsSecurityConfig : public testing::Test {
     }
     std::string security;
     for (const auto& [k, v] : keys) security += (security.empty() ? "" : ", ") + k + ": " + v;
-    const std::string text =
-        "segments:\n"
-        "  - name: lan\n"
-        "    type: dds\n"
-        "    domain: 4\n"
-        "    security: {" +
-        security +
-        "}\n"
-        "channels: []\n";
+    const std::string text = gateway +
+                             "segments:\n"
+                             "  - name: lan\n"
+                             "    type: dds\n"
+                             "    domain: 4\n"
+                             "    security: {" +
+                             security +
+                             "}\n"
+                             "channels: []\n";
     security_line_ = "    security: {" + security + "}";
     return parse_config(text, (pki_ / "gateway.yaml").string(), options);
   }
@@ -255,6 +256,31 @@ TEST_F(DdsSecurityConfig, AdmissionCountsWhatSecurityAddsToEachSample) {
   const ConfigResult bad = with(", cost: soon");
   ASSERT_EQ(bad.errors.size(), 1u);
   EXPECT_EQ(bad.errors.front().path, "segments[1].security.cost");
+}
+
+// gateway.federation.peers on a secure federation segment: each subject read in either form and
+// normalised, with its participant keys; a malformed one refused where it stands.
+TEST_F(DdsSecurityConfig, FederationPeersAreReadAsSubjectsOnASecureSegment) {
+  const ConfigResult result =
+      load({}, {}, "gateway:\n  federation: {segment: lan, peers: ['CN=gateway-b,O=cosmic', /O=cosmic/CN=gateway-c]}\n");
+  ASSERT_TRUE(result.errors.empty()) << result.errors.front().to_string();
+  const auto& peers = result.config.gateway.federation.peers;
+  ASSERT_EQ(peers.size(), 2u);
+  EXPECT_EQ(peers[0].subject, "/O=cosmic/CN=gateway-b");
+  EXPECT_EQ(peers[1].subject, "/O=cosmic/CN=gateway-c");
+  // O and CN may each be UTF8String or PrintableString in a certificate: four keys.
+  EXPECT_EQ(peers[0].key_prefixes.size(), 4u);
+  EXPECT_NE(peers[0].key_prefixes, peers[1].key_prefixes);
+
+  const ConfigResult bad =
+      load({}, {}, "gateway:\n  federation: {segment: lan, peers: [CN=gateway-b, 'CN=gateway-c,O']}\n");
+  ASSERT_EQ(bad.errors.size(), 1u);
+  EXPECT_EQ(bad.errors.front().path, "gateway.federation.peers[1]");
+  EXPECT_EQ(bad.errors.front().line, 2);
+  EXPECT_EQ(bad.errors.front().column, 52);
+  EXPECT_NE(bad.errors.front().message.find("'CN=gateway-c,O' is not a certificate subject: 'O' has no '='"),
+            std::string::npos)
+      << bad.errors.front().to_string();
 }
 
 }  // namespace

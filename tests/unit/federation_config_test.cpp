@@ -49,6 +49,10 @@ TEST(FederationConfig, EveryMistakeIsReportedWithItsPlace) {
       {"  federation: {segment: lan, domain: 3}\n", "", "gateway.federation.domain"},
       {"  federation: {segment: lan, claim_window: 50ms}\n", "",
        "gateway.federation.claim_window: claim_window out of range (from 300ms"},
+      {"  federation: {segment: lan, peers: [CN=gw2]}\n", "",
+       "g.yaml:3:37: gateway.federation.peers: peers needs a secure federation segment: segment 'lan' has no "
+       "security, so no peer's subject can be authenticated (give segment lan a security: section"},
+      {"  federation: {segment: lan, peers: CN=gw2}\n", "", "gateway.federation.peers"},
       {"", "  - {name: body2, type: can, interface: can1, bitrate: 500kbit/s, network: body-bus}\n",
        "segments[2].network: segment 'body2' attaches the same network as segment 'body'"},
   };

@@ -99,6 +99,30 @@ TEST(FederationView, APeerDescribesOnlyItself) {
   EXPECT_NEAR(lan_bps(view), 0.1, 1e-9) << "nothing refused reached admission";
 }
 
+// On a secure segment the transport says who authenticated: a listed gateway's subject is kept
+// with it; an unlisted one's announcement is refused and counted like any other, reserving nothing
+// and waiting for no takeover, even when it names an alive gateway's id.
+TEST(FederationView, WhatTheTransportRefusesIsCountedAndNeverApplied) {
+  FederationView view(kSelf);
+  FederationMessage listed = said(peer(0x22, "gw2", 0.1), "w2");
+  listed.subject = "/O=cosmic/CN=gateway-b";
+  ASSERT_TRUE(view.apply(listed, Nanos(1s)));
+  EXPECT_EQ(view.peers().at(0x22).subject, "/O=cosmic/CN=gateway-b");
+  std::string why;
+  for (const std::uint64_t id : {std::uint64_t{0x33}, std::uint64_t{0x22}}) {
+    FederationMessage unlisted = said(peer(id, "gw3", 0.4, 7), "w3");
+    unlisted.refusal = "authenticated as /O=cosmic/CN=gateway-c, which gateway.federation.peers does not list";
+    EXPECT_FALSE(view.apply(unlisted, Nanos(2s), &why));
+    EXPECT_EQ(why, unlisted.refusal + " (from writer w3)");
+  }
+  EXPECT_EQ(view.counters().refused, 2u);
+  EXPECT_EQ(view.counters().last_refusal, why);
+  EXPECT_EQ(view.peers().size(), 1u);
+  EXPECT_EQ(view.pending_takeovers(), 0u);
+  EXPECT_FALSE(view.apply({Kind::lost, "w2-other", 0, {}}, Nanos(3s)));
+  EXPECT_NEAR(lan_bps(view), 0.1, 1e-9) << "the unlisted gateway's reservation counted";
+}
+
 TEST(FederationView, OlderRevisionsAreStale) {
   FederationView view(kSelf);
   ASSERT_TRUE(view.apply(said(peer(0x22, "gw2", 0.1, 5), "w2"), Nanos(1s)));

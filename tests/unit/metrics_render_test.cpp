@@ -158,6 +158,24 @@ TEST(MetricsRender, OwnDatagramsDroppedOnlyWhereTheFilterDropsThem) {
   EXPECT_EQ(m.find("cosmic_segment_own_datagrams_dropped_total{segment=\"body-can\""), std::string::npos);
 }
 
+// `unauthenticated` counts messages on an LCM segment and participants on a secure DDS segment:
+// each in a family of its own, so no sum mixes the two.
+TEST(MetricsRender, UnauthenticatedMessagesAndParticipantsAreFamiliesApart) {
+  MetricsSnapshot s = robot();
+  cosmic::SegmentInfo viz = segment("viz", cosmic::SegmentType::lcm, cosmic::SegmentHealth::up);
+  viz.adapter.transport.push_back(cosmic::TransportCounter{"unauthenticated", 7});
+  s.segments.push_back(viz);
+  cosmic::SegmentInfo secure = segment("secure", cosmic::SegmentType::dds, cosmic::SegmentHealth::up);
+  secure.adapter.transport.push_back(cosmic::TransportCounter{"unauthenticated", 2});
+  s.segments.push_back(secure);
+  const std::string m = render_metrics(s, ExpositionFormat::prometheus_text);
+  EXPECT_LINE(m, "cosmic_segment_unauthenticated_total{segment=\"viz\",type=\"lcm\"} 7");
+  EXPECT_LINE(m, "cosmic_segment_unauthenticated_participants_total{segment=\"secure\",type=\"dds\"} 2");
+  EXPECT_EQ(m.find("cosmic_segment_unauthenticated_total{segment=\"secure\""), std::string::npos);
+  EXPECT_EQ(m.find("cosmic_segment_unauthenticated_participants_total{segment=\"viz\""), std::string::npos);
+  EXPECT_EQ(m.find("cosmic_segment_unauthenticated_participants_total{segment=\"lan\""), std::string::npos);
+}
+
 TEST(MetricsRender, PerHopCountersAndEveryDropReason) {
   const std::string m = text();
   const std::string in = "channel=\"distance\",class=\"hrt\",segment=\"body-can\",role=\"publisher\"";

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "cosmic/certificate_subject.hpp"
+
 namespace cosmic::config_detail {
 namespace {
 
@@ -15,10 +17,28 @@ constexpr Nanos kMaxLease{3'600'000'000'000};
 constexpr Nanos kMinClaimWindow{300'000'000};
 constexpr Nanos kMaxClaimWindow{10'000'000'000};
 
+// gateway.federation.peers: certificate subjects, each normalised (DER) for its participant keys.
+void parse_peers(YamlReader& reader, const YAML::Node& node, const std::string& path,
+                 std::vector<FederationPeerSpec>& out) {
+  if (!reader.is_list(node, path)) return;
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    const std::string at = indexed(path, i);
+    const auto text = reader.string(node[i], at);
+    if (!text) continue;
+    auto subject = parse_certificate_subject(*text);
+    if (!subject) {
+      reader.error_at(node[i], at, "'" + *text + "' is not a certificate subject: " + subject.error().text,
+                      "a subject as in the peer's certificate: CN=gateway-b,O=cosmic or /O=cosmic/CN=gateway-b");
+      continue;
+    }
+    out.push_back(FederationPeerSpec{subject.value().text, subject.value().prefixes});
+  }
+}
+
 }  // namespace
 
 void parse_federation(YamlReader& reader, const YAML::Node& node, const std::string& path, FederationSpec& out) {
-  if (!reader.check_map(node, path, {"segment", "lease", "claim_window"})) return;
+  if (!reader.check_map(node, path, {"segment", "lease", "claim_window", "peers"})) return;
   if (!has(node, "segment")) {
     reader.error_at(node, key(path, "segment"), "missing required key 'segment'",
                     "the name of a DDS segment to federate over");
@@ -44,6 +64,7 @@ void parse_federation(YamlReader& reader, const YAML::Node& node, const std::str
       }
     }
   }
+  if (has(node, "peers")) parse_peers(reader, node["peers"], key(path, "peers"), out.peers);
 }
 
 void check_federation_segment(YamlReader& reader, const YAML::Node& node, const std::string& path,
@@ -62,6 +83,12 @@ void check_federation_segment(YamlReader& reader, const YAML::Node& node, const 
     reader.error_at(node["segment"], key(path, "segment"),
                     "segment '" + federation.segment + "' is " + to_string(segment->type),
                     "a DDS segment: gateways federate over DDS");
+  } else if (has(node, "peers") && !segment->dds.security) {
+    // Without DDS Security a participant's subject is whatever it says: a list would only look safe.
+    reader.error_at(node["peers"], key(path, "peers"),
+                    "peers needs a secure federation segment: segment '" + federation.segment +
+                        "' has no security, so no peer's subject can be authenticated",
+                    "give segment " + federation.segment + " a security: section (docs/security.md), or remove peers");
   }
 }
 

@@ -225,6 +225,7 @@ Json ControlProtocol::segments() const {
                  {"overflow_drops", s.adapter.overflow_drops},
                  {"backlog", s.adapter.backlog}}}};
     for (const TransportCounter& c : s.adapter.transport) entry["adapter"][c.name] = c.value;
+    for (const TransportNote& n : s.adapter.transport_notes) entry["adapter"][n.name] = n.text;
     if (s.spec.type == SegmentType::can) {
       entry["interface"] = s.spec.can.interface;
       entry["bitrate"] = s.spec.can.bitrate.bits_per_second;

@@ -115,6 +115,7 @@ std::string FederationView::cheap_refusal(const FederationMessage& message) {
 }
 
 bool FederationView::take_announcement(const FederationMessage& message, Nanos now, std::string* refusal) {
+  if (!message.refusal.empty()) return refuse(message, message.refusal, refusal);
   if (std::string why = cheap_refusal(message); !why.empty()) return refuse(message, why, refusal);
   DecodedAnnouncement decoded = decode_announcement(message.body);
   if (!decoded.announcement) return refuse(message, decoded.error, refusal);
@@ -139,6 +140,7 @@ bool FederationView::take_announcement(const FederationMessage& message, Nanos n
   if (peer.state != PeerState::alive || peer.announcements == 0) peer.state_since = now;
   peer.announcement = std::move(a);
   peer.source = message.source;
+  peer.subject = message.subject;
   peer.last_heard = now;
   peer.state = PeerState::alive;
   ++peer.announcements;

@@ -73,20 +73,7 @@ cat >"$WORK/big.yaml" <<'YAML'
    publishers: [edge], subscribers: [backbone]}
 YAML
 
-# peers_state NAME PEER: the state gateway NAME shows for gateway PEER ("" when not listed).
-peers_state() {
-  ctl "$1" --json peers | python3 -c '
-import json, sys
-print(next((p["state"] for p in json.load(sys.stdin)["peers"] if p["name"] == sys.argv[1]), ""))' "$2"
-}
-state_is() { [ "$(peers_state "$1" "$2")" = "$3" ]; }
-# backbone_field NAME FIELD: a field of the backbone in `segments --json`.
-backbone_field() {
-  ctl "$1" --json segments | python3 -c '
-import json, sys
-print(next(s[sys.argv[1]] for s in json.load(sys.stdin)["segments"] if s["name"] == "backbone"))' "$2"
-}
-near() { python3 -c 'import sys; sys.exit(0 if abs(float(sys.argv[1]) - float(sys.argv[2])) < 0.005 else 1)' "$1" "$2"; }
+peers_state() { peer_field "$1" "$2" state; }
 peers_load_is() { near "$(backbone_field "$1" peers)" "$2"; }
 
 for i in 1 2 3; do start_daemon "gw$i" "$WORK/gw$i.yaml" || exit 1; done
@@ -102,7 +89,10 @@ wait_until 10 "gw1 counts 20% of the backbone for gw2 and gw3" peers_load_is gw1
 # 10% telemetry1 + 0.832% relay (8 B + 96 B every 100 ms) + 20% for gw2 and gw3.
 near "$(backbone_field gw1 utilization)" 0.30832 || fail "gw1 backbone utilization $(backbone_field gw1 utilization), want 0.30832"
 ctl gw1 peers >"$WORK/peers.txt" || fail "cosmicctl peers failed"
-grep -Eq '^gw2 +[0-9a-f]{16} +alive ' "$WORK/peers.txt" || fail "cosmicctl peers: gw2 not listed alive: $(cat "$WORK/peers.txt")"
+grep -Eq '^gw2 +[0-9a-f]{16} +alive +- ' "$WORK/peers.txt" ||
+  fail "cosmicctl peers: gw2 not listed alive, without a subject (no security): $(cat "$WORK/peers.txt")"
+[ "$(ctl gw1 --json peers | python3 -c 'import json,sys; print([p["subject"] for p in json.load(sys.stdin)["peers"]])')" = "[None, None]" ] ||
+  fail "cosmicctl peers --json: a subject on a segment without security"
 grep -q 'backbone \[dds:domain=41\] 10.0%' "$WORK/peers.txt" || fail "cosmicctl peers: no backbone load: $(cat "$WORK/peers.txt")"
 passed
 

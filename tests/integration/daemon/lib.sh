@@ -102,6 +102,26 @@ settled() {
   [ "$before" = "$after" ]
 }
 
+# peer_field GW PEER FIELD: a field of gateway GW's entry for gateway PEER in `peers --json` ("" when not listed).
+peer_field() {
+  ctl "$1" --json peers | python3 -c '
+import json, sys
+p = next((p for p in json.load(sys.stdin)["peers"] if p["name"] == sys.argv[1]), None)
+print("" if p is None else ("null" if p[sys.argv[2]] is None else p[sys.argv[2]]))' "$2" "$3"
+}
+# state_is GW PEER STATE: gateway GW shows gateway PEER in STATE.
+state_is() { [ "$(peer_field "$1" "$2" state)" = "$3" ]; }
+
+# backbone_field NAME FIELD: a field of the segment named backbone in `segments --json` (the
+# federation tests' shared network).
+backbone_field() {
+  ctl "$1" --json segments | python3 -c '
+import json, sys
+print(next(s[sys.argv[1]] for s in json.load(sys.stdin)["segments"] if s["name"] == "backbone"))' "$2"
+}
+# near A B: two numbers within 0.005 of each other.
+near() { python3 -c 'import sys; sys.exit(0 if abs(float(sys.argv[1]) - float(sys.argv[2])) < 0.005 else 1)' "$1" "$2"; }
+
 # stderr_has FILE TEXT
 stderr_has() { grep -q -- "$2" "$1"; }
 

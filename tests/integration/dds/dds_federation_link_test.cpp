@@ -24,6 +24,13 @@ SegmentSpec federation_segment() {
   return s;
 }
 
+FederationSpec lease_of(Nanos lease) {
+  FederationSpec f;
+  f.segment = "backbone";
+  f.lease = lease;
+  return f;
+}
+
 // Takes from `link` until `wanted` is among what it delivered (all kept in `heard`).
 bool hears(FederationLink& link, std::vector<FederationMessage>& heard,
            const std::function<bool(const FederationMessage&)>& wanted) {
@@ -37,8 +44,8 @@ bool hears(FederationLink& link, std::vector<FederationMessage>& heard,
 
 TEST(DdsFederationLink, AnnouncesWithdrawsAndReportsAWriterThatGoes) {
   test::StderrLogger log;
-  auto a = make_dds_federation_link(federation_segment(), GatewayIdentity{0xA, "a"}, Nanos(1s), log);
-  auto b = make_dds_federation_link(federation_segment(), GatewayIdentity{0xB, "b"}, Nanos(1s), log);
+  auto a = make_dds_federation_link(federation_segment(), GatewayIdentity{0xA, "a"}, lease_of(1s), log);
+  auto b = make_dds_federation_link(federation_segment(), GatewayIdentity{0xB, "b"}, lease_of(1s), log);
   ASSERT_EQ(a->start(), "");
   ASSERT_EQ(b->start(), "");
   ASSERT_TRUE(a->publish(0xA, "first"));

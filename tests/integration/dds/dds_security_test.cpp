@@ -2,13 +2,17 @@
 // namespace, with a test PKI the openssl command line makes here (tests/support/make_test_pki.sh):
 // two gateways' adapters, each with its own identity, authenticate and exchange a channel both
 // ways; a participant without security (cosmic-dds-peer, plain Fast DDS) on the same domain never
-// receives a sample of it; an authenticated gateway cannot publish a topic its permissions do not grant.
+// receives a sample of it and is counted once as unauthenticated; an authenticated gateway cannot
+// publish a topic its permissions do not grant; the federation's links take announcements only from
+// the gateways gateway.federation.peers lists, by the subject their authenticated GUID proves.
 #include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
 
 #include "cosmic/build_paths.hpp"
+#include "cosmic/certificate_subject.hpp"
+#include "cosmic/dds_federation_link.hpp"
 #include "dds_adapter_fixture.hpp"
 
 namespace cosmic::dds_test {
@@ -92,6 +96,18 @@ TEST_F(DdsSecurityTest, AuthenticatedGatewaysExchangeAndAPlainParticipantReceive
   ASSERT_TRUE(plain_exit.has_value());
   EXPECT_EQ(*plain_exit, 1) << "a participant without security received an authenticated gateway's sample";
   EXPECT_TRUE(plain.out_lines().empty());
+  // Fast DDS 2.9.1 reports the plain participant as refused authentication, to each of a's
+  // participants: counted once, with its GUID (a plain participant's prefix starts 01.0f).
+  ASSERT_TRUE(test::eventually(
+      [&] { return a.adapter->statistics().transport_counter("unauthenticated").value_or(0) >= 1; }, kWait));
+  const AdapterStatistics stats = a.adapter->statistics();
+  EXPECT_EQ(stats.transport_counter("unauthenticated"), 1u) << "one plain participant, counted once";
+  ASSERT_EQ(stats.transport_notes.size(), 1u);
+  EXPECT_EQ(stats.transport_notes.front().name, "last_unauthenticated");
+  EXPECT_EQ(stats.transport_notes.front().text.rfind("01.0f.", 0), 0u) << stats.transport_notes.front().text;
+  EXPECT_EQ(b.adapter->statistics().transport_counter("unauthenticated").value_or(0), 1u);
+  EXPECT_FALSE(Fixture(dds_segment(kDomain), 0xD4).adapter->statistics().transport_counter("unauthenticated"))
+      << "a segment without security counts no such thing";
   a.adapter->stop();
   b.adapter->stop();
 }
@@ -112,6 +128,56 @@ TEST_F(DdsSecurityTest, AnAuthenticatedGatewayCannotPublishWhatItsPermissionsDoN
   EXPECT_EQ(status.error.find("telemetry"), std::string::npos) << status.error;
   EXPECT_EQ(status.error.find("drive"), std::string::npos) << status.error;
   c.adapter->stop();
+}
+
+// gateway-a lists gateway-b only; gateway-c authenticates too (its permissions let it publish
+// cosmic/federation) but is not listed: its announcement arrives refused, naming the subject its
+// GUID proves; gateway-b's arrives with its subject. Without a list every authenticated gateway
+// counts, with the subject its GUID proves.
+TEST_F(DdsSecurityTest, TheFederationTakesOnlyListedGatewaysByTheSubjectTheyAuthenticatedWith) {
+  constexpr std::uint32_t kDomain = 63;
+  test::StderrLogger log;
+  FederationSpec listing_b;
+  listing_b.segment = "backbone";
+  listing_b.lease = std::chrono::seconds(1);
+  auto subject = parse_certificate_subject("CN=gateway-b,O=cosmic");
+  ASSERT_TRUE(subject);
+  listing_b.peers.push_back(FederationPeerSpec{subject.value().text, subject.value().prefixes});
+  FederationSpec open = listing_b;
+  open.peers.clear();
+  auto a = make_dds_federation_link(secure_segment(kDomain, "gateway-a"), GatewayIdentity{0xA, "a"}, listing_b, log);
+  auto b = make_dds_federation_link(secure_segment(kDomain, "gateway-b"), GatewayIdentity{0xB, "b"}, open, log);
+  auto c = make_dds_federation_link(secure_segment(kDomain, "gateway-c"), GatewayIdentity{0xC, "c"}, open, log);
+  ASSERT_EQ(a->start(), "");
+  ASSERT_EQ(b->start(), "");
+  ASSERT_EQ(c->start(), "");
+  ASSERT_TRUE(a->publish(0xA, "a's"));
+  ASSERT_TRUE(b->publish(0xB, "b's"));
+  ASSERT_TRUE(c->publish(0xC, "c's"));
+  std::map<std::uint64_t, FederationMessage> at_a;
+  std::map<std::uint64_t, FederationMessage> at_b;
+  auto heard = [](FederationLink& link, std::map<std::uint64_t, FederationMessage>& out, std::size_t count) {
+    return test::eventually(
+        [&] {
+          for (FederationMessage& m : link.take()) {
+            if (m.kind == FederationMessage::Kind::announcement) out[m.key] = std::move(m);
+          }
+          return out.size() >= count;
+        },
+        std::chrono::seconds(30));
+  };
+  ASSERT_TRUE(heard(*a, at_a, 2)) << "gateway-a heard " << at_a.size() << " announcements";
+  EXPECT_EQ(at_a[0xB].subject, "/O=cosmic/CN=gateway-b");
+  EXPECT_EQ(at_a[0xB].refusal, "");
+  EXPECT_EQ(at_a[0xC].subject, "");
+  EXPECT_NE(at_a[0xC].refusal.find(" authenticated as /O=cosmic/CN=gateway-c, which gateway.federation.peers does "
+                                   "not list"),
+            std::string::npos)
+      << at_a[0xC].refusal;
+  ASSERT_TRUE(heard(*b, at_b, 2)) << "gateway-b heard " << at_b.size() << " announcements";
+  EXPECT_EQ(at_b[0xA].subject, "/O=cosmic/CN=gateway-a");
+  EXPECT_EQ(at_b[0xC].subject, "/O=cosmic/CN=gateway-c");
+  EXPECT_EQ(at_b[0xC].refusal, "");
 }
 
 }  // namespace

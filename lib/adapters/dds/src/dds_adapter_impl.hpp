@@ -122,14 +122,24 @@ struct ReaderEntry : dds::DataReaderListener {
 class DdsAdapter final : public DdsSegmentAdapter {
  public:
   DdsAdapter(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log)
-      : segment_(segment), self_(self), log_(log), prefix_(segment_log_prefix(SegmentType::dds, segment.name)) {}
+      : segment_(segment),
+        self_(self),
+        log_(log),
+        prefix_(segment_log_prefix(SegmentType::dds, segment.name)),
+        authentications_(prefix_, log, true) {
+    if (segment_.dds.security) discovery_.watch_authentications(&authentications_);
+  }
   ~DdsAdapter() override { stop(); }
 
   Status start(EventSink& sink) override;
   Status configure(std::span<const ChannelBinding> bindings) override;
   SendStatus send(const OutboundEvent& event) override;
   HealthReport health() const override { return health_.get(); }
-  AdapterStatistics statistics() const override { return counters_.snapshot(); }
+  AdapterStatistics statistics() const override {
+    AdapterStatistics out = counters_.snapshot();
+    if (segment_.dds.security) authentications_.report(out);
+    return out;
+  }
   void stop() override;
   std::size_t matched_endpoints(ChannelId channel, HopRole role) const override;
   std::optional<std::size_t> matched_peers(ChannelId channel) const override {
@@ -180,6 +190,8 @@ class DdsAdapter final : public DdsSegmentAdapter {
   const GatewayIdentity self_;
   Logger& log_;
   const std::string prefix_;  // "DDS segment NAME: " (cosmic/log_prefix.hpp)
+  // A secure segment's remote participants refused authentication (the listener's, via discovery_).
+  ParticipantAuthentications authentications_;
 
   // Serialises start/configure/stop (control thread); never taken on a send or receive path.
   Mutex control_mutex_;

@@ -24,6 +24,7 @@
 #include "cosmic/dds_names.hpp"
 #include "cosmic/dds_qos_match.hpp"
 #include "cosmic/segment_adapter.hpp"
+#include "dds_authentication.hpp"
 
 namespace cosmic::dds_detail {
 
@@ -38,6 +39,17 @@ class DiscoveryBook final : public eprosima::fastdds::dds::DomainParticipantList
                                eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override;
   void on_publisher_discovery(eprosima::fastdds::dds::DomainParticipant*,
                               eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override;
+  // On a secure segment: remote participants and their authentication go to `authentications`.
+  void on_participant_discovery(eprosima::fastdds::dds::DomainParticipant*,
+                                eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+    if (authentications_) authentications_->discovered(info);
+  }
+  void onParticipantAuthentication(eprosima::fastdds::dds::DomainParticipant*,
+                                   eprosima::fastrtps::rtps::ParticipantAuthenticationInfo&& info) override {
+    if (authentications_) authentications_->authenticated(info);
+  }
+  // Before the first participant is created (the callbacks read it unguarded).
+  void watch_authentications(ParticipantAuthentications* authentications) { authentications_ = authentications; }
 
   // The adapter's own participants: their endpoints are never remote peers of each other.
   void add_own_participant(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix);
@@ -51,6 +63,7 @@ class DiscoveryBook final : public eprosima::fastdds::dds::DomainParticipantList
   using Table = std::map<eprosima::fastrtps::rtps::GUID_t, RemoteEndpoint>;
   void store(Table& table, const eprosima::fastrtps::rtps::GUID_t& guid, bool removed, RemoteEndpoint endpoint);
 
+  ParticipantAuthentications* authentications_ = nullptr;
   mutable std::mutex mutex_;
   std::set<eprosima::fastrtps::rtps::GuidPrefix_t> own_;
   Table readers_;

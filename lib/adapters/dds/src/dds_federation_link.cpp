@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <mutex>
+#include <sstream>
 #include <thread>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -17,8 +18,10 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
+#include "cosmic/certificate_subject.hpp"
 #include "cosmic/dds_names.hpp"
 #include "cosmic_dds_idl/FederationPubSubTypes.h"
+#include "dds_authentication.hpp"
 #include "dds_qos.hpp"
 
 namespace cosmic {
@@ -54,10 +57,36 @@ bool from_prefix(const dds::InstanceHandle_t& handle, const eprosima::fastrtps::
   return true;
 }
 
+eprosima::fastrtps::rtps::GuidPrefix_t prefix_of(const dds::InstanceHandle_t& handle) {
+  eprosima::fastrtps::rtps::GuidPrefix_t prefix;
+  for (std::size_t i = 0; i < prefix.size; ++i) prefix.value[i] = handle.value[i];
+  return prefix;
+}
+
+std::string prefix_text(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) {
+  std::ostringstream out;
+  out << prefix;
+  return out.str();
+}
+
+// The subject a participant claims, when its GUID prefix proves it holds it (the prefix follows
+// from the certificate's subject under PKI-DH); empty otherwise.
+std::string proven(const std::string& claim, const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) {
+  if (claim.empty()) return {};
+  const auto subject = parse_certificate_subject(claim);
+  return subject && holds_subject(subject.value(), prefix.value) ? subject.value().text : std::string();
+}
+
 class DdsFederationLink final : public FederationLink, private dds::DataReaderListener {
  public:
-  DdsFederationLink(SegmentSpec segment, GatewayIdentity self, Nanos lease, Logger& log)
-      : segment_(std::move(segment)), self_(std::move(self)), lease_(lease), log_(log) {}
+  DdsFederationLink(SegmentSpec segment, GatewayIdentity self, FederationSpec federation, Logger& log)
+      : segment_(std::move(segment)),
+        self_(std::move(self)),
+        federation_(std::move(federation)),
+        lease_(federation_.lease),
+        log_(log),
+        authentications_("federation: ", log, false),
+        participant_listener_(authentications_) {}
 
   ~DdsFederationLink() override { close(); }
 
@@ -73,7 +102,7 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
     // participant after the lease *that participant* announced, so gateways may differ in lease.
     qos.wire_protocol().builtin.discovery_config.leaseDuration = duration_of(lease_);
     qos.wire_protocol().builtin.discovery_config.leaseDuration_announcementperiod = duration_of(lease_ / 3);
-    participant_ = create_participant(qos);
+    participant_ = create_participant(qos, segment_.dds.security ? &participant_listener_ : nullptr);
     if (participant_ == nullptr)
       return "cannot create the federation's DDS participant in domain " + std::to_string(segment_.dds.domain);
     own_prefix_ = participant_->guid().guidPrefix;
@@ -160,13 +189,14 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
   }
 
   // Fast DDS threads inherit their creator's name: they show as fed:<segment> in ps and top.
-  dds::DomainParticipant* create_participant(const dds::DomainParticipantQos& qos) {
+  dds::DomainParticipant* create_participant(const dds::DomainParticipantQos& qos,
+                                             dds::DomainParticipantListener* listener) {
     dds::DomainParticipant* created = nullptr;
     const std::string name = ("fed:" + segment_.name).substr(0, 15);
     std::thread creator([&] {
       pthread_setname_np(pthread_self(), name.c_str());
       created = dds::DomainParticipantFactory::get_instance()->create_participant(
-          static_cast<dds::DomainId_t>(segment_.dds.domain), qos);
+          static_cast<dds::DomainId_t>(segment_.dds.domain), qos, listener, dds::StatusMask::none());
     });
     creator.join();
     return created;
@@ -217,6 +247,7 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
       if (info.valid_data) {
         m.key = sample.gateway();
         m.body = std::move(sample.body());
+        if (segment_.dds.security) authenticate(prefix_of(info.publication_handle), m);
       } else {
         m.kind = info.instance_state == dds::NOT_ALIVE_DISPOSED_INSTANCE_STATE ? FederationMessage::Kind::withdrawn
                                                                                : FederationMessage::Kind::lost;
@@ -224,6 +255,36 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
       std::lock_guard lock(mutex_);
       queue(std::move(m));
     }
+  }
+
+  // On a secure segment: the sender's subject, or why its announcement does not count. Its
+  // participant authenticated (the handshake proved it holds the certificate behind its GUID), and
+  // with gateway.federation.peers its GUID prefix is one a listed subject gives.
+  void authenticate(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix, FederationMessage& m) const {
+    const std::string participant = "participant " + prefix_text(prefix);
+    if (!authentications_.authorized(prefix)) {
+      m.refusal = participant + " has not authenticated";
+      return;
+    }
+    const std::string claim = authentications_.claimed_subject(prefix);
+    if (federation_.peers.empty()) {
+      m.subject = proven(claim, prefix);
+      return;
+    }
+    for (const FederationPeerSpec& peer : federation_.peers) {
+      for (const auto& key : peer.key_prefixes) {
+        if (std::equal(key.begin(), key.end(), prefix.value)) {
+          m.subject = peer.subject;
+          return;
+        }
+      }
+    }
+    const std::string holds = proven(claim, prefix);
+    m.refusal = participant +
+                (!holds.empty()   ? " authenticated as " + holds
+                 : !claim.empty() ? " authenticated and claims subject " + claim
+                                  : " authenticated without naming its subject") +
+                ", which gateway.federation.peers does not list";
   }
 
   // A writer unmatched: its participant's lease expired (killed, cut off) or it was deleted without
@@ -237,8 +298,11 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
 
   SegmentSpec segment_;
   GatewayIdentity self_;
+  FederationSpec federation_;
   Nanos lease_;
   Logger& log_;
+  dds_detail::ParticipantAuthentications authentications_;  // secure segments only
+  dds_detail::AuthenticationListener participant_listener_;
   dds::DomainParticipant* participant_ = nullptr;
   dds::Topic* topic_ = nullptr;
   dds::Publisher* publisher_ = nullptr;
@@ -256,8 +320,8 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
 }  // namespace
 
 std::unique_ptr<FederationLink> make_dds_federation_link(const SegmentSpec& segment, const GatewayIdentity& self,
-                                                         Nanos lease, Logger& log) {
-  return std::make_unique<DdsFederationLink>(segment, self, lease, log);
+                                                         const FederationSpec& federation, Logger& log) {
+  return std::make_unique<DdsFederationLink>(segment, self, federation, log);
 }
 
 }  // namespace cosmic

@@ -321,12 +321,25 @@ struct RealtimeSpec {
 
 // gateway.federation (docs/federation.md): the DDS segment over which this gateway announces
 // itself and hears the others; off when `segment` is empty.
+// A gateway whose announcements count on a secure federation segment (gateway.federation.peers,
+// docs/federation.md): its identity certificate's subject, and the participant key prefixes DDS
+// Security's PKI-DH gives a holder of that subject (cosmic/certificate_subject.hpp), by which an
+// authenticated participant is told to be that gateway.
+struct FederationPeerSpec {
+  std::string subject;  // OpenSSL's one-line form, "/O=cosmic/CN=gateway-b"
+  std::vector<std::array<std::uint8_t, 6>> key_prefixes;
+  friend bool operator==(const FederationPeerSpec&, const FederationPeerSpec&) = default;
+};
+
 struct FederationSpec {
   std::string segment;
   Nanos lease{Nanos(3'000'000'000)};  // a peer silent (its participant's lease) this long is lost
   // A bind that adds load to a network other gateways share first claims it for this long, so a
   // concurrent bind on another gateway sees it (lower gateway id goes first).
   Nanos claim_window{Nanos(500'000'000)};
+  // Only on a secure segment. Empty: every participant that authenticated (and that the
+  // permissions let publish cosmic/federation) counts; else only these.
+  std::vector<FederationPeerSpec> peers;
   bool enabled() const { return !segment.empty(); }
   friend bool operator==(const FederationSpec&, const FederationSpec&) = default;
 };

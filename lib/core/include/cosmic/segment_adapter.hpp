@@ -121,6 +121,13 @@ struct TransportCounter {
   friend bool operator==(const TransportCounter&, const TransportCounter&) = default;
 };
 
+// A fact of one transport's own, in words (AdapterStatistics::transport_notes).
+struct TransportNote {
+  std::string name;
+  std::string text;
+  friend bool operator==(const TransportNote&, const TransportNote&) = default;
+};
+
 struct AdapterStatistics {
   std::uint64_t received = 0;        // messages/frames read from the network
   std::uint64_t sent = 0;            // messages/frames written to the network
@@ -134,8 +141,12 @@ struct AdapterStatistics {
   //    limit, answered later or not at all; also counted in receive_errors;
   //  - own_datagrams_dropped (LCM with own_datagrams: drop): the datagrams the gateway sent whose
   //    looped-back copy its own receive filter dropped in the kernel, one per datagram sent; each is
-  //    also one in the host's UDP InErrors and in the socket's drops, and none in overflow_drops.
+  //    also one in the host's UDP InErrors and in the socket's drops, and none in overflow_drops;
+  //  - unauthenticated: on an LCM segment with auth, messages without a valid tag (also replayed:
+  //    with a valid tag, sent before); on a DDS segment with security, remote participants refused
+  //    authentication, each counted once (transport_notes' last_unauthenticated: the last one's GUID).
   std::vector<TransportCounter> transport;
+  std::vector<TransportNote> transport_notes;
   std::optional<std::uint64_t> transport_counter(std::string_view name) const {
     for (const TransportCounter& c : transport) {
       if (c.name == name) return c.value;

@@ -3,15 +3,14 @@
 // attach. Fed by a FederationLink's messages; no I/O. One owner (the daemon's control thread).
 //
 // A peer is trusted to describe itself only. Refused and counted (never applied): an announcement
-// that does not decode, one filed under another gateway's id than it names, one naming this
-// gateway's id, one from a writer that already announces another gateway (one gateway per writer),
-// one naming a gateway another writer announces while that writer is alive, and a new gateway
-// beyond max_peers. The cheap checks (ids, writer) run before the body is decoded. The latest
-// announcement refused only because its gateway's writer is alive is kept (one per gateway) and
-// applied once that writer is lost or left: a gateway that rejoined with a new writer before its old
-// one was gone is taken over then. An older or repeated revision is ignored (counted as stale).
-// A gateway that left (withdrew) stays `left` until it announces again; a lost one comes back when
-// its writer is matched again.
+// the transport refuses (FederationMessage::refusal), one that does not decode, one filed under another gateway's id
+// than it names, one naming this gateway's id, one from a writer that already announces another gateway (one gateway
+// per writer), one naming a gateway another writer announces while that writer is alive, and a new gateway beyond
+// max_peers. The cheap checks (ids, writer) run before the body is decoded. The latest announcement refused only
+// because its gateway's writer is alive is kept (one per gateway) and applied once that writer is lost or left: a
+// gateway that rejoined with a new writer before its old one was gone is taken over then. An older or repeated revision
+// is ignored (counted as stale). A gateway that left (withdrew) stays `left` until it announces again; a lost one comes
+// back when its writer is matched again.
 #pragma once
 
 #include <cstdint>
@@ -35,6 +34,12 @@ struct FederationMessage {
   std::string source;     // the writer (DDS: its GUID), as the transport identifies it
   std::uint64_t key = 0;  // the gateway id the transport filed it under; 0 when it cannot tell
   std::string body;
+  // On a secure federation segment (docs/federation.md): the certificate subject the sender
+  // authenticated with, as the transport proved it (empty: not secure, or nothing proves one), and
+  // why the transport refuses the sender (an authenticated gateway gateway.federation.peers does not
+  // list): such an announcement is counted as refused and never applied.
+  std::string subject{};
+  std::string refusal{};
 };
 
 enum class PeerState { alive, lost, left };
@@ -43,6 +48,7 @@ const char* to_string(PeerState value);
 struct PeerRecord {
   Announcement announcement;
   std::string source;
+  std::string subject;  // its authenticated subject (FederationMessage::subject), empty when none
   PeerState state = PeerState::alive;
   Nanos first_heard{0};
   Nanos last_heard{0};  // last announcement or change of state

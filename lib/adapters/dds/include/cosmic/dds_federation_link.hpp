@@ -9,6 +9,11 @@
 // key, the source being its writer's GUID), a disposed instance -> withdrawn, a writer unmatched
 // (its participant's lease expired) -> lost, matched again -> alive. This gateway's own samples
 // are dropped by GUID prefix.
+// On a secure segment (DDS Security) an announcement counts only from a participant that
+// authenticated and, when gateway.federation.peers lists subjects, whose GUID prefix one of them
+// gives under PKI-DH (cosmic/certificate_subject.hpp); the message carries the subject, or the
+// refusal (FederationMessage::subject, refusal). Without peers, the subject is the one the
+// participant claims when its GUID proves it.
 //
 // Threads: Fast DDS's listener threads queue messages under a mutex (never touching anything
 // else); start/publish/withdraw/take run on the owner's control thread.
@@ -22,8 +27,9 @@
 
 namespace cosmic {
 
-// `segment` is the DDS segment named by gateway.federation.segment.
+// `segment` is the DDS segment named by gateway.federation.segment; `federation` gives the lease
+// and, on a secure segment, the peers.
 std::unique_ptr<FederationLink> make_dds_federation_link(const SegmentSpec& segment, const GatewayIdentity& self,
-                                                         Nanos lease, Logger& log);
+                                                         const FederationSpec& federation, Logger& log);
 
 }  // namespace cosmic
