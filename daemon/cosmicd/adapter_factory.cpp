@@ -1,5 +1,7 @@
 #include "adapter_factory.hpp"
 
+#include <filesystem>
+
 #include "cosmic/dds_adapter.hpp"
 #include "cosmic/lcm_adapter.hpp"
 #if COSMIC_HAS_CAN
@@ -8,23 +10,37 @@
 
 namespace cosmicd {
 
-std::unique_ptr<cosmic::SegmentAdapter> make_adapter(const cosmic::SegmentSpec& segment,
-                                                     const cosmic::GatewayIdentity& self, cosmic::Logger& log,
-                                                     const std::string& state_directory) {
+struct AdapterFactory::State {
+#if COSMIC_HAS_CAN
+  std::map<std::string, cosmic::CanSecocState> secoc;
+#endif
+};
+
+AdapterFactory::AdapterFactory(std::string state_directory)
+    : state_directory_(std::move(state_directory)), state_(std::make_unique<State>()) {}
+
+AdapterFactory::~AdapterFactory() = default;
+
+std::unique_ptr<cosmic::SegmentAdapter> AdapterFactory::make(const cosmic::SegmentSpec& segment,
+                                                             const cosmic::GatewayIdentity& self, cosmic::Logger& log) {
   switch (segment.type) {
     case cosmic::SegmentType::dds:
       return cosmic::make_dds_adapter(segment, self, log);
     case cosmic::SegmentType::lcm:
       return cosmic::make_lcm_adapter(segment, self, log);
-    case cosmic::SegmentType::can:
+    case cosmic::SegmentType::can: {
 #if COSMIC_HAS_CAN
-      return cosmic::make_can_adapter(segment, self, log,
-                                      cosmic::CanAdapterOptions{state_directory + "/secoc-" + segment.name + ".json"});
+      cosmic::CanSecocState& secoc = state_->secoc[segment.name];
+      if (!secoc) {
+        const auto file = std::filesystem::path(state_directory_) / ("secoc-" + segment.name + ".json");
+        secoc = cosmic::make_can_secoc_state(file.string(), segment.name, log);
+      }
+      return cosmic::make_can_adapter(segment, self, log, cosmic::CanAdapterOptions{secoc});
 #else
-      (void)state_directory;
       log.log(cosmic::LogLevel::error, "segment " + segment.name + ": this build has no CAN support");
       return nullptr;
 #endif
+    }
   }
   return nullptr;
 }

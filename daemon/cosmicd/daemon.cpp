@@ -43,6 +43,13 @@ cosmic::LogLevel parse_level(const std::string& text) {
   return cosmic::LogLevel::info;
 }
 
+// The absolute directory of the state file (a relative --state-file is the working directory's).
+std::string directory_of(const std::string& file) {
+  std::error_code failed;
+  const std::filesystem::path absolute = std::filesystem::absolute(file, failed);
+  return (failed ? std::filesystem::path(file) : absolute).parent_path().string();
+}
+
 std::string default_state_file() {
   const char* directory = std::getenv("STATE_DIRECTORY");  // set by systemd's StateDirectory=
   const std::string base =
@@ -81,11 +88,10 @@ class Daemon {
       : options_(options),
         log_(parse_level(options.log_level)),
         state_file_(options.state_file.empty() ? default_state_file() : options.state_file),
-        gateway_(
-            [this](const cosmic::SegmentSpec& segment, const cosmic::GatewayIdentity& self, cosmic::Logger& log) {
-              return make_adapter(segment, self, log, std::filesystem::path(state_file_).parent_path().string());
-            },
-            log_, random_gateway_id()),
+        adapters_(directory_of(state_file_)),
+        gateway_([this](const cosmic::SegmentSpec& segment, const cosmic::GatewayIdentity& self,
+                        cosmic::Logger& log) { return adapters_.make(segment, self, log); },
+                 log_, random_gateway_id()),
         federation_(gateway_, log_, cosmic::make_dds_federation_link) {}
 
   int run() {
@@ -349,6 +355,7 @@ class Daemon {
   DaemonOptions options_;
   DaemonLogger log_;
   std::string state_file_;
+  AdapterFactory adapters_;        // before gateway_: the adapters' shared state outlives them
   bool state_file_usable_ = true;  // false: unusable at start and could not be set aside
   cosmic::Gateway gateway_;
   FederationMember federation_;  // after gateway_: it uses the gateway until it is destroyed

@@ -261,8 +261,8 @@ TEST_F(DdsSecurityConfig, AdmissionCountsWhatSecurityAddsToEachSample) {
 // gateway.federation.peers on a secure federation segment: each subject read in either form and
 // normalised, with its participant keys; a malformed one refused where it stands.
 TEST_F(DdsSecurityConfig, FederationPeersAreReadAsSubjectsOnASecureSegment) {
-  const ConfigResult result =
-      load({}, {}, "gateway:\n  federation: {segment: lan, peers: ['CN=gateway-b,O=cosmic', /O=cosmic/CN=gateway-c]}\n");
+  const ConfigResult result = load(
+      {}, {}, "gateway:\n  federation: {segment: lan, peers: ['CN=gateway-b,O=cosmic', /O=cosmic/CN=gateway-c]}\n");
   ASSERT_TRUE(result.errors.empty()) << result.errors.front().to_string();
   const auto& peers = result.config.gateway.federation.peers;
   ASSERT_EQ(peers.size(), 2u);

@@ -195,6 +195,31 @@ TEST_F(SecocConfig, TheCalibratedCostIsPartOfTheHopsLatency) {
   EXPECT_NE(render_channel_text(r).find("+4 B 3 ms"), std::string::npos) << render_channel_text(r);
 }
 
+// CAN to CAN with SecOC on both hops: verifying after the publisher hop and protecting before the
+// subscriber hop each count once, end to end, and protecting delays the frame's release (its jitter).
+TEST_F(SecocConfig, BothCostsCountOnceEndToEnd) {
+  const auto both = [&](const std::string& in, const std::string& out) {
+    const std::string text =
+        "segments:\n"
+        "  - {name: bus, type: can, interface: vcan0, bitrate: 500kbit/s}\n"
+        "  - {name: other, type: can, interface: vcan1, bitrate: 500kbit/s}\n"
+        "channels:\n"
+        "  - {name: brake, subject: 0x10, class: srt, period: 10ms, reaction_time: 40ms, payload: 4B,\n"
+        "     publishers: [bus], subscribers: [other],\n"
+        "     secoc: {bus: {key_file: body.key" +
+        in + "}, other: {key_file: body.key" + out + "}}}\n";
+    const ConfigResult result = parse_config(text, (dir_ / "gateway.yaml").string());
+    EXPECT_TRUE(result.errors.empty()) << result.errors.front().to_string();
+    return evaluate_first(result);
+  };
+  const ChannelReport plain = both("", "");
+  const ChannelReport costed = both(", cost: 1ms", ", cost: 2ms");
+  ASSERT_TRUE(plain.end_to_end.latency && costed.end_to_end.latency);
+  EXPECT_EQ(*costed.end_to_end.latency - *plain.end_to_end.latency, std::chrono::milliseconds(3));
+  EXPECT_EQ(hop(costed, "other").can->jitter - hop(plain, "other").can->jitter, std::chrono::milliseconds(1 + 2))
+      << "the subscriber frame is released after the publisher hop's check and its own protection";
+}
+
 TEST_F(SecocConfig, ARuntimeBindingKeepsItsSecocEntryButNeverTheKey) {
   const ConfigResult result = load("{bus: {key_file: body.key, data_id: 7, cost: 1ms}}");
   ASSERT_TRUE(result.errors.empty()) << result.errors.front().to_string();

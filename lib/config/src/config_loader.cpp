@@ -410,13 +410,9 @@ class ConfigParser {
     auto channel = parse_channel(node, path);
     if (!channel) return;
     if (!check_unique(node, path, *channel)) return;
-    if (node["native"]) {
-      native_.add(reader_, node["native"], key(path, "native"), *channel,
-                  derive_bindings_ && !(node["publishers"] && node["subscribers"]));
-    }
-    if (node["secoc"])
-      secoc_.add(reader_, node["secoc"], key(path, "secoc"), *channel,
-                 derive_bindings_ && !(node["publishers"] && node["subscribers"]));
+    const bool derived = derive_bindings_ && !(node["publishers"] && node["subscribers"]);
+    if (node["native"]) native_.add(reader_, node["native"], key(path, "native"), *channel, derived);
+    if (node["secoc"]) secoc_.add(reader_, node["secoc"], key(path, "secoc"), *channel, derived);
     typed_.add(node, path, *channel);
     config_.channels.push_back(std::move(*channel));
   }

@@ -305,8 +305,10 @@ bool AdmissionSet::update_jitters(CanSide& side, const Trial* newcomer) const {
         }
         upstream = upstream && latency ? std::optional<Nanos>(std::max(*upstream, *latency)) : std::nullopt;
       }
+      // SecOC protects the frame before it is released: its cost is part of the release jitter.
+      const Nanos protect = can_hop_security_cost(segment_specs_[s], *m.spec);
       const Nanos jitter =
-          upstream ? std::min(kUnboundedJitter, *upstream + gateway_.residence_bound) : kUnboundedJitter;
+          upstream ? std::min(kUnboundedJitter, *upstream + gateway_.residence_bound + protect) : kUnboundedJitter;
       CanHopPlan& plan = side.plans[s][pos];
       if (plan.jitter == jitter) continue;
       plan.jitter = jitter;
@@ -385,9 +387,10 @@ ChannelReport AdmissionSet::report_of(const ChannelSpec& spec, const ChannelData
     if (segment.type == SegmentType::can) {
       CanHopPlan plan = can ? can->plans[p.segment][p.position] : segments_[p.segment].plans[p.position];
       if (diverged && p.role == HopRole::subscriber) plan.response_time = std::nullopt;
-      // SecOC's cryptography: checking a received frame, or protecting one before its release.
+      // SecOC's cryptography: checking a received frame after it; protecting one is in the release
+      // jitter, and so in the response time, of a subscriber hop.
       h.latency = plan.response_time;
-      if (h.latency) *h.latency += can_hop_security_cost(segment, spec);
+      if (h.latency && p.role == HopRole::publisher) *h.latency += can_hop_security_cost(segment, spec);
       h.background = background_delaying(segment, segments_[p.segment].background, spec, plan);
       h.can = plan;
     } else {

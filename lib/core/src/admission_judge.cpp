@@ -203,7 +203,9 @@ std::optional<Nanos> Judge::end_to_end_latency(const ChannelReport& report) cons
     Nanos& worst = h.role == HopRole::publisher ? worst_publisher : worst_subscriber;
     // A subscriber-side CAN response time already contains its release jitter (upstream
     // latency + residence): count only what the hop adds after the gateway releases the frame.
-    const Nanos added = h.can && h.role == HopRole::subscriber ? *h.latency - h.can->jitter : *h.latency;
+    // SecOC's protection is in that jitter but happens after the gateway's residence: it counts.
+    const Nanos protect = h.can && h.security && h.security->time ? *h.security->time : Nanos(0);
+    const Nanos added = h.can && h.role == HopRole::subscriber ? *h.latency - (h.can->jitter - protect) : *h.latency;
     worst = std::max(worst, added);
   }
   return worst_publisher + gateway_.residence_bound + worst_subscriber;

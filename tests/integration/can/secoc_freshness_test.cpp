@@ -100,39 +100,72 @@ TEST_F(SecocFreshnessTest, WhatASenderProtectsVerifiesAndCanFdPadsTheDataToThePa
   EXPECT_EQ(rx->verify(0x123, frame, 4, true).status, SecocStatus::replayed);
 }
 
-TEST_F(SecocFreshnessTest, ASenderUsesOnlyPersistedValuesAndARestartContinuesPastThem) {
-  const SecocSpec spec = spec_with();  // 8 bits: leases of 128
-  std::uint64_t lease = 0;
+// The sender's freshness value `fresh` as a receiver that accepted `last` reads it (0: not authentic).
+std::uint64_t read_by(const SecocSpec& spec, std::uint32_t data_id, std::uint64_t last,
+                      std::span<const std::uint8_t> frame) {
+  SecocReceiver receiver = receiver_for(spec, data_id, last);
+  const SecocReading reading = receiver.verify(frame);
+  return reading.status == SecocStatus::authentic ? reading.freshness : 0;
+}
+
+TEST_F(SecocFreshnessTest, ASenderUsesOnlyPersistedValuesAndACleanRestartContinuesWhereItStopped) {
+  const SecocSpec spec = spec_with();  // 8 bits: leases of 128, a start's first lease 8
+  const std::array<std::uint8_t, 4> data{1, 2, 3, 4};
+  std::array<std::uint8_t, 8> out{};
+  {
+    SecocFreshness store(file_, "bus: ", "fv:bus", log_);
+    store.attach();
+    auto tx = store.sender("wheel", spec, 0x77).value();
+    EXPECT_EQ(tx->protect(data, 4, false, out), 0u) << "nothing is persisted yet: no value may be used";
+    ASSERT_TRUE(store.persist_now());
+    EXPECT_EQ(state()["senders"]["wheel/119"], 8u);
+    for (int i = 0; i < 8; ++i) ASSERT_EQ(tx->protect(data, 4, false, out), 8u) << i;
+    // The lane poked the store's thread at the first frame: a whole step beyond the last value used.
+    ASSERT_TRUE(eventually([&] { return tx->lease() > 8; })) << tx->lease();
+    EXPECT_GE(tx->lease(), 1u + 128u);
+    for (int i = 0; i < 100; ++i) {
+      ASSERT_TRUE(eventually([&] { return tx->protect(data, 4, false, out) == 8u; })) << i;
+      store.poke();
+    }
+    EXPECT_EQ(tx->last_used(), 108u);
+    EXPECT_GT(state()["senders"]["wheel/119"].get<std::uint64_t>(), 108u);
+    store.detach();  // a clean stop: the lease is cut back to the last value used
+    EXPECT_EQ(state()["senders"]["wheel/119"], 108u);
+    EXPECT_EQ(tx->protect(data, 4, false, out), 0u) << "a retired sender sends nothing";
+  }
+  SecocFreshness again(file_, "bus: ", "fv:bus", log_);
+  again.attach();
+  auto tx = again.sender("wheel", spec, 0x77).value();
+  ASSERT_TRUE(again.persist_now());
+  ASSERT_EQ(tx->protect(data, 4, false, out), 8u);
+  EXPECT_EQ(read_by(spec, 0x77, 108, out), 109u) << "a clean restart skips nothing";
+  again.detach();
+}
+
+TEST_F(SecocFreshnessTest, CrashesWithoutFramesInBetweenStayWithinAReceiversReach) {
+  const SecocSpec spec = spec_with();
+  const std::array<std::uint8_t, 4> data{1, 2, 3, 4};
+  std::array<std::uint8_t, 8> out{};
   {
     SecocFreshness store(file_, "bus: ", "fv:bus", log_);
     auto tx = store.sender("wheel", spec, 0x77).value();
-    std::array<std::uint8_t, 8> out{};
-    const std::array<std::uint8_t, 4> data{1, 2, 3, 4};
-    EXPECT_EQ(tx->protect(data, 4, false, out), 0u) << "nothing is persisted yet: no value may be used";
-    store.persist_now();
-    EXPECT_EQ(state()["senders"]["wheel/119"], 128u);
-    for (int i = 0; i < 100; ++i) ASSERT_EQ(tx->protect(data, 4, false, out), 8u) << i;
-    // Past half the lease: the lane poked the store's thread, which persisted a further one.
+    ASSERT_TRUE(store.persist_now());
+    for (int i = 0; i < 3; ++i) ASSERT_EQ(tx->protect(data, 4, false, out), 8u);
     store.poke();
-    ASSERT_TRUE(eventually([&] { return tx->lease() > 128; })) << tx->lease();
-    EXPECT_EQ(tx->lease(), 100u + 128u);
-    EXPECT_EQ(state()["senders"]["wheel/119"], 228u);
-    for (int i = 0; i < 10; ++i) ASSERT_EQ(tx->protect(data, 4, false, out), 8u);
-    store.stop();
-    lease = state()["senders"]["wheel/119"].get<std::uint64_t>();
-    EXPECT_GE(lease, 110u);
+    ASSERT_TRUE(eventually([&] { return tx->lease() > 8; }));
+  }                                           // a crash: no detach, the lease stays as persisted (3 + 128)
+  for (int start = 0; start < 10; ++start) {  // ten crashes in a row, no frame sent in between
+    SecocFreshness store(file_, "bus: ", "fv:bus", log_);
+    (void)store.sender("wheel", spec, 0x77).value();
+    ASSERT_TRUE(store.persist_now());
   }
-  SecocFreshness again(file_, "bus: ", "fv:bus", log_);
-  auto tx = again.sender("wheel", spec, 0x77).value();
-  again.persist_now();
-  std::array<std::uint8_t, 8> out{};
-  const std::array<std::uint8_t, 4> data{1, 2, 3, 4};
+  SecocFreshness last(file_, "bus: ", "fv:bus", log_);
+  auto tx = last.sender("wheel", spec, 0x77).value();
+  ASSERT_TRUE(last.persist_now());
   ASSERT_EQ(tx->protect(data, 4, false, out), 8u);
-  // The first value after the restart is lease + 1: past everything used, within an epoch.
-  SecocReceiver receiver = receiver_for(spec, 0x77, 110);
-  const SecocReading reading = receiver.verify(out);
-  EXPECT_EQ(reading.status, SecocStatus::authentic);
-  EXPECT_EQ(reading.freshness, lease + 1);
+  // The lease 131 after the first crash, 8 more for each of the ten starts that sent nothing: the
+  // next start sends 212, within the 255 a receiver that last took 3 can follow.
+  EXPECT_EQ(read_by(spec, 0x77, 3, out), 3u + 128u + 10u * 8u + 1u);
 }
 
 TEST_F(SecocFreshnessTest, ARestoredReceiverRefusesTheLastFrameItAccepted) {
@@ -143,13 +176,13 @@ TEST_F(SecocFreshnessTest, ARestoredReceiverRefusesTheLastFrameItAccepted) {
   const std::array<std::uint8_t, 4> data{9, 8, 7, 6};
   {
     SecocFreshness store(file_, "bus: ", "fv:bus", log_);
+    store.attach();
     auto rx = store.receiver("wheel", spec, false).value();
     for (int i = 0; i < 3; ++i) {
       ASSERT_EQ(tx->protect(data, 4, false, frame), 8u);
       ASSERT_EQ(rx->verify(0x123, frame, 4, false).status, SecocStatus::authentic);
     }
-    store.persist_now();
-    store.stop();
+    store.detach();
   }
   EXPECT_EQ(state()["receivers"]["wheel/291"], 3u);
   SecocFreshness again(file_, "bus: ", "fv:bus", log_);
@@ -160,52 +193,79 @@ TEST_F(SecocFreshnessTest, ARestoredReceiverRefusesTheLastFrameItAccepted) {
 }
 
 TEST_F(SecocFreshnessTest, ABrokenFileRefusesSecocAndIsLeftAsItIs) {
-  std::ofstream(file_) << "{\"version\": 1, \"senders\": {\"wheel/119\": -5}}";
-  SecocFreshness store(file_, "bus: ", "fv:bus", log_);
-  const auto tx = store.sender("wheel", spec_with(), 0x77);
-  ASSERT_FALSE(tx);
-  EXPECT_NE(tx.error().text.find("is not an unsigned number"), std::string::npos) << tx.error().text;
-  EXPECT_FALSE(store.receiver("wheel", spec_with(), false));
-  store.persist_now();
-  store.stop();
-  std::ifstream in(file_);
-  std::stringstream text;
-  text << in.rdbuf();
-  EXPECT_EQ(text.str(), "{\"version\": 1, \"senders\": {\"wheel/119\": -5}}");
+  for (const std::string broken : {"{\"version\": 1, \"senders\": {\"wheel/119\": -5}}", "{\"version\": \"1\"}", "[1]",
+                                   "{\"version\": 1, \"receivers\": 7}", "not json"}) {
+    std::ofstream(file_) << broken;
+    SecocFreshness store(file_, "bus: ", "fv:bus", log_);
+    store.attach();
+    const auto tx = store.sender("wheel", spec_with(), 0x77);
+    ASSERT_FALSE(tx) << broken;
+    EXPECT_NE(tx.error().text.find("SecOC is refused on this segment"), std::string::npos) << tx.error().text;
+    EXPECT_FALSE(store.receiver("wheel", spec_with(), false));
+    store.persist_now();
+    store.detach();
+    std::ifstream in(file_);
+    std::stringstream text;
+    text << in.rdbuf();
+    EXPECT_EQ(text.str(), broken);
+  }
 }
 
-TEST_F(SecocFreshnessTest, AChangedKeyKeepsTheCounterGoing) {
+TEST_F(SecocFreshnessTest, AChangedKeyRetiresTheOldSenderAndTheNewOneContinues) {
   SecocFreshness store("", "bus: ", "fv:bus", log_);
   SecocSpec spec = spec_with();
   auto tx = store.sender("wheel", spec, 0x77).value();
   std::array<std::uint8_t, 8> out{};
   const std::array<std::uint8_t, 4> data{1, 2, 3, 4};
   for (int i = 0; i < 5; ++i) ASSERT_EQ(tx->protect(data, 4, false, out), 8u);
-  EXPECT_EQ(store.sender("wheel", spec, 0x77).value(), tx) << "unchanged: the same state";
+  spec.cost = std::chrono::microseconds(30);
+  spec.key_file = "/elsewhere/the-same.key";
+  EXPECT_EQ(store.sender("wheel", spec, 0x77).value(), tx) << "the same MACs: the same state";
   spec.key = SecretKey(std::vector<std::uint8_t>(16, 0x42));
   auto changed = store.sender("wheel", spec, 0x77).value();
   EXPECT_NE(changed, tx);
   EXPECT_EQ(changed->last_used(), 5u);
+  EXPECT_EQ(tx->protect(data, 4, false, out), 0u) << "the old state never sends a value the new one will";
+  ASSERT_EQ(changed->protect(data, 4, false, out), 8u);
+  EXPECT_EQ(read_by(spec, 0x77, 5, out), 6u);
 }
 
-TEST_F(SecocFreshnessTest, ForgedSendersNeverEvictOneThatWasHeard) {
+TEST_F(SecocFreshnessTest, AdaptersThatShareTheStoreRetireItsSendersOnlyWhenTheLastLeaves) {
   const SecocSpec spec = spec_with();
+  SecocFreshness store(file_, "bus: ", "fv:bus", log_);
+  store.attach();  // the adapter of the running configuration
+  store.attach();  // its replacement, made by a reload
+  auto tx = store.sender("wheel", spec, 0x77).value();
+  ASSERT_TRUE(store.persist_now());
+  std::array<std::uint8_t, 8> out{};
+  const std::array<std::uint8_t, 4> data{1, 2, 3, 4};
+  ASSERT_EQ(tx->protect(data, 4, false, out), 8u);
+  store.detach();  // the old adapter stops: the replacement still sends
+  EXPECT_EQ(tx->protect(data, 4, false, out), 8u);
+  store.detach();
+  EXPECT_EQ(state()["senders"]["wheel/119"], 2u);
+}
+
+TEST_F(SecocFreshnessTest, WithAGivenDataIdEachSenderKeepsItsOwnFreshness) {
+  SecocSpec spec = spec_with();
+  spec.data_id = 0x1234;
   SecocFreshness store("", "bus: ", "fv:bus", log_);
   auto rx = store.receiver("brake", spec, true).value();
-  auto heard = store.sender("brake", spec, secoc_data_id(spec, 0x0C01E064 | CAN_EFF_FLAG, true)).value();
+  SecocFreshness node_a("", "a: ", "fv:a", log_);
+  SecocFreshness node_b("", "b: ", "fv:b", log_);
+  auto a = node_a.sender("brake", spec, 0x1234).value();
+  auto b = node_b.sender("brake", spec, 0x1234).value();
+  const canid_t from_a = (0x30u << 21) | (1u << 14) | 0x64 | CAN_EFF_FLAG;
+  const canid_t from_b = (0x30u << 21) | (2u << 14) | 0x64 | CAN_EFF_FLAG;
   std::array<std::uint8_t, 8> frame{};
-  const std::array<std::uint8_t, 4> data{1, 1, 1, 1};
-  ASSERT_EQ(heard->protect(data, 4, false, frame), 8u);
-  ASSERT_EQ(rx->verify(0x0C01E064 | CAN_EFF_FLAG, frame, 4, false).status, SecocStatus::authentic);
-  // 200 other TxNodes (with the same etag) send forgeries: more than the table holds.
-  const std::array<std::uint8_t, 8> forged{1, 1, 1, 1, 2, 0, 0, 0};
-  for (std::uint32_t node = 0; node < 200; ++node) {
-    const canid_t id = (0x30u << 21) | ((node & 0x7F) << 14) | (0x64 + (node >> 7)) | CAN_EFF_FLAG;
-    EXPECT_EQ(rx->verify(id, forged, 4, false).status, SecocStatus::unauthenticated);
+  const std::array<std::uint8_t, 4> data{5, 5, 5, 5};
+  for (int i = 0; i < 5; ++i) {
+    ASSERT_EQ(a->protect(data, 4, false, frame), 8u);
+    ASSERT_EQ(rx->verify(from_a, frame, 4, false).status, SecocStatus::authentic) << i;
   }
-  ASSERT_EQ(heard->protect(data, 4, false, frame), 8u);
-  EXPECT_EQ(rx->verify(0x0C01E064 | CAN_EFF_FLAG, frame, 4, false).status, SecocStatus::authentic);
-  EXPECT_EQ(rx->snapshot().size(), 1u);
+  ASSERT_EQ(b->protect(data, 4, false, frame), 8u);  // node b's first frame: freshness 1
+  EXPECT_EQ(rx->verify(from_b, frame, 4, false).status, SecocStatus::authentic);
+  EXPECT_EQ(rx->snapshot().size(), 2u);
 }
 
 TEST(SecocDataId, TheLayoutLeavesThePriorityOutANativeIdentifierIsWhole) {
@@ -218,6 +278,8 @@ TEST(SecocDataId, TheLayoutLeavesThePriorityOutANativeIdentifierIsWhole) {
   EXPECT_EQ(secoc_lease_step(8), 128u);
   EXPECT_EQ(secoc_lease_step(16), 32768u);
   EXPECT_EQ(secoc_lease_step(64), 65536u);
+  EXPECT_EQ(secoc_start_step(8), 8u);
+  EXPECT_EQ(secoc_source((0x30u << 21) | (3u << 14) | 0x3FFE | CAN_EFF_FLAG, true), (3u << 14) | 0x3FFE);
 }
 
 }  // namespace

@@ -14,6 +14,7 @@ Status CanAdapter::start(EventSink& sink) {
   ctl_fd_ = ctl.value();
   sink_ = &sink;
   started_ = true;
+  secoc_freshness_->attach();
   check_link();  // opens the socket now when the interface is there: health is right at once
   ThreadPolicy policy = sink.receive_thread_policy();
   policy.name = "rx:" + segment_.name;
@@ -23,6 +24,7 @@ Status CanAdapter::start(EventSink& sink) {
     ctl_fd_ = -1;
     sink_ = nullptr;
     started_ = false;
+    secoc_freshness_->detach();
     return Status::failure(running.error().text);
   }
   return Status::success();
@@ -32,7 +34,7 @@ void CanAdapter::stop() {
   if (!started_) return;
   receiver_.stop();
   close_socket();
-  secoc_freshness_.stop();  // the lanes have stopped sending: the last values persist
+  secoc_freshness_->detach();  // the lanes have stopped sending: the last values persist
   {
     PiLock lock(io_mutex_);
     table_ = std::make_shared<Table>();  // stop() forgets the bindings (SegmentAdapter's lifecycle)
@@ -67,8 +69,6 @@ Status CanAdapter::configure(std::span<const ChannelBinding> bindings) {
   BindingPlan plan(bindings);
   std::shared_ptr<Table> table = plan_table(plan);
   Status status = plan.status();
-  // The leases of new SecOC senders, persisted before their first frame (file I/O: outside io_mutex_).
-  secoc_freshness_.persist_now();
   {
     PiLock lock(io_mutex_);
     if (sock_ >= 0 && ::setsockopt(sock_, SOL_CAN_RAW, CAN_RAW_FILTER, table->filters.data(),
@@ -304,7 +304,12 @@ namespace cosmic {
 std::unique_ptr<SegmentAdapter> make_can_adapter(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log,
                                                  CanAdapterOptions options) {
   (void)self;  // CAN frames carry no envelope: the gateway is known by its TxNode
-  return std::make_unique<can_detail::CanAdapter>(segment, log, std::move(options.secoc_state_file));
+  return std::make_unique<can_detail::CanAdapter>(segment, log, std::move(options.secoc));
+}
+
+CanSecocState make_can_secoc_state(std::string file, const std::string& segment, Logger& log) {
+  return std::make_shared<can_detail::SecocFreshness>(std::move(file), segment_log_prefix(SegmentType::can, segment),
+                                                      "fv:" + segment, log);
 }
 
 }  // namespace cosmic

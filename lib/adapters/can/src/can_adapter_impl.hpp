@@ -118,7 +118,7 @@ using TxSocketRef = std::shared_ptr<const TxSocket>;
 
 class CanAdapter final : public SegmentAdapter {
  public:
-  CanAdapter(const SegmentSpec& segment, Logger& log, std::string secoc_state_file)
+  CanAdapter(const SegmentSpec& segment, Logger& log, CanSecocState secoc)
       : segment_(segment),
         log_(log),
         prefix_(segment_log_prefix(SegmentType::can, segment.name)),
@@ -133,7 +133,8 @@ class CanAdapter final : public SegmentAdapter {
                                                         : std::nullopt),
         table_(std::make_shared<const Table>()),
         answers_(answer_gap(segment.can)),
-        secoc_freshness_(std::move(secoc_state_file), prefix_, "fv:" + segment.name, log) {}
+        secoc_freshness_(secoc ? std::move(secoc)
+                               : std::make_shared<SecocFreshness>(std::string(), prefix_, "fv:" + segment.name, log)) {}
 
   ~CanAdapter() override { stop(); }
 
@@ -328,8 +329,8 @@ class CanAdapter final : public SegmentAdapter {
   can_census::BusCensus census_;
 
   // SecOC (secoc_freshness.hpp): the counters of the hops' senders and receivers, persisted.
-  SecocFreshness secoc_freshness_;
-  std::atomic<bool> secoc_bound_{false};  // a SecOC hop was bound: statistics show its counters
+  const std::shared_ptr<SecocFreshness> secoc_freshness_;  // never null; attached while started
+  std::atomic<bool> secoc_bound_{false};                   // a SecOC hop was bound: statistics show its counters
   std::atomic<std::uint64_t> secoc_unauthenticated_{0};
   std::atomic<std::uint64_t> secoc_replayed_{0};
 };

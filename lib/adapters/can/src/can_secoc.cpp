@@ -16,12 +16,16 @@ Result<CanAdapter::SecocStreams> CanAdapter::bind_secoc(const ChannelBinding& b,
   const bool layout = !b.can->native;
   SecocStreams streams;
   if (b.role == HopRole::subscriber) {
-    auto tx = secoc_freshness_.sender(b.spec.name, *spec, secoc_data_id(*spec, identifier, layout));
+    auto tx = secoc_freshness_->sender(b.spec.name, *spec, secoc_data_id(*spec, identifier, layout));
     if (!tx) return Error{"SecOC: " + tx.error().text};
+    // Its lease persisted before its first frame (file I/O on the control thread, no lock held).
+    if (!secoc_freshness_->persist_now())
+      return Error{"SecOC: the freshness counter cannot be persisted: " + secoc_freshness_->last_error()};
     streams.tx = tx.value();
   } else {
-    auto rx = secoc_freshness_.receiver(b.spec.name, *spec, layout);
+    auto rx = secoc_freshness_->receiver(b.spec.name, *spec, layout);
     if (!rx) return Error{"SecOC: " + rx.error().text};
+    secoc_freshness_->persist_now();  // starts the thread that keeps the receivers' values
     streams.rx = rx.value();
   }
   secoc_bound_.store(true, std::memory_order_relaxed);
@@ -32,7 +36,7 @@ std::span<const std::uint8_t> CanAdapter::secure(const CanTxBinding& binding, st
                                                  std::span<std::uint8_t> out) {
   if (!binding.secoc) return payload;
   const std::size_t size = binding.secoc->protect(payload, binding.payload, segment_.can.fd, out);
-  if (binding.secoc->lease_due()) secoc_freshness_.poke();
+  if (binding.secoc->lease_due()) secoc_freshness_->poke();
   if (size == 0) {
     counters_.send_errors.fetch_add(1, std::memory_order_relaxed);
     return {};

@@ -22,8 +22,16 @@ SecocParameters parameters_of(const SecocSpec& spec, std::uint32_t data_id) {
 
 std::uint32_t secoc_data_id(const SecocSpec& spec, canid_t can_id, bool layout) {
   if (spec.data_id) return *spec.data_id;
+  return secoc_source(can_id, layout);
+}
+
+std::uint32_t secoc_source(canid_t can_id, bool layout) {
   if (layout) return can_id & kLayoutSenderBits;
   return can_id & ((can_id & CAN_EFF_FLAG) ? CAN_EFF_MASK : CAN_SFF_MASK);
+}
+
+std::uint64_t secoc_start_step(std::uint32_t freshness_bits) {
+  return std::max<std::uint64_t>(1, secoc_lease_step(freshness_bits) / 16);
 }
 
 std::uint64_t secoc_lease_step(std::uint32_t freshness_bits) {
@@ -53,6 +61,18 @@ SecocTx::SecocTx(const SecocSpec& spec, std::uint32_t data_id, SecocSender sende
       last_used_(sender_.freshness()),
       lease_(persisted) {}
 
+void SecocTx::persisted(std::uint64_t value) noexcept {
+  std::uint64_t current = lease_.load(std::memory_order_acquire);
+  while (value > current && !lease_.compare_exchange_weak(current, value, std::memory_order_acq_rel)) {
+  }
+}
+
+std::uint64_t SecocTx::retire() noexcept {
+  PiLock lock(mutex_);
+  lease_.store(sender_.freshness(), std::memory_order_release);
+  return sender_.freshness();
+}
+
 bool SecocTx::lease_due() const noexcept {
   const std::uint64_t lease = lease_.load(std::memory_order_acquire);
   const std::uint64_t used = last_used_.load(std::memory_order_acquire);
@@ -70,7 +90,10 @@ std::size_t SecocTx::protect(std::span<const std::uint8_t> data, std::size_t pay
   // Never a value beyond what a restart would start past.
   if (sender_.freshness() >= lease_.load(std::memory_order_acquire)) return 0;
   const std::size_t size = sender_.protect(std::span<const std::uint8_t>(out.data(), data_size), out);
-  if (size != 0) last_used_.store(sender_.freshness(), std::memory_order_release);
+  if (size != 0) {
+    last_used_.store(sender_.freshness(), std::memory_order_release);
+    sent_.store(true, std::memory_order_release);
+  }
   return size;
 }
 
@@ -79,8 +102,8 @@ std::size_t SecocTx::protect(std::span<const std::uint8_t> data, std::size_t pay
 SecocRx::SecocRx(const SecocSpec& spec, bool layout, std::map<std::uint32_t, std::uint64_t> restored)
     : spec_(spec), layout_(layout), restored_(std::move(restored)) {}
 
-SecocReceiver* SecocRx::receiver_of(std::uint32_t data_id) {
-  if (const auto it = receivers_.find(data_id); it != receivers_.end()) return &it->second;
+SecocReceiver* SecocRx::receiver_of(std::uint32_t source, std::uint32_t data_id) {
+  if (const auto it = receivers_.find(source); it != receivers_.end()) return &it->second;
   if (receivers_.size() >= kMaxSources) {
     // Make room from a sender never heard authentic (a forger's identifier), never from one that was.
     const auto unheard =
@@ -89,11 +112,11 @@ SecocReceiver* SecocRx::receiver_of(std::uint32_t data_id) {
     if (unheard == receivers_.end()) return nullptr;
     receivers_.erase(unheard);
   }
-  const auto known = restored_.find(data_id);
+  const auto known = restored_.find(source);
   Result<SecocReceiver> made = SecocReceiver::make(spec_.key.bytes(), parameters_of(spec_, data_id),
                                                    known == restored_.end() ? 0 : known->second);
   if (!made) return nullptr;
-  return &receivers_.emplace(data_id, std::move(made).value()).first->second;
+  return &receivers_.emplace(source, std::move(made).value()).first->second;
 }
 
 SecocCheck SecocRx::verify(canid_t can_id, std::span<const std::uint8_t> data, std::size_t payload, bool fd) noexcept {
@@ -106,13 +129,13 @@ SecocCheck SecocRx::verify(canid_t can_id, std::span<const std::uint8_t> data, s
   }
   if (data.size() < overhead) return {};
   try {
-    const std::uint32_t data_id = secoc_data_id(spec_, can_id, layout_);
+    const std::uint32_t source = secoc_source(can_id, layout_);
     PiLock lock(mutex_);
-    SecocReceiver* receiver = receiver_of(data_id);
+    SecocReceiver* receiver = receiver_of(source, secoc_data_id(spec_, can_id, layout_));
     if (receiver == nullptr) return {};
     const SecocReading reading = receiver->verify(data);
     if (reading.status != SecocStatus::authentic) return SecocCheck{reading.status, {}};
-    restored_[data_id] = reading.freshness;  // heard: kept, and what the store persists
+    restored_[source] = reading.freshness;  // heard: kept, and what the store persists
     return SecocCheck{SecocStatus::authentic, data.first(reading.authentic_size)};
   } catch (...) {  // a receiver's first frame allocates; out of memory reads as not authentic
     return {};

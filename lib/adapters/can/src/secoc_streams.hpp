@@ -44,6 +44,13 @@ std::uint32_t secoc_data_id(const SecocSpec& spec, canid_t can_id, bool layout);
 // How far a sender's freshness may run ahead of what is persisted: half an epoch of the
 // truncated value, at most 2^16 (see above).
 std::uint64_t secoc_lease_step(std::uint32_t freshness_bits);
+// The first lease after a start, before the sender sent anything: a sixteenth of the step (8 with
+// 8-bit freshness), so starts that send nothing (a crash loop) move the counter little.
+std::uint64_t secoc_start_step(std::uint32_t freshness_bits);
+
+// Who sent a frame, as a receiver keeps its freshness apart: the native identifier, or in this
+// project's layout the TxNode and etag (whatever data ID the MAC uses).
+std::uint32_t secoc_source(canid_t can_id, bool layout);
 
 // Secured PDU size of `data_size` bytes of data on a hop whose events are at most `payload`
 // bytes: on CAN FD the data is padded to `payload` (see above).
@@ -68,9 +75,14 @@ class SecocTx {
   std::uint64_t last_used() const noexcept { return last_used_.load(std::memory_order_acquire); }
   // Whether the store should persist a new lease now (used past half of it). Any thread.
   bool lease_due() const noexcept;
-  // The store persisted `value`: the sender may use values up to it. Store thread.
-  void persisted(std::uint64_t value) noexcept { lease_.store(value, std::memory_order_release); }
+  // Whether a frame was protected since this state was made (the next lease is a whole step).
+  bool sent() const noexcept { return sent_.load(std::memory_order_acquire); }
+  // The store persisted `value`: the sender may use values up to it (never lowered). Store thread.
+  void persisted(std::uint64_t value) noexcept;
   std::uint64_t lease() const noexcept { return lease_.load(std::memory_order_acquire); }
+  // No further frame: the lease is cut back to the last used value, which is returned (a clean
+  // stop persists it; a state that replaces this one continues from it). Any thread.
+  std::uint64_t retire() noexcept;
 
  private:
   SecocTx(const SecocSpec& spec, std::uint32_t data_id, SecocSender sender, std::uint64_t persisted);
@@ -82,6 +94,7 @@ class SecocTx {
   SecocSender sender_ COSMIC_GUARDED_BY(mutex_);
   std::atomic<std::uint64_t> last_used_;
   std::atomic<std::uint64_t> lease_;
+  std::atomic<bool> sent_{false};
 };
 
 // What the receive thread does with one frame of a SecOC hop.
@@ -90,26 +103,27 @@ struct SecocCheck {
   std::span<const std::uint8_t> data;  // the authentic data (status authentic)
 };
 
-// One channel's receiving state on the segment: a receiver per sender (data ID), made when its
-// first authentic frame arrives (or restored by the store), at most kMaxSources.
+// One channel's receiving state on the segment: a receiver per sender (secoc_source), made when its
+// first frame arrives (or restored by the store), at most kMaxSources; one never heard authentic
+// makes room for another.
 class SecocRx {
  public:
   static constexpr std::size_t kMaxSources = 128;  // a TxNode has 7 bits
 
-  // `restored`: the last accepted freshness value per data ID, as the store kept it.
+  // `restored`: the last accepted freshness value per sender, as the store kept it.
   SecocRx(const SecocSpec& spec, bool layout, std::map<std::uint32_t, std::uint64_t> restored);
 
   // Checks the frame `data` (cut to the frame's length) of identifier `can_id` on a hop whose
   // events are at most `payload` bytes. Receive thread.
   SecocCheck verify(canid_t can_id, std::span<const std::uint8_t> data, std::size_t payload, bool fd) noexcept;
 
-  // The last accepted freshness value per data ID. Store thread.
+  // The last accepted freshness value per sender. Store thread.
   std::map<std::uint32_t, std::uint64_t> snapshot() const;
   const SecocSpec& spec() const noexcept { return spec_; }
   bool layout() const noexcept { return layout_; }
 
  private:
-  SecocReceiver* receiver_of(std::uint32_t data_id) COSMIC_REQUIRES(mutex_);
+  SecocReceiver* receiver_of(std::uint32_t source, std::uint32_t data_id) COSMIC_REQUIRES(mutex_);
 
   const SecocSpec spec_;
   const bool layout_;      // the channel's frames are in this project's layout (else a native identifier)

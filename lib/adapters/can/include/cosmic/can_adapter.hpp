@@ -14,10 +14,18 @@
 
 namespace cosmic {
 
+namespace can_detail {
+class SecocFreshness;
+}
+// The SecOC freshness counters of one CAN segment's channels (docs/security.md), persisted in
+// `file` across restarts. One per segment for the life of the process: the adapters that attach
+// the segment in turn (a reload that replaces the adapter) share it, so no counter is used twice.
+using CanSecocState = std::shared_ptr<can_detail::SecocFreshness>;
+CanSecocState make_can_secoc_state(std::string file, const std::string& segment, Logger& log);
+
 struct CanAdapterOptions {
-  // Where the SecOC freshness counters of the segment's channels persist across restarts
-  // (docs/security.md); empty: not persisted (tests), and senders are not held to a lease.
-  std::string secoc_state_file;
+  // Null: the adapter keeps its own, not persisted (tests), and senders are not held to a lease.
+  CanSecocState secoc;
 };
 
 // Never null. start() succeeds even when the interface is down or missing (health says so).
