@@ -8,7 +8,8 @@
 #   1. a Cyclone participant authenticated as gateway-a exchanges a channel with cosmicd both ways:
 #      its samples reach the plain domain through cosmicd, the plain domain's reach it, exactly;
 #   2. a Cyclone participant without security publishing the same topic on the secure domain reaches
-#      nothing: cosmicd takes none of its samples while it takes the authenticated peer's;
+#      nothing: cosmicd takes none of its samples while it takes the authenticated peer's, and counts
+#      it as unauthenticated (cosmicctl segments --json: the segment's adapter.unauthenticated);
 #   3. monitor, authenticated but granted no topic to publish, cannot publish: Cyclone's own access
 #      control refuses its writer (DDS_RETCODE_NOT_ALLOWED_BY_SECURITY), and it still receives.
 # Fast DDS 2.9 and Cyclone 0.10 complete a PKI-DH handshake only when Cyclone starts it, that is when
@@ -188,6 +189,8 @@ grep -q "^PEER $COSMICD_PREFIX" "$WORK/secure-writer.err" ||
   fail "cosmicd's GUID is not the one derived from gateway-b's subject ($COSMICD_PREFIX): $(grep PEER "$WORK/secure-writer.err")"
 # The outsider: Cyclone without security, the same topic on the secure domain, 12-byte payloads
 # (the authenticated writer's are 16), writing before, during and after the authenticated writer.
+# cosmicd counts each participant it refused once (a restarted stalled peer may have been one).
+refused_before=$(segment_adapter_field gw secure unauthenticated)
 "$CYCLONE_PEER" pub --domain "$SECURE" --topic cosmic/obstacle --count 150 --size 12 --period-ms 20 --await-match no \
   </dev/null 2>"$WORK/outsider.err" &
 outsider=$!
@@ -199,13 +202,17 @@ wait "$plain_reader" || fail "the plain reader failed: $(cat "$WORK/plain-reader
 check_exact "$WORK/plain-reader.out" 20 16 || fail "the plain reader did not get exactly gateway-a's 20 events"
 passed
 
-scenario "an outsider without security on the secure domain: none of its samples is taken or forwarded"
+scenario "an outsider without security on the secure domain: none of its samples is taken or forwarded, it is counted"
 wait "$outsider" || fail "the outsider failed: $(cat "$WORK/outsider.err")"
 # It heard cosmicd's participant (announced in the clear): it was on the same wire all along.
 grep -q "^PEER $COSMICD_PREFIX" "$WORK/outsider.err" || fail "the outsider never discovered cosmicd: $(cat "$WORK/outsider.err")"
 wait_until 10 "cosmicd's counters settle" settled gw
 expect_field gw obstacle secure rx 20
 expect_field gw obstacle plain tx 20
+wait_until 10 "cosmicd counted the outsider as unauthenticated" segment_field_at_least gw secure unauthenticated $((refused_before + 1))
+refused=$(segment_adapter_field gw secure unauthenticated)
+[ "$refused" -eq $((refused_before + 1)) ] ||
+  fail "cosmicd counted $((refused - refused_before)) unauthenticated participants for the one outsider"
 passed
 
 # --- 1. plain -> secure
