@@ -10,30 +10,8 @@
 #   scripts/can-vm -- bash tests/integration/can/federation_can_test.sh COSMICD COSMICCTL
 set -uo pipefail
 COSMICD=$1 COSMICCTL=$2
-if [ "$(id -u)" -ne 0 ] || ! ip link show vcan0 >/dev/null 2>&1; then
-  echo "federation_can: needs root and vcan0: run it through scripts/can-vm" >&2
-  exit 64
-fi
-python=/usr/bin/python3
-[ -x "$python" ] || python=$(command -v python3)
-WORK=$(mktemp -d /tmp/cosmic-fedcan.XXXXXX)
-PIDS=()
-FAILED=0
-cleanup() {
-  for pid in "${PIDS[@]}"; do kill "$pid" 2>/dev/null || true; done
-  for pid in "${PIDS[@]}"; do wait "$pid" 2>/dev/null || true; done
-}
-trap 'cleanup; [ -n "${KEEP_WORK:-}" ] || rm -rf "$WORK"' EXIT
-log() { printf '%s\n' "$*" >&2; }
-fail() { log "FAIL: $*"; FAILED=1; }
-wait_until() { # wait_until TIMEOUT_S WHAT CMD...
-  local deadline=$((SECONDS + $1)) what=$2
-  shift 2
-  until "$@" >/dev/null 2>&1; do
-    [ "$SECONDS" -ge "$deadline" ] && { fail "timed out waiting for: $what"; return 1; }
-    sleep 0.1
-  done
-}
+. "$(dirname "${BASH_SOURCE[0]}")/vm_test_lib.sh"
+vm_test_begin fedcan vcan0
 ctl() { local name=$1; shift; "$COSMICCTL" --socket "$WORK/$name.sock" "$@"; }
 
 # 500 kbit/s: an 8-byte extended frame takes at most 320 us, a 1-byte one 180 us. gw1 sends `steer`

@@ -13,30 +13,8 @@
 #   scripts/can-vm -- bash tests/integration/can/secoc_test.sh COSMICD COSMICCTL
 set -uo pipefail
 COSMICD=$1 COSMICCTL=$2
-if [ "$(id -u)" -ne 0 ] || ! ip link show vcan1 >/dev/null 2>&1; then
-  echo "secoc_test: needs root, vcan0 and vcan1: run it through scripts/can-vm" >&2
-  exit 64
-fi
-python=/usr/bin/python3
-[ -x "$python" ] || python=$(command -v python3)
-WORK=$(mktemp -d /tmp/cosmic-secoc.XXXXXX)
-PIDS=()
-FAILED=0
-cleanup() {
-  for pid in "${PIDS[@]}"; do kill "$pid" 2>/dev/null || true; done
-  for pid in "${PIDS[@]}"; do wait "$pid" 2>/dev/null || true; done
-}
-trap 'cleanup; [ -n "${KEEP_WORK:-}" ] || rm -rf "$WORK"' EXIT
-log() { printf '%s\n' "$*" >&2; }
-fail() { log "FAIL: $*"; FAILED=1; }
-wait_until() { # wait_until TIMEOUT_S WHAT CMD...
-  local deadline=$((SECONDS + $1)) what=$2
-  shift 2
-  until "$@" >/dev/null 2>&1; do
-    [ "$SECONDS" -ge "$deadline" ] && { fail "timed out waiting for: $what"; return 1; }
-    sleep 0.1
-  done
-}
+. "$(dirname "${BASH_SOURCE[0]}")/vm_test_lib.sh"
+vm_test_begin secoc vcan1
 ctl() { "$COSMICCTL" --socket "$WORK/gw.sock" "$@"; }
 
 KEY=2b7e151628aed2a6abf7158809cf4f3c  # RFC 4493's example key
