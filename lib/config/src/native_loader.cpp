@@ -298,22 +298,26 @@ void parse_native(YamlReader& reader, const YAML::Node& node, const std::string&
   }
 }
 
+void check_hop_segment(YamlReader& reader, const YAML::Node& node, const std::string& path, const ChannelSpec& channel,
+                       const std::string& segment, const std::string& valid) {
+  const bool used = std::count(channel.publishers.begin(), channel.publishers.end(), segment) +
+                        std::count(channel.subscribers.begin(), channel.subscribers.end(), segment) >
+                    0;
+  if (used) return;
+  YAML::Node where = node;
+  for (const auto& entry : node) {
+    if (entry.first.Scalar() == segment) where = entry.first;
+  }
+  reader.error_at(where, key(path, segment),
+                  "segment '" + segment + "' is neither a publisher nor a subscriber of channel " + channel.name,
+                  valid);
+}
+
 void check_native_segments(YamlReader& reader, const YAML::Node& node, const std::string& path,
                            const ChannelSpec& channel) {
-  for (const NativeBinding& binding : channel.native) {
-    const bool used = std::count(channel.publishers.begin(), channel.publishers.end(), binding.segment) +
-                          std::count(channel.subscribers.begin(), channel.subscribers.end(), binding.segment) >
-                      0;
-    if (used) continue;
-    YAML::Node where = node;
-    for (const auto& entry : node) {
-      if (entry.first.Scalar() == binding.segment) where = entry.first;
-    }
-    reader.error_at(
-        where, key(path, binding.segment),
-        "segment '" + binding.segment + "' is neither a publisher nor a subscriber of channel " + channel.name,
-        "a native identity on one of the channel's segments");
-  }
+  for (const NativeBinding& binding : channel.native)
+    check_hop_segment(reader, node, path, channel, binding.segment,
+                      "a native identity on one of the channel's segments");
 }
 
 void NativeDeclarations::add(YamlReader& reader, const YAML::Node& node, const std::string& path,

@@ -21,6 +21,11 @@ namespace cosmic::config_detail {
 void parse_native(YamlReader& reader, const YAML::Node& node, const std::string& path, const Config& config,
                   ChannelSpec& channel, std::vector<std::string>& included);
 
+// Reports `segment`, a key of the channel's map `node` (`native`, `secoc`), at that key when it is
+// neither a publisher nor a subscriber of `channel`; `valid` says what belongs there.
+void check_hop_segment(YamlReader& reader, const YAML::Node& node, const std::string& path, const ChannelSpec& channel,
+                       const std::string& segment, const std::string& valid);
+
 // Once the channel's publishers and subscribers are final (given or derived from components):
 // every native entry names one of them. `node` is the channel's `native` map.
 void check_native_segments(YamlReader& reader, const YAML::Node& node, const std::string& path,

@@ -1,9 +1,8 @@
 // A channel's `secoc` key (secoc_loader.hpp).
 #include "secoc_loader.hpp"
 
-#include <algorithm>
-
 #include "key_file_loader.hpp"
+#include "native_loader.hpp"
 
 namespace cosmic::config_detail {
 namespace {
@@ -71,19 +70,8 @@ std::optional<SecocSpec> parse_entry(YamlReader& reader, const YAML::Node& node,
 }
 
 void check_segments(YamlReader& reader, const YAML::Node& node, const std::string& path, const ChannelSpec& channel) {
-  for (const SecocSpec& spec : channel.secoc) {
-    const bool used = std::count(channel.publishers.begin(), channel.publishers.end(), spec.segment) +
-                          std::count(channel.subscribers.begin(), channel.subscribers.end(), spec.segment) >
-                      0;
-    if (used) continue;
-    YAML::Node where = node;
-    for (const auto& entry : node) {
-      if (entry.first.Scalar() == spec.segment) where = entry.first;
-    }
-    reader.error_at(where, key(path, spec.segment),
-                    "segment '" + spec.segment + "' is neither a publisher nor a subscriber of channel " + channel.name,
-                    "SecOC on one of the channel's CAN segments");
-  }
+  for (const SecocSpec& spec : channel.secoc)
+    check_hop_segment(reader, node, path, channel, spec.segment, "SecOC on one of the channel's CAN segments");
 }
 
 }  // namespace
