@@ -14,7 +14,7 @@ _cosmicctl_global_options="--help --json --socket --version"
 _cosmicctl_command_options() {
   case $1 in
     bind) echo "--replace --match-timeout" ;;
-    calibrate) echo "--seconds --rate" ;;
+    calibrate) echo "--seconds --rate --dds-samples" ;;
     diagram) echo "--format --detail" ;;
     echo) echo "--count --interval --timeout" ;;
     gen) echo "--component --output" ;;

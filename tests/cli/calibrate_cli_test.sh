@@ -108,6 +108,50 @@ run secoc_text 1 calibrate "$WORK/secoc.yaml" --seconds 0.3 --rate 500
 contains secoc_text out "brake@bus"
 contains secoc_text out "BELOW p99.9 (1 ns)"
 
+# 3c. A secure DDS segment (docs/security.md, "What it costs"): its governance's protection
+# (everything ENCRYPT in the test PKI) timed through Fast DDS's plugins with two participants of
+# cosmicctl's own on shared memory, compared with security.cost: 60 s covers, 1 ns does not.
+"$SRC/tests/support/make_test_pki.sh" "$WORK/pki" || fail "make_test_pki.sh"
+with_dds_security() {  # with_dds_security FILE COST
+  cat >"$1" <<YAML
+gateway: {residence_bound: 60s}
+segments:
+  - name: lan
+    type: dds
+    domain: 232
+    security: {identity_ca: pki/identity_ca.pem, certificate: pki/gateway-a_cert.pem,
+               private_key: pki/gateway-a_key.pem, permissions_ca: pki/permissions_ca.pem,
+               governance: pki/governance.p7s, permissions: pki/permissions.p7s, cost: $2}
+  - {name: viz, type: lcm, url: "udpm://239.255.76.67:7667?ttl=0"}
+channels:
+  - {name: obstacle, subject: 0x10, class: nrt, payload: 24B, publishers: [lan], subscribers: [viz]}
+YAML
+}
+with_dds_security "$WORK/dds_loose.yaml" 60s
+with_dds_security "$WORK/dds_tight.yaml" 1ns
+mkdir -p "$WORK/tmp"
+export TMPDIR="$WORK/tmp"  # where the throw-away PKI goes, and must be gone from afterwards
+run dds_json 0 calibrate "$WORK/dds_loose.yaml" --seconds 0.3 --rate 500 --dds-samples 300 --json
+python3 - "$WORK/dds_json.out" <<'PY' || fail "dds_json: the DDS Security figures"
+import json, sys
+d = json.load(open(sys.argv[1]))
+[a] = d["authentication"]
+assert a["segment"] == "lan" and a["channel"] is None and a["scheme"] == "DDS Security encrypt", a
+assert a["message_bytes"] == 24 and a["runs"] == 300 and a["lost"] == 0, a
+assert 0 <= a["p50_us"] <= a["p99_us"] <= a["p999_us"] <= a["max_us"], a
+for run in ("plain", "protected"):
+    r = a[run]
+    assert r["runs"] == 300 and 0 < r["p50_us"] <= r["p99_us"] <= r["p999_us"] <= r["max_us"], (run, r)
+assert a["protected_cpu_us_per_sample"] > 0 and a["plain_cpu_us_per_sample"] > 0, a
+assert a["configured_cost_us"] == 60e6 and a["cost_covers_p999"] is True, a
+PY
+run dds_tight 1 calibrate "$WORK/dds_tight.yaml" --seconds 0.3 --rate 500 --dds-samples 300
+contains dds_tight out "DDS Security encrypt: one-way p50"
+contains dds_tight err "warning: segment lan: security.cost 1 ns is below the p99.9 measured here"
+[ -z "$(ls -A "$WORK/tmp")" ] || fail "calibrate left its PKI behind: $(ls -A "$WORK/tmp")"
+unset TMPDIR
+run bad_dds_samples 64 calibrate "$WORK/dds_loose.yaml" --dds-samples 5
+
 # 4. Bad input: a usage error or a located configuration error, nothing measured.
 run bad_rate 64 calibrate --rate 0
 run bad_seconds 64 calibrate --seconds -1

@@ -281,3 +281,33 @@ TEST(DdsPermissions, AConfigurationWithoutSecureSegmentsOrWithoutAnIdentityIsRef
 
 }  // namespace
 }  // namespace cosmic
+
+namespace cosmic {
+namespace {
+
+// What `cosmicctl calibrate` times a secure segment with: the strongest kind the governance names.
+TEST(DdsPermissions, AGovernancesProtectionIsTheStrongestKindItNames) {
+  const std::vector<std::uint32_t> domains{0, 5};
+  for (const DdsProtection kind : {DdsProtection::encrypt, DdsProtection::sign, DdsProtection::none}) {
+    const auto read = governance_protection(governance_xml(domains, kind));
+    ASSERT_TRUE(read) << read.error().text;
+    EXPECT_EQ(read.value(), kind) << to_string(kind);
+  }
+  // Anywhere: a topic's ENCRYPT under a participant's SIGN, origin authentication, spaces, and a
+  // closing tag that looks like an opening one never count.
+  EXPECT_EQ(governance_protection("<rtps_protection_kind>SIGN</rtps_protection_kind>"
+                                  "<data_protection_kind> ENCRYPT_WITH_ORIGIN_AUTHENTICATION</data_protection_kind>")
+                .value(),
+            DdsProtection::encrypt);
+  EXPECT_EQ(governance_protection("<rtps_protection_kind>\n  SIGN_WITH_ORIGIN_AUTHENTICATION\n</rtps_protection_kind>")
+                .value(),
+            DdsProtection::sign);
+  EXPECT_EQ(governance_protection("<x>ENCRYPT</x><rtps_protection_kind>NONE</rtps_protection_kind>").value(),
+            DdsProtection::none);
+  const auto not_governance = governance_protection("<permissions><grant/></permissions>");
+  ASSERT_FALSE(not_governance);
+  EXPECT_EQ(not_governance.error().text, "names no protection kind: not a DDS Security governance document");
+}
+
+}  // namespace
+}  // namespace cosmic

@@ -20,7 +20,9 @@ Nanos percentile(const std::vector<Nanos>& sorted, double fraction) {
   return sorted[std::min(index, sorted.size() - 1)];
 }
 
-AuthTiming summary(std::size_t bytes, std::vector<Nanos>& samples) {
+}  // namespace
+
+AuthTiming timing_summary(std::size_t bytes, std::vector<Nanos>& samples) {
   AuthTiming out;
   out.message_bytes = bytes;
   if (samples.empty()) return out;
@@ -33,8 +35,6 @@ AuthTiming summary(std::size_t bytes, std::vector<Nanos>& samples) {
   return out;
 }
 
-}  // namespace
-
 AuthTiming time_secoc(std::size_t data_bytes, unsigned mac_bits, unsigned freshness_bits, std::size_t runs) {
   const std::vector<std::uint8_t> key(kSecocKeyBytes, 0x2b);
   SecocParameters parameters;
@@ -44,7 +44,7 @@ AuthTiming time_secoc(std::size_t data_bytes, unsigned mac_bits, unsigned freshn
   auto sender = SecocSender::make(key, parameters, 0);
   auto receiver = SecocReceiver::make(key, parameters, 0);
   std::vector<Nanos> samples;
-  if (!sender || !receiver) return summary(data_bytes, samples);
+  if (!sender || !receiver) return timing_summary(data_bytes, samples);
   std::vector<std::uint8_t> data(data_bytes, 0x5a);
   std::vector<std::uint8_t> frame(data_bytes + secoc_overhead_bytes(parameters));
   samples.reserve(runs);
@@ -56,7 +56,7 @@ AuthTiming time_secoc(std::size_t data_bytes, unsigned mac_bits, unsigned freshn
     receiver.value().verify(std::span(frame).first(size));
     samples.push_back(std::max(protecting, elapsed_since(start)));
   }
-  return summary(data_bytes, samples);
+  return timing_summary(data_bytes, samples);
 }
 
 AuthTiming time_lcm_auth(std::size_t message_bytes, std::size_t runs) {

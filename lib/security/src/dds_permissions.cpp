@@ -263,4 +263,25 @@ Result<DdsAccessDocuments> dds_access_documents(const Config& config, std::span<
   return out;
 }
 
+Result<DdsProtection> governance_protection(std::string_view governance) {
+  constexpr std::string_view kSuffix = "_protection_kind>";
+  bool named = false;
+  DdsProtection strongest = DdsProtection::none;
+  for (std::size_t at = governance.find(kSuffix); at != std::string_view::npos;
+       at = governance.find(kSuffix, at + kSuffix.size())) {
+    // An opening tag (`<rtps_protection_kind>`), not a closing one: its value follows it.
+    const std::size_t open = governance.rfind('<', at);
+    if (open == std::string_view::npos || governance.substr(open, 2) == "</") continue;
+    named = true;
+    std::size_t value = at + kSuffix.size();
+    while (value < governance.size() && std::string_view(" \t\r\n").find(governance[value]) != std::string_view::npos)
+      ++value;
+    const std::string_view kind = governance.substr(value);
+    if (kind.starts_with("ENCRYPT")) strongest = DdsProtection::encrypt;
+    if (kind.starts_with("SIGN") && strongest == DdsProtection::none) strongest = DdsProtection::sign;
+  }
+  if (!named) return Error{"names no protection kind: not a DDS Security governance document"};
+  return strongest;
+}
+
 }  // namespace cosmic

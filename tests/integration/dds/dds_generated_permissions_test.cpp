@@ -12,32 +12,13 @@
 #include <fstream>
 #include <sstream>
 
-#include <fastrtps/xmlparser/XMLProfileManager.h>
-
 #include "cosmic/dds_permissions.hpp"
+#include "cosmic/dds_security_timing.hpp"
 #include "cosmic/smime_sign.hpp"
 #include "dds_adapter_fixture.hpp"
 
 namespace cosmic::dds_test {
 namespace {
-
-// Fast DDS hands samples between participants of one process directly (intra-process delivery),
-// past the cryptography: while this lives, they go over the wire as between two hosts, protected as
-// the governance asks.
-class OverTheWire {
- public:
-  OverTheWire() : saved_(eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings()) {
-    auto settings = saved_;
-    settings.intraprocess_delivery = eprosima::fastrtps::INTRAPROCESS_OFF;
-    eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(settings);
-  }
-  ~OverTheWire() { eprosima::fastrtps::xmlparser::XMLProfileManager::library_settings(saved_); }
-  OverTheWire(const OverTheWire&) = delete;
-  OverTheWire& operator=(const OverTheWire&) = delete;
-
- private:
-  eprosima::fastrtps::LibrarySettingsAttributes saved_;
-};
 
 class DdsGeneratedPermissionsTest : public ::testing::Test {
  protected:
@@ -131,7 +112,7 @@ std::filesystem::path DdsGeneratedPermissionsTest::pki_;
 
 TEST_F(DdsGeneratedPermissionsTest, GatewaysExchangeTheirTablesChannelsBothWaysWithSignedMessages) {
   constexpr std::uint32_t kDomain = 63;
-  const OverTheWire over_the_wire;
+  const IntraProcessDeliveryOff over_the_wire;  // the samples go over the wire, protected
   // obstacle: a sends, b receives; drive: b sends, a receives (ids are table order: sends first).
   const Config config_a = gateway_config("gateway-a", "sign", kDomain, {"obstacle"}, {"drive"});
   const Config config_b = gateway_config("gateway-b", "sign", kDomain, {"drive"}, {"obstacle"});

@@ -81,7 +81,7 @@ struct DdsSecuritySpec {
   std::string subject;             // the certificate's subject ("/O=cosmic/CN=gateway-a")
   std::uint64_t content_hash = 0;  // of the six files' bytes: a reload sees a file changed in place
   // What the plugins' cryptography adds to one sample's hop at worst on this machine (`cost`, as
-  // the DDS Security rows of scripts/bench measure it): admission adds it to the hop's latency.
+  // `cosmicctl calibrate` measures it, cosmic/dds_security_timing.hpp): admission adds it to the hop's latency.
   // None: not counted.
   std::optional<Nanos> cost{};
   friend bool operator==(const DdsSecuritySpec&, const DdsSecuritySpec&) = default;

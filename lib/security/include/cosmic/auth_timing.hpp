@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstddef>
+#include <vector>
 
 #include "cosmic/units.hpp"
 
@@ -18,6 +19,10 @@ struct AuthTiming {
   std::size_t runs = 0;
   Nanos p50{0}, p99{0}, p999{0}, max{0};  // per message: the slower of signing and checking it
 };
+
+// The figures of `samples` (one per message of `message_bytes`; sorted in place): what the timings
+// below return, for measurements made elsewhere (a DDS hop's cryptography, cosmic/dds_security_timing.hpp).
+AuthTiming timing_summary(std::size_t message_bytes, std::vector<Nanos>& samples);
 
 AuthTiming time_lcm_auth(std::size_t message_bytes, std::size_t runs);
 

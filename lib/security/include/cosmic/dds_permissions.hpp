@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "cosmic/model.hpp"
@@ -97,5 +98,11 @@ Result<DdsAccessDocuments> dds_access_documents(const Config& config, std::span<
 // The documents' XML (UTF-8), names and subjects escaped.
 std::string governance_xml(std::span<const std::uint32_t> domains, DdsProtection protection);
 std::string permissions_xml(std::span<const DdsGrant> grants);
+
+// The strongest protection a governance document (its XML, signed or not) asks for anywhere: any
+// *_protection_kind of ENCRYPT or ENCRYPT_WITH_ORIGIN_AUTHENTICATION is `encrypt`, else any SIGN... is
+// `sign`, else `none`. What `cosmicctl calibrate` times a secure segment's hop with: the worst its
+// samples can meet. Fails when the text names no protection kind at all (not a governance).
+Result<DdsProtection> governance_protection(std::string_view governance);
 
 }  // namespace cosmic
