@@ -21,6 +21,7 @@
 #include "type_loader.hpp"
 #include "federation_loader.hpp"
 #include "realtime_loader.hpp"
+#include "recording_loader.hpp"
 #include "dds_security_loader.hpp"
 #include "folded_names.hpp"
 #include "key_file_loader.hpp"
@@ -53,7 +54,7 @@ class ConfigParser {
       result.errors = reader_.take_errors();
       return result;
     }
-    if (reader_.check_map(*root, "", {"gateway", "segments", "channels", "components"})) {
+    if (reader_.check_map(*root, "", {"gateway", "segments", "channels", "components", "recording"})) {
       if (has(*root, "gateway")) parse_gateway((*root)["gateway"]);
       if (require(*root, "", "segments", "a list of segments (type can, dds or lcm)"))
         parse_segments((*root)["segments"]);
@@ -67,6 +68,10 @@ class ConfigParser {
       native_.check_derived(reader_, config_);
       secoc_.check_derived(reader_, config_);
       typed_.check(reader_, config_.channels, config_.segments);
+      if (has(*root, "recording")) {
+        config_detail::parse_recording(reader_, (*root)["recording"], "recording", config_.recording);
+        config_detail::check_recording(reader_, (*root)["recording"], "recording", config_);
+      }
     }
     result.config = std::move(config_);
     result.errors = reader_.take_errors();

@@ -1,5 +1,7 @@
 #include "cosmic/model.hpp"
 
+#include <fnmatch.h>
+
 #include <algorithm>
 
 #include "cosmic/can_background.hpp"
@@ -91,6 +93,12 @@ const SegmentSpec* Config::find_segment(const std::string& name) const {
 const ChannelSpec* Config::find_channel(const std::string& name) const {
   const auto it = std::find_if(channels.begin(), channels.end(), [&](const auto& c) { return c.name == name; });
   return it == channels.end() ? nullptr : &*it;
+}
+
+bool RecordingSpec::selects(const std::string& name) const {
+  if (channels.empty()) return true;
+  return std::any_of(channels.begin(), channels.end(),
+                     [&](const std::string& pattern) { return ::fnmatch(pattern.c_str(), name.c_str(), 0) == 0; });
 }
 
 }  // namespace cosmic

@@ -371,8 +371,30 @@ struct ComponentSpec {
   friend bool operator==(const ComponentSpec&, const ComponentSpec&) = default;
 };
 
+// What cosmicd records of the channels that cross it (issue 37; `recording:`, docs/recording.md):
+// MCAP files in `directory`, of the channels whose names match `channels` (names or globs), and
+// the CAN segments in `candump` also as `candump -l` logs.
+enum class RecordCompression { zstd, none };
+
+struct RecordingSpec {
+  std::string directory;              // absolute (the loader anchors a relative one at the file)
+  std::vector<std::string> channels;  // names or fnmatch(3) globs; empty: every channel
+  RecordCompression compression = RecordCompression::zstd;
+  std::uint64_t chunk_size = 1u << 20;    // bytes of messages per MCAP chunk, before compression
+  std::uint64_t rotate_size = 256u << 20; // a new file when one holds this many bytes
+  Nanos rotate_duration{Nanos(600'000'000'000)};  // or has been written this long
+  std::uint64_t memory = 16u << 20;       // what events may wait for the writer, at most
+  bool start = true;                      // recording from the start (else `cosmicctl record start`)
+  std::vector<std::string> candump;       // CAN segments also logged as candump -l
+  bool enabled() const { return !directory.empty(); }
+  // Whether channel `name` is recorded (a name or glob of `channels` matches it).
+  bool selects(const std::string& name) const;
+  friend bool operator==(const RecordingSpec&, const RecordingSpec&) = default;
+};
+
 struct Config {
   GatewaySpec gateway;
+  RecordingSpec recording;
   std::vector<SegmentSpec> segments;
   std::vector<ChannelSpec> channels;
   std::vector<ComponentSpec> components;  // optional application model, may be empty
