@@ -51,6 +51,7 @@ class Scanner {
   std::uint64_t data_limit_ = 0;      // where the data section's records must end
   std::uint64_t header_end_ = 0;
   bool data_end_seen_ = false;
+  bool callback_failed_ = false;
 };
 
 Result<McapScan> Scanner::run() {
@@ -201,7 +202,7 @@ Result<void> Scanner::chunk_record(const McapRecordView& inner, std::uint64_t ch
     default:  // nothing else belongs in a chunk; a later version's record is skipped
       break;
   }
-  if (handled) return handled;
+  if (handled || callback_failed_) return handled;  // the caller's own error comes back as it was
   return Error{handled.error().text + " (record at byte " + std::to_string(inner.offset) + " of the chunk's records)",
                handled.error().code};
 }
@@ -245,7 +246,9 @@ Result<void> Scanner::message(std::span<const std::uint8_t> content, std::uint64
     return error_at(offset, "message on channel " + std::to_string(m.channel_id) + ", not declared before it");
   ++out_.message_count;
   if (!on_message_) return {};
-  return on_message_(m, out_.channels[known->second]);
+  auto taken = on_message_(m, out_.channels[known->second]);
+  callback_failed_ = !taken;
+  return taken;
 }
 
 Result<void> Scanner::read_summary() {
