@@ -19,8 +19,8 @@
 namespace cosmic {
 namespace {
 
-using mcap_test::Bytes;
 using mcap_test::build_file;
+using mcap_test::Bytes;
 using mcap_test::messages_of;
 using mcap_test::small_chunks;
 using mcap_test::write_sample;
@@ -91,8 +91,8 @@ TEST(McapTruncation, SaysWhereTheFileEnds) {
   const McapChunkIndex second = summary_of(file).chunk_indexes.at(1);
   auto read = read_mcap(std::span(file).first(second.chunk_start_offset + 20));
   ASSERT_TRUE(read);
-  EXPECT_THAT(read.value().truncation, HasSubstr("chunk record that starts at " +
-                                                 std::to_string(second.chunk_start_offset)));
+  EXPECT_THAT(read.value().truncation,
+              HasSubstr("chunk record that starts at " + std::to_string(second.chunk_start_offset)));
   EXPECT_EQ(read.value().complete_bytes, second.chunk_start_offset);
   EXPECT_FALSE(read.value().summary);
   // Without a footer there is no summary to read on its own.
@@ -174,7 +174,9 @@ TEST(McapDamage, MessageOnAnUndeclaredChannel) {
 }
 
 TEST(McapDamage, ChannelOnAnUndeclaredSchemaAndRedefinitions) {
-  EXPECT_THAT(error_of(build_file([](Bytes& f) { append_mcap_record(f, McapChannel{1, 4, "t", "cdr", {}}); })),
+  EXPECT_THAT(error_of(build_file([](Bytes& f) {
+                append_mcap_record(f, McapChannel{1, 4, "t", "cdr", {}});
+              })),
               HasSubstr("schema 4"));
   EXPECT_THAT(error_of(build_file([](Bytes& f) {
                 append_mcap_record(f, McapChannel{1, 0, "t", "cdr", {}});
@@ -237,8 +239,8 @@ TEST(McapReader, ReadsLz4Chunks) {
   ASSERT_FALSE(LZ4F_isError(n));
   packed.resize(n);
   ASSERT_LT(packed.size(), records.size());
-  auto read = read_mcap(
-      build_file([&](Bytes& f) { append_chunk(f, "lz4", packed, records.size(), mcap_crc32(records)); }));
+  auto read =
+      read_mcap(build_file([&](Bytes& f) { append_chunk(f, "lz4", packed, records.size(), mcap_crc32(records)); }));
   ASSERT_TRUE(read) << read.error().text;
   ASSERT_EQ(read.value().messages.size(), 2u);
   EXPECT_EQ(read.value().messages[0].data, a);

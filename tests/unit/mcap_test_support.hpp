@@ -60,7 +60,8 @@ inline Sample write_sample(McapWriterOptions options, std::uint32_t count) {
   if (!writer) return s;
   McapWriter& w = writer.value();
   s.schemas.push_back({1, "cosmic_msgs/msg/Distance", "ros2msg", bytes_of("float32 meters\nuint8 quality\n")});
-  s.schemas.push_back({2, "Speed", "jsonschema", bytes_of(R"({"type":"object","properties":{"v":{"type":"number"}}})")});
+  s.schemas.push_back(
+      {2, "Speed", "jsonschema", bytes_of(R"({"type":"object","properties":{"v":{"type":"number"}}})")});
   s.channels.push_back({1, 1, "distance", "cdr", {{"segment", "body-can"}, {"origin", "7"}}});
   s.channels.push_back({2, 2, "speed", "json", {}});
   s.channels.push_back({3, 0, "raw/opaque", "x-cosmic-raw", {{"subject", "0x42"}}});

@@ -59,7 +59,8 @@ TEST_P(McapWriterRoundTrip, CountersMatchTheFile) {
   ASSERT_TRUE(writer);
   McapWriter& w = writer.value();
   for (const McapSchema& s : sample.schemas) ASSERT_TRUE(w.add_schema(s.name, s.encoding, s.data));
-  for (const McapChannel& c : sample.channels) ASSERT_TRUE(w.add_channel(c.schema_id, c.topic, c.message_encoding, c.metadata));
+  for (const McapChannel& c : sample.channels)
+    ASSERT_TRUE(w.add_channel(c.schema_id, c.topic, c.message_encoding, c.metadata));
   for (std::size_t i = 0; i < sample.messages.size(); ++i) {
     if (i == sample.messages.size() / 3) {
       ASSERT_TRUE(w.add_metadata(sample.metadata.name, sample.metadata.metadata));

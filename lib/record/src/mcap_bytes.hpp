@@ -12,7 +12,11 @@
 #include <string_view>
 #include <vector>
 
+#include "cosmic/mcap_records.hpp"
+
 namespace cosmic::mcap_detail {
+
+inline std::uint8_t opcode_byte(McapOpcode opcode) { return static_cast<std::uint8_t>(opcode); }
 
 inline void put_le(std::vector<std::uint8_t>& out, std::uint64_t value, std::size_t bytes) {
   for (std::size_t i = 0; i < bytes; ++i) out.push_back(static_cast<std::uint8_t>(value >> (8 * i)));

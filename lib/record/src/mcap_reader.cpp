@@ -279,7 +279,8 @@ Result<McapScan> scan_mcap(std::span<const std::uint8_t> file, const McapMessage
 Result<McapFile> read_mcap(std::span<const std::uint8_t> file, const McapReadLimits& limits) {
   std::vector<McapMessage> messages;
   const McapMessageCallback keep = [&messages](const McapMessageView& m, const McapChannel&) -> Result<void> {
-    messages.push_back(McapMessage{m.channel_id, m.sequence, m.log_time, m.publish_time, {m.data.begin(), m.data.end()}});
+    messages.push_back(
+        McapMessage{m.channel_id, m.sequence, m.log_time, m.publish_time, {m.data.begin(), m.data.end()}});
     return {};
   };
   auto scan = scan_mcap(file, keep, limits);

@@ -23,8 +23,6 @@ using mcap_detail::put_u8;
 
 namespace {
 
-std::uint8_t op(McapOpcode opcode) { return static_cast<std::uint8_t>(opcode); }
-
 // A Map's or Array's byte length goes in front of its entries: written as 0, patched after them.
 std::size_t begin_block(std::vector<std::uint8_t>& out) {
   const std::size_t at = out.size();
@@ -84,14 +82,14 @@ std::uint32_t mcap_crc32(std::span<const std::uint8_t> bytes, std::uint32_t crc)
 }
 
 void append_mcap_record(std::vector<std::uint8_t>& out, const McapHeader& header) {
-  const std::size_t at = begin_record(out, op(McapOpcode::header));
+  const std::size_t at = begin_record(out, mcap_detail::opcode_byte(McapOpcode::header));
   put_string(out, header.profile);
   put_string(out, header.library);
   end_record(out, at);
 }
 
 void append_mcap_record(std::vector<std::uint8_t>& out, const McapFooter& footer) {
-  const std::size_t at = begin_record(out, op(McapOpcode::footer));
+  const std::size_t at = begin_record(out, mcap_detail::opcode_byte(McapOpcode::footer));
   put_u64(out, footer.summary_start);
   put_u64(out, footer.summary_offset_start);
   put_u32(out, footer.summary_crc);
@@ -99,7 +97,7 @@ void append_mcap_record(std::vector<std::uint8_t>& out, const McapFooter& footer
 }
 
 void append_mcap_record(std::vector<std::uint8_t>& out, const McapSchema& schema) {
-  const std::size_t at = begin_record(out, op(McapOpcode::schema));
+  const std::size_t at = begin_record(out, mcap_detail::opcode_byte(McapOpcode::schema));
   put_u16(out, schema.id);
   put_string(out, schema.name);
   put_string(out, schema.encoding);
@@ -109,7 +107,7 @@ void append_mcap_record(std::vector<std::uint8_t>& out, const McapSchema& schema
 }
 
 void append_mcap_record(std::vector<std::uint8_t>& out, const McapChannel& channel) {
-  const std::size_t at = begin_record(out, op(McapOpcode::channel));
+  const std::size_t at = begin_record(out, mcap_detail::opcode_byte(McapOpcode::channel));
   put_u16(out, channel.id);
   put_u16(out, channel.schema_id);
   put_string(out, channel.topic);
@@ -119,7 +117,7 @@ void append_mcap_record(std::vector<std::uint8_t>& out, const McapChannel& chann
 }
 
 void append_mcap_record(std::vector<std::uint8_t>& out, const McapMessageView& message) {
-  const std::size_t at = begin_record(out, op(McapOpcode::message));
+  const std::size_t at = begin_record(out, mcap_detail::opcode_byte(McapOpcode::message));
   put_u16(out, message.channel_id);
   put_u32(out, message.sequence);
   put_u64(out, message.log_time);
@@ -129,7 +127,7 @@ void append_mcap_record(std::vector<std::uint8_t>& out, const McapMessageView& m
 }
 
 void append_mcap_record(std::vector<std::uint8_t>& out, const McapChunkView& chunk) {
-  const std::size_t at = begin_record(out, op(McapOpcode::chunk));
+  const std::size_t at = begin_record(out, mcap_detail::opcode_byte(McapOpcode::chunk));
   put_u64(out, chunk.message_start_time);
   put_u64(out, chunk.message_end_time);
   put_u64(out, chunk.uncompressed_size);
@@ -141,7 +139,7 @@ void append_mcap_record(std::vector<std::uint8_t>& out, const McapChunkView& chu
 }
 
 void append_mcap_record(std::vector<std::uint8_t>& out, const McapMessageIndex& index) {
-  const std::size_t at = begin_record(out, op(McapOpcode::message_index));
+  const std::size_t at = begin_record(out, mcap_detail::opcode_byte(McapOpcode::message_index));
   put_u16(out, index.channel_id);
   const std::size_t array_at = begin_block(out);
   for (const auto& [log_time, offset] : index.entries) {
@@ -153,7 +151,7 @@ void append_mcap_record(std::vector<std::uint8_t>& out, const McapMessageIndex& 
 }
 
 void append_mcap_record(std::vector<std::uint8_t>& out, const McapChunkIndex& index) {
-  const std::size_t at = begin_record(out, op(McapOpcode::chunk_index));
+  const std::size_t at = begin_record(out, mcap_detail::opcode_byte(McapOpcode::chunk_index));
   put_u64(out, index.message_start_time);
   put_u64(out, index.message_end_time);
   put_u64(out, index.chunk_start_offset);
@@ -167,7 +165,7 @@ void append_mcap_record(std::vector<std::uint8_t>& out, const McapChunkIndex& in
 }
 
 void append_mcap_record(std::vector<std::uint8_t>& out, const McapStatistics& s) {
-  const std::size_t at = begin_record(out, op(McapOpcode::statistics));
+  const std::size_t at = begin_record(out, mcap_detail::opcode_byte(McapOpcode::statistics));
   put_u64(out, s.message_count);
   put_u16(out, s.schema_count);
   put_u32(out, s.channel_count);
@@ -181,14 +179,14 @@ void append_mcap_record(std::vector<std::uint8_t>& out, const McapStatistics& s)
 }
 
 void append_mcap_record(std::vector<std::uint8_t>& out, const McapMetadata& metadata) {
-  const std::size_t at = begin_record(out, op(McapOpcode::metadata));
+  const std::size_t at = begin_record(out, mcap_detail::opcode_byte(McapOpcode::metadata));
   put_string(out, metadata.name);
   put_map(out, metadata.metadata);
   end_record(out, at);
 }
 
 void append_mcap_record(std::vector<std::uint8_t>& out, const McapMetadataIndex& index) {
-  const std::size_t at = begin_record(out, op(McapOpcode::metadata_index));
+  const std::size_t at = begin_record(out, mcap_detail::opcode_byte(McapOpcode::metadata_index));
   put_u64(out, index.offset);
   put_u64(out, index.length);
   put_string(out, index.name);
@@ -196,7 +194,7 @@ void append_mcap_record(std::vector<std::uint8_t>& out, const McapMetadataIndex&
 }
 
 void append_mcap_record(std::vector<std::uint8_t>& out, const McapSummaryOffset& offset) {
-  const std::size_t at = begin_record(out, op(McapOpcode::summary_offset));
+  const std::size_t at = begin_record(out, mcap_detail::opcode_byte(McapOpcode::summary_offset));
   put_u8(out, offset.group_opcode);
   put_u64(out, offset.group_start);
   put_u64(out, offset.group_length);
@@ -204,7 +202,7 @@ void append_mcap_record(std::vector<std::uint8_t>& out, const McapSummaryOffset&
 }
 
 void append_mcap_record(std::vector<std::uint8_t>& out, const McapDataEnd& data_end) {
-  const std::size_t at = begin_record(out, op(McapOpcode::data_end));
+  const std::size_t at = begin_record(out, mcap_detail::opcode_byte(McapOpcode::data_end));
   put_u32(out, data_end.data_section_crc);
   end_record(out, at);
 }
@@ -382,9 +380,9 @@ McapRecordAt mcap_record_at(std::span<const std::uint8_t> bytes, std::uint64_t a
 
 std::string mcap_opcode_name(std::uint8_t opcode) {
   static constexpr const char* kNames[] = {
-      "header",           "footer",     "schema",   "channel",        "message",        "chunk",
-      "message index",    "chunk index", "attachment", "attachment index", "statistics", "metadata",
-      "metadata index",   "summary offset", "data end"};
+      "header",     "footer",        "schema",         "channel",        "message",
+      "chunk",      "message index", "chunk index",    "attachment",     "attachment index",
+      "statistics", "metadata",      "metadata index", "summary offset", "data end"};
   if (opcode >= 0x01 && opcode <= 0x0F) return kNames[opcode - 1];
   char text[24];
   std::snprintf(text, sizeof text, "unknown (0x%02x)", opcode);

@@ -99,8 +99,8 @@ Result<void> parse_summary_region(std::span<const std::uint8_t> region, std::uin
   while (at < region.size()) {
     const McapRecordAt found = mcap_record_at(region, at);
     if (found.incomplete)
-      return error_at(start + at, "summary: a record runs past the footer at offset " +
-                                      std::to_string(start + region.size()));
+      return error_at(start + at,
+                      "summary: a record runs past the footer at offset " + std::to_string(start + region.size()));
     McapRecordView record = found.record;
     record.offset += start;
     if (auto added = add_summary_record(record, summary); !added) return added;
@@ -141,8 +141,9 @@ Result<std::optional<McapSummary>> read_mcap_summary(std::uint64_t file_size, co
   if (!tail) return std::move(tail).error();
   const auto footer = mcap_detail::footer_in_tail(tail.value());
   if (!footer)
-    return error_at(footer_offset, "no footer and closing magic at the end: the file is truncated or still being "
-                                   "written (scan it from the start instead)");
+    return error_at(footer_offset,
+                    "no footer and closing magic at the end: the file is truncated or still being "
+                    "written (scan it from the start instead)");
   const std::uint64_t header_end = kHeadBytes + header_length;
   auto start = mcap_detail::summary_region_start(*footer, header_end, footer_offset);
   if (!start) return std::move(start).error();
@@ -167,8 +168,7 @@ Result<std::optional<McapSummary>> read_mcap_summary(std::uint64_t file_size, co
   return std::optional<McapSummary>(std::move(summary));
 }
 
-Result<std::optional<McapSummary>> read_mcap_summary(std::span<const std::uint8_t> file,
-                                                     const McapReadLimits& limits) {
+Result<std::optional<McapSummary>> read_mcap_summary(std::span<const std::uint8_t> file, const McapReadLimits& limits) {
   const McapReadAt read_at = [file](std::uint64_t offset, std::span<std::uint8_t> out) -> Result<void> {
     if (offset > file.size() || out.size() > file.size() - offset)
       return error_at(offset, "read of " + std::to_string(out.size()) + " bytes past the end of the file");

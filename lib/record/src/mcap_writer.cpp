@@ -6,6 +6,7 @@
 #include <limits>
 #include <utility>
 
+#include "mcap_bytes.hpp"
 #include "mcap_compression.hpp"
 
 namespace cosmic {
@@ -13,8 +14,6 @@ namespace cosmic {
 namespace {
 
 constexpr std::size_t kMaxIds = std::numeric_limits<std::uint16_t>::max();
-
-std::uint8_t op(McapOpcode opcode) { return static_cast<std::uint8_t>(opcode); }
 
 // Widens [start, end] to take in `t`; `first` when the range is still empty.
 void widen(std::uint64_t& start, std::uint64_t& end, std::uint64_t t, bool first) {
@@ -202,7 +201,8 @@ std::vector<std::uint8_t> McapWriter::build_summary(std::uint64_t summary_start)
   const auto group = [&](McapOpcode opcode, const auto& records) {
     const std::size_t start = out.size();
     for (const auto& record : records) append_mcap_record(out, record);
-    if (out.size() > start) groups.push_back({op(opcode), summary_start + start, out.size() - start});
+    if (out.size() > start)
+      groups.push_back({mcap_detail::opcode_byte(opcode), summary_start + start, out.size() - start});
   };
   McapStatistics statistics = statistics_;
   statistics.schema_count = static_cast<std::uint16_t>(schemas_.size());

@@ -62,7 +62,7 @@ struct McapScan {
   std::uint64_t chunk_count = 0;
   std::optional<McapSummary> summary;  // when the file is whole and has one
   bool truncated = false;
-  std::string truncation;        // where and how a truncated file ends, for a person
+  std::string truncation;            // where and how a truncated file ends, for a person
   std::uint64_t complete_bytes = 0;  // the file's bytes up to the end of its last complete record
 };
 

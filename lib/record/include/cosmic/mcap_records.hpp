@@ -114,8 +114,8 @@ struct McapMessageIndex {
 struct McapChunkIndex {
   std::uint64_t message_start_time = 0;
   std::uint64_t message_end_time = 0;
-  std::uint64_t chunk_start_offset = 0;  // from the start of the file
-  std::uint64_t chunk_length = 0;        // the whole Chunk record
+  std::uint64_t chunk_start_offset = 0;                          // from the start of the file
+  std::uint64_t chunk_length = 0;                                // the whole Chunk record
   std::map<std::uint16_t, std::uint64_t> message_index_offsets;  // channel -> its Message Index record
   std::uint64_t message_index_length = 0;                        // all Message Index records of the chunk
   std::string compression;

@@ -65,8 +65,8 @@ class McapWriter {
   Result<std::uint16_t> add_schema(std::string_view name, std::string_view encoding,
                                    std::span<const std::uint8_t> data);
   // Registers a channel; `schema_id` 0 for messages without a schema. Its id, from 1.
-  Result<std::uint16_t> add_channel(std::uint16_t schema_id, std::string_view topic,
-                                    std::string_view message_encoding, const McapMap& metadata = {});
+  Result<std::uint16_t> add_channel(std::uint16_t schema_id, std::string_view topic, std::string_view message_encoding,
+                                    const McapMap& metadata = {});
   // Appends one message to the open chunk; the chunk goes to the sink when it reaches chunk_size.
   Result<void> write_message(std::uint16_t channel_id, std::uint32_t sequence, std::uint64_t log_time_ns,
                              std::uint64_t publish_time_ns, std::span<const std::uint8_t> data);
