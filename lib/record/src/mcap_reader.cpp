@@ -207,34 +207,34 @@ Result<void> Scanner::chunk_record(const McapRecordView& inner, std::uint64_t ch
                handled.error().code};
 }
 
+// A Schema or Channel record: kept the first time its id appears; repeated, it must be identical.
+template <typename Record>
+Result<void> declare(Record record, std::map<std::uint16_t, std::size_t>& at, std::vector<Record>& records,
+                     const char* kind, std::uint64_t offset) {
+  if (const auto known = at.find(record.id); known != at.end()) {
+    if (records[known->second] == record) return {};
+    return error_at(offset, std::string(kind) + " " + std::to_string(record.id) + " redefined differently");
+  }
+  at[record.id] = records.size();
+  records.push_back(std::move(record));
+  return {};
+}
+
 Result<void> Scanner::schema(std::span<const std::uint8_t> content, std::uint64_t offset) {
   auto parsed = parse_mcap_schema(content);
   if (!parsed) return error_at(offset, parsed.error().text);
-  McapSchema& s = parsed.value();
-  if (s.id == 0) return {};  // id 0 is invalid: the specification says to ignore it
-  if (const auto known = schema_at_.find(s.id); known != schema_at_.end()) {
-    if (out_.schemas[known->second] == s) return {};
-    return error_at(offset, "schema " + std::to_string(s.id) + " redefined differently");
-  }
-  schema_at_[s.id] = out_.schemas.size();
-  out_.schemas.push_back(std::move(s));
-  return {};
+  if (parsed.value().id == 0) return {};  // id 0 is invalid: the specification says to ignore it
+  return declare(std::move(parsed).value(), schema_at_, out_.schemas, "schema", offset);
 }
 
 Result<void> Scanner::channel(std::span<const std::uint8_t> content, std::uint64_t offset) {
   auto parsed = parse_mcap_channel(content);
   if (!parsed) return error_at(offset, parsed.error().text);
-  McapChannel& c = parsed.value();
+  const McapChannel& c = parsed.value();
   if (c.schema_id != 0 && !schema_at_.contains(c.schema_id))
     return error_at(offset, "channel " + std::to_string(c.id) + " ('" + c.topic + "') names schema " +
                                 std::to_string(c.schema_id) + ", not declared before it");
-  if (const auto known = channel_at_.find(c.id); known != channel_at_.end()) {
-    if (out_.channels[known->second] == c) return {};
-    return error_at(offset, "channel " + std::to_string(c.id) + " redefined differently");
-  }
-  channel_at_[c.id] = out_.channels.size();
-  out_.channels.push_back(std::move(c));
-  return {};
+  return declare(std::move(parsed).value(), channel_at_, out_.channels, "channel", offset);
 }
 
 Result<void> Scanner::message(std::span<const std::uint8_t> content, std::uint64_t offset) {
