@@ -84,9 +84,10 @@ void parse_recording(YamlReader& reader, const YAML::Node& node, const std::stri
   }
   if (auto v = reader.string(node["directory"], key(path, "directory"))) {
     const std::filesystem::path directory(*v);
-    out.directory = directory.is_absolute()
-                        ? directory.lexically_normal().string()
-                        : (std::filesystem::absolute(reader.file()).parent_path() / directory).lexically_normal().string();
+    out.directory =
+        directory.is_absolute()
+            ? directory.lexically_normal().string()
+            : (std::filesystem::absolute(reader.file()).parent_path() / directory).lexically_normal().string();
   }
   if (has(node, "channels") && reader.is_list(node["channels"], key(path, "channels"))) {
     // Strings, not names: a glob's * ? [ ] are no name's characters.
@@ -123,10 +124,10 @@ void check_recording(YamlReader& reader, const YAML::Node& node, const std::stri
     const std::string& name = candump[i].Scalar();
     const SegmentSpec* segment = config.find_segment(name);
     if (segment != nullptr && segment->type == SegmentType::can) continue;
-    reader.error_at(candump[i], indexed(key(path, "candump"), i),
-                    segment == nullptr ? "unknown segment '" + name + "'"
-                                       : "segment '" + name + "' is not a CAN segment",
-                    "a CAN segment of this file");
+    reader.error_at(
+        candump[i], indexed(key(path, "candump"), i),
+        segment == nullptr ? "unknown segment '" + name + "'" : "segment '" + name + "' is not a CAN segment",
+        "a CAN segment of this file");
   }
 }
 

@@ -39,6 +39,9 @@ struct ChannelState {
   std::atomic<std::uint32_t> next_sequence{0};
   std::atomic<std::uint64_t> forwarded{0};
   std::atomic<bool> removed{false};
+  // The recording selects this channel (Router::select_recorded): its admitted events go to the
+  // record hook. Set by the control thread, read by ingress threads.
+  std::atomic<bool> recorded{false};
   // Set when the route was changed under the same channel id (a replaced definition): events
   // already queued still go to the subscriber segments the new route keeps, not to the others
   // (indexed by segment slot).

@@ -138,6 +138,8 @@ void Router::apply(std::vector<Route> routes) {
   }
   std::sort(next.channels.begin(), next.channels.end(),
             [](const auto& a, const auto& b) { return a->route.id < b->route.id; });
+  for (const auto& state : next.channels)
+    state->recorded.store(record_selection_ && record_selection_(state->route.spec), std::memory_order_relaxed);
   for (const auto& old : current.channels) {
     const auto kept = std::lower_bound(next.channels.begin(), next.channels.end(), old->route.id,
                                        [](const auto& s, ChannelId v) { return s->route.id < v; });
@@ -158,6 +160,13 @@ void Router::apply(std::vector<Route> routes) {
   // The old table is freed here, on the control thread, once its last reader is done
   // (microseconds: readers hold it for one event or one statistics pass).
   const Table retired = SnapshotTable<Table>::retire(table_.publish(std::move(next)));
+}
+
+void Router::select_recorded(std::function<bool(const ChannelSpec&)> selects) {
+  LockGuard serial(apply_mutex_);
+  record_selection_ = std::move(selects);
+  for (const auto& state : table_.current_for_publisher().channels)
+    state->recorded.store(record_selection_ && record_selection_(state->route.spec), std::memory_order_relaxed);
 }
 
 std::shared_ptr<ChannelState> Router::find(ChannelId id) const {
@@ -202,7 +211,7 @@ void Router::receive(std::size_t segment, const InboundEvent& event) {
     checked.payload = compact.first(converted.size);
   }
   if (!admit(*channel, counters, checked)) return;
-  enqueue(channel, checked);
+  enqueue(channel, segment, checked);
 }
 
 // A protected frame's CRC and counter (cosmic/e2e_protection.hpp): a corrupt frame and a repeated
@@ -258,7 +267,7 @@ bool Router::admit(ChannelState& channel, SegmentCounters& counters, const Inbou
 }
 
 // Copies the payload once and queues the event on the lane of each subscriber segment.
-void Router::enqueue(const std::shared_ptr<ChannelState>& channel, const InboundEvent& event) {
+void Router::enqueue(const std::shared_ptr<ChannelState>& channel, std::size_t segment, const InboundEvent& event) {
   const Route& route = channel->route;
   EventHeader header = event.header;
   header.hop_count = static_cast<std::uint8_t>(header.hop_count + 1);
@@ -270,6 +279,11 @@ void Router::enqueue(const std::shared_ptr<ChannelState>& channel, const Inbound
   }
   // A tap sees the event as it leaves (cosmicctl echo): one atomic load while none is open.
   taps_.offer(route.id, header, event.received_at, event.payload);
+  // The recorder copies it into its own bounded queue or counts it dropped: never a wait here.
+  if (channel->recorded.load(std::memory_order_relaxed)) {
+    if (RecordHook* hook = record_hook_.load(std::memory_order_acquire))
+      hook->offer(route.id, segment, header, event.received_at, event.payload);
+  }
   if (route.subscribers.empty()) return;
   const auto fanout = static_cast<std::uint32_t>(route.subscribers.size());
   PayloadBuffer* buffer = pool_->acquire(event.payload, fanout);

@@ -380,12 +380,12 @@ struct RecordingSpec {
   std::string directory;              // absolute (the loader anchors a relative one at the file)
   std::vector<std::string> channels;  // names or fnmatch(3) globs; empty: every channel
   RecordCompression compression = RecordCompression::zstd;
-  std::uint64_t chunk_size = 1u << 20;    // bytes of messages per MCAP chunk, before compression
-  std::uint64_t rotate_size = 256u << 20; // a new file when one holds this many bytes
+  std::uint64_t chunk_size = 1u << 20;            // bytes of messages per MCAP chunk, before compression
+  std::uint64_t rotate_size = 256u << 20;         // a new file when one holds this many bytes
   Nanos rotate_duration{Nanos(600'000'000'000)};  // or has been written this long
-  std::uint64_t memory = 16u << 20;       // what events may wait for the writer, at most
-  bool start = true;                      // recording from the start (else `cosmicctl record start`)
-  std::vector<std::string> candump;       // CAN segments also logged as candump -l
+  std::uint64_t memory = 16u << 20;               // what events may wait for the writer, at most
+  bool start = true;                              // recording from the start (else `cosmicctl record start`)
+  std::vector<std::string> candump;               // CAN segments also logged as candump -l
   bool enabled() const { return !directory.empty(); }
   // Whether channel `name` is recorded (a name or glob of `channels` matches it).
   bool selects(const std::string& name) const;

@@ -17,6 +17,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <span>
@@ -24,6 +25,7 @@
 #include <vector>
 
 #include "cosmic/channel_tap.hpp"
+#include "cosmic/record_hook.hpp"
 #include "cosmic/event.hpp"
 #include "cosmic/log.hpp"
 #include "cosmic/model.hpp"
@@ -132,6 +134,12 @@ class Router {
   // Taps on channels' admitted events (cosmicctl echo; cosmic/channel_tap.hpp). Control thread.
   TapBoard& taps() { return taps_; }
 
+  // The recorder's hook (cosmic/record_hook.hpp), or null; it must outlive the inboxes' use. Which
+  // channels it sees: those `selects` (a channel's spec -> recorded) picks, now and in every later
+  // apply(); an empty function selects none. Control thread.
+  void set_record_hook(RecordHook* hook) { record_hook_.store(hook, std::memory_order_release); }
+  void select_recorded(std::function<bool(const ChannelSpec&)> selects) COSMIC_EXCLUDES(apply_mutex_);
+
  private:
   struct Table;
   class SegmentInbox;
@@ -141,7 +149,7 @@ class Router {
   bool admit(ChannelState& channel, SegmentCounters& counters, const InboundEvent& event);
   bool e2e_admit(ChannelState& channel, std::size_t segment, const E2eProtection& e2e,
                  std::span<const std::uint8_t> frame);
-  void enqueue(const std::shared_ptr<ChannelState>& channel, const InboundEvent& event);
+  void enqueue(const std::shared_ptr<ChannelState>& channel, std::size_t segment, const InboundEvent& event);
   std::shared_ptr<ChannelState> find(ChannelId id) const;
   EgressLane& lane(std::size_t segment, ChannelClass cls);
 
@@ -166,6 +174,8 @@ class Router {
   std::vector<std::unique_ptr<EgressLane>> lanes_;  // segment * 3 + class
 
   TapBoard taps_;
+  std::atomic<RecordHook*> record_hook_{nullptr};
+  std::function<bool(const ChannelSpec&)> record_selection_ COSMIC_GUARDED_BY(apply_mutex_);
   Mutex problems_mutex_;
   std::vector<std::string> thread_problems_ COSMIC_GUARDED_BY(problems_mutex_);
 };

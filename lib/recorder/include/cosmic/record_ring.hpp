@@ -1,0 +1,90 @@
+// The recorder's queue (issue 37, docs/recording.md): records of any length from many producers
+// (the ingress threads of every segment) to one consumer (the recorder's writer thread), in one
+// block of memory allocated up front, after Aeron's many-to-one ring buffer. A producer claims room
+// with one compare-and-swap on the tail, copies its record in and commits it by storing its length
+// last; it never waits: a record that does not fit now is refused and the caller counts it. The
+// consumer takes committed records in claim order, zeroes what it took and releases the room.
+//
+// Layout: each record starts on an 8-byte boundary with an 8-byte header (u32 length including the
+// header, 0 while uncommitted; u32 kind: data or padding); a record that would run past the end
+// leaves a padding record there and goes to the start.
+//
+// Threads: try_write() on any number of threads at once; read() on one thread only.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+
+namespace cosmic {
+
+class RecordRing {
+ public:
+  static constexpr std::size_t kMinCapacity = 4096;
+
+  // `capacity_bytes` rounded down to a power of two, at least kMinCapacity. Allocates and zeroes it.
+  explicit RecordRing(std::size_t capacity_bytes);
+  RecordRing(const RecordRing&) = delete;
+  RecordRing& operator=(const RecordRing&) = delete;
+
+  std::size_t capacity() const noexcept { return capacity_; }
+  // The longest record accepted (a quarter of the capacity, so one always fits once the ring drains).
+  std::size_t max_record() const noexcept { return capacity_ / 4 - kHeaderBytes; }
+
+  // Copies the parts, one after the other, as one record. False when the record is longer than
+  // max_record() or the ring has no room for it now. Never blocks, never allocates.
+  bool try_write(std::span<const std::span<const std::uint8_t>> parts) noexcept;
+
+  // Hands each committed record to `take(std::span<const std::uint8_t>)` in order, at most `limit`;
+  // returns how many. Stops at the first record claimed but not yet committed. The span is valid
+  // during the call only.
+  template <typename Take>
+  std::size_t read(Take&& take, std::size_t limit);
+
+  // Bytes claimed and not yet released (an estimate while producers write).
+  std::size_t used() const noexcept {
+    return static_cast<std::size_t>(tail_.load(std::memory_order_relaxed) - head_.load(std::memory_order_relaxed));
+  }
+
+ private:
+  static constexpr std::size_t kHeaderBytes = 8;
+  static constexpr std::uint32_t kData = 1;
+  static constexpr std::uint32_t kPadding = 2;
+
+  static std::size_t aligned(std::size_t n) noexcept { return (n + 7) & ~std::size_t{7}; }
+  std::uint8_t* at(std::uint64_t position) noexcept { return bytes_ + (position & (capacity_ - 1)); }
+  static void commit(std::uint8_t* header, std::uint32_t length, std::uint32_t kind) noexcept;
+  static std::uint32_t committed_length(std::uint8_t* header) noexcept;
+  static std::uint32_t kind_of(const std::uint8_t* header) noexcept;
+  // Zeroes `length` bytes at `position` and releases them to the producers.
+  void release(std::uint64_t position, std::size_t length) noexcept;
+
+  std::size_t capacity_;
+  std::unique_ptr<std::uint64_t[]> storage_;  // 8-byte aligned
+  std::uint8_t* bytes_;
+  alignas(64) std::atomic<std::uint64_t> tail_{0};  // next position to claim (producers)
+  alignas(64) std::atomic<std::uint64_t> head_{0};  // next position to read (consumer)
+};
+
+template <typename Take>
+std::size_t RecordRing::read(Take&& take, std::size_t limit) {
+  std::size_t count = 0;
+  std::uint64_t head = head_.load(std::memory_order_relaxed);
+  while (count < limit) {
+    std::uint8_t* header = at(head);
+    const std::uint32_t length = committed_length(header);
+    if (length == 0) break;
+    const std::size_t span = aligned(length);
+    if (kind_of(header) == kData) {
+      take(std::span<const std::uint8_t>(header + kHeaderBytes, length - kHeaderBytes));
+      ++count;
+    }
+    release(head, span);
+    head += span;
+  }
+  return count;
+}
+
+}  // namespace cosmic

@@ -1,0 +1,135 @@
+// The recorder (cosmic/recorder.hpp): the ingress side (offer) and the control side here, the
+// writer thread's loop in recorder_writer.cpp.
+#include "cosmic/recorder.hpp"
+
+#include <sys/stat.h>
+
+#include <cstring>
+#include <filesystem>
+
+#include "recorder_shared.hpp"
+#include "recording_file.hpp"
+
+namespace cosmic {
+namespace {
+
+using recorder_detail::QueuedHead;
+
+std::int64_t clock_ns(clockid_t clock) {
+  timespec now{};
+  ::clock_gettime(clock, &now);
+  return static_cast<std::int64_t>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
+}
+
+}  // namespace
+
+Recorder::Recorder(RecordingSpec spec, std::string gateway, Logger& log)
+    : spec_(std::move(spec)),
+      gateway_(std::move(gateway)),
+      log_(log),
+      ring_(spec_.memory),
+      shared_(std::make_unique<Shared>()) {
+  shared_->spec = spec_;
+  shared_->status.directory = spec_.directory;
+  shared_->status.queue_bytes = ring_.capacity();
+  thread_ = std::thread([this] { run(); });
+}
+
+Recorder::~Recorder() {
+  {
+    const std::lock_guard lock(shared_->mutex);
+    shared_->quit = true;
+  }
+  shared_->wake.notify_all();
+  thread_.join();
+}
+
+void Recorder::offer(ChannelId channel, std::size_t from_segment, const EventHeader& header, Nanos received_at,
+                     std::span<const std::uint8_t> payload) noexcept {
+  QueuedHead head{};
+  head.channel = channel;
+  head.segment = static_cast<std::uint32_t>(from_segment);
+  head.origin = header.origin;
+  head.sequence = header.sequence;
+  head.created_ns = header.created_ns;
+  // The arrival on this host's UTC clock: now, less the time since the adapter took it in.
+  head.arrival_ns = clock_ns(CLOCK_REALTIME) - (clock_ns(CLOCK_MONOTONIC) - received_at.count());
+  const std::span<const std::uint8_t> parts[] = {{reinterpret_cast<const std::uint8_t*>(&head), sizeof head}, payload};
+  if (!ring_.try_write(parts)) dropped_full_.fetch_add(1, std::memory_order_relaxed);
+}
+
+void Recorder::set_channels(std::vector<RecordedChannel> channels) {
+  auto table = std::make_shared<Shared::ChannelTable>();
+  for (auto& channel : channels) {
+    const ChannelId id = channel.id;
+    (*table)[id] = std::make_shared<const RecordedChannel>(std::move(channel));
+  }
+  const std::lock_guard lock(shared_->mutex);
+  shared_->channels = std::move(table);
+}
+
+void Recorder::set_segment_names(std::vector<std::string> names) {
+  auto table = std::make_shared<const std::vector<std::string>>(std::move(names));
+  const std::lock_guard lock(shared_->mutex);
+  shared_->segments = std::move(table);
+}
+
+Result<void> Recorder::start() {
+  std::error_code failed;
+  std::filesystem::create_directories(spec_.directory, failed);
+  if (failed) return Error{"cannot make the recording directory " + spec_.directory + ": " + failed.message()};
+  if (::access(spec_.directory.c_str(), W_OK | X_OK) != 0)
+    return Error::from_errno("cannot write into the recording directory " + spec_.directory, errno);
+  std::uint64_t generation = 0;
+  {
+    const std::lock_guard lock(shared_->mutex);
+    if (shared_->want_recording) return {};
+    shared_->want_recording = true;
+    generation = ++shared_->generation;
+  }
+  shared_->wake.notify_all();
+  // The writer opens the first file; its verdict is this call's.
+  std::unique_lock lock(shared_->mutex);
+  shared_->acknowledged.wait_for(lock, std::chrono::seconds(10), [&] { return shared_->acked >= generation; });
+  if (shared_->acked < generation) return Error{"the recorder's writer did not answer within 10 s"};
+  if (!shared_->status.recording) {
+    shared_->want_recording = false;
+    return Error{shared_->status.last_error};
+  }
+  log_.log(LogLevel::notice, "recording to " + shared_->status.file);
+  return {};
+}
+
+void Recorder::stop() {
+  std::uint64_t generation = 0;
+  {
+    const std::lock_guard lock(shared_->mutex);
+    if (!shared_->want_recording) return;
+    shared_->want_recording = false;
+    generation = ++shared_->generation;
+  }
+  shared_->wake.notify_all();
+  std::unique_lock lock(shared_->mutex);
+  shared_->acknowledged.wait_for(lock, std::chrono::seconds(10), [&] { return shared_->acked >= generation; });
+}
+
+void Recorder::reconfigure(RecordingSpec spec) {
+  spec.memory = spec_.memory;  // the queue keeps its size (its memory is the ingress threads')
+  spec_ = std::move(spec);
+  const std::lock_guard lock(shared_->mutex);
+  shared_->spec = spec_;
+  shared_->status.directory = spec_.directory;
+}
+
+RecorderStatus Recorder::status() const {
+  RecorderStatus out;
+  {
+    const std::lock_guard lock(shared_->mutex);
+    out = shared_->status;
+  }
+  out.dropped_full = dropped_full_.load(std::memory_order_relaxed);
+  out.queued_bytes = ring_.used();
+  return out;
+}
+
+}  // namespace cosmic

@@ -1,0 +1,233 @@
+// The recorder's writer thread (cosmic/recorder.hpp): takes the queued events, writes them into the
+// current MCAP file, rotates, flushes chunks, and answers start and stop.
+#include <cstring>
+#include <filesystem>
+
+#include "cosmic/recorder.hpp"
+#include "cosmic/thread_policy.hpp"
+#include "recorder_shared.hpp"
+#include "recording_file.hpp"
+
+namespace cosmic {
+
+using recorder_detail::QueuedHead;
+using recorder_detail::RecordingFile;
+using recorder_detail::TakenEvent;
+
+class Recorder::Writer {
+ public:
+  using Clock = std::chrono::steady_clock;
+  // How often the queue is emptied; what it must hold meanwhile is `memory`'s business.
+  static constexpr std::chrono::milliseconds kPoll{20};
+  // The open chunk is closed at least this often: what a crash can lose of what was queued.
+  static constexpr std::chrono::seconds kFlushEvery{1};
+  // After a failed open or write, the next file is tried this much later.
+  static constexpr std::chrono::seconds kRetryEvery{5};
+  static constexpr std::size_t kBatch = 4096;
+
+  explicit Writer(Recorder& recorder) : recorder_(recorder), shared_(*recorder.shared_) {}
+
+  void loop() {
+    for (const std::string& problem : apply_thread_policy(ThreadPolicy{"record", 0, 19, {}}))
+      recorder_.log_.log(LogLevel::warning, "recorder: could not get " + problem);
+    for (;;) {
+      bool quit = false;
+      std::uint64_t generation = 0;
+      bool want = false;
+      {
+        std::unique_lock lock(shared_.mutex);
+        shared_.wake.wait_for(lock, kPoll, [&] { return shared_.quit || shared_.generation != seen_generation_; });
+        quit = shared_.quit;
+        generation = shared_.generation;
+        want = shared_.want_recording;
+        spec_ = shared_.spec;
+        channels_ = shared_.channels;
+        segments_ = shared_.segments;
+      }
+      // What was queued before a stop still belongs to the recording.
+      drain();
+      const auto now = Clock::now();
+      if (generation != seen_generation_) act_on(want, now);
+      if (recording_) keep_up(now);
+      publish(generation);
+      if (quit) break;
+    }
+    finish_file();
+    publish(seen_generation_);
+  }
+
+ private:
+  void drain() {
+    while (recorder_.ring_.read([this](std::span<const std::uint8_t> record) { take(record); }, kBatch) == kBatch) {
+    }
+  }
+
+  void take(std::span<const std::uint8_t> record) {
+    if (!recording_) return;  // offered just before a stop: not part of any recording
+    QueuedHead head{};
+    std::memcpy(&head, record.data(), sizeof head);
+    const std::span<const std::uint8_t> payload = record.subspan(sizeof head);
+    const auto found = channels_->find(head.channel);
+    if (found == channels_->end()) {
+      ++dropped_invalid_;
+      return;
+    }
+    if (!file_) {
+      ++dropped_failed_;
+      return;
+    }
+    const RecordedChannel& channel = *found->second;
+    TakenEvent event;
+    event.channel = head.channel;
+    event.segment = head.segment < segments_->size() ? (*segments_)[head.segment] : std::to_string(head.segment);
+    event.origin = head.origin;
+    event.sequence = head.sequence;
+    event.created_ns = head.created_ns;
+    event.arrival_ns = head.arrival_ns;
+    event.contents = payload;
+    if (channel.json) {
+      json_.resize(channel.json->max_size());
+      const auto size = channel.json->write(payload, json_);
+      if (!size) {
+        ++dropped_invalid_;  // an event of the channel's previous type, queued before a rebind
+        return;
+      }
+      event.contents = {reinterpret_cast<const std::uint8_t*>(json_.data()), *size};
+    }
+    const auto written = file_->write(channel, event);
+    if (!written) {
+      ++dropped_failed_;
+      fail(written.error().text, Clock::now());
+    } else if (!written.value()) {
+      ++dropped_invalid_;
+    } else if (file_->writer().bytes_written() >= spec_.rotate_size) {
+      rotate(Clock::now());  // here, not only between polls: one poll may bring a file's worth
+    }
+  }
+
+  void rotate(Clock::time_point now) {
+    finish_file();
+    open_file(now);
+  }
+
+  void act_on(bool want, Clock::time_point now) {
+    if (want && !recording_) {
+      recording_ = true;
+      last_error_.clear();
+      open_file(now);
+      // A start that cannot open its first file is refused (Recorder::start reports why).
+      if (!file_) recording_ = false;
+    } else if (!want && recording_) {
+      finish_file();
+      recording_ = false;
+    }
+  }
+
+  void keep_up(Clock::time_point now) {
+    if (!file_) {
+      if (now >= next_retry_) open_file(now);
+      return;
+    }
+    const McapWriter& writer = file_->writer();
+    const bool full = writer.bytes_written() >= spec_.rotate_size;
+    const bool old = now - opened_ >= spec_.rotate_duration;
+    if (full || old) {
+      rotate(now);
+    } else if (now >= next_flush_) {
+      if (auto flushed = file_->flush_chunk(); !flushed) fail(flushed.error().text, now);
+      next_flush_ = now + kFlushEvery;
+    }
+  }
+
+  void open_file(Clock::time_point now) {
+    const std::int64_t utc =
+        std::chrono::duration_cast<Nanos>(std::chrono::system_clock::now().time_since_epoch()).count();
+    std::error_code ignored;
+    std::filesystem::create_directories(spec_.directory, ignored);
+    const std::string path = (std::filesystem::path(spec_.directory) /
+                              recorder_detail::recording_file_name(recorder_.gateway_, utc, ++numbered_))
+                                 .string();
+    auto file = RecordingFile::create(path, spec_, recorder_.gateway_, utc);
+    if (!file) {
+      fail(file.error().text, now);
+      return;
+    }
+    file_ = std::move(file).value();
+    opened_ = now;
+    next_flush_ = now + kFlushEvery;
+  }
+
+  void finish_file() {
+    if (auto closed = close_file(); !closed) {
+      last_error_ = closed.error().text;
+      recorder_.log_.log(LogLevel::error, "recorder: " + last_error_ + "; the file keeps what was written");
+    }
+  }
+
+  // Ends the current file, if any, and adds what it holds to the totals.
+  Result<void> close_file() {
+    if (!file_) return {};
+    auto finished = file_->finish();
+    const McapWriter& writer = file_->writer();
+    messages_ += writer.message_count();
+    bytes_ += writer.bytes_written();
+    uncompressed_ += writer.uncompressed_bytes();
+    compressed_ += writer.compressed_bytes();
+    ++files_;
+    file_.reset();
+    return finished;
+  }
+
+  // The file cannot go on: what it holds stays (readable up to its last whole chunk), the events
+  // count as dropped until the next file opens.
+  void fail(const std::string& why, Clock::time_point now) {
+    if (why != last_error_) recorder_.log_.log(LogLevel::error, "recorder: " + why);
+    last_error_ = why;
+    auto closed = close_file();
+    static_cast<void>(closed);  // already failing: the first reason is the one that counts
+    next_retry_ = now + kRetryEvery;
+  }
+
+  void publish(std::uint64_t generation) {
+    const std::lock_guard lock(shared_.mutex);
+    RecorderStatus& s = shared_.status;
+    s.recording = recording_;
+    s.directory = spec_.directory;
+    s.file = file_ ? file_->path() : std::string();
+    s.files = files_;
+    const McapWriter* writer = file_ ? &file_->writer() : nullptr;
+    s.messages = messages_ + (writer ? writer->message_count() : 0);
+    s.bytes = bytes_ + (writer ? writer->bytes_written() : 0);
+    s.uncompressed = uncompressed_ + (writer ? writer->uncompressed_bytes() : 0);
+    s.compressed = compressed_ + (writer ? writer->compressed_bytes() : 0);
+    s.dropped_failed = dropped_failed_;
+    s.dropped_invalid = dropped_invalid_;
+    s.last_error = last_error_;
+    if (generation != seen_generation_) {
+      seen_generation_ = generation;
+      shared_.acked = generation;
+      shared_.acknowledged.notify_all();
+    }
+  }
+
+  Recorder& recorder_;
+  Shared& shared_;
+  bool recording_ = false;
+  std::uint64_t seen_generation_ = 0;
+  RecordingSpec spec_;
+  std::shared_ptr<const Shared::ChannelTable> channels_;
+  std::shared_ptr<const std::vector<std::string>> segments_;
+  std::unique_ptr<RecordingFile> file_;
+  Clock::time_point opened_{};
+  Clock::time_point next_flush_{};
+  Clock::time_point next_retry_{};
+  std::uint64_t numbered_ = 0;
+  std::uint64_t files_ = 0, messages_ = 0, bytes_ = 0, uncompressed_ = 0, compressed_ = 0;
+  std::uint64_t dropped_failed_ = 0, dropped_invalid_ = 0;
+  std::string last_error_;
+  std::vector<char> json_;
+};
+
+void Recorder::run() { Writer(*this).loop(); }
+
+}  // namespace cosmic

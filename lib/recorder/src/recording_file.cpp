@@ -1,0 +1,112 @@
+// One MCAP file of the recorder (recording_file.hpp).
+#include "recording_file.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <ctime>
+
+namespace cosmic::recorder_detail {
+namespace {
+
+// Everything of `bytes` written to `fd`, however many calls that takes.
+Result<void> write_all(int fd, const std::string& path, std::span<const std::uint8_t> bytes) {
+  while (!bytes.empty()) {
+    auto written = posix_call("cannot write " + path, [&] { return ::write(fd, bytes.data(), bytes.size()); });
+    if (!written) return std::move(written).error();
+    bytes = bytes.subspan(static_cast<std::size_t>(written.value()));
+  }
+  return {};
+}
+
+std::string hex(std::uint64_t value) {
+  char text[20];
+  std::snprintf(text, sizeof text, "%llx", static_cast<unsigned long long>(value));
+  return text;
+}
+
+}  // namespace
+
+std::string recording_file_name(const std::string& gateway, std::int64_t utc_ns, std::uint64_t n) {
+  const std::time_t seconds = static_cast<std::time_t>(utc_ns / 1'000'000'000);
+  std::tm parts{};
+  ::gmtime_r(&seconds, &parts);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &parts);
+  return gateway + "-" + stamp + "-" + std::to_string(n) + ".mcap";
+}
+
+Result<std::unique_ptr<RecordingFile>> RecordingFile::create(const std::string& path, const RecordingSpec& spec,
+                                                             const std::string& gateway, std::int64_t opened_ns) {
+  auto fd = posix_call("cannot create " + path,
+                       [&] { return ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0640); });
+  if (!fd) return std::move(fd).error();
+  OwnedFd owned(fd.value());
+  McapWriterOptions options;
+  options.profile = "x-cosmic";
+  options.library = "cosmic-gateway";
+  options.compression = spec.compression == RecordCompression::zstd ? McapCompression::zstd : McapCompression::none;
+  options.chunk_size = spec.chunk_size;
+  const int raw = owned.get();
+  auto writer = McapWriter::open(
+      options, [raw, path](std::span<const std::uint8_t> bytes) { return write_all(raw, path, bytes); });
+  if (!writer) return std::move(writer).error();
+  std::unique_ptr<RecordingFile> file(new RecordingFile(path, std::move(owned), opened_ns, std::move(writer).value()));
+  const McapMap about{{"gateway", gateway}, {"opened_utc_ns", std::to_string(opened_ns)}};
+  if (auto written = file->writer_.add_metadata("cosmic", about); !written) return std::move(written).error();
+  return file;
+}
+
+RecordingFile::RecordingFile(std::string path, OwnedFd fd, std::int64_t opened_ns, McapWriter writer)
+    : path_(std::move(path)), fd_(std::move(fd)), opened_ns_(opened_ns), writer_(std::move(writer)) {}
+
+RecordingFile::~RecordingFile() = default;
+
+Result<std::uint16_t> RecordingFile::channel_id(const RecordedChannel& channel, const TakenEvent& event) {
+  const auto key = std::make_tuple(channel.id, event.segment, event.origin);
+  if (const auto it = channels_.find(key); it != channels_.end()) return it->second;
+  std::uint16_t schema = 0;
+  if (channel.json) {
+    if (const auto it = schemas_.find(channel.id); it != schemas_.end()) {
+      schema = it->second;
+    } else {
+      const auto* text = reinterpret_cast<const std::uint8_t*>(channel.json_schema.data());
+      auto added = writer_.add_schema(channel.name, "jsonschema", {text, channel.json_schema.size()});
+      if (!added) return std::move(added).error();
+      schema = schemas_[channel.id] = added.value();
+    }
+  }
+  McapMap metadata = channel.metadata;
+  metadata["segment"] = event.segment;
+  metadata["origin"] = hex(event.origin);
+  auto added = writer_.add_channel(schema, channel.name, channel.json ? "json" : "x-cosmic-bytes", metadata);
+  if (!added) return std::move(added).error();
+  channels_.emplace(key, added.value());
+  return added.value();
+}
+
+Result<bool> RecordingFile::write(const RecordedChannel& channel, const TakenEvent& event) {
+  // Declaring writes nothing to the file yet (the records go into the open chunk): a refusal here
+  // is this event's, not the file's.
+  const auto id = channel_id(channel, event);
+  if (!id) return false;
+  auto written =
+      writer_.write_message(id.value(), event.sequence, static_cast<std::uint64_t>(event.arrival_ns),
+                            static_cast<std::uint64_t>(std::max<std::int64_t>(event.created_ns, 0)), event.contents);
+  if (!written) return std::move(written).error();
+  return true;
+}
+
+Result<void> RecordingFile::finish() {
+  auto finished = writer_.finish();
+  if (const int fd = fd_.release(); fd >= 0) {
+    // What was written is the file's either way; a failed fsync is as bad as a failed write.
+    const bool synced = ::fdatasync(fd) == 0;
+    const int err = errno;
+    ::close(fd);
+    if (finished && !synced) return Error::from_errno("cannot sync " + path_, err);
+  }
+  return finished;
+}
+
+}  // namespace cosmic::recorder_detail

@@ -1,0 +1,230 @@
+// The recorder (cosmic/recorder.hpp) over real files in a temporary directory, read back with the
+// MCAP reader: events offered while recording come out of the file with their channel, source
+// segment, origin, sequence, arrival and creation times and contents (a typed channel's as JSON,
+// with its schema); files rotate by size, each whole; nothing is recorded before start() or after
+// stop(); a directory that cannot be written refuses start() with the reason; an event too long for
+// the queue, or of a channel the recorder does not know, is counted, not written.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "cosmic/mcap_reader.hpp"
+#include "cosmic/recorder.hpp"
+
+namespace cosmic {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+class CollectingLogger final : public Logger {
+ public:
+  void log(LogLevel, std::string_view message) override {
+    const std::lock_guard lock(mutex_);
+    lines_.emplace_back(message);
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::string> lines_;
+};
+
+Nanos steady_now() { return std::chrono::duration_cast<Nanos>(std::chrono::steady_clock::now().time_since_epoch()); }
+
+std::int64_t utc_now() {
+  return std::chrono::duration_cast<Nanos>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+ChannelType distance_type() {
+  FieldType f32;
+  f32.kind = FieldType::Kind::scalar;
+  f32.scalar = ScalarKind::float32;
+  ChannelType type;
+  type.fields.push_back(TypeField{"distance", f32, "m", std::nullopt, std::nullopt, std::nullopt});
+  return type;
+}
+
+std::vector<std::uint8_t> float_bytes(float value) {
+  std::vector<std::uint8_t> out(4);
+  std::memcpy(out.data(), &value, 4);
+  return out;
+}
+
+class RecorderTest : public testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(testing::TempDir()) / ("recorder_test_" + std::to_string(::getpid()) + "_" +
+                                           testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    spec_.directory = (dir_ / "rec").string();
+    spec_.chunk_size = 4096;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::vector<RecordedChannel> channels() const {
+    RecordedChannel bytes;
+    bytes.id = 1;
+    bytes.name = "obstacle";
+    bytes.metadata = {{"subject", "0x10"}, {"class", "hrt"}};
+    RecordedChannel typed;
+    typed.id = 2;
+    typed.name = "range";
+    typed.json = std::make_shared<const JsonRepresentation>(distance_type());
+    typed.json_schema = R"({"type":"object"})";
+    return {bytes, typed};
+  }
+
+  std::vector<fs::path> files() const {
+    std::vector<fs::path> out;
+    for (const auto& entry : fs::directory_iterator(spec_.directory)) out.push_back(entry.path());
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+
+  static McapFile read(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    auto file = read_mcap(bytes);
+    EXPECT_TRUE(file) << path << ": " << (file ? "" : file.error().text);
+    return file ? std::move(file).value() : McapFile{};
+  }
+
+  static EventHeader header(std::uint64_t origin, std::uint32_t sequence, std::int64_t created) {
+    EventHeader h;
+    h.origin = origin;
+    h.sequence = sequence;
+    h.created_ns = created;
+    return h;
+  }
+
+  fs::path dir_;
+  RecordingSpec spec_;
+  CollectingLogger log_;
+};
+
+TEST_F(RecorderTest, EventsComeBackWithTheirChannelSegmentOriginTimesAndContents) {
+  Recorder recorder(spec_, "gw", log_);
+  recorder.set_channels(channels());
+  recorder.set_segment_names({"body-can", "lan"});
+  const std::vector<std::uint8_t> before{0xEE};
+  recorder.offer(1, 0, header(0xA1, 1, 5), steady_now(), before);  // not recording yet
+  ASSERT_TRUE(recorder.start().ok());
+  const std::int64_t started = utc_now();
+  const std::vector<std::uint8_t> obstacle{1, 2, 3};
+  recorder.offer(1, 0, header(0xA1, 7, 1'000), steady_now(), obstacle);
+  recorder.offer(1, 1, header(0xB2, 8, 2'000), steady_now(), obstacle);
+  recorder.offer(2, 1, header(0xA1, 9, 3'000), steady_now(), float_bytes(1.5f));
+  recorder.stop();
+  recorder.offer(1, 0, header(0xA1, 10, 4'000), steady_now(), before);  // stopped
+  const RecorderStatus status = recorder.status();
+  EXPECT_FALSE(status.recording);
+  EXPECT_EQ(status.files, 1u);
+  EXPECT_EQ(status.messages, 3u);
+  EXPECT_EQ(status.dropped_full + status.dropped_failed + status.dropped_invalid, 0u);
+
+  const auto paths = files();
+  ASSERT_EQ(paths.size(), 1u);
+  EXPECT_EQ(paths[0].filename().string().substr(0, 3), "gw-");
+  EXPECT_EQ(paths[0].extension(), ".mcap");
+  const McapFile file = read(paths[0]);
+  EXPECT_FALSE(file.truncated);
+  ASSERT_TRUE(file.summary.has_value());
+  ASSERT_EQ(file.messages.size(), 3u);
+  // One MCAP channel per channel, source segment and origin; the topic is the channel's name.
+  ASSERT_EQ(file.channels.size(), 3u);
+  std::set<std::string> seen;
+  for (const McapChannel& c : file.channels)
+    seen.insert(c.topic + "|" + c.message_encoding + "|" + c.metadata.at("segment") + "|" + c.metadata.at("origin"));
+  EXPECT_EQ(seen, (std::set<std::string>{"obstacle|x-cosmic-bytes|body-can|a1", "obstacle|x-cosmic-bytes|lan|b2",
+                                         "range|json|lan|a1"}));
+  EXPECT_EQ(file.channels[0].metadata.at("subject"), "0x10");
+  ASSERT_EQ(file.schemas.size(), 1u);
+  EXPECT_EQ(file.schemas[0].name, "range");
+  EXPECT_EQ(file.schemas[0].encoding, "jsonschema");
+  EXPECT_EQ(std::string(file.schemas[0].data.begin(), file.schemas[0].data.end()), R"({"type":"object"})");
+
+  EXPECT_EQ(file.messages[0].sequence, 7u);
+  EXPECT_EQ(file.messages[0].publish_time, 1'000u);
+  EXPECT_EQ(file.messages[0].data, obstacle);
+  EXPECT_EQ(file.messages[1].sequence, 8u);
+  EXPECT_EQ(file.messages[2].sequence, 9u);
+  EXPECT_EQ(file.messages[2].publish_time, 3'000u);
+  EXPECT_EQ(std::string(file.messages[2].data.begin(), file.messages[2].data.end()), R"({"distance":1.5})");
+  for (const McapMessage& m : file.messages) {
+    // Arrival on this host's UTC clock, within the test's run.
+    EXPECT_GE(static_cast<std::int64_t>(m.log_time), started - 1'000'000'000);
+    EXPECT_LE(static_cast<std::int64_t>(m.log_time), utc_now());
+  }
+}
+
+TEST_F(RecorderTest, FilesRotateBySizeAndEachIsWhole) {
+  spec_.rotate_size = 1 << 20;
+  spec_.compression = RecordCompression::none;  // the size grows as the events do
+  Recorder recorder(spec_, "gw", log_);
+  recorder.set_channels(channels());
+  recorder.set_segment_names({"body-can"});
+  ASSERT_TRUE(recorder.start().ok());
+  const std::vector<std::uint8_t> payload(1000, 0x5a);
+  constexpr std::uint32_t kEvents = 3000;  // about 3 MB
+  for (std::uint32_t n = 1; n <= kEvents; ++n) {
+    recorder.offer(1, 0, header(1, n, n), steady_now(), payload);
+    // Paced by what the writer has taken, so the queue never fills: every event is written.
+    while (recorder.status().queued_bytes > recorder.status().queue_bytes / 2) std::this_thread::yield();
+  }
+  recorder.stop();
+  EXPECT_EQ(recorder.status().dropped_full, 0u);
+  const auto paths = files();
+  ASSERT_GE(paths.size(), 3u);
+  std::uint32_t next = 1;
+  for (const auto& path : paths) {
+    const McapFile file = read(path);
+    EXPECT_FALSE(file.truncated) << path;
+    EXPECT_TRUE(file.summary.has_value()) << path;
+    for (const McapMessage& m : file.messages) EXPECT_EQ(m.sequence, next++);
+    EXPECT_LE(fs::file_size(path), (1u << 20) + 64 * 1024) << path;
+  }
+  EXPECT_EQ(next, kEvents + 1) << "every event, in order, across the files";
+  EXPECT_EQ(recorder.status().files, paths.size());
+}
+
+TEST_F(RecorderTest, ADirectoryThatCannotBeWrittenRefusesStartWithTheReason) {
+  fs::create_directories(dir_);
+  std::ofstream(dir_ / "plain-file") << "not a directory";
+  spec_.directory = (dir_ / "plain-file" / "rec").string();
+  Recorder recorder(spec_, "gw", log_);
+  const auto started = recorder.start();
+  ASSERT_FALSE(started.ok());
+  EXPECT_NE(started.error().text.find("cannot make the recording directory " + spec_.directory), std::string::npos)
+      << started.error().text;
+  EXPECT_FALSE(recorder.status().recording);
+}
+
+TEST_F(RecorderTest, TooLongAndUnknownEventsAreCountedNotWritten) {
+  spec_.memory = 1 << 20;
+  Recorder recorder(spec_, "gw", log_);
+  recorder.set_channels(channels());
+  ASSERT_TRUE(recorder.start().ok());
+  const std::vector<std::uint8_t> huge(300 * 1024, 1);  // beyond a quarter of the 1 MiB queue
+  recorder.offer(1, 0, header(1, 1, 1), steady_now(), huge);
+  recorder.offer(99, 0, header(1, 2, 1), steady_now(), std::vector<std::uint8_t>{1});    // not a recorded channel
+  recorder.offer(2, 0, header(1, 3, 1), steady_now(), std::vector<std::uint8_t>{1, 2});  // not a float32
+  recorder.offer(1, 0, header(1, 4, 1), steady_now(), std::vector<std::uint8_t>{1});
+  recorder.stop();
+  const RecorderStatus status = recorder.status();
+  EXPECT_EQ(status.dropped_full, 1u);
+  EXPECT_EQ(status.dropped_invalid, 2u);
+  EXPECT_EQ(status.messages, 1u);
+  const McapFile file = read(files().at(0));
+  ASSERT_EQ(file.messages.size(), 1u);
+  EXPECT_EQ(file.messages[0].sequence, 4u);
+}
+
+}  // namespace
+}  // namespace cosmic
