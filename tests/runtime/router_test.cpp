@@ -459,3 +459,55 @@ TEST(RouterLanes, StartingAndStoppingAtOnceNeverHangs) {
 
 }  // namespace
 }  // namespace cosmic
+
+namespace cosmic {
+namespace {
+
+// What the recorder sees (cosmic/record_hook.hpp): every admitted event of a selected channel,
+// with its source segment and the header it leaves with; nothing of unselected channels, nor of
+// events ingress refused; a new selection applies to channels already bound.
+class SeenByRecorder final : public RecordHook {
+ public:
+  void offer(ChannelId channel, std::size_t from_segment, const EventHeader& header, Nanos,
+             std::span<const std::uint8_t> payload) noexcept override {
+    seen.push_back({channel, from_segment, header.sequence, header.origin, {payload.begin(), payload.end()}});
+  }
+  struct Seen {
+    ChannelId channel;
+    std::size_t segment;
+    std::uint32_t sequence;
+    std::uint64_t origin;
+    std::vector<std::uint8_t> payload;
+  };
+  std::vector<Seen> seen;
+};
+
+TEST_F(RouterTest, TheRecordHookSeesTheAdmittedEventsOfSelectedChannelsOnly) {
+  SeenByRecorder recorder;
+  router.set_record_hook(&recorder);
+  router.select_recorded([](const ChannelSpec& spec) { return spec.name == "recorded"; });
+  bind({channel("recorded", ChannelClass::nrt), channel("other", ChannelClass::nrt)});
+  deliver(1, EventHeader{}, Nanos(1000), {7, 8});
+  deliver(2, EventHeader{}, Nanos(1000), {9});
+  EventHeader foreign;
+  foreign.hop_count = kMaxHops;  // a loop: refused at ingress, never recorded
+  deliver(1, foreign, Nanos(2000));
+  ASSERT_EQ(recorder.seen.size(), 1u);
+  EXPECT_EQ(recorder.seen[0].channel, 1u);
+  EXPECT_EQ(recorder.seen[0].segment, 0u);
+  EXPECT_EQ(recorder.seen[0].origin, kSelf) << "as it leaves: this gateway originates it";
+  EXPECT_EQ(recorder.seen[0].sequence, 1u);
+  EXPECT_EQ(recorder.seen[0].payload, (std::vector<std::uint8_t>{7, 8}));
+  router.select_recorded([](const ChannelSpec& spec) { return spec.name == "other"; });
+  deliver(1, EventHeader{}, Nanos(3000));
+  deliver(2, EventHeader{}, Nanos(3000), {5});
+  ASSERT_EQ(recorder.seen.size(), 2u);
+  EXPECT_EQ(recorder.seen[1].channel, 2u);
+  router.select_recorded({});
+  deliver(2, EventHeader{}, Nanos(4000));
+  EXPECT_EQ(recorder.seen.size(), 2u);
+  router.set_record_hook(nullptr);
+}
+
+}  // namespace
+}  // namespace cosmic
