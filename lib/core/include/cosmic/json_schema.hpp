@@ -7,6 +7,8 @@
 //   record       {"type": "object", "properties" in field order, "required": the fields without
 //                present_when, "additionalProperties": false}; each conditional field adds an
 //                if/then/else to "allOf": present exactly while its selector holds the value
+//                (a selector value of 2^53 or more leaves the field merely optional: validators
+//                that read numbers as doubles cannot tell it from its neighbours)
 //   bool         {"type": "boolean"}
 //   intN, uintN  {"type": "integer"} within the kind's limits
 //   float32/64   {"type": ["number", "null"]} (NaN and infinities are written as null); float32
