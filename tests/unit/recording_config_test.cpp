@@ -11,7 +11,7 @@ namespace {
 
 using namespace std::chrono_literals;
 
-std::string document(const std::string& recording) {
+std::string recording_document(const std::string& recording) {
   return "segments:\n"
          "  - {name: lan, type: dds, domain: 3}\n"
          "  - {name: body, type: can, interface: can0, bitrate: 500kbit/s}\n"
@@ -23,13 +23,13 @@ std::string document(const std::string& recording) {
 }
 
 TEST(RecordingConfig, WithoutTheSectionNothingIsRecorded) {
-  const ConfigResult r = parse_config(document(""), "/etc/cosmic/g.yaml");
+  const ConfigResult r = parse_config(recording_document(""), "/etc/cosmic/g.yaml");
   ASSERT_TRUE(r.ok()) << test::errors_text(r);
   EXPECT_FALSE(r.config.recording.enabled());
 }
 
 TEST(RecordingConfig, DefaultsSelectEveryChannelWithZstdChunksAndRotation) {
-  const ConfigResult r = parse_config(document("recording: {directory: rec}\n"), "/etc/cosmic/g.yaml");
+  const ConfigResult r = parse_config(recording_document("recording: {directory: rec}\n"), "/etc/cosmic/g.yaml");
   ASSERT_TRUE(r.ok()) << test::errors_text(r);
   const RecordingSpec& rec = r.config.recording;
   EXPECT_TRUE(rec.enabled());
@@ -46,15 +46,15 @@ TEST(RecordingConfig, DefaultsSelectEveryChannelWithZstdChunksAndRotation) {
 }
 
 TEST(RecordingConfig, ReadsEveryKeyAndSelectsByNameAndGlob) {
-  const ConfigResult r = parse_config(document("recording:\n"
-                                               "  directory: /var/lib/cosmicd/rec/\n"
-                                               "  channels: [obstacle, 'drive_c*']\n"
-                                               "  compression: none\n"
-                                               "  chunk_size: 64KiB\n"
-                                               "  rotate: {size: 8MiB, duration: 30s}\n"
-                                               "  memory: 4MiB\n"
-                                               "  start: false\n"
-                                               "  candump: [body]\n"),
+  const ConfigResult r = parse_config(recording_document("recording:\n"
+                                                         "  directory: /var/lib/cosmicd/rec/\n"
+                                                         "  channels: [obstacle, 'drive_c*']\n"
+                                                         "  compression: none\n"
+                                                         "  chunk_size: 64KiB\n"
+                                                         "  rotate: {size: 8MiB, duration: 30s}\n"
+                                                         "  memory: 4MiB\n"
+                                                         "  start: false\n"
+                                                         "  candump: [body]\n"),
                                       "g.yaml");
   ASSERT_TRUE(r.ok()) << test::errors_text(r);
   const RecordingSpec& rec = r.config.recording;
@@ -102,14 +102,14 @@ TEST(RecordingConfig, EveryMistakeIsReportedWithItsPlace) {
       {"recording: [rec]\n", "recording"},
   };
   for (const Case& c : cases) {
-    const ConfigResult r = parse_config(document(c.recording), "g.yaml");
+    const ConfigResult r = parse_config(recording_document(c.recording), "g.yaml");
     test::expect_refused_with(r, c.expected);
   }
 }
 
 TEST(RecordingConfig, AllMistakesOfTheSectionAreReportedAtOnce) {
-  const ConfigResult r =
-      parse_config(document("recording: {directory: rec, channels: [nope], memory: 1KiB, candump: [lan]}\n"), "g.yaml");
+  const ConfigResult r = parse_config(
+      recording_document("recording: {directory: rec, channels: [nope], memory: 1KiB, candump: [lan]}\n"), "g.yaml");
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.errors.size(), 3u) << test::errors_text(r);
 }

@@ -1,5 +1,7 @@
 #include "cosmic/dds_security_files.hpp"
 
+#include <openssl/pem.h>
+
 #include "openssl_handles.hpp"
 
 namespace cosmic {
