@@ -32,6 +32,7 @@ std::vector<CommandRunner> add_daemon_commands(CLI::App& app, const GlobalOption
 CommandRunner add_diagram_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_echo_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_gen_command(CLI::App& app, const GlobalOptions& options);
+CommandRunner add_record_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_security_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_top_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_types_command(CLI::App& app, const GlobalOptions& options);

@@ -1,5 +1,4 @@
 #include "control_client.hpp"
-#include "cosmic/posix_call.hpp"
 
 #include <poll.h>
 #include <sys/socket.h>
@@ -9,6 +8,10 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <iostream>
+
+#include "commands.hpp"
+#include "cosmic/posix_call.hpp"
 
 namespace cosmicctl {
 namespace {
@@ -110,6 +113,29 @@ ClientResult request(const std::string& socket_path, const nlohmann::json& reque
   auto parsed = nlohmann::json::parse(answer, nullptr, false);
   if (parsed.is_discarded()) return failure("cosmicd sent an unreadable answer");
   return ClientResult{std::move(parsed), {}, false};
+}
+
+namespace {
+std::string error_text(const nlohmann::json& value) {
+  return value.is_string() ? value.get<std::string>() : value.dump();
+}
+}  // namespace
+
+void print_errors(const nlohmann::json& response) {
+  std::cerr << "cosmicctl: " << error_text(response["error"].value("message", nlohmann::json("request failed")))
+            << "\n";
+  if (response.contains("errors")) {
+    for (const auto& e : response["errors"]) std::cerr << error_text(e["text"]) << "\n";
+  }
+}
+
+int exit_code_for_failure(const nlohmann::json& response) {
+  const std::string code = response["error"].value("code", "");
+  if (code == "permission_denied") return kExitNoPermission;
+  if (code == "config_error") return kExitConfigError;
+  if (code == "bad_request" || code == "unknown_command") return kExitUsage;
+  if (code == "busy" || code == "timeout") return kExitTempFail;
+  return kExitRejected;
 }
 
 }  // namespace cosmicctl

@@ -26,22 +26,6 @@ std::string micros(double seconds) {
 
 std::string text(const Json& value) { return value.is_string() ? value.get<std::string>() : value.dump(); }
 
-void print_errors(const Json& response) {
-  std::cerr << "cosmicctl: " << text(response["error"].value("message", Json("request failed"))) << "\n";
-  if (response.contains("errors")) {
-    for (const auto& e : response["errors"]) std::cerr << text(e["text"]) << "\n";
-  }
-}
-
-int exit_code_for_failure(const Json& response) {
-  const std::string code = response["error"].value("code", "");
-  if (code == "permission_denied") return kExitNoPermission;
-  if (code == "config_error") return kExitConfigError;
-  if (code == "bad_request" || code == "unknown_command") return kExitUsage;
-  if (code == "busy" || code == "timeout") return kExitTempFail;
-  return kExitRejected;
-}
-
 // JSON carries UTF-8 only: other bytes get a clear message instead of an encoder exception.
 bool is_utf8(const std::string& what, const std::string& text) {
   const auto bad = first_invalid_utf8(text);

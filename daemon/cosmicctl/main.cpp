@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   commands.push_back(cosmicctl::add_diagram_command(app, options));
   commands.push_back(cosmicctl::add_echo_command(app, options));
   commands.push_back(cosmicctl::add_gen_command(app, options));
+  commands.push_back(cosmicctl::add_record_command(app, options));
   commands.push_back(cosmicctl::add_security_command(app, options));
   commands.push_back(cosmicctl::add_top_command(app, options));
   commands.push_back(cosmicctl::add_types_command(app, options));

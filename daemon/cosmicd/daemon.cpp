@@ -21,6 +21,7 @@
 #include "cosmic/thread_policy.hpp"
 #include "daemon_logger.hpp"
 #include "federation_member.hpp"
+#include "recording_service.hpp"
 #include "metrics_server.hpp"
 #include "realtime_watchdog.hpp"
 #include "service_notifier.hpp"
@@ -119,6 +120,9 @@ class Daemon {
         server.offload());
     protocol_ = &protocol;
     protocol.add_reader("peers", [this] { return federation_.peers_json(steady_now()); });
+    protocol.add_reader("record_status", [this] { return recording_.status(); });
+    protocol.add_operator("record_start", [this](const nlohmann::json&) { return recording_.start(); });
+    protocol.add_operator("record_stop", [this](const nlohmann::json&) { return recording_.stop(); });
     protocol.set_bind_gate([this](const cosmic::BindPlan& plan, std::function<void()> commit) {
       federation_.gate(plan, std::move(commit));
     });
@@ -143,7 +147,8 @@ class Daemon {
     notifier_.stopping();
     server.close_all();  // joins the admission worker before `protocol` goes
     protocol_ = nullptr;
-    federation_.leave();  // peers release this gateway's reservations now, not after the lease
+    federation_.leave();     // peers release this gateway's reservations now, not after the lease
+    recording_.shut_down();  // the last file finished before the adapters go
     gateway_.stop();
     log_.log(cosmic::LogLevel::notice, "cosmicd stopped");
     return kExitOk;
@@ -184,6 +189,7 @@ class Daemon {
       return false;
     }
     log_verdicts(log_, started.channels);
+    recording_.configure(gateway_, gateway_.config());
     report_realtime(config.gateway.realtime);
     restore_runtime_bindings();
     return true;
@@ -259,6 +265,7 @@ class Daemon {
     if (command == "reload") {
       state_ = {};  // the file is the truth again
       file_config_ = gateway_.config();
+      recording_.configure(gateway_, gateway_.config());
     } else if (command == "bind" || command == "replace") {
       // A replacement is saved as a bind of the new definitions: at the next start they are
       // bound in place of the file's (or the earlier runtime) definitions of the same names.
@@ -355,8 +362,9 @@ class Daemon {
   DaemonOptions options_;
   DaemonLogger log_;
   std::string state_file_;
-  AdapterFactory adapters_;        // before gateway_: the adapters' shared state outlives them
-  bool state_file_usable_ = true;  // false: unusable at start and could not be set aside
+  AdapterFactory adapters_;           // before gateway_: the adapters' shared state outlives them
+  bool state_file_usable_ = true;     // false: unusable at start and could not be set aside
+  RecordingService recording_{log_};  // before gateway_: the router may call its recorder until it stops
   cosmic::Gateway gateway_;
   FederationMember federation_;  // after gateway_: it uses the gateway until it is destroyed
   ServiceNotifier notifier_;

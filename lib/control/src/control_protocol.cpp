@@ -101,7 +101,8 @@ std::string ControlProtocol::next_log_tag(const char* kind, const PeerCredential
 ControlProtocol::Answer ControlProtocol::dispatch(const Json& request, const PeerCredentials& peer,
                                                   const Reply& later) {
   const std::string command = request["command"].get<std::string>();
-  const bool mutating = is_mutating(command);
+  const auto op = operators_.find(command);
+  const bool mutating = is_mutating(command) || op != operators_.end();
   if (!(mutating ? policy_.may_modify(peer) : policy_.may_read(peer))) {
     if (const auto count = denials_.deny(peer.uid, command, std::chrono::steady_clock::now())) {
       std::string line = next_log_tag("denied", peer) + " may not run " + printable(command);
@@ -123,10 +124,12 @@ ControlProtocol::Answer ControlProtocol::dispatch(const Json& request, const Pee
   if (command == "echo_open") return echo_->open(request, now);
   if (command == "echo_read") return echo_->read(request, now);
   if (command == "echo_close") return echo_->close(request);
+  if (op != operators_.end()) return op->second(request);
   if (mutating) return mutate(command, request, peer, later);
   if (const auto reader = readers_.find(command); reader != readers_.end()) return reader->second();
   std::string known = "status, segments, channels, channel, echo_open, echo_read, echo_close";
   for (const auto& [name, answer] : readers_) known += ", " + name;
+  for (const auto& [name, answer] : operators_) known += ", " + name;
   return failure("unknown_command",
                  "unknown command '" + printable(command) + "' (" + known + ", bind, replace, unbind, reload)");
 }

@@ -56,6 +56,8 @@ BindResult Gateway::start(const Config& config) {
   identity_.name = config.gateway.name;
   const RouterLimits limits = router_limits(config.gateway);
   router_ = std::make_unique<Router>(identity_, kMaxSegments, limits);
+  router_->set_record_hook(record_hook_);
+  router_->select_recorded(record_selection_);
   const ThreadPolicy receive{"rx", config.gateway.realtime.receive_priority, 0, config.gateway.realtime.cpus.receive};
   for (std::size_t i = 0; i < kMaxSegments; ++i) {
     EventSink& inbox = router_->inbox(i);
@@ -211,7 +213,28 @@ void Gateway::apply_routes() {
     if (channel.type && !add_representations(route)) continue;
     routes.push_back(std::move(route));
   }
-  router_->apply(std::move(routes));
+  if (!on_routes_) {
+    router_->apply(std::move(routes));
+    return;
+  }
+  router_->apply(routes);
+  on_routes_(routes);
+}
+
+void Gateway::set_recording(RecordHook* hook, std::function<bool(const ChannelSpec&)> selects,
+                            RouteObserver on_routes) {
+  record_hook_ = hook;
+  record_selection_ = std::move(selects);
+  on_routes_ = std::move(on_routes);
+  if (!router_) return;
+  router_->set_record_hook(record_hook_);
+  router_->select_recorded(record_selection_);
+  apply_routes();  // the same table again (no channel's state changes), shown to the observer
+}
+
+void Gateway::select_recorded(std::function<bool(const ChannelSpec&)> selects) {
+  record_selection_ = std::move(selects);
+  if (router_) router_->select_recorded(record_selection_);
 }
 
 // Each hop's representation of a typed channel. Admission has rejected a channel with a hop that

@@ -82,6 +82,11 @@ class ControlProtocol {
   void add_reader(std::string command, std::function<nlohmann::json()> answer) {
     readers_[std::move(command)] = std::move(answer);
   }
+  // Adds a command that changes the gateway (may_modify applies) answered by `answer` on the control
+  // thread, e.g. `record_start` from the daemon's recorder; its answer carries "ok" itself.
+  void add_operator(std::string command, std::function<nlohmann::json(const nlohmann::json& request)> answer) {
+    operators_[std::move(command)] = std::move(answer);
+  }
   // Installs the gate binds pass before their commit (only with an Offload: inline binds commit at once).
   void set_bind_gate(BindGate gate) { gate_ = std::move(gate); }
 
@@ -134,7 +139,8 @@ class ControlProtocol {
   std::string running_;             // what admission runs off the control thread, for `busy` answers
   std::uint64_t log_sequence_ = 0;  // numbers audit and denial lines: no two are alike, none folded
   DenialLog denials_;               // which denials are logged (a burst is summarised)
-  std::map<std::string, std::function<Json()>> readers_;  // add_reader()
+  std::map<std::string, std::function<Json()>> readers_;               // add_reader()
+  std::map<std::string, std::function<Json(const Json&)>> operators_;  // add_operator()
   BindGate gate_;
   std::unique_ptr<control_detail::EchoTaps> echo_;  // echo_open, echo_read, echo_close
 };

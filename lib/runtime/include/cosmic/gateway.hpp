@@ -241,6 +241,14 @@ class Gateway {
   std::optional<TapRead> read_tap(std::uint32_t tap);
   void close_tap(std::uint32_t tap);
 
+  // The recorder (issue 37; cosmic/record_hook.hpp): `hook` sees the admitted events of the
+  // channels `selects` picks, in this route table and every later one, and `on_routes` is shown
+  // each route table as applied (start, bind, unbind, reload). The hook must outlive the gateway's
+  // router. select_recorded() changes only the selection (recording started or stopped).
+  using RouteObserver = std::function<void(const std::vector<Route>&)>;
+  void set_recording(RecordHook* hook, std::function<bool(const ChannelSpec&)> selects, RouteObserver on_routes);
+  void select_recorded(std::function<bool(const ChannelSpec&)> selects);
+
  private:
   struct SegmentSlot {
     std::size_t index = 0;
@@ -295,6 +303,9 @@ class Gateway {
   std::unique_ptr<KnowledgeBase> kb_;
   std::unique_ptr<Router> router_;
   std::map<std::string, RuntimeTrack> runtime_;  // by channel name
+  RecordHook* record_hook_ = nullptr;
+  std::function<bool(const ChannelSpec&)> record_selection_;
+  RouteObserver on_routes_;
   // What each routed typed channel's hops carry (Representation::describe()), as apply_routes() built
   // them: channel -> segment -> form.
   std::map<std::string, std::map<std::string, std::string>> hop_forms_;

@@ -1,0 +1,150 @@
+// cosmicd's recording (recording_service.hpp).
+#include "recording_service.hpp"
+
+#include <cstdio>
+
+#include "cosmic/json_schema.hpp"
+
+namespace cosmicd {
+namespace {
+
+using Json = nlohmann::json;
+
+Json failure(const std::string& code, const std::string& message) {
+  return Json{{"ok", false}, {"error", {{"code", code}, {"message", message}}}};
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& name : names) out += (out.empty() ? "" : ",") + name;
+  return out;
+}
+
+// What a reader of the file should know of the channel's contract (MCAP channel metadata).
+cosmic::McapMap contract_of(const cosmic::ChannelSpec& spec) {
+  char subject[24];
+  std::snprintf(subject, sizeof subject, "0x%llx", static_cast<unsigned long long>(spec.subject));
+  cosmic::McapMap out{{"subject", subject},
+                      {"class", cosmic::to_string(spec.cls)},
+                      {"payload_bytes", std::to_string(spec.payload)},
+                      {"publishers", joined(spec.publishers)},
+                      {"subscribers", joined(spec.subscribers)}};
+  if (spec.period) out["period"] = cosmic::format_duration(*spec.period);
+  if (spec.type) out["type"] = cosmic::describe(*spec.type);
+  return out;
+}
+
+}  // namespace
+
+void RecordingService::configure(cosmic::Gateway& gateway, const cosmic::Config& config) {
+  gateway_ = &gateway;
+  const cosmic::RecordingSpec& next = config.recording;
+  const bool added = next.enabled() && !spec_.enabled();
+  const bool changed = next != spec_;
+  spec_ = next;
+  if (!spec_.enabled()) {
+    if (recording_) stop();
+    return;
+  }
+  if (!recorder_) {
+    recorder_ = std::make_unique<cosmic::Recorder>(spec_, config.gateway.name, log_);
+    gateway.set_recording(recorder_.get(), {}, [this](const std::vector<cosmic::Route>& routes) { on_routes(routes); });
+  } else if (changed) {
+    recorder_->reconfigure(spec_);
+  }
+  if (added && spec_.start) {
+    if (const Json answer = start(); !answer.value("ok", false))
+      log_.log(cosmic::LogLevel::error, "recording did not start: " + answer["error"].value("message", ""));
+    return;
+  }
+  if (recording_ && changed) {
+    // The new directory, compression and rotation from a new file on, the new selection now.
+    recorder_->stop();
+    select(true);
+    if (auto started = recorder_->start(); !started) {
+      recording_ = false;
+      select(false);
+      log_.log(cosmic::LogLevel::error, "recording stopped: " + started.error().text);
+    }
+  }
+}
+
+void RecordingService::on_routes(const std::vector<cosmic::Route>& routes) {
+  std::vector<cosmic::RecordedChannel> channels;
+  std::vector<std::string> segments;
+  for (const cosmic::Route& route : routes) {
+    for (std::size_t i = 0; i < route.publishers.size() && i < route.spec.publishers.size(); ++i) {
+      if (segments.size() <= route.publishers[i]) segments.resize(route.publishers[i] + 1);
+      segments[route.publishers[i]] = route.spec.publishers[i];
+    }
+    if (!spec_.selects(route.spec.name)) continue;
+    cosmic::RecordedChannel channel;
+    channel.id = route.id;
+    channel.name = route.spec.name;
+    channel.metadata = contract_of(route.spec);
+    if (route.spec.type) {
+      channel.json = std::make_shared<const cosmic::JsonRepresentation>(*route.spec.type);
+      channel.json_schema = cosmic::json_schema(*route.spec.type, route.spec.name);
+    }
+    channels.push_back(std::move(channel));
+  }
+  recorder_->set_channels(std::move(channels));
+  recorder_->set_segment_names(std::move(segments));
+}
+
+void RecordingService::select(bool recording) {
+  if (!gateway_) return;
+  if (!recording) {
+    gateway_->select_recorded({});
+    return;
+  }
+  gateway_->select_recorded([spec = spec_](const cosmic::ChannelSpec& channel) { return spec.selects(channel.name); });
+}
+
+Json RecordingService::start() {
+  if (!recorder_ || !spec_.enabled())
+    return failure("not_configured", "the configuration has no recording section (recording: {directory: ...})");
+  if (recording_) return status();
+  // Files first, then the selection: no event is taken before a file can hold it.
+  if (auto started = recorder_->start(); !started) return failure("record_failed", started.error().text);
+  recording_ = true;
+  select(true);
+  return status();
+}
+
+Json RecordingService::stop() {
+  if (!recorder_ || !recording_) return status();
+  select(false);
+  recorder_->stop();
+  recording_ = false;
+  log_.log(cosmic::LogLevel::notice, "recording stopped");
+  return status();
+}
+
+void RecordingService::shut_down() {
+  if (recording_) stop();
+}
+
+Json RecordingService::status() const {
+  if (!recorder_) return Json{{"ok", true}, {"recording", {{"configured", false}, {"active", false}}}};
+  const cosmic::RecorderStatus s = recorder_->status();
+  const double ratio = s.compressed > 0 ? static_cast<double>(s.uncompressed) / static_cast<double>(s.compressed) : 0;
+  return Json{{"ok", true},
+              {"recording",
+               {{"configured", spec_.enabled()},
+                {"active", s.recording},
+                {"directory", s.directory},
+                {"file", s.file},
+                {"channels", spec_.channels.empty() ? Json::array({"*"}) : Json(spec_.channels)},
+                {"files", s.files},
+                {"messages", s.messages},
+                {"bytes", s.bytes},
+                {"compression_ratio", ratio},
+                {"record_dropped",
+                 {{"queue_full", s.dropped_full}, {"not_written", s.dropped_failed}, {"invalid", s.dropped_invalid}}},
+                {"queue_bytes", s.queue_bytes},
+                {"queued_bytes", s.queued_bytes},
+                {"last_error", s.last_error}}}};
+}
+
+}  // namespace cosmicd

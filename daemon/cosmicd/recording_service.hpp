@@ -1,0 +1,49 @@
+// cosmicd's recording (issue 37, docs/recording.md): the `recording:` section of the configuration
+// turned into a cosmic::Recorder attached to the gateway, started at start when `start` is true, and
+// the control commands record_start, record_stop and record_status.
+//
+// A reload applies the new section: recording stays as it was (started or stopped) unless the
+// section was added or removed; the new directory, compression, chunking and rotation take effect
+// at once (the current file is finished and a new one opened), the channel selection at once, the
+// queue's size (`memory`) at the next start of cosmicd. The recorder, once made, lives as long as
+// the process: the router may hold its hook until then.
+//
+// Threads: the control thread only (the recorder's own thread writes).
+#pragma once
+
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "cosmic/gateway.hpp"
+#include "cosmic/recorder.hpp"
+
+namespace cosmicd {
+
+class RecordingService {
+ public:
+  explicit RecordingService(cosmic::Logger& log) : log_(log) {}
+  RecordingService(const RecordingService&) = delete;
+  RecordingService& operator=(const RecordingService&) = delete;
+
+  // At start and after every reload, with the configuration the gateway now runs.
+  void configure(cosmic::Gateway& gateway, const cosmic::Config& config);
+  // Control commands: the answers, "ok" included.
+  nlohmann::json start();
+  nlohmann::json stop();
+  nlohmann::json status() const;
+  // Before the gateway stops: the current file is finished.
+  void shut_down();
+
+ private:
+  void on_routes(const std::vector<cosmic::Route>& routes);
+  void select(bool recording);
+
+  cosmic::Logger& log_;
+  cosmic::Gateway* gateway_ = nullptr;
+  cosmic::RecordingSpec spec_;
+  std::unique_ptr<cosmic::Recorder> recorder_;
+  bool recording_ = false;
+};
+
+}  // namespace cosmicd
