@@ -1,6 +1,6 @@
 // `cosmicctl record start|stop|status` (issue 37, docs/recording.md): the daemon's recording
 // started, stopped and shown, through the control protocol's record_start, record_stop and
-// record_status.
+// record_status; and `record info FILE`, what a recording holds (record_info.cpp).
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -53,8 +53,14 @@ CommandRunner add_record_command(CLI::App& app, const GlobalOptions& options) {
   auto* start = command->add_subcommand("start", "Start recording the channels recording.channels selects");
   auto* stop = command->add_subcommand("stop", "Finish the current file and stop recording");
   auto* status = command->add_subcommand("status", "Show the recording: file, counts, drops");
-  return [command, start, stop, status, &options]() -> int {
+  auto* info = command->add_subcommand("info",
+                                       "Show what a recording (an MCAP file) holds: channels, counts, "
+                                       "time span, rates, gaps, drops");
+  auto file = std::make_shared<std::string>();
+  info->add_option("FILE", *file, "An MCAP file cosmicd recorded")->required()->check(CLI::ExistingFile);
+  return [command, start, stop, status, info, file, &options]() -> int {
     if (!command->parsed()) return -1;
+    if (info->parsed()) return run_record_info(*file, options.json);
     const char* name = start->parsed() ? "record_start" : stop->parsed() ? "record_stop" : "record_status";
     (void)status;
     const ClientResult result = request(options.socket, Json{{"command", name}});

@@ -16,7 +16,9 @@
 #include <vector>
 
 #include "cosmic/mcap_reader.hpp"
+#include "cosmic/mcap_writer.hpp"
 #include "cosmic/recorder.hpp"
+#include "cosmic/recording_info.hpp"
 
 namespace cosmic {
 namespace {
@@ -224,6 +226,67 @@ TEST_F(RecorderTest, TooLongAndUnknownEventsAreCountedNotWritten) {
   const McapFile file = read(files().at(0));
   ASSERT_EQ(file.messages.size(), 1u);
   EXPECT_EQ(file.messages[0].sequence, 4u);
+}
+
+}  // namespace
+}  // namespace cosmic
+
+namespace cosmic {
+namespace {
+
+// `cosmicctl record info`'s figures (cosmic/recording_info.hpp) on a file written here: per stream
+// its count, bytes, span, largest gap and the sequence numbers skipped (a repeat or a lower number,
+// as after a publisher's restart, skips none); the closing drops; a file cut short counts what it
+// keeps.
+TEST(RecordingInfo, CountsStreamsGapsMissingNumbersAndDrops) {
+  std::vector<std::uint8_t> bytes;
+  auto writer = McapWriter::open({}, [&](std::span<const std::uint8_t> b) -> Result<void> {
+    bytes.insert(bytes.end(), b.begin(), b.end());
+    return {};
+  });
+  ASSERT_TRUE(writer);
+  McapWriter& w = writer.value();
+  ASSERT_TRUE(w.add_metadata("cosmic", {{"gateway", "gw"}}));
+  const auto a = w.add_channel(0, "obstacle", "x-cosmic-bytes", {{"segment", "field"}, {"origin", "a1"}});
+  const auto b = w.add_channel(0, "obstacle", "x-cosmic-bytes", {{"segment", "lan"}, {"origin", "b2"}});
+  ASSERT_TRUE(a && b);
+  const std::vector<std::uint8_t> four{1, 2, 3, 4};
+  // Stream a: numbers 1 2 4 7 3 (3 after 7: skips none) at 1, 2, 3, 10, 11 s.
+  const std::uint32_t numbers[] = {1, 2, 4, 7, 3};
+  const std::uint64_t seconds[] = {1, 2, 3, 10, 11};
+  for (int i = 0; i < 5; ++i) ASSERT_TRUE(w.write_message(a.value(), numbers[i], seconds[i] * 1'000'000'000, 0, four));
+  ASSERT_TRUE(w.write_message(b.value(), 5, 4'000'000'000, 0, std::vector<std::uint8_t>{9}));
+  ASSERT_TRUE(w.add_metadata("cosmic.closing", {{"dropped_queue_full", "3"}}));
+  ASSERT_TRUE(w.finish());
+
+  const auto info = recording_info(bytes);
+  ASSERT_TRUE(info) << info.error().text;
+  const RecordingInfo& i = info.value();
+  EXPECT_TRUE(i.whole);
+  EXPECT_EQ(i.gateway, "gw");
+  EXPECT_EQ(i.messages, 6u);
+  EXPECT_EQ(i.start_ns, 1'000'000'000u);
+  EXPECT_EQ(i.end_ns, 11'000'000'000u);
+  EXPECT_EQ(i.closing.at("dropped_queue_full"), "3");
+  ASSERT_EQ(i.streams.size(), 2u);
+  const RecordedStream& s = i.streams[0];
+  EXPECT_EQ(s.segment, "field");
+  EXPECT_EQ(s.origin, "a1");
+  EXPECT_EQ(s.messages, 5u);
+  EXPECT_EQ(s.bytes, 20u);
+  EXPECT_EQ(s.largest_gap_ns, 7'000'000'000u);
+  EXPECT_EQ(s.missing, 1u + 2u);  // 3 between 2 and 4; 5 and 6 between 4 and 7
+  EXPECT_DOUBLE_EQ(s.rate_hz(), 4.0 / 10.0);
+  EXPECT_EQ(i.streams[1].messages, 1u);
+  EXPECT_EQ(i.streams[1].rate_hz(), 0.0);
+
+  // Cut inside the summary: everything of the data section is still counted.
+  const auto cut = recording_info(std::span<const std::uint8_t>(bytes).first(bytes.size() - 40));
+  ASSERT_TRUE(cut) << cut.error().text;
+  EXPECT_FALSE(cut.value().whole);
+  EXPECT_EQ(cut.value().messages, 6u);
+  const std::vector<std::uint8_t> garbage{'n', 'o', 't', ' ', 'm', 'c', 'a', 'p', 0, 0, 0, 0};
+  EXPECT_FALSE(recording_info(garbage));
 }
 
 }  // namespace

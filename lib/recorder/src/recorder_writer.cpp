@@ -154,6 +154,9 @@ class Recorder::Writer {
     }
     file_ = std::move(file).value();
     opened_ = now;
+    file_dropped_full_ = recorder_.dropped_full_.load(std::memory_order_relaxed);
+    file_dropped_failed_ = dropped_failed_;
+    file_dropped_invalid_ = dropped_invalid_;
     next_flush_ = now + kFlushEvery;
   }
 
@@ -164,10 +167,15 @@ class Recorder::Writer {
     }
   }
 
-  // Ends the current file, if any, and adds what it holds to the totals.
+  // Ends the current file, if any, with what was dropped while it was open, and adds what it holds
+  // to the totals.
   Result<void> close_file() {
     if (!file_) return {};
-    auto finished = file_->finish();
+    const std::uint64_t full = recorder_.dropped_full_.load(std::memory_order_relaxed);
+    const McapMap closing{{"dropped_queue_full", std::to_string(full - file_dropped_full_)},
+                          {"dropped_not_written", std::to_string(dropped_failed_ - file_dropped_failed_)},
+                          {"dropped_invalid", std::to_string(dropped_invalid_ - file_dropped_invalid_)}};
+    auto finished = file_->finish(closing);
     const McapWriter& writer = file_->writer();
     messages_ += writer.message_count();
     bytes_ += writer.bytes_written();
@@ -224,6 +232,8 @@ class Recorder::Writer {
   std::uint64_t numbered_ = 0;
   std::uint64_t files_ = 0, messages_ = 0, bytes_ = 0, uncompressed_ = 0, compressed_ = 0;
   std::uint64_t dropped_failed_ = 0, dropped_invalid_ = 0;
+  // The drop counts when the current file was opened: its own drops are the difference.
+  std::uint64_t file_dropped_full_ = 0, file_dropped_failed_ = 0, file_dropped_invalid_ = 0;
   std::string last_error_;
   std::vector<char> json_;
 };

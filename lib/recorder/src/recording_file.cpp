@@ -97,8 +97,9 @@ Result<bool> RecordingFile::write(const RecordedChannel& channel, const TakenEve
   return true;
 }
 
-Result<void> RecordingFile::finish() {
-  auto finished = writer_.finish();
+Result<void> RecordingFile::finish(const McapMap& closing) {
+  auto finished = writer_.add_metadata("cosmic.closing", closing);
+  if (finished) finished = writer_.finish();
   if (const int fd = fd_.release(); fd >= 0) {
     // What was written is the file's either way; a failed fsync is as bad as a failed write.
     const bool synced = ::fdatasync(fd) == 0;

@@ -43,8 +43,10 @@ class RecordingFile {
   // means the file can take no more: finish() it and open another.
   Result<bool> write(const RecordedChannel& channel, const TakenEvent& event);
   Result<void> flush_chunk() { return writer_.flush_chunk(); }
-  // Ends the file (summary, footer) and closes it; what was written stays either way.
-  Result<void> finish();
+  // Ends the file (summary, footer) and closes it; what was written stays either way. `closing`
+  // goes in first as the Metadata record "cosmic.closing" (what was dropped while this file was
+  // open, for `cosmicctl record info`).
+  Result<void> finish(const McapMap& closing);
 
   const std::string& path() const { return path_; }
   std::int64_t opened_ns() const { return opened_ns_; }

@@ -10,6 +10,8 @@
 #     opens a new one; SIGTERM finishes the last;
 #   - a crash (SIGKILL) leaves a file McapStreamReader reads up to its last complete chunk: the
 #     chunks written within the flush interval (1 s) hold every event recorded before;
+#   - `cosmicctl record info` counts each file's channels, messages, gaps and drops (a crashed file's
+#     up to its cut), and refuses a file that is not MCAP;
 #   - a directory that cannot be written: `record start` fails with the reason, exit 1, and
 #     forwarding goes on; a cosmicd without a recording section says so.
 #   recording_test.sh COSMICD COSMICCTL COSMIC_LCM_PEER NODE_MODULES SOURCE_DIR
@@ -82,7 +84,7 @@ d = json.load(open(sys.argv[1]))
 assert d["profile"] == "x-cosmic", d["profile"]
 assert d["ordered"], "messages not in time order"
 assert d["statistics"]["messageCount"] == 30, d["statistics"]
-assert d["chunkIndexes"] >= 1 and d["metadataIndexes"] == 1, d
+assert d["chunkIndexes"] >= 1 and d["metadataIndexes"] == 2, d  # "cosmic" and "cosmic.closing"
 topics = {c["topic"]: c for c in d["channels"]}
 assert set(topics) == {"obstacle", "range"}, topics  # chatter is not selected
 assert topics["obstacle"]["messageEncoding"] == "x-cosmic-bytes" and topics["obstacle"]["schemaId"] == 0
@@ -104,6 +106,20 @@ assert all(m["data"] == {"distance": 1.5, "valid": True} for m in ranges), range
 assert [m["sequence"] for m in obstacle] == list(range(1, 21)), [m["sequence"] for m in obstacle]
 assert all(int(m["publishTime"]) > 0 and int(m["logTime"]) >= int(m["publishTime"]) - 10**9 for m in d["messages"])
 PY
+ctl g --json record info "${files[0]}" >"$WORK/info.json" || fail "record info failed"
+python3 - "$WORK/info.json" <<'PY' || fail "record info of the first file: $(head -c 800 "$WORK/info.json")"
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["whole"] and d["messages"] == 30 and d["gateway"] == "gw-rec", d
+assert d["closing"] == {"dropped_queue_full": "0", "dropped_not_written": "0", "dropped_invalid": "0"}, d["closing"]
+streams = {s["channel"]: s for s in d["streams"]}
+assert streams["obstacle"]["messages"] == 20 and streams["obstacle"]["missing"] == 0, streams
+assert streams["obstacle"]["segment"] == "field" and streams["obstacle"]["origin"] == "a1", streams
+assert streams["range"]["messages"] == 10 and streams["range"]["encoding"] == "json", streams
+assert 0 < streams["obstacle"]["rate_hz"] < 1000, streams["obstacle"]
+PY
+ctl g record info "${files[0]}" >"$WORK/info.txt" || fail "record info (text) failed"
+grep -q "30 messages in" "$WORK/info.txt" || fail "record info text: $(cat "$WORK/info.txt")"
 passed
 
 scenario "record start opens a new file; SIGTERM finishes it"
@@ -140,6 +156,16 @@ d = json.load(open(sys.argv[1]))
 assert not d["done"], "a crashed file cannot be whole"
 assert [m["data"] for m in d["messages"]] == ["02020202"] * 40, len(d["messages"])
 ' "$WORK/crash.json" || fail "the crashed file: $(head -c 600 "$WORK/crash.json")"
+ctl g --json record info "$crashed" >"$WORK/crash_info.json" || fail "record info of the crashed file failed"
+python3 -c '
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert not d["whole"] and d["messages"] == 40 and d["truncation"], d
+' "$WORK/crash_info.json" || fail "record info of the crashed file: $(head -c 600 "$WORK/crash_info.json")"
+printf 'not mcap' >"$WORK/garbage.mcap"
+ctl g record info "$WORK/garbage.mcap" >"$WORK/garbage.out" 2>&1
+[ $? -eq 1 ] || fail "record info of a file that is not MCAP did not exit 1"
+grep -q "is not a readable MCAP recording" "$WORK/garbage.out" || fail "record info garbage: $(cat "$WORK/garbage.out")"
 passed
 
 scenario "a directory that cannot be written: start fails with the reason, forwarding goes on"
