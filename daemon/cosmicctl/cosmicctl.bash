@@ -1,13 +1,14 @@
 # bash completion for cosmicctl (installed as /usr/share/bash-completion/completions/cosmicctl).
 # Commands and options are those `cosmicctl --help` and `cosmicctl COMMAND --help` list:
 # tests/cli/man_completion_test.sh fails when a command or option is missing here or no longer
-# exists (`security` has the subcommand `permissions`, whose options follow it). Values: FILE
+# exists (`security` has the subcommand `permissions`, whose options follow it; `record` has start,
+# stop, status and info FILE, an MCAP file). Values: FILE
 # arguments complete to YAML files, --output to directories, --format and --protection to their
 # choices, --sign-with to two files, --component to the components: of the FILE on the line, channel NAMEs (channel,
 # unbind, echo) to the channels of the running gateway (`cosmicctl --json channels`, silent when it
 # cannot be reached). Needs nothing from the bash-completion package.
 
-_cosmicctl_commands="bind calibrate channel channels check diagram echo gen peers reload security segments status top types unbind"
+_cosmicctl_commands="bind calibrate channel channels check diagram echo gen peers record reload security segments status top types unbind"
 _cosmicctl_global_options="--help --json --socket --version"
 
 # The options of one command (besides the global ones, which may follow it too).
@@ -113,6 +114,15 @@ _cosmicctl() {
       elif [ "$file" = permissions ] && [ -z "$more" ]; then
         compopt -o filenames 2>/dev/null
         mapfile -t COMPREPLY < <(compgen -f -X '!*.yaml' -- "$cur"; compgen -f -X '!*.yml' -- "$cur"; compgen -d -- "$cur")
+      fi
+      ;;
+    record)
+      # record start|stop|status|info FILE.mcap
+      if [ -z "$file" ]; then
+        mapfile -t COMPREPLY < <(compgen -W "start stop status info" -- "$cur")
+      elif [ "$file" = info ] && [ -z "$more" ]; then
+        compopt -o filenames 2>/dev/null
+        mapfile -t COMPREPLY < <(compgen -f -X '!*.mcap' -- "$cur"; compgen -d -- "$cur")
       fi
       ;;
     channel | unbind | echo)
