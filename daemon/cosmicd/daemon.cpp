@@ -139,6 +139,7 @@ class Daemon {
       server.post([this] {
         MetricsSnapshot snapshot = take_metrics_snapshot(gateway_, started_);
         snapshot.federation = federation_.snapshot(steady_now());
+        snapshot.recording = recording_.recorder_status();
         metrics_.publish(std::move(snapshot));
       });
     });

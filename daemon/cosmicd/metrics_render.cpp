@@ -350,6 +350,28 @@ void render_federation(Exposition& out, const FederationSnapshot& f) {
   out.sample({}, f.link.published);
 }
 
+// Present while cosmicd has a recorder (a recording: section; docs/recording.md).
+void render_recording(Exposition& out, const std::optional<cosmic::RecorderStatus>& recording) {
+  if (!recording) return;
+  const cosmic::RecorderStatus& r = *recording;
+  out.family("cosmic_record_active", MetricType::gauge, "1 while the recording is on.");
+  out.sample({}, static_cast<std::uint64_t>(r.recording ? 1 : 0));
+  out.family("cosmic_record_messages", MetricType::counter, "Events written into recordings.");
+  out.sample({}, r.messages);
+  out.family("cosmic_record_bytes", MetricType::counter, "Bytes written into recordings.");
+  out.sample({}, r.bytes);
+  out.family("cosmic_record_files", MetricType::counter, "Recordings finished.");
+  out.sample({}, r.files);
+  out.family("cosmic_record_dropped", MetricType::counter,
+             "Events of recorded channels not recorded, by reason: queue_full (the writer fell behind), "
+             "not_written (no file could be written), invalid.");
+  out.sample({{"reason", "queue_full"}}, r.dropped_full);
+  out.sample({{"reason", "not_written"}}, r.dropped_failed);
+  out.sample({{"reason", "invalid"}}, r.dropped_invalid);
+  out.family("cosmic_record_queued_bytes", MetricType::gauge, "Bytes of events waiting for the writer.");
+  out.sample({}, static_cast<std::uint64_t>(r.queued_bytes));
+}
+
 std::string render_metrics(const MetricsSnapshot& snapshot, ExpositionFormat format) {
   Exposition out(format);
   render_gateway(out, snapshot);
@@ -362,6 +384,7 @@ std::string render_metrics(const MetricsSnapshot& snapshot, ExpositionFormat for
   render_hop_counters(out, hops);
   render_residence(out, hops);
   render_federation(out, snapshot.federation);
+  render_recording(out, snapshot.recording);
   return out.finish();
 }
 

@@ -4,10 +4,12 @@
 
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "cosmic/gateway.hpp"
+#include "cosmic/recorder.hpp"
 #include "federation_member.hpp"
 
 namespace cosmicd {
@@ -23,6 +25,7 @@ struct MetricsSnapshot {
   std::vector<cosmic::ChannelReport> channels;      // admission's verdicts and numbers
   std::vector<cosmic::ChannelStatsSnapshot> stats;  // the router's counters, by channel name
   FederationSnapshot federation;                    // filled in by the daemon
+  std::optional<cosmic::RecorderStatus> recording;  // filled in by the daemon while it has a recorder
 };
 
 // Control thread only.

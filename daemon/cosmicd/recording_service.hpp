@@ -12,6 +12,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <vector>
 
@@ -32,6 +33,10 @@ class RecordingService {
   nlohmann::json start();
   nlohmann::json stop();
   nlohmann::json status() const;
+  // For /metrics: nullopt while there is no recorder (no recording: section since the start).
+  std::optional<cosmic::RecorderStatus> recorder_status() const {
+    return recorder_ ? std::optional(recorder_->status()) : std::nullopt;
+  }
   // Before the gateway stops: the current file is finished.
   void shut_down();
 

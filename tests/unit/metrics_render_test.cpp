@@ -128,6 +128,31 @@ TEST(MetricsRender, GatewayAndRouter) {
   EXPECT_LINE(m, "cosmic_router_handled_events_total 777");
 }
 
+// Only with a recorder; its counters by name and drop reason.
+TEST(MetricsRender, RecordingCountersAndDropsByReason) {
+  EXPECT_EQ(text().find("cosmic_record_"), std::string::npos);
+  MetricsSnapshot s = robot();
+  cosmic::RecorderStatus r;
+  r.recording = true;
+  r.messages = 1200;
+  r.bytes = 64000;
+  r.files = 2;
+  r.dropped_full = 7;
+  r.dropped_failed = 3;
+  r.dropped_invalid = 1;
+  r.queued_bytes = 4096;
+  s.recording = r;
+  const std::string m = render_metrics(s, ExpositionFormat::prometheus_text);
+  EXPECT_LINE(m, "cosmic_record_active 1");
+  EXPECT_LINE(m, "cosmic_record_messages_total 1200");
+  EXPECT_LINE(m, "cosmic_record_bytes_total 64000");
+  EXPECT_LINE(m, "cosmic_record_files_total 2");
+  EXPECT_LINE(m, "cosmic_record_dropped_total{reason=\"queue_full\"} 7");
+  EXPECT_LINE(m, "cosmic_record_dropped_total{reason=\"not_written\"} 3");
+  EXPECT_LINE(m, "cosmic_record_dropped_total{reason=\"invalid\"} 1");
+  EXPECT_LINE(m, "cosmic_record_queued_bytes 4096");
+}
+
 TEST(MetricsRender, SegmentsHealthLoadAndAdapterCounters) {
   const std::string m = text();
   EXPECT_LINE(m, "cosmic_segment_up{segment=\"body-can\",type=\"can\"} 1");
