@@ -14,6 +14,18 @@ using recorder_detail::QueuedHead;
 using recorder_detail::RecordingFile;
 using recorder_detail::TakenEvent;
 
+namespace {
+
+// Whether a slot named in both tables names two different segments (a slot named in one only is a
+// segment added or removed: the streams found so far stay right).
+bool renamed(const std::vector<std::string>& before, const std::vector<std::string>& after) {
+  for (std::size_t i = 0; i < before.size() && i < after.size(); ++i)
+    if (!before[i].empty() && !after[i].empty() && before[i] != after[i]) return true;
+  return false;
+}
+
+}  // namespace
+
 class Recorder::Writer {
  public:
   using Clock = std::chrono::steady_clock;
@@ -42,6 +54,8 @@ class Recorder::Writer {
         want = shared_.want_recording;
         spec_ = shared_.spec;
         channels_ = shared_.channels;
+        // Streams are found by segment slot: a slot that now names another segment needs new ones.
+        if (file_ && segments_ && renamed(*segments_, *shared_.segments)) file_->forget_streams();
         segments_ = shared_.segments;
       }
       // What was queued before a stop still belongs to the recording.
@@ -79,7 +93,8 @@ class Recorder::Writer {
     const RecordedChannel& channel = *found->second;
     TakenEvent event;
     event.channel = head.channel;
-    event.segment = head.segment < segments_->size() ? (*segments_)[head.segment] : std::to_string(head.segment);
+    event.segment_slot = head.segment;
+    event.segment = head.segment < segments_->size() ? &(*segments_)[head.segment] : nullptr;
     event.origin = head.origin;
     event.sequence = head.sequence;
     event.created_ns = head.created_ns;

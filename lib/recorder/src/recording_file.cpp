@@ -63,7 +63,7 @@ RecordingFile::RecordingFile(std::string path, OwnedFd fd, std::int64_t opened_n
 RecordingFile::~RecordingFile() = default;
 
 Result<std::uint16_t> RecordingFile::channel_id(const RecordedChannel& channel, const TakenEvent& event) {
-  const auto key = std::make_tuple(channel.id, event.segment, event.origin);
+  const StreamKey key{channel.id, event.segment_slot, event.origin};
   if (const auto it = channels_.find(key); it != channels_.end()) return it->second;
   std::uint16_t schema = 0;
   if (channel.json) {
@@ -77,7 +77,7 @@ Result<std::uint16_t> RecordingFile::channel_id(const RecordedChannel& channel, 
     }
   }
   McapMap metadata = channel.metadata;
-  metadata["segment"] = event.segment;
+  metadata["segment"] = event.segment != nullptr ? *event.segment : std::to_string(event.segment_slot);
   metadata["origin"] = hex(event.origin);
   auto added = writer_.add_channel(schema, channel.name, channel.json ? "json" : "x-cosmic-bytes", metadata);
   if (!added) return std::move(added).error();

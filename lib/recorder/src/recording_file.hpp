@@ -7,7 +7,7 @@
 #include <map>
 #include <optional>
 #include <string>
-#include <tuple>
+#include <unordered_map>
 
 #include "cosmic/mcap_writer.hpp"
 #include "cosmic/model.hpp"
@@ -20,7 +20,8 @@ namespace cosmic::recorder_detail {
 // What the recorder knows of one event taken from its queue.
 struct TakenEvent {
   ChannelId channel = kNoChannel;
-  std::string segment;  // the source segment's name
+  std::uint32_t segment_slot = 0;        // the router's slot of the source segment
+  const std::string* segment = nullptr;  // its name (the recorder's table of slot names)
   std::uint64_t origin = 0;
   std::uint32_t sequence = 0;
   std::int64_t created_ns = 0;             // on the origin's clock
@@ -43,6 +44,9 @@ class RecordingFile {
   // means the file can take no more: finish() it and open another.
   Result<bool> write(const RecordedChannel& channel, const TakenEvent& event);
   Result<void> flush_chunk() { return writer_.flush_chunk(); }
+  // The router's segment slots were renamed (a reload): later events get MCAP channels naming the
+  // new segments; those declared so far stay in the file.
+  void forget_streams() { channels_.clear(); }
   // Ends the file (summary, footer) and closes it; what was written stays either way. `closing`
   // goes in first as the Metadata record "cosmic.closing" (what was dropped while this file was
   // open, for `cosmicctl record info`).
@@ -60,8 +64,20 @@ class RecordingFile {
   OwnedFd fd_;
   std::int64_t opened_ns_;
   McapWriter writer_;
+  // By (channel, source slot, origin): found per event without building a string.
+  struct StreamKey {
+    ChannelId channel;
+    std::uint32_t slot;
+    std::uint64_t origin;
+    friend bool operator==(const StreamKey&, const StreamKey&) = default;
+  };
+  struct StreamKeyHash {
+    std::size_t operator()(const StreamKey& k) const noexcept {
+      return std::hash<std::uint64_t>{}(k.origin * 0x9e3779b97f4a7c15ull ^ (std::uint64_t{k.channel} << 32 | k.slot));
+    }
+  };
   std::map<ChannelId, std::uint16_t> schemas_;
-  std::map<std::tuple<ChannelId, std::string, std::uint64_t>, std::uint16_t> channels_;
+  std::unordered_map<StreamKey, std::uint16_t, StreamKeyHash> channels_;
 };
 
 // "GATEWAY-YYYYMMDD-HHMMSS-N.mcap" for a file opened at `utc_ns`, the Nth of this recorder.
