@@ -175,7 +175,8 @@ void CandumpRecorder::take(std::span<const std::uint8_t> record) {
   }
   append_candump_line(head.utc_ns, log.segment.interface, *frame, log.pending);
   ++log.pending_lines;
-  if (log.pending.size() >= kWriteAt) flush(log);
+  // At the limit, so a file ends with the line that takes it there (flush rotates).
+  if (log.pending.size() >= kWriteAt || log.bytes_in_file + log.pending.size() >= spec_.rotate_size) flush(log);
 }
 
 void CandumpRecorder::flush(SegmentLog& log) {
