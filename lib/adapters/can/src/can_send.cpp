@@ -51,8 +51,12 @@ void CanAdapter::tap_sent(std::span<const canfd_frame> frames, bool fd) const no
   const Nanos now = steady_now();
   const std::int64_t utc = realtime_now_ns();
   for (const canfd_frame& frame : frames) {
+    canfd_frame seen = frame;
+    // As every reader of the bus gets it: the kernel marks each CAN FD frame it carries with
+    // CANFD_FDF (linux/can.h), so the tap's received and sent FD frames look alike.
+    if (fd) seen.flags |= CANFD_FDF;
     tap_->on_wire(WireUnit{
-        WireDirection::sent, now, utc, {reinterpret_cast<const std::uint8_t*>(&frame), fd ? CANFD_MTU : CAN_MTU}});
+        WireDirection::sent, now, utc, {reinterpret_cast<const std::uint8_t*>(&seen), fd ? CANFD_MTU : CAN_MTU}});
   }
 }
 
