@@ -20,6 +20,21 @@ std::string megabytes(std::uint64_t bytes) {
   return text;
 }
 
+// The CAN logs (candump -l) of the segments recording.candump lists, when it lists any.
+void print_candump(const Json& c) {
+  std::string segments;
+  for (const auto& s : c.value("segments", Json::array()))
+    segments += (segments.empty() ? "" : ", ") + s.get<std::string>();
+  if (segments.empty()) return;
+  std::cout << "candump: " << segments << ": " << c.value("lines", 0ull) << " lines in " << c.value("files", 0ull)
+            << " file(s), dropped " << c.value("dropped", 0ull) << " (" << c.value("dropped_queue_full", 0ull)
+            << " queue full, " << c.value("dropped_not_written", 0ull) << " not written)\n";
+  for (const auto& file : c.value("files_open", Json::array()))
+    std::cout << "candump file: " << file.get<std::string>() << "\n";
+  const std::string error = c.value("last_error", "");
+  if (!error.empty()) std::cout << "candump last error: " << error << "\n";
+}
+
 void print_recording(const Json& r) {
   if (!r.value("configured", false)) {
     std::cout << "recording: not configured (the configuration has no recording: section)\n";
@@ -43,6 +58,7 @@ void print_recording(const Json& r) {
             << megabytes(r.value("queue_bytes", 0ull)) << "\n";
   const std::string error = r.value("last_error", "");
   if (!error.empty()) std::cout << "last error: " << error << "\n";
+  print_candump(r.value("candump", Json::object()));
 }
 
 }  // namespace

@@ -16,8 +16,8 @@ struct AdapterFactory::State {
 #endif
 };
 
-AdapterFactory::AdapterFactory(std::string state_directory)
-    : state_directory_(std::move(state_directory)), state_(std::make_unique<State>()) {}
+AdapterFactory::AdapterFactory(std::string state_directory, WireTapSource taps)
+    : state_directory_(std::move(state_directory)), taps_(std::move(taps)), state_(std::make_unique<State>()) {}
 
 AdapterFactory::~AdapterFactory() = default;
 
@@ -35,7 +35,8 @@ std::unique_ptr<cosmic::SegmentAdapter> AdapterFactory::make(const cosmic::Segme
         const auto file = std::filesystem::path(state_directory_) / ("secoc-" + segment.name + ".json");
         secoc = cosmic::make_can_secoc_state(file.string(), segment.name, log);
       }
-      return cosmic::make_can_adapter(segment, self, log, cosmic::CanAdapterOptions{secoc});
+      return cosmic::make_can_adapter(segment, self, log,
+                                      cosmic::CanAdapterOptions{secoc, taps_ ? taps_(segment) : nullptr});
 #else
       log.log(cosmic::LogLevel::error, "segment " + segment.name + ": this build has no CAN support");
       return nullptr;

@@ -40,8 +40,13 @@ void RecordingService::configure(cosmic::Gateway& gateway, const cosmic::Config&
   gateway_ = &gateway;
   const cosmic::RecordingSpec& next = config.recording;
   const bool added = next.enabled() && !spec_.enabled();
-  const bool changed = next != spec_;
+  std::map<std::string, std::string> interfaces;
+  for (const cosmic::SegmentSpec& segment : config.segments) {
+    if (segment.type == cosmic::SegmentType::can) interfaces[segment.name] = segment.can.interface;
+  }
+  const bool changed = next != spec_ || (!next.candump.empty() && interfaces != interfaces_);
   spec_ = next;
+  interfaces_ = std::move(interfaces);
   if (!spec_.enabled()) {
     if (recording_) stop();
     return;
@@ -52,6 +57,11 @@ void RecordingService::configure(cosmic::Gateway& gateway, const cosmic::Config&
   } else if (changed) {
     recorder_->reconfigure(spec_);
   }
+  if (!candump_ && !spec_.candump.empty()) {
+    candump_ = std::make_unique<cosmic::CandumpRecorder>(spec_, config.gateway.name, log_);
+  } else if (candump_ && changed) {
+    candump_->reconfigure(spec_);
+  }
   if (added && spec_.start) {
     if (const Json answer = start(); !answer.value("ok", false))
       log_.log(cosmic::LogLevel::error, "recording did not start: " + answer["error"].value("message", ""));
@@ -59,9 +69,9 @@ void RecordingService::configure(cosmic::Gateway& gateway, const cosmic::Config&
   }
   if (recording_ && changed) {
     // The new directory, compression and rotation from a new file on, the new selection now.
-    recorder_->stop();
+    stop_both();
     select(true);
-    if (auto started = recorder_->start(); !started) {
+    if (auto started = start_both(); !started) {
       recording_ = false;
       select(false);
       log_.log(cosmic::LogLevel::error, "recording stopped: " + started.error().text);
@@ -106,7 +116,7 @@ Json RecordingService::start() {
     return failure("not_configured", "the configuration has no recording section (recording: {directory: ...})");
   if (recording_) return status();
   // Files first, then the selection: no event is taken before a file can hold it.
-  if (auto started = recorder_->start(); !started) return failure("record_failed", started.error().text);
+  if (auto started = start_both(); !started) return failure("record_failed", started.error().text);
   recording_ = true;
   select(true);
   return status();
@@ -115,10 +125,41 @@ Json RecordingService::start() {
 Json RecordingService::stop() {
   if (!recorder_ || !recording_) return status();
   select(false);
-  recorder_->stop();
+  stop_both();
   recording_ = false;
   log_.log(cosmic::LogLevel::notice, "recording stopped");
   return status();
+}
+
+cosmic::Result<void> RecordingService::start_both() {
+  if (auto started = recorder_->start(); !started) return started;
+  if (candump_ && !spec_.candump.empty()) {
+    if (auto started = candump_->start(candump_segments()); !started) {
+      recorder_->stop();
+      return started;
+    }
+  }
+  return {};
+}
+
+void RecordingService::stop_both() {
+  if (candump_) candump_->stop();
+  recorder_->stop();
+}
+
+std::vector<cosmic::CandumpSegment> RecordingService::candump_segments() {
+  std::vector<cosmic::CandumpSegment> out;
+  for (const std::string& name : spec_.candump) {
+    auto tap = taps_.try_emplace(name, std::make_shared<cosmic::CandumpTap>()).first->second;
+    const auto interface = interfaces_.find(name);
+    out.push_back({name, interface != interfaces_.end() ? interface->second : name, std::move(tap)});
+  }
+  return out;
+}
+
+std::shared_ptr<cosmic::WireTap> RecordingService::wire_tap(const cosmic::SegmentSpec& segment) {
+  if (segment.type != cosmic::SegmentType::can) return nullptr;
+  return taps_.try_emplace(segment.name, std::make_shared<cosmic::CandumpTap>()).first->second;
 }
 
 void RecordingService::shut_down() {
@@ -128,6 +169,20 @@ void RecordingService::shut_down() {
 Json RecordingService::status() const {
   if (!recorder_) return Json{{"ok", true}, {"recording", {{"configured", false}, {"active", false}}}};
   const cosmic::RecorderStatus s = recorder_->status();
+  Json candump = Json{{"segments", spec_.candump}, {"active", false}, {"files", 0}, {"lines", 0}, {"dropped", 0}};
+  if (candump_) {
+    const cosmic::CandumpStatus c = candump_->status();
+    candump = Json{{"segments", spec_.candump},
+                   {"active", c.recording},
+                   {"files_open", c.files_open},
+                   {"files", c.files},
+                   {"lines", c.lines},
+                   {"bytes", c.bytes},
+                   {"dropped", c.dropped_full + c.dropped_failed},
+                   {"dropped_queue_full", c.dropped_full},
+                   {"dropped_not_written", c.dropped_failed},
+                   {"last_error", c.last_error}};
+  }
   const double ratio = s.compressed > 0 ? static_cast<double>(s.uncompressed) / static_cast<double>(s.compressed) : 0;
   return Json{{"ok", true},
               {"recording",
@@ -144,7 +199,8 @@ Json RecordingService::status() const {
                  {{"queue_full", s.dropped_full}, {"not_written", s.dropped_failed}, {"invalid", s.dropped_invalid}}},
                 {"queue_bytes", s.queue_bytes},
                 {"queued_bytes", s.queued_bytes},
-                {"last_error", s.last_error}}}};
+                {"last_error", s.last_error},
+                {"candump", std::move(candump)}}}};
 }
 
 }  // namespace cosmicd

@@ -1,6 +1,8 @@
 // cosmicd's recording (issue 37, docs/recording.md): the `recording:` section of the configuration
 // turned into a cosmic::Recorder attached to the gateway, started at start when `start` is true, and
-// the control commands record_start, record_stop and record_status.
+// the control commands record_start, record_stop and record_status. The CAN segments listed in
+// `candump` are logged alongside in candump -l format while recording is on (a
+// cosmic::CandumpRecorder fed by each CAN adapter's wire tap, which wire_tap() hands out).
 //
 // A reload applies the new section: recording stays as it was (started or stopped) unless the
 // section was added or removed; the new directory, compression, chunking and rotation take effect
@@ -11,11 +13,14 @@
 // Threads: the control thread only (the recorder's own thread writes).
 #pragma once
 
+#include <map>
 #include <memory>
 #include <optional>
 #include <nlohmann/json.hpp>
+#include <string>
 #include <vector>
 
+#include "cosmic/candump_recorder.hpp"
 #include "cosmic/gateway.hpp"
 #include "cosmic/recorder.hpp"
 
@@ -39,15 +44,25 @@ class RecordingService {
   }
   // Before the gateway stops: the current file is finished.
   void shut_down();
+  // The tap a CAN segment's adapter is made with (the same one for every adapter of that segment,
+  // for the life of the process); null for other segments. The adapter factory calls it.
+  std::shared_ptr<cosmic::WireTap> wire_tap(const cosmic::SegmentSpec& segment);
 
  private:
   void on_routes(const std::vector<cosmic::Route>& routes);
   void select(bool recording);
+  // The MCAP recorder and the CAN logs started together: an error, and neither running, when one fails.
+  cosmic::Result<void> start_both();
+  void stop_both();
+  std::vector<cosmic::CandumpSegment> candump_segments();
 
   cosmic::Logger& log_;
   cosmic::Gateway* gateway_ = nullptr;
   cosmic::RecordingSpec spec_;
   std::unique_ptr<cosmic::Recorder> recorder_;
+  std::map<std::string, std::shared_ptr<cosmic::CandumpTap>> taps_;  // by CAN segment name
+  std::map<std::string, std::string> interfaces_;                    // CAN segment name -> interface
+  std::unique_ptr<cosmic::CandumpRecorder> candump_;                 // once `candump` lists a segment
   bool recording_ = false;
 };
 

@@ -160,7 +160,7 @@ class Recorder::Writer {
     std::error_code ignored;
     std::filesystem::create_directories(spec_.directory, ignored);
     const std::string path = (std::filesystem::path(spec_.directory) /
-                              recorder_detail::recording_file_name(recorder_.gateway_, utc, ++numbered_))
+                              recorder_detail::recording_file_name(recorder_.gateway_, utc, ++numbered_, ".mcap"))
                                  .string();
     auto file = RecordingFile::create(path, spec_, recorder_.gateway_, utc);
     if (!file) {

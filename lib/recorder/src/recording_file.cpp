@@ -9,7 +9,14 @@
 namespace cosmic::recorder_detail {
 namespace {
 
-// Everything of `bytes` written to `fd`, however many calls that takes.
+std::string hex(std::uint64_t value) {
+  char text[20];
+  std::snprintf(text, sizeof text, "%llx", static_cast<unsigned long long>(value));
+  return text;
+}
+
+}  // namespace
+
 Result<void> write_all(int fd, const std::string& path, std::span<const std::uint8_t> bytes) {
   while (!bytes.empty()) {
     auto written = posix_call("cannot write " + path, [&] { return ::write(fd, bytes.data(), bytes.size()); });
@@ -19,21 +26,14 @@ Result<void> write_all(int fd, const std::string& path, std::span<const std::uin
   return {};
 }
 
-std::string hex(std::uint64_t value) {
-  char text[20];
-  std::snprintf(text, sizeof text, "%llx", static_cast<unsigned long long>(value));
-  return text;
-}
-
-}  // namespace
-
-std::string recording_file_name(const std::string& gateway, std::int64_t utc_ns, std::uint64_t n) {
+std::string recording_file_name(const std::string& stem, std::int64_t utc_ns, std::uint64_t n,
+                                std::string_view extension) {
   const std::time_t seconds = static_cast<std::time_t>(utc_ns / 1'000'000'000);
   std::tm parts{};
   ::gmtime_r(&seconds, &parts);
   char stamp[32];
   std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &parts);
-  return gateway + "-" + stamp + "-" + std::to_string(n) + ".mcap";
+  return stem + "-" + stamp + "-" + std::to_string(n) + std::string(extension);
 }
 
 Result<std::unique_ptr<RecordingFile>> RecordingFile::create(const std::string& path, const RecordingSpec& spec,

@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 
 #include "cosmic/mcap_writer.hpp"
@@ -80,7 +81,12 @@ class RecordingFile {
   std::unordered_map<StreamKey, std::uint16_t, StreamKeyHash> channels_;
 };
 
-// "GATEWAY-YYYYMMDD-HHMMSS-N.mcap" for a file opened at `utc_ns`, the Nth of this recorder.
-std::string recording_file_name(const std::string& gateway, std::int64_t utc_ns, std::uint64_t n);
+// "STEM-YYYYMMDD-HHMMSS-N.EXT" for a file opened at `utc_ns`, the Nth of its recorder (the MCAP
+// recorder's stem is the gateway's name, the CAN logs' GATEWAY-SEGMENT).
+std::string recording_file_name(const std::string& stem, std::int64_t utc_ns, std::uint64_t n,
+                                std::string_view extension);
+
+// Everything of `bytes` written to `fd`, however many calls that takes.
+Result<void> write_all(int fd, const std::string& path, std::span<const std::uint8_t> bytes);
 
 }  // namespace cosmic::recorder_detail

@@ -304,7 +304,7 @@ namespace cosmic {
 std::unique_ptr<SegmentAdapter> make_can_adapter(const SegmentSpec& segment, const GatewayIdentity& self, Logger& log,
                                                  CanAdapterOptions options) {
   (void)self;  // CAN frames carry no envelope: the gateway is known by its TxNode
-  return std::make_unique<can_detail::CanAdapter>(segment, log, std::move(options.secoc));
+  return std::make_unique<can_detail::CanAdapter>(segment, log, std::move(options.secoc), std::move(options.tap));
 }
 
 CanSecocState make_can_secoc_state(std::string file, const std::string& segment, Logger& log) {

@@ -118,7 +118,7 @@ using TxSocketRef = std::shared_ptr<const TxSocket>;
 
 class CanAdapter final : public SegmentAdapter {
  public:
-  CanAdapter(const SegmentSpec& segment, Logger& log, CanSecocState secoc)
+  CanAdapter(const SegmentSpec& segment, Logger& log, CanSecocState secoc, std::shared_ptr<WireTap> tap)
       : segment_(segment),
         log_(log),
         prefix_(segment_log_prefix(SegmentType::can, segment.name)),
@@ -134,7 +134,8 @@ class CanAdapter final : public SegmentAdapter {
         table_(std::make_shared<const Table>()),
         answers_(answer_gap(segment.can)),
         secoc_freshness_(secoc ? std::move(secoc)
-                               : std::make_shared<SecocFreshness>(std::string(), prefix_, "fv:" + segment.name, log)) {}
+                               : std::make_shared<SecocFreshness>(std::string(), prefix_, "fv:" + segment.name, log)),
+        tap_(std::move(tap)) {}
 
   ~CanAdapter() override { stop(); }
 
@@ -251,6 +252,8 @@ class CanAdapter final : public SegmentAdapter {
       COSMIC_REQUIRES(io_mutex_);
   void drain_answers() COSMIC_EXCLUDES(io_mutex_);
   void wake();
+  // The frames written, to the wire tap (if any). Any thread that writes.
+  void tap_sent(std::span<const canfd_frame> frames, bool fd) const noexcept;
   // Returns the warning to log once io_mutex_ is given up (empty when nothing was queued).
   std::string drop_backlog(const char* why) COSMIC_REQUIRES(io_mutex_);
 
@@ -333,6 +336,8 @@ class CanAdapter final : public SegmentAdapter {
   std::atomic<bool> secoc_bound_{false};                   // a SecOC hop was bound: statistics show its counters
   std::atomic<std::uint64_t> secoc_unauthenticated_{0};
   std::atomic<std::uint64_t> secoc_replayed_{0};
+
+  const std::shared_ptr<WireTap> tap_;  // null: none (CanAdapterOptions::tap)
 };
 
 }  // namespace cosmic::can_detail

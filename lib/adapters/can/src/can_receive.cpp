@@ -249,6 +249,9 @@ void CanAdapter::drain_answers() {
   if (n == static_cast<ssize_t>(CAN_MTU)) {
     counters_.sent.fetch_add(1, std::memory_order_relaxed);
     answers_.sent(now);
+    canfd_frame written{};
+    std::memcpy(&written, &answer, CAN_MTU);
+    tap_sent({&written, 1}, false);
     return;
   }
   if (err == EAGAIN || err == EWOULDBLOCK || err == ENOBUFS) {

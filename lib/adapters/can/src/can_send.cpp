@@ -46,6 +46,20 @@ std::size_t write_frames(int fd, std::span<const canfd_frame> frames, bool fd_fr
 
 }  // namespace
 
+void CanAdapter::tap_sent(std::span<const canfd_frame> frames, bool fd) const noexcept {
+  if (!tap_ || frames.empty()) return;
+  const Nanos now = steady_now();
+  const std::int64_t utc = realtime_now_ns();
+  for (const canfd_frame& frame : frames) {
+    canfd_frame seen = frame;
+    // As every reader of the bus gets it: the kernel marks each CAN FD frame it carries with
+    // CANFD_FDF (linux/can.h), so the tap's received and sent FD frames look alike.
+    if (fd) seen.flags |= CANFD_FDF;
+    tap_->on_wire(WireUnit{
+        WireDirection::sent, now, utc, {reinterpret_cast<const std::uint8_t*>(&seen), fd ? CANFD_MTU : CAN_MTU}});
+  }
+}
+
 std::string CanAdapter::drop_backlog(const char* why) {
   if (backlog_.empty()) return {};
   counters_.send_errors.fetch_add(backlog_.size(), std::memory_order_relaxed);
@@ -129,6 +143,7 @@ CanAdapter::WriteResult CanAdapter::submit(std::span<const canfd_frame> frames, 
   int err = 0;
   while (written < frames.size()) {
     const std::size_t n = write_frames(socket->fd(), frames.subspan(written), fd, err);
+    tap_sent(frames.subspan(written, n), fd);
     written += n;
     counters_.sent.fetch_add(n, std::memory_order_relaxed);
     if (err != 0) break;
@@ -177,6 +192,7 @@ void CanAdapter::drain_backlog() {
     for (std::size_t i = 0; i < count; ++i) frames[i] = taken[i].frame;
     int err = 0;
     const std::size_t written = write_frames(socket->fd(), std::span(frames.data(), count), fd, err);
+    tap_sent(std::span(frames.data(), written), fd);
     counters_.sent.fetch_add(written, std::memory_order_relaxed);
     std::string log_line;
     {

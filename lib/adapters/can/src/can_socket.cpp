@@ -332,14 +332,20 @@ void CanAdapter::handle_datagram(canfd_frame& frame, msghdr& msg, std::size_t by
     }
   }
   const Nanos arrival = steady_arrival_now(arrival_ns);
-  if (bytes == CAN_MTU) {
-    frame.flags = 0;  // the byte is padding in struct can_frame
-    handle_frame(frame, false, arrival);
-  } else if (bytes == CANFD_MTU) {
-    handle_frame(frame, true, arrival);
-  } else {
+  if (bytes != CAN_MTU && bytes != CANFD_MTU) {
     problem(kNoChannel, InboundProblem::decode_error);
+    return;
   }
+  const bool fd_frame = bytes == CANFD_MTU;
+  if (!fd_frame) frame.flags = 0;  // the byte is padding in struct can_frame
+  if (tap_) {
+    const WireUnit unit{WireDirection::received,
+                        arrival,
+                        arrival_ns != 0 ? arrival_ns : realtime_now_ns(),
+                        {reinterpret_cast<const std::uint8_t*>(&frame), bytes}};
+    tap_->on_wire(unit);
+  }
+  handle_frame(frame, fd_frame, arrival);
 }
 
 }  // namespace cosmic::can_detail

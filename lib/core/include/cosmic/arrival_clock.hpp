@@ -23,12 +23,17 @@ inline Nanos steady_arrival(std::int64_t arrival_realtime_ns, Nanos steady_now, 
   return steady_now - Nanos(waited);
 }
 
+// The realtime clock now, in ns since the epoch.
+inline std::int64_t realtime_now_ns() {
+  using namespace std::chrono;
+  return duration_cast<Nanos>(system_clock::now().time_since_epoch()).count();
+}
+
 // The same with both clocks read now.
 inline Nanos steady_arrival_now(std::int64_t arrival_realtime_ns) {
   using namespace std::chrono;
   const Nanos steady = duration_cast<Nanos>(steady_clock::now().time_since_epoch());
-  const std::int64_t realtime = duration_cast<Nanos>(system_clock::now().time_since_epoch()).count();
-  return steady_arrival(arrival_realtime_ns, steady, realtime);
+  return steady_arrival(arrival_realtime_ns, steady, realtime_now_ns());
 }
 
 }  // namespace cosmic

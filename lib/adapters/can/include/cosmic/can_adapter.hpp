@@ -11,6 +11,7 @@
 #include "cosmic/log.hpp"
 #include "cosmic/model.hpp"
 #include "cosmic/segment_adapter.hpp"
+#include "cosmic/wire_tap.hpp"
 
 namespace cosmic {
 
@@ -26,6 +27,10 @@ CanSecocState make_can_secoc_state(std::string file, const std::string& segment,
 struct CanAdapterOptions {
   // Null: the adapter keeps its own, not persisted (tests), and senders are not held to a lease.
   CanSecocState secoc;
+  // Null: none. Otherwise handed every frame the adapter reads from its socket (its bound channels'
+  // and the binding protocols' frames, error frames) and every frame it writes, as the bytes of a
+  // struct can_frame or canfd_frame (cosmic/wire_tap.hpp), from the threads that read and write.
+  std::shared_ptr<WireTap> tap;
 };
 
 // Never null. start() succeeds even when the interface is down or missing (health says so).
