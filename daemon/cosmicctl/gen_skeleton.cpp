@@ -156,6 +156,8 @@ std::string client_segment(const cosmic::SegmentSpec& s, unsigned can_node) {
       return "lcm:" + s.lcm.url;
     case cosmic::SegmentType::can:
       return "can:" + s.can.interface + "?node=" + std::to_string(can_node);
+    case cosmic::SegmentType::replay:  // the configuration refuses components there
+      break;
   }
   return "";
 }

@@ -4,6 +4,7 @@
 
 #include "cosmic/dds_adapter.hpp"
 #include "cosmic/lcm_adapter.hpp"
+#include "cosmic/replay_adapter.hpp"
 #if COSMIC_HAS_CAN
 #include "cosmic/can_adapter.hpp"
 #endif
@@ -28,6 +29,8 @@ std::unique_ptr<cosmic::SegmentAdapter> AdapterFactory::make(const cosmic::Segme
       return cosmic::make_dds_adapter(segment, self, log);
     case cosmic::SegmentType::lcm:
       return cosmic::make_lcm_adapter(segment, self, log);
+    case cosmic::SegmentType::replay:
+      return cosmic::make_replay_adapter(segment, log);
     case cosmic::SegmentType::can: {
 #if COSMIC_HAS_CAN
       cosmic::CanSecocState& secoc = state_->secoc[segment.name];

@@ -103,6 +103,12 @@ class ComponentsLoader {
                        "one of the segments: " + joined(known));
       return;
     }
+    if (config_.find_segment(*name)->type == SegmentType::replay) {
+      reader_.error_at(node["segment"], path + ".segment",
+                       "segment '" + *name + "' is a replay: it publishes a recording, no component lives there",
+                       "a CAN, DDS or LCM segment");
+      return;
+    }
     c.segment = *name;
   }
 

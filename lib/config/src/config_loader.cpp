@@ -22,6 +22,7 @@
 #include "federation_loader.hpp"
 #include "realtime_loader.hpp"
 #include "recording_loader.hpp"
+#include "replay_loader.hpp"
 #include "dds_security_loader.hpp"
 #include "folded_names.hpp"
 #include "key_file_loader.hpp"
@@ -219,18 +220,42 @@ class ConfigParser {
     const std::size_t errors_before = reader_.error_count();
     SegmentSpec s;
     std::optional<std::size_t> type;
-    if (require(node, path, "type", "type: can, dds or lcm"))
-      type = reader_.choice(node["type"], key(path, "type"), {"can", "dds", "lcm"});
+    if (require(node, path, "type", "type: can, dds, lcm or replay"))
+      type = reader_.choice(node["type"], key(path, "type"), {"can", "dds", "lcm", "replay"});
     if (require(node, path, "name", "a segment name")) {
       if (auto v = reader_.name(node["name"], key(path, "name"))) s.name = *v;
     }
     if (!type) {
-      reader_.check_map(
-          node, path,
-          {"name",          "type",        "interface",       "profile",          "bitrate",    "fd",
-           "data_bitrate",  "errors",      "max_utilization", "background",       "domain",     "latency_bound",
-           "bandwidth",     "reliability", "realtime",        "max_message_size", "interfaces", "discovery_server",
-           "shared_memory", "url",         "network",         "own_datagrams",    "auth",       "security"});
+      reader_.check_map(node, path,
+                        {"name",
+                         "type",
+                         "interface",
+                         "profile",
+                         "bitrate",
+                         "fd",
+                         "data_bitrate",
+                         "errors",
+                         "max_utilization",
+                         "background",
+                         "domain",
+                         "latency_bound",
+                         "bandwidth",
+                         "reliability",
+                         "realtime",
+                         "max_message_size",
+                         "interfaces",
+                         "discovery_server",
+                         "shared_memory",
+                         "url",
+                         "network",
+                         "own_datagrams",
+                         "auth",
+                         "security",
+                         "file",
+                         "channels",
+                         "speed",
+                         "loop",
+                         "start_offset"});
       return std::nullopt;
     }
     s.type = static_cast<SegmentType>(*type);
@@ -249,6 +274,9 @@ class ConfigParser {
         break;
       case SegmentType::lcm:
         parse_lcm(node, path, s);
+        break;
+      case SegmentType::replay:
+        config_detail::parse_replay(reader_, node, path, s, included_);
         break;
     }
     if (reader_.error_count() != errors_before) return std::nullopt;

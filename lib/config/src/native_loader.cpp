@@ -293,6 +293,11 @@ void parse_native(YamlReader& reader, const YAML::Node& node, const std::string&
       case SegmentType::dds:
         ok = parse_dds(reader, entry.second, entry_path, binding);
         break;
+      case SegmentType::replay:
+        reader.error_at(entry.first, entry_path,
+                        "segment '" + name + "' is a replay: its events are the recording's, with no native form",
+                        "a CAN, DDS or LCM segment");
+        break;
     }
     if (ok) channel.native.push_back(std::move(binding));
   }

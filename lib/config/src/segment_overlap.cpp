@@ -48,6 +48,8 @@ std::optional<Overlap> overlap(const SegmentSpec& a, const SegmentSpec& b) {
     case SegmentType::can:
       if (a.can.interface != b.can.interface) return std::nullopt;
       return Overlap{"interface", "CAN interface " + a.can.interface, "one segment per CAN interface"};
+    case SegmentType::replay:  // two replays of one file are two sources: nothing to share
+      return std::nullopt;
   }
   return std::nullopt;
 }

@@ -244,6 +244,10 @@ Json ControlProtocol::segments() const {
       entry["unexplained_others"] = s.adapter.unexplained_others;
     } else if (s.spec.type == SegmentType::dds) {
       entry["domain"] = s.spec.dds.domain;
+    } else if (s.spec.type == SegmentType::replay) {
+      entry["file"] = s.spec.replay.file;
+      entry["speed"] = s.spec.replay.speed;
+      entry["loop"] = s.spec.replay.loop;
     } else {
       entry["url"] = s.spec.lcm.url;
     }

@@ -153,7 +153,8 @@ const ChannelReport* AdmissionReport::find(const std::string& name) const {
 }
 
 Verdict consequence_of(const std::string& check, ChannelClass cls) {
-  if (cls == ChannelClass::hrt || check == "frame_fit" || check == "representation" || check == "authentication")
+  if (cls == ChannelClass::hrt || check == "frame_fit" || check == "representation" || check == "authentication" ||
+      check == "replay_events")
     return Verdict::rejected;
   return Verdict::degraded;
 }

@@ -78,9 +78,32 @@ void add_security_checks(const ChannelSpec& channel, const SegmentSpec& segment,
   h.checks.push_back(Check{"authentication", carried ? 1.0 : 0.0, 1.0, "bool", ">=", carried});
 }
 
+// A replay segment is a publisher like any other (issue 37): the recording must hold the channel's
+// events, and play them no closer together than the channel's minimum inter-arrival time allows.
+void add_replay_checks(const ChannelSpec& channel, const SegmentSpec& segment, HopReport& h) {
+  if (segment.type != SegmentType::replay || h.role != HopRole::publisher) return;
+  const ReplayStream* stream = segment.replay.stream(channel.name);
+  const double events = stream ? static_cast<double>(stream->events) : 0.0;
+  h.checks.push_back(Check{"replay_events", events, 1.0, "events", ">=", events >= 1.0});
+  if (!stream || stream->events < 2 || !channel.period) return;
+  const double spacing = to_seconds(stream->tightest) / segment.replay.speed;
+  const double limit = to_seconds(*channel.period);
+  h.checks.push_back(Check{"replay_rate", spacing, limit, "s", ">=", spacing >= limit});
+}
+
 std::string failure_text(const Check& check, const HopReport& h, const SegmentSpec& segment,
                          const ChannelSpec& channel) {
   const std::string on = " on " + h.segment;
+  if (check.check == "replay_events") {
+    return "the recording " + segment.replay.file + " replayed" + on + " holds no event of this channel" +
+           (segment.replay.channels.empty() ? "" : " among the channels the segment selects");
+  }
+  if (check.check == "replay_rate") {
+    return "the replay" + on + " sends events as close as " + format_seconds(check.value) +
+           " apart (tightest recorded spacing at speed " + shortest_number_text(segment.replay.speed) +
+           ") < the channel's minimum inter-arrival " + format_seconds(check.limit) +
+           ": slow the replay (speed) or give the channel a period that covers the recording";
+  }
   if (check.check == "authentication" && segment.type == SegmentType::can) {
     return "SecOC" + on +
            " needs this project's frame layout or a native identifier: FAMOUSO's frames (profile: famouso) cannot "
@@ -173,6 +196,7 @@ void Judge::add_hop_checks(const ChannelSpec& channel, const SegmentSpec& segmen
   const HopPayload* hop = channel.type ? channel.hop_on(segment.name) : nullptr;
   add_representation_checks(hop, h);
   add_security_checks(channel, segment, h);
+  add_replay_checks(channel, segment, h);
   // A hop that cannot carry the type has no message size: its frame is not judged.
   if (hop == nullptr || hop->unfit.empty()) add_frame_fit(channel, segment, h);
   if (channel.period) {

@@ -28,6 +28,8 @@ const char* to_string(SegmentType value) {
       return "dds";
     case SegmentType::lcm:
       return "lcm";
+    case SegmentType::replay:
+      return "replay";
   }
   return "?";
 }
@@ -93,6 +95,12 @@ const SegmentSpec* Config::find_segment(const std::string& name) const {
 const ChannelSpec* Config::find_channel(const std::string& name) const {
   const auto it = std::find_if(channels.begin(), channels.end(), [&](const auto& c) { return c.name == name; });
   return it == channels.end() ? nullptr : &*it;
+}
+
+const ReplayStream* ReplaySegmentProperties::stream(const std::string& channel) const {
+  const auto it =
+      std::find_if(streams.begin(), streams.end(), [&](const ReplayStream& s) { return s.channel == channel; });
+  return it == streams.end() ? nullptr : &*it;
 }
 
 bool RecordingSpec::selects(const std::string& name) const {

@@ -10,6 +10,7 @@ std::string network_identity(const SegmentSpec& segment) {
   if (!segment.network.empty()) return std::string(to_string(segment.type)) + ":" + segment.network;
   switch (segment.type) {
     case SegmentType::can:
+    case SegmentType::replay:  // a file in this process: no network shared with anyone
       return {};
     case SegmentType::dds:
       return "dds:domain=" + std::to_string(segment.dds.domain) +

@@ -19,7 +19,7 @@
 namespace cosmic {
 
 enum class ChannelClass { hrt, srt, nrt };
-enum class SegmentType { can, dds, lcm };
+enum class SegmentType { can, dds, lcm, replay };
 enum class Reliability { reliable, best_effort };
 enum class LcmEncoding { envelope, raw };
 
@@ -131,6 +131,32 @@ struct LcmSegmentProperties {
   friend bool operator==(const LcmSegmentProperties&, const LcmSegmentProperties&) = default;
 };
 
+// One channel of a recording a replay segment publishes: how many events the recording holds of it
+// and the tightest spacing of two of them as recorded (before `speed`).
+struct ReplayStream {
+  std::string channel;
+  std::uint64_t events = 0;
+  Nanos tightest{0};  // 0 with fewer than two events
+  friend bool operator==(const ReplayStream&, const ReplayStream&) = default;
+};
+
+// A segment that publishes a recording into the channels it holds (issue 37, `type: replay`,
+// docs/recording.md): the recorded events of the selected channels with their recorded spacing,
+// divided by `speed`, from `start_offset` into the recording, over again with `loop`.
+struct ReplaySegmentProperties {
+  std::string file;                   // an MCAP recording, absolute
+  std::vector<std::string> channels;  // names or fnmatch(3) globs; empty: every channel recorded
+  double speed = 1.0;                 // 2: twice as fast as recorded
+  bool loop = false;
+  Nanos start_offset{0};
+  // Read from the file at load (the loader's scan), one per recorded channel the selection takes, in
+  // the order of their first events; and the file's bytes hashed, so a reload sees a changed file.
+  std::vector<ReplayStream> streams;
+  std::uint64_t content_hash = 0;
+  const ReplayStream* stream(const std::string& channel) const;
+  friend bool operator==(const ReplaySegmentProperties&, const ReplaySegmentProperties&) = default;
+};
+
 struct SegmentSpec {
   std::string name;
   SegmentType type = SegmentType::dds;
@@ -144,6 +170,7 @@ struct SegmentSpec {
   CanSegmentProperties can;
   DdsSegmentProperties dds;
   LcmSegmentProperties lcm;
+  ReplaySegmentProperties replay;
   // Segment key `network`: the name of the network this segment attaches, the same on every
   // gateway attached to it (federation, docs/federation.md). CAN buses are shared only through it.
   std::string network;

@@ -1,0 +1,249 @@
+// A replay segment (cosmic/replay_adapter.hpp).
+#include "cosmic/replay_adapter.hpp"
+
+#include <fcntl.h>
+#include <fnmatch.h>
+#include <pthread.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <condition_variable>
+#include <cstring>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include "cosmic/binding_plan.hpp"
+#include "cosmic/mcap_reader.hpp"
+#include "cosmic/router_stats.hpp"
+#include "cosmic/steady_clock.hpp"
+
+namespace cosmic {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The recording, mapped read-only while the segment runs.
+class MappedFile {
+ public:
+  static Result<std::unique_ptr<MappedFile>> open(const std::string& path) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return Error::from_errno("cannot open " + path, errno);
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || st.st_size <= 0) {
+      ::close(fd);
+      return Error{path + " is empty or unreadable"};
+    }
+    const auto size = static_cast<std::size_t>(st.st_size);
+    void* at = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE, fd, 0);
+    const int err = errno;
+    ::close(fd);
+    if (at == MAP_FAILED) return Error::from_errno("cannot map " + path, err);
+    return std::unique_ptr<MappedFile>(new MappedFile(static_cast<const std::uint8_t*>(at), size));
+  }
+  ~MappedFile() { ::munmap(const_cast<std::uint8_t*>(data_), size_); }
+  MappedFile(const MappedFile&) = delete;
+  MappedFile& operator=(const MappedFile&) = delete;
+  std::span<const std::uint8_t> bytes() const { return {data_, size_}; }
+
+ private:
+  MappedFile(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {}
+  const std::uint8_t* data_;
+  std::size_t size_;
+};
+
+std::string micros(Nanos value) { return std::to_string(value.count() / 1000) + " us"; }
+
+class ReplayAdapter final : public SegmentAdapter {
+ public:
+  ReplayAdapter(SegmentSpec spec, Logger& log) : spec_(std::move(spec)), log_(log) {}
+  ~ReplayAdapter() override { stop(); }
+
+  Status start(EventSink& sink) override {
+    std::unique_lock lock(mutex_);
+    if (sink_ != nullptr) return Status::failure("segment " + spec_.name + " already started");
+    auto file = MappedFile::open(spec_.replay.file);
+    if (!file) {
+      health_ = HealthReport{SegmentHealth::down, file.error().text};
+      return Status::failure(file.error().text);
+    }
+    file_ = std::move(file).value();
+    sink_ = &sink;
+    stopping_ = false;
+    health_ = HealthReport{SegmentHealth::up, "waiting for a channel of the recording to be bound"};
+    thread_ = std::thread([this] { run(); });
+    return Status::success();
+  }
+
+  Status configure(std::span<const ChannelBinding> bindings) override {
+    std::lock_guard lock(mutex_);
+    if (sink_ == nullptr) return not_started(spec_.name);
+    BindingPlan plan(bindings);
+    std::map<std::string, ChannelId> bound;
+    for (const ChannelBinding* b : plan.accepted()) {
+      if (b->role != HopRole::publisher) {
+        plan.refuse(*b, "a replay segment only publishes: nothing can be sent into a recording");
+      } else if (b->spec.type) {
+        plan.refuse(*b, "typed channels are recorded as JSON, which this build does not read back");
+      } else {
+        bound[b->spec.name] = b->id;
+      }
+    }
+    if (bound_.empty() && !bound.empty()) ++pass_request_;  // carrying again: a new pass from the start
+    bound_ = std::move(bound);
+    wake_.notify_all();
+    return plan.status();
+  }
+
+  SendStatus send(const OutboundEvent&) override { return SendStatus::failed; }
+
+  HealthReport health() const override {
+    std::lock_guard lock(mutex_);
+    return health_;
+  }
+
+  AdapterStatistics statistics() const override {
+    std::lock_guard lock(mutex_);
+    AdapterStatistics out;
+    out.received = replayed_;
+    out.transport = {{"passes", passes_},
+                     {"lateness_p50_ns", static_cast<std::uint64_t>(lateness_->quantile(0.50).count())},
+                     {"lateness_p99_ns", static_cast<std::uint64_t>(lateness_->quantile(0.99).count())},
+                     {"lateness_max_ns", static_cast<std::uint64_t>(lateness_->max().count())}};
+    return out;
+  }
+
+  std::optional<std::size_t> matched_peers(ChannelId) const override { return std::nullopt; }
+
+  void stop() override {
+    {
+      std::lock_guard lock(mutex_);
+      if (sink_ == nullptr) return;
+      stopping_ = true;
+    }
+    wake_.notify_all();
+    if (thread_.joinable()) thread_.join();
+    std::lock_guard lock(mutex_);
+    sink_ = nullptr;
+    bound_.clear();
+    file_.reset();
+    health_ = HealthReport{SegmentHealth::down, "stopped"};
+  }
+
+ private:
+  // The pass in progress: where the recording's time starts and when it started here.
+  struct Pass {
+    std::optional<std::uint64_t> first_log_time;  // of the selection, before start_offset
+    std::uint64_t origin_log_time = 0;            // first_log_time + start_offset
+    Clock::time_point started{};
+  };
+
+  bool selected(const std::string& channel) const {
+    if (spec_.replay.channels.empty()) return true;
+    for (const auto& p : spec_.replay.channels)
+      if (::fnmatch(p.c_str(), channel.c_str(), 0) == 0) return true;
+    return false;
+  }
+
+  void run() {
+    const std::string name = ("replay:" + spec_.name).substr(0, 15);
+    pthread_setname_np(pthread_self(), name.c_str());
+    std::uint64_t played_request = 0;
+    for (;;) {
+      {
+        std::unique_lock lock(mutex_);
+        wake_.wait(lock, [&] { return stopping_ || (!bound_.empty() && pass_request_ != played_request); });
+        if (stopping_) return;
+        played_request = pass_request_;
+      }
+      while (play_pass(played_request)) {
+        std::lock_guard lock(mutex_);
+        ++passes_;
+        if (!spec_.replay.loop) {
+          health_ = HealthReport{SegmentHealth::up, "finished: " + summary_locked()};
+          break;
+        }
+      }
+    }
+  }
+
+  // One pass over the recording; false when it was cut short (stopped, unbound, damaged).
+  bool play_pass(std::uint64_t request) {
+    Pass pass;
+    pass.started = Clock::now();
+    {
+      std::lock_guard lock(mutex_);
+      lateness_ = std::make_unique<LatencyHistogram>();
+      health_ = HealthReport{SegmentHealth::up, "replaying " + spec_.replay.file};
+    }
+    const auto on_message = [&](const McapMessageView& m, const McapChannel& channel) -> Result<void> {
+      return play(pass, request, m, channel);
+    };
+    const auto scanned = scan_mcap(file_->bytes(), on_message);
+    if (scanned) return true;
+    std::lock_guard lock(mutex_);
+    if (!stopping_ && request == pass_request_ && !bound_.empty()) {
+      health_ = HealthReport{SegmentHealth::degraded, "the recording cannot be read on: " + scanned.error().text};
+      log_.log(LogLevel::error, "segment " + spec_.name + ": " + health_.detail);
+    }
+    return false;
+  }
+
+  Result<void> play(Pass& pass, std::uint64_t request, const McapMessageView& m, const McapChannel& channel) {
+    if (!selected(channel.topic)) return {};
+    if (!pass.first_log_time) {
+      pass.first_log_time = m.log_time;
+      pass.origin_log_time = m.log_time + static_cast<std::uint64_t>(spec_.replay.start_offset.count());
+    }
+    if (m.log_time < pass.origin_log_time) return {};
+    const auto offset = static_cast<double>(m.log_time - pass.origin_log_time) / spec_.replay.speed;
+    const Clock::time_point due = pass.started + std::chrono::nanoseconds(static_cast<std::int64_t>(offset));
+    ChannelId id = kNoChannel;
+    {
+      std::unique_lock lock(mutex_);
+      wake_.wait_until(lock, due, [&] { return stopping_ || request != pass_request_ || bound_.empty(); });
+      if (stopping_ || request != pass_request_ || bound_.empty()) return Error{"cut short"};
+      const auto it = bound_.find(channel.topic);
+      if (it == bound_.end()) return {};
+      id = it->second;
+    }
+    // No identity of its own: the router makes this gateway its origin and numbers it.
+    const InboundEvent event{id, EventHeader{}, m.data, steady_now(), FormatIdentity{false, false, false, false}};
+    sink_->on_event(event);
+    const Nanos late = std::chrono::duration_cast<Nanos>(Clock::now() - due);
+    std::lock_guard lock(mutex_);
+    lateness_->record(std::max(late, Nanos(0)));
+    ++replayed_;
+    return {};
+  }
+
+  std::string summary_locked() const {
+    return std::to_string(replayed_) + " events in " + std::to_string(passes_) + " pass(es); lateness p50 " +
+           micros(lateness_->quantile(0.5)) + ", p99 " + micros(lateness_->quantile(0.99)) + ", max " +
+           micros(lateness_->max());
+  }
+
+  const SegmentSpec spec_;
+  Logger& log_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  EventSink* sink_ = nullptr;  // set while started
+  bool stopping_ = false;
+  std::unique_ptr<MappedFile> file_;
+  std::map<std::string, ChannelId> bound_;  // channel name -> id, publisher bindings
+  std::uint64_t pass_request_ = 0;          // bumped when the segment starts carrying channels again
+  std::unique_ptr<LatencyHistogram> lateness_ = std::make_unique<LatencyHistogram>();  // of the current pass
+  std::uint64_t replayed_ = 0;
+  std::uint64_t passes_ = 0;
+  HealthReport health_{SegmentHealth::down, "not started"};
+  std::thread thread_;
+};
+
+}  // namespace
+
+std::unique_ptr<SegmentAdapter> make_replay_adapter(const SegmentSpec& segment, Logger& log) {
+  return std::make_unique<ReplayAdapter>(segment, log);
+}
+
+}  // namespace cosmic

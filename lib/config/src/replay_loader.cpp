@@ -1,0 +1,169 @@
+// A replay segment (replay_loader.hpp).
+#include "replay_loader.hpp"
+
+#include <fcntl.h>
+#include <fnmatch.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <filesystem>
+#include <map>
+
+#include "cosmic/mcap_reader.hpp"
+
+namespace cosmic::config_detail {
+namespace {
+
+constexpr double kMinSpeed = 0.001;
+constexpr double kMaxSpeed = 1000;
+
+// The recording's bytes, mapped read-only for the scan.
+class MappedRecording {
+ public:
+  explicit MappedRecording(const std::string& path) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) {
+      error_ = std::strerror(errno);
+      return;
+    }
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+      error_ = "not a regular file";
+    } else if (st.st_size > 0) {
+      size_ = static_cast<std::size_t>(st.st_size);
+      void* at = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd, 0);
+      if (at == MAP_FAILED) {
+        error_ = std::strerror(errno);
+        size_ = 0;
+      } else {
+        data_ = static_cast<const std::uint8_t*>(at);
+      }
+    }
+    ::close(fd);
+  }
+  ~MappedRecording() {
+    if (data_ != nullptr) ::munmap(const_cast<std::uint8_t*>(data_), size_);
+  }
+  MappedRecording(const MappedRecording&) = delete;
+  MappedRecording& operator=(const MappedRecording&) = delete;
+  std::span<const std::uint8_t> bytes() const { return {data_, size_}; }
+  const std::string& error() const { return error_; }
+
+ private:
+  const std::uint8_t* data_ = nullptr;
+  std::size_t size_ = 0;
+  std::string error_;
+};
+
+bool selected(const std::vector<std::string>& patterns, const std::string& channel) {
+  if (patterns.empty()) return true;
+  for (const auto& p : patterns)
+    if (::fnmatch(p.c_str(), channel.c_str(), 0) == 0) return true;
+  return false;
+}
+
+std::uint64_t fnv1a(std::span<const std::uint8_t> bytes) {
+  std::uint64_t hash = 0xcbf29ce484222325ull;
+  for (const std::uint8_t b : bytes) hash = (hash ^ b) * 0x100000001b3ull;
+  return hash;
+}
+
+// Per selected channel (an MCAP topic): its events and the tightest spacing of two in log time.
+Result<std::vector<ReplayStream>> streams_of(std::span<const std::uint8_t> file,
+                                             const std::vector<std::string>& patterns) {
+  std::vector<ReplayStream> out;
+  std::map<std::string, std::pair<std::size_t, std::uint64_t>> seen;  // topic -> (index, last log time)
+  const auto on_message = [&](const McapMessageView& m, const McapChannel& channel) -> Result<void> {
+    if (!selected(patterns, channel.topic)) return {};
+    auto [it, added] = seen.try_emplace(channel.topic, out.size(), m.log_time);
+    if (added) {
+      out.push_back({channel.topic, 0, Nanos(0)});
+    } else if (m.log_time >= it->second.second) {
+      const Nanos gap(static_cast<std::int64_t>(m.log_time - it->second.second));
+      ReplayStream& stream = out[it->second.first];
+      stream.tightest = stream.events < 2 ? gap : std::min(stream.tightest, gap);
+    }
+    it->second.second = std::max(it->second.second, m.log_time);
+    ++out[it->second.first].events;
+    return {};
+  };
+  auto scanned = scan_mcap(file, on_message);
+  if (!scanned) return std::move(scanned).error();
+  return out;
+}
+
+void parse_options(YamlReader& reader, const YAML::Node& node, const std::string& path, ReplaySegmentProperties& r) {
+  if (has(node, "channels") && reader.is_list(node["channels"], key(path, "channels"))) {
+    for (std::size_t i = 0; i < node["channels"].size(); ++i) {
+      if (auto v = reader.string(node["channels"][i], indexed(key(path, "channels"), i))) r.channels.push_back(*v);
+    }
+  }
+  if (has(node, "speed")) {
+    if (auto v = reader.number(node["speed"], key(path, "speed"))) {
+      if (*v < kMinSpeed || *v > kMaxSpeed) {
+        reader.error_at(node["speed"], key(path, "speed"), "speed out of range",
+                        "from 0.001 to 1000: 1 as recorded, 2 twice as fast");
+      } else {
+        r.speed = *v;
+      }
+    }
+  }
+  if (has(node, "loop")) {
+    if (auto v = reader.boolean(node["loop"], key(path, "loop"))) r.loop = *v;
+  }
+  if (has(node, "start_offset")) {
+    if (auto v = reader.duration(node["start_offset"], key(path, "start_offset"), true)) r.start_offset = *v;
+  }
+}
+
+}  // namespace
+
+void parse_replay(YamlReader& reader, const YAML::Node& node, const std::string& path, SegmentSpec& segment,
+                  std::vector<std::string>& included) {
+  reader.check_map(
+      node, path,
+      {"name", "type", "file", "channels", "speed", "loop", "start_offset", "latency_bound", "max_utilization"});
+  // A source in this process: what the timer adds to the recorded spacing, at worst.
+  segment.latency_bound = Nanos(1'000'000);
+  segment.realtime = false;
+  if (has(node, "latency_bound")) {
+    if (auto v = reader.duration(node["latency_bound"], key(path, "latency_bound"), false)) segment.latency_bound = *v;
+  }
+  ReplaySegmentProperties& r = segment.replay;
+  parse_options(reader, node, path, r);
+  if (!has(node, "file")) {
+    reader.error_at(node, key(path, "file"), "missing required key 'file'", "an MCAP file cosmicd recorded");
+    return;
+  }
+  const auto text = reader.string(node["file"], key(path, "file"));
+  if (!text) return;
+  const std::filesystem::path given(*text);
+  r.file = given.is_absolute()
+               ? given.lexically_normal().string()
+               : (std::filesystem::absolute(reader.file()).parent_path() / given).lexically_normal().string();
+  included.push_back(r.file);
+  const MappedRecording mapped(r.file);
+  if (!mapped.error().empty()) {
+    reader.error_at(node["file"], key(path, "file"), "cannot read " + r.file + ": " + mapped.error(),
+                    "an MCAP file cosmicd recorded");
+    return;
+  }
+  auto streams = streams_of(mapped.bytes(), r.channels);
+  if (!streams) {
+    reader.error_at(node["file"], key(path, "file"), r.file + " is not a readable recording: " + streams.error().text,
+                    "an MCAP file cosmicd recorded");
+    return;
+  }
+  if (streams.value().empty()) {
+    reader.error_at(node["file"], key(path, "file"),
+                    r.file + " holds no event of " + (r.channels.empty() ? "any channel" : "the selected channels"),
+                    "a recording of the channels the segment publishes");
+    return;
+  }
+  r.streams = std::move(streams).value();
+  r.content_hash = fnv1a(mapped.bytes());
+}
+
+}  // namespace cosmic::config_detail
