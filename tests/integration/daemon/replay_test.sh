@@ -4,7 +4,8 @@
 #     `field`) is published by a `type: replay` segment of another cosmicd into the same channel:
 #     every event reaches an LCM subscriber with its contents, this gateway as origin and new
 #     sequence numbers, spaced as recorded (the median gap within 20% of 10 ms), and the segment
-#     reports its lateness (p50/p99/max) and passes; `speed: 2` halves the spacing;
+#     reports its lateness (p50/p99/max) and passes; `speed: 2` halves the spacing; `start_offset`
+#     skips the events before it and `loop` plays the rest again, pass after pass;
 #   - admission treats it as a publisher: `cosmicctl check` degrades the channel when the
 #     recording's tightest spacing at the replay's speed is below the channel's period, with the
 #     numbers, and rejects a replay whose recording has no event of the channel;
@@ -111,6 +112,30 @@ wait "$SUB" || fail "the subscriber did not get 40 events at speed 2: $(cat "$WO
 gap=$(median_gap_ms "$WORK/fast.jsonl")
 python3 -c 'import sys; g = float(sys.argv[1]); sys.exit(0 if 4 <= g <= 6 else 1)' "$gap" ||
   fail "median gap at speed 2: $gap ms, expected 5"
+kill -TERM "$PID_g"
+wait "$PID_g" 2>/dev/null
+PIDS=()
+passed
+
+scenario "start_offset skips the first events, loop plays the recording again"
+cat >"$WORK/loop.yaml" <<YAML
+gateway: {name: gw-replay}
+segments:
+  - {name: viz, type: lcm, url: "$VIZ", latency_bound: 2ms}
+  - {name: lidar-replay, type: replay, file: $RECORDING, speed: 10, loop: true, start_offset: 195ms}
+channels:
+  - {name: obstacle, subject: 0x600, class: nrt, payload: 4B, period: 500us, publishers: [lidar-replay], subscribers: [viz]}
+YAML
+start_daemon g "$WORK/loop.yaml" || exit 1
+# 40 events 10 ms apart, from 195 ms on: the last 20 of them, each pass.
+passes_at_least() { [ "$(segment_adapter_field g lidar-replay passes)" -ge "$1" ]; }
+wait_until 20 "three passes" passes_at_least 3
+ctl g --json segments | python3 -c '
+import json, sys
+a = next(s for s in json.load(sys.stdin)["segments"] if s["name"] == "lidar-replay")["adapter"]
+extra = a["received"] - 20 * a["passes"]
+assert 0 <= extra < 20, a
+' || fail "loop with start_offset: $(ctl g --json segments | head -c 800)"
 kill -TERM "$PID_g"
 wait "$PID_g" 2>/dev/null
 PIDS=()
