@@ -51,6 +51,37 @@ TEST_F(TypedForwardingTest, AFrameShorterThanItsMessageIsADecodeError) {
   EXPECT_EQ(dropped("wheel", "body", DropReason::decode_error), 1u);
 }
 
+// A tool publishes the channel as JSON on a native LCM hop (issue 37): each text is read into the
+// compact layout (its fields in any order) and leaves the envelope hop as such; a text that is not
+// one event of the type (a field missing) is counted as decode_error and goes no further.
+TEST_F(TypedForwardingTest, JsonATextPublishedOnAnLcmHopIsReadIntoTheCompactLayout) {
+  start();
+  ChannelsResult json_in = parse_channels(R"(
+- name: wheel_in
+  subject: 0x21
+  class: nrt
+  type: {dbc: wheel.dbc, message: WheelSpeed}
+  publishers: [viz]
+  subscribers: [lan]
+  native: {viz: {channel: WHEEL_IN, representation: json}}
+)",
+                                          (dir_ / "bind.yaml").string(), gateway.config());
+  ASSERT_TRUE(json_in.ok()) << json_in.errors[0].to_string();
+  const BindResult bound = gateway.bind(json_in.channels);
+  ASSERT_TRUE(bound.applied);
+  const auto text = [](std::string_view json) { return std::vector<std::uint8_t>(json.begin(), json.end()); };
+  ASSERT_TRUE(adapters["viz"]->inject("wheel_in", text(R"({"Speed":12.34,"Gear":-1})")));
+  ASSERT_TRUE(adapters["viz"]->inject("wheel_in", text(R"( {"Valid": true, "Gear": -1.0, "Speed": 12.34} )")));
+  std::vector<std::uint8_t> compact;
+  const double speed = 12.34;
+  put_le(compact, &speed, 8);
+  compact.push_back(0xFF);
+  compact.push_back(0x01);
+  EXPECT_EQ(sent_on("lan", 0), compact);
+  EXPECT_EQ(adapters["lan"]->sent().size(), 1u);
+  EXPECT_EQ(dropped("wheel_in", "viz", DropReason::decode_error), 1u);
+}
+
 // The envelope hop brings the compact layout: {Torque: float64, Mode: uint8}.
 std::vector<std::uint8_t> drive_event(double torque, std::uint8_t mode) {
   std::vector<std::uint8_t> compact;

@@ -25,7 +25,7 @@ TEST(JsonEventRefusal, AMissingUnknownOrRepeatedFieldIsRefused) {
   // Given twice before its turn.
   EXPECT_EQ(tolerant_refusal(R"("speed":1.5,)", R"("gear":-3,"gear":1,"speed":1.5,)"),
             "gear (byte 11): the field is given twice");
-  EXPECT_EQ(tolerant_refusal(R"(,"y":2)", ""), "pose.y (byte 98): missing");
+  EXPECT_EQ(tolerant_refusal(R"(,"y":2)", ""), "pose.y (byte 97): missing");
   EXPECT_EQ(tolerant_refusal(R"(,"y":2)", ","), "pose (byte 98): expected a field's name");
   EXPECT_EQ(tolerant_refusal(R"("y":2)", R"("y":2,"z":3)"), "pose (byte 104): no field is named z");
 }
