@@ -15,6 +15,7 @@
 #include <string>
 
 #include "cosmic/compact_layout.hpp"
+#include "json_scanner.hpp"
 #include "json_text.hpp"
 
 namespace cosmic {
@@ -23,62 +24,6 @@ namespace json_reading {
 namespace {
 
 constexpr std::size_t kMaxTextBytes = std::size_t{64} << 20;  // text positions fit 32 bits
-constexpr std::size_t kMaxPathParts = 2 * kMaxJsonNesting;
-constexpr std::size_t kMaxNameBytes = 64;  // valid_field_name: field and enumeration value names
-
-// Why a text was refused: "<what><detail><number><tail>" at byte `at`, inside the value `path`
-// names (innermost first: a field's name, or an element's index when the name is empty).
-struct Refusal {
-  struct Part {
-    std::string_view name;
-    std::size_t index = 0;
-  };
-  std::size_t at = 0;
-  const char* what = "";
-  std::string_view detail;
-  std::optional<std::uint64_t> number;
-  const char* tail = "";
-  std::array<Part, kMaxPathParts> path{};
-  std::size_t path_size = 0;
-
-  std::string text() const {
-    std::string where;
-    for (std::size_t i = path_size; i-- > 0;) {
-      if (path[i].name.empty()) {
-        where += "[" + std::to_string(path[i].index) + "]";
-      } else {
-        where += (where.empty() ? "" : ".") + std::string(path[i].name);
-      }
-    }
-    std::string out = where.empty() ? "byte " + std::to_string(at) : where + " (byte " + std::to_string(at) + ")";
-    out += std::string(": ") + what + std::string(detail);
-    if (number) out += std::to_string(*number);
-    return out + tail;
-  }
-};
-
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
-bool is_digit(char c) { return c >= '0' && c <= '9'; }
-
-// What a value starting with `c` is, for "expected a number, found a string".
-const char* found_kind(char c) {
-  switch (c) {
-    case '{':
-      return ", found an object";
-    case '[':
-      return ", found an array";
-    case '"':
-      return ", found a string";
-    case 't':
-    case 'f':
-      return ", found true or false";
-    case 'n':
-      return ", found null";
-    default:
-      return c == '-' || is_digit(c) ? ", found a number" : ", found no JSON value";
-  }
-}
-
 // The integers a kind holds.
 std::int64_t signed_lowest(ScalarKind kind) {
   return scalar_size(kind) == 8 ? std::numeric_limits<std::int64_t>::min()
@@ -91,44 +36,10 @@ std::uint64_t unsigned_highest(ScalarKind kind) {
                                 : (std::uint64_t{1} << (8 * scalar_size(kind))) - 1;
 }
 
-// A JSON number's span in the text, checked against JSON's grammar.
-struct NumberToken {
-  std::size_t begin = 0;
-  std::size_t end = 0;
-  bool whole_syntax = true;  // no fraction and no exponent: read as an integer
-};
-
-// The power of ten of a number's first significant digit (1234.5 -> 3, 0.01 -> -2, 5e-400 -> -400),
-// to tell an overflow from an underflow when from_chars says only "out of range".
-std::int64_t decimal_magnitude(std::string_view number) {
-  std::size_t i = !number.empty() && number[0] == '-' ? 1 : 0;
-  const std::size_t integer_begin = i;
-  while (i < number.size() && is_digit(number[i])) ++i;
-  std::optional<std::int64_t> first;
-  for (std::size_t k = integer_begin; k < i && !first; ++k) {
-    if (number[k] != '0') first = static_cast<std::int64_t>(i - k) - 1;
-  }
-  if (i < number.size() && number[i] == '.') {
-    for (std::int64_t place = -1; ++i < number.size() && is_digit(number[i]); --place) {
-      if (!first && number[i] != '0') first = place;
-    }
-  }
-  std::int64_t exponent = 0;
-  if (i < number.size() && (number[i] == 'e' || number[i] == 'E')) {
-    const bool negative = ++i < number.size() && number[i] == '-';
-    if (i < number.size() && (number[i] == '-' || number[i] == '+')) ++i;
-    for (; i < number.size() && is_digit(number[i]); ++i) {
-      exponent = std::min<std::int64_t>(exponent * 10 + (number[i] - '0'), std::int64_t{1} << 40);
-    }
-    if (negative) exponent = -exponent;
-  }
-  return first.value_or(0) + exponent;
-}
-
-class JsonEventParser {
+class JsonEventParser : public JsonScanner {
  public:
   JsonEventParser(std::string_view text, std::span<std::uint8_t> out, const json_text::Selectors& selectors)
-      : text_(text), out_(out), selectors_(selectors) {}
+      : JsonScanner(text), out_(out), selectors_(selectors) {}
 
   bool event(const std::vector<TypeField>& fields) {
     skip_space();
@@ -142,48 +53,6 @@ class JsonEventParser {
   const Refusal& refusal() const { return refusal_; }
 
  private:
-  // --- refusals -----------------------------------------------------------------------------------
-
-  bool fail(std::size_t at, const char* what, std::string_view detail = {},
-            std::optional<std::uint64_t> number = std::nullopt, const char* tail = "") {
-    refusal_.at = at;
-    refusal_.what = what;
-    refusal_.detail = detail;
-    refusal_.number = number;
-    refusal_.tail = tail;
-    refusal_.path_size = 0;
-    return false;
-  }
-  bool wrong_type(const char* expected) { return fail(pos_, "expected ", expected, std::nullopt, found_kind(peek())); }
-  // A refusal inside a field or an element, named on the way out.
-  bool inside(std::string_view name, std::size_t index = 0) {
-    if (refusal_.path_size < refusal_.path.size()) refusal_.path[refusal_.path_size++] = Refusal::Part{name, index};
-    return false;
-  }
-
-  // --- text ---------------------------------------------------------------------------------------
-
-  char peek() const { return pos_ < text_.size() ? text_[pos_] : '\0'; }
-  void skip_space() {
-    while (pos_ < text_.size() && is_space(text_[pos_])) ++pos_;
-  }
-  bool literal(std::string_view word) {
-    if (text_.substr(pos_, word.size()) != word) return false;
-    pos_ += word.size();
-    return true;
-  }
-  bool punctuation(char c, const char* what) {
-    skip_space();
-    if (peek() != c || pos_ >= text_.size()) return fail(pos_, what);
-    ++pos_;
-    return true;
-  }
-  bool enter() {
-    if (++depth_ > kMaxJsonNesting) return fail(pos_, "nested deeper than ", {}, kMaxJsonNesting, " arrays and objects");
-    ++pos_;
-    return true;
-  }
-
   // --- the compact layout -------------------------------------------------------------------------
 
   std::uint8_t* reserve(std::size_t size) {
@@ -268,41 +137,6 @@ class JsonEventParser {
       return put(kind, v);
     }
     return whole(kind, v, integer) && put(kind, v);
-  }
-
-  bool number(NumberToken& token) {
-    token.begin = pos_;
-    std::size_t i = pos_ + (peek() == '-' ? 1 : 0);
-    const auto digit_at = [&](std::size_t at) { return at < text_.size() && is_digit(text_[at]); };
-    const auto digits = [&] {
-      while (digit_at(i)) ++i;
-    };
-    if (!digit_at(i)) return i == pos_ ? wrong_type("a number") : fail(pos_, "a number without digits");
-    if (text_[i] == '0' && digit_at(i + 1)) return fail(pos_, "a number with a leading zero");
-    digits();
-    if (i < text_.size() && text_[i] == '.') {
-      token.whole_syntax = false;
-      if (!digit_at(++i)) return fail(pos_, "a number without digits after its point");
-      digits();
-    }
-    if (i < text_.size() && (text_[i] == 'e' || text_[i] == 'E')) {
-      token.whole_syntax = false;
-      if (++i < text_.size() && (text_[i] == '+' || text_[i] == '-')) ++i;
-      if (!digit_at(i)) return fail(pos_, "a number without digits in its exponent");
-      digits();
-    }
-    token.end = pos_ = i;
-    return true;
-  }
-
-  // The double nearest a checked number: an infinity beyond float64, a zero below its smallest.
-  double nearest_double(const NumberToken& token) const {
-    const std::string_view spelled = text_.substr(token.begin, token.end - token.begin);
-    double d = 0;
-    if (std::from_chars(spelled.data(), spelled.data() + spelled.size(), d).ec == std::errc()) return d;
-    const bool negative = spelled[0] == '-';
-    if (decimal_magnitude(spelled) < 0) return negative ? -0.0 : 0.0;
-    return negative ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::infinity();
   }
 
   bool real(ScalarKind kind, double& out) {
@@ -531,154 +365,9 @@ class JsonEventParser {
     return fail(begin, "no field is named ", raw_string(begin));
   }
 
-  // The characters of the string starting at `begin` as the text spells them (for a refusal).
-  std::string_view raw_string(std::size_t begin) const {
-    const std::string_view rest = text_.substr(begin + 1, kMaxNameBytes + 2);
-    return rest.substr(0, rest.find('"'));
-  }
-
-  // --- strings ------------------------------------------------------------------------------------
-
-  enum class Decoded : std::uint8_t { ok, too_long, invalid };
-
-  // The string at pos_ (its opening quote) into `out` (at most `room` bytes; null: only checked):
-  // escapes decoded to UTF-8, every raw byte valid UTF-8. ok: pos_ after its closing quote, `size`
-  // the bytes; too_long: it needs more than `room`; invalid: the refusal says why.
-  Decoded decode_string(std::uint8_t* out, std::size_t room, std::size_t& size) {
-    const auto emit = [&](const char* bytes, std::size_t count) {
-      if (room - size < count) return false;
-      if (out != nullptr) std::memcpy(out + size, bytes, count);
-      size += count;
-      return true;
-    };
-    std::size_t i = pos_ + 1;
-    while (i < text_.size()) {
-      const char c = text_[i];
-      if (c == '"') {
-        pos_ = i + 1;
-        return Decoded::ok;
-      }
-      if (static_cast<unsigned char>(c) < 0x20) {
-        fail(i, "a control character in a string (JSON escapes them)");
-        return Decoded::invalid;
-      }
-      std::size_t length = 1;
-      std::array<char, 4> utf8{};
-      const char* bytes = text_.data() + i;
-      std::size_t count = 1;
-      if (c == '\\') {
-        if (!escape(i, length, utf8, count)) return Decoded::invalid;
-        bytes = utf8.data();
-      } else if (static_cast<unsigned char>(c) >= 0x80) {
-        length = count = json_text::utf8_sequence(text_.substr(i));
-        if (length == 0) {
-          fail(i, "a byte that is not part of valid UTF-8");
-          return Decoded::invalid;
-        }
-      }
-      if (!emit(bytes, count)) return Decoded::too_long;
-      i += length;
-    }
-    fail(pos_, "a string without its closing quote");
-    return Decoded::invalid;
-  }
-
-  // The escape at `at` (a backslash): its `length` in the text and its `count` bytes of UTF-8.
-  bool escape(std::size_t at, std::size_t& length, std::array<char, 4>& utf8, std::size_t& count) {
-    const char kind = at + 1 < text_.size() ? text_[at + 1] : '\0';
-    length = 2;
-    count = 1;
-    static constexpr std::string_view kSimple = "\"\\/bfnrt";
-    static constexpr std::string_view kMeaning = "\"\\/\b\f\n\r\t";
-    if (const std::size_t simple = kSimple.find(kind); kind != '\0' && simple != std::string_view::npos) {
-      utf8[0] = kMeaning[simple];
-      return true;
-    }
-    std::uint32_t code = 0;
-    if (kind != 'u' || !hex4(at + 2, code)) return fail(at, "an invalid escape in a string");
-    length = 6;
-    if (code >= 0xDC00 && code <= 0xDFFF) return fail(at, "an unpaired surrogate escape in a string");
-    if (code >= 0xD800 && code <= 0xDBFF) {
-      std::uint32_t low = 0;
-      if (text_.substr(at + 6, 2) != "\\u" || !hex4(at + 8, low) || low < 0xDC00 || low > 0xDFFF)
-        return fail(at, "an unpaired surrogate escape in a string");
-      code = 0x10000 + ((code - 0xD800) << 10) + (low - 0xDC00);
-      length = 12;
-    }
-    const auto byte = [](std::uint32_t v) { return static_cast<char>(static_cast<unsigned char>(v)); };
-    if (code < 0x80) {
-      utf8[0] = byte(code);
-    } else if (code < 0x800) {
-      utf8 = {byte(0xC0 | (code >> 6)), byte(0x80 | (code & 0x3F))};
-      count = 2;
-    } else if (code < 0x10000) {
-      utf8 = {byte(0xE0 | (code >> 12)), byte(0x80 | ((code >> 6) & 0x3F)), byte(0x80 | (code & 0x3F))};
-      count = 3;
-    } else {
-      utf8 = {byte(0xF0 | (code >> 18)), byte(0x80 | ((code >> 12) & 0x3F)), byte(0x80 | ((code >> 6) & 0x3F)),
-              byte(0x80 | (code & 0x3F))};
-      count = 4;
-    }
-    return true;
-  }
-
-  bool hex4(std::size_t at, std::uint32_t& code) const {
-    if (text_.size() < at + 4) return false;
-    const char* first = text_.data() + at;
-    if (!std::all_of(first, first + 4, [](char c) { return std::isxdigit(static_cast<unsigned char>(c)) != 0; }))
-      return false;
-    return std::from_chars(first, first + 4, code, 16).ec == std::errc();
-  }
-
-  // --- skipping a value given before its turn -----------------------------------------------------
-
-  bool skip_value() {
-    skip_space();
-    const char c = peek();
-    if (c == '{' || c == '[') {
-      const char close = c == '{' ? '}' : ']';
-      if (!enter()) return false;
-      skip_space();
-      if (peek() == close && pos_ < text_.size()) {
-        ++pos_;
-        --depth_;
-        return true;
-      }
-      for (;;) {
-        skip_space();
-        if (c == '{') {
-          std::size_t ignored = 0;
-          if (peek() != '"') return fail(pos_, "expected a member's name");
-          if (decode_string(nullptr, std::numeric_limits<std::size_t>::max(), ignored) != Decoded::ok) return false;
-          if (!punctuation(':', "expected : after a member's name")) return false;
-        }
-        if (!skip_value()) return false;
-        skip_space();
-        if (peek() == close && pos_ < text_.size()) {
-          ++pos_;
-          --depth_;
-          return true;
-        }
-        if (!punctuation(',', c == '{' ? "expected , or } after a member" : "expected , or ] after an element"))
-          return false;
-      }
-    }
-    if (c == '"') {
-      std::size_t ignored = 0;
-      return decode_string(nullptr, std::numeric_limits<std::size_t>::max(), ignored) == Decoded::ok;
-    }
-    if (literal("true") || literal("false") || literal("null")) return true;
-    NumberToken token;
-    return number(token);
-  }
-
-  std::string_view text_;
   std::span<std::uint8_t> out_;
   const json_text::Selectors& selectors_;
-  std::size_t pos_ = 0;
   std::size_t out_at_ = 0;
-  std::size_t depth_ = 0;
-  Refusal refusal_;
 };
 
 // Runs the parser unless the text is too long; the parser (or nullopt for the length) says why not.
