@@ -140,8 +140,18 @@ class CanonicalEventMaker {
   }
 
   void text(std::uint32_t bound, Bytes& out) {
-    static const std::string pieces[] = {"a", "Z", "\"", "\\", "/", "\n", "\x01", std::string(1, '\0'),
-                                         "\xC3\xA9", "\xE2\x82\xAC", "\xEF\xBF\xBD", "\xF0\x9F\x98\x80"};
+    static const std::string pieces[] = {"a",
+                                         "Z",
+                                         "\"",
+                                         "\\",
+                                         "/",
+                                         "\n",
+                                         "\x01",
+                                         std::string(1, '\0'),
+                                         "\xC3\xA9",
+                                         "\xE2\x82\xAC",
+                                         "\xEF\xBF\xBD",
+                                         "\xF0\x9F\x98\x80"};
     std::string s;
     const std::size_t wanted = pick(bound + 1);
     while (s.size() < wanted) {
@@ -207,8 +217,8 @@ TEST(JsonEventReader, WriteReadWriteGivesTheSameTextAndTheVeryEvent) {
 TEST(JsonEventReader, AnEventWithTheLongestStringsAndFullestSequencesFitsMaxCompactSize) {
   const ChannelType type = strings();
   const JsonEventReader reader{ChannelType(type)};
-  const std::string text = R"({"one":"x","three":"abc","sixteen":"0123456789abcdef","long":")" +
-                           std::string(64, 'x') + R"(","words":["12345","12345","12345","12345"]})";
+  const std::string text = R"({"one":"x","three":"abc","sixteen":"0123456789abcdef","long":")" + std::string(64, 'x') +
+                           R"(","words":["12345","12345","12345","12345"]})";
   EXPECT_EQ(read_json(type, text).size(), reader.max_compact_size());
   Bytes short_buffer(reader.max_compact_size() - 1);
   const auto refused = reader.read(text, short_buffer);
@@ -239,7 +249,8 @@ TEST(JsonEventReader, IntegersReadFromIntegralNumbersOfAnySpelling) {
 }
 
 TEST(JsonEventReader, FloatsReadFromAnyNumberAndNullAsNaN) {
-  const ChannelType type = channel_type({field("a", scalar(ScalarKind::float32)), field("b", scalar(ScalarKind::float64))});
+  const ChannelType type =
+      channel_type({field("a", scalar(ScalarKind::float32)), field("b", scalar(ScalarKind::float64))});
   const auto floats = [&](const std::string& text) {
     const Bytes event = read_json(type, text);
     float a = 0;
@@ -279,7 +290,8 @@ TEST(JsonEventReader, EnumerationsReadByNameOrByNumberNamedOrNot) {
   const Bytes canonical = read_json(type, kTolerantCanonical);
   EXPECT_EQ(read_json(type, tolerant_with("\"state\":\"ON\"", "\"state\":1")), canonical);
   const Bytes unnamed = read_json(type, tolerant_with("\"state\":\"ON\"", "\"state\":200"));
-  EXPECT_EQ(written_json(JsonRepresentation{ChannelType(type)}, unnamed), tolerant_with("\"state\":\"ON\"", "\"state\":200"));
+  EXPECT_EQ(written_json(JsonRepresentation{ChannelType(type)}, unnamed),
+            tolerant_with("\"state\":\"ON\"", "\"state\":200"));
   EXPECT_EQ(read_json(type, tolerant_with("\"state\":\"ON\"", "\"state\":\"\\u004fN\"")), canonical);
 }
 

@@ -103,7 +103,8 @@ TEST(JsonEventRefusal, TextThatIsNotJsonIsRefused) {
   EXPECT_EQ(tolerant_refusal("-3", "3e"), "gear (byte 20): a number without digits in its exponent");
   EXPECT_EQ(tolerant_refusal("-3", "+3"), "gear (byte 20): expected a number, found no JSON value");
   EXPECT_EQ(tolerant_refusal("1.5", "NaN"), "speed (byte 9): expected a number, found no JSON value");
-  EXPECT_EQ(tolerant_refusal("\"hi\"", "\"h\ti\""), "name (byte 55): a control character in a string (JSON escapes them)");
+  EXPECT_EQ(tolerant_refusal("\"hi\"", "\"h\ti\""),
+            "name (byte 55): a control character in a string (JSON escapes them)");
   EXPECT_EQ(tolerant_refusal("\"hi\"", "\"h\xFFi\""), "name (byte 55): a byte that is not part of valid UTF-8");
   EXPECT_EQ(tolerant_refusal("\"hi\"", "\"h\xC0\xAF\""), "name (byte 55): a byte that is not part of valid UTF-8");
   EXPECT_EQ(tolerant_refusal("\"hi\"", "\"\\x\""), "name (byte 54): an invalid escape in a string");
@@ -131,10 +132,11 @@ TEST(JsonEventRefusal, ATextOverTheBoundIsRefusedBeforeItIsRead) {
   const JsonRepresentation writer{ChannelType(type)};
   EXPECT_EQ(reader.max_text_size(), 2 * writer.max_size() + 4096);
   // Whitespace is read up to the bound, not past it.
-  const std::string padded = std::string(kTolerantCanonical) + std::string(reader.max_text_size() - kTolerantCanonical.size(), ' ');
+  const std::string padded =
+      std::string(kTolerantCanonical) + std::string(reader.max_text_size() - kTolerantCanonical.size(), ' ');
   EXPECT_EQ(read_json(type, padded), read_json(type, std::string(kTolerantCanonical)));
-  EXPECT_EQ(refusal_of(type, padded + " "), "a text of " + std::to_string(padded.size() + 1) + " bytes, more than the " +
-                                                std::to_string(reader.max_text_size()) +
+  EXPECT_EQ(refusal_of(type, padded + " "), "a text of " + std::to_string(padded.size() + 1) +
+                                                " bytes, more than the " + std::to_string(reader.max_text_size()) +
                                                 " read for an event of the type");
 }
 

@@ -197,8 +197,8 @@ class JsonEventParser : public JsonScanner {
     const Decoded decoded = decode_string(name.data(), name.size(), size);
     if (decoded == Decoded::invalid) return false;
     const std::string_view spelled(reinterpret_cast<const char*>(name.data()), size);
-    const auto named = std::find_if(type.values.begin(), type.values.end(),
-                                    [&](const EnumValue& v) { return v.name == spelled; });
+    const auto named =
+        std::find_if(type.values.begin(), type.values.end(), [&](const EnumValue& v) { return v.name == spelled; });
     if (decoded == Decoded::too_long || named == type.values.end()) {
       return fail(begin, "no value of the enumeration is named ", raw_string(begin));
     }
@@ -244,8 +244,9 @@ class JsonEventParser : public JsonScanner {
       for (;;) {
         skip_space();
         if (count == bound) {
-          return fail(pos_, exact ? "more elements than the array's length " : "more elements than the sequence's bound ",
-                      {}, bound);
+          return fail(pos_,
+                      exact ? "more elements than the array's length " : "more elements than the sequence's bound ", {},
+                      bound);
         }
         std::int64_t ignored = 0;
         if (!value(element, ignored)) return inside({}, count);
@@ -292,7 +293,8 @@ class JsonEventParser : public JsonScanner {
         if (f.present_when && !selected(f, values)) {
           if (given_at[next] != 0) {
             return fail(given_at[next], "given while ", f.present_when->selector, std::nullopt,
-                        " does not select it") || inside(f.name);
+                        " does not select it") ||
+                   inside(f.name);
           }
           if (!zero(f.type)) return inside(f.name);
           values[next] = 0;
@@ -322,8 +324,9 @@ class JsonEventParser : public JsonScanner {
         const TypeField& f = fields[index];
         if (index < next || given_at[index] != 0) {
           const bool unselected = index < next && f.present_when && !selected(f, values);
-          return (unselected ? fail(key_at, "given while ", f.present_when->selector, std::nullopt, " does not select it")
-                             : fail(key_at, "the field is given twice")) ||
+          return (unselected
+                      ? fail(key_at, "given while ", f.present_when->selector, std::nullopt, " does not select it")
+                      : fail(key_at, "the field is given twice")) ||
                  inside(f.name);
         }
         if (index == next) {  // its turn (catch_up has written every unselected field before it)
@@ -396,11 +399,10 @@ JsonEventReader::JsonEventReader(ChannelType type) : type_(std::move(type)) {
   json_text::index_selectors(type_.fields, selectors_);
 }
 
-
 Result<std::size_t> JsonEventReader::read(std::string_view json, std::span<std::uint8_t> compact) const {
   std::string why;
-  const std::optional<std::size_t> size =
-      json_reading::parse_event(type_, selectors_, max_text_size_, json, compact, [&](const json_reading::Refusal* refusal) {
+  const std::optional<std::size_t> size = json_reading::parse_event(
+      type_, selectors_, max_text_size_, json, compact, [&](const json_reading::Refusal* refusal) {
         why = refusal != nullptr ? refusal->text()
                                  : "a text of " + std::to_string(json.size()) + " bytes, more than the " +
                                        std::to_string(max_text_size_) + " read for an event of the type";
@@ -411,7 +413,8 @@ Result<std::size_t> JsonEventReader::read(std::string_view json, std::span<std::
 
 std::optional<std::size_t> JsonEventReader::read_unexplained(std::string_view json,
                                                              std::span<std::uint8_t> compact) const noexcept {
-  return json_reading::parse_event(type_, selectors_, max_text_size_, json, compact, [](const json_reading::Refusal*) {});
+  return json_reading::parse_event(type_, selectors_, max_text_size_, json, compact,
+                                   [](const json_reading::Refusal*) {});
 }
 
 }  // namespace cosmic

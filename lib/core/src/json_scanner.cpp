@@ -209,7 +209,6 @@ bool JsonScanner::hex4(std::size_t at, std::uint32_t& code) const {
   return std::from_chars(first, first + 4, code, 16).ec == std::errc();
 }
 
-
 bool JsonScanner::skip_value() {
   skip_space();
   const char c = peek();

@@ -57,7 +57,6 @@ class JsonScanner {
  protected:
   enum class Decoded : std::uint8_t { ok, too_long, invalid };
 
-
   bool fail(std::size_t at, const char* what, std::string_view detail = {},
             std::optional<std::uint64_t> number = std::nullopt, const char* tail = "") {
     refusal_.at = at;
@@ -75,7 +74,6 @@ class JsonScanner {
     return false;
   }
 
-
   char peek() const { return pos_ < text_.size() ? text_[pos_] : '\0'; }
   void skip_space() {
     while (pos_ < text_.size() && is_space(text_[pos_])) ++pos_;
@@ -92,7 +90,8 @@ class JsonScanner {
     return true;
   }
   bool enter() {
-    if (++depth_ > kMaxJsonNesting) return fail(pos_, "nested deeper than ", {}, kMaxJsonNesting, " arrays and objects");
+    if (++depth_ > kMaxJsonNesting)
+      return fail(pos_, "nested deeper than ", {}, kMaxJsonNesting, " arrays and objects");
     ++pos_;
     return true;
   }
