@@ -192,11 +192,10 @@ class JsonEventParser : public JsonScanner {
       return whole(type.scalar, v, integer) && put(type.scalar, v);
     }
     const std::size_t begin = pos_;
-    std::array<std::uint8_t, kMaxNameBytes> name{};
-    std::size_t size = 0;
-    const Decoded decoded = decode_string(name.data(), name.size(), size);
+    std::array<std::uint8_t, kMaxNameBytes> name;  // NOLINT(cppcoreguidelines-pro-type-member-init)
+    std::string_view spelled;
+    const Decoded decoded = decode_name(name, spelled);
     if (decoded == Decoded::invalid) return false;
-    const std::string_view spelled(reinterpret_cast<const char*>(name.data()), size);
     const auto named =
         std::find_if(type.values.begin(), type.values.end(), [&](const EnumValue& v) { return v.name == spelled; });
     if (decoded == Decoded::too_long || named == type.values.end()) {
@@ -355,11 +354,10 @@ class JsonEventParser : public JsonScanner {
   bool field_name(const std::vector<TypeField>& fields, std::size_t hint, std::size_t& index) {
     if (peek() != '"') return fail(pos_, "expected a field's name");
     const std::size_t begin = pos_;
-    std::array<std::uint8_t, kMaxNameBytes> name{};
-    std::size_t size = 0;
-    const Decoded decoded = decode_string(name.data(), name.size(), size);
+    std::array<std::uint8_t, kMaxNameBytes> name;  // NOLINT(cppcoreguidelines-pro-type-member-init)
+    std::string_view spelled;
+    const Decoded decoded = decode_name(name, spelled);
     if (decoded == Decoded::invalid) return false;
-    const std::string_view spelled(reinterpret_cast<const char*>(name.data()), size);
     const std::size_t n = fields.size();
     for (std::size_t k = 0; decoded == Decoded::ok && k < n; ++k) {
       index = (hint + k) % n;

@@ -105,6 +105,14 @@ class JsonScanner {
   // escapes decoded to UTF-8, every raw byte valid UTF-8. ok: pos_ after its closing quote, `size`
   // the bytes; too_long: it needs more than `room`; invalid: the refusal says why.
   Decoded decode_string(std::uint8_t* out, std::size_t room, std::size_t& size);
+  // A field's or an enumeration value's name (at most kMaxNameBytes; too_long: no such name) into
+  // `buffer`, `spelled` its bytes there.
+  Decoded decode_name(std::array<std::uint8_t, kMaxNameBytes>& buffer, std::string_view& spelled) {
+    std::size_t size = 0;
+    const Decoded decoded = decode_string(buffer.data(), buffer.size(), size);
+    spelled = std::string_view(reinterpret_cast<const char*>(buffer.data()), size);
+    return decoded;
+  }
   // A whole value of any kind, checked and passed over.
   bool skip_value();
 

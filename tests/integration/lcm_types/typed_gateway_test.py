@@ -17,7 +17,7 @@ out on B and C is received by this script's own sockets. Checked:
 Then the other way (issue 37): python3's json module (a JSON writer we did not write) sends each
 message's values as one JSON text on group D, channel POSE_JSON_IN (representation: json; every
 other text with its keys sorted, not in the struct's order, with json.dumps's ", " and ": " and
-\u escapes), and the channel pose_in leaves on group C, channel POSE_FROM_JSON, in the LCM encoding:
+ASCII-only \\u escapes), and the channel pose_in leaves on group C, channel POSE_FROM_JSON, in the LCM encoding:
   - every text arrives as exactly the message lcm-gen's encode() gives for the same values;
   - a text missing a field and one with a value beyond its kind are counted as decode_error.
 """
