@@ -28,15 +28,21 @@ namespace {
 
 using namespace typed_test;
 
-TEST_F(TypedForwardingTest, ADbcFrameLeavesAsTheCompactLayoutAndAsJson) {
-  start();
-  // Speed 12.34 km/h (raw 1234), Gear -1, Valid 1.
-  ASSERT_TRUE(adapters["body"]->inject("wheel", {0xD2, 0x04, 0xFF, 0x01}));
+// WheelSpeed {Speed: 12.34, Gear: -1, Valid: true} in the compact layout.
+std::vector<std::uint8_t> wheel_speed_12_34_compact() {
   std::vector<std::uint8_t> compact;
   const double speed = 12.34;
   put_le(compact, &speed, 8);
   compact.push_back(0xFF);
   compact.push_back(0x01);
+  return compact;
+}
+
+TEST_F(TypedForwardingTest, ADbcFrameLeavesAsTheCompactLayoutAndAsJson) {
+  start();
+  // Speed 12.34 km/h (raw 1234), Gear -1, Valid 1.
+  ASSERT_TRUE(adapters["body"]->inject("wheel", {0xD2, 0x04, 0xFF, 0x01}));
+  const std::vector<std::uint8_t> compact = wheel_speed_12_34_compact();
   EXPECT_EQ(sent_on("lan", 0), compact);
   const std::vector<std::uint8_t> json = sent_on("viz", 0);
   EXPECT_EQ(std::string(json.begin(), json.end()), R"({"Speed":12.34,"Gear":-1,"Valid":true})");
@@ -49,6 +55,33 @@ TEST_F(TypedForwardingTest, AFrameShorterThanItsMessageIsADecodeError) {
   EXPECT_EQ(sent_on("lan", 0).size(), 10u);  // the sound frame passed; the short one did not
   EXPECT_EQ(adapters["lan"]->sent().size(), 1u);
   EXPECT_EQ(dropped("wheel", "body", DropReason::decode_error), 1u);
+}
+
+// A tool publishes the channel as JSON on a native LCM hop (issue 37): each text is read into the
+// compact layout (its fields in any order) and leaves the envelope hop as such; a text that is not
+// one event of the type (a field missing) is counted as decode_error and goes no further.
+TEST_F(TypedForwardingTest, JsonATextPublishedOnAnLcmHopIsReadIntoTheCompactLayout) {
+  start();
+  ChannelsResult json_in = parse_channels(R"(
+- name: wheel_in
+  subject: 0x21
+  class: nrt
+  type: {dbc: wheel.dbc, message: WheelSpeed}
+  publishers: [viz]
+  subscribers: [lan]
+  native: {viz: {channel: WHEEL_IN, representation: json}}
+)",
+                                          (dir_ / "bind.yaml").string(), gateway.config());
+  ASSERT_TRUE(json_in.ok()) << json_in.errors[0].to_string();
+  const BindResult bound = gateway.bind(json_in.channels);
+  ASSERT_TRUE(bound.applied);
+  const auto text = [](std::string_view json) { return std::vector<std::uint8_t>(json.begin(), json.end()); };
+  ASSERT_TRUE(adapters["viz"]->inject("wheel_in", text(R"({"Speed":12.34,"Gear":-1})")));
+  ASSERT_TRUE(adapters["viz"]->inject("wheel_in", text(R"( {"Valid": true, "Gear": -1.0, "Speed": 12.34} )")));
+  const std::vector<std::uint8_t> compact = wheel_speed_12_34_compact();
+  EXPECT_EQ(sent_on("lan", 0), compact);
+  EXPECT_EQ(adapters["lan"]->sent().size(), 1u);
+  EXPECT_EQ(dropped("wheel_in", "viz", DropReason::decode_error), 1u);
 }
 
 // The envelope hop brings the compact layout: {Torque: float64, Mode: uint8}.

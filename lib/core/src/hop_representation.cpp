@@ -60,11 +60,17 @@ Conversion DbcFrameRepresentation::from_compact(std::span<const std::uint8_t> co
   return {codec_.frame_length(), ConversionFault::none, packed.out_of_range};
 }
 
-JsonHopRepresentation::JsonHopRepresentation(ChannelType type)
-    : json_(type), compact_size_(cosmic::max_compact_size(type)) {}
+JsonHopRepresentation::JsonHopRepresentation(ChannelType type) : json_(type), reader_(std::move(type)) {}
 
-Conversion JsonHopRepresentation::to_compact(std::span<const std::uint8_t>, std::span<std::uint8_t>) const noexcept {
-  return {0, ConversionFault::malformed, 0};
+Conversion JsonHopRepresentation::to_compact(std::span<const std::uint8_t> wire,
+                                             std::span<std::uint8_t> compact) const noexcept {
+  if (compact.size() < reader_.max_compact_size()) return {0, ConversionFault::too_small, 0};
+  // Without the reason: a malformed text is counted (decode_error), and the forwarding path
+  // allocates nothing for it.
+  const std::string_view text(reinterpret_cast<const char*>(wire.data()), wire.size());
+  const std::optional<std::size_t> read = reader_.read_unexplained(text, compact);
+  if (!read) return {0, ConversionFault::malformed, 0};
+  return {*read, ConversionFault::none, 0};
 }
 
 Conversion JsonHopRepresentation::from_compact(std::span<const std::uint8_t> compact,
@@ -187,17 +193,9 @@ Made hop_representation(const ChannelSpec& channel, const SegmentSpec& segment) 
   const NativeBinding* native = channel.native_on(segment.name);
   // Without a native identity the hop is the gateway's own format: the compact layout, also for
   // an LCM segment's `encoding: raw` channel (its datagrams are the compact event).
-  Made made = native != nullptr
-                  ? native_form(channel, *native)
-                  : Made(std::shared_ptr<const Representation>(std::make_shared<CompactRepresentation>(*channel.type)));
-  if (!made) return made;
-  const bool publishes = std::count(channel.publishers.begin(), channel.publishers.end(), segment.name) > 0;
-  if (publishes && !made.value()->reads()) {
-    return hop_error(made.value()->describe() +
-                     " is written for tools, not read: the segment can only be "
-                     "a subscriber of the channel");
-  }
-  return made;
+  return native != nullptr
+             ? native_form(channel, *native)
+             : Made(std::shared_ptr<const Representation>(std::make_shared<CompactRepresentation>(*channel.type)));
 }
 
 std::uint64_t TypedHops::largest() const {

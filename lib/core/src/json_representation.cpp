@@ -11,19 +11,30 @@
 #include <string_view>
 
 #include "cosmic/compact_layout.hpp"
+#include "json_text.hpp"
 
 namespace cosmic {
+namespace json_text {
 namespace {
 
-constexpr std::size_t kNumberText = 32;  // the longest number to_chars writes, with room
-
 std::size_t max_value_size(const FieldType& type);
+
+void index_selectors_of(const FieldType& type, Selectors& out) {
+  if (type.kind == FieldType::Kind::record) index_selectors(type.fields, out);
+  for (const FieldType& element : type.element) index_selectors_of(element, out);
+}
+
+}  // namespace
+
+constexpr std::size_t kNumberText = 32;  // the longest number to_chars writes, with room
 
 std::size_t max_record_size(const std::vector<TypeField>& fields) {
   std::size_t sum = 2;                                                                  // {}
   for (const TypeField& f : fields) sum += f.name.size() + 4 + max_value_size(f.type);  // "name": and a comma
   return sum;
 }
+
+namespace {
 
 std::size_t max_value_size(const FieldType& type) {
   switch (type.kind) {
@@ -45,14 +56,9 @@ std::size_t max_value_size(const FieldType& type) {
   return 0;
 }
 
-void index_selectors(const std::vector<TypeField>& fields, std::unordered_map<const TypeField*, std::size_t>& out);
+}  // namespace
 
-void index_selectors_of(const FieldType& type, std::unordered_map<const TypeField*, std::size_t>& out) {
-  if (type.kind == FieldType::Kind::record) index_selectors(type.fields, out);
-  for (const FieldType& element : type.element) index_selectors_of(element, out);
-}
-
-void index_selectors(const std::vector<TypeField>& fields, std::unordered_map<const TypeField*, std::size_t>& out) {
+void index_selectors(const std::vector<TypeField>& fields, Selectors& out) {
   for (const TypeField& f : fields) {
     if (f.present_when) {
       const auto selector = std::find_if(fields.begin(), fields.end(),
@@ -91,6 +97,13 @@ std::size_t utf8_sequence(std::string_view text) {
   const bool surrogate = code >= 0xD800 && code <= 0xDFFF;
   return overlong || surrogate || code > 0x10FFFF ? 0 : length;
 }
+
+}  // namespace json_text
+
+namespace {
+
+using json_text::kNumberText;
+using json_text::utf8_sequence;
 
 class JsonWriter {
  public:
@@ -246,8 +259,8 @@ class JsonWriter {
 }  // namespace
 
 JsonRepresentation::JsonRepresentation(ChannelType type) : type_(std::move(type)) {
-  max_size_ = max_record_size(type_.fields);
-  index_selectors(type_.fields, selectors_);
+  max_size_ = json_text::max_record_size(type_.fields);
+  json_text::index_selectors(type_.fields, selectors_);
 }
 
 std::optional<std::size_t> JsonRepresentation::write(std::span<const std::uint8_t> compact, std::span<char> out) const {

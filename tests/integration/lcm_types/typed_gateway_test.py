@@ -14,6 +14,12 @@ out on B and C is received by this script's own sockets. Checked:
   - a message of another fingerprint and one cut short are dropped and counted as decode_error;
   - `cosmicctl channel pose` names each hop's representation;
   - `cosmicctl echo pose --json` prints the first events with their decoded fields.
+Then the other way (issue 37): python3's json module (a JSON writer we did not write) sends each
+message's values as one JSON text on group D, channel POSE_JSON_IN (representation: json; every
+other text with its keys sorted, not in the struct's order, with json.dumps's ", " and ": " and
+ASCII-only \\u escapes), and the channel pose_in leaves on group C, channel POSE_FROM_JSON, in the LCM encoding:
+  - every text arrives as exactly the message lcm-gen's encode() gives for the same values;
+  - a text missing a field and one with a value beyond its kind are counted as decode_error.
 """
 import json
 import os
@@ -27,7 +33,7 @@ import time
 
 COSMICD, COSMICCTL, LCM_GEN, SOURCE_DIR = sys.argv[1:5]
 GROUP = "239.255.76.67"
-PORT_IN, PORT_JSON, PORT_OUT = 7931, 7932, 7933
+PORT_IN, PORT_JSON, PORT_OUT, PORT_JSON_IN = 7931, 7932, 7933, 7934
 COUNT = 40
 LCM_MAGIC = 0x4C433032  # "LC02": a small LCM UDPM message
 
@@ -93,6 +99,7 @@ segments:
   - {{name: a, type: lcm, url: "udpm://{GROUP}:{PORT_IN}?ttl=0", latency_bound: 2ms}}
   - {{name: b, type: lcm, url: "udpm://{GROUP}:{PORT_JSON}?ttl=0", latency_bound: 2ms}}
   - {{name: c, type: lcm, url: "udpm://{GROUP}:{PORT_OUT}?ttl=0", latency_bound: 2ms}}
+  - {{name: d, type: lcm, url: "udpm://{GROUP}:{PORT_JSON_IN}?ttl=0", latency_bound: 2ms}}
 channels:
   - name: pose
     subject: 0x51
@@ -104,6 +111,15 @@ channels:
       a: {{channel: POSE}}
       b: {{channel: POSE_JSON, representation: json}}
       c: {{channel: POSE_OUT}}
+  - name: pose_in
+    subject: 0x52
+    class: nrt
+    type: {{lcm: {os.path.join(SOURCE_DIR, "pose.lcm")}, name: demo.pose_t, max_length: {{ranges: 8}}}}
+    publishers: [d]
+    subscribers: [c]
+    native:
+      d: {{channel: POSE_JSON_IN, representation: json}}
+      c: {{channel: POSE_FROM_JSON}}
 """)
     sock_path = os.path.join(work, "gw.sock")
     log = open(os.path.join(work, "gw.log"), "w")
@@ -118,6 +134,7 @@ channels:
                 return
             time.sleep(0.05)
         run(sock_path, pose_t, point_t)
+        run_json_in(sock_path, pose_t, point_t)
     finally:
         daemon.terminate()
         daemon.wait(10)
@@ -196,6 +213,34 @@ def run(sock_path, pose_t, point_t):
     if not failures:
         print(f"checked: {COUNT} demo.pose_t messages from lcm-gen's Python code crossed cosmicd, byte for byte in "
               f"the LCM encoding and with the exact values as JSON; 2 malformed counted as decode_error")
+
+
+def run_json_in(sock_path, pose_t, point_t):
+    rng = random.Random(20270412)
+    out_sock = receiver(PORT_OUT)
+    send = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
+    send.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)
+    messages = [sample(pose_t, point_t, i, rng) for i in range(COUNT)]
+    texts = [json.dumps(as_json_values(m), sort_keys=bool(i % 2)) for i, m in enumerate(messages)]
+    missing = dict(as_json_values(messages[0]))
+    del missing["valid"]
+    beyond = dict(as_json_values(messages[0]), flags=128)  # flags is an int8_t
+    for seq, text in enumerate([json.dumps(missing), json.dumps(beyond)] + texts):
+        send.sendto(lcm_datagram("POSE_JSON_IN", text.encode(), seq), (GROUP, PORT_JSON_IN))
+        time.sleep(0.002)
+    got = collect(out_sock, "POSE_FROM_JSON", COUNT, time.monotonic() + 20)
+    check(len(got) == COUNT, f"{len(got)} messages on POSE_FROM_JSON, expected {COUNT}")
+    for i, (payload, m) in enumerate(zip(got, messages)):
+        check(payload == m.encode(), f"POSE_FROM_JSON message {i}: {payload.hex()} is not lcm-gen's {m.encode().hex()} "
+              f"for {texts[i]}")
+    answer = json.loads(ctl(sock_path, "--json", "channel", "pose_in").stdout)
+    hops = {s["segment"]: s for s in answer["channel"]["segments"]}
+    check(hops["d"]["representation"] == "JSON", f"representation on d: {hops['d']['representation']}")
+    check(hops["d"]["dropped"]["decode_error"] == 2,
+          f"decode_error on d: {hops['d']['dropped']['decode_error']}, expected 2")
+    if not failures:
+        print(f"checked: {COUNT} JSON texts from python3's json module crossed cosmicd into exactly lcm-gen's "
+              f"demo.pose_t encoding; a text missing a field and one beyond int8 counted as decode_error")
 
 
 if __name__ == "__main__":

@@ -5,7 +5,7 @@
 //   - a native CAN hop carries the DBC message's frame when the type comes from a DBC file (or the
 //     compact layout with `representation: compact`);
 //   - a native LCM hop carries the LCM type's encoding when the type comes from an LCM file, the
-//     compact layout, or JSON for tools (`representation: json`, written only);
+//     compact layout, or JSON for tools (`representation: json`), written and read;
 //   - a native DDS hop carries CDR of the type as an IDL struct, in the version its `representation`
 //     names (xcdr1, xcdr2), and reads either.
 // An untyped channel has no representation: its contents cross as the bytes they came in.
@@ -24,6 +24,7 @@
 #include "cosmic/channel_type.hpp"
 #include "cosmic/dbc_frames.hpp"
 #include "cosmic/e2e_protection.hpp"
+#include "cosmic/json_event_reader.hpp"
 #include "cosmic/json_representation.hpp"
 #include "cosmic/model.hpp"
 #include "cosmic/representation.hpp"
@@ -68,20 +69,21 @@ class DbcFrameRepresentation final : public Representation {
   std::optional<E2eProtection> e2e_;
 };
 
-// JSON text (cosmic/json_representation.hpp), written for tools; never read.
+// JSON text for tools: written as cosmic/json_representation.hpp sets out, read back (a tool
+// publishing on the hop) as cosmic/json_event_reader.hpp does. max_wire_size() is what write()
+// needs; a text read may be longer (a producer's whitespace), up to the reader's max_text_size().
 class JsonHopRepresentation final : public Representation {
  public:
   explicit JsonHopRepresentation(ChannelType type);
   std::string describe() const override { return "JSON"; }
   std::size_t max_wire_size() const noexcept override { return json_.max_size(); }
-  std::size_t max_compact_size() const noexcept override { return compact_size_; }
-  bool reads() const noexcept override { return false; }
+  std::size_t max_compact_size() const noexcept override { return reader_.max_compact_size(); }
   Conversion to_compact(std::span<const std::uint8_t> wire, std::span<std::uint8_t> compact) const noexcept override;
   Conversion from_compact(std::span<const std::uint8_t> compact, std::span<std::uint8_t> wire) const noexcept override;
 
  private:
   JsonRepresentation json_;
-  std::size_t compact_size_ = 0;
+  JsonEventReader reader_;
 };
 
 // The representation of `channel` on `segment` (one of its publishers or subscribers): null for an

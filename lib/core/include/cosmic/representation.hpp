@@ -44,9 +44,6 @@ class Representation {
   // The most bytes one message of the hop takes, and the most one event in the compact layout takes.
   virtual std::size_t max_wire_size() const noexcept = 0;
   virtual std::size_t max_compact_size() const noexcept = 0;
-  // Whether the hop can bring events in (a DBC frame, LCM, CDR, compact: yes; JSON: written for
-  // tools only, never read).
-  virtual bool reads() const noexcept { return true; }
   // The end-to-end protection the hop's messages carry (a DBC message's counter and CRC;
   // cosmic/e2e_protection.hpp), or null. The router checks it on what the hop brings in, before
   // to_compact(), and writes it on what from_compact() made, with the counters it keeps per hop.
