@@ -19,6 +19,7 @@
 #include "cosmic/mcap_writer.hpp"
 #include "cosmic/recorder.hpp"
 #include "cosmic/recording_info.hpp"
+#include "recording_file.hpp"
 
 namespace cosmic {
 namespace {
@@ -194,6 +195,30 @@ TEST_F(RecorderTest, FilesRotateBySizeAndEachIsWhole) {
   }
   EXPECT_EQ(next, kEvents + 1) << "every event, in order, across the files";
   EXPECT_EQ(recorder.status().files, paths.size());
+}
+
+// A cosmicd restarted within the same second finds its first names taken: it numbers on, never
+// overwriting (nor failing on) another's file.
+TEST_F(RecorderTest, ANameTakenWithinTheSameSecondIsSkipped) {
+  fs::create_directories(spec_.directory);
+  const std::int64_t now = utc_now();
+  for (std::int64_t second = 0; second < 3; ++second) {
+    for (std::uint64_t n = 1; n <= 3; ++n) {
+      const std::string name = recorder_detail::recording_file_name("gw", now + second * 1'000'000'000, n, ".mcap");
+      std::ofstream(fs::path(spec_.directory) / name) << "";
+    }
+  }
+  Recorder recorder(spec_, "gw", log_);
+  recorder.set_channels(channels());
+  ASSERT_TRUE(recorder.start().ok());
+  const std::string file = recorder.status().file;
+  recorder.stop();
+  EXPECT_EQ(file.substr(file.size() - 7), "-4.mcap") << file;
+  for (const auto& path : files()) {
+    if (path.string() != file) {
+      EXPECT_EQ(fs::file_size(path), 0u) << path << " was overwritten";
+    }
+  }
 }
 
 TEST_F(RecorderTest, ADirectoryThatCannotBeWrittenRefusesStartWithTheReason) {

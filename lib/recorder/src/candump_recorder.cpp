@@ -200,11 +200,18 @@ void CandumpRecorder::flush(SegmentLog& log) {
 }
 
 Result<void> CandumpRecorder::open(SegmentLog& log) {
-  const std::string name =
-      recording_file_name(gateway_ + "-" + log.segment.name, realtime_now_ns(), ++numbered_, ".log");
-  const std::string path = (std::filesystem::path(spec_.directory) / name).string();
-  auto fd = posix_call("cannot create " + path,
-                       [&] { return ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0640); });
+  const std::int64_t utc = realtime_now_ns();
+  std::string path;
+  const auto create = [&] {
+    path = (std::filesystem::path(spec_.directory) /
+            recording_file_name(gateway_ + "-" + log.segment.name, utc, ++numbered_, ".log"))
+               .string();
+    return posix_call("cannot create " + path,
+                      [&] { return ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0640); });
+  };
+  auto fd = create();
+  // A file of that name exists (a cosmicd restarted within the same second): the next number.
+  for (int tries = 0; !fd && fd.error().code == EEXIST && tries < 1000; ++tries) fd = create();
   if (!fd) return std::move(fd).error();
   log.fd = OwnedFd(fd.value());
   log.path = path;

@@ -159,10 +159,15 @@ class Recorder::Writer {
         std::chrono::duration_cast<Nanos>(std::chrono::system_clock::now().time_since_epoch()).count();
     std::error_code ignored;
     std::filesystem::create_directories(spec_.directory, ignored);
-    const std::string path = (std::filesystem::path(spec_.directory) /
-                              recorder_detail::recording_file_name(recorder_.gateway_, utc, ++numbered_, ".mcap"))
-                                 .string();
-    auto file = RecordingFile::create(path, spec_, recorder_.gateway_, utc);
+    const auto path_for = [&](std::uint64_t n) {
+      return (std::filesystem::path(spec_.directory) /
+              recorder_detail::recording_file_name(recorder_.gateway_, utc, n, ".mcap"))
+          .string();
+    };
+    auto file = RecordingFile::create(path_for(++numbered_), spec_, recorder_.gateway_, utc);
+    // A file of that name exists (a cosmicd restarted within the same second): the next number.
+    for (int tries = 0; !file && file.error().code == EEXIST && tries < 1000; ++tries)
+      file = RecordingFile::create(path_for(++numbered_), spec_, recorder_.gateway_, utc);
     if (!file) {
       fail(file.error().text, now);
       return;

@@ -10,6 +10,7 @@
 #     opens a new one; SIGTERM finishes the last;
 #   - a crash (SIGKILL) leaves a file McapStreamReader reads up to its last complete chunk: the
 #     chunks written within the flush interval (1 s) hold every event recorded before;
+#   - a typed channel's recorded JSON replays (a `type: replay` segment) as its compact events;
 #   - `cosmicctl record info` counts each file's channels, messages, gaps and drops (a crashed file's
 #     up to its cut), and refuses a file that is not MCAP;
 #   - a directory that cannot be written: `record start` fails with the reason, exit 1, and
@@ -55,7 +56,7 @@ recorded_at_least() { [ "$(record_field "$1" messages)" -ge "$2" ]; }
 files_in() { find "$1" -name '*.mcap' | sort; }
 # on_disk N: the newest file holds N messages in complete chunks, as the stream reader finds them.
 on_disk() {
-  [ "$(read_mcap stream "$(files_in "$WORK/rec" | tail -n 1)" |
+  [ "$(read_mcap stream "$(crash_file)" |
     python3 -c 'import json,sys; print(len(json.load(sys.stdin)["messages"]))')" -eq "$1" ]
 }
 
@@ -141,14 +142,17 @@ passed
 
 scenario "a crash keeps every complete chunk"
 PIDS=()
+files_in "$WORK/rec" >"$WORK/before-crash"
 start_daemon g "$WORK/g.yaml" || exit 1
+# The file this cosmicd writes: the one that was not there before (names may share their second).
+crash_file() { files_in "$WORK/rec" | grep -vxFf "$WORK/before-crash" | head -n 1; }
 "$LCM_PEER" pub --url "$IN" --channel obstacle --count 40 --rate 400 --subject 0x500 --origin 0xA1 --payload-hex 02020202
 wait_until 10 "40 events recorded" recorded_at_least g 40
 # Within the writer's flush interval (1 s) the events are in a complete chunk on disk.
 wait_until 10 "the 40 events in complete chunks on disk" on_disk 40
 kill -KILL "$PID_g"
 wait "$PID_g" 2>/dev/null
-crashed=$(files_in "$WORK/rec" | tail -n 1)
+crashed=$(crash_file)
 read_mcap stream "$crashed" >"$WORK/crash.json" || fail "@mcap/core's stream reader failed on the crashed file"
 python3 -c '
 import json, sys
@@ -166,6 +170,35 @@ printf 'not mcap' >"$WORK/garbage.mcap"
 ctl g record info "$WORK/garbage.mcap" >"$WORK/garbage.out" 2>&1
 [ $? -eq 1 ] || fail "record info of a file that is not MCAP did not exit 1"
 grep -q "is not a readable MCAP recording" "$WORK/garbage.out" || fail "record info garbage: $(cat "$WORK/garbage.out")"
+passed
+
+scenario "a typed channel replays from its recorded JSON into the compact layout"
+cat >"$WORK/typed-replay.yaml" <<YAML
+gateway: {name: gw-replay}
+segments:
+  - {name: viz, type: lcm, url: "$OUT", latency_bound: 2ms}
+  - {name: again, type: replay, file: ${files[0]}, channels: [range]}
+channels:
+  - name: range
+    subject: 0x501
+    class: nrt
+    publishers: [again]
+    subscribers: [viz]
+    type: {fields: [{name: distance, type: float32, unit: m}, {name: valid, type: bool}]}
+YAML
+"$LCM_PEER" sub --url "$OUT" --channel range --count 10 --timeout 30 >"$WORK/typed.jsonl" 2>"$WORK/typed.err" &
+sub=$!
+PIDS=()
+start_daemon t "$WORK/typed-replay.yaml" || exit 1
+wait "$sub" || fail "the typed replay did not deliver 10 events: $(cat "$WORK/typed.err")"
+python3 -c '
+import json, sys
+p = [json.loads(l)["payload"] for l in open(sys.argv[1]) if l.strip()]
+assert p == [sys.argv[2]] * 10, p
+' "$WORK/typed.jsonl" "$RANGE_HEX" || fail "typed replay payloads: $(head -n 2 "$WORK/typed.jsonl")"
+kill -TERM "$PID_t"
+wait "$PID_t" 2>/dev/null
+PIDS=()
 passed
 
 scenario "a directory that cannot be written: start fails with the reason, forwarding goes on"

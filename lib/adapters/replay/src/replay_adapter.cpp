@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "cosmic/binding_plan.hpp"
+#include "cosmic/json_event_reader.hpp"
 #include "cosmic/mcap_reader.hpp"
 #include "cosmic/router_stats.hpp"
 #include "cosmic/steady_clock.hpp"
@@ -80,15 +81,16 @@ class ReplayAdapter final : public SegmentAdapter {
     std::lock_guard lock(mutex_);
     if (sink_ == nullptr) return not_started(spec_.name);
     BindingPlan plan(bindings);
-    std::map<std::string, ChannelId> bound;
+    std::map<std::string, Bound> bound;
     for (const ChannelBinding* b : plan.accepted()) {
       if (b->role != HopRole::publisher) {
         plan.refuse(*b, "a replay segment only publishes: nothing can be sent into a recording");
-      } else if (b->spec.type) {
-        plan.refuse(*b, "typed channels are recorded as JSON, which this build does not read back");
-      } else {
-        bound[b->spec.name] = b->id;
+        continue;
       }
+      Bound& entry = bound[b->spec.name];
+      entry.id = b->id;
+      // A typed channel was recorded as JSON: read back into the compact layout the router takes.
+      if (b->spec.type) entry.json = std::make_shared<const JsonEventReader>(*b->spec.type);
     }
     if (bound_.empty() && !bound.empty()) ++pass_request_;  // carrying again: a new pass from the start
     bound_ = std::move(bound);
@@ -107,6 +109,7 @@ class ReplayAdapter final : public SegmentAdapter {
     std::lock_guard lock(mutex_);
     AdapterStatistics out;
     out.received = replayed_;
+    out.receive_errors = undecodable_;
     out.transport = {{"passes", passes_},
                      {"lateness_p50_ns", static_cast<std::uint64_t>(lateness_->quantile(0.50).count())},
                      {"lateness_p99_ns", static_cast<std::uint64_t>(lateness_->quantile(0.99).count())},
@@ -199,17 +202,31 @@ class ReplayAdapter final : public SegmentAdapter {
     if (m.log_time < pass.origin_log_time) return {};
     const auto offset = static_cast<double>(m.log_time - pass.origin_log_time) / spec_.replay.speed;
     const Clock::time_point due = pass.started + std::chrono::nanoseconds(static_cast<std::int64_t>(offset));
-    ChannelId id = kNoChannel;
+    Bound target;
     {
       std::unique_lock lock(mutex_);
       wake_.wait_until(lock, due, [&] { return stopping_ || request != pass_request_ || bound_.empty(); });
       if (stopping_ || request != pass_request_ || bound_.empty()) return Error{"cut short"};
       const auto it = bound_.find(channel.topic);
       if (it == bound_.end()) return {};
-      id = it->second;
+      target = it->second;
+    }
+    std::span<const std::uint8_t> contents = m.data;
+    if (target.json) {
+      compact_.resize(target.json->max_compact_size());
+      const std::string_view text(reinterpret_cast<const char*>(m.data.data()), m.data.size());
+      const auto size =
+          channel.message_encoding == "json" ? target.json->read_unexplained(text, compact_) : std::nullopt;
+      if (!size) {
+        std::lock_guard lock(mutex_);
+        ++undecodable_;  // recorded under another type, or not as JSON
+        return {};
+      }
+      contents = std::span<const std::uint8_t>(compact_).first(*size);
     }
     // No identity of its own: the router makes this gateway its origin and numbers it.
-    const InboundEvent event{id, EventHeader{}, m.data, steady_now(), FormatIdentity{false, false, false, false}};
+    const InboundEvent event{target.id, EventHeader{}, contents, steady_now(),
+                             FormatIdentity{false, false, false, false}};
     sink_->on_event(event);
     const Nanos late = std::chrono::duration_cast<Nanos>(Clock::now() - due);
     std::lock_guard lock(mutex_);
@@ -231,10 +248,17 @@ class ReplayAdapter final : public SegmentAdapter {
   EventSink* sink_ = nullptr;  // set while started
   bool stopping_ = false;
   std::unique_ptr<MappedFile> file_;
-  std::map<std::string, ChannelId> bound_;  // channel name -> id, publisher bindings
-  std::uint64_t pass_request_ = 0;          // bumped when the segment starts carrying channels again
+  // A channel bound here: its id, and for a typed channel the reader of its recorded JSON.
+  struct Bound {
+    ChannelId id = kNoChannel;
+    std::shared_ptr<const JsonEventReader> json;
+  };
+  std::map<std::string, Bound> bound_;  // by channel name, publisher bindings
+  std::vector<std::uint8_t> compact_;   // the replay thread's: a typed event read back
+  std::uint64_t pass_request_ = 0;      // bumped when the segment starts carrying channels again
   std::unique_ptr<LatencyHistogram> lateness_ = std::make_unique<LatencyHistogram>();  // of the current pass
   std::uint64_t replayed_ = 0;
+  std::uint64_t undecodable_ = 0;  // events of a bound typed channel that did not read back
   std::uint64_t passes_ = 0;
   HealthReport health_{SegmentHealth::down, "not started"};
   std::thread thread_;

@@ -3,7 +3,9 @@
 // by `speed`, from `start_offset` into the recording, and again from the start with `loop`. To the
 // router it is a segment like any other: its events enter by the same ingress checks and policing,
 // with this gateway as their origin and new sequence numbers; so `bind --replace` can swap it in for
-// a live sensor's segment and back. A pass starts when the segment first carries a channel of the
+// a live sensor's segment and back. A typed channel's events, recorded as JSON, are read back into
+// the compact layout (cosmic/json_event_reader.hpp); one that does not read counts as a receive
+// error. A pass starts when the segment first carries a channel of the
 // recording (or again after it carried none).
 //
 // It reports how far it ran from the recorded timing: each event's lateness (delivered minus due),
