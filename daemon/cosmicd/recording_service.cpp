@@ -56,6 +56,9 @@ void RecordingService::configure(cosmic::Gateway& gateway, const cosmic::Config&
     gateway.set_recording(recorder_.get(), {}, [this](const std::vector<cosmic::Route>& routes) { on_routes(routes); });
   } else if (changed) {
     recorder_->reconfigure(spec_);
+    // The routes were applied before this new section was known (a reload): the recorder's table
+    // must hold the channels the new selection takes.
+    on_routes(last_routes_);
   }
   if (!candump_ && !spec_.candump.empty()) {
     candump_ = std::make_unique<cosmic::CandumpRecorder>(spec_, config.gateway.name, log_);
@@ -80,6 +83,7 @@ void RecordingService::configure(cosmic::Gateway& gateway, const cosmic::Config&
 }
 
 void RecordingService::on_routes(const std::vector<cosmic::Route>& routes) {
+  if (&routes != &last_routes_) last_routes_ = routes;
   std::vector<cosmic::RecordedChannel> channels;
   std::vector<std::string> segments;
   for (const cosmic::Route& route : routes) {

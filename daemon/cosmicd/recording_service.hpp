@@ -60,6 +60,7 @@ class RecordingService {
   cosmic::Gateway* gateway_ = nullptr;
   cosmic::RecordingSpec spec_;
   std::unique_ptr<cosmic::Recorder> recorder_;
+  std::vector<cosmic::Route> last_routes_;                           // the gateway's table as last applied
   std::map<std::string, std::shared_ptr<cosmic::CandumpTap>> taps_;  // by CAN segment name
   std::map<std::string, std::string> interfaces_;                    // CAN segment name -> interface
   std::unique_ptr<cosmic::CandumpRecorder> candump_;                 // once `candump` lists a segment

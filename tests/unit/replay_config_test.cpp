@@ -63,14 +63,14 @@ class ReplayConfig : public testing::Test {
 
 TEST_F(ReplayConfig, TheRecordingIsReadAtLoadAndARelativeFileIsTheConfigurations) {
   const ConfigResult r = parse_config(
-      document("{name: rec, type: replay, file: run.mcap, speed: 2, loop: true, start_offset: 1s}"), file());
+      document("{name: rec, type: replay, file: run.mcap, speed: 2, loop: true, start_offset: 10ms}"), file());
   ASSERT_TRUE(r.ok()) << test::errors_text(r);
   const SegmentSpec& rec = r.config.segments[1];
   EXPECT_EQ(rec.type, SegmentType::replay);
   EXPECT_EQ(rec.replay.file, (dir_ / "run.mcap").string());
   EXPECT_EQ(rec.replay.speed, 2.0);
   EXPECT_TRUE(rec.replay.loop);
-  EXPECT_EQ(rec.replay.start_offset, Nanos(1'000'000'000));
+  EXPECT_EQ(rec.replay.start_offset, Nanos(10'000'000));
   EXPECT_EQ(rec.latency_bound, Nanos(1'000'000));
   ASSERT_EQ(rec.replay.streams.size(), 2u);
   EXPECT_EQ(rec.replay.streams[0], (ReplayStream{"obstacle", 4, Nanos(8'000'000)}));
@@ -100,6 +100,8 @@ TEST_F(ReplayConfig, EveryMistakeIsReportedWithItsPlace) {
       {"{name: rec, type: replay, file: run.mcap, speed: 5000}", "", "segments[1].speed: speed out of range"},
       {"{name: rec, type: replay, file: run.mcap, url: x}", "", "segments[1].url"},
       {"{name: rec, type: replay, file: run.mcap, start_offset: soon}", "", "segments[1].start_offset"},
+      {"{name: rec, type: replay, file: run.mcap, start_offset: 31ms}", "",
+       "segments[1].start_offset: start_offset beyond the recording (at most 30 ms"},
       {"{name: rec, type: replay, file: run.mcap}",
        "components:\n  - {name: lidar, segment: rec, publishes: [obstacle]}\n",
        "segment 'rec' is a replay: it publishes a recording, no component lives there"},

@@ -70,13 +70,22 @@ std::uint64_t fnv1a(std::span<const std::uint8_t> bytes) {
   return hash;
 }
 
-// Per selected channel (an MCAP topic): its events and the tightest spacing of two in log time.
-Result<std::vector<ReplayStream>> streams_of(std::span<const std::uint8_t> file,
-                                             const std::vector<std::string>& patterns) {
-  std::vector<ReplayStream> out;
+// Per selected channel (an MCAP topic): its events and the tightest spacing of two in log time;
+// and the selection's span (its first and last log times).
+struct Selection {
+  std::vector<ReplayStream> streams;
+  std::uint64_t first = 0;
+  std::uint64_t last = 0;
+};
+
+Result<Selection> streams_of(std::span<const std::uint8_t> file, const std::vector<std::string>& patterns) {
+  Selection selection;
+  std::vector<ReplayStream>& out = selection.streams;
   std::map<std::string, std::pair<std::size_t, std::uint64_t>> seen;  // topic -> (index, last log time)
   const auto on_message = [&](const McapMessageView& m, const McapChannel& channel) -> Result<void> {
     if (!selected(patterns, channel.topic)) return {};
+    selection.first = out.empty() ? m.log_time : std::min(selection.first, m.log_time);
+    selection.last = std::max(selection.last, m.log_time);
     auto [it, added] = seen.try_emplace(channel.topic, out.size(), m.log_time);
     if (added) {
       out.push_back({channel.topic, 0, Nanos(0)});
@@ -91,7 +100,7 @@ Result<std::vector<ReplayStream>> streams_of(std::span<const std::uint8_t> file,
   };
   auto scanned = scan_mcap(file, on_message);
   if (!scanned) return std::move(scanned).error();
-  return out;
+  return selection;
 }
 
 void parse_options(YamlReader& reader, const YAML::Node& node, const std::string& path, ReplaySegmentProperties& r) {
@@ -156,13 +165,21 @@ void parse_replay(YamlReader& reader, const YAML::Node& node, const std::string&
                     "an MCAP file cosmicd recorded");
     return;
   }
-  if (streams.value().empty()) {
+  if (streams.value().streams.empty()) {
     reader.error_at(node["file"], key(path, "file"),
                     r.file + " holds no event of " + (r.channels.empty() ? "any channel" : "the selected channels"),
                     "a recording of the channels the segment publishes");
     return;
   }
-  r.streams = std::move(streams).value();
+  const Selection& selection = streams.value();
+  const std::uint64_t span = selection.last - selection.first;
+  if (static_cast<std::uint64_t>(r.start_offset.count()) > span && has(node, "start_offset")) {
+    reader.error_at(node["start_offset"], key(path, "start_offset"), "start_offset beyond the recording",
+                    "at most " + format_duration(Nanos(static_cast<std::int64_t>(span))) +
+                        ", the span of the selected channels' events");
+    return;
+  }
+  r.streams = selection.streams;
   r.content_hash = fnv1a(mapped.bytes());
 }
 

@@ -85,8 +85,11 @@ void add_replay_checks(const ChannelSpec& channel, const SegmentSpec& segment, H
   const ReplayStream* stream = segment.replay.stream(channel.name);
   const double events = stream ? static_cast<double>(stream->events) : 0.0;
   h.checks.push_back(Check{"replay_events", events, 1.0, "events", ">=", events >= 1.0});
-  if (!stream || stream->events < 2 || !channel.period) return;
-  const double spacing = to_seconds(stream->tightest) / segment.replay.speed;
+  if (!stream || !channel.period) return;
+  // A loop of one event has no spacing of its own: it would be played back to back.
+  const double spacing =
+      stream->events < 2 ? (segment.replay.loop ? 0.0 : -1.0) : to_seconds(stream->tightest) / segment.replay.speed;
+  if (spacing < 0) return;
   const double limit = to_seconds(*channel.period);
   h.checks.push_back(Check{"replay_rate", spacing, limit, "s", ">=", spacing >= limit});
 }

@@ -91,7 +91,14 @@ Result<void> Recorder::start() {
   // The writer opens the first file; its verdict is this call's.
   std::unique_lock lock(shared_->mutex);
   shared_->acknowledged.wait_for(lock, std::chrono::seconds(10), [&] { return shared_->acked >= generation; });
-  if (shared_->acked < generation) return Error{"the recorder's writer did not answer within 10 s"};
+  if (shared_->acked < generation) {
+    // Taken back, so a late writer neither opens a file nobody stops nor merges this with a stop.
+    shared_->want_recording = false;
+    ++shared_->generation;
+    lock.unlock();
+    shared_->wake.notify_all();
+    return Error{"the recorder's writer did not answer within 10 s"};
+  }
   if (!shared_->status.recording) {
     shared_->want_recording = false;
     return Error{shared_->status.last_error};

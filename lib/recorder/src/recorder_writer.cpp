@@ -36,19 +36,23 @@ class Recorder::Writer {
   // After a failed open or write, the next file is tried this much later.
   static constexpr std::chrono::seconds kRetryEvery{5};
   static constexpr std::size_t kBatch = 4096;
+  static constexpr std::size_t kDrainBatches = 8;
 
   explicit Writer(Recorder& recorder) : recorder_(recorder), shared_(*recorder.shared_) {}
 
   void loop() {
     for (const std::string& problem : apply_thread_policy(ThreadPolicy{"record", 0, 19, {}}))
       recorder_.log_.log(LogLevel::warning, "recorder: could not get " + problem);
+    bool behind = false;
     for (;;) {
       bool quit = false;
       std::uint64_t generation = 0;
       bool want = false;
       {
         std::unique_lock lock(shared_.mutex);
-        shared_.wake.wait_for(lock, kPoll, [&] { return shared_.quit || shared_.generation != seen_generation_; });
+        // Behind (the last drain stopped at its budget): no pause, only the requests are looked at.
+        shared_.wake.wait_for(lock, behind ? std::chrono::milliseconds(0) : kPoll,
+                              [&] { return shared_.quit || shared_.generation != seen_generation_; });
         quit = shared_.quit;
         generation = shared_.generation;
         want = shared_.want_recording;
@@ -59,7 +63,7 @@ class Recorder::Writer {
         segments_ = shared_.segments;
       }
       // What was queued before a stop still belongs to the recording.
-      drain();
+      behind = drain();
       const auto now = Clock::now();
       if (generation != seen_generation_) act_on(want, now);
       if (recording_) keep_up(now);
@@ -71,9 +75,14 @@ class Recorder::Writer {
   }
 
  private:
-  void drain() {
-    while (recorder_.ring_.read([this](std::span<const std::uint8_t> record) { take(record); }, kBatch) == kBatch) {
+  // Takes what is queued, at most kDrainBatches batches: under a flood the queue never empties, and
+  // start, stop, flushing and rotation must still be served. True when it stopped at that budget.
+  bool drain() {
+    for (std::size_t batch = 0; batch < kDrainBatches; ++batch) {
+      if (recorder_.ring_.read([this](std::span<const std::uint8_t> record) { take(record); }, kBatch) < kBatch)
+        return false;
     }
+    return true;
   }
 
   void take(std::span<const std::uint8_t> record) {

@@ -50,10 +50,15 @@ Result<std::unique_ptr<RecordingFile>> RecordingFile::create(const std::string& 
   const int raw = owned.get();
   auto writer = McapWriter::open(
       options, [raw, path](std::span<const std::uint8_t> bytes) { return write_all(raw, path, bytes); });
-  if (!writer) return std::move(writer).error();
+  // A file that cannot even take its header is not left behind (a full disk would gather one per retry).
+  const auto discard = [&path](Error error) {
+    ::unlink(path.c_str());
+    return error;
+  };
+  if (!writer) return discard(std::move(writer).error());
   std::unique_ptr<RecordingFile> file(new RecordingFile(path, std::move(owned), opened_ns, std::move(writer).value()));
   const McapMap about{{"gateway", gateway}, {"opened_utc_ns", std::to_string(opened_ns)}};
-  if (auto written = file->writer_.add_metadata("cosmic", about); !written) return std::move(written).error();
+  if (auto written = file->writer_.add_metadata("cosmic", about); !written) return discard(std::move(written).error());
   return file;
 }
 

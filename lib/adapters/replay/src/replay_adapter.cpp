@@ -140,6 +140,8 @@ class ReplayAdapter final : public SegmentAdapter {
     std::optional<std::uint64_t> first_log_time;  // of the selection, before start_offset
     std::uint64_t origin_log_time = 0;            // first_log_time + start_offset
     Clock::time_point started{};
+    Clock::time_point last_due{};  // of the last event delivered
+    std::uint64_t delivered = 0;
   };
 
   bool selected(const std::string& channel) const {
@@ -160,21 +162,38 @@ class ReplayAdapter final : public SegmentAdapter {
         if (stopping_) return;
         played_request = pass_request_;
       }
-      while (play_pass(played_request)) {
+      Clock::time_point start = Clock::now();
+      for (;;) {
+        Pass pass;
+        pass.started = start;
+        if (!play_pass(played_request, pass)) break;
         std::lock_guard lock(mutex_);
         ++passes_;
-        if (!spec_.replay.loop) {
-          health_ = HealthReport{SegmentHealth::up, "finished: " + summary_locked()};
+        if (!spec_.replay.loop || pass.delivered == 0 || stopping_) {
+          health_ = HealthReport{
+              SegmentHealth::up,
+              (pass.delivered == 0 ? "finished: nothing at or after start_offset; " : "finished: ") + summary_locked()};
           break;
         }
+        // The next pass keeps the recording's pace across the seam: its first event one tightest
+        // spacing after the last one of this pass, never back to back.
+        start = std::max(Clock::now(), pass.last_due + loop_gap());
       }
     }
   }
 
+  // The smallest recorded spacing of the selected channels at the replay's speed, at least 1 ms.
+  Clock::duration loop_gap() const {
+    Nanos tightest{0};
+    for (const ReplayStream& stream : spec_.replay.streams)
+      if (stream.events >= 2 && (tightest.count() == 0 || stream.tightest < tightest)) tightest = stream.tightest;
+    const auto gap =
+        std::chrono::nanoseconds(static_cast<std::int64_t>(static_cast<double>(tightest.count()) / spec_.replay.speed));
+    return std::max<Clock::duration>(gap, std::chrono::milliseconds(1));
+  }
+
   // One pass over the recording; false when it was cut short (stopped, unbound, damaged).
-  bool play_pass(std::uint64_t request) {
-    Pass pass;
-    pass.started = Clock::now();
+  bool play_pass(std::uint64_t request, Pass& pass) {
     {
       std::lock_guard lock(mutex_);
       lateness_ = std::make_unique<LatencyHistogram>();
@@ -200,7 +219,8 @@ class ReplayAdapter final : public SegmentAdapter {
       pass.origin_log_time = m.log_time + static_cast<std::uint64_t>(spec_.replay.start_offset.count());
     }
     if (m.log_time < pass.origin_log_time) return {};
-    const auto offset = static_cast<double>(m.log_time - pass.origin_log_time) / spec_.replay.speed;
+    // Clamped: a third party's file may hold absurd times (the loader bounds the selection's span).
+    const double offset = std::min(static_cast<double>(m.log_time - pass.origin_log_time) / spec_.replay.speed, 1e17);
     const Clock::time_point due = pass.started + std::chrono::nanoseconds(static_cast<std::int64_t>(offset));
     Bound target;
     {
@@ -229,6 +249,8 @@ class ReplayAdapter final : public SegmentAdapter {
                              FormatIdentity{false, false, false, false}};
     sink_->on_event(event);
     const Nanos late = std::chrono::duration_cast<Nanos>(Clock::now() - due);
+    pass.last_due = due;
+    ++pass.delivered;
     std::lock_guard lock(mutex_);
     lateness_->record(std::max(late, Nanos(0)));
     ++replayed_;

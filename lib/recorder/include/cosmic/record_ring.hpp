@@ -12,6 +12,7 @@
 // Threads: try_write() on any number of threads at once; read() on one thread only.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -45,7 +46,10 @@ class RecordRing {
 
   // Bytes claimed and not yet released (an estimate while producers write).
   std::size_t used() const noexcept {
-    return static_cast<std::size_t>(tail_.load(std::memory_order_relaxed) - head_.load(std::memory_order_relaxed));
+    // Head first: read after the tail, it could have passed it and the difference would wrap.
+    const std::uint64_t head = head_.load(std::memory_order_acquire);
+    const std::uint64_t tail = tail_.load(std::memory_order_acquire);
+    return tail > head ? static_cast<std::size_t>(std::min<std::uint64_t>(tail - head, capacity_)) : 0;
   }
 
  private:
