@@ -10,6 +10,7 @@
 #     opens a new one; SIGTERM finishes the last;
 #   - a crash (SIGKILL) leaves a file McapStreamReader reads up to its last complete chunk: the
 #     chunks written within the flush interval (1 s) hold every event recorded before;
+#   - a reload that widens recording.channels records the newly selected channel at once;
 #   - a typed channel's recorded JSON replays (a `type: replay` segment) as its compact events;
 #   - `cosmicctl record info` counts each file's channels, messages, gaps and drops (a crashed file's
 #     up to its cut), and refuses a file that is not MCAP;
@@ -198,6 +199,29 @@ assert p == [sys.argv[2]] * 10, p
 ' "$WORK/typed.jsonl" "$RANGE_HEX" || fail "typed replay payloads: $(head -n 2 "$WORK/typed.jsonl")"
 kill -TERM "$PID_t"
 wait "$PID_t" 2>/dev/null
+PIDS=()
+passed
+
+scenario "a reload that widens recording.channels records the newly selected channel"
+write_config "$WORK/reload.yaml" "$WORK/rec-reload"
+PIDS=()
+start_daemon r "$WORK/reload.yaml" || exit 1
+sed -i "s/channels: \[obstacle, 'ran\*'\]/channels: [obstacle, 'ran*', chatter]/" "$WORK/reload.yaml"
+grep -q "chatter\]" "$WORK/reload.yaml" || fail "could not widen the selection in reload.yaml"
+ctl r reload >"$WORK/reload.out" 2>&1 || fail "reload failed: $(cat "$WORK/reload.out")"
+"$LCM_PEER" pub --url "$IN" --channel chatter --count 6 --rate 200 --subject 0x502 --origin 0xC1 --payload-hex 06060606
+wait_until 10 "6 chatter events recorded" recorded_at_least r 6
+ctl r record stop >/dev/null || fail "record stop after the reload failed"
+[ "$(ctl r --json record status | python3 -c 'import json,sys; d=json.load(sys.stdin)["recording"]; print(d["record_dropped"]["invalid"])')" -eq 0 ] ||
+  fail "events counted invalid after the reload: $(ctl r record status)"
+reloaded=$(files_in "$WORK/rec-reload" | tail -n 1)
+read_mcap indexed "$reloaded" | python3 -c '
+import json, sys
+d = json.load(sys.stdin)
+assert [m["data"] for m in d["messages"] if m["topic"] == "chatter"] == ["06060606"] * 6, d["messages"]
+' || fail "the reloaded selection did not record chatter: $(read_mcap indexed "$reloaded" | head -c 400)"
+kill -TERM "$PID_r"
+wait "$PID_r" 2>/dev/null
 PIDS=()
 passed
 
