@@ -67,7 +67,7 @@ const std::vector<BadConfig> kBadConfigs = {
   {"max_message_size_too_small.yaml", {{4, 23, "segments[0].max_message_size", "too small (more than 96B)"}}},
   {"interface_too_long.yaml", {{4, 16, "segments[0].interface", "interface name 'can-interface-name0' is too long (at most 15 characters)"}}},
   {"bad_class.yaml", {{9, 12, "channels[0].class", "'firm' is not allowed here (one of: hrt, srt, nrt)"}}},
-  {"unknown_segment_type.yaml", {{3, 11, "segments[0].type", "'zenoh' is not allowed here (one of: can, dds, lcm)"}}},
+  {"unknown_segment_type.yaml", {{3, 11, "segments[0].type", "'zenoh' is not allowed here (one of: can, dds, lcm, replay)"}}},
   {"bad_own_datagrams.yaml", {{6, 20, "segments[1].own_datagrams", "'discard' is not allowed here (one of: cut, drop)"}}},
   {"bad_reliability.yaml", {{4, 18, "segments[0].reliability", "'sometimes' is not allowed here (one of: reliable, best_effort)"}}},
   {"invalid_name.yaml", {{7, 11, "channels[0].name", "invalid name 'my channel'"}}},
@@ -109,7 +109,7 @@ const std::vector<BadConfig> kBadConfigs = {
   {"hrt_without_reaction_time.yaml", {{9, 5, "channels[0].reaction_time", "an hrt or srt channel needs reaction_time"}}},
   {"data_bitrate_without_fd.yaml", {{6, 19, "segments[0].data_bitrate", "data_bitrate needs fd: true"}}},
   {"errors_without_window.yaml", {{6, 13, "segments[0].errors.window", "missing required key 'window'"}}},
-  {"missing_segment_type.yaml", {{2, 5, "segments[0].type", "missing required key 'type' (type: can, dds or lcm)"}}},
+  {"missing_segment_type.yaml", {{2, 5, "segments[0].type", "missing required key 'type' (type: can, dds, lcm or replay)"}}},
   // documents
   {"yaml_syntax_error.yaml", {{7, 10, "", "YAML syntax error: end of sequence flow not found"}}},
   {"empty.yaml", {{1, 1, "", "the document is empty"}}},
