@@ -1,62 +1,20 @@
 // `cosmicctl record info FILE` (issue 37, docs/recording.md): what a recording holds, read offline
 // from the file mapped into memory (cosmic/recording_info.hpp), as text or --json.
-#include <fcntl.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <cstdio>
-#include <cstring>
 #include <ctime>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
 
 #include "commands.hpp"
+#include "cosmic/mapped_file.hpp"
 #include "cosmic/recording_info.hpp"
 
 namespace cosmicctl {
 namespace {
 
 using Json = nlohmann::json;
-
-// A read-only mapping of a whole file, unmapped at the end of its scope.
-class MappedFile {
- public:
-  explicit MappedFile(const std::string& path) {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) {
-      error_ = std::strerror(errno);
-      return;
-    }
-    struct stat st {};
-    if (::fstat(fd, &st) != 0) {
-      error_ = std::strerror(errno);
-    } else if (st.st_size > 0) {
-      size_ = static_cast<std::size_t>(st.st_size);
-      void* at = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd, 0);
-      if (at == MAP_FAILED) {
-        error_ = std::strerror(errno);
-        size_ = 0;
-      } else {
-        data_ = static_cast<const std::uint8_t*>(at);
-      }
-    }
-    ::close(fd);
-  }
-  ~MappedFile() {
-    if (data_ != nullptr) ::munmap(const_cast<std::uint8_t*>(data_), size_);
-  }
-  MappedFile(const MappedFile&) = delete;
-  MappedFile& operator=(const MappedFile&) = delete;
-  std::span<const std::uint8_t> bytes() const { return {data_, size_}; }
-  const std::string& error() const { return error_; }
-
- private:
-  const std::uint8_t* data_ = nullptr;
-  std::size_t size_ = 0;
-  std::string error_;
-};
 
 // "2026-11-30T02:55:01.123Z"
 std::string utc_text(std::uint64_t ns) {
@@ -156,12 +114,12 @@ void print_info(const std::string& file, const cosmic::RecordingInfo& info) {
 }  // namespace
 
 int run_record_info(const std::string& file, bool json) {
-  const MappedFile mapped(file);
-  if (!mapped.error().empty()) {
-    std::cerr << "cosmicctl: cannot read " << file << ": " << mapped.error() << "\n";
+  const auto mapped = cosmic::MappedFile::open(file);
+  if (!mapped) {
+    std::cerr << "cosmicctl: cannot read " << file << ": " << mapped.error().text << "\n";
     return kExitUnavailable;
   }
-  const auto info = cosmic::recording_info(mapped.bytes());
+  const auto info = cosmic::recording_info(mapped.value()->bytes());
   if (!info) {
     std::cerr << "cosmicctl: " << file << " is not a readable MCAP recording: " << info.error().text << "\n";
     return kExitRejected;

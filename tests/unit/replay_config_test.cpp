@@ -92,7 +92,7 @@ TEST_F(ReplayConfig, EveryMistakeIsReportedWithItsPlace) {
   const std::vector<Case> cases = {
       {"{name: rec, type: replay}", "", "segments[1].file: missing required key 'file'"},
       {"{name: rec, type: replay, file: missing.mcap}", "",
-       "segments[1].file: cannot read " + (dir_ / "missing.mcap").string()},
+       "segments[1].file: cannot open " + (dir_ / "missing.mcap").string()},
       {"{name: rec, type: replay, file: bogus.mcap}", "",
        "segments[1].file: " + (dir_ / "bogus.mcap").string() + " is not a readable recording"},
       {"{name: rec, type: replay, file: run.mcap, channels: [lidar]}", "", "holds no event of the selected channels"},

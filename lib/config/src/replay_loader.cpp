@@ -1,16 +1,12 @@
 // A replay segment (replay_loader.hpp).
 #include "replay_loader.hpp"
 
-#include <fcntl.h>
 #include <fnmatch.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
-#include <cstring>
 #include <filesystem>
 #include <map>
 
+#include "cosmic/mapped_file.hpp"
 #include "cosmic/mcap_reader.hpp"
 
 namespace cosmic::config_detail {
@@ -18,44 +14,6 @@ namespace {
 
 constexpr double kMinSpeed = 0.001;
 constexpr double kMaxSpeed = 1000;
-
-// The recording's bytes, mapped read-only for the scan.
-class MappedRecording {
- public:
-  explicit MappedRecording(const std::string& path) {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) {
-      error_ = std::strerror(errno);
-      return;
-    }
-    struct stat st {};
-    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-      error_ = "not a regular file";
-    } else if (st.st_size > 0) {
-      size_ = static_cast<std::size_t>(st.st_size);
-      void* at = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, fd, 0);
-      if (at == MAP_FAILED) {
-        error_ = std::strerror(errno);
-        size_ = 0;
-      } else {
-        data_ = static_cast<const std::uint8_t*>(at);
-      }
-    }
-    ::close(fd);
-  }
-  ~MappedRecording() {
-    if (data_ != nullptr) ::munmap(const_cast<std::uint8_t*>(data_), size_);
-  }
-  MappedRecording(const MappedRecording&) = delete;
-  MappedRecording& operator=(const MappedRecording&) = delete;
-  std::span<const std::uint8_t> bytes() const { return {data_, size_}; }
-  const std::string& error() const { return error_; }
-
- private:
-  const std::uint8_t* data_ = nullptr;
-  std::size_t size_ = 0;
-  std::string error_;
-};
 
 bool selected(const std::vector<std::string>& patterns, const std::string& channel) {
   if (patterns.empty()) return true;
@@ -153,13 +111,12 @@ void parse_replay(YamlReader& reader, const YAML::Node& node, const std::string&
                ? given.lexically_normal().string()
                : (std::filesystem::absolute(reader.file()).parent_path() / given).lexically_normal().string();
   included.push_back(r.file);
-  const MappedRecording mapped(r.file);
-  if (!mapped.error().empty()) {
-    reader.error_at(node["file"], key(path, "file"), "cannot read " + r.file + ": " + mapped.error(),
-                    "an MCAP file cosmicd recorded");
+  const auto mapped = MappedFile::open(r.file);
+  if (!mapped) {
+    reader.error_at(node["file"], key(path, "file"), mapped.error().text, "an MCAP file cosmicd recorded");
     return;
   }
-  auto streams = streams_of(mapped.bytes(), r.channels);
+  auto streams = streams_of(mapped.value()->bytes(), r.channels);
   if (!streams) {
     reader.error_at(node["file"], key(path, "file"), r.file + " is not a readable recording: " + streams.error().text,
                     "an MCAP file cosmicd recorded");
@@ -180,7 +137,7 @@ void parse_replay(YamlReader& reader, const YAML::Node& node, const std::string&
     return;
   }
   r.streams = selection.streams;
-  r.content_hash = fnv1a(mapped.bytes());
+  r.content_hash = fnv1a(mapped.value()->bytes());
 }
 
 }  // namespace cosmic::config_detail

@@ -1,12 +1,8 @@
 // A replay segment (cosmic/replay_adapter.hpp).
 #include "cosmic/replay_adapter.hpp"
 
-#include <fcntl.h>
 #include <fnmatch.h>
 #include <pthread.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <condition_variable>
 #include <cstring>
@@ -16,6 +12,7 @@
 
 #include "cosmic/binding_plan.hpp"
 #include "cosmic/json_event_reader.hpp"
+#include "cosmic/mapped_file.hpp"
 #include "cosmic/mcap_reader.hpp"
 #include "cosmic/router_stats.hpp"
 #include "cosmic/steady_clock.hpp"
@@ -24,35 +21,6 @@ namespace cosmic {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// The recording, mapped read-only while the segment runs.
-class MappedFile {
- public:
-  static Result<std::unique_ptr<MappedFile>> open(const std::string& path) {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) return Error::from_errno("cannot open " + path, errno);
-    struct stat st {};
-    if (::fstat(fd, &st) != 0 || st.st_size <= 0) {
-      ::close(fd);
-      return Error{path + " is empty or unreadable"};
-    }
-    const auto size = static_cast<std::size_t>(st.st_size);
-    void* at = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE, fd, 0);
-    const int err = errno;
-    ::close(fd);
-    if (at == MAP_FAILED) return Error::from_errno("cannot map " + path, err);
-    return std::unique_ptr<MappedFile>(new MappedFile(static_cast<const std::uint8_t*>(at), size));
-  }
-  ~MappedFile() { ::munmap(const_cast<std::uint8_t*>(data_), size_); }
-  MappedFile(const MappedFile&) = delete;
-  MappedFile& operator=(const MappedFile&) = delete;
-  std::span<const std::uint8_t> bytes() const { return {data_, size_}; }
-
- private:
-  MappedFile(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {}
-  const std::uint8_t* data_;
-  std::size_t size_;
-};
 
 std::string micros(Nanos value) { return std::to_string(value.count() / 1000) + " us"; }
 
