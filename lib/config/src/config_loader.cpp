@@ -20,13 +20,13 @@
 #include "typed_hops_loader.hpp"
 #include "type_loader.hpp"
 #include "federation_loader.hpp"
+#include "metrics_loader.hpp"
 #include "realtime_loader.hpp"
 #include "recording_loader.hpp"
 #include "replay_loader.hpp"
 #include "dds_security_loader.hpp"
 #include "folded_names.hpp"
 #include "key_file_loader.hpp"
-#include "listen_address.hpp"
 #include "segment_overlap.hpp"
 #include "yaml_reader.hpp"
 
@@ -36,8 +36,6 @@ namespace {
 using config_detail::has;
 using config_detail::indexed;
 using config_detail::key;
-using config_detail::ListenAddress;
-using config_detail::parse_listen_address;
 using config_detail::YamlReader;
 
 constexpr std::uint64_t kMaxPayload = 1 << 20;
@@ -156,35 +154,11 @@ class ConfigParser {
         }
       }
     }
-    if (has(node, "metrics")) parse_metrics(node["metrics"], key(path, "metrics"));
+    if (has(node, "metrics")) {
+      if (auto m = config_detail::parse_metrics(reader_, node["metrics"], key(path, "metrics"))) g.metrics = *m;
+    }
     if (has(node, "federation"))
       config_detail::parse_federation(reader_, node["federation"], key(path, "federation"), g.federation);
-  }
-
-  // A host outside loopback shows the gateway's channels and load to the network, so it needs
-  // an explicit allow_remote: true.
-  void parse_metrics(const YAML::Node& node, const std::string& path) {
-    if (!reader_.check_map(node, path, {"listen", "allow_remote"})) return;
-    MetricsSpec metrics;
-    if (has(node, "allow_remote")) {
-      if (auto v = reader_.boolean(node["allow_remote"], key(path, "allow_remote"))) metrics.allow_remote = *v;
-    }
-    if (!require(node, path, "listen", "HOST:PORT, e.g. 127.0.0.1:9877")) return;
-    const auto text = reader_.string(node["listen"], key(path, "listen"));
-    if (!text) return;
-    const ListenAddress listen = parse_listen_address(*text);
-    if (!listen.error.empty()) {
-      reader_.error_at(node["listen"], key(path, "listen"), "'" + *text + "' " + listen.error,
-                       "IP:PORT such as 127.0.0.1:9877 or [::1]:9877");
-    } else if (!listen.loopback && !metrics.allow_remote) {
-      reader_.error_at(node["listen"], key(path, "listen"), "'" + *text + "' is not a loopback address",
-                       "127.0.0.1:PORT or [::1]:PORT, or allow_remote: true to serve other hosts");
-    } else {
-      metrics.enabled = true;
-      metrics.host = listen.host;
-      metrics.port = listen.port;
-      config_.gateway.metrics = metrics;
-    }
   }
 
   void parse_segments(const YAML::Node& node) {
