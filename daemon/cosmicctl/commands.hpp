@@ -33,6 +33,8 @@ CommandRunner add_diagram_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_echo_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_gen_command(CLI::App& app, const GlobalOptions& options);
 CommandRunner add_record_command(CLI::App& app, const GlobalOptions& options);
+// `cosmicctl replay FILE ...` and `replay stop NAME` (replay_command.cpp).
+std::vector<CommandRunner> add_replay_command(CLI::App& app, const GlobalOptions& options);
 // `cosmicctl record info FILE` (record_info.cpp): offline, no daemon.
 int run_record_info(const std::string& file, bool json);
 CommandRunner add_security_command(CLI::App& app, const GlobalOptions& options);

@@ -2,13 +2,13 @@
 # Commands and options are those `cosmicctl --help` and `cosmicctl COMMAND --help` list:
 # tests/cli/man_completion_test.sh fails when a command or option is missing here or no longer
 # exists (`security` has the subcommand `permissions`, whose options follow it; `record` has start,
-# stop, status and info FILE, an MCAP file). Values: FILE
+# stop, status and info FILE, an MCAP file; `replay` takes FILE, an MCAP file, or stop NAME). Values: FILE
 # arguments complete to YAML files, --output to directories, --format and --protection to their
 # choices, --sign-with to two files, --component to the components: of the FILE on the line, channel NAMEs (channel,
 # unbind, echo) to the channels of the running gateway (`cosmicctl --json channels`, silent when it
 # cannot be reached). Needs nothing from the bash-completion package.
 
-_cosmicctl_commands="bind calibrate channel channels check diagram echo gen peers record reload security segments status top types unbind"
+_cosmicctl_commands="bind calibrate channel channels check diagram echo gen peers record reload replay security segments status top types unbind"
 _cosmicctl_global_options="--help --json --socket --version"
 
 # The options of one command (besides the global ones, which may follow it too).
@@ -19,6 +19,7 @@ _cosmicctl_command_options() {
     diagram) echo "--format --detail" ;;
     echo) echo "--count --interval --timeout" ;;
     gen) echo "--component --output" ;;
+    replay) [ "$2" != stop ] && echo "--channel --speed --loop --start-offset --name --alongside --match-timeout" ;;
     security) [ "$2" = permissions ] && echo "--sign-with --protection --valid-days" ;;
     top) echo "--interval --iterations" ;;
     types) echo "--type-path --name" ;;
@@ -123,6 +124,13 @@ _cosmicctl() {
       elif [ "$file" = info ] && [ -z "$more" ]; then
         compopt -o filenames 2>/dev/null
         mapfile -t COMPREPLY < <(compgen -f -X '!*.mcap' -- "$cur"; compgen -d -- "$cur")
+      fi
+      ;;
+    replay)
+      # replay FILE.mcap [options] | replay stop NAME
+      if [ -z "$file" ]; then
+        compopt -o filenames 2>/dev/null
+        mapfile -t COMPREPLY < <(compgen -W "stop" -- "$cur"; compgen -f -X '!*.mcap' -- "$cur"; compgen -d -- "$cur")
       fi
       ;;
     channel | unbind | echo)

@@ -6,6 +6,7 @@
 #include <memory>
 #include <sstream>
 
+#include "bind_output.hpp"
 #include "commands.hpp"
 #include "control_client.hpp"
 #include "cosmic/report.hpp"
@@ -17,76 +18,6 @@ namespace {
 using Json = nlohmann::json;
 using cosmic::format_percent;
 using cosmic::pad_column;
-
-std::string micros(double seconds) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.0fus", seconds * 1e6);
-  return buffer;
-}
-
-std::string text(const Json& value) { return value.is_string() ? value.get<std::string>() : value.dump(); }
-
-// JSON carries UTF-8 only: other bytes get a clear message instead of an encoder exception.
-bool is_utf8(const std::string& what, const std::string& text) {
-  const auto bad = first_invalid_utf8(text);
-  if (bad) std::cerr << "cosmicctl: " << what << " is not valid UTF-8 (byte " << *bad << ")\n";
-  return !bad;
-}
-
-void print_verdicts(const Json& channels) {
-  for (const auto& c : channels) {
-    std::cout << pad_column(text(c["name"]), 20) << pad_column(text(c["class"]), 5) << text(c["verdict"]) << "\n";
-    for (const auto& r : c["reasons"]) std::cout << "    - " << text(r) << "\n";
-    for (const auto& hop : c["hops"]) {
-      for (const auto& check : hop["checks"]) {
-        if (check["check"] == "response_time" || check["check"] == "latency") {
-          const bool ok = check["ok"].get<bool>();
-          std::cout << "    " << text(hop["segment"]) << ": " << text(check["check"]) << " "
-                    << (check["value"].is_null() ? std::string("unbounded") : micros(check["value"].get<double>()))
-                    << " " << (ok ? text(check["relation"]) : std::string(">")) << " "
-                    << micros(check["limit"].get<double>()) << (ok ? "" : "  FAIL") << "\n";
-        }
-      }
-    }
-  }
-}
-
-// What a replacement changed per channel, and which hops kept their endpoints.
-void print_replaced(const Json& replaced) {
-  auto hops = [](const Json& list) {
-    std::string out;
-    for (const auto& h : list)
-      out += (out.empty() ? "" : ", ") + text(h["segment"]) + (h["role"] == "publisher" ? " (P)" : " (S)");
-    return out.empty() ? std::string("-") : out;
-  };
-  for (const auto& c : replaced) {
-    std::cout << "replaced " << text(c["name"]) << ":\n";
-    for (const auto& change : c["changes"]) std::cout << "    " << text(change) << "\n";
-    if (c["changes"].empty()) std::cout << "    (the same definition)\n";
-    std::cout << "    hops kept: " << hops(c["hops"]["kept"]) << "; added: " << hops(c["hops"]["added"])
-              << "; removed: " << hops(c["hops"]["removed"]) << "\n";
-  }
-}
-
-// How a replacement switched over (made before break): the wait and each new publisher's matches.
-void print_switch_over(const Json& s) {
-  char waited[64];
-  std::snprintf(waited, sizeof waited, "%.0f ms", s["waited_s"].get<double>() * 1e3);
-  std::cout << "switched over after " << waited;
-  if (s["publishers"].empty()) std::cout << " (no new publisher to wait for)";
-  std::cout << "\n";
-  for (const auto& p : s["publishers"]) {
-    std::cout << "    new publisher " << text(p["segment"]) << " of " << text(p["channel"]) << ": ";
-    if (p["matched"].is_null()) {
-      std::cout << "no discovery on this transport (receiving since the switch)\n";
-    } else if (p["matched"].get<std::size_t>() == 0) {
-      std::cout << "NO writer matched within the match timeout (" << s["match_timeout_s"].get<double>()
-                << " s): events published there before discovery completes are lost\n";
-    } else {
-      std::cout << p["matched"].get<std::size_t>() << " writer(s) matched before the switch\n";
-    }
-  }
-}
 
 void print_status(const Json& r) {
   const Json& g = r["gateway"];
@@ -217,8 +148,8 @@ void print_channels(const Json& r) {
             << pad_column("RX", 9) << pad_column("TX", 9) << pad_column("RESIDENCE p50/p99", 19) << "DROPPED\n";
   for (const auto& c : r["channels"]) {
     bool first = true;
-    const std::string residence =
-        micros(c["residence"]["p50_s"].get<double>()) + "/" + micros(c["residence"]["p99_s"].get<double>());
+    const std::string residence = seconds_as_micros(c["residence"]["p50_s"].get<double>()) + "/" +
+                                  seconds_as_micros(c["residence"]["p99_s"].get<double>());
     const std::string runtime = c.value("runtime_state", "bound") == "violated" ? "VIOLATED" : "ok";
     for (const auto& s : c["segments"]) {
       std::cout << pad_column(first ? text(c["name"]) : "", 16) << pad_column(first ? text(c["class"]) : "", 6)
@@ -239,21 +170,24 @@ void print_channels(const Json& r) {
 // Admission's prediction next to what the gateway measured, per egress hop.
 void print_runtime(const Json& c) {
   std::cout << "\nruntime: " << c.value("runtime_state", "bound") << " (" << c.value("violations", 0)
-            << " violation episodes), residence bound " << micros(c["residence"]["bound_s"].get<double>());
+            << " violation episodes), residence bound " << seconds_as_micros(c["residence"]["bound_s"].get<double>());
   if (c.contains("predicted_end_to_end_s"))
-    std::cout << ", end-to-end predicted " << micros(c["predicted_end_to_end_s"].get<double>());
-  if (c.contains("reaction_time_s")) std::cout << " <= reaction_time " << micros(c["reaction_time_s"].get<double>());
+    std::cout << ", end-to-end predicted " << seconds_as_micros(c["predicted_end_to_end_s"].get<double>());
+  if (c.contains("reaction_time_s"))
+    std::cout << " <= reaction_time " << seconds_as_micros(c["reaction_time_s"].get<double>());
   std::cout << "\n";
   for (const auto& s : c["segments"]) {
     if (!s.contains("runtime")) continue;
     const Json& h = s["runtime"];
     std::cout << "  to " << pad_column(text(s["segment"]), 12) << "predicted hop "
-              << pad_column(
-                     h["predicted_latency_s"].is_null() ? "unbounded" : micros(h["predicted_latency_s"].get<double>()),
-                     10)
-              << "measured residence p50 " << micros(h["residence_p50_s"].get<double>()) << " p99 "
-              << micros(h["residence_p99_s"].get<double>()) << " p99.9 " << micros(h["residence_p999_s"].get<double>())
-              << " max " << micros(h["residence_max_s"].get<double>()) << "  misses: residence " << h["residence_miss"]
+              << pad_column(h["predicted_latency_s"].is_null()
+                                ? "unbounded"
+                                : seconds_as_micros(h["predicted_latency_s"].get<double>()),
+                            10)
+              << "measured residence p50 " << seconds_as_micros(h["residence_p50_s"].get<double>()) << " p99 "
+              << seconds_as_micros(h["residence_p99_s"].get<double>()) << " p99.9 "
+              << seconds_as_micros(h["residence_p999_s"].get<double>()) << " max "
+              << seconds_as_micros(h["residence_max_s"].get<double>()) << "  misses: residence " << h["residence_miss"]
               << ", deadline " << h["deadline_miss"] << "\n";
   }
 }
@@ -275,14 +209,16 @@ void print_channel(const Json& r) {
   if (c["admission"].contains("upstream")) {
     const Json& e2e = c["admission"]["end_to_end"];
     std::cout << "  path over gateways: "
-              << (e2e["upstream_s"].is_null() ? std::string("unbounded") : micros(e2e["upstream_s"].get<double>()))
+              << (e2e["upstream_s"].is_null() ? std::string("unbounded")
+                                              : seconds_as_micros(e2e["upstream_s"].get<double>()))
               << " before this one, "
-              << (e2e["local_s"].is_null() ? std::string("unbounded") : micros(e2e["local_s"].get<double>()))
+              << (e2e["local_s"].is_null() ? std::string("unbounded") : seconds_as_micros(e2e["local_s"].get<double>()))
               << " here\n";
     for (const auto& hop : c["admission"]["upstream"]) {
       std::cout << "  " << text(hop["role"]) << " " << text(hop["segment"]) << " on gateway " << text(hop["gateway"])
                 << "  "
-                << (hop["latency_s"].is_null() ? std::string("unbounded") : micros(hop["latency_s"].get<double>()))
+                << (hop["latency_s"].is_null() ? std::string("unbounded")
+                                               : seconds_as_micros(hop["latency_s"].get<double>()))
                 << "\n";
     }
   }
@@ -303,7 +239,7 @@ void print_channel(const Json& r) {
     if (hop.contains("security")) {
       const Json& security = hop["security"];
       std::cout << "  signed " << text(security["scheme"]) << " +" << text(security["bytes"]) << " B";
-      if (security["time_s"].is_number()) std::cout << " " << micros(security["time_s"].get<double>());
+      if (security["time_s"].is_number()) std::cout << " " << seconds_as_micros(security["time_s"].get<double>());
     }
     std::cout << "\n";
     for (const auto& check : hop["checks"]) {
@@ -312,34 +248,6 @@ void print_channel(const Json& r) {
                 << text(check["unit"]) << "\n";
     }
   }
-}
-
-// Registers a subcommand that sends one request and prints the answer.
-template <typename Build, typename Print>
-CommandRunner add_request_command(CLI::App& app, const GlobalOptions& options, CLI::App* command, Build build,
-                                  Print print) {
-  (void)app;
-  return [command, &options, build, print]() -> int {
-    if (!command->parsed()) return -1;
-    Json req;
-    if (const int code = build(req); code != kExitOk) return code;
-    const ClientResult result = request(options.socket, req);
-    if (!result.response) {
-      std::cerr << "cosmicctl: " << result.error << "\n";
-      return result.permission_denied ? kExitNoPermission : kExitUnavailable;
-    }
-    const Json& response = *result.response;
-    if (options.json) std::cout << response.dump(2) << "\n";
-    if (!response.value("ok", false)) {
-      if (!options.json) {
-        if (response.contains("channels")) print_verdicts(response["channels"]);
-        print_errors(response);
-      }
-      return exit_code_for_failure(response);
-    }
-    if (!options.json) print(response);
-    return kExitOk;
-  };
 }
 
 }  // namespace

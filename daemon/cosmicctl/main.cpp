@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   commands.push_back(cosmicctl::add_top_command(app, options));
   commands.push_back(cosmicctl::add_types_command(app, options));
   for (auto& command : cosmicctl::add_daemon_commands(app, options)) commands.push_back(std::move(command));
+  for (auto& command : cosmicctl::add_replay_command(app, options)) commands.push_back(std::move(command));
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {  // --help, --version

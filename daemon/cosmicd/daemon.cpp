@@ -264,6 +264,8 @@ class Daemon {
 
   // Returns why the new state could not be saved, or an empty string.
   std::string remember(const std::string& command, const nlohmann::json& request) {
+    // A run-time replay lasts until replay_stop, a reload or the next start: nothing to keep.
+    if (command == "replay" || command == "replay_stop") return {};
     if (command == "reload") {
       state_ = {};  // the file is the truth again
       file_config_ = gateway_.config();

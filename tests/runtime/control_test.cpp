@@ -231,6 +231,27 @@ TEST_F(ControlTest, ReloadOfABrokenFileKeepsTheRunningConfiguration) {
   EXPECT_EQ(client.call({{"command", "channels"}})["channels"].size(), 1u);
 }
 
+// cosmicctl replay's requests (control_replay.cpp): each malformed one is refused before anything is
+// read or added, and the gateway keeps its segments.
+TEST_F(ControlTest, BadReplayRequestsAreRefusedAndAddNoSegment) {
+  serve();
+  Client client(socket_path);
+  const auto code = [&](const Json& request) { return client.call(request)["error"]["code"].get<std::string>(); };
+  EXPECT_EQ(code({{"command", "replay"}}), "bad_request");
+  EXPECT_EQ(code({{"command", "replay"}, {"segment", {{"file", "relative.mcap"}}}}), "bad_request");
+  EXPECT_EQ(code({{"command", "replay"}, {"segment", {{"file", "/r.mcap"}, {"type", "dds"}}}}), "bad_request");
+  EXPECT_EQ(code({{"command", "replay"}, {"segment", {{"file", "/r.mcap"}}}, {"mode", "instead"}}), "bad_request");
+  EXPECT_EQ(code({{"command", "replay"}, {"segment", {{"file", "/r.mcap"}}}, {"match_timeout_s", 600}}), "bad_request");
+  const Json missing = client.call({{"command", "replay"}, {"segment", {{"file", "/nonexistent/r.mcap"}}}});
+  EXPECT_EQ(missing["error"]["code"], "config_error");
+  EXPECT_EQ(missing["errors"][0]["path"], "segment.file");
+  EXPECT_EQ(code({{"command", "replay_stop"}}), "bad_request");
+  const Json unknown = client.call({{"command", "replay_stop"}, {"name", "lidar"}});
+  EXPECT_EQ(unknown["error"]["code"], "not_found");
+  EXPECT_NE(unknown["error"]["message"].get<std::string>().find("(running: none)"), std::string::npos);
+  EXPECT_EQ(client.call({{"command", "segments"}})["segments"].size(), 2u);
+}
+
 TEST_F(ControlTest, PermissionsAreCheckedPerCommandClass) {
   AccessPolicy policy;
   policy.may_modify = [](const PeerCredentials&) { return false; };
@@ -238,6 +259,8 @@ TEST_F(ControlTest, PermissionsAreCheckedPerCommandClass) {
   Client client(socket_path);
   EXPECT_EQ(client.call({{"command", "status"}})["ok"], true);
   EXPECT_EQ(client.call({{"command", "unbind"}, {"name", "speed"}})["error"]["code"], "permission_denied");
+  EXPECT_EQ(client.call({{"command", "replay"}, {"segment", {{"file", "/r.mcap"}}}})["error"]["code"],
+            "permission_denied");
   EXPECT_NE(gateway.knowledge_base().find_bound("speed"), nullptr);
 }
 

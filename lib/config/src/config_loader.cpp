@@ -14,6 +14,7 @@
 
 #include "cosmic/admission.hpp"
 #include "background_loader.hpp"
+#include "can_segment_loader.hpp"
 #include "components_loader.hpp"
 #include "native_loader.hpp"
 #include "secoc_loader.hpp"
@@ -39,8 +40,6 @@ using config_detail::key;
 using config_detail::YamlReader;
 
 constexpr std::uint64_t kMaxPayload = 1 << 20;
-constexpr std::uint64_t kClassicCanMaxBitrate = 1'000'000;
-constexpr std::uint64_t kFdMaxDataBitrate = 8'000'000;
 
 class ConfigParser {
  public:
@@ -104,17 +103,28 @@ class ConfigParser {
     return result;
   }
 
+  SegmentResult parse_segment_document(std::string_view text, const Config& running) {
+    SegmentResult result;
+    if (const auto root = reader_.load(text, "a segment map")) {
+      auto segment = parse_segment(*root, "segment");
+      if (segment && running.find_segment(segment->name)) {
+        reader_.error_at((*root)["name"], "segment.name", "a segment named '" + segment->name + "' is running",
+                         "a name no segment of the gateway has");
+      } else if (segment) {
+        result.segment = std::move(*segment);
+      }
+    }
+    result.errors = reader_.take_errors();
+    return result;
+  }
+
  private:
   std::optional<YAML::Node> load(std::string_view text) {
     return reader_.load(text, "a map with gateway, segments and channels");
   }
 
   bool require(const YAML::Node& map, const std::string& path, const char* name, const char* valid) {
-    if (has(map, name)) return true;
-    if (map.IsMap() && map[name]) return false;  // present without a value: check_map reports it
-    reader_.error_at(map, path.empty() ? name : key(path, name), std::string("missing required key '") + name + "'",
-                     valid);
-    return false;
+    return reader_.require(map, path, name, valid);
   }
 
   void parse_gateway(const YAML::Node& node) {
@@ -241,7 +251,7 @@ class ConfigParser {
     }
     switch (s.type) {
       case SegmentType::can:
-        parse_can(node, path, s);
+        config_detail::parse_can(reader_, node, path, s, included_);
         break;
       case SegmentType::dds:
         parse_dds(node, path, s);
@@ -255,69 +265,6 @@ class ConfigParser {
     }
     if (reader_.error_count() != errors_before) return std::nullopt;
     return s;
-  }
-
-  void parse_can(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
-    reader_.check_map(node, path,
-                      {"name", "type", "interface", "profile", "bitrate", "fd", "data_bitrate", "errors",
-                       "max_utilization", "background", "network"});
-    CanSegmentProperties& can = s.can;
-    if (require(node, path, "interface", "a network interface such as can0")) {
-      if (auto v = reader_.string(node["interface"], key(path, "interface"))) {
-        if (const Result<void> valid = check_interface_name(*v); !valid) {
-          reader_.error_at(node["interface"], key(path, "interface"), valid.error().text,
-                           "a network interface such as can0");
-        }
-        can.interface = *v;
-      }
-    }
-    if (has(node, "fd")) can.fd = reader_.boolean(node["fd"], key(path, "fd")).value_or(false);
-    if (has(node, "profile")) {
-      const std::string p = key(path, "profile");
-      if (auto v = reader_.choice(node["profile"], p, {"cosmic", "famouso"})) can.profile = static_cast<CanProfile>(*v);
-      if (can.profile == CanProfile::famouso && can.fd) {
-        reader_.error_at(node["profile"], p, "profile famouso is classic CAN only", "fd: false, or profile: cosmic");
-      }
-    }
-    if (require(node, path, "bitrate", "the nominal bit rate, e.g. 500kbit/s")) {
-      if (auto v = reader_.bitrate(node["bitrate"], key(path, "bitrate"))) {
-        if (v->bits_per_second > kClassicCanMaxBitrate) {
-          reader_.error_at(node["bitrate"], key(path, "bitrate"), "CAN nominal bit rate above 1Mbit/s",
-                           "at most 1Mbit/s; use fd: true with data_bitrate for faster data phases");
-        }
-        can.bitrate = *v;
-      }
-    }
-    can.data_bitrate = can.bitrate;
-    if (has(node, "data_bitrate")) {
-      const std::string p = key(path, "data_bitrate");
-      if (!can.fd) {
-        reader_.error_at(node["data_bitrate"], p, "data_bitrate needs fd: true", "remove it, or set fd: true");
-      } else if (auto v = reader_.bitrate(node["data_bitrate"], p)) {
-        if (*v < can.bitrate || v->bits_per_second > kFdMaxDataBitrate) {
-          reader_.error_at(node["data_bitrate"], p, "data bit rate out of range",
-                           "from the nominal bitrate up to 8Mbit/s");
-        }
-        can.data_bitrate = *v;
-      }
-    }
-    if (has(node, "errors")) parse_fault_hypothesis(node["errors"], key(path, "errors"), can.errors);
-    if (has(node, "background"))
-      config_detail::parse_background(reader_, node["background"], key(path, "background"), can, included_);
-  }
-
-  void parse_fault_hypothesis(const YAML::Node& node, const std::string& path, CanFaultHypothesis& errors) {
-    if (!reader_.check_map(node, path, {"max_per_window", "window"})) return;
-    if (require(node, path, "max_per_window", "a whole number of error frames, 0 for an error-free bus")) {
-      if (auto v = reader_.unsigned_int(node["max_per_window"], key(path, "max_per_window"), 0, 1000)) {
-        errors.max_per_window = static_cast<std::uint32_t>(*v);
-      }
-    }
-    if (errors.max_per_window > 0 && require(node, path, "window", "the window length, e.g. 10ms")) {
-      if (auto v = reader_.duration(node["window"], key(path, "window"), false)) errors.window = *v;
-    } else if (has(node, "window")) {
-      reader_.duration(node["window"], key(path, "window"), false);
-    }
   }
 
   void parse_ip_common(const YAML::Node& node, const std::string& path, SegmentSpec& s) {
@@ -599,6 +546,10 @@ class ConfigParser {
 
 ConfigResult parse_config(std::string_view text, const std::string& file_name, const LoadOptions& options) {
   return ConfigParser(file_name, options).parse_document(text);
+}
+
+SegmentResult parse_segment(std::string_view text, const std::string& file_name, const Config& running) {
+  return ConfigParser(file_name).parse_segment_document(text, running);
 }
 
 ChannelsResult parse_channels(std::string_view text, const std::string& file_name, const Config& running) {

@@ -216,6 +216,13 @@ bool YamlReader::is_list(const YAML::Node& node, const std::string& path) {
   return false;
 }
 
+bool YamlReader::require(const YAML::Node& map, const std::string& path, const char* name, const char* valid) {
+  if (has(map, name)) return true;
+  if (map.IsMap() && map[name]) return false;
+  error_at(map, path.empty() ? name : key(path, name), std::string("missing required key '") + name + "'", valid);
+  return false;
+}
+
 std::optional<std::string> YamlReader::scalar(const YAML::Node& node, const std::string& path, const char* expected) {
   if (!node.IsScalar()) {
     error_at(node, path, node.IsNull() ? "value is missing" : "expected a single value, not a list or map", expected);

@@ -48,6 +48,9 @@ class YamlReader {
   // True when `node` is a map; reports unknown and duplicate keys against `allowed`.
   bool check_map(const YAML::Node& node, const std::string& path, std::initializer_list<const char*> allowed);
   bool is_list(const YAML::Node& node, const std::string& path);
+  // True when map `map` at `path` has key `name` with a value; else reports it missing (a key
+  // present without a value is check_map's to report) and returns false.
+  bool require(const YAML::Node& map, const std::string& path, const char* name, const char* valid);
 
   std::optional<std::string> string(const YAML::Node& node, const std::string& path);
   std::optional<bool> boolean(const YAML::Node& node, const std::string& path);

@@ -59,7 +59,8 @@ ControlProtocol::ControlProtocol(Gateway& gateway, std::function<ConfigResult()>
 ControlProtocol::~ControlProtocol() = default;
 
 bool ControlProtocol::is_mutating(std::string_view command) {
-  return command == "bind" || command == "replace" || command == "unbind" || command == "reload";
+  return command == "bind" || command == "replace" || command == "unbind" || command == "reload" ||
+         command == "replay" || command == "replay_stop";
 }
 
 std::optional<std::string> ControlProtocol::handle(std::string_view request_line, const PeerCredentials& peer,
@@ -130,8 +131,8 @@ ControlProtocol::Answer ControlProtocol::dispatch(const Json& request, const Pee
   std::string known = "status, segments, channels, channel, echo_open, echo_read, echo_close";
   for (const auto& [name, answer] : readers_) known += ", " + name;
   for (const auto& [name, answer] : operators_) known += ", " + name;
-  return failure("unknown_command",
-                 "unknown command '" + printable(command) + "' (" + known + ", bind, replace, unbind, reload)");
+  return failure("unknown_command", "unknown command '" + printable(command) + "' (" + known +
+                                        ", bind, replace, unbind, reload, replay, replay_stop)");
 }
 
 ControlProtocol::Answer ControlProtocol::mutate(const std::string& command, const Json& request,
@@ -146,6 +147,8 @@ ControlProtocol::Answer ControlProtocol::mutate(const std::string& command, cons
   }
   if (command == "bind" || command == "replace") return bind(request, command == "replace", later);
   if (command == "reload") return reload(later);
+  if (command == "replay") return replay(request, later);
+  if (command == "replay_stop") return stop_replay(request, later);
   return finish(command, request, unbind(request));
 }
 
@@ -248,6 +251,7 @@ Json ControlProtocol::segments() const {
       entry["file"] = s.spec.replay.file;
       entry["speed"] = s.spec.replay.speed;
       entry["loop"] = s.spec.replay.loop;
+      entry["run_time"] = replays_.count(s.spec.name) > 0;  // added by `replay`, ended by `replay_stop`
     } else {
       entry["url"] = s.spec.lcm.url;
     }
@@ -402,12 +406,8 @@ ControlProtocol::Answer ControlProtocol::bind(const Json& request, bool replace,
     out["errors"] = to_json(parsed.errors);
     return out;
   }
-  if (replace && request.contains("match_timeout_s")) {
-    const Json& timeout = request["match_timeout_s"];
-    if (!timeout.is_number() || !(timeout.get<double>() >= 0 && timeout.get<double>() <= kMaxMatchTimeoutS)) {
-      return failure("bad_request", "\"match_timeout_s\" must be a number of seconds from 0 to " +
-                                        std::to_string(static_cast<int>(kMaxMatchTimeoutS)) + "; nothing changed");
-    }
+  if (replace) {
+    if (auto bad = bad_match_timeout(request)) return bad;
   }
   if (replace) {
     // A replacement of something not bound is most likely a wrong name: binding it would leave
@@ -479,6 +479,15 @@ Json ControlProtocol::unbind(const Json& request) {
   return Json{{"ok", true}, {"unbound", name}};
 }
 
+std::optional<nlohmann::json> ControlProtocol::bad_match_timeout(const Json& request) const {
+  if (!request.contains("match_timeout_s")) return std::nullopt;
+  const Json& timeout = request["match_timeout_s"];
+  if (timeout.is_number() && timeout.get<double>() >= 0 && timeout.get<double>() <= kMaxMatchTimeoutS)
+    return std::nullopt;
+  return failure("bad_request", "\"match_timeout_s\" must be a number of seconds from 0 to " +
+                                    std::to_string(static_cast<int>(kMaxMatchTimeoutS)) + "; nothing changed");
+}
+
 // Loading the file and admission both run off the control thread; the swap runs on it.
 ControlProtocol::Answer ControlProtocol::reload(const Reply& later) {
   auto loaded = std::make_shared<ConfigResult>();
@@ -497,6 +506,7 @@ ControlProtocol::Answer ControlProtocol::reload(const Reply& later) {
       return out;
     }
     const BindResult result = gateway_.commit_reload(std::move(*plan));
+    if (result.applied) replays_.clear();  // their segments went with the running configuration
     Json out = bind_answer(result);
     if (!result.applied) out["error"] = {{"code", "reload_failed"}, {"message", result.error}};
     return finish("reload", Json{{"command", "reload"}}, std::move(out));

@@ -87,6 +87,7 @@ Json ControlProtocol::switched(SwitchWait& wait, bool timed_out) {
                                       late + " (events published there before discovery completes are lost)");
     }
   }
+  settle_replay(wait.command, result, answer);
   return finish(wait.command, wait.request, std::move(answer));
 }
 

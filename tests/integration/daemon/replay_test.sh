@@ -12,7 +12,12 @@
 #   - `bind --replace` swaps the replay in for the live sensor's segment and back: live events flow,
 #     then the recording's, then live again (the replay plays from when its hop opens, just before
 #     the switch: events due before it count as no_route, as for any new publisher);
-#   - a configuration naming a file that is not a recording is refused at its key.
+#   - a configuration naming a file that is not a recording is refused at its key;
+#   - `cosmicctl replay FILE` does the same at run time, with no replay segment configured: the
+#     recording takes the live publisher's place (live, replay, live in order after `replay stop`),
+#     `--alongside` adds it beside the publisher, a reload ends it, and every bad request (no
+#     recording, nothing selected, a speed out of range, a taken name, a channel not bound, an
+#     unknown replay to stop) is refused with its reason while the running channel stays as it was.
 #   replay_test.sh COSMICD COSMICCTL COSMIC_LCM_PEER
 set -uo pipefail
 [ "${COSMIC_IN_NETNS:-}" = 1 ] || { echo "run me through scripts/netns-run" >&2; exit 2; }
@@ -160,6 +165,23 @@ grep -q "segments\[2\].file: $WORK/bogus.mcap is not a readable recording" "$WOR
   fail "check: $(cat "$WORK/bogus.out")"
 passed
 
+# expect_live_replay_live FILE REPLAYED: the subscriber (SUB, writing FILE) gets 5 live events, the
+# REPLAYED recorded ones and 5 live ones again, in that order; then it is stopped.
+expect_live_replay_live() {
+  lines() { [ "$(grep -c . "$1")" -ge "$2" ]; }
+  wait_until 10 "the subscriber got live, replayed and live events" lines "$1" "$((5 + $2 + 5))"
+  kill -TERM "$SUB" 2>/dev/null
+  wait "$SUB" 2>/dev/null
+  python3 -c '
+import json, sys
+p = [json.loads(l)["payload"] for l in open(sys.argv[1]) if l.strip()]
+replayed = int(sys.argv[2])
+assert 35 <= replayed <= 40, replayed
+assert p == ["11111111"] * 5 + ["c0ffee01"] * replayed + ["22222222"] * 5, p
+' "$1" "$2" || fail "the order live, replay, live: $(python3 -c '
+import json, sys; print([json.loads(l)["payload"] for l in open(sys.argv[1]) if l.strip()])' "$1")"
+}
+
 scenario "bind --replace swaps the replay in for the live sensor and back"
 replay_config "$WORK/live.yaml" 1 5ms field
 start_daemon g "$WORK/live.yaml" || exit 1
@@ -185,18 +207,100 @@ cat >"$WORK/to-live.yaml" <<YAML
 YAML
 ctl g bind --replace "$WORK/to-live.yaml" >"$WORK/to-live.out" 2>&1 || fail "replace back to live: $(cat "$WORK/to-live.out")"
 "$LCM_PEER" pub --url "$FIELD" --channel obstacle --count 5 --rate 100 --subject 0x600 --origin 0xB2 --payload-hex 22222222
-lines() { [ "$(grep -c . "$WORK/swap.jsonl")" -ge "$1" ]; }
-wait_until 10 "the subscriber got live, replayed and live events" lines "$((5 + replayed + 5))"
-kill -TERM "$SUB" 2>/dev/null
-wait "$SUB" 2>/dev/null
-python3 -c '
+expect_live_replay_live "$WORK/swap.jsonl" "$replayed"
+kill -TERM "$PID_g"
+wait "$PID_g" 2>/dev/null
+PIDS=()
+passed
+
+# publishers_of DAEMON CHANNEL: the channel's publisher segments, comma-separated.
+publishers_of() {
+  ctl "$1" --json channel "$2" | python3 -c '
 import json, sys
-p = [json.loads(l)["payload"] for l in open(sys.argv[1]) if l.strip()]
-replayed = int(sys.argv[2])
-assert 35 <= replayed <= 40, replayed
-assert p == ["11111111"] * 5 + ["c0ffee01"] * replayed + ["22222222"] * 5, p
-' "$WORK/swap.jsonl" "$replayed" || fail "the order live, replay, live: $(python3 -c '
-import json, sys; print([json.loads(l)["payload"] for l in open(sys.argv[1]) if l.strip()])' "$WORK/swap.jsonl")"
+print(",".join(h["segment"] for h in json.load(sys.stdin)["channel"]["admission"]["hops"] if h["role"] == "publisher"))'
+}
+has_segment() { ctl "$1" --json segments | python3 -c '
+import json, sys
+sys.exit(0 if any(s["name"] == sys.argv[1] for s in json.load(sys.stdin)["segments"]) else 1)' "$2"; }
+
+scenario "cosmicctl replay swaps a recording in at run time; replay stop puts the live sensor back"
+cat >"$WORK/run.yaml" <<YAML
+gateway: {name: gw-run}
+segments:
+  - {name: field, type: lcm, url: "$FIELD", latency_bound: 2ms}
+  - {name: viz, type: lcm, url: "$VIZ", latency_bound: 2ms}
+channels:
+  - {name: obstacle, subject: 0x600, class: nrt, payload: 4B, period: 5ms, publishers: [field], subscribers: [viz]}
+YAML
+start_daemon g "$WORK/run.yaml" || exit 1
+"$LCM_PEER" sub --url "$VIZ" --channel obstacle --count 100 --timeout 60 >"$WORK/run.jsonl" 2>"$WORK/run.err" &
+SUB=$!
+wait_until 10 "the subscriber ready" grep -q READY "$WORK/run.err"
+"$LCM_PEER" pub --url "$FIELD" --channel obstacle --count 5 --rate 100 --subject 0x600 --origin 0xB1 --payload-hex 11111111
+expect_field g obstacle viz tx 5
+ctl g replay "$RECORDING" --channel obstacle --name lidar >"$WORK/run-replay.out" 2>&1 ||
+  fail "cosmicctl replay: $(cat "$WORK/run-replay.out")"
+grep -q "replaying $RECORDING as segment lidar at speed 1" "$WORK/run-replay.out" ||
+  fail "replay answer: $(cat "$WORK/run-replay.out")"
+grep -q "obstacle: 40 events, tightest spacing" "$WORK/run-replay.out" || fail "replay streams: $(cat "$WORK/run-replay.out")"
+[ "$(publishers_of g obstacle)" = lidar ] || fail "publishers while replaying: $(publishers_of g obstacle)"
+replayed_all() { [ "$(segment_adapter_field g lidar received)" -ge 40 ]; }
+wait_until 10 "the run-time replay played the recording" replayed_all
+wait_until 10 "cosmicd settled" settled g
+replayed=$(channel_field g obstacle viz tx)
+ctl g --json segments | python3 -c '
+import json, sys
+s = next(s for s in json.load(sys.stdin)["segments"] if s["name"] == "lidar")
+assert s["type"] == "replay" and s["run_time"] is True, s
+' || fail "the run-time replay segment: $(ctl g --json segments | head -c 800)"
+ctl g replay stop lidar >"$WORK/run-stop.out" 2>&1 || fail "replay stop: $(cat "$WORK/run-stop.out")"
+grep -q "stopped replay lidar" "$WORK/run-stop.out" || fail "replay stop answer: $(cat "$WORK/run-stop.out")"
+[ "$(publishers_of g obstacle)" = field ] || fail "publishers after the stop: $(publishers_of g obstacle)"
+has_segment g lidar && fail "the replay segment outlived replay stop"
+"$LCM_PEER" pub --url "$FIELD" --channel obstacle --count 5 --rate 100 --subject 0x600 --origin 0xB2 --payload-hex 22222222
+expect_live_replay_live "$WORK/run.jsonl" "$replayed"
+passed
+
+scenario "cosmicctl replay --alongside adds the recording beside the publisher; a reload ends a run-time replay"
+ctl g replay "$RECORDING" --alongside --loop --speed 10 --name beside >"$WORK/beside.out" 2>&1 ||
+  fail "replay --alongside: $(cat "$WORK/beside.out")"
+[ "$(publishers_of g obstacle)" = field,beside ] || fail "publishers alongside: $(publishers_of g obstacle)"
+wait_until 10 "the looped replay made two passes" segment_field_at_least g beside passes 2
+ctl g reload >"$WORK/reload.out" 2>&1 || fail "reload: $(cat "$WORK/reload.out")"
+has_segment g beside && fail "a reload kept the run-time replay's segment"
+[ "$(publishers_of g obstacle)" = field ] || fail "publishers after the reload: $(publishers_of g obstacle)"
+ctl g replay stop beside >"$WORK/gone.out" 2>&1
+[ $? -eq 1 ] || fail "replay stop of a replay the reload ended did not exit 1"
+grep -q "no run-time replay named 'beside' (running: none)" "$WORK/gone.out" || fail "stop: $(cat "$WORK/gone.out")"
+passed
+
+scenario "bad run-time replays are refused with their reason; the channel keeps its publisher"
+refused() {  # refused EXIT TEXT ARGS...: cosmicctl replay ARGS exits EXIT and prints TEXT
+  local want=$1 text=$2
+  shift 2
+  ctl g replay "$@" >"$WORK/refused.out" 2>&1
+  local got=$?
+  [ "$got" -eq "$want" ] || fail "replay $*: exit $got, expected $want: $(cat "$WORK/refused.out")"
+  grep -qF -- "$text" "$WORK/refused.out" || fail "replay $*: no '$text' in: $(cat "$WORK/refused.out")"
+}
+refused 64 "File does not exist" "$WORK/missing.mcap"
+refused 2 "is not a readable recording" "$WORK/bogus.mcap"
+refused 2 "holds no event of the selected channels" "$RECORDING" --channel 'nothing*'
+refused 2 "speed out of range" "$RECORDING" --speed 5000
+refused 2 "a segment named 'field' is running" "$RECORDING" --name field
+refused 2 "start_offset beyond the recording" "$RECORDING" --start-offset 60s
+ctl g unbind obstacle >/dev/null 2>&1 || fail "unbind obstacle"
+refused 1 "the recording's channel(s) 'obstacle' are not bound here" "$RECORDING"
+ctl g replay stop nosuch >"$WORK/nosuch.out" 2>&1
+[ $? -eq 1 ] && grep -q "no run-time replay named 'nosuch'" "$WORK/nosuch.out" || fail "stop nosuch: $(cat "$WORK/nosuch.out")"
+ctl g --json segments | python3 -c '
+import json, sys
+names = sorted(s["name"] for s in json.load(sys.stdin)["segments"])
+assert names == ["field", "viz"], names
+' || fail "a refused replay left a segment behind"
+kill -TERM "$PID_g"
+wait "$PID_g" 2>/dev/null
+PIDS=()
 passed
 
 exit "$FAILED"

@@ -66,6 +66,17 @@ class ConfigFileLoader {
   bool last_unchanged_ = false;
 };
 
+struct SegmentResult {
+  SegmentSpec segment;  // meaningful only when errors is empty
+  std::vector<ConfigError> errors;
+  bool ok() const { return errors.empty(); }
+};
+
+// Parses one segment map for a segment added at run time (`cosmicctl replay`), checked as a
+// configuration's segment is (a replay's recording read and scanned); its name must not be one of
+// `running`'s segments. Key paths start at "segment".
+SegmentResult parse_segment(std::string_view text, const std::string& file_name, const Config& running);
+
 // Parses channel definitions for a runtime bind: a document with a `channels:` list, a list of
 // channel maps, or one channel map, validated against the segments of `running`.
 ChannelsResult parse_channels(std::string_view text, const std::string& file_name, const Config& running);

@@ -127,6 +127,22 @@ class ControlProtocol {
   Answer bind(const Json& request, bool replace, const Reply& later);
   Json unbind(const Json& request);
   Answer reload(const Reply& later);
+  // Run-time replays (control_replay.cpp): `replay` adds a replay segment and swaps it in as the
+  // publisher of the recorded channels (or beside their publishers); `replay_stop` swaps the
+  // definitions back and removes the segment. A reload ends them all (its file does not name them).
+  struct RunTimeReplay {
+    std::string name;                   // the segment's
+    std::string file;                   // the recording
+    std::vector<ChannelSpec> before;    // the channels' definitions when the replay began
+    std::vector<ChannelSpec> replayed;  // what the replay bound in their place
+  };
+  Answer replay(const Json& request, const Reply& later);
+  Answer begin_replay(SegmentSpec segment, const Json& request, const Reply& later);
+  Answer stop_replay(const Json& request, const Reply& later);
+  // After a replacement's switch (control_switch_over.cpp): a replay's start or stop completed or
+  // undone, the segment removed where it no longer serves.
+  void settle_replay(const std::string& command, const BindResult& result, Json& answer);
+  std::optional<Json> bad_match_timeout(const Json& request) const;
   Json channel_entry(const ChannelReport& verdict, const ChannelStatsSnapshot* stats) const;
 
   Gateway& gateway_;
@@ -142,6 +158,8 @@ class ControlProtocol {
   std::map<std::string, std::function<Json()>> readers_;               // add_reader()
   std::map<std::string, std::function<Json(const Json&)>> operators_;  // add_operator()
   BindGate gate_;
+  std::map<std::string, RunTimeReplay> replays_;    // by segment name
+  std::optional<RunTimeReplay> pending_replay_;     // a replay or replay_stop while its switch runs
   std::unique_ptr<control_detail::EchoTaps> echo_;  // echo_open, echo_read, echo_close
 };
 
