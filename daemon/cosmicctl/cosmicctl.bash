@@ -19,7 +19,7 @@ _cosmicctl_command_options() {
     diagram) echo "--format --detail" ;;
     echo) echo "--count --interval --timeout" ;;
     gen) echo "--component --output" ;;
-    replay) [ "$2" != stop ] && echo "--channel --speed --loop --start-offset --name --alongside --match-timeout" ;;
+    replay) [ "$2" != stop ] && echo "--channel --speed --loop --start-offset --name --realtime --latency-bound --alongside --match-timeout" ;;
     security) [ "$2" = permissions ] && echo "--sign-with --protection --valid-days" ;;
     top) echo "--interval --iterations" ;;
     types) echo "--type-path --name" ;;

@@ -22,6 +22,8 @@ struct ReplayOptions {
   std::string start_offset;
   std::string name;
   bool alongside = false;
+  bool realtime = false;
+  std::string latency_bound;
   std::string match_timeout;
   std::string stop_name;
 };
@@ -71,6 +73,8 @@ int build_replay(const ReplayOptions& o, Json& req) {
     if (!is_utf8("channel " + c, c)) return kExitUsage;
   if (!o.start_offset.empty()) segment["start_offset"] = o.start_offset;
   if (!o.name.empty()) segment["name"] = o.name;
+  if (o.realtime) segment["realtime"] = true;
+  if (!o.latency_bound.empty()) segment["latency_bound"] = o.latency_bound;
   req = {{"command", "replay"}, {"segment", segment}, {"mode", o.alongside ? "alongside" : "replace"}};
   if (!o.match_timeout.empty()) {
     const auto timeout = cosmic::parse_duration(o.match_timeout);
@@ -98,6 +102,10 @@ std::vector<CommandRunner> add_replay_command(CLI::App& app, const GlobalOptions
   replay->add_flag("--loop", o->loop, "Play the recording again when it ends");
   replay->add_option("--start-offset", o->start_offset, "Start this far into the recording, e.g. 2s");
   replay->add_option("--name", o->name, "The replay segment's name (default replay-N)");
+  replay->add_flag("--realtime", o->realtime,
+                   "Declare the replay real-time (it plays at the receive threads' priority): needed for hrt channels");
+  replay->add_option("--latency-bound", o->latency_bound,
+                     "What the replay's timer may add to the recorded spacing, at worst (default 1ms)");
   replay->add_flag("--alongside", o->alongside, "Add the replay beside the channels' publishers instead of in place");
   replay->add_option("--match-timeout", o->match_timeout,
                      "How long the switch waits for new publishers to match (as bind --replace; default 5s)");

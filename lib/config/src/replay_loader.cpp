@@ -89,12 +89,18 @@ void parse_options(YamlReader& reader, const YAML::Node& node, const std::string
 
 void parse_replay(YamlReader& reader, const YAML::Node& node, const std::string& path, SegmentSpec& segment,
                   std::vector<std::string>& included) {
-  reader.check_map(
-      node, path,
-      {"name", "type", "file", "channels", "speed", "loop", "start_offset", "latency_bound", "max_utilization"});
+  reader.check_map(node, path,
+                   {"name", "type", "file", "channels", "speed", "loop", "start_offset", "latency_bound", "realtime",
+                    "max_utilization"});
   // A source in this process: what the timer adds to the recorded spacing, at worst.
   segment.latency_bound = Nanos(1'000'000);
+  // Declared, as for an IP segment: the replay thread then runs with the receive threads' policy
+  // (gateway.realtime), so the gateway's real-time set-up is what keeps the bound; its lateness
+  // figures show whether it did.
   segment.realtime = false;
+  if (has(node, "realtime")) {
+    if (auto v = reader.boolean(node["realtime"], key(path, "realtime"))) segment.realtime = *v;
+  }
   if (has(node, "latency_bound")) {
     if (auto v = reader.duration(node["latency_bound"], key(path, "latency_bound"), false)) segment.latency_bound = *v;
   }

@@ -4,6 +4,8 @@
 #include <fnmatch.h>
 #include <pthread.h>
 
+#include "cosmic/thread_policy.hpp"
+
 #include <condition_variable>
 #include <cstring>
 #include <map>
@@ -39,6 +41,8 @@ class ReplayAdapter final : public SegmentAdapter {
     }
     file_ = std::move(file).value();
     sink_ = &sink;
+    // A segment declared real-time plays at the receive threads' priority and on their CPUs.
+    if (spec_.realtime) policy_ = sink.receive_thread_policy();
     stopping_ = false;
     health_ = HealthReport{SegmentHealth::up, "waiting for a channel of the recording to be bound"};
     thread_ = std::thread([this] { run(); });
@@ -120,8 +124,10 @@ class ReplayAdapter final : public SegmentAdapter {
   }
 
   void run() {
-    const std::string name = ("replay:" + spec_.name).substr(0, 15);
-    pthread_setname_np(pthread_self(), name.c_str());
+    ThreadPolicy policy = policy_;
+    policy.name = "replay:" + spec_.name;
+    for (const std::string& problem : apply_thread_policy(policy))
+      log_.log(LogLevel::warning, "segment " + spec_.name + ": could not get " + problem);
     std::uint64_t played_request = 0;
     for (;;) {
       {
@@ -252,6 +258,7 @@ class ReplayAdapter final : public SegmentAdapter {
   std::uint64_t passes_ = 0;
   HealthReport health_{SegmentHealth::down, "not started"};
   std::thread thread_;
+  ThreadPolicy policy_;  // start()'s: the receive threads' when the segment is declared real-time
 };
 
 }  // namespace
