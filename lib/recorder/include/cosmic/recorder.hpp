@@ -5,7 +5,8 @@
 // copies the event with its arrival time, creation time, source segment and origin into a bounded
 // many-to-one queue (cosmic/record_ring.hpp, `recording.memory` bytes) or counts it dropped when
 // the queue is full. One writer thread ("record", nice 19: below the NRT lanes) takes the events,
-// turns a typed channel's compact events into JSON (with the channel's JSON Schema) and writes them
+// turns a typed channel's compact events into CDR (with the type's ROS 2 message definition) or
+// JSON (with its JSON Schema), as recording.typed_encoding and the type allow, and writes them
 // into chunked, compressed MCAP files in `recording.directory`, named
 // GATEWAY-YYYYMMDD-HHMMSS-N.mcap (UTC), a new file when one reaches `rotate.size` or has been
 // written for `rotate.duration`. The open chunk is closed at least once a second, so a crash loses
