@@ -14,6 +14,8 @@
 #     typed_encoding: json the typed channel is recorded as JSON with its JSON Schema;
 #   - a typed channel's recorded CDR, and its recorded JSON, replay (a `type: replay` segment) as
 #     its compact events;
+#   - a typed channel whose type has no ROS 2 form (a CamelCase field) is recorded as JSON, and
+#     cosmicd says why, once (across a reload of the recording section);
 #   - `cosmicctl record info` counts each file's channels, messages, gaps and drops (a crashed file's
 #     up to its cut), and refuses a file that is not MCAP;
 #   - a directory that cannot be written: `record start` fails with the reason, exit 1, and
@@ -242,6 +244,40 @@ passed
 
 scenario "a typed channel replays from its recorded JSON into the compact layout"
 replay_typed json "$reloaded"
+passed
+
+scenario "a typed channel without a ROS 2 form falls back to JSON, said once"
+cat >"$WORK/fallback.yaml" <<YAML
+gateway: {name: gw-fallback}
+segments:
+  - {name: field, type: lcm, url: "$IN", latency_bound: 2ms}
+  - {name: viz, type: lcm, url: "$OUT", latency_bound: 2ms}
+channels:
+  - {name: status, subject: 0x503, class: nrt, publishers: [field], subscribers: [viz],
+     type: {fields: [{name: Mode, type: uint8}]}}
+recording: {directory: $WORK/rec-fallback, chunk_size: 4KiB}
+YAML
+PIDS=()
+start_daemon f "$WORK/fallback.yaml" || exit 1
+# A reload that changes the section starts a new file; the warning is not repeated.
+sed -i 's/chunk_size: 4KiB/chunk_size: 8KiB/' "$WORK/fallback.yaml"
+ctl f reload >"$WORK/fallback-reload.out" 2>&1 || fail "reload failed: $(cat "$WORK/fallback-reload.out")"
+"$LCM_PEER" pub --url "$IN" --channel status --count 3 --rate 200 --subject 0x503 --origin 0xD1 --payload-hex 05
+wait_until 10 "3 status events recorded" recorded_at_least f 3
+ctl f record stop >/dev/null || fail "record stop failed"
+warnings=$(grep -c "recording: channel status is recorded as JSON, not CDR (typed_encoding: cdr): field Mode is not a ROS 2 field name" "$WORK/f.log")
+[ "$warnings" -eq 1 ] || fail "expected one fallback warning, found $warnings: $(grep -i 'recorded as JSON' "$WORK/f.log")"
+fallback=$(files_in "$WORK/rec-fallback" | tail -n 1)
+read_mcap indexed "$fallback" | python3 -c '
+import json, sys
+d = json.load(sys.stdin)
+assert [s["encoding"] for s in d["schemas"]] == ["jsonschema"], d["schemas"]
+assert {c["messageEncoding"] for c in d["channels"]} == {"json"}, d["channels"]
+assert [m["data"] for m in d["messages"]] == [{"Mode": 5}] * 3, d["messages"]
+' || fail "the fallback file: $(read_mcap indexed "$fallback" | head -c 600)"
+kill -TERM "$PID_f"
+wait "$PID_f" 2>/dev/null
+PIDS=()
 passed
 
 scenario "a directory that cannot be written: start fails with the reason, forwarding goes on"
