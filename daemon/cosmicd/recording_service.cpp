@@ -3,8 +3,6 @@
 
 #include <cstdio>
 
-#include "cosmic/json_schema.hpp"
-
 namespace cosmicd {
 namespace {
 
@@ -97,8 +95,12 @@ void RecordingService::on_routes(const std::vector<cosmic::Route>& routes) {
     channel.name = route.spec.name;
     channel.metadata = contract_of(route.spec);
     if (route.spec.type) {
-      channel.json = std::make_shared<const cosmic::JsonRepresentation>(*route.spec.type);
-      channel.json_schema = cosmic::json_schema(*route.spec.type, route.spec.name);
+      const auto why_not = cosmic::set_typed_encoding(channel, *route.spec.type, spec_.typed_encoding);
+      // Said once per channel and reason, not at every rebind or reload that keeps the type.
+      if (why_not && warned_json_.insert(channel.name + '\n' + *why_not).second) {
+        log_.log(cosmic::LogLevel::warning, "recording: channel " + channel.name +
+                                                " is recorded as JSON, not CDR (typed_encoding: cdr): " + *why_not);
+      }
     }
     channels.push_back(std::move(channel));
   }

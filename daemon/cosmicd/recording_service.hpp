@@ -18,6 +18,7 @@
 #include <optional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <set>
 #include <vector>
 
 #include "cosmic/candump_recorder.hpp"
@@ -64,6 +65,7 @@ class RecordingService {
   std::map<std::string, std::shared_ptr<cosmic::CandumpTap>> taps_;  // by CAN segment name
   std::map<std::string, std::string> interfaces_;                    // CAN segment name -> interface
   std::unique_ptr<cosmic::CandumpRecorder> candump_;                 // once `candump` lists a segment
+  std::set<std::string> warned_json_;  // "channel\nreason" of typed channels said to fall back to JSON
   bool recording_ = false;
 };
 

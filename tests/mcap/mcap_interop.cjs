@@ -9,6 +9,11 @@
 //     the npm McapWriter (zstd chunks from @foxglove/wasm-zstd) writes a deterministic file; TOOL
 //     dumps what cosmic's reader finds, which must be what was written; the file cut in the middle
 //     of its last chunk must give the messages of the complete chunks, marked truncated.
+//   node mcap_interop.cjs npm-decodes-cdr TOOL WORKDIR
+//     TOOL (mcap_cdr_sample) writes typed events of a type with every kind of field as the recorder
+//     does under typed_encoding: cdr, and the values they carry; @foxglove/rosmsg parses the
+//     ros2msg schema and @foxglove/rosmsg2-serialization's MessageReader decodes every message
+//     (read_recording.cjs) to exactly those values, field by field.
 // Run with NODE_PATH naming the node_modules of `npm ci` in this directory (mcap_interop_test.sh).
 "use strict";
 
@@ -20,6 +25,7 @@ const { McapIndexedReader, McapStreamReader, McapWriter } = require("@mcap/core"
 const { FileHandleReadable, FileHandleWritable } = require("@mcap/nodejs");
 const { loadDecompressHandlers } = require("@mcap/support");
 const zstd = require("@foxglove/wasm-zstd");
+const { indexed } = require("./read_recording.cjs");
 
 const hex = (bytes) => Buffer.from(bytes).toString("hex");
 const mapObject = (map) => Object.fromEntries([...map.entries()].sort());
@@ -220,12 +226,39 @@ async function cosmicReadsNpm(tool, work) {
   );
 }
 
+async function npmDecodesCdr(tool, work, decompressHandlers) {
+  const file = path.join(work, "cdr.mcap");
+  const expectedFile = path.join(work, "cdr.json");
+  execFileSync(tool, [file, expectedFile], { stdio: "inherit" });
+  const expected = JSON.parse(fs.readFileSync(expectedFile, "utf8"));
+  const read = await indexed(file, decompressHandlers);
+  assert.deepEqual(
+    read.schemas.map((s) => [s.name, s.encoding]),
+    [[expected.schemaName, "ros2msg"]],
+  );
+  assert.deepEqual(
+    read.channels.map((c) => c.messageEncoding),
+    ["cdr"],
+  );
+  assert.equal(read.messages.length, expected.values.length);
+  read.messages.forEach((m, i) => {
+    for (const [name, value] of Object.entries(expected.values[i]))
+      assert.deepEqual(m.data[name], value, `message ${i + 1}, field ${name}`);
+    assert.deepEqual(Object.keys(m.data), Object.keys(expected.values[i]), `message ${i + 1}: the fields in order`);
+  });
+  console.log(
+    `npm-decodes-cdr: ${read.messages.length} messages of ${expected.schemaName} decoded by ` +
+      `@foxglove/rosmsg2-serialization to the values sent, ${Object.keys(expected.values[0]).length} fields each`,
+  );
+}
+
 async function main() {
   const [mode, tool, work] = process.argv.slice(2);
-  if (!mode || !tool || !work) throw new Error("usage: mcap_interop.cjs npm-reads-cosmic|cosmic-reads-npm TOOL WORKDIR");
+  if (!mode || !tool || !work) throw new Error("usage: mcap_interop.cjs npm-reads-cosmic|cosmic-reads-npm|npm-decodes-cdr TOOL WORKDIR");
   fs.mkdirSync(work, { recursive: true });
   if (mode === "npm-reads-cosmic") return npmReadsCosmic(tool, work, await loadDecompressHandlers());
   if (mode === "cosmic-reads-npm") return cosmicReadsNpm(tool, work);
+  if (mode === "npm-decodes-cdr") return npmDecodesCdr(tool, work, await loadDecompressHandlers());
   throw new Error(`unknown mode ${mode}`);
 }
 

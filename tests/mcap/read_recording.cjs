@@ -3,7 +3,9 @@
 //   node read_recording.cjs indexed FILE
 //     McapIndexedReader (summary, chunk indexes, statistics): channels, schemas, statistics, the
 //     number of chunk indexes, and every message in log-time order with its topic (a `json`
-//     message parsed, others as hex); `ordered` says whether the log times never went back.
+//     message parsed; a `cdr` one decoded by @foxglove/rosmsg2-serialization's MessageReader with
+//     its `ros2msg` schema as @foxglove/rosmsg parses it, 64-bit integers as decimal strings and
+//     typed arrays as arrays; others as hex); `ordered` says whether the log times never went back.
 //   node read_recording.cjs stream FILE
 //     McapStreamReader over the bytes as they are (a file cut short by a crash): the channels and
 //     messages of every complete record, and whether the reader reached the end of a whole file.
@@ -14,10 +16,45 @@ const fs = require("node:fs");
 const { McapIndexedReader, McapStreamReader } = require("@mcap/core");
 const { FileHandleReadable } = require("@mcap/nodejs");
 const { loadDecompressHandlers } = require("@mcap/support");
+const { parse: parseMessageDefinition } = require("@foxglove/rosmsg");
+const { MessageReader } = require("@foxglove/rosmsg2-serialization");
 
 const text = (bytes) => Buffer.from(bytes).toString("utf8");
 
-function messageJson(message, channel) {
+// What MessageReader decoded, as JSON can carry it: BigInt (int64, uint64) as its decimal text,
+// typed arrays (numeric arrays and sequences) as plain arrays.
+function plain(value) {
+  if (typeof value === "bigint") return value.toString();
+  if (ArrayBuffer.isView(value)) return Array.from(value, plain);
+  if (Array.isArray(value)) return value.map(plain);
+  if (value !== null && typeof value === "object") {
+    return Object.fromEntries(Object.entries(value).map(([k, v]) => [k, plain(v)]));
+  }
+  return value;
+}
+
+// One MessageReader per ros2msg schema, built from the schema's text as Foxglove builds it.
+const cdrReaders = new Map();
+function decodeCdr(message, schema) {
+  if (!schema || schema.encoding !== "ros2msg") throw new Error(`a cdr message without a ros2msg schema`);
+  let reader = cdrReaders.get(schema);
+  if (!reader) {
+    reader = new MessageReader(parseMessageDefinition(text(schema.data), { ros2: true }));
+    cdrReaders.set(schema, reader);
+  }
+  const value = plain(reader.readMessage(message.data));
+  // Every byte read but the padding to a multiple of 4 after the last member.
+  if (message.data.byteLength - reader.lastReadByteLength() > 3) throw new Error("CDR bytes left over");
+  return value;
+}
+
+function messageData(message, channel, schema) {
+  if (channel.messageEncoding === "json") return JSON.parse(text(message.data));
+  if (channel.messageEncoding === "cdr") return decodeCdr(message, schema);
+  return Buffer.from(message.data).toString("hex");
+}
+
+function messageJson(message, channel, schema) {
   return {
     topic: channel.topic,
     channelId: message.channelId,
@@ -26,7 +63,7 @@ function messageJson(message, channel) {
     sequence: message.sequence,
     logTime: String(message.logTime),
     publishTime: String(message.publishTime),
-    data: channel.messageEncoding === "json" ? JSON.parse(text(message.data)) : Buffer.from(message.data).toString("hex"),
+    data: messageData(message, channel, schema),
   };
 }
 
@@ -49,7 +86,10 @@ async function indexed(file, decompressHandlers) {
   try {
     const reader = await McapIndexedReader.Initialize({ readable: new FileHandleReadable(handle), decompressHandlers });
     const messages = [];
-    for await (const m of reader.readMessages()) messages.push(messageJson(m, reader.channelsById.get(m.channelId)));
+    for await (const m of reader.readMessages()) {
+      const channel = reader.channelsById.get(m.channelId);
+      messages.push(messageJson(m, channel, reader.schemasById.get(channel.schemaId)));
+    }
     const stats = reader.statistics;
     return {
       profile: reader.header.profile,
@@ -75,11 +115,16 @@ async function indexed(file, decompressHandlers) {
 function stream(file, decompressHandlers) {
   const reader = new McapStreamReader({ decompressHandlers, validateCrcs: true });
   reader.append(fs.readFileSync(file));
+  const schemas = new Map();
   const channels = new Map();
   const messages = [];
   for (let record; (record = reader.nextRecord()); ) {
+    if (record.type === "Schema") schemas.set(record.id, record);
     if (record.type === "Channel") channels.set(record.id, record);
-    if (record.type === "Message") messages.push(messageJson(record, channels.get(record.channelId)));
+    if (record.type === "Message") {
+      const channel = channels.get(record.channelId);
+      messages.push(messageJson(record, channel, schemas.get(channel.schemaId)));
+    }
   }
   return { channels: [...channels.values()].map(channelJson), messages, done: reader.done() };
 }
@@ -91,7 +136,12 @@ async function main() {
   process.stdout.write(JSON.stringify(out) + "\n");
 }
 
-main().catch((error) => {
-  process.stderr.write(`read_recording: ${error.stack || error}\n`);
-  process.exit(1);
-});
+// mcap_interop.cjs reads with the same code.
+module.exports = { indexed };
+
+if (require.main === module) {
+  main().catch((error) => {
+    process.stderr.write(`read_recording: ${error.stack || error}\n`);
+    process.exit(1);
+  });
+}

@@ -7,9 +7,11 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <set>
 #include <string>
@@ -164,6 +166,67 @@ TEST_F(RecorderTest, EventsComeBackWithTheirChannelSegmentOriginTimesAndContents
     // Arrival on this host's UTC clock, within the test's run.
     EXPECT_GE(static_cast<std::int64_t>(m.log_time), started - 1'000'000'000);
     EXPECT_LE(static_cast<std::int64_t>(m.log_time), utc_now());
+  }
+}
+
+// typed_encoding: cdr. A type with a CDR form is recorded as the XCDR1 sample ROS 2 writes, with
+// its ROS 2 message definition; one without (a conditional field) as JSON, and the reason is given.
+TEST_F(RecorderTest, ATypedChannelIsRecordedAsCdrWithItsRos2MessageDefinition) {
+  RecordedChannel typed;
+  typed.id = 2;
+  typed.name = "range";
+  EXPECT_EQ(set_typed_encoding(typed, distance_type(), TypedEncoding::cdr), std::nullopt);
+  ASSERT_TRUE(typed.cdr);
+  EXPECT_FALSE(typed.json);
+  RecordedChannel multiplexed;
+  multiplexed.id = 3;
+  multiplexed.name = "status";
+  ChannelType conditional = distance_type();
+  conditional.fields.insert(conditional.fields.begin(),
+                            TypeField{"mode", FieldType{FieldType::Kind::scalar, ScalarKind::uint8, {}, 0, {}, {}}, "",
+                                      std::nullopt, std::nullopt, std::nullopt});
+  conditional.fields.back().present_when = FieldPresence{"mode", 1};
+  const auto why_not = set_typed_encoding(multiplexed, conditional, TypedEncoding::cdr);
+  ASSERT_TRUE(why_not.has_value());
+  EXPECT_NE(why_not->find("field distance is conditional"), std::string::npos) << *why_not;
+  EXPECT_TRUE(multiplexed.json);
+  EXPECT_FALSE(multiplexed.cdr);
+
+  Recorder recorder(spec_, "gw", log_);
+  recorder.set_channels({typed, multiplexed});
+  recorder.set_segment_names({"lan"});
+  ASSERT_TRUE(recorder.start().ok());
+  recorder.offer(2, 0, header(0xA1, 1, 1'000), steady_now(), float_bytes(1.5f));
+  std::vector<std::uint8_t> status_event{1};  // mode 1: distance present
+  for (const std::uint8_t b : float_bytes(2.5f)) status_event.push_back(b);
+  recorder.offer(3, 0, header(0xA1, 2, 2'000), steady_now(), status_event);
+  recorder.stop();
+  EXPECT_EQ(recorder.status().dropped_invalid, 0u);
+
+  const auto paths = files();
+  ASSERT_EQ(paths.size(), 1u);
+  const McapFile file = read(paths[0]);
+  ASSERT_EQ(file.channels.size(), 2u);
+  ASSERT_EQ(file.schemas.size(), 2u);
+  std::map<std::string, const McapSchema*> schemas;
+  for (const McapSchema& s : file.schemas) schemas[s.encoding] = &s;
+  ASSERT_TRUE(schemas.count("ros2msg") && schemas.count("jsonschema"));
+  EXPECT_EQ(schemas["ros2msg"]->name, "cosmic/msg/Range");
+  EXPECT_EQ(std::string(schemas["ros2msg"]->data.begin(), schemas["ros2msg"]->data.end()), "float32 distance # [m]\n");
+  EXPECT_EQ(schemas["jsonschema"]->name, "status");
+  ASSERT_EQ(file.messages.size(), 2u);
+  for (const McapChannel& c : file.channels) {
+    const McapMessage& m = *std::find_if(file.messages.begin(), file.messages.end(),
+                                         [&](const McapMessage& x) { return x.channel_id == c.id; });
+    if (c.topic == "range") {
+      EXPECT_EQ(c.message_encoding, "cdr");
+      EXPECT_EQ(c.schema_id, schemas["ros2msg"]->id);
+      // CDR_LE encapsulation, then the float32 1.5 little-endian.
+      EXPECT_EQ(m.data, (std::vector<std::uint8_t>{0x00, 0x01, 0x00, 0x00, 0x00, 0x00, 0xc0, 0x3f}));
+    } else {
+      EXPECT_EQ(c.message_encoding, "json");
+      EXPECT_EQ(std::string(m.data.begin(), m.data.end()), R"({"mode":1,"distance":2.5})");
+    }
   }
 }
 

@@ -35,6 +35,7 @@ TEST(RecordingConfig, DefaultsSelectEveryChannelWithZstdChunksAndRotation) {
   EXPECT_TRUE(rec.enabled());
   EXPECT_EQ(rec.directory, "/etc/cosmic/rec");
   EXPECT_EQ(rec.compression, RecordCompression::zstd);
+  EXPECT_EQ(rec.typed_encoding, TypedEncoding::cdr);
   EXPECT_EQ(rec.chunk_size, 1u << 20);
   EXPECT_EQ(rec.rotate_size, 256u << 20);
   EXPECT_EQ(rec.rotate_duration, Nanos(10min));
@@ -50,6 +51,7 @@ TEST(RecordingConfig, ReadsEveryKeyAndSelectsByNameAndGlob) {
                                                          "  directory: /var/lib/cosmicd/rec/\n"
                                                          "  channels: [obstacle, 'drive_c*']\n"
                                                          "  compression: none\n"
+                                                         "  typed_encoding: json\n"
                                                          "  chunk_size: 64KiB\n"
                                                          "  rotate: {size: 8MiB, duration: 30s}\n"
                                                          "  memory: 4MiB\n"
@@ -60,6 +62,7 @@ TEST(RecordingConfig, ReadsEveryKeyAndSelectsByNameAndGlob) {
   const RecordingSpec& rec = r.config.recording;
   EXPECT_EQ(rec.directory, "/var/lib/cosmicd/rec/");
   EXPECT_EQ(rec.compression, RecordCompression::none);
+  EXPECT_EQ(rec.typed_encoding, TypedEncoding::json);
   EXPECT_EQ(rec.chunk_size, 64u << 10);
   EXPECT_EQ(rec.rotate_size, 8u << 20);
   EXPECT_EQ(rec.rotate_duration, Nanos(30s));
@@ -84,6 +87,7 @@ TEST(RecordingConfig, EveryMistakeIsReportedWithItsPlace) {
        "'drive*')"},
       {"recording: {directory: rec, channels: obstacle}\n", "recording.channels"},
       {"recording: {directory: rec, compression: lz5}\n", "recording.compression"},
+      {"recording: {directory: rec, typed_encoding: protobuf}\n", "g.yaml:8:45: recording.typed_encoding"},
       {"recording: {directory: rec, chunk_size: 1KiB}\n",
        "recording.chunk_size: chunk_size below 4KiB (from 4KiB to 64MiB, e.g. 1MiB)"},
       {"recording: {directory: rec, chunk_size: 1GiB}\n", "recording.chunk_size"},

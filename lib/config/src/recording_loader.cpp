@@ -75,7 +75,8 @@ void parse_sizes(YamlReader& reader, const YAML::Node& node, const std::string& 
 
 void parse_recording(YamlReader& reader, const YAML::Node& node, const std::string& path, RecordingSpec& out) {
   if (!reader.check_map(node, path,
-                        {"directory", "channels", "compression", "chunk_size", "rotate", "memory", "start", "candump"}))
+                        {"directory", "channels", "compression", "typed_encoding", "chunk_size", "rotate", "memory",
+                         "start", "candump"}))
     return;
   if (!has(node, "directory")) {
     reader.error_at(node, key(path, "directory"), "missing required key 'directory'",
@@ -98,6 +99,10 @@ void parse_recording(YamlReader& reader, const YAML::Node& node, const std::stri
   if (has(node, "compression")) {
     if (auto v = reader.choice(node["compression"], key(path, "compression"), {"zstd", "none"}))
       out.compression = *v == 0 ? RecordCompression::zstd : RecordCompression::none;
+  }
+  if (has(node, "typed_encoding")) {
+    if (auto v = reader.choice(node["typed_encoding"], key(path, "typed_encoding"), {"cdr", "json"}))
+      out.typed_encoding = *v == 0 ? TypedEncoding::cdr : TypedEncoding::json;
   }
   parse_sizes(reader, node, path, out);
   if (has(node, "start")) {

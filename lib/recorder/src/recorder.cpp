@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "cosmic/json_schema.hpp"
 #include "recorder_shared.hpp"
 #include "recording_file.hpp"
 
@@ -56,6 +57,30 @@ void Recorder::offer(ChannelId channel, std::size_t from_segment, const EventHea
   head.arrival_ns = clock_ns(CLOCK_REALTIME) - (clock_ns(CLOCK_MONOTONIC) - received_at.count());
   const std::span<const std::uint8_t> parts[] = {{reinterpret_cast<const std::uint8_t*>(&head), sizeof head}, payload};
   if (!ring_.try_write(parts)) dropped_full_.fetch_add(1, std::memory_order_relaxed);
+}
+
+std::optional<std::string> set_typed_encoding(RecordedChannel& channel, const ChannelType& type,
+                                              TypedEncoding encoding) {
+  channel.cdr.reset();
+  channel.ros2msg = {};
+  channel.json.reset();
+  channel.json_schema.clear();
+  std::string why_not;
+  if (encoding == TypedEncoding::cdr) {
+    // XCDR1, final, little-endian: what ROS 2's rmw writes, and what the definition reads.
+    auto schema = ros2_msg_schema(type, channel.name);
+    auto cdr = CdrRepresentation::make(type, DdsRepresentation::xcdr1, CdrExtensibility::final_type);
+    if (schema && cdr) {
+      channel.cdr = std::make_shared<const CdrRepresentation>(std::move(cdr).value());
+      channel.ros2msg = std::move(schema).value();
+      return std::nullopt;
+    }
+    why_not = !schema ? schema.error().text : cdr.error().text;
+  }
+  channel.json = std::make_shared<const JsonRepresentation>(type);
+  channel.json_schema = json_schema(type, channel.name);
+  if (why_not.empty()) return std::nullopt;
+  return why_not;
 }
 
 void Recorder::set_channels(std::vector<RecordedChannel> channels) {

@@ -109,14 +109,9 @@ class Recorder::Writer {
     event.created_ns = head.created_ns;
     event.arrival_ns = head.arrival_ns;
     event.contents = payload;
-    if (channel.json) {
-      json_.resize(channel.json->max_size());
-      const auto size = channel.json->write(payload, json_);
-      if (!size) {
-        ++dropped_invalid_;  // an event of the channel's previous type, queued before a rebind
-        return;
-      }
-      event.contents = {reinterpret_cast<const std::uint8_t*>(json_.data()), *size};
+    if (!encode(channel, event.contents)) {
+      ++dropped_invalid_;  // an event of the channel's previous type, queued before a rebind
+      return;
     }
     const auto written = file_->write(channel, event);
     if (!written) {
@@ -127,6 +122,25 @@ class Recorder::Writer {
     } else if (file_->writer().bytes_written() >= spec_.rotate_size) {
       rotate(Clock::now());  // here, not only between polls: one poll may bring a file's worth
     }
+  }
+
+  // A typed channel's event replaced by what is recorded of it (CDR or JSON, in this thread's
+  // buffer, which grows to the largest a channel needs and is then reused); false when it is not
+  // an event of the channel's type. An untyped channel's stays as it came.
+  bool encode(const RecordedChannel& channel, std::span<const std::uint8_t>& contents) {
+    if (channel.cdr) {
+      if (encoded_.size() < channel.cdr->max_wire_size()) encoded_.resize(channel.cdr->max_wire_size());
+      const Conversion converted = channel.cdr->from_compact(contents, encoded_);
+      if (!converted.ok()) return false;
+      contents = std::span<const std::uint8_t>(encoded_).first(converted.size);
+    } else if (channel.json) {
+      if (encoded_.size() < channel.json->max_size()) encoded_.resize(channel.json->max_size());
+      const auto size = channel.json->write(
+          contents, std::span<char>(reinterpret_cast<char*>(encoded_.data()), channel.json->max_size()));
+      if (!size) return false;
+      contents = std::span<const std::uint8_t>(encoded_).first(*size);
+    }
+    return true;
   }
 
   void rotate(Clock::time_point now) {
@@ -264,7 +278,7 @@ class Recorder::Writer {
   // The drop counts when the current file was opened: its own drops are the difference.
   std::uint64_t file_dropped_full_ = 0, file_dropped_failed_ = 0, file_dropped_invalid_ = 0;
   std::string last_error_;
-  std::vector<char> json_;
+  std::vector<std::uint8_t> encoded_;
 };
 
 void Recorder::run() { Writer(*this).loop(); }

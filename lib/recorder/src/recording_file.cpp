@@ -15,6 +15,21 @@ std::string hex(std::uint64_t value) {
   return text;
 }
 
+// The MCAP encodings of a recorded channel's messages and of their schema (none: empty), and the
+// schema's name and text.
+struct RecordedForm {
+  std::string_view message_encoding;
+  std::string_view schema_encoding;
+  std::string_view schema_name;
+  std::string_view schema;
+};
+
+RecordedForm recorded_form(const RecordedChannel& channel) {
+  if (channel.cdr) return {"cdr", "ros2msg", channel.ros2msg.name, channel.ros2msg.text};
+  if (channel.json) return {"json", "jsonschema", channel.name, channel.json_schema};
+  return {"x-cosmic-bytes", {}, {}, {}};
+}
+
 }  // namespace
 
 Result<void> write_all(int fd, const std::string& path, std::span<const std::uint8_t> bytes) {
@@ -70,13 +85,14 @@ RecordingFile::~RecordingFile() = default;
 Result<std::uint16_t> RecordingFile::channel_id(const RecordedChannel& channel, const TakenEvent& event) {
   const StreamKey key{channel.id, event.segment_slot, event.origin};
   if (const auto it = channels_.find(key); it != channels_.end()) return it->second;
+  const RecordedForm form = recorded_form(channel);
   std::uint16_t schema = 0;
-  if (channel.json) {
+  if (!form.schema_encoding.empty()) {
     if (const auto it = schemas_.find(channel.id); it != schemas_.end()) {
       schema = it->second;
     } else {
-      const auto* text = reinterpret_cast<const std::uint8_t*>(channel.json_schema.data());
-      auto added = writer_.add_schema(channel.name, "jsonschema", {text, channel.json_schema.size()});
+      const auto* text = reinterpret_cast<const std::uint8_t*>(form.schema.data());
+      auto added = writer_.add_schema(form.schema_name, form.schema_encoding, {text, form.schema.size()});
       if (!added) return std::move(added).error();
       schema = schemas_[channel.id] = added.value();
     }
@@ -84,7 +100,7 @@ Result<std::uint16_t> RecordingFile::channel_id(const RecordedChannel& channel, 
   McapMap metadata = channel.metadata;
   metadata["segment"] = event.segment != nullptr ? *event.segment : std::to_string(event.segment_slot);
   metadata["origin"] = hex(event.origin);
-  auto added = writer_.add_channel(schema, channel.name, channel.json ? "json" : "x-cosmic-bytes", metadata);
+  auto added = writer_.add_channel(schema, channel.name, form.message_encoding, metadata);
   if (!added) return std::move(added).error();
   channels_.emplace(key, added.value());
   return added.value();

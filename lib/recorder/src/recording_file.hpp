@@ -27,7 +27,7 @@ struct TakenEvent {
   std::uint32_t sequence = 0;
   std::int64_t created_ns = 0;             // on the origin's clock
   std::int64_t arrival_ns = 0;             // UTC, this host's clock
-  std::span<const std::uint8_t> contents;  // JSON for a typed channel, else the event's bytes
+  std::span<const std::uint8_t> contents;  // CDR or JSON for a typed channel, else the event's bytes
 };
 
 class RecordingFile {

@@ -2,16 +2,20 @@
 # Recording (issue 37, docs/recording.md) end to end over real LCM, each file read by the MCAP
 # implementation we did not write (npm's @mcap/core with @mcap/nodejs and @mcap/support):
 #   - cosmicd records from start (recording.start defaults to true) the channels recording.channels
-#     selects, and only those: an untyped channel as its bytes, a typed one as JSON with its JSON
-#     Schema; McapIndexedReader finds the summary, chunk indexes and statistics, every message
-#     time-ordered with its source segment, origin, sequence and contents, the JSON decoding to the
-#     values sent;
+#     selects, and only those: an untyped channel as its bytes, a typed one as CDR with its ROS 2
+#     message definition (typed_encoding defaults to cdr); McapIndexedReader finds the summary,
+#     chunk indexes and statistics, every message time-ordered with its source segment, origin,
+#     sequence and contents, and @foxglove/rosmsg2-serialization decodes the CDR to the values sent;
 #   - `cosmicctl record stop` finishes the file (status counts what it holds); `record start`
 #     opens a new one; SIGTERM finishes the last;
 #   - a crash (SIGKILL) leaves a file McapStreamReader reads up to its last complete chunk: the
 #     chunks written within the flush interval (1 s) hold every event recorded before;
-#   - a reload that widens recording.channels records the newly selected channel at once;
-#   - a typed channel's recorded JSON replays (a `type: replay` segment) as its compact events;
+#   - a reload that widens recording.channels records the newly selected channel at once; with
+#     typed_encoding: json the typed channel is recorded as JSON with its JSON Schema;
+#   - a typed channel's recorded CDR, and its recorded JSON, replay (a `type: replay` segment) as
+#     its compact events;
+#   - a typed channel whose type has no ROS 2 form (a CamelCase field) is recorded as JSON, and
+#     cosmicd says why, once (across a reload of the recording section);
 #   - `cosmicctl record info` counts each file's channels, messages, gaps and drops (a crashed file's
 #     up to its cut), and refuses a file that is not MCAP;
 #   - a directory that cannot be written: `record start` fails with the reason, exit 1, and
@@ -28,7 +32,7 @@ trap 'cleanup; [ -n "${KEEP_WORK:-}" ] || rm -rf "$WORK"' EXIT
 IN="udpm://239.255.76.67:7841?ttl=0"
 OUT="udpm://239.255.76.67:7842?ttl=0"
 
-write_config() {  # write_config FILE DIRECTORY
+write_config() {  # write_config FILE DIRECTORY [TYPED_ENCODING]
   cat >"$1" <<YAML
 gateway: {name: gw-rec}
 segments:
@@ -43,7 +47,7 @@ channels:
     subscribers: [viz]
     type: {fields: [{name: distance, type: float32, unit: m}, {name: valid, type: bool}]}
   - {name: chatter, subject: 0x502, class: nrt, payload: 4B, publishers: [field], subscribers: [viz]}
-recording: {directory: $2, channels: [obstacle, 'ran*'], chunk_size: 4KiB}
+recording: {directory: $2, channels: [obstacle, 'ran*'], chunk_size: 4KiB${3:+, typed_encoding: $3}}
 YAML
 }
 
@@ -90,16 +94,15 @@ assert d["chunkIndexes"] >= 1 and d["metadataIndexes"] == 2, d  # "cosmic" and "
 topics = {c["topic"]: c for c in d["channels"]}
 assert set(topics) == {"obstacle", "range"}, topics  # chatter is not selected
 assert topics["obstacle"]["messageEncoding"] == "x-cosmic-bytes" and topics["obstacle"]["schemaId"] == 0
-assert topics["range"]["messageEncoding"] == "json", topics["range"]
+assert topics["range"]["messageEncoding"] == "cdr", topics["range"]
 for name, c in topics.items():
     assert c["metadata"]["segment"] == "field", c
     assert c["metadata"]["publishers"] == "field" and c["metadata"]["subscribers"] == "viz", c
 assert topics["obstacle"]["metadata"]["origin"] == "a1" and topics["obstacle"]["metadata"]["subject"] == "0x500"
 assert topics["range"]["metadata"]["origin"] == "b2"
 [schema] = d["schemas"]
-assert schema["name"] == "range" and schema["encoding"] == "jsonschema", schema
-props = json.loads(schema["data"])["properties"]
-assert list(props) == ["distance", "valid"] and props["valid"]["type"] == "boolean", props
+assert schema["name"] == "cosmic/msg/Range" and schema["encoding"] == "ros2msg", schema
+assert schema["data"] == "float32 distance # [m]\nbool valid\n", schema["data"]
 obstacle = [m for m in d["messages"] if m["topic"] == "obstacle"]
 ranges = [m for m in d["messages"] if m["topic"] == "range"]
 assert len(obstacle) == 20 and len(ranges) == 10
@@ -117,7 +120,7 @@ assert d["closing"] == {"dropped_queue_full": "0", "dropped_not_written": "0", "
 streams = {s["channel"]: s for s in d["streams"]}
 assert streams["obstacle"]["messages"] == 20 and streams["obstacle"]["missing"] == 0, streams
 assert streams["obstacle"]["segment"] == "field" and streams["obstacle"]["origin"] == "a1", streams
-assert streams["range"]["messages"] == 10 and streams["range"]["encoding"] == "json", streams
+assert streams["range"]["messages"] == 10 and streams["range"]["encoding"] == "cdr", streams
 assert 0 < streams["obstacle"]["rate_hz"] < 1000, streams["obstacle"]
 PY
 ctl g record info "${files[0]}" >"$WORK/info.txt" || fail "record info (text) failed"
@@ -173,12 +176,14 @@ ctl g record info "$WORK/garbage.mcap" >"$WORK/garbage.out" 2>&1
 grep -q "is not a readable MCAP recording" "$WORK/garbage.out" || fail "record info garbage: $(cat "$WORK/garbage.out")"
 passed
 
-scenario "a typed channel replays from its recorded JSON into the compact layout"
-cat >"$WORK/typed-replay.yaml" <<YAML
+# replay_typed NAME FILE: a replay segment plays FILE's range events, which reach an LCM subscriber
+# as the compact events that were published.
+replay_typed() {
+  cat >"$WORK/typed-$1.yaml" <<YAML
 gateway: {name: gw-replay}
 segments:
   - {name: viz, type: lcm, url: "$OUT", latency_bound: 2ms}
-  - {name: again, type: replay, file: ${files[0]}, channels: [range]}
+  - {name: again, type: replay, file: $2, channels: [range]}
 channels:
   - name: range
     subject: 0x501
@@ -187,30 +192,35 @@ channels:
     subscribers: [viz]
     type: {fields: [{name: distance, type: float32, unit: m}, {name: valid, type: bool}]}
 YAML
-"$LCM_PEER" sub --url "$OUT" --channel range --count 10 --timeout 30 >"$WORK/typed.jsonl" 2>"$WORK/typed.err" &
-sub=$!
-PIDS=()
-start_daemon t "$WORK/typed-replay.yaml" || exit 1
-wait "$sub" || fail "the typed replay did not deliver 10 events: $(cat "$WORK/typed.err")"
-python3 -c '
+  "$LCM_PEER" sub --url "$OUT" --channel range --count 10 --timeout 30 >"$WORK/typed-$1.jsonl" 2>"$WORK/typed-$1.err" &
+  local sub=$!
+  PIDS=()
+  start_daemon t "$WORK/typed-$1.yaml" || exit 1
+  wait "$sub" || fail "the typed replay ($1) did not deliver 10 events: $(cat "$WORK/typed-$1.err")"
+  python3 -c '
 import json, sys
 p = [json.loads(l)["payload"] for l in open(sys.argv[1]) if l.strip()]
 assert p == [sys.argv[2]] * 10, p
-' "$WORK/typed.jsonl" "$RANGE_HEX" || fail "typed replay payloads: $(head -n 2 "$WORK/typed.jsonl")"
-kill -TERM "$PID_t"
-wait "$PID_t" 2>/dev/null
-PIDS=()
+' "$WORK/typed-$1.jsonl" "$RANGE_HEX" || fail "typed replay ($1) payloads: $(head -n 2 "$WORK/typed-$1.jsonl")"
+  kill -TERM "$PID_t"
+  wait "$PID_t" 2>/dev/null
+  PIDS=()
+}
+
+scenario "a typed channel replays from its recorded CDR into the compact layout"
+replay_typed cdr "${files[0]}"
 passed
 
 scenario "a reload that widens recording.channels records the newly selected channel"
-write_config "$WORK/reload.yaml" "$WORK/rec-reload"
+write_config "$WORK/reload.yaml" "$WORK/rec-reload" json
 PIDS=()
 start_daemon r "$WORK/reload.yaml" || exit 1
 sed -i "s/channels: \[obstacle, 'ran\*'\]/channels: [obstacle, 'ran*', chatter]/" "$WORK/reload.yaml"
 grep -q "chatter\]" "$WORK/reload.yaml" || fail "could not widen the selection in reload.yaml"
 ctl r reload >"$WORK/reload.out" 2>&1 || fail "reload failed: $(cat "$WORK/reload.out")"
 "$LCM_PEER" pub --url "$IN" --channel chatter --count 6 --rate 200 --subject 0x502 --origin 0xC1 --payload-hex 06060606
-wait_until 10 "6 chatter events recorded" recorded_at_least r 6
+"$LCM_PEER" pub --url "$IN" --channel range --count 10 --rate 200 --subject 0x501 --origin 0xC2 --payload-hex "$RANGE_HEX"
+wait_until 10 "16 events recorded" recorded_at_least r 16
 ctl r record stop >/dev/null || fail "record stop after the reload failed"
 [ "$(ctl r --json record status | python3 -c 'import json,sys; d=json.load(sys.stdin)["recording"]; print(d["record_dropped"]["invalid"])')" -eq 0 ] ||
   fail "events counted invalid after the reload: $(ctl r record status)"
@@ -219,9 +229,54 @@ read_mcap indexed "$reloaded" | python3 -c '
 import json, sys
 d = json.load(sys.stdin)
 assert [m["data"] for m in d["messages"] if m["topic"] == "chatter"] == ["06060606"] * 6, d["messages"]
-' || fail "the reloaded selection did not record chatter: $(read_mcap indexed "$reloaded" | head -c 400)"
+# typed_encoding: json: the typed channel as JSON with its JSON Schema.
+[schema] = d["schemas"]
+assert schema["name"] == "range" and schema["encoding"] == "jsonschema", schema
+props = json.loads(schema["data"])["properties"]
+assert list(props) == ["distance", "valid"] and props["valid"]["type"] == "boolean", props
+assert {c["messageEncoding"] for c in d["channels"] if c["topic"] == "range"} == {"json"}, d["channels"]
+assert [m["data"] for m in d["messages"] if m["topic"] == "range"] == [{"distance": 1.5, "valid": True}] * 10
+' || fail "the reloaded file (chatter, range as JSON): $(read_mcap indexed "$reloaded" | head -c 600)"
 kill -TERM "$PID_r"
 wait "$PID_r" 2>/dev/null
+PIDS=()
+passed
+
+scenario "a typed channel replays from its recorded JSON into the compact layout"
+replay_typed json "$reloaded"
+passed
+
+scenario "a typed channel without a ROS 2 form falls back to JSON, said once"
+cat >"$WORK/fallback.yaml" <<YAML
+gateway: {name: gw-fallback}
+segments:
+  - {name: field, type: lcm, url: "$IN", latency_bound: 2ms}
+  - {name: viz, type: lcm, url: "$OUT", latency_bound: 2ms}
+channels:
+  - {name: status, subject: 0x503, class: nrt, publishers: [field], subscribers: [viz],
+     type: {fields: [{name: Mode, type: uint8}]}}
+recording: {directory: $WORK/rec-fallback, chunk_size: 4KiB}
+YAML
+PIDS=()
+start_daemon f "$WORK/fallback.yaml" || exit 1
+# A reload that changes the section starts a new file; the warning is not repeated.
+sed -i 's/chunk_size: 4KiB/chunk_size: 8KiB/' "$WORK/fallback.yaml"
+ctl f reload >"$WORK/fallback-reload.out" 2>&1 || fail "reload failed: $(cat "$WORK/fallback-reload.out")"
+"$LCM_PEER" pub --url "$IN" --channel status --count 3 --rate 200 --subject 0x503 --origin 0xD1 --payload-hex 05
+wait_until 10 "3 status events recorded" recorded_at_least f 3
+ctl f record stop >/dev/null || fail "record stop failed"
+warnings=$(grep -c "recording: channel status is recorded as JSON, not CDR (typed_encoding: cdr): field Mode is not a ROS 2 field name" "$WORK/f.log")
+[ "$warnings" -eq 1 ] || fail "expected one fallback warning, found $warnings: $(grep -i 'recorded as JSON' "$WORK/f.log")"
+fallback=$(files_in "$WORK/rec-fallback" | tail -n 1)
+read_mcap indexed "$fallback" | python3 -c '
+import json, sys
+d = json.load(sys.stdin)
+assert [s["encoding"] for s in d["schemas"]] == ["jsonschema"], d["schemas"]
+assert {c["messageEncoding"] for c in d["channels"]} == {"json"}, d["channels"]
+assert [m["data"] for m in d["messages"]] == [{"Mode": 5}] * 3, d["messages"]
+' || fail "the fallback file: $(read_mcap indexed "$fallback" | head -c 600)"
+kill -TERM "$PID_f"
+wait "$PID_f" 2>/dev/null
 PIDS=()
 passed
 

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "cosmic/binding_plan.hpp"
+#include "cosmic/cdr_representation.hpp"
 #include "cosmic/json_event_reader.hpp"
 #include "cosmic/mapped_file.hpp"
 #include "cosmic/mcap_reader.hpp"
@@ -61,8 +62,13 @@ class ReplayAdapter final : public SegmentAdapter {
       }
       Bound& entry = bound[b->spec.name];
       entry.id = b->id;
-      // A typed channel was recorded as JSON: read back into the compact layout the router takes.
-      if (b->spec.type) entry.json = std::make_shared<const JsonEventReader>(*b->spec.type);
+      // A typed channel was recorded as CDR or JSON: read back into the compact layout the router
+      // takes. A type without a CDR form (a conditional field) was recorded as JSON.
+      if (b->spec.type) {
+        entry.json = std::make_shared<const JsonEventReader>(*b->spec.type);
+        if (auto cdr = CdrRepresentation::make(*b->spec.type, DdsRepresentation::xcdr1, CdrExtensibility::final_type))
+          entry.cdr = std::make_shared<const CdrRepresentation>(std::move(cdr).value());
+      }
     }
     if (bound_.empty() && !bound.empty()) ++pass_request_;  // carrying again: a new pass from the start
     bound_ = std::move(bound);
@@ -207,13 +213,10 @@ class ReplayAdapter final : public SegmentAdapter {
     }
     std::span<const std::uint8_t> contents = m.data;
     if (target.json) {
-      compact_.resize(target.json->max_compact_size());
-      const std::string_view text(reinterpret_cast<const char*>(m.data.data()), m.data.size());
-      const auto size =
-          channel.message_encoding == "json" ? target.json->read_unexplained(text, compact_) : std::nullopt;
+      const auto size = read_typed(target, channel.message_encoding, m.data);
       if (!size) {
         std::lock_guard lock(mutex_);
-        ++undecodable_;  // recorded under another type, or not as JSON
+        ++undecodable_;  // recorded under another type, or neither as CDR nor as JSON
         return {};
       }
       contents = std::span<const std::uint8_t>(compact_).first(*size);
@@ -248,7 +251,23 @@ class ReplayAdapter final : public SegmentAdapter {
   struct Bound {
     ChannelId id = kNoChannel;
     std::shared_ptr<const JsonEventReader> json;
+    std::shared_ptr<const CdrRepresentation> cdr;  // null when the type has no CDR form
   };
+
+  // A typed channel's recorded message read into compact_: CDR (any plain encoding
+  // CdrRepresentation reads) or JSON.
+  std::optional<std::size_t> read_typed(const Bound& target, const std::string& encoding,
+                                        std::span<const std::uint8_t> data) {
+    compact_.resize(target.json->max_compact_size());
+    if (encoding == "cdr" && target.cdr) {
+      const Conversion read = target.cdr->to_compact(data, compact_);
+      return read.ok() ? std::optional(read.size) : std::nullopt;
+    }
+    if (encoding != "json") return std::nullopt;
+    return target.json->read_unexplained(std::string_view(reinterpret_cast<const char*>(data.data()), data.size()),
+                                         compact_);
+  }
+
   std::map<std::string, Bound> bound_;  // by channel name, publisher bindings
   std::vector<std::uint8_t> compact_;   // the replay thread's: a typed event read back
   std::uint64_t pass_request_ = 0;      // bumped when the segment starts carrying channels again

@@ -1,6 +1,7 @@
 // The JSON Schema (draft 2020-12) of a typed channel's events as cosmic::JsonRepresentation writes
 // them (issue 37): cosmicd records typed channels into MCAP as `json` messages with a `jsonschema`
-// schema, so Foxglove and other MCAP readers show named, decoded fields.
+// schema (recording.typed_encoding: json, or a type without a CDR form), so Foxglove and other
+// MCAP readers show named, decoded fields.
 //
 // The schema holds for every text JsonRepresentation writes for the type, and is otherwise as tight
 // as the type allows:

@@ -402,11 +402,16 @@ struct ComponentSpec {
 // MCAP files in `directory`, of the channels whose names match `channels` (names or globs), and
 // the CAN segments in `candump` also as `candump -l` logs.
 enum class RecordCompression { zstd, none };
+// How a typed channel's events are recorded: CDR with its ROS 2 message definition (what ROS 2
+// tools and Foxglove decode; a type without that form falls back to JSON), or JSON with its JSON
+// Schema.
+enum class TypedEncoding { cdr, json };
 
 struct RecordingSpec {
   std::string directory;              // absolute (the loader anchors a relative one at the file)
   std::vector<std::string> channels;  // names or fnmatch(3) globs; empty: every channel
   RecordCompression compression = RecordCompression::zstd;
+  TypedEncoding typed_encoding = TypedEncoding::cdr;
   std::uint64_t chunk_size = 1u << 20;            // bytes of messages per MCAP chunk, before compression
   std::uint64_t rotate_size = 256u << 20;         // a new file when one holds this many bytes
   Nanos rotate_duration{Nanos(600'000'000'000)};  // or has been written this long

@@ -5,7 +5,8 @@
 // copies the event with its arrival time, creation time, source segment and origin into a bounded
 // many-to-one queue (cosmic/record_ring.hpp, `recording.memory` bytes) or counts it dropped when
 // the queue is full. One writer thread ("record", nice 19: below the NRT lanes) takes the events,
-// turns a typed channel's compact events into JSON (with the channel's JSON Schema) and writes them
+// turns a typed channel's compact events into CDR (with the type's ROS 2 message definition) or
+// JSON (with its JSON Schema), as recording.typed_encoding and the type allow, and writes them
 // into chunked, compressed MCAP files in `recording.directory`, named
 // GATEWAY-YYYYMMDD-HHMMSS-N.mcap (UTC), a new file when one reaches `rotate.size` or has been
 // written for `rotate.duration`. The open chunk is closed at least once a second, so a crash loses
@@ -31,6 +32,7 @@
 #include <thread>
 #include <vector>
 
+#include "cosmic/cdr_representation.hpp"
 #include "cosmic/json_representation.hpp"
 #include "cosmic/log.hpp"
 #include "cosmic/mcap_records.hpp"
@@ -38,6 +40,7 @@
 #include "cosmic/record_hook.hpp"
 #include "cosmic/record_ring.hpp"
 #include "cosmic/result.hpp"
+#include "cosmic/ros2_msg_schema.hpp"
 
 namespace cosmic {
 
@@ -50,8 +53,20 @@ struct RecordedChannel {
   // whose events are recorded as the bytes they came in (message encoding "x-cosmic-bytes").
   std::shared_ptr<const JsonRepresentation> json{};
   std::string json_schema{};
+  // A typed channel recorded as CDR (recording.typed_encoding: cdr), which takes precedence over
+  // json: its events as the XCDR1 samples ROS 2 writes (message encoding "cdr") and the ROS 2
+  // message definition that reads them (schema encoding "ros2msg").
+  std::shared_ptr<const CdrRepresentation> cdr{};
+  Ros2MsgSchema ros2msg{};
   McapMap metadata{};  // the channel's contract: subject, class, period, payload, ...
 };
+
+// Sets how the typed channel `channel` (its id and name set) records events of `type`: as CDR
+// when `encoding` asks for it and the type has a CDR form and a ROS 2 message definition, else as
+// JSON. Returns why CDR was asked for and not used, for the caller to say once; nullopt otherwise.
+// Builds the representations and schema text: once per channel when the channel table is built.
+std::optional<std::string> set_typed_encoding(RecordedChannel& channel, const ChannelType& type,
+                                              TypedEncoding encoding);
 
 struct RecorderStatus {
   bool recording = false;
