@@ -10,6 +10,7 @@
 
 #include "config_test_support.hpp"
 #include "cosmic/config_loader.hpp"
+#include "cosmic/knowledge_base.hpp"
 #include "cosmic/mcap_writer.hpp"
 
 namespace cosmic {
@@ -83,6 +84,32 @@ TEST_F(ReplayConfig, TheRecordingIsReadAtLoadAndARelativeFileIsTheConfigurations
   EXPECT_EQ(selected.config.segments[1].replay.streams[0].channel, "obstacle");
 }
 
+// An hrt channel needs a real-time publisher segment: a replay is one only when declared so.
+TEST_F(ReplayConfig, AnHrtChannelIsReplayedOnlyFromAReplayDeclaredRealTime) {
+  for (const bool realtime : {false, true}) {
+    const ConfigResult r = parse_config(
+        std::string("segments:\n"
+                    "  - {name: viz, type: lcm, url: \"udpm://239.255.76.67:7667?ttl=0\", realtime: true}\n"
+                    "  - {name: rec, type: replay, file: run.mcap, channels: [obstacle], realtime: ") +
+            (realtime ? "true" : "false") +
+            "}\n"
+            "channels:\n"
+            "  - {name: obstacle, subject: 0x10, class: hrt, period: 5ms, reaction_time: 40ms, omission_degree: 1,\n"
+            "     publishers: [rec], subscribers: [viz]}\n",
+        file());
+    ASSERT_TRUE(r.ok()) << test::errors_text(r);
+    EXPECT_EQ(r.config.segments[1].realtime, realtime);
+    const AdmissionReport report = admit_all(r.config);
+    const ChannelReport* verdict = report.find("obstacle");
+    ASSERT_NE(verdict, nullptr);
+    std::string reasons;
+    for (const auto& reason : verdict->reasons) reasons += reason + "; ";
+    EXPECT_EQ(verdict->verdict, realtime ? Verdict::bound : Verdict::rejected) << reasons;
+    EXPECT_EQ(reasons.find("hrt on rec, which declares no real-time guarantee") != std::string::npos, !realtime)
+        << reasons;
+  }
+}
+
 TEST_F(ReplayConfig, EveryMistakeIsReportedWithItsPlace) {
   struct Case {
     std::string replay;
@@ -102,6 +129,7 @@ TEST_F(ReplayConfig, EveryMistakeIsReportedWithItsPlace) {
       {"{name: rec, type: replay, file: run.mcap, start_offset: soon}", "", "segments[1].start_offset"},
       {"{name: rec, type: replay, file: run.mcap, start_offset: 31ms}", "",
        "segments[1].start_offset: start_offset beyond the recording (at most 30 ms"},
+      {"{name: rec, type: replay, file: run.mcap, realtime: maybe}", "", "segments[1].realtime"},
       {"{name: rec, type: replay, file: run.mcap}",
        "components:\n  - {name: lidar, segment: rec, publishes: [obstacle]}\n",
        "segment 'rec' is a replay: it publishes a recording, no component lives there"},
