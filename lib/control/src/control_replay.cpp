@@ -173,11 +173,7 @@ void ControlProtocol::settle_replay(const std::string& command, const BindResult
   Json summary{{"name", name}, {"file", replay.file}, {"channels", Json::array()}};
   for (const ChannelSpec& c : replay.before) summary["channels"].push_back(c.name);
   if (command == "replay") {
-    if (result.applied) {
-      replays_[name] = std::move(replay);
-    } else {
-      static_cast<void>(gateway_.remove_segment(name));  // never carried a channel
-    }
+    // The recording's numbers answer a rejection too: they say why the replay's rate did not fit.
     if (const SegmentSpec* segment = gateway_.config().find_segment(name)) {
       summary["speed"] = segment->replay.speed;
       summary["loop"] = segment->replay.loop;
@@ -186,6 +182,11 @@ void ControlProtocol::settle_replay(const std::string& command, const BindResult
       for (const ReplayStream& s : segment->replay.streams)
         streams.push_back({{"channel", s.channel}, {"events", s.events}, {"tightest_ns", s.tightest.count()}});
       summary["streams"] = std::move(streams);
+    }
+    if (result.applied) {
+      replays_[name] = std::move(replay);
+    } else {
+      static_cast<void>(gateway_.remove_segment(name));  // never carried a channel
     }
   } else if (result.applied) {
     if (const Result<void> removed = gateway_.remove_segment(name); !removed) {
