@@ -59,6 +59,19 @@ void Recorder::offer(ChannelId channel, std::size_t from_segment, const EventHea
   if (!ring_.try_write(parts)) dropped_full_.fetch_add(1, std::memory_order_relaxed);
 }
 
+namespace {
+
+std::uint64_t fingerprint(std::initializer_list<std::string_view> parts) {
+  std::uint64_t hash = 0xcbf29ce484222325ull;
+  for (const std::string_view part : parts) {
+    for (const char c : part) hash = (hash ^ static_cast<std::uint8_t>(c)) * 0x100000001b3ull;
+    hash = (hash ^ 0xffu) * 0x100000001b3ull;  // "ab","c" differs from "a","bc"
+  }
+  return hash;
+}
+
+}  // namespace
+
 std::optional<std::string> set_typed_encoding(RecordedChannel& channel, const ChannelType& type,
                                               TypedEncoding encoding) {
   channel.cdr.reset();
@@ -73,12 +86,14 @@ std::optional<std::string> set_typed_encoding(RecordedChannel& channel, const Ch
     if (schema && cdr) {
       channel.cdr = std::make_shared<const CdrRepresentation>(std::move(cdr).value());
       channel.ros2msg = std::move(schema).value();
+      channel.form = fingerprint({"cdr", channel.ros2msg.name, channel.ros2msg.text});
       return std::nullopt;
     }
     why_not = !schema ? schema.error().text : cdr.error().text;
   }
   channel.json = std::make_shared<const JsonRepresentation>(type);
   channel.json_schema = json_schema(type, channel.name);
+  channel.form = fingerprint({"json", channel.json_schema});
   if (why_not.empty()) return std::nullopt;
   return why_not;
 }

@@ -83,18 +83,18 @@ RecordingFile::RecordingFile(std::string path, OwnedFd fd, std::int64_t opened_n
 RecordingFile::~RecordingFile() = default;
 
 Result<std::uint16_t> RecordingFile::channel_id(const RecordedChannel& channel, const TakenEvent& event) {
-  const StreamKey key{channel.id, event.segment_slot, event.origin};
+  const StreamKey key{channel.id, event.segment_slot, event.origin, channel.form};
   if (const auto it = channels_.find(key); it != channels_.end()) return it->second;
   const RecordedForm form = recorded_form(channel);
   std::uint16_t schema = 0;
   if (!form.schema_encoding.empty()) {
-    if (const auto it = schemas_.find(channel.id); it != schemas_.end()) {
+    if (const auto it = schemas_.find({channel.id, channel.form}); it != schemas_.end()) {
       schema = it->second;
     } else {
       const auto* text = reinterpret_cast<const std::uint8_t*>(form.schema.data());
       auto added = writer_.add_schema(form.schema_name, form.schema_encoding, {text, form.schema.size()});
       if (!added) return std::move(added).error();
-      schema = schemas_[channel.id] = added.value();
+      schema = schemas_[{channel.id, channel.form}] = added.value();
     }
   }
   McapMap metadata = channel.metadata;

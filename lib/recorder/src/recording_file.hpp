@@ -65,19 +65,21 @@ class RecordingFile {
   OwnedFd fd_;
   std::int64_t opened_ns_;
   McapWriter writer_;
-  // By (channel, source slot, origin): found per event without building a string.
+  // By (channel, its form, source slot, origin): found per event without building a string.
   struct StreamKey {
     ChannelId channel;
     std::uint32_t slot;
     std::uint64_t origin;
+    std::uint64_t form;
     friend bool operator==(const StreamKey&, const StreamKey&) = default;
   };
   struct StreamKeyHash {
     std::size_t operator()(const StreamKey& k) const noexcept {
-      return std::hash<std::uint64_t>{}(k.origin * 0x9e3779b97f4a7c15ull ^ (std::uint64_t{k.channel} << 32 | k.slot));
+      return std::hash<std::uint64_t>{}((k.origin ^ k.form) * 0x9e3779b97f4a7c15ull ^
+                                        (std::uint64_t{k.channel} << 32 | k.slot));
     }
   };
-  std::map<ChannelId, std::uint16_t> schemas_;
+  std::map<std::pair<ChannelId, std::uint64_t>, std::uint16_t> schemas_;  // by (channel, form)
   std::unordered_map<StreamKey, std::uint16_t, StreamKeyHash> channels_;
 };
 

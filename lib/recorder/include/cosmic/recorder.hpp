@@ -59,6 +59,10 @@ struct RecordedChannel {
   std::shared_ptr<const CdrRepresentation> cdr{};
   Ros2MsgSchema ros2msg{};
   McapMap metadata{};  // the channel's contract: subject, class, period, payload, ...
+  // How its events are written (encoding and schema), as a fingerprint: a channel whose type a
+  // replacement changed (same id) gets a schema and MCAP channels of its own in the open file, so
+  // every message reads with the schema it was written for. 0: its bytes.
+  std::uint64_t form = 0;
 };
 
 // Sets how the typed channel `channel` (its id and name set) records events of `type`: as CDR
