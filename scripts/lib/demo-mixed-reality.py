@@ -246,9 +246,7 @@ class Scene:
                 pid = self.controller.pid
                 print(f"speed_controller (pid {pid}) drives at {NOMINAL}; distance comes from {self.publishers()}")
                 self.show("record", "start")
-                # The robot drives freely a moment first: a replay plays from when its hop opens,
-                # just before the switch, so the recording's start is not an obstacle.
-                time.sleep(0.5)
+                time.sleep(0.5)  # the robot drives freely a moment before the first obstacle
                 results.append(("CAN distance sensor (body-can)", self.episodes("body-can"), self.promise_ms(), ""))
                 self.show("record", "stop")
 

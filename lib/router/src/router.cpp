@@ -50,6 +50,7 @@ class Router::SegmentInbox final : public EventSink {
   SegmentInbox(Router& router, std::size_t segment) : router_(router), segment_(segment) {}
   void on_event(const InboundEvent& event) override { router_.receive(segment_, event); }
   void on_problem(ChannelId channel, InboundProblem problem) override { router_.problem(segment_, channel, problem); }
+  bool routes(ChannelId channel) const override { return router_.routes_from(segment_, channel); }
 
  private:
   Router& router_;
@@ -175,6 +176,13 @@ std::shared_ptr<ChannelState> Router::find(ChannelId id) const {
                                    [](const auto& s, ChannelId v) { return s->route.id < v; });
   if (it == table->channels.end() || (*it)->route.id != id) return nullptr;
   return *it;
+}
+
+bool Router::routes_from(std::size_t segment, ChannelId id) const {
+  const auto channel = find(id);
+  if (!channel) return false;
+  const auto& publishers = channel->route.publishers;
+  return std::find(publishers.begin(), publishers.end(), segment) != publishers.end();
 }
 
 void Router::receive(std::size_t segment, const InboundEvent& event) {

@@ -60,6 +60,9 @@ class ReplayAdapter final : public SegmentAdapter {
         plan.refuse(*b, "a replay segment only publishes: nothing can be sent into a recording");
         continue;
       }
+      // Opened ahead of a replacement's switch: played from the switch on, so that no event is due
+      // while the router has no route from here yet (it would count as no_route and be lost).
+      if (b->ahead_of_switch) continue;
       Bound& entry = bound[b->spec.name];
       entry.id = b->id;
       // A typed channel was recorded as CDR or JSON: read back into the compact layout the router
@@ -120,7 +123,11 @@ class ReplayAdapter final : public SegmentAdapter {
     Clock::time_point started{};
     Clock::time_point last_due{};  // of the last event delivered
     std::uint64_t delivered = 0;
+    bool routed = false;  // the router took the pass's first event's channel from here
   };
+  // How long a pass's first event waits for the router to route its channel from this segment (a
+  // replacement's switch takes microseconds to milliseconds); then it goes anyway.
+  static constexpr std::chrono::seconds kRouteWait{1};
 
   bool selected(const std::string& channel) const {
     if (spec_.replay.channels.empty()) return true;
@@ -201,7 +208,7 @@ class ReplayAdapter final : public SegmentAdapter {
     if (m.log_time < pass.origin_log_time) return {};
     // Clamped: a third party's file may hold absurd times (the loader bounds the selection's span).
     const double offset = std::min(static_cast<double>(m.log_time - pass.origin_log_time) / spec_.replay.speed, 1e17);
-    const Clock::time_point due = pass.started + std::chrono::nanoseconds(static_cast<std::int64_t>(offset));
+    Clock::time_point due = pass.started + std::chrono::nanoseconds(static_cast<std::int64_t>(offset));
     Bound target;
     {
       std::unique_lock lock(mutex_);
@@ -210,6 +217,19 @@ class ReplayAdapter final : public SegmentAdapter {
       const auto it = bound_.find(channel.topic);
       if (it == bound_.end()) return {};
       target = it->second;
+      if (!pass.routed) {
+        // The pass begins when the gateway routes from here: its timing shifts by the wait.
+        const Clock::time_point asked = Clock::now();
+        while (!sink_->routes(target.id) && Clock::now() - asked < kRouteWait) {
+          wake_.wait_for(lock, std::chrono::milliseconds(1),
+                         [&] { return stopping_ || request != pass_request_ || bound_.empty(); });
+          if (stopping_ || request != pass_request_ || bound_.empty()) return Error{"cut short"};
+        }
+        pass.routed = true;
+        const Clock::duration shift = Clock::now() - asked;
+        pass.started += shift;
+        due += shift;
+      }
     }
     std::span<const std::uint8_t> contents = m.data;
     if (target.json) {

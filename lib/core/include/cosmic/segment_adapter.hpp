@@ -41,7 +41,14 @@ struct ChannelBinding {
   ChannelSpec spec;
   HopRole role = HopRole::publisher;  // publisher: the gateway receives it here; subscriber: sends it here
   std::optional<CanHopPlan> can;      // CAN segments only
-  friend bool operator==(const ChannelBinding&, const ChannelBinding&) = default;
+  // Opened by a replacement made before break ahead of its switch (Gateway::prepare_replace): no
+  // route leads from this hop yet. A source that needs no matching to be ready (a replay) waits
+  // for the switch, the same binding given again without this flag, before it plays. Not part of
+  // equality: it is the same hop, whose endpoint the switch keeps.
+  bool ahead_of_switch = false;
+  friend bool operator==(const ChannelBinding& a, const ChannelBinding& b) {
+    return a.id == b.id && a.spec == b.spec && a.role == b.role && a.can == b.can;
+  }
 };
 
 // Why an inbound message could not become an event.
@@ -57,6 +64,13 @@ class EventSink {
  public:
   virtual void on_event(const InboundEvent& event) = 0;
   virtual void on_problem(ChannelId channel, InboundProblem problem) = 0;
+  // Whether events of `channel` arriving here are routed now. A source that needs no matching to
+  // be ready (a replay) waits for it before its first event, so that none is due while the
+  // gateway's routes do not yet lead from this segment (a switch in progress). Any thread.
+  virtual bool routes(ChannelId channel) const {
+    static_cast<void>(channel);
+    return true;
+  }
 
   // How the adapter's receive threads should run (gateway.realtime): an adapter applies it, with
   // its own thread name, to every receive thread it owns, and logs what it could not get.

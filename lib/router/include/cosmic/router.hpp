@@ -145,6 +145,8 @@ class Router {
   class SegmentInbox;
 
   void receive(std::size_t segment, const InboundEvent& event);
+  // Whether the current routes take channel `id`'s events arriving on `segment` (any thread).
+  bool routes_from(std::size_t segment, ChannelId id) const;
   void problem(std::size_t segment, ChannelId channel, InboundProblem what);
   bool admit(ChannelState& channel, SegmentCounters& counters, const InboundEvent& event);
   bool e2e_admit(ChannelState& channel, std::size_t segment, const E2eProtection& e2e,
