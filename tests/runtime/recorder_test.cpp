@@ -253,6 +253,25 @@ TEST_F(RecorderTest, TooLongAndUnknownEventsAreCountedNotWritten) {
   EXPECT_EQ(file.messages[0].sequence, 4u);
 }
 
+// A stop finds the writer far behind (events offered much faster than it writes them): it still
+// writes every event queued before it, not only the writer's usual budget of one pass.
+TEST_F(RecorderTest, AStopWritesEverythingQueuedBeforeIt) {
+  spec_.chunk_size = 1 << 20;
+  Recorder recorder(spec_, "gw", log_);
+  recorder.set_channels(channels());
+  ASSERT_TRUE(recorder.start().ok());
+  constexpr std::uint32_t kEvents = 200'000;  // about 11 MB queued, more than one pass takes
+  const std::vector<std::uint8_t> payload(8, 0x5a);
+  for (std::uint32_t n = 1; n <= kEvents; ++n) recorder.offer(1, 0, header(1, n, n), steady_now(), payload);
+  recorder.stop();
+  const RecorderStatus status = recorder.status();
+  EXPECT_EQ(status.dropped_full, 0u);
+  EXPECT_EQ(status.messages, kEvents);
+  const McapFile file = read(files().at(0));
+  ASSERT_EQ(file.messages.size(), kEvents);
+  EXPECT_EQ(file.messages.back().sequence, kEvents);
+}
+
 }  // namespace
 }  // namespace cosmic
 

@@ -62,8 +62,9 @@ class Recorder::Writer {
         if (file_ && segments_ && renamed(*segments_, *shared_.segments)) file_->forget_streams();
         segments_ = shared_.segments;
       }
-      // What was queued before a stop still belongs to the recording.
-      behind = drain();
+      // What was queued before a stop still belongs to the recording: all of it, not one budget.
+      const bool stopping = quit || (generation != seen_generation_ && !want);
+      behind = drain(stopping ? whole_queue_batches() : kDrainBatches);
       const auto now = Clock::now();
       if (generation != seen_generation_) act_on(want, now);
       if (recording_) keep_up(now);
@@ -75,14 +76,20 @@ class Recorder::Writer {
   }
 
  private:
-  // Takes what is queued, at most kDrainBatches batches: under a flood the queue never empties, and
+  // Takes what is queued, at most `batches` batches: under a flood the queue never empties, and
   // start, stop, flushing and rotation must still be served. True when it stopped at that budget.
-  bool drain() {
-    for (std::size_t batch = 0; batch < kDrainBatches; ++batch) {
+  bool drain(std::size_t batches) {
+    for (std::size_t batch = 0; batch < batches; ++batch) {
       if (recorder_.ring_.read([this](std::span<const std::uint8_t> record) { take(record); }, kBatch) < kBatch)
         return false;
     }
     return true;
+  }
+
+  // Batches enough to take everything queued now (and what producers add meanwhile, up to one queue's
+  // worth more, so a flood cannot hold a stop back).
+  std::size_t whole_queue_batches() const {
+    return recorder_.ring_.capacity() / RecordRing::kMinRecordBytes / kBatch + 1;
   }
 
   void take(std::span<const std::uint8_t> record) {

@@ -24,6 +24,8 @@ namespace cosmic {
 class RecordRing {
  public:
   static constexpr std::size_t kMinCapacity = 4096;
+  // What the smallest record (an empty one: its header alone) takes of the ring.
+  static constexpr std::size_t kMinRecordBytes = 8;
 
   // `capacity_bytes` rounded down to a power of two, at least kMinCapacity. Allocates and zeroes it.
   explicit RecordRing(std::size_t capacity_bytes);
@@ -53,7 +55,7 @@ class RecordRing {
   }
 
  private:
-  static constexpr std::size_t kHeaderBytes = 8;
+  static constexpr std::size_t kHeaderBytes = kMinRecordBytes;
   static constexpr std::uint32_t kData = 1;
   static constexpr std::uint32_t kPadding = 2;
 
