@@ -125,9 +125,11 @@ class Recorder::Writer {
       }
       event.contents = {reinterpret_cast<const std::uint8_t*>(json_.data()), *size};
     }
+    const std::uint64_t taken = file_->writer().message_count();
     const auto written = file_->write(channel, event);
     if (!written) {
-      ++dropped_failed_;
+      // In the chunk whose write failed, the event is counted with that chunk's (close_file).
+      if (file_->writer().message_count() == taken) ++dropped_failed_;
       fail(written.error().text, Clock::now());
     } else if (!written.value()) {
       ++dropped_invalid_;
@@ -213,7 +215,10 @@ class Recorder::Writer {
                           {"dropped_invalid", std::to_string(dropped_invalid_ - file_dropped_invalid_)}};
     auto finished = file_->finish(closing);
     const McapWriter& writer = file_->writer();
-    messages_ += writer.message_count();
+    // A chunk the file could not take (a failed write, here or before) lost its messages.
+    const std::uint64_t lost = writer.chunk_message_count();
+    dropped_failed_ += lost;
+    messages_ += writer.message_count() - lost;
     bytes_ += writer.bytes_written();
     uncompressed_ += writer.uncompressed_bytes();
     compressed_ += writer.compressed_bytes();
