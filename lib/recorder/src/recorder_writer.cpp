@@ -1,5 +1,7 @@
 // The recorder's writer thread (cosmic/recorder.hpp): takes the queued events, writes them into the
 // current MCAP file, rotates, flushes chunks, and answers start and stop.
+#include <time.h>
+
 #include <cstring>
 #include <filesystem>
 
@@ -15,6 +17,18 @@ using recorder_detail::RecordingFile;
 using recorder_detail::TakenEvent;
 
 namespace {
+
+// How far the UTC clock is ahead of CLOCK_MONOTONIC now. An event's arrival on the UTC clock is its
+// monotonic arrival plus this, read once per batch the writer takes instead of twice per event on
+// the ingress thread: the two clocks drift apart by at most NTP's slew (500 ppm) meanwhile, 10 us
+// over the writer's 20 ms poll.
+std::int64_t utc_minus_monotonic_ns() {
+  timespec utc{};
+  timespec monotonic{};
+  ::clock_gettime(CLOCK_MONOTONIC, &monotonic);
+  ::clock_gettime(CLOCK_REALTIME, &utc);
+  return (static_cast<std::int64_t>(utc.tv_sec) - monotonic.tv_sec) * 1'000'000'000 + (utc.tv_nsec - monotonic.tv_nsec);
+}
 
 // Whether a slot named in both tables names two different segments (a slot named in one only is a
 // segment added or removed: the streams found so far stay right).
@@ -80,6 +94,7 @@ class Recorder::Writer {
   // start, stop, flushing and rotation must still be served. True when it stopped at that budget.
   bool drain(std::size_t batches) {
     for (std::size_t batch = 0; batch < batches; ++batch) {
+      utc_offset_ns_ = utc_minus_monotonic_ns();
       if (recorder_.ring_.read([this](std::span<const std::uint8_t> record) { take(record); }, kBatch) < kBatch)
         return false;
     }
@@ -114,7 +129,7 @@ class Recorder::Writer {
     event.origin = head.origin;
     event.sequence = head.sequence;
     event.created_ns = head.created_ns;
-    event.arrival_ns = head.arrival_ns;
+    event.arrival_ns = head.received_ns + utc_offset_ns_;
     event.contents = payload;
     if (channel.json) {
       json_.resize(channel.json->max_size());
@@ -277,6 +292,7 @@ class Recorder::Writer {
   std::uint64_t file_dropped_full_ = 0, file_dropped_failed_ = 0, file_dropped_invalid_ = 0;
   std::string last_error_;
   std::vector<char> json_;
+  std::int64_t utc_offset_ns_ = 0;  // utc_minus_monotonic_ns() for the batch being taken
 };
 
 void Recorder::run() { Writer(*this).loop(); }

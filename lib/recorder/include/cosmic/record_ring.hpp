@@ -3,7 +3,8 @@
 // block of memory allocated up front, after Aeron's many-to-one ring buffer. A producer claims room
 // with one compare-and-swap on the tail, copies its record in and commits it by storing its length
 // last; it never waits: a record that does not fit now is refused and the caller counts it. The
-// consumer takes committed records in claim order, zeroes what it took and releases the room.
+// consumer takes committed records in claim order, then zeroes what it took and releases the room
+// once per read() (one store to the head, which every producer reads, per batch, not per record).
 //
 // Layout: each record starts on an 8-byte boundary with an 8-byte header (u32 length including the
 // header, 0 while uncommitted; u32 kind: data or padding); a record that would run past the end
@@ -64,8 +65,8 @@ class RecordRing {
   static void commit(std::uint8_t* header, std::uint32_t length, std::uint32_t kind) noexcept;
   static std::uint32_t committed_length(std::uint8_t* header) noexcept;
   static std::uint32_t kind_of(const std::uint8_t* header) noexcept;
-  // Zeroes `length` bytes at `position` and releases them to the producers.
-  void release(std::uint64_t position, std::size_t length) noexcept;
+  // Zeroes the bytes from `from` to `to` and releases them to the producers.
+  void release(std::uint64_t from, std::uint64_t to) noexcept;
 
   std::size_t capacity_;
   std::unique_ptr<std::uint64_t[]> storage_;  // 8-byte aligned
@@ -77,19 +78,21 @@ class RecordRing {
 template <typename Take>
 std::size_t RecordRing::read(Take&& take, std::size_t limit) {
   std::size_t count = 0;
-  std::uint64_t head = head_.load(std::memory_order_relaxed);
-  while (count < limit) {
+  const std::uint64_t start = head_.load(std::memory_order_relaxed);
+  std::uint64_t head = start;
+  // At most one capacity's worth: what was taken is zeroed only at the end, so past that the first
+  // record taken would read as committed again.
+  while (count < limit && head - start < capacity_) {
     std::uint8_t* header = at(head);
     const std::uint32_t length = committed_length(header);
     if (length == 0) break;
-    const std::size_t span = aligned(length);
     if (kind_of(header) == kData) {
       take(std::span<const std::uint8_t>(header + kHeaderBytes, length - kHeaderBytes));
       ++count;
     }
-    release(head, span);
-    head += span;
+    head += aligned(length);
   }
+  if (head != start) release(start, head);
   return count;
 }
 
