@@ -4,7 +4,8 @@
 // with one compare-and-swap on the tail, copies its record in and commits it by storing its length
 // last; it never waits: a record that does not fit now is refused and the caller counts it. The
 // consumer takes committed records in claim order, then zeroes what it took and releases the room
-// once per read() (one store to the head, which every producer reads, per batch, not per record).
+// in pieces (one store to the head, which every producer reads, per eighth of the ring or per
+// read(), not per record).
 //
 // Layout: each record starts on an 8-byte boundary with an 8-byte header (u32 length including the
 // header, 0 while uncommitted; u32 kind: data or padding); a record that would run past the end
@@ -78,11 +79,15 @@ class RecordRing {
 template <typename Take>
 std::size_t RecordRing::read(Take&& take, std::size_t limit) {
   std::size_t count = 0;
-  const std::uint64_t start = head_.load(std::memory_order_relaxed);
-  std::uint64_t head = start;
-  // At most one capacity's worth: what was taken is zeroed only at the end, so past that the first
-  // record taken would read as committed again.
-  while (count < limit && head - start < capacity_) {
+  std::uint64_t released = head_.load(std::memory_order_relaxed);
+  std::uint64_t head = released;
+  while (count < limit) {
+    // What was taken is released in pieces of an eighth of the ring at most: a take that waits (a
+    // slow write) holds back little room, and no record is met twice before its room is zeroed.
+    if (head - released >= capacity_ / 8) {
+      release(released, head);
+      released = head;
+    }
     std::uint8_t* header = at(head);
     const std::uint32_t length = committed_length(header);
     if (length == 0) break;
@@ -92,7 +97,7 @@ std::size_t RecordRing::read(Take&& take, std::size_t limit) {
     }
     head += aligned(length);
   }
-  if (head != start) release(start, head);
+  if (head != released) release(released, head);
   return count;
 }
 
