@@ -2,13 +2,16 @@
 // MCAP reader: events offered while recording come out of the file with their channel, source
 // segment, origin, sequence, arrival and creation times and contents (a typed channel's as JSON,
 // with its schema); files rotate by size, each whole; nothing is recorded before start() or after
-// stop(); a directory that cannot be written refuses start() with the reason; an event too long for
-// the queue, or of a channel the recorder does not know, is counted, not written.
+// stop(), and everything queued before stop(); a directory that cannot be written refuses start()
+// with the reason; an event too long for the queue, or of a channel the recorder does not know, is
+// counted, not written, and so is every event of a chunk whose write failed.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -314,6 +317,67 @@ TEST_F(RecorderTest, TooLongAndUnknownEventsAreCountedNotWritten) {
   const McapFile file = read(files().at(0));
   ASSERT_EQ(file.messages.size(), 1u);
   EXPECT_EQ(file.messages[0].sequence, 4u);
+}
+
+// A stop finds the writer far behind (events offered much faster than it writes them): it still
+// writes every event queued before it, not only the writer's usual budget of one pass.
+TEST_F(RecorderTest, AStopWritesEverythingQueuedBeforeIt) {
+  spec_.chunk_size = 1 << 20;
+  Recorder recorder(spec_, "gw", log_);
+  recorder.set_channels(channels());
+  ASSERT_TRUE(recorder.start().ok());
+  constexpr std::uint32_t kEvents = 200'000;  // about 11 MB queued, more than one pass takes
+  const std::vector<std::uint8_t> payload(8, 0x5a);
+  for (std::uint32_t n = 1; n <= kEvents; ++n) recorder.offer(1, 0, header(1, n, n), steady_now(), payload);
+  recorder.stop();
+  const RecorderStatus status = recorder.status();
+  EXPECT_EQ(status.dropped_full, 0u);
+  EXPECT_EQ(status.messages, kEvents);
+  const McapFile file = read(files().at(0));
+  ASSERT_EQ(file.messages.size(), kEvents);
+  EXPECT_EQ(file.messages.back().sequence, kEvents);
+}
+
+// Files may grow to `bytes` while it lives (write(2) then fails with EFBIG, SIGXFSZ ignored).
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    ::getrlimit(RLIMIT_FSIZE, &saved_);
+    saved_handler_ = std::signal(SIGXFSZ, SIG_IGN);
+    rlimit limited = saved_;
+    limited.rlim_cur = bytes;
+    ::setrlimit(RLIMIT_FSIZE, &limited);
+  }
+  ~FileSizeLimit() {
+    ::setrlimit(RLIMIT_FSIZE, &saved_);
+    std::signal(SIGXFSZ, saved_handler_);
+  }
+  FileSizeLimit(const FileSizeLimit&) = delete;
+  FileSizeLimit& operator=(const FileSizeLimit&) = delete;
+
+ private:
+  rlimit saved_{};
+  void (*saved_handler_)(int) = SIG_DFL;
+};
+
+// A chunk the file cannot take (its write fails) loses every event in it: each counts as not
+// written, none as written.
+TEST_F(RecorderTest, EveryEventOfAChunkThatFailedToWriteCountsAsNotWritten) {
+  spec_.chunk_size = 4096;
+  spec_.compression = RecordCompression::none;  // the chunk stays larger than the limit
+  Recorder recorder(spec_, "gw", log_);
+  recorder.set_channels(channels());
+  const FileSizeLimit limit(2048);  // the header and first metadata fit, the first chunk does not
+  ASSERT_TRUE(recorder.start().ok());
+  constexpr std::uint32_t kEvents = 50;  // about 7 kB of Message records: the first chunk closes
+  const std::vector<std::uint8_t> payload(100, 0x5a);
+  for (std::uint32_t n = 1; n <= kEvents; ++n) recorder.offer(1, 0, header(1, n, n), steady_now(), payload);
+  recorder.stop();
+  const RecorderStatus status = recorder.status();
+  EXPECT_NE(status.last_error.find("cannot write"), std::string::npos) << status.last_error;
+  EXPECT_EQ(status.messages, 0u);
+  EXPECT_EQ(status.dropped_failed, kEvents);
+  EXPECT_EQ(status.dropped_full + status.dropped_invalid, 0u);
 }
 
 }  // namespace

@@ -333,5 +333,33 @@ TEST(McapWriter, ASinkFailureStopsTheWriter) {
   EXPECT_EQ(calls, 2);  // refused without touching the sink again
 }
 
+// What a failed flush loses: the open chunk's messages, which the writer still reports (the
+// recorder counts them as not written), while every message of a chunk the sink took is gone from
+// that count.
+TEST(McapWriter, ReportsTheMessagesOfTheChunkItCouldNotWrite) {
+  bool refuse = false;
+  const McapSink sink = [&refuse](std::span<const std::uint8_t>) -> Result<void> {
+    if (refuse) return Error{"disk full", 28};
+    return {};
+  };
+  auto writer = McapWriter::open(small_chunks(McapCompression::zstd, 1 << 20), sink);
+  ASSERT_TRUE(writer);
+  McapWriter& w = writer.value();
+  const auto channel = w.add_channel(0, "t", "x-raw");
+  ASSERT_TRUE(channel);
+  const Bytes data(100, 7);
+  for (std::uint32_t n = 0; n < 3; ++n) ASSERT_TRUE(w.write_message(channel.value(), n, n, n, data));
+  EXPECT_EQ(w.chunk_message_count(), 3u);
+  ASSERT_TRUE(w.flush_chunk());
+  EXPECT_EQ(w.chunk_message_count(), 0u);  // with the sink
+  for (std::uint32_t n = 3; n < 8; ++n) ASSERT_TRUE(w.write_message(channel.value(), n, n, n, data));
+  refuse = true;
+  EXPECT_FALSE(w.flush_chunk());
+  EXPECT_EQ(w.message_count(), 8u);
+  EXPECT_EQ(w.chunk_message_count(), 5u);  // never reached the sink
+  EXPECT_FALSE(w.finish());
+  EXPECT_EQ(w.chunk_message_count(), 5u);
+}
+
 }  // namespace
 }  // namespace cosmic

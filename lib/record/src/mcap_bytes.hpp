@@ -5,8 +5,10 @@
 // Threads: plain values; any thread.
 #pragma once
 
+#include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <span>
 #include <string>
 #include <string_view>
@@ -17,6 +19,16 @@
 namespace cosmic::mcap_detail {
 
 inline std::uint8_t opcode_byte(McapOpcode opcode) { return static_cast<std::uint8_t>(opcode); }
+
+// `value` little-endian at `at`, which has room for it (records built in one piece: the hot path).
+template <typename T>
+inline void store_le(std::uint8_t* at, T value) noexcept {
+  if constexpr (std::endian::native == std::endian::little) {
+    std::memcpy(at, &value, sizeof value);
+  } else {
+    for (std::size_t i = 0; i < sizeof value; ++i) at[i] = static_cast<std::uint8_t>(value >> (8 * i));
+  }
+}
 
 inline void put_le(std::vector<std::uint8_t>& out, std::uint64_t value, std::size_t bytes) {
   for (std::size_t i = 0; i < bytes; ++i) out.push_back(static_cast<std::uint8_t>(value >> (8 * i)));

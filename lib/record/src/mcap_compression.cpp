@@ -56,13 +56,13 @@ void ZstdCompressor::Free::operator()(ZSTD_CCtx_s* context) const noexcept { ZST
 
 ZstdCompressor::ZstdCompressor() : context_(ZSTD_createCCtx()) {}
 
-Result<void> ZstdCompressor::compress(std::span<const std::uint8_t> in, int level, std::vector<std::uint8_t>& out) {
+Result<std::size_t> ZstdCompressor::compress(std::span<const std::uint8_t> in, int level,
+                                             std::vector<std::uint8_t>& out) {
   if (!context_) return Error{"zstd: cannot create a compression context"};
-  out.resize(ZSTD_compressBound(in.size()));
+  if (const std::size_t bound = ZSTD_compressBound(in.size()); out.size() < bound) out.resize(bound);
   const std::size_t n = ZSTD_compressCCtx(context_.get(), out.data(), out.size(), in.data(), in.size(), level);
   if (ZSTD_isError(n)) return Error{std::string("zstd: ") + ZSTD_getErrorName(n)};
-  out.resize(n);
-  return {};
+  return n;
 }
 
 Result<void> decompress_chunk(std::string_view compression, std::span<const std::uint8_t> in,

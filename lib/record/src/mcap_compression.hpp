@@ -21,8 +21,10 @@ namespace cosmic::mcap_detail {
 class ZstdCompressor {
  public:
   ZstdCompressor();
-  // `in` compressed at `level` into `out` (replacing its contents).
-  Result<void> compress(std::span<const std::uint8_t> in, int level, std::vector<std::uint8_t>& out);
+  // `in` compressed at `level` into the start of `out`, grown to zstd's bound when shorter and never
+  // shrunk (a buffer kept from chunk to chunk is neither reallocated nor zeroed again); how many
+  // bytes the compressed frame takes.
+  Result<std::size_t> compress(std::span<const std::uint8_t> in, int level, std::vector<std::uint8_t>& out);
 
  private:
   struct Free {

@@ -3,6 +3,7 @@
 #include "cosmic/mcap_writer.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <limits>
 #include <utility>
 
@@ -19,6 +20,26 @@ constexpr std::size_t kMaxIds = std::numeric_limits<std::uint16_t>::max();
 void widen(std::uint64_t& start, std::uint64_t& end, std::uint64_t t, bool first) {
   start = first ? t : std::min(start, t);
   end = first ? t : std::max(end, t);
+}
+
+// Fields of a Message record before its data: channel_id, sequence, log_time, publish_time.
+constexpr std::size_t kMessageFields = 2 + 4 + 8 + 8;
+
+// A Message record appended in one piece (append_mcap_record(McapMessageView) writes the same
+// bytes field by field; this runs for every recorded event).
+void append_message_record(std::vector<std::uint8_t>& out, std::uint16_t channel_id, std::uint32_t sequence,
+                           std::uint64_t log_time, std::uint64_t publish_time, std::span<const std::uint8_t> data) {
+  const std::size_t at = out.size();
+  out.resize(at + kMcapRecordPrefix + kMessageFields + data.size());
+  std::uint8_t* p = out.data() + at;
+  p[0] = mcap_detail::opcode_byte(McapOpcode::message);
+  mcap_detail::store_le(p + 1, std::uint64_t{kMessageFields + data.size()});
+  p += kMcapRecordPrefix;
+  mcap_detail::store_le(p, channel_id);
+  mcap_detail::store_le(p + 2, sequence);
+  mcap_detail::store_le(p + 6, log_time);
+  mcap_detail::store_le(p + 14, publish_time);
+  if (!data.empty()) std::memcpy(p + kMessageFields, data.data(), data.size());
 }
 
 }  // namespace
@@ -78,7 +99,8 @@ Result<std::uint16_t> McapWriter::add_channel(std::uint16_t schema_id, std::stri
   const auto id = static_cast<std::uint16_t>(channels_.size() + 1);
   channels_.push_back(McapChannel{id, schema_id, std::string(topic), std::string(message_encoding), metadata});
   channel_written_.push_back(false);
-  statistics_.channel_message_counts[id] = 0;
+  channel_messages_.push_back(0);
+  chunk_channel_messages_.push_back(0);
   return id;
 }
 
@@ -101,16 +123,14 @@ Result<void> McapWriter::write_message(std::uint16_t channel_id, std::uint32_t s
     return Error{"mcap writer: message on channel " + std::to_string(channel_id) + ", which was not added"};
   declare_channel_in_chunk(channel_id);
 
-  const bool chunk_empty = chunk_indexes_.empty();
-  widen(chunk_start_time_, chunk_end_time_, log_time_ns, chunk_empty);
-  McapMessageIndex& index = chunk_indexes_[channel_id];
-  index.channel_id = channel_id;
-  index.entries.emplace_back(log_time_ns, chunk_records_.size());
-  append_mcap_record(chunk_records_, McapMessageView{channel_id, sequence, log_time_ns, publish_time_ns, data});
+  widen(chunk_start_time_, chunk_end_time_, log_time_ns, chunk_entries_.empty());
+  if (chunk_channel_messages_[channel_id - 1]++ == 0) chunk_channels_.push_back(channel_id);
+  chunk_entries_.push_back(ChunkEntry{log_time_ns, chunk_records_.size(), channel_id});
+  append_message_record(chunk_records_, channel_id, sequence, log_time_ns, publish_time_ns, data);
 
   widen(statistics_.message_start_time, statistics_.message_end_time, log_time_ns, statistics_.message_count == 0);
   ++statistics_.message_count;
-  ++statistics_.channel_message_counts[channel_id];
+  ++channel_messages_[channel_id - 1];
 
   if (chunk_records_.size() >= options_.chunk_size) return close_chunk();
   return {};
@@ -141,43 +161,82 @@ Result<void> McapWriter::close_chunk() {
   chunk.uncompressed_size = chunk_records_.size();
   chunk.uncompressed_crc = mcap_crc32(chunk_records_);
   if (options_.compression == McapCompression::zstd) {
-    if (auto packed = zstd_->compress(chunk_records_, options_.zstd_level, compressed_); !packed) {
+    auto packed = zstd_->compress(chunk_records_, options_.zstd_level, compressed_);
+    if (!packed) {
       failed_ = true;  // the chunk's messages are lost: the file must not go on as if they were not
       return Error{"mcap writer: " + packed.error().text};
     }
     chunk.compression = "zstd";
-    chunk.records = compressed_;
+    chunk.records = std::span<const std::uint8_t>(compressed_).first(packed.value());
   } else {
     chunk.records = chunk_records_;
   }
 
-  std::vector<std::uint8_t> out;
-  out.reserve(chunk.records.size() + 128 + chunk_indexes_.size() * 64);
-  append_mcap_record(out, chunk);
+  chunk_out_.clear();
+  append_mcap_record(chunk_out_, chunk);
   McapChunkIndex index;
   index.message_start_time = chunk.message_start_time;
   index.message_end_time = chunk.message_end_time;
   index.chunk_start_offset = offset_;
-  index.chunk_length = out.size();
+  index.chunk_length = chunk_out_.size();
   index.compression = chunk.compression;
   index.compressed_size = chunk.records.size();
   index.uncompressed_size = chunk.uncompressed_size;
-  for (const auto& [channel_id, message_index] : chunk_indexes_) {
-    index.message_index_offsets[channel_id] = offset_ + out.size();
-    append_mcap_record(out, message_index);
-  }
-  index.message_index_length = out.size() - index.chunk_length;
+  append_message_indexes(index);
+  index.message_index_length = chunk_out_.size() - index.chunk_length;
 
-  if (auto written = emit(out); !written) return written;
+  if (auto written = emit(chunk_out_); !written) return written;
   chunk_index_records_.push_back(std::move(index));
   ++statistics_.chunk_count;
   uncompressed_bytes_ += chunk.uncompressed_size;
   compressed_bytes_ += chunk.records.size();
   chunk_records_.clear();
-  chunk_indexes_.clear();
+  chunk_entries_.clear();
+  chunk_channels_.clear();
   // Above a few chunk sizes, give the memory back (one huge message must not pin it).
-  if (chunk_records_.capacity() > 4 * options_.chunk_size) chunk_records_.shrink_to_fit();
+  if (chunk_records_.capacity() > 4 * options_.chunk_size) {
+    chunk_records_.shrink_to_fit();
+    compressed_ = {};
+    chunk_out_ = {};
+  }
   return {};
+}
+
+// The open chunk's Message Index records after its Chunk record in chunk_out_, one per channel in
+// ascending id, each listing that channel's messages in written order; their offsets into `index`.
+void McapWriter::append_message_indexes(McapChunkIndex& index) {
+  std::span<const ChunkEntry> entries = chunk_entries_;
+  if (chunk_channels_.size() > 1) {
+    // Grouped by channel in one pass: each channel's count becomes where its entries start.
+    std::sort(chunk_channels_.begin(), chunk_channels_.end());
+    std::uint32_t start = 0;
+    for (const std::uint16_t id : chunk_channels_) start += std::exchange(chunk_channel_messages_[id - 1], start);
+    grouped_entries_.resize(chunk_entries_.size());
+    for (const ChunkEntry& entry : chunk_entries_)
+      grouped_entries_[chunk_channel_messages_[entry.channel_id - 1]++] = entry;
+    entries = grouped_entries_;
+  }
+  for (std::size_t i = 0; i < entries.size();) {
+    const std::uint16_t id = entries[i].channel_id;
+    std::size_t end = i;
+    while (end < entries.size() && entries[end].channel_id == id) ++end;
+    index.message_index_offsets[id] = offset_ + chunk_out_.size();
+    // channel_id, then the entries as an array of (log_time, offset) with its byte length first.
+    const std::uint64_t array_bytes = 16 * (end - i);
+    const std::size_t at = chunk_out_.size();
+    chunk_out_.resize(at + kMcapRecordPrefix + 2 + 4 + array_bytes);
+    std::uint8_t* p = chunk_out_.data() + at;
+    p[0] = mcap_detail::opcode_byte(McapOpcode::message_index);
+    mcap_detail::store_le(p + 1, std::uint64_t{2 + 4 + array_bytes});
+    mcap_detail::store_le(p + kMcapRecordPrefix, id);
+    mcap_detail::store_le(p + kMcapRecordPrefix + 2, static_cast<std::uint32_t>(array_bytes));
+    p += kMcapRecordPrefix + 2 + 4;
+    for (; i < end; ++i, p += 16) {
+      mcap_detail::store_le(p, entries[i].log_time);
+      mcap_detail::store_le(p + 8, entries[i].offset);
+    }
+  }
+  for (const std::uint16_t id : chunk_channels_) chunk_channel_messages_[id - 1] = 0;
 }
 
 Result<void> McapWriter::finish() {
@@ -205,6 +264,8 @@ std::vector<std::uint8_t> McapWriter::build_summary(std::uint64_t summary_start)
       groups.push_back({mcap_detail::opcode_byte(opcode), summary_start + start, out.size() - start});
   };
   McapStatistics statistics = statistics_;
+  for (std::size_t i = 0; i < channel_messages_.size(); ++i)
+    statistics.channel_message_counts[static_cast<std::uint16_t>(i + 1)] = channel_messages_[i];
   statistics.schema_count = static_cast<std::uint16_t>(schemas_.size());
   statistics.channel_count = static_cast<std::uint32_t>(channels_.size());
   group(McapOpcode::schema, schemas_);

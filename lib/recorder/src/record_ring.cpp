@@ -27,12 +27,15 @@ std::uint32_t RecordRing::kind_of(const std::uint8_t* header) noexcept {
   return kind;
 }
 
-void RecordRing::release(std::uint64_t position, std::size_t length) noexcept {
-  std::uint8_t* start = at(position);
-  // Zeroed before the room is released, so a header there reads 0 until its producer commits.
-  std::atomic_ref<std::uint32_t>(*reinterpret_cast<std::uint32_t*>(start)).store(0, std::memory_order_relaxed);
-  std::memset(start + 4, 0, length - 4);
-  head_.store(position + length, std::memory_order_release);
+void RecordRing::release(std::uint64_t from, std::uint64_t to) noexcept {
+  // Zeroed before the room is released, so a header there reads 0 until its producer commits (no
+  // producer touches these bytes before the store to the head below).
+  const auto offset = static_cast<std::size_t>(from & (capacity_ - 1));
+  const auto length = static_cast<std::size_t>(to - from);
+  const std::size_t first = std::min(length, capacity_ - offset);
+  std::memset(bytes_ + offset, 0, first);
+  std::memset(bytes_, 0, length - first);  // what wrapped around to the start
+  head_.store(to, std::memory_order_release);
 }
 
 bool RecordRing::try_write(std::span<const std::span<const std::uint8_t>> parts) noexcept {

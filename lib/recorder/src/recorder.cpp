@@ -16,12 +16,6 @@ namespace {
 
 using recorder_detail::QueuedHead;
 
-std::int64_t clock_ns(clockid_t clock) {
-  timespec now{};
-  ::clock_gettime(clock, &now);
-  return static_cast<std::int64_t>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
-}
-
 }  // namespace
 
 Recorder::Recorder(RecordingSpec spec, std::string gateway, Logger& log)
@@ -53,8 +47,8 @@ void Recorder::offer(ChannelId channel, std::size_t from_segment, const EventHea
   head.origin = header.origin;
   head.sequence = header.sequence;
   head.created_ns = header.created_ns;
-  // The arrival on this host's UTC clock: now, less the time since the adapter took it in.
-  head.arrival_ns = clock_ns(CLOCK_REALTIME) - (clock_ns(CLOCK_MONOTONIC) - received_at.count());
+  // No clock read here: the writer puts the arrival on the UTC clock.
+  head.received_ns = received_at.count();
   const std::span<const std::uint8_t> parts[] = {{reinterpret_cast<const std::uint8_t*>(&head), sizeof head}, payload};
   if (!ring_.try_write(parts)) dropped_full_.fetch_add(1, std::memory_order_relaxed);
 }

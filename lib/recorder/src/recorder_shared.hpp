@@ -24,7 +24,7 @@ struct QueuedHead {
   std::uint32_t sequence;
   std::uint32_t reserved;  // keeps the layout free of padding
   std::int64_t created_ns;
-  std::int64_t arrival_ns;  // UTC
+  std::int64_t received_ns;  // CLOCK_MONOTONIC (the writer turns it into UTC, one clock reading a batch)
 };
 
 }  // namespace recorder_detail

@@ -10,8 +10,10 @@
 // Indexes), a Summary Offset per group, the Footer and the closing magic. A file cut short
 // anywhere keeps every chunk the sink had completely received.
 //
-// Memory: the open chunk (about chunk_size plus one message, and as much again compressed), the
-// channels and schemas, and per chunk written one Chunk Index (kept for the summary).
+// Memory: the open chunk (about chunk_size plus one message, and as much again compressed), its
+// message index (24 bytes a message, twice while the chunk closes), the channels and schemas, and
+// per chunk written one Chunk Index (kept for the summary). The buffers are kept from chunk to
+// chunk, so a recording in its stride allocates nothing per message.
 //
 // Errors: a call that cannot go on returns an Error; after the sink fails the writer refuses every
 // further call (what the file holds is then unknown), the recorder drops the file or starts a new
@@ -78,7 +80,11 @@ class McapWriter {
   Result<void> finish();
 
   std::uint64_t bytes_written() const noexcept { return offset_; }
+  // Messages taken by write_message, the open chunk's included.
   std::uint64_t message_count() const noexcept { return statistics_.message_count; }
+  // Messages in the open chunk: not yet given to the sink. After a failed flush (or finish) these
+  // never reach the file: the caller counts them lost, not written.
+  std::uint64_t chunk_message_count() const noexcept { return chunk_entries_.size(); }
   // The chunks' records before and after compression (their ratio is the compression ratio).
   std::uint64_t uncompressed_bytes() const noexcept { return uncompressed_bytes_; }
   std::uint64_t compressed_bytes() const noexcept { return compressed_bytes_; }
@@ -105,16 +111,31 @@ class McapWriter {
   std::vector<bool> schema_written_;
   std::vector<bool> channel_written_;
 
-  // The open chunk: its uncompressed records, message times and per channel index entries.
+  // One message of the open chunk, for its channel's Message Index record.
+  struct ChunkEntry {
+    std::uint64_t log_time = 0;
+    std::uint64_t offset = 0;  // in the chunk's uncompressed records
+    std::uint16_t channel_id = 0;
+  };
+  void append_message_indexes(McapChunkIndex& index);
+
+  // The open chunk: its uncompressed records, message times and index entries in written order.
   std::vector<std::uint8_t> chunk_records_;
-  std::vector<std::uint8_t> compressed_;  // reused buffer
+  std::vector<ChunkEntry> chunk_entries_;
   std::uint64_t chunk_start_time_ = 0;
   std::uint64_t chunk_end_time_ = 0;
-  std::map<std::uint16_t, McapMessageIndex> chunk_indexes_;
+  std::vector<std::uint32_t> chunk_channel_messages_;  // by channel id - 1: its messages in the chunk
+  std::vector<std::uint16_t> chunk_channels_;          // the channels with messages in the chunk
+  // Reused while a chunk closes: the compressed records (kept at zstd's bound), the entries grouped
+  // by channel, the Chunk record with its Message Indexes.
+  std::vector<std::uint8_t> compressed_;
+  std::vector<ChunkEntry> grouped_entries_;
+  std::vector<std::uint8_t> chunk_out_;
 
   std::vector<McapChunkIndex> chunk_index_records_;
   std::vector<McapMetadataIndex> metadata_indexes_;
-  McapStatistics statistics_;
+  McapStatistics statistics_;                    // its per-channel counts filled in by the summary
+  std::vector<std::uint64_t> channel_messages_;  // by channel id - 1: its messages in the file
   std::uint64_t uncompressed_bytes_ = 0;
   std::uint64_t compressed_bytes_ = 0;
 };

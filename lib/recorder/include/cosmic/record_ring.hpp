@@ -3,7 +3,9 @@
 // block of memory allocated up front, after Aeron's many-to-one ring buffer. A producer claims room
 // with one compare-and-swap on the tail, copies its record in and commits it by storing its length
 // last; it never waits: a record that does not fit now is refused and the caller counts it. The
-// consumer takes committed records in claim order, zeroes what it took and releases the room.
+// consumer takes committed records in claim order, then zeroes what it took and releases the room
+// in pieces (one store to the head, which every producer reads, per eighth of the ring or per
+// read(), not per record).
 //
 // Layout: each record starts on an 8-byte boundary with an 8-byte header (u32 length including the
 // header, 0 while uncommitted; u32 kind: data or padding); a record that would run past the end
@@ -24,6 +26,8 @@ namespace cosmic {
 class RecordRing {
  public:
   static constexpr std::size_t kMinCapacity = 4096;
+  // What the smallest record (an empty one: its header alone) takes of the ring.
+  static constexpr std::size_t kMinRecordBytes = 8;
 
   // `capacity_bytes` rounded down to a power of two, at least kMinCapacity. Allocates and zeroes it.
   explicit RecordRing(std::size_t capacity_bytes);
@@ -53,7 +57,7 @@ class RecordRing {
   }
 
  private:
-  static constexpr std::size_t kHeaderBytes = 8;
+  static constexpr std::size_t kHeaderBytes = kMinRecordBytes;
   static constexpr std::uint32_t kData = 1;
   static constexpr std::uint32_t kPadding = 2;
 
@@ -62,8 +66,8 @@ class RecordRing {
   static void commit(std::uint8_t* header, std::uint32_t length, std::uint32_t kind) noexcept;
   static std::uint32_t committed_length(std::uint8_t* header) noexcept;
   static std::uint32_t kind_of(const std::uint8_t* header) noexcept;
-  // Zeroes `length` bytes at `position` and releases them to the producers.
-  void release(std::uint64_t position, std::size_t length) noexcept;
+  // Zeroes the bytes from `from` to `to` and releases them to the producers.
+  void release(std::uint64_t from, std::uint64_t to) noexcept;
 
   std::size_t capacity_;
   std::unique_ptr<std::uint64_t[]> storage_;  // 8-byte aligned
@@ -75,19 +79,25 @@ class RecordRing {
 template <typename Take>
 std::size_t RecordRing::read(Take&& take, std::size_t limit) {
   std::size_t count = 0;
-  std::uint64_t head = head_.load(std::memory_order_relaxed);
+  std::uint64_t released = head_.load(std::memory_order_relaxed);
+  std::uint64_t head = released;
   while (count < limit) {
+    // What was taken is released in pieces of an eighth of the ring at most: a take that waits (a
+    // slow write) holds back little room, and no record is met twice before its room is zeroed.
+    if (head - released >= capacity_ / 8) {
+      release(released, head);
+      released = head;
+    }
     std::uint8_t* header = at(head);
     const std::uint32_t length = committed_length(header);
     if (length == 0) break;
-    const std::size_t span = aligned(length);
     if (kind_of(header) == kData) {
       take(std::span<const std::uint8_t>(header + kHeaderBytes, length - kHeaderBytes));
       ++count;
     }
-    release(head, span);
-    head += span;
+    head += aligned(length);
   }
+  if (head != released) release(released, head);
   return count;
 }
 

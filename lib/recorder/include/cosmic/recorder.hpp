@@ -11,8 +11,9 @@
 // GATEWAY-YYYYMMDD-HHMMSS-N.mcap (UTC), a new file when one reaches `rotate.size` or has been
 // written for `rotate.duration`. The open chunk is closed at least once a second, so a crash loses
 // at most that much of what was queued. A write that fails (a full disk) closes the file as it is
-// (readable up to its last whole chunk), the events meanwhile count as dropped, and a new file is
-// tried every few seconds.
+// (readable up to its last whole chunk), the events of the chunk it could not write and those
+// meanwhile count as dropped (not written), and a new file is tried every few seconds. stop()
+// writes every event queued before it.
 //
 // MCAP channels: one per cosmic channel, source segment and origin (the topic is the channel's
 // name for all of them; their metadata names the segment and origin), because a message record
