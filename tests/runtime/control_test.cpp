@@ -241,6 +241,7 @@ TEST_F(ControlTest, BadReplayRequestsAreRefusedAndAddNoSegment) {
   EXPECT_EQ(code({{"command", "replay"}, {"segment", {{"file", "relative.mcap"}}}}), "bad_request");
   EXPECT_EQ(code({{"command", "replay"}, {"segment", {{"file", "/r.mcap"}, {"type", "dds"}}}}), "bad_request");
   EXPECT_EQ(code({{"command", "replay"}, {"segment", {{"file", "/r.mcap"}}}, {"mode", "instead"}}), "bad_request");
+  EXPECT_EQ(code({{"command", "replay"}, {"segment", {{"file", "/r.mcap"}}}, {"mode", 5}}), "bad_request");
   EXPECT_EQ(code({{"command", "replay"}, {"segment", {{"file", "/r.mcap"}}}, {"match_timeout_s", 600}}), "bad_request");
   const Json missing = client.call({{"command", "replay"}, {"segment", {{"file", "/nonexistent/r.mcap"}}}});
   EXPECT_EQ(missing["error"]["code"], "config_error");

@@ -85,6 +85,34 @@ TEST_F(GatewaySegmentsTest, AnAddedSegmentKeepsEveryBindingAndItsEtag) {
   EXPECT_EQ(adapters["viz"]->wait_sent(before + 1, std::chrono::seconds(5)), before + 1);
 }
 
+// Every bound channel's CAN identifier, in report order.
+std::vector<std::uint32_t> identifiers_on_the_bus(const KnowledgeBase& kb) {
+  std::vector<std::uint32_t> ids;
+  for (const ChannelReport& channel : kb.report().channels) {
+    for (const HopReport& hop : channel.hops) {
+      if (hop.can) ids.push_back(hop.can->can_id);
+    }
+  }
+  return ids;
+}
+
+// An unbind keeps the bus's priorities (pinned); adding and removing an unrelated segment must not
+// plan the bus afresh, which would move the frames of running CAN channels.
+TEST_F(GatewaySegmentsTest, AddingAndRemovingASegmentKeepsTheBusPrioritiesAnUnbindPinned) {
+  ASSERT_TRUE(gateway
+                  .bind(channels("- {name: c3, subject: 3, class: nrt, payload: 2B, publishers: [body], subscribers: "
+                                 "[viz]}\n- {name: c4, subject: 4, class: srt, period: 5ms, reaction_time: 50ms, "
+                                 "payload: 2B, publishers: [body], subscribers: [viz]}"))
+                  .applied);
+  ASSERT_TRUE(gateway.unbind("distance"));
+  const auto pinned = identifiers_on_the_bus(gateway.knowledge_base());
+  ASSERT_FALSE(pinned.empty());
+  ASSERT_TRUE(gateway.add_segment(lcm_segment("sim")).ok());
+  EXPECT_EQ(identifiers_on_the_bus(gateway.knowledge_base()), pinned);
+  ASSERT_TRUE(gateway.remove_segment("sim").ok());
+  EXPECT_EQ(identifiers_on_the_bus(gateway.knowledge_base()), pinned);
+}
+
 TEST_F(GatewaySegmentsTest, ATakenNameIsRefusedAndNothingChanges) {
   const auto generation = gateway.generation();
   const auto added = gateway.add_segment(lcm_segment("viz"));

@@ -1,8 +1,6 @@
 // A replay segment (replay_loader.hpp).
 #include "replay_loader.hpp"
 
-#include <fnmatch.h>
-
 #include <filesystem>
 #include <map>
 
@@ -14,13 +12,6 @@ namespace {
 
 constexpr double kMinSpeed = 0.001;
 constexpr double kMaxSpeed = 1000;
-
-bool selected(const std::vector<std::string>& patterns, const std::string& channel) {
-  if (patterns.empty()) return true;
-  for (const auto& p : patterns)
-    if (::fnmatch(p.c_str(), channel.c_str(), 0) == 0) return true;
-  return false;
-}
 
 std::uint64_t fnv1a(std::span<const std::uint8_t> bytes) {
   std::uint64_t hash = 0xcbf29ce484222325ull;
@@ -36,12 +27,12 @@ struct Selection {
   std::uint64_t last = 0;
 };
 
-Result<Selection> streams_of(std::span<const std::uint8_t> file, const std::vector<std::string>& patterns) {
+Result<Selection> streams_of(std::span<const std::uint8_t> file, const ReplaySegmentProperties& replay) {
   Selection selection;
   std::vector<ReplayStream>& out = selection.streams;
   std::map<std::string, std::pair<std::size_t, std::uint64_t>> seen;  // topic -> (index, last log time)
   const auto on_message = [&](const McapMessageView& m, const McapChannel& channel) -> Result<void> {
-    if (!selected(patterns, channel.topic)) return {};
+    if (!replay.selects(channel.topic)) return {};
     selection.first = out.empty() ? m.log_time : std::min(selection.first, m.log_time);
     selection.last = std::max(selection.last, m.log_time);
     auto [it, added] = seen.try_emplace(channel.topic, out.size(), m.log_time);
@@ -122,7 +113,7 @@ void parse_replay(YamlReader& reader, const YAML::Node& node, const std::string&
     reader.error_at(node["file"], key(path, "file"), mapped.error().text, "an MCAP file cosmicd recorded");
     return;
   }
-  auto streams = streams_of(mapped.value()->bytes(), r.channels);
+  auto streams = streams_of(mapped.value()->bytes(), r);
   if (!streams) {
     reader.error_at(node["file"], key(path, "file"), r.file + " is not a readable recording: " + streams.error().text,
                     "an MCAP file cosmicd recorded");

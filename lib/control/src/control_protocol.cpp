@@ -406,10 +406,20 @@ ControlProtocol::Answer ControlProtocol::bind(const Json& request, bool replace,
     out["errors"] = to_json(parsed.errors);
     return out;
   }
-  if (replace) {
-    if (auto bad = bad_match_timeout(request)) return bad;
+  // A run-time replay is not saved: a saved definition naming its segment would not bind at the
+  // next start (and would take the channel's file definition with it).
+  for (const auto& c : parsed.channels) {
+    ChannelSpec uses = c;
+    uses.publishers.insert(uses.publishers.end(), c.subscribers.begin(), c.subscribers.end());
+    if (const std::string replay = run_time_replay_in(uses); !replay.empty()) {
+      return failure("replay_failed", "channel " + c.name + " names " + replay +
+                                          ", a run-time replay's segment; nothing changed (cosmicctl replay and "
+                                          "replay stop " +
+                                          replay + " handle it)");
+    }
   }
   if (replace) {
+    if (auto bad = bad_match_timeout(request)) return bad;
     // A replacement of something not bound is most likely a wrong name: binding it would leave
     // the channel meant to be replaced running as it was.
     std::string unbound;

@@ -41,11 +41,34 @@ std::string quoted_list(const std::vector<std::string>& list) {
 
 }  // namespace
 
+std::string ControlProtocol::run_time_replay_in(const ChannelSpec& channel) const {
+  for (const auto& [name, replay] : replays_)
+    if (names(channel.publishers, name)) return name;
+  return {};
+}
+
+void ControlProtocol::drop_segment(RunTimeReplay replay) {
+  if (const Result<void> removed = gateway_.remove_segment(replay.name); !removed) {
+    log_.log(LogLevel::error, "replay " + replay.name + ": its segment stays: " + removed.error().text +
+                                  " (replay stop " + replay.name + " removes it later)");
+    replay.before.clear();
+    replay.replayed.clear();
+    replays_[replay.name] = std::move(replay);
+  }
+}
+
+void ControlProtocol::abandon_replay() {
+  if (!pending_replay_) return;
+  RunTimeReplay replay = std::move(*pending_replay_);
+  pending_replay_.reset();
+  if (replays_.count(replay.name) == 0) drop_segment(std::move(replay));
+}
+
 ControlProtocol::Answer ControlProtocol::replay(const Json& request, const Reply& later) {
   if (!request.contains("segment") || !request["segment"].is_object()) {
-    return failure(
-        "bad_request",
-        "\"segment\" (an object: file, and optionally name, channels, speed, loop, start_offset) is required");
+    return failure("bad_request",
+                   "\"segment\" (an object: file, and optionally name, channels, speed, loop, "
+                   "start_offset, realtime, latency_bound) is required");
   }
   Json segment = request["segment"];
   if (!segment.contains("type")) segment["type"] = "replay";
@@ -63,8 +86,7 @@ ControlProtocol::Answer ControlProtocol::replay(const Json& request, const Reply
       }
     }
   }
-  const std::string mode = request.contains("mode") && request["mode"].is_string() ? request["mode"].get<std::string>()
-                                                                                   : std::string("replace");
+  const Json mode = request.contains("mode") ? request["mode"] : Json("replace");
   if (mode != "replace" && mode != "alongside")
     return failure("bad_request", "\"mode\" is \"replace\" (the default) or \"alongside\"");
   if (auto bad = bad_match_timeout(request)) return bad;
@@ -97,7 +119,14 @@ ControlProtocol::Answer ControlProtocol::begin_replay(SegmentSpec segment, const
     return failure("not_found", "the recording's channel(s) " + quoted_list(unbound) +
                                     " are not bound here; nothing changed (select the channels to replay)");
   }
-  const bool alongside = request.value("mode", std::string("replace")) == "alongside";
+  // One replay per channel at a time: the definition a stop puts back must name live segments only.
+  for (const ChannelSpec& channel : replay.before) {
+    if (const std::string other = run_time_replay_in(channel); !other.empty()) {
+      return failure("replay_failed", "channel " + channel.name + " is being replayed by " + other +
+                                          "; nothing changed (cosmicctl replay stop " + other + " first)");
+    }
+  }
+  const bool alongside = request.contains("mode") && request["mode"] == "alongside";  // checked by replay()
   std::string yaml;
   for (const ChannelSpec& channel : replay.before) {
     std::vector<std::string> publishers{segment.name};
@@ -138,13 +167,22 @@ ControlProtocol::Answer ControlProtocol::stop_replay(const Json& request, const 
     if (!now || !names(now->publishers, name)) continue;  // unbound or rebound since: nothing of the replay's left
     const auto replayed = std::find_if(replay.replayed.begin(), replay.replayed.end(),
                                        [&](const ChannelSpec& r) { return r.name == before.name; });
-    std::vector<std::string> publishers = now->publishers;
-    std::erase(publishers, name);
-    // As the replay left it: back to what it was; changed since (another bind named the replay too):
-    // only the replay's hop goes, the channel's own publishers back where none is left.
-    if (replayed != replay.replayed.end() && *replayed == *now) publishers = before.publishers;
-    if (publishers.empty()) publishers = before.publishers;
-    yaml += with_publishers(replayed != replay.replayed.end() && *replayed == *now ? before : *now, publishers);
+    // As the replay left it: back to what it was. Changed since: only the replay's hop goes, and
+    // the channel's own publishers come back where none is left, with their native bindings and SecOC.
+    if (replayed != replay.replayed.end() && *replayed == *now) {
+      yaml += with_publishers(before, before.publishers);
+      continue;
+    }
+    ChannelSpec restored = *now;
+    std::erase(restored.publishers, name);
+    if (restored.publishers.empty()) {
+      restored.publishers = before.publishers;
+      for (const NativeBinding& n : before.native)
+        if (names(before.publishers, n.segment) && !restored.native_on(n.segment)) restored.native.push_back(n);
+      for (const SecocSpec& c : before.secoc)
+        if (names(before.publishers, c.segment) && !restored.secoc_on(c.segment)) restored.secoc.push_back(c);
+    }
+    yaml += with_publishers(restored, restored.publishers);
   }
   pending_replay_ = replay;
   if (yaml.empty()) {
@@ -186,13 +224,23 @@ void ControlProtocol::settle_replay(const std::string& command, const BindResult
     if (result.applied) {
       replays_[name] = std::move(replay);
     } else {
-      static_cast<void>(gateway_.remove_segment(name));  // never carried a channel
+      drop_segment(std::move(replay));  // never carried a channel
     }
   } else if (result.applied) {
     if (const Result<void> removed = gateway_.remove_segment(name); !removed) {
-      summary["segment_kept"] = removed.error().text;  // another bind still names it
+      // Kept under its name with nothing to restore: a later replay_stop removes it.
+      summary["segment_kept"] = removed.error().text;
+      replay.before.clear();
+      replay.replayed.clear();
+      replays_[name] = std::move(replay);
+    } else {
+      replays_.erase(name);
     }
-    replays_.erase(name);
+  } else if (answer.contains("error")) {
+    answer["error"]["message"] = answer["error"].value("message", std::string()) +
+                                 "; the replay runs on: change the channel with bind --replace or unbind it, then "
+                                 "replay stop " +
+                                 name + " removes the segment";
   }
   answer["replay"] = std::move(summary);
 }

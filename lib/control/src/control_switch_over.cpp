@@ -66,6 +66,7 @@ void ControlProtocol::await_match(const std::shared_ptr<SwitchWait>& wait) {
                answer = switched(*wait, !matched);
              } catch (const std::exception& e) {
                running_.clear();
+               abandon_replay();
                answer = failure("internal_error", e.what());
              }
              wait->later(render(answer));

@@ -170,15 +170,17 @@ AdmissionSet::AdmissionSet(GatewaySpec gateway, std::vector<SegmentSpec> segment
     : gateway_(std::move(gateway)), segment_specs_(std::move(segments)), segments_(segment_specs_.size()) {
   // What a network carries before any channel is bound: a CAN bus its background frames (other
   // gateways' frames among them), an IP network what other gateways reserve there.
-  for (std::size_t s = 0; s < segments_.size(); ++s) {
-    if (segment_specs_[s].type == SegmentType::can) {
-      segments_[s].background = background_streams(segment_specs_[s].can);
-      segments_[s].background_load = utilization(segments_[s].background);
-    } else {
-      segments_[s].background_load = segment_specs_[s].peer_load;
-    }
-    segments_[s].load = segments_[s].background_load;
+  for (std::size_t s = 0; s < segments_.size(); ++s) init_segment(s);
+}
+
+void AdmissionSet::init_segment(std::size_t s) {
+  if (segment_specs_[s].type == SegmentType::can) {
+    segments_[s].background = background_streams(segment_specs_[s].can);
+    segments_[s].background_load = utilization(segments_[s].background);
+  } else {
+    segments_[s].background_load = segment_specs_[s].peer_load;
   }
+  segments_[s].load = segments_[s].background_load;
 }
 
 AdmissionSet AdmissionSet::whole(GatewaySpec gateway, std::vector<SegmentSpec> segments,

@@ -225,6 +225,11 @@ std::vector<SegmentSpec> KnowledgeBase::analysed_segments() const {
 void KnowledgeBase::set_peer_reservations(PeerNetworks peers) {
   if (peers == peers_) return;
   peers_ = std::move(peers);
+  collect_peer_etags();
+  set_ = AdmissionSet::whole(set_.gateway(), analysed_segments(), set_.channels(), etags_);
+}
+
+void KnowledgeBase::collect_peer_etags() {
   peer_etags_.clear();
   for (const SegmentState& state : segments_) {
     const PeerReservations* peer = state.spec.type == SegmentType::can ? peers_on(state.spec) : nullptr;
@@ -233,7 +238,35 @@ void KnowledgeBase::set_peer_reservations(PeerNetworks peers) {
       if (frame.extended) peer_etags_.emplace(static_cast<std::uint16_t>(frame.can_id & kEtagMask), frame.name);
     }
   }
-  set_ = AdmissionSet::whole(set_.gateway(), analysed_segments(), set_.channels(), etags_);
+}
+
+void KnowledgeBase::add_segment(SegmentSpec segment) {
+  for (const CanBackgroundFrame& frame : segment.can.background) {
+    if (segment.type == SegmentType::can && frame.extended) etag_taken_.set(frame.can_id & kEtagMask);
+  }
+  segments_.push_back(SegmentState{std::move(segment), SegmentHealth::up, {}});
+  collect_peer_etags();
+  set_.add_segment(analysed_segments().back());
+}
+
+bool KnowledgeBase::remove_segment(const std::string& name) {
+  const auto found =
+      std::find_if(segments_.begin(), segments_.end(), [&](const SegmentState& s) { return s.spec.name == name; });
+  if (found == segments_.end() || !set_.remove_segment(name)) return false;
+  segments_.erase(found);
+  // Its background frames' etag bits are free again unless reserved, bound or another's.
+  etag_taken_.reset();
+  for (const std::uint16_t etag : reserved_etags_) {
+    if (etag <= kMaxEtag) etag_taken_.set(etag);
+  }
+  for (const SegmentState& segment : segments_) {
+    for (const CanBackgroundFrame& frame : segment.spec.can.background) {
+      if (segment.spec.type == SegmentType::can && frame.extended) etag_taken_.set(frame.can_id & kEtagMask);
+    }
+  }
+  for (const auto& [channel, etag] : etags_) etag_taken_.set(etag);
+  collect_peer_etags();
+  return true;
 }
 
 void KnowledgeBase::set_health(const std::string& segment, SegmentHealth health, std::string detail) {

@@ -103,10 +103,17 @@ const ReplayStream* ReplaySegmentProperties::stream(const std::string& channel) 
   return it == streams.end() ? nullptr : &*it;
 }
 
-bool RecordingSpec::selects(const std::string& name) const {
-  if (channels.empty()) return true;
-  return std::any_of(channels.begin(), channels.end(),
+namespace {
+// Empty: every name; else a name some fnmatch(3) pattern of `patterns` matches.
+bool any_matches(const std::vector<std::string>& patterns, const std::string& name) {
+  if (patterns.empty()) return true;
+  return std::any_of(patterns.begin(), patterns.end(),
                      [&](const std::string& pattern) { return ::fnmatch(pattern.c_str(), name.c_str(), 0) == 0; });
 }
+}  // namespace
+
+bool RecordingSpec::selects(const std::string& name) const { return any_matches(channels, name); }
+
+bool ReplaySegmentProperties::selects(const std::string& channel) const { return any_matches(channels, channel); }
 
 }  // namespace cosmic

@@ -6,38 +6,21 @@
 
 namespace cosmic {
 
-Result<std::unique_ptr<KnowledgeBase>> Gateway::rebound_knowledge_base(const Config& config) const {
-  auto kb = knowledge_base_for(config);
-  kb->set_peer_reservations(kb_->peer_reservations());
-  // In the order they were bound, each with its etag: admission then reaches the same state.
-  for (const ChannelSpec& channel : kb_->bound_channels()) {
-    const BindOutcome outcome = kb->bind(channel, kb_->etag_of(channel.name));
-    if (!outcome.bound()) return Error{"channel " + channel.name + " would no longer be admitted"};
-  }
-  for (const SegmentState& state : kb_->segments()) {
-    if (config.find_segment(state.spec.name)) kb->set_health(state.spec.name, state.health, state.health_detail);
-  }
-  return kb;
-}
-
 Result<void> Gateway::add_segment(const SegmentSpec& segment) {
   if (!router_) return Error{"the gateway is not running"};
   if (slots_.count(segment.name) || config_.find_segment(segment.name))
     return Error{"a segment named '" + segment.name + "' is running"};
   const std::size_t index = free_slot();
   if (index >= kMaxSegments) return Error{"the gateway runs " + std::to_string(kMaxSegments) + " segments, its most"};
-  Config next = config_;
-  next.segments.push_back(segment);
-  auto kb = rebound_knowledge_base(next);
-  if (!kb) return std::move(kb).error();
   SegmentSlot slot{index, segment, factory_(segment, identity_, log_), {}};
   if (!slot.adapter) return Error{"cannot create the adapter of segment " + segment.name};
   router_->set_segment(slot.index, segment.name, slot.adapter.get(), egress_lane_floor(segment));
   const Status started = slot.adapter->start(router_->inbox(slot.index));
   if (!started.ok) log_.log(LogLevel::error, "segment " + segment.name + " did not start: " + started.error);
   slots_.emplace(segment.name, std::move(slot));
-  config_ = std::move(next);
-  kb_ = std::move(kb).value();
+  config_.segments.push_back(segment);
+  // Known to admission from now on; nothing bound is analysed again (CAN priorities and etags stay).
+  kb_->add_segment(segment);
   ++generation_;
   log_.log(LogLevel::notice, "segment " + segment.name + " added (" + to_string(segment.type) + ")");
   return {};
@@ -53,15 +36,11 @@ Result<void> Gateway::remove_segment(const std::string& name) {
     if (on(channel.publishers) || on(channel.subscribers))
       return Error{"channel " + channel.name + " still has a hop on segment " + name};
   }
-  Config next = config_;
-  std::erase_if(next.segments, [&](const SegmentSpec& s) { return s.name == name; });
-  auto kb = rebound_knowledge_base(next);
-  if (!kb) return std::move(kb).error();
+  if (!kb_->remove_segment(name)) return Error{"admission still counts a hop on segment " + name};
   router_->set_segment(slot->second.index, "", nullptr);
   slot->second.adapter->stop();
   slots_.erase(slot);
-  config_ = std::move(next);
-  kb_ = std::move(kb).value();
+  std::erase_if(config_.segments, [&](const SegmentSpec& s) { return s.name == name; });
   ++generation_;
   log_.log(LogLevel::notice, "segment " + name + " removed");
   return {};

@@ -15,7 +15,8 @@
 #   - a configuration naming a file that is not a recording is refused at its key;
 #   - `cosmicctl replay FILE` does the same at run time, with no replay segment configured: the
 #     recording takes the live publisher's place (live, replay, live in order after `replay stop`),
-#     `--alongside` adds it beside the publisher, a reload ends it, and every bad request (no
+#     `--alongside` adds it beside the publisher, a second replay of the channel and a bind naming
+#     the replay's segment are refused, a reload ends it, and every bad request (no
 #     recording, nothing selected, a speed out of range, a taken name, a channel not bound, an
 #     unknown replay to stop) is refused with its reason while the running channel stays as it was.
 #   replay_test.sh COSMICD COSMICCTL COSMIC_LCM_PEER
@@ -265,6 +266,17 @@ ctl g replay "$RECORDING" --alongside --loop --speed 10 --name beside >"$WORK/be
   fail "replay --alongside: $(cat "$WORK/beside.out")"
 [ "$(publishers_of g obstacle)" = field,beside ] || fail "publishers alongside: $(publishers_of g obstacle)"
 wait_until 10 "the looped replay made two passes" segment_field_at_least g beside passes 2
+# One replay per channel at a time, and no saved binding may name a run-time replay's segment.
+ctl g replay "$RECORDING" --name second >"$WORK/second.out" 2>&1
+[ $? -eq 1 ] && grep -q "channel obstacle is being replayed by beside" "$WORK/second.out" ||
+  fail "a second replay of obstacle: $(cat "$WORK/second.out")"
+cat >"$WORK/names-replay.yaml" <<YAML
+- {name: obstacle, subject: 0x600, class: nrt, payload: 4B, period: 5ms, publishers: [beside], subscribers: [viz]}
+YAML
+ctl g bind --replace "$WORK/names-replay.yaml" >"$WORK/names-replay.out" 2>&1
+[ $? -eq 1 ] && grep -q "names beside, a run-time replay's segment" "$WORK/names-replay.out" ||
+  fail "a bind naming the replay's segment: $(cat "$WORK/names-replay.out")"
+[ "$(publishers_of g obstacle)" = field,beside ] || fail "publishers after the refusals: $(publishers_of g obstacle)"
 ctl g reload >"$WORK/reload.out" 2>&1 || fail "reload: $(cat "$WORK/reload.out")"
 has_segment g beside && fail "a reload kept the run-time replay's segment"
 [ "$(publishers_of g obstacle)" = field ] || fail "publishers after the reload: $(publishers_of g obstacle)"

@@ -1,7 +1,6 @@
 // A replay segment (cosmic/replay_adapter.hpp).
 #include "cosmic/replay_adapter.hpp"
 
-#include <fnmatch.h>
 #include <pthread.h>
 
 #include "cosmic/thread_policy.hpp"
@@ -129,13 +128,6 @@ class ReplayAdapter final : public SegmentAdapter {
   // replacement's switch takes microseconds to milliseconds); then it goes anyway.
   static constexpr std::chrono::seconds kRouteWait{1};
 
-  bool selected(const std::string& channel) const {
-    if (spec_.replay.channels.empty()) return true;
-    for (const auto& p : spec_.replay.channels)
-      if (::fnmatch(p.c_str(), channel.c_str(), 0) == 0) return true;
-    return false;
-  }
-
   void run() {
     ThreadPolicy policy = policy_;
     policy.name = "replay:" + spec_.name;
@@ -200,7 +192,7 @@ class ReplayAdapter final : public SegmentAdapter {
   }
 
   Result<void> play(Pass& pass, std::uint64_t request, const McapMessageView& m, const McapChannel& channel) {
-    if (!selected(channel.topic)) return {};
+    if (!spec_.replay.selects(channel.topic)) return {};
     if (!pass.first_log_time) {
       pass.first_log_time = m.log_time;
       pass.origin_log_time = m.log_time + static_cast<std::uint64_t>(spec_.replay.start_offset.count());

@@ -283,6 +283,12 @@ class AdmissionSet {
   // refused as "would break"); binds elsewhere leave it as it is. Until then the set differs from
   // what evaluate() gives for the same channels, by design. False when not bound.
   bool remove(const std::string& name);
+  // A segment added after the others (a run-time replay's), carrying nothing yet: no analysis
+  // changes, every bound channel keeps its plan (a CAN bus its pinned priorities).
+  void add_segment(SegmentSpec segment);
+  // Removes a segment no bound channel has a hop on; false (nothing changes) otherwise or when
+  // there is no such segment. The others keep their analysis.
+  bool remove_segment(const std::string& name);
 
   const std::vector<ChannelSpec>& channels() const { return specs_; }
   const ChannelSpec* find(const std::string& name) const;
@@ -309,6 +315,8 @@ class AdmissionSet {
   Member member(std::size_t segment, std::size_t position, const Trial* newcomer) const;
   bool update_jitters(CanSide& side, const Trial* newcomer) const;
   void apply(CanSide side);
+  // What segment `s` carries before any channel is bound (its background), from its spec.
+  void init_segment(std::size_t s);
 
   GatewaySpec gateway_;
   std::vector<SegmentSpec> segment_specs_;

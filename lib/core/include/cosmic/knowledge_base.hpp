@@ -77,6 +77,11 @@ class KnowledgeBase {
   ChannelReport probe(const ChannelSpec& channel) const;
 
   void set_health(const std::string& segment, SegmentHealth health, std::string detail);
+  // A segment added to the running set (a run-time replay's): known to admission from now on,
+  // nothing bound re-analysed (CAN priorities, etags and verdicts stay). The name must be new.
+  void add_segment(SegmentSpec segment);
+  // Removes a segment no bound channel has a hop on; false (nothing changes) otherwise.
+  bool remove_segment(const std::string& name);
 
   // Replaces what other gateways reserve on the networks this gateway's segments attach (segments
   // are matched by network_identity(); networks no segment attaches are ignored) and analyses the
@@ -119,6 +124,8 @@ class KnowledgeBase {
   // The path another gateway gives `channel`'s events before a network this gateway receives it
   // from (the slowest, when several do), applied to its report.
   void add_upstream(const ChannelSpec& channel, ChannelReport& report) const;
+  // peer_etags_ from what the peers reserve on the CAN segments there are now.
+  void collect_peer_etags();
 
   std::vector<SegmentState> segments_;
   AdmissionSet set_;

@@ -154,6 +154,8 @@ struct ReplaySegmentProperties {
   std::vector<ReplayStream> streams;
   std::uint64_t content_hash = 0;
   const ReplayStream* stream(const std::string& channel) const;
+  // Whether `channel` (a recorded topic) is among those `channels` selects.
+  bool selects(const std::string& channel) const;
   friend bool operator==(const ReplaySegmentProperties&, const ReplaySegmentProperties&) = default;
 };
 

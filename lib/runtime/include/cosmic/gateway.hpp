@@ -187,10 +187,10 @@ class Gateway {
   // reload) that admission rejected then and that is not bound now; null otherwise.
   const ChannelReport* rejected_at_load(const std::string& name) const;
   // A segment added to the running gateway (cosmicctl replay, control thread): its adapter created
-  // and started, the knowledge base told of it, every bound channel kept as admitted (its etag
-  // too). Nothing changes when the name is taken, no slot is free or the adapter cannot be made.
-  // The segment carries no channel until a bind or replacement names it; a reload whose file does
-  // not name it removes it. Changes generation().
+  // and started, the knowledge base told of it without analysing anything bound again (verdicts,
+  // etags and CAN priorities stay). Nothing changes when the name is taken, no slot is free or the adapter cannot be
+  // made. The segment carries no channel until a bind or replacement names it; a reload whose file does not name it
+  // removes it. Changes generation().
   Result<void> add_segment(const SegmentSpec& segment);
   // Removes a segment add_segment() added, or any other, once no bound channel has a hop on it.
   Result<void> remove_segment(const std::string& name);
@@ -303,9 +303,6 @@ class Gateway {
   // Lowest slot index used neither by a running segment nor by one in `also_taken`.
   std::size_t free_slot(const std::set<std::size_t>& also_taken = {}) const;
   static std::unique_ptr<KnowledgeBase> knowledge_base_for(const Config& config);
-  // The knowledge base of `config` (the running one with a segment more or less) holding every
-  // bound channel as admitted now; the reason when one would not bind there.
-  Result<std::unique_ptr<KnowledgeBase>> rebound_knowledge_base(const Config& config) const;
 
   AdapterFactory factory_;
   Logger& log_;
