@@ -237,7 +237,7 @@ class ComponentsLoader {
   void fmu_disagrees(const FmuSpec& f, const char* role, const ChannelSpec& channel, const std::string& valid) {
     const YAML::Node list = root_["fmus"];
     for (std::size_t i = 0; i < list.size(); ++i) {
-      if (!list[i]["name"] || list[i]["name"].Scalar() != f.name) continue;
+      if (!list[i].IsMap() || !list[i]["name"] || list[i]["name"].Scalar() != f.name) continue;
       const YAML::Node map = list[i][role];
       for (auto it = map.begin(); it != map.end(); ++it) {
         if (!it->second.IsScalar() || !it->second.Scalar().starts_with(channel.name + ".")) continue;

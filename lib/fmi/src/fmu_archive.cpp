@@ -45,6 +45,16 @@ class Archive {
   explicit Archive(std::string path) : path_(std::move(path)) {}
 
   bool open(std::vector<std::string>& errors) {
+    // A regular file only, said plainly (libzip answers "Operation not supported" for a FIFO).
+    struct stat file_stat {};
+    if (::stat(path_.c_str(), &file_stat) != 0) {
+      errors.push_back("cannot open " + path_ + ": " + errno_text(errno));
+      return false;
+    }
+    if (!S_ISREG(file_stat.st_mode)) {
+      errors.push_back(path_ + " is not an FMU: not a regular file");
+      return false;
+    }
     int code = 0;
     zip_.reset(zip_open(path_.c_str(), ZIP_RDONLY, &code));
     if (!zip_) {

@@ -2,9 +2,10 @@
 // the build compiles from fmi_test_model.c: read without extracting; opened, the platform's binary
 // and the resources extracted and the library loadable; refused: not a zip, no description, no
 // binary for this platform (naming the ones there are), a zip-slip entry, a symbolic link, a
-// description with problems, a work directory that is not empty.
+// description with problems, a directory or FIFO in the FMU's place, a work directory that is not empty.
 #include <dlfcn.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -92,6 +93,7 @@ TEST_F(FmuArchive, OpenExtractsTheBinaryAndResourcesAndTheLibraryLoads) {
 
 TEST_F(FmuArchive, EveryRefusalSaysWhy) {
   std::ofstream(dir_ / "text.fmu") << "not a zip";
+  ASSERT_EQ(::mkfifo((dir_ / "pipe.fmu").c_str(), 0600), 0);
   auto no_linux = plant("darwin64");
   auto slip = plant();
   slip.push_back({"resources/../../escaped.txt", "x"});
@@ -108,7 +110,9 @@ TEST_F(FmuArchive, EveryRefusalSaysWhy) {
   };
   const std::vector<Case> cases = {
       {(dir_ / "text.fmu").string(), "text.fmu is not an FMU: not a zip archive"},
-      {(dir_ / "missing.fmu").string(), "cannot open"},
+      {(dir_ / "missing.fmu").string(), "cannot open " + (dir_ / "missing.fmu").string() + ": No such file"},
+      {dir_.string(), "is not an FMU: not a regular file"},
+      {(dir_ / "pipe.fmu").string(), "pipe.fmu is not an FMU: not a regular file"},
       {fmu("empty.fmu", {{"README", "x"}}), "empty.fmu is not an FMU: it holds no modelDescription.xml"},
       {fmu("mac.fmu", no_linux),
        "mac.fmu has no binary for this platform (binaries/linux64/Plant.so); its platforms: darwin64, win64"},
