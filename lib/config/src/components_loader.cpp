@@ -193,9 +193,29 @@ class ComponentsLoader {
     check_fmu_agreement(channel);
   }
 
+  // Whether an `fmus:` entry that was refused (with errors of its own) maps `channel` in `role`
+  // ("outputs": it would have published it; "inputs": subscribed it).
+  bool named_by_refused_fmu(const std::string& channel, const char* role) const {
+    const YAML::Node list = root_["fmus"];
+    if (!list || !list.IsSequence()) return false;
+    for (const auto& entry : list) {
+      if (!entry.IsMap() || !entry[role] || !entry[role].IsMap()) continue;
+      const std::string name = entry["name"] && entry["name"].IsScalar() ? entry["name"].Scalar() : "";
+      const bool loaded =
+          std::any_of(config_.fmus.begin(), config_.fmus.end(), [&](const FmuSpec& f) { return f.name == name; });
+      if (loaded) continue;
+      for (auto it = entry[role].begin(); it != entry[role].end(); ++it)
+        if (it->second.IsScalar() && it->second.Scalar().starts_with(channel + ".")) return true;
+    }
+    return false;
+  }
+
   void report_empty(const YAML::Node& map, const std::string& path, const char* role,
                     const std::vector<std::string>& list, const char* valid) {
     if (!list.empty() || present(map, role)) return;
+    // A refused FMU would have given the segment: its own errors say what to fix.
+    if (named_by_refused_fmu(map["name"].Scalar(), std::string_view(role) == "publishers" ? "outputs" : "inputs"))
+      return;
     reader_.error_at(map, path + "." + role, std::string("no ") + role + " given and none derived from components",
                      valid);
   }

@@ -93,8 +93,10 @@ class FmusLoader {
     read_step(node, path, description ? &*description : nullptr, f);
     const fmi::FmuDescription* d = description ? &*description : nullptr;
     read_mappings(node, path, "inputs", fmi::Flow::input, d, f.inputs);
+    const std::size_t errors_before_outputs = reader_.error_count();
     read_mappings(node, path, "outputs", fmi::Flow::output, d, f.outputs);
-    check_outputs_complete(node, path, f);
+    // Fields whose output was refused are not missing on top of it.
+    if (reader_.error_count() == errors_before_outputs) check_outputs_complete(node, path, f);
     read_parameters(node, path, d, f);
     if (reader_.error_count() != errors_before) return;
     if (components_.count(f.name) || !names_.insert(f.name).second) {

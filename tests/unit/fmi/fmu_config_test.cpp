@@ -167,6 +167,29 @@ TEST_F(FmuConfig, EveryMistakeIsLocated) {
   for (const Case& c : cases) test::expect_refused_with(parse_config(document(c.fmu), file()), c.expected);
 }
 
+// A refused FMU leaves its channels without the segment it would have given them: its own errors
+// say so, not a second error on each channel.
+TEST_F(FmuConfig, ARefusedFmuIsReportedOnceNotAgainOnItsChannels) {
+  const ConfigResult r = parse_config(document(plant("    parameters: {gain: 11}\n")), file());
+  ASSERT_EQ(r.errors.size(), 1u) << test::errors_text(r);
+  EXPECT_NE(r.errors[0].to_string().find("fmus[0].parameters.gain"), std::string::npos);
+  // A refused output is not reported again as a field the outputs leave unset.
+  const ConfigResult output =
+      parse_config(document(plant("", "{y: state.pose.v, count: state.pose.n, ready: state.pose.v}")), file());
+  ASSERT_EQ(output.errors.size(), 1u) << test::errors_text(output);
+  EXPECT_NE(output.errors[0].to_string().find("fmus[0].outputs.ready"), std::string::npos);
+  // A channel nobody publishes, with a loaded FMU subscribing it, still lacks publishers.
+  const ConfigResult unpublished = parse_config(
+      "segments:\n"
+      "  - {name: lan, type: dds, domain: 0}\n"
+      "channels:\n"
+      "  - {name: c, subject: 0x10, class: nrt, period: 10ms, type: {fields: [{name: v, type: float64}]}}\n"
+      "fmus:\n"
+      "  - {name: plant, fmu: plant.fmu, segment: lan, inputs: {u: c.v}}\n",
+      file());
+  test::expect_refused_with(unpublished, "channels[0].publishers: no publishers given and none derived");
+}
+
 // Channels that name their segments must agree with the FMU, as with a component.
 TEST_F(FmuConfig, AnOutputChannelNeedsTheFmusSegmentAmongItsPublishers) {
   const std::string text =
