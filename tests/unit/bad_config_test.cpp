@@ -50,7 +50,7 @@ const std::vector<BadConfig> kBadConfigs = {
                               {9, 19, "channels[0].subscribers[0]", "unknown segment 'lan'"}}},
   {"channel_not_map.yaml", {{7, 5, "channels[0]", "expected a map of keys"}}},
   {"bool_not_boolean.yaml", {{6, 9, "segments[0].fd", "'yes' is not a boolean (true or false)"}}},
-  {"root_is_list.yaml", {{1, 1, "", "expected a map of keys (keys: gateway, segments, channels, components, recording)"}}},
+  {"root_is_list.yaml", {{1, 1, "", "expected a map of keys (keys: gateway, segments, channels, components, fmus, recording)"}}},
   {"subject_not_a_number.yaml", {{8, 14, "channels[0].subject", "'distance' is not a whole number"}}},
   {"value_missing.yaml", {{11, 5, "channels[0].reaction_time", "value is missing"},
                           {12, 5, "channels[0].temp_validity", "value is missing"}}},
@@ -192,7 +192,7 @@ TEST(BadConfigs, FileNameOnlyLabelsErrors) {
   ASSERT_EQ(result.errors.size(), 1u) << describe_errors(result.errors);
   EXPECT_EQ(result.errors[0].to_string(),
             "label.yaml:3:1: extra: unknown key 'extra' (valid keys here: gateway, segments, channels, components, "
-            "recording)");
+            "fmus, recording)");
 }
 
 TEST(BadConfigs, ArbitraryBytesNeverCrash) {

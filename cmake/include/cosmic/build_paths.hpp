@@ -13,5 +13,6 @@ extern const char* const lcm_peer;             // the cosmic-lcm-peer program
 extern const char* const lcm_logger;           // Debian's lcm-logger ("" when not installed)
 extern const char* const client_config_dir;    // the build tree's cosmic_client CMake package
 extern const char* const cosmicctl_build_dir;  // where cosmicctl is built
+extern const char* const fmi_test_model;       // the shared library of the tests' FMUs (tests/unit/fmi)
 
 }  // namespace cosmic::build_paths

@@ -158,17 +158,18 @@ class ComponentsLoader {
     return joined(names);
   }
 
-  // Segments, in the order of `segments:`, of the components that publish (or subscribe) `channel`.
+  // Segments, in the order of `segments:`, of the components that publish (or subscribe) `channel`;
+  // an FMU (`fmus:`) is a component publishing its output channels and subscribing its input channels.
   std::vector<std::string> segments_of(const std::string& channel, bool publishes) const {
     std::vector<std::string> out;
     for (const auto& segment : config_.segments) {
-      for (const auto& c : config_.components) {
-        const auto& list = publishes ? c.publishes : c.subscribes;
-        if (c.segment == segment.name && contains(list, channel)) {
-          out.push_back(segment.name);
-          break;
-        }
-      }
+      const bool component = std::any_of(config_.components.begin(), config_.components.end(), [&](const auto& c) {
+        return c.segment == segment.name && contains(publishes ? c.publishes : c.subscribes, channel);
+      });
+      const bool fmu = std::any_of(config_.fmus.begin(), config_.fmus.end(), [&](const FmuSpec& f) {
+        return f.segment == segment.name && contains(publishes ? f.publishes() : f.subscribes(), channel);
+      });
+      if (component || fmu) out.push_back(segment.name);
     }
     return out;
   }
@@ -189,11 +190,32 @@ class ComponentsLoader {
     report_empty(map, node->second.path, "subscribers", channel.subscribers,
                  "a component on another segment that subscribes it, or subscribers: [SEGMENT]");
     check_agreement(channel);
+    check_fmu_agreement(channel);
+  }
+
+  // Whether an `fmus:` entry that was refused (with errors of its own) maps `channel` in `role`
+  // ("outputs": it would have published it; "inputs": subscribed it).
+  bool named_by_refused_fmu(const std::string& channel, const char* role) const {
+    const YAML::Node list = root_["fmus"];
+    if (!list || !list.IsSequence()) return false;
+    for (const auto& entry : list) {
+      if (!entry.IsMap() || !entry[role] || !entry[role].IsMap()) continue;
+      const std::string name = entry["name"] && entry["name"].IsScalar() ? entry["name"].Scalar() : "";
+      const bool loaded =
+          std::any_of(config_.fmus.begin(), config_.fmus.end(), [&](const FmuSpec& f) { return f.name == name; });
+      if (loaded) continue;
+      for (auto it = entry[role].begin(); it != entry[role].end(); ++it)
+        if (it->second.IsScalar() && it->second.Scalar().starts_with(channel + ".")) return true;
+    }
+    return false;
   }
 
   void report_empty(const YAML::Node& map, const std::string& path, const char* role,
                     const std::vector<std::string>& list, const char* valid) {
     if (!list.empty() || present(map, role)) return;
+    // A refused FMU would have given the segment: its own errors say what to fix.
+    if (named_by_refused_fmu(map["name"].Scalar(), std::string_view(role) == "publishers" ? "outputs" : "inputs"))
+      return;
     reader_.error_at(map, path + "." + role, std::string("no ") + role + " given and none derived from components",
                      valid);
   }
@@ -212,6 +234,39 @@ class ComponentsLoader {
         disagree(tags, "subscribes", c, channel,
                  "a segment among its publishers or subscribers (" + joined(channel.publishers) + "; " +
                      joined(channel.subscribers) + ")");
+      }
+    }
+  }
+
+  // As for components: an FMU's outputs leave from a P segment of their channel, its inputs arrive on
+  // a P or S segment.
+  void check_fmu_agreement(const ChannelSpec& channel) {
+    for (const auto& f : config_.fmus) {
+      if (contains(f.publishes(), channel.name) && !contains(channel.publishers, f.segment)) {
+        fmu_disagrees(f, "outputs", channel, "a segment listed in its publishers (" + joined(channel.publishers) + ")");
+      }
+      if (contains(f.subscribes(), channel.name) && !contains(channel.publishers, f.segment) &&
+          !contains(channel.subscribers, f.segment)) {
+        fmu_disagrees(f, "inputs", channel,
+                      "a segment among its publishers or subscribers (" + joined(channel.publishers) + "; " +
+                          joined(channel.subscribers) + ")");
+      }
+    }
+  }
+
+  void fmu_disagrees(const FmuSpec& f, const char* role, const ChannelSpec& channel, const std::string& valid) {
+    const YAML::Node list = root_["fmus"];
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      if (!list[i].IsMap() || !list[i]["name"] || list[i]["name"].Scalar() != f.name) continue;
+      const YAML::Node map = list[i][role];
+      for (auto it = map.begin(); it != map.end(); ++it) {
+        if (!it->second.IsScalar() || !it->second.Scalar().starts_with(channel.name + ".")) continue;
+        reader_.error_at(it->second, item_path("fmus", i) + "." + role + "." + it->first.Scalar(),
+                         "FMU '" + f.name + "' on segment '" + f.segment + "' " +
+                             (std::string_view(role) == "outputs" ? "publishes" : "subscribes") + " '" + channel.name +
+                             "', which the gateway does not bind there",
+                         "an FMU on " + valid);
+        return;
       }
     }
   }

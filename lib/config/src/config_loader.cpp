@@ -16,6 +16,7 @@
 #include "background_loader.hpp"
 #include "can_segment_loader.hpp"
 #include "components_loader.hpp"
+#include "fmus_loader.hpp"
 #include "native_loader.hpp"
 #include "secoc_loader.hpp"
 #include "typed_hops_loader.hpp"
@@ -52,16 +53,17 @@ class ConfigParser {
       result.errors = reader_.take_errors();
       return result;
     }
-    if (reader_.check_map(*root, "", {"gateway", "segments", "channels", "components", "recording"})) {
+    if (reader_.check_map(*root, "", {"gateway", "segments", "channels", "components", "fmus", "recording"})) {
       if (has(*root, "gateway")) parse_gateway((*root)["gateway"]);
       if (require(*root, "", "segments", "a list of segments (type can, dds or lcm)"))
         parse_segments((*root)["segments"]);
-      derive_bindings_ = config_detail::has_components(*root);
+      derive_bindings_ = config_detail::has_components(*root) || has(*root, "fmus");
       if (require(*root, "", "channels", "a list of channels")) parse_channel_list((*root)["channels"], "channels");
       if (has(*root, "gateway") && has((*root)["gateway"], "federation")) {
         config_detail::check_federation_segment(reader_, (*root)["gateway"]["federation"], "gateway.federation",
                                                 config_);
       }
+      config_detail::load_fmus(reader_, *root, config_, included_);
       config_detail::load_components(reader_, *root, config_);
       native_.check_derived(reader_, config_);
       secoc_.check_derived(reader_, config_);

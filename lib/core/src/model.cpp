@@ -117,3 +117,20 @@ bool RecordingSpec::selects(const std::string& name) const { return any_matches(
 bool ReplaySegmentProperties::selects(const std::string& channel) const { return any_matches(channels, channel); }
 
 }  // namespace cosmic
+
+namespace cosmic {
+namespace {
+
+std::vector<std::string> channels_of(const std::vector<FmuVariableMapping>& mappings) {
+  std::vector<std::string> out;
+  for (const auto& m : mappings)
+    if (std::find(out.begin(), out.end(), m.channel) == out.end()) out.push_back(m.channel);
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> FmuSpec::publishes() const { return channels_of(outputs); }
+std::vector<std::string> FmuSpec::subscribes() const { return channels_of(inputs); }
+
+}  // namespace cosmic

@@ -400,6 +400,43 @@ struct ComponentSpec {
   friend bool operator==(const ComponentSpec&, const ComponentSpec&) = default;
 };
 
+// An FMU variable and the channel field it carries (`fmus:` inputs and outputs, docs/fmu.md): the
+// field a path into the channel's type, dotted through nested records ("speed", "pose.x").
+struct FmuVariableMapping {
+  std::string variable;
+  std::string channel;
+  std::string field;
+  friend bool operator==(const FmuVariableMapping&, const FmuVariableMapping&) = default;
+};
+
+// A parameter the runner sets before initialization, as written (checked against its type at load).
+struct FmuParameter {
+  std::string variable;
+  std::string value;
+  friend bool operator==(const FmuParameter&, const FmuParameter&) = default;
+};
+
+// A co-simulation FMU run as a component on one segment (issue 38, `fmus:`, docs/fmu.md): each step
+// takes its inputs from channel fields and publishes its outputs. It counts as a component that
+// publishes its output channels and subscribes its input channels. The runner (cosmic-fmu) is the
+// next step; the configuration reads and checks the FMU at load.
+struct FmuSpec {
+  std::string name;
+  std::string fmu;  // the FMU file, absolute (a relative one is anchored at the configuration)
+  std::string segment;
+  Nanos step{Nanos(10'000'000)};  // the communication step (given, or the FMU's DefaultExperiment stepSize)
+  std::vector<FmuVariableMapping> inputs;
+  std::vector<FmuVariableMapping> outputs;
+  std::vector<FmuParameter> parameters;
+  // Read from the FMU at load:
+  std::string fmi_version;       // "2.0", "3.0"
+  std::string model_identifier;  // its shared library's name
+  // The channels its outputs set (inputs read), each once, in the order first mapped.
+  std::vector<std::string> publishes() const;
+  std::vector<std::string> subscribes() const;
+  friend bool operator==(const FmuSpec&, const FmuSpec&) = default;
+};
+
 // What cosmicd records of the channels that cross it (issue 37; `recording:`, docs/recording.md):
 // MCAP files in `directory`, of the channels whose names match `channels` (names or globs), and
 // the CAN segments in `candump` also as `candump -l` logs.
@@ -432,6 +469,7 @@ struct Config {
   std::vector<SegmentSpec> segments;
   std::vector<ChannelSpec> channels;
   std::vector<ComponentSpec> components;  // optional application model, may be empty
+  std::vector<FmuSpec> fmus;              // optional FMUs as components, may be empty
 
   const SegmentSpec* find_segment(const std::string& name) const;
   const ChannelSpec* find_channel(const std::string& name) const;
