@@ -122,7 +122,8 @@ class ReplayAdapter final : public SegmentAdapter {
     Clock::time_point started{};
     Clock::time_point last_due{};  // of the last event delivered
     std::uint64_t delivered = 0;
-    bool routed = false;  // the router took the pass's first event's channel from here
+    bool routed = false;                            // the router took the pass's first event's channel from here
+    std::map<std::string, Clock::time_point> sent;  // by channel: when its last event went
   };
   // How long a pass's first event waits for the router to route its channel from this segment (a
   // replacement's switch takes microseconds to milliseconds); then it goes anyway.
@@ -159,6 +160,14 @@ class ReplayAdapter final : public SegmentAdapter {
         start = std::max(Clock::now(), pass.last_due + loop_gap());
       }
     }
+  }
+
+  // The tightest recorded spacing of `channel` at the replay's speed (0 with fewer than two events).
+  Clock::duration tightest_gap(const std::string& channel) const {
+    const ReplayStream* stream = spec_.replay.stream(channel);
+    if (!stream || stream->events < 2) return Clock::duration::zero();
+    return std::chrono::nanoseconds(
+        static_cast<std::int64_t>(static_cast<double>(stream->tightest.count()) / spec_.replay.speed));
   }
 
   // The smallest recorded spacing of the selected channels at the replay's speed, at least 1 ms.
@@ -201,10 +210,16 @@ class ReplayAdapter final : public SegmentAdapter {
     // Clamped: a third party's file may hold absurd times (the loader bounds the selection's span).
     const double offset = std::min(static_cast<double>(m.log_time - pass.origin_log_time) / spec_.replay.speed, 1e17);
     Clock::time_point due = pass.started + std::chrono::nanoseconds(static_cast<std::int64_t>(offset));
+    // Never closer to the channel's previous event than the recording's tightest spacing at this
+    // speed, the rate admission granted: a replay that fell behind (a late wake-up on a busy host)
+    // catches up no faster than that, so the channel's rate policing never cuts a recorded event.
+    Clock::time_point send_at = due;
+    if (const auto last = pass.sent.find(channel.topic); last != pass.sent.end())
+      send_at = std::max(due, last->second + tightest_gap(channel.topic));
     Bound target;
     {
       std::unique_lock lock(mutex_);
-      wake_.wait_until(lock, due, [&] { return stopping_ || request != pass_request_ || bound_.empty(); });
+      wake_.wait_until(lock, send_at, [&] { return stopping_ || request != pass_request_ || bound_.empty(); });
       if (stopping_ || request != pass_request_ || bound_.empty()) return Error{"cut short"};
       const auto it = bound_.find(channel.topic);
       if (it == bound_.end()) return {};
@@ -221,6 +236,7 @@ class ReplayAdapter final : public SegmentAdapter {
         const Clock::duration shift = Clock::now() - asked;
         pass.started += shift;
         due += shift;
+        send_at += shift;
       }
     }
     std::span<const std::uint8_t> contents = m.data;
@@ -237,7 +253,9 @@ class ReplayAdapter final : public SegmentAdapter {
     const InboundEvent event{target.id, EventHeader{}, contents, steady_now(),
                              FormatIdentity{false, false, false, false}};
     sink_->on_event(event);
-    const Nanos late = std::chrono::duration_cast<Nanos>(Clock::now() - due);
+    const Clock::time_point sent = Clock::now();
+    pass.sent[channel.topic] = sent;
+    const Nanos late = std::chrono::duration_cast<Nanos>(sent - due);
     pass.last_due = due;
     ++pass.delivered;
     std::lock_guard lock(mutex_);
