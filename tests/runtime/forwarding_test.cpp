@@ -347,14 +347,20 @@ TEST(ForwardingTest, AReloadedResidenceBoundIsWhatTheLanesCheck) {
   const auto reloaded = parse_config(relaxed, "hrt.yaml");
   ASSERT_TRUE(reloaded.ok());
   ASSERT_TRUE(gateway.reload(reloaded.config).applied);
-  ASSERT_TRUE(adapters["lan"]->inject("distance", {1, 2, 3, 4}));
-  ASSERT_EQ(adapters["rt"]->wait_sent(1, 5s), 1u);
+  // Three events (what the channel's rate policing lets through at once): under the old bound
+  // (1 ns) every one misses; under the reloaded one (40 ms) at most one that a loaded host stalled
+  // that long (a fresh-clone run once saw one event miss it).
+  constexpr std::size_t kEvents = 3;
+  for (std::size_t i = 0; i < kEvents; ++i) {
+    ASSERT_TRUE(adapters["lan"]->inject("distance", {1, 2, 3, 4}));
+    ASSERT_EQ(adapters["rt"]->wait_sent(i + 1, 5s), i + 1);
+  }
   for (auto deadline = steady_now() + Nanos(5'000'000'000);
-       gateway.channel_stats().at(0).segments.back().egress->events == 0;) {
+       gateway.channel_stats().at(0).segments.back().egress->events < kEvents;) {
     ASSERT_LT(steady_now(), deadline);
     std::this_thread::yield();
   }
-  EXPECT_EQ(gateway.channel_stats().at(0).residence_miss, 0u);  // 1 ns would have been missed
+  EXPECT_LE(gateway.channel_stats().at(0).residence_miss, 1u);
   gateway.stop();
 }
 
