@@ -409,9 +409,7 @@ ControlProtocol::Answer ControlProtocol::bind(const Json& request, bool replace,
   // A run-time replay is not saved: a saved definition naming its segment would not bind at the
   // next start (and would take the channel's file definition with it).
   for (const auto& c : parsed.channels) {
-    ChannelSpec uses = c;
-    uses.publishers.insert(uses.publishers.end(), c.subscribers.begin(), c.subscribers.end());
-    if (const std::string replay = run_time_replay_in(uses); !replay.empty()) {
+    if (const std::string replay = run_time_replay_in(c); !replay.empty()) {
       return failure("replay_failed", "channel " + c.name + " names " + replay +
                                           ", a run-time replay's segment; nothing changed (cosmicctl replay and "
                                           "replay stop " +

@@ -43,7 +43,7 @@ std::string quoted_list(const std::vector<std::string>& list) {
 
 std::string ControlProtocol::run_time_replay_in(const ChannelSpec& channel) const {
   for (const auto& [name, replay] : replays_)
-    if (names(channel.publishers, name)) return name;
+    if (names(channel.publishers, name) || names(channel.subscribers, name)) return name;
   return {};
 }
 

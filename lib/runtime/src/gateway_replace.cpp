@@ -102,8 +102,7 @@ std::multimap<std::string, ChannelBinding> Gateway::added_hops(const BindPlan& p
              std::find(before->subscribers.begin(), before->subscribers.end(), segment) != before->subscribers.end();
     };
     for (const auto& hop : verdict->hops) {
-      if (!uses(hop.segment))
-        added.emplace(hop.segment, ChannelBinding{id->second.second, channel, hop.role, hop.can, true});
+      if (!uses(hop.segment)) added.emplace(hop.segment, ChannelBinding{id->second.second, channel, hop.role, hop.can});
     }
   }
   return added;

@@ -59,9 +59,6 @@ class ReplayAdapter final : public SegmentAdapter {
         plan.refuse(*b, "a replay segment only publishes: nothing can be sent into a recording");
         continue;
       }
-      // Opened ahead of a replacement's switch: played from the switch on, so that no event is due
-      // while the router has no route from here yet (it would count as no_route and be lost).
-      if (b->ahead_of_switch) continue;
       Bound& entry = bound[b->spec.name];
       entry.id = b->id;
       // A typed channel was recorded as CDR or JSON: read back into the compact layout the router
@@ -125,9 +122,6 @@ class ReplayAdapter final : public SegmentAdapter {
     bool routed = false;                            // the router took the pass's first event's channel from here
     std::map<std::string, Clock::time_point> sent;  // by channel: when its last event went
   };
-  // How long a pass's first event waits for the router to route its channel from this segment (a
-  // replacement's switch takes microseconds to milliseconds); then it goes anyway.
-  static constexpr std::chrono::seconds kRouteWait{1};
 
   void run() {
     ThreadPolicy policy = policy_;
@@ -225,9 +219,10 @@ class ReplayAdapter final : public SegmentAdapter {
       if (it == bound_.end()) return {};
       target = it->second;
       if (!pass.routed) {
-        // The pass begins when the gateway routes from here: its timing shifts by the wait.
+        // The pass begins when the gateway routes from here (a replacement's hop opens ahead of its
+        // switch, which may wait seconds for other publishers to match): its timing shifts by the wait.
         const Clock::time_point asked = Clock::now();
-        while (!sink_->routes(target.id) && Clock::now() - asked < kRouteWait) {
+        while (!sink_->routes(target.id)) {
           wake_.wait_for(lock, std::chrono::milliseconds(1),
                          [&] { return stopping_ || request != pass_request_ || bound_.empty(); });
           if (stopping_ || request != pass_request_ || bound_.empty()) return Error{"cut short"};

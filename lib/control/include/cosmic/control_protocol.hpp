@@ -143,7 +143,7 @@ class ControlProtocol {
   // undone, the segment removed where it no longer serves.
   void settle_replay(const std::string& command, const BindResult& result, Json& answer);
   std::optional<Json> bad_match_timeout(const Json& request) const;
-  // The run-time replay publishing `channel`, or empty.
+  // The run-time replay whose segment `channel` names, or empty.
   std::string run_time_replay_in(const ChannelSpec& channel) const;
   // Removes a replay's segment; one that cannot go stays listed (nothing to restore) for replay_stop.
   void drop_segment(RunTimeReplay replay);

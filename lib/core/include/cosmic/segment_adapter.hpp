@@ -41,14 +41,7 @@ struct ChannelBinding {
   ChannelSpec spec;
   HopRole role = HopRole::publisher;  // publisher: the gateway receives it here; subscriber: sends it here
   std::optional<CanHopPlan> can;      // CAN segments only
-  // Opened by a replacement made before break ahead of its switch (Gateway::prepare_replace): no
-  // route leads from this hop yet. A source that needs no matching to be ready (a replay) waits
-  // for the switch, the same binding given again without this flag, before it plays. Not part of
-  // equality: it is the same hop, whose endpoint the switch keeps.
-  bool ahead_of_switch = false;
-  friend bool operator==(const ChannelBinding& a, const ChannelBinding& b) {
-    return a.id == b.id && a.spec == b.spec && a.role == b.role && a.can == b.can;
-  }
+  friend bool operator==(const ChannelBinding&, const ChannelBinding&) = default;
 };
 
 // Why an inbound message could not become an event.
@@ -66,7 +59,8 @@ class EventSink {
   virtual void on_problem(ChannelId channel, InboundProblem problem) = 0;
   // Whether events of `channel` arriving here are routed now. A source that needs no matching to
   // be ready (a replay) waits for it before its first event, so that none is due while the
-  // gateway's routes do not yet lead from this segment (a switch in progress). Any thread.
+  // gateway's routes do not yet lead from this segment (a replacement's hop opened ahead of its
+  // switch, a bind between its adapters' configuration and its routes). Any thread.
   virtual bool routes(ChannelId channel) const {
     static_cast<void>(channel);
     return true;
