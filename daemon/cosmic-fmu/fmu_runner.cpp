@@ -197,7 +197,7 @@ void FmuRunner::trace_step(std::uint64_t index) {
   };
   for (const auto& m : spec_.inputs) column(m);
   for (const auto& m : spec_.outputs) column(m);
-  trace_ << '\n';
+  trace_ << std::endl;  // line by line, so the trace can be followed while the FMU runs
 }
 
 void FmuRunner::set_state(RunnerState state, std::string message) {
