@@ -89,7 +89,10 @@ void StatusReporter::loop() {
 
 void StatusReporter::send(const RunnerStatus& status) {
   const std::string line = summary_line(runner_.spec().step, status);
-  ::sd_notifyf(0, "STATUS=%s", line.c_str());  // nothing without NOTIFY_SOCKET
+  // Nothing without NOTIFY_SOCKET. READY=1 once the FMU steps: extracted, initialized, joined.
+  const bool ready = status.state != RunnerState::starting;
+  ::sd_notifyf(0, "%sSTATUS=%s", ready && !ready_sent_ ? "READY=1\n" : "", line.c_str());
+  ready_sent_ = ready_sent_ || ready;
   if (options_.socket.empty()) return;
   const auto answer =
       cosmicctl::request(options_.socket, report_request(runner_.spec().name, runner_.spec().step, status),

@@ -1,6 +1,7 @@
 // cosmic-fmu's status (issue 38, docs/fmu.md "Timing"): every interval the runner's counters go to
 // the gateway as a `fmu_report` control request (docs/control-protocol.md), to the service manager
-// as STATUS= (when NOTIFY_SOCKET is set), and now and then to the log.
+// as STATUS= (when NOTIFY_SOCKET is set; READY=1 with the first report once the FMU steps), and now
+// and then to the log.
 //
 // Owns one thread ("fmu-report"); never touches the FMU. The control socket is asked with a
 // timeout, so a gateway that hangs delays only the next report, never a step.
@@ -48,6 +49,7 @@ class StatusReporter {
   ReporterOptions options_;
   cosmic::Logger& log_;
   bool warned_unreachable_ = false;  // the reporter thread's
+  bool ready_sent_ = false;          // the reporter thread's: READY=1 went to the service manager
   cosmic::Mutex mutex_;
   std::condition_variable wake_;
   bool stopping_ COSMIC_GUARDED_BY(mutex_) = false;
