@@ -5,12 +5,14 @@
 // a step: its own messages are logged); 2 the configuration has errors or no such FMU; 64 usage.
 #include <pthread.h>
 #include <signal.h>
+#include <sys/mman.h>
 
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <cstdlib>
 
 #include "cosmic/config_loader.hpp"
+#include "cosmic/thread_policy.hpp"
 #include "cosmic/units.hpp"
 #include "cosmic/version.hpp"
 #include "daemon_logger.hpp"
@@ -43,8 +45,22 @@ struct Arguments {
   std::string work_dir;
   std::string trace;
   int can_node = -1;
+  int priority = 0;
+  std::vector<int> cpus;
   std::string log_level = "info";
 };
+
+// The step thread's scheduling (--priority, --cpus), applied once everything else is started, so
+// that only the step thread runs SCHED_FIFO (threads inherit their creator's class); with a
+// priority the process's memory is locked as cosmicd locks it, so no page fault delays a step.
+void apply_step_policy(const Arguments& args, cosmic::Logger& log) {
+  if (args.priority == 0 && args.cpus.empty()) return;
+  cosmic::ThreadPolicy policy{"fmu-step", args.priority, 0, args.cpus};
+  for (const auto& why : cosmic::apply_thread_policy(policy))
+    log.log(cosmic::LogLevel::warning, "the step thread runs without " + why);
+  if (args.priority > 0 && ::mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
+    log.log(cosmic::LogLevel::warning, "memory not locked (mlockall: " + cosmic::errno_text(errno) + ")");
+}
 
 // A duration option's value, or a usage error naming the option.
 cosmic::Nanos duration_option(const std::string& option, const std::string& text) {
@@ -101,6 +117,7 @@ int run(const Arguments& args, cosmic::Nanos report_interval, cosmic::Nanos read
     reporting.socket = args.no_report ? "" : !args.socket.empty() ? args.socket : config.gateway.control_socket;
     reporting.interval = std::chrono::duration_cast<std::chrono::milliseconds>(report_interval);
     cosmic_fmu::StatusReporter reporter(*runner.value(), reporting, log);
+    apply_step_policy(args, log);
     result = runner.value()->run(g_stop);
     log.log(result ? cosmic::LogLevel::info : cosmic::LogLevel::error,
             "fmu " + spec->name + " " + cosmic_fmu::summary_line(spec->step, runner.value()->status()));
@@ -135,6 +152,12 @@ int main(int argc, char** argv) {
   app.add_option("--trace", args.trace, "Write every step's inputs and outputs to this CSV file");
   app.add_option("--can-node", args.can_node, "TxNode on a CAN segment (0-127; default after the components')")
       ->check(CLI::Range(0, 127));
+  app.add_option("--priority", args.priority, "SCHED_FIFO priority of the step thread (1-99; 0: time-shared)")
+      ->check(CLI::Range(0, 99))
+      ->capture_default_str();
+  app.add_option("--cpus", args.cpus, "CPUs the step thread may run on (comma-separated; default any)")
+      ->delimiter(',')
+      ->check(CLI::Range(0, 1023));
   app.add_option("-l,--log-level", args.log_level, "debug, info, notice, warning or error")
       ->check(CLI::IsMember({"debug", "info", "notice", "warning", "error"}))
       ->capture_default_str();

@@ -13,6 +13,7 @@
 #     stays at 0 and fails, a lost setpoint leaves drive at 0;
 #   - the runners' status lines count their steps (and the skipped input events), and cosmicd
 #     counts the events it forwarded for them;
+#   - unpaced (--pace free), the steps run back to back with none late and the FMU's time advancing;
 #   - a doStep that fails (EveryType's `fail` input, set by an event) stops its runner with exit
 #     code 1 and the FMU's own message in the log.
 #   fmu_loop_test.sh COSMICD COSMICCTL COSMIC_FMU COSMIC_LCM_PEER FMU_DIR LOOP_REFERENCE
@@ -133,7 +134,15 @@ grep -q "stopped: $((STEPS + 200)) steps of 10 ms" "$WORK/controller.log" ||
 field_at_least loop speed lan tx 100 || fail "cosmicd forwarded $(channel_field loop speed lan tx) speed events to the controller"
 field_at_least loop drive viz tx 100 || fail "cosmicd forwarded $(channel_field loop drive viz tx) drive events to the plant"
 
-# 2. A doStep that fails stops the runner with the FMU's own words.
+# 2. Unpaced (--pace free, as against a replay): the steps run back to back, none is late, and the
+#    FMU's time still advances by the step (2000 steps: t = 20 s at the end, in far less wall time).
+"$COSMIC_FMU" --config "$WORK/loop.yaml" --name plant --pace free --steps 2000 --no-report --work-dir "$WORK" \
+  --trace "$WORK/free.csv" 2>"$WORK/free.log" || fail "the unpaced runner failed: $(tail -n 3 "$WORK/free.log")"
+[ "$(tail -n 1 "$WORK/free.csv" | cut -d, -f1,2)" = "1999,20" ] || fail "unpaced trace ends with $(tail -n 1 "$WORK/free.csv")"
+grep -q "stopped: 2000 steps of 10 ms, 0 late" "$WORK/free.log" || fail "unpaced status: $(tail -n 1 "$WORK/free.log")"
+grep -q "unpaced" "$WORK/free.log" || fail "the unpaced runner does not say so"
+
+# 3. A doStep that fails stops the runner with the FMU's own words.
 "$COSMIC_FMU" --config "$WORK/loop.yaml" --name every --socket "$WORK/loop.sock" --work-dir "$WORK" \
   --trace "$WORK/every.csv" 2>"$WORK/every.log" &
 EVERY=$!
