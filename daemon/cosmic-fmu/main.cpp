@@ -25,14 +25,6 @@ std::atomic<bool> g_stop{false};  // set by SIGINT / SIGTERM; the step loop look
 
 void on_stop_signal(int) { g_stop.store(true); }
 
-cosmic::LogLevel parse_level(const std::string& text) {
-  if (text == "debug") return cosmic::LogLevel::debug;
-  if (text == "notice") return cosmic::LogLevel::notice;
-  if (text == "warning") return cosmic::LogLevel::warning;
-  if (text == "error") return cosmic::LogLevel::error;
-  return cosmic::LogLevel::info;
-}
-
 struct Arguments {
   std::string config;
   std::string name;
@@ -78,7 +70,7 @@ unsigned default_can_node(const cosmic::Config& config, const cosmic::FmuSpec& s
 }
 
 int run(const Arguments& args, cosmic::Nanos report_interval, cosmic::Nanos ready_timeout) {
-  cosmicd::DaemonLogger log(parse_level(args.log_level));
+  cosmicd::DaemonLogger log(cosmicd::parse_log_level(args.log_level));
   const cosmic::ConfigResult loaded = cosmic::load_config_file(args.config);
   if (!loaded.errors.empty()) {
     for (const auto& e : loaded.errors) log.log(cosmic::LogLevel::error, e.to_string());
