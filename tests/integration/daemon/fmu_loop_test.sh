@@ -13,6 +13,7 @@
 #     stays at 0 and fails, a lost setpoint leaves drive at 0;
 #   - the runners' status lines count their steps (and the skipped input events), and cosmicd
 #     counts the events it forwarded for them;
+#   - `cosmicctl diagram` draws each FMU as a component, with its step;
 #   - unpaced (--pace free), the steps run back to back with none late and the FMU's time advancing;
 #   - a doStep that fails (EveryType's `fail` input, set by an event) stops its runner with exit
 #     code 1 and the FMU's own message in the log.
@@ -86,6 +87,15 @@ fmus:
     outputs: {real_out: echoed.real}
 YAML
 start_daemon loop "$WORK/loop.yaml" || exit 1
+
+# 0. The Event-Channel Diagram draws the FMUs as the components they are: the plant publishes speed
+#    on viz (no bare segment node for it), with its step.
+"$COSMICCTL" diagram --format dot "$WORK/loop.yaml" >"$WORK/loop.dot" || fail "cosmicctl diagram exited $?"
+grep -q '"P_component_plant" .*class="component fmu publisher", label="plant\\n(FMU, 10 ms)"' "$WORK/loop.dot" ||
+  fail "the diagram does not draw the plant FMU: $(grep plant "$WORK/loop.dot" | head -n 2)"
+grep -q '"P_component_plant" -> "channel_speed"' "$WORK/loop.dot" || fail "no P edge from the plant FMU to speed"
+grep -q 'segment viz (lcm) publishes command, fault (no modelled component)' "$WORK/loop.dot" ||
+  fail "the diagram's bare viz segment: $(grep P_segment_viz "$WORK/loop.dot" | head -n 1)"
 
 # 1. The loop: both runners, then the setpoint (1.0 m/s, every 100 ms) from an LCM peer.
 "$COSMIC_FMU" --config "$WORK/loop.yaml" --name plant --steps $((STEPS + 200)) --trace "$WORK/plant.csv" \
