@@ -1,6 +1,7 @@
 # The Debian packages: `cpack -G DEB` in the build directory writes, as Debian splits a project,
-#   cosmic-gateway_VERSION_ARCH.deb         cosmicd, cosmicctl, the unit, sysusers file, example
-#                                           configuration (a conffile), manual pages, bash completion
+#   cosmic-gateway_VERSION_ARCH.deb         cosmicd, cosmicctl, cosmic-fmu, the units, sysusers file,
+#                                           example configuration (a conffile), manual pages, bash
+#                                           completions
 #   libcosmic-client0_VERSION_ARCH.deb      libcosmic-client.so.0 (the runtime library of components)
 #   libcosmic-client-dev_VERSION_ARCH.deb   headers, libcosmic-client.so, cosmic-client.pc, the CMake
 #                                           package cosmic_client: what building a component needs
@@ -29,7 +30,9 @@ set(CPACK_DEBIAN_GATEWAY_PACKAGE_NAME cosmic-gateway)
 set(CPACK_COMPONENT_GATEWAY_DESCRIPTION "${CPACK_PACKAGE_DESCRIPTION_SUMMARY}
  cosmicd forwards COSMIC event channels between SocketCAN buses, Fast DDS domains and LCM
  multicast groups, with admission and QoS-mismatch checks on every binding; cosmicctl inspects
- and steers it, checks configurations offline and generates component skeletons.")
+ and steers it, checks configurations offline and generates component skeletons; cosmic-fmu runs
+ a co-simulation FMU (FMI 2.0 or 3.0) of the configuration as a component on its channels, one
+ per instance of the unit cosmic-fmu@.service.")
 set(CPACK_DEBIAN_GATEWAY_PACKAGE_CONTROL_EXTRA
   "${PROJECT_SOURCE_DIR}/systemd/debian/postinst;${PROJECT_SOURCE_DIR}/systemd/debian/prerm;${PROJECT_SOURCE_DIR}/systemd/debian/postrm;${PROJECT_SOURCE_DIR}/systemd/debian/conffiles")
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `cpack -G DEB` builds installable packages (issue 5, item 8; split as Debian does in issue 23,
-# item 7): cosmic-gateway holds the binaries, the unit, the sysusers file, the example
-# configuration (a conffile), the manual pages and the bash completion; libcosmic-client0 the
+# item 7): cosmic-gateway holds the binaries, the units, the sysusers file, the example
+# configuration (a conffile), the manual pages and the bash completions (cosmic-fmu's with its
+# template unit, man page and docs/fmu.md too, issue 38); libcosmic-client0 the
 # shared library (with a shlibs file), libcosmic-client-dev what building a component needs,
 # python3-cosmic the Python package; every binary is stripped and its debug symbols are in the
 # PACKAGE-dbgsym .ddeb under its build id. Every package's Depends (dpkg-shlibdeps) cover every
@@ -53,14 +54,19 @@ expect_entry() {  # expect_entry MODE PATH
 }
 expect_entry -rwxr-xr-x /usr/sbin/cosmicd
 expect_entry -rwxr-xr-x /usr/bin/cosmicctl
+expect_entry -rwxr-xr-x /usr/bin/cosmic-fmu
 expect_entry -rw-r--r-- /usr/lib/systemd/system/cosmicd.service
+expect_entry -rw-r--r-- /usr/lib/systemd/system/cosmic-fmu@.service
 expect_entry -rw-r--r-- /usr/lib/sysusers.d/cosmic.conf
 expect_entry -rw-r--r-- /etc/cosmic/cosmicd.yaml
 expect_entry -rw-r--r-- /usr/share/doc/cosmic-gateway/operations.md
 expect_entry -rw-r--r-- /usr/share/doc/cosmic-gateway/examples/overloaded.yaml
 expect_entry -rw-r--r-- /usr/share/man/man8/cosmicd.8.gz
 expect_entry -rw-r--r-- /usr/share/man/man1/cosmicctl.1.gz
+expect_entry -rw-r--r-- /usr/share/man/man1/cosmic-fmu.1.gz
 expect_entry -rw-r--r-- /usr/share/bash-completion/completions/cosmicctl
+expect_entry -rw-r--r-- /usr/share/bash-completion/completions/cosmic-fmu
+expect_entry -rw-r--r-- /usr/share/doc/cosmic-gateway/fmu.md
 strays=$(awk '{ print $6 }' "$WORK/contents" | grep -vE '^\./(etc/|etc/cosmic/.*|usr/.*)$')
 [ -z "$strays" ] || fail "files outside /etc/cosmic and /usr: $strays"
 
@@ -69,6 +75,7 @@ field() { dpkg-deb -f "$DEB" "$1"; }
 [ "$(field Package)" = cosmic-gateway ] || fail "Package: $(field Package)"
 [ "$(field Version)" = "$VERSION" ] || fail "Version: $(field Version), expected $VERSION"
 [ "$(field Architecture)" = "$ARCH" ] || fail "Architecture: $(field Architecture), expected $ARCH"
+field Description | grep -q "cosmic-fmu runs" || fail "the Description does not mention cosmic-fmu: $(field Description)"
 DEPENDS=$(field Depends)
 [ -n "$DEPENDS" ] || fail "no Depends"
 # Every library each binary of each package links directly (DT_NEEDED) comes from a package that
@@ -191,8 +198,8 @@ if ! dpkg_root -i "$DEB" >"$WORK/install.log" 2>&1; then
   sed 's/^/    /' "$WORK/install.log" >&2
 fi
 dpkg_root -s cosmic-gateway 2>/dev/null | grep -q '^Status: install ok installed$' || fail "the package is not installed in the scratch root"
-for f in /usr/sbin/cosmicd /usr/bin/cosmicctl /usr/lib/systemd/system/cosmicd.service \
-         /usr/lib/sysusers.d/cosmic.conf /etc/cosmic/cosmicd.yaml; do
+for f in /usr/sbin/cosmicd /usr/bin/cosmicctl /usr/bin/cosmic-fmu /usr/lib/systemd/system/cosmicd.service \
+         /usr/lib/systemd/system/cosmic-fmu@.service /usr/lib/sysusers.d/cosmic.conf /etc/cosmic/cosmicd.yaml; do
   [ -f "$ROOT$f" ] || fail "$f not installed"
 done
 grep -q '^cosmic:' "$ROOT/etc/passwd" 2>/dev/null || fail "postinst did not create the user cosmic in the root"
@@ -204,6 +211,7 @@ done
 "$ROOT/usr/bin/cosmicctl" check "$ROOT/etc/cosmic/cosmicd.yaml" >"$WORK/check.out" 2>&1 ||
   { fail "the installed cosmicctl does not accept the installed configuration"; sed 's/^/    /' "$WORK/check.out" >&2; }
 "$ROOT/usr/sbin/cosmicd" --help >/dev/null 2>&1 || fail "the installed cosmicd does not run"
+"$ROOT/usr/bin/cosmic-fmu" --help >/dev/null 2>&1 || fail "the installed cosmic-fmu does not run"
 
 note "reinstall keeps a changed configuration (conffile)"
 echo "# changed by the operator" >>"$ROOT/etc/cosmic/cosmicd.yaml"
@@ -217,6 +225,7 @@ note "remove, then purge"
 mkdir -p "$ROOT/var/lib/cosmicd" && echo '{}' >"$ROOT/var/lib/cosmicd/bindings.json"
 dpkg_root -r cosmic-gateway >"$WORK/remove.log" 2>&1 || { fail "dpkg -r failed"; sed 's/^/    /' "$WORK/remove.log" >&2; }
 [ -e "$ROOT/usr/sbin/cosmicd" ] && fail "dpkg -r left /usr/sbin/cosmicd"
+[ -e "$ROOT/usr/bin/cosmic-fmu" ] && fail "dpkg -r left /usr/bin/cosmic-fmu"
 [ -f "$ROOT/etc/cosmic/cosmicd.yaml" ] || fail "dpkg -r removed the conffile (only purge should)"
 dpkg_root -P cosmic-gateway >"$WORK/purge.log" 2>&1 || { fail "dpkg -P failed"; sed 's/^/    /' "$WORK/purge.log" >&2; }
 [ -e "$ROOT/etc/cosmic" ] && fail "purge left /etc/cosmic"
