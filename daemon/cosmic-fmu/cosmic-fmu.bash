@@ -5,7 +5,7 @@
 # components:), --pace and --log-level to their choices, --work-dir to directories, --socket and
 # --trace to files. Needs nothing from the bash-completion package.
 
-_cosmic_fmu_options="--can-node --config --help --log-level --name --no-report --pace --ready-timeout --report-interval --socket --steps --trace --version --work-dir"
+_cosmic_fmu_options="--can-node --config --cpus --help --log-level --name --no-report --pace --priority --ready-timeout --report-interval --socket --steps --trace --version --work-dir"
 
 # The names of the fmus: section of a YAML file (both `- name: x` and `- {name: x, ...}`).
 _cosmic_fmu_names() {
@@ -46,7 +46,7 @@ _cosmic_fmu() {
       compopt -o filenames 2>/dev/null
       mapfile -t COMPREPLY < <(compgen -f -- "$cur")
       return ;;
-    --steps | --report-interval | --ready-timeout | --can-node)
+    --steps | --report-interval | --ready-timeout | --can-node | --priority | --cpus)
       return ;;
   esac
   mapfile -t COMPREPLY < <(compgen -W "$_cosmic_fmu_options" -- "$cur")
