@@ -48,10 +48,18 @@ const std::vector<std::string>& segments_of(const cosmic::ChannelSpec& channel, 
   return side == Side::publisher ? channel.publishers : channel.subscribers;
 }
 
+// The model's components with its FMUs among them (an FMU is a component that publishes its output
+// channels and subscribes its input channels; docs/fmu.md), in the file's order: components first.
+std::vector<cosmic::ComponentSpec> drawn_components(const cosmic::Config& config) {
+  std::vector<cosmic::ComponentSpec> out = config.components;
+  for (const auto& f : config.fmus) out.push_back({f.name, f.segment, f.publishes(), f.subscribes()});
+  return out;
+}
+
 class DotWriter {
  public:
   DotWriter(const cosmic::Config& config, const DiagramStatus& status, DiagramDetail detail)
-      : config_(config), status_(status), detail_(detail) {}
+      : config_(config), status_(status), detail_(detail), components_(drawn_components(config)) {}
 
   std::string write(const std::string& title) {
     out_ << "digraph event_channels {\n"
@@ -85,10 +93,9 @@ class DotWriter {
 
   // Whether a modelled component on `segment` accounts for the channel's P (or S) tag there.
   bool covered(const cosmic::ChannelSpec& c, const std::string& segment, Side side) const {
-    return std::any_of(config_.components.begin(), config_.components.end(),
-                       [&](const cosmic::ComponentSpec& component) {
-                         return component.segment == segment && lists(channels_of(component, side), c.name);
-                       });
+    return std::any_of(components_.begin(), components_.end(), [&](const cosmic::ComponentSpec& component) {
+      return component.segment == segment && lists(channels_of(component, side), c.name);
+    });
   }
 
   // The channels with a tag on `segment` that no component accounts for.
@@ -111,7 +118,7 @@ class DotWriter {
   // the segment that no component accounts for, the segment itself.
   void write_cluster(const cosmic::SegmentSpec& s, Side side) {
     std::vector<const cosmic::ComponentSpec*> components;
-    for (const auto& c : config_.components) {
+    for (const auto& c : components_) {
       if (c.segment == s.name && drawn_on(c, side)) components.push_back(&c);
     }
     const std::vector<std::string> uncovered = uncovered_channels(s.name, side);
@@ -125,9 +132,15 @@ class DotWriter {
     for (const auto* c : components) {
       const std::string node = component_id(side, c->name);
       column.push_back(node);
-      out_ << "    " << node << " [shape=box, style=\"rounded,filled\", fillcolor=\"#fff8e1\", class=\"component "
-           << role(side) << "\", label=\"" << c->name
-           << "\", tooltip=" << dot_string({c->name + " on " + segment + verb + joined(channels_of(*c, side))})
+      const cosmic::FmuSpec* fmu = fmu_named(c->name);
+      // An FMU: its own fill, "FMU, step" under its name, the model and version in its tooltip.
+      const std::string kind = fmu ? "FMU " + fmu->model_identifier + " (FMI " + fmu->fmi_version + "), step " +
+                                         cosmic::format_duration(fmu->step) + ", "
+                                   : "";
+      out_ << "    " << node << " [shape=box, style=\"rounded,filled\", fillcolor=\"" << (fmu ? "#f3e5f5" : "#fff8e1")
+           << "\", class=\"" << (fmu ? "component fmu " : "component ") << role(side) << "\", label=\"" << c->name
+           << (fmu ? "\\n(FMU, " + cosmic::format_duration(fmu->step) + ")" : "")
+           << "\", tooltip=" << dot_string({kind + c->name + " on " + segment + verb + joined(channels_of(*c, side))})
            << "];\n";
     }
     if (!uncovered.empty()) {
@@ -155,7 +168,7 @@ class DotWriter {
   // that leave, as in Fig. 6: the tags sit around the channel, not halfway along the edges.
   void write_edges(const cosmic::ChannelSpec& c) {
     const std::string node = channel_id(c.name);
-    for (const auto& component : config_.components) {
+    for (const auto& component : components_) {
       if (lists(component.publishes, c.name)) {
         edge(component_id(Side::publisher, component.name), node, Side::publisher,
              component.name + " publishes " + c.name + " on " + component.segment);
@@ -165,7 +178,7 @@ class DotWriter {
       if (!covered(c, s, Side::publisher))
         edge(segment_id(Side::publisher, s), node, Side::publisher, c.name + " is published on " + s);
     }
-    for (const auto& component : config_.components) {
+    for (const auto& component : components_) {
       if (lists(component.subscribes, c.name)) {
         edge(node, component_id(Side::subscriber, component.name), Side::subscriber,
              component.name + " subscribes " + c.name + " on " + component.segment);
@@ -192,9 +205,16 @@ class DotWriter {
     out_ << " }\n";
   }
 
+  const cosmic::FmuSpec* fmu_named(const std::string& name) const {
+    const auto it =
+        std::find_if(config_.fmus.begin(), config_.fmus.end(), [&](const auto& f) { return f.name == name; });
+    return it == config_.fmus.end() ? nullptr : &*it;
+  }
+
   const cosmic::Config& config_;
   const DiagramStatus& status_;
   const DiagramDetail detail_;
+  const std::vector<cosmic::ComponentSpec> components_;
   std::vector<std::string> publisher_nodes_;
   std::vector<std::string> channel_nodes_;
   std::vector<std::string> subscriber_nodes_;

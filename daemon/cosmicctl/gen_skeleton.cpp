@@ -147,21 +147,6 @@ cosmic::Result<void> check_identifiers(const cosmic::Config& config, const cosmi
   return {};
 }
 
-std::string client_segment(const cosmic::SegmentSpec& s, unsigned can_node) {
-  switch (s.type) {
-    case cosmic::SegmentType::dds:
-      return "dds:" + std::to_string(s.dds.domain) +
-             (s.reliability == cosmic::Reliability::best_effort ? "?reliability=best_effort" : "");
-    case cosmic::SegmentType::lcm:
-      return "lcm:" + s.lcm.url;
-    case cosmic::SegmentType::can:
-      return "can:" + s.can.interface + "?node=" + std::to_string(can_node);
-    case cosmic::SegmentType::replay:  // the configuration refuses components there
-      break;
-  }
-  return "";
-}
-
 Skeleton generate_skeleton(const cosmic::Config& config, const cosmic::ComponentSpec& component,
                            const std::string& model_file, const std::string& client_config_dir) {
   const std::string cls = camel(component.name);
@@ -180,7 +165,7 @@ Skeleton generate_skeleton(const cosmic::Config& config, const cosmic::Component
       // item 4): the model's path goes into comments, the segment string into a literal.
       {"MODEL", comment_text(model_file)},
       {"SEGMENT", component.segment},
-      {"CLIENT_SEGMENT", literal_text(client_segment(*config.find_segment(component.segment), node))},
+      {"CLIENT_SEGMENT", literal_text(cosmic::client_segment(*config.find_segment(component.segment), node))},
       {"CLIENT_CONFIG_DIR", client_config_dir},
       {"DESCS", p.descs},
       {"ALL", p.all},

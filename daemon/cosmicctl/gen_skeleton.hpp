@@ -33,7 +33,4 @@ Skeleton generate_skeleton(const cosmic::Config& config, const cosmic::Component
 // in '-', '.' or '_' would become one C++ identifier (issue 22, item 5). nullopt when none.
 cosmic::Result<void> check_identifiers(const cosmic::Config& config, const cosmic::ComponentSpec& component);
 
-// How a component on `segment` opens it with cosmic_open() (CAN: TxNode `can_node`).
-std::string client_segment(const cosmic::SegmentSpec& segment, unsigned can_node);
-
 }  // namespace cosmicctl

@@ -36,14 +36,6 @@ std::uint64_t random_gateway_id() {
   return id;
 }
 
-cosmic::LogLevel parse_level(const std::string& text) {
-  if (text == "debug") return cosmic::LogLevel::debug;
-  if (text == "notice") return cosmic::LogLevel::notice;
-  if (text == "warning") return cosmic::LogLevel::warning;
-  if (text == "error") return cosmic::LogLevel::error;
-  return cosmic::LogLevel::info;
-}
-
 // The absolute directory of the state file (a relative --state-file is the working directory's).
 std::string directory_of(const std::string& file) {
   std::error_code failed;
@@ -87,7 +79,7 @@ class Daemon {
  public:
   explicit Daemon(const DaemonOptions& options)
       : options_(options),
-        log_(parse_level(options.log_level)),
+        log_(parse_log_level(options.log_level)),
         state_file_(options.state_file.empty() ? default_state_file() : options.state_file),
         adapters_(directory_of(state_file_),
                   [this](const cosmic::SegmentSpec& segment) { return recording_.wire_tap(segment); }),

@@ -6,6 +6,14 @@
 #include <cstdlib>
 
 namespace cosmicd {
+
+cosmic::LogLevel parse_log_level(const std::string& text) {
+  if (text == "debug") return cosmic::LogLevel::debug;
+  if (text == "notice") return cosmic::LogLevel::notice;
+  if (text == "warning") return cosmic::LogLevel::warning;
+  if (text == "error") return cosmic::LogLevel::error;
+  return cosmic::LogLevel::info;
+}
 namespace {
 
 constexpr std::size_t kMaxTrackedMessages = 256;

@@ -19,6 +19,10 @@ class logger;
 
 namespace cosmicd {
 
+// "debug", "notice", "warning", "error" as their level; anything else (the command lines check
+// the word) info.
+cosmic::LogLevel parse_log_level(const std::string& text);
+
 class DaemonLogger final : public cosmic::Logger {
  public:
   explicit DaemonLogger(cosmic::LogLevel threshold, std::chrono::milliseconds repeat_window = std::chrono::seconds(1));

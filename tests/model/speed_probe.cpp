@@ -9,6 +9,10 @@
 // drive. T1 - T0 is the end-to-end reaction (sensor -> gateway -> controller -> gateway -> drive).
 // Last, an obstacle: a new command must then give speed 0 (Fig. 8's refresh_ns) within --stop-s
 // (default 5). --ready-s (default 30) bounds the wait for the chain to carry at all.
+// --controller fmu: the controller is the SpeedController FMU run by cosmic-fmu as a proportional
+// controller (speed = command - actual speed, docs/fmu.md "Demo"), which publishes every step: a
+// sample then waits for the drive to hear 0 (actual = nominal) instead of silence, T1 is the first
+// 500 after T0 as before, and there is no obstacle step (the FMU has no obstacle input).
 // Prints one line per sample and a JSON summary {"samples","p50_us","p99_us","max_us","obstacle_stop",
 // "ready_ms","stop_ms"} (ready_ms: start until the chain carried; stop_ms: the first obstacle event
 // until the drive heard 0, -1 if it did not).
@@ -22,6 +26,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cosmic/client.hpp"
@@ -98,6 +103,7 @@ double percentile(std::vector<double> v, double p) {
 
 int main(int argc, char** argv) {
   const int count = std::stoi(arg(argc, argv, "--count", "20"));
+  const bool fmu = arg(argc, argv, "--controller", "fig8") == "fmu";
   try {
     // The drive is declared before the clients and its subscription after it: the handler stops
     // first, then the drive goes, then the clients (a handler outliving the drive was issue 18).
@@ -128,8 +134,17 @@ int main(int argc, char** argv) {
     }
     std::vector<double> samples;
     for (int i = 0; i < count; ++i) {
+      const auto settle_from = Clock::now();
       actual.publish_value(kNominal);
-      if (!drive.wait_quiet(std::chrono::milliseconds(50), Clock::now() + std::chrono::seconds(2))) continue;
+      const bool settled =
+          fmu ? drive.wait_for(0, settle_from, settle_from + std::chrono::seconds(2)).has_value()
+              : drive.wait_quiet(std::chrono::milliseconds(50), Clock::now() + std::chrono::seconds(2));
+      if (!settled) continue;
+      // actual_speed's rate is 50/s (robot.yaml): the next sensor event keeps its spacing, or the
+      // gateway's rate policing drops it (Fig. 8's controller waited 50 ms for silence already).
+      // The FMU steps every 10 ms and the probe hears it at each step: T0 moves 3 ms further into
+      // the step each sample, so the samples cover every phase instead of locking onto one.
+      if (fmu) std::this_thread::sleep_until(settle_from + std::chrono::milliseconds(40 + (3 * i) % 10));
       const auto t0 = Clock::now();
       actual.publish_value(std::int32_t{0});
       if (const auto t1 = drive.wait_for(kNominal, t0, t0 + std::chrono::seconds(2))) {
@@ -143,10 +158,10 @@ int main(int argc, char** argv) {
     // events are lost, so it is repeated, with the command and a sensor value, until the drive
     // hears 0 or --stop-s have passed.
     const auto obstacle_from = Clock::now();
-    obstacle.publish_value(std::uint8_t{1});
+    if (!fmu) obstacle.publish_value(std::uint8_t{1});
     const auto stop_by = obstacle_from + std::chrono::seconds(std::stoi(arg(argc, argv, "--stop-s", "5")));
     std::optional<Clock::time_point> stopped;
-    while (!stopped && Clock::now() < stop_by) {  // the obstacle and the command arrive independently
+    while (!fmu && !stopped && Clock::now() < stop_by) {  // the obstacle and the command arrive independently
       const auto t = Clock::now();
       obstacle.publish_value(std::uint8_t{1});
       command.publish_value(kNominal);
@@ -158,7 +173,7 @@ int main(int argc, char** argv) {
               << ",\"p99_us\":" << percentile(samples, 0.99) << ",\"max_us\":" << percentile(samples, 1.0)
               << ",\"obstacle_stop\":" << (stopped ? "true" : "false") << ",\"ready_ms\":" << ms(*ready - started)
               << ",\"stop_ms\":" << (stopped ? ms(*stopped - obstacle_from) : -1) << "}" << std::endl;
-    return static_cast<int>(samples.size()) == count && stopped ? 0 : 1;
+    return static_cast<int>(samples.size()) == count && (stopped || fmu) ? 0 : 1;
   } catch (const std::exception& e) {
     std::cerr << "speed-probe: " << e.what() << "\n";
     return 1;

@@ -12,6 +12,12 @@
 #   PROOF_BUILD_ONLY=1        only generate and build the controller into PROOF_CONTROLLER_DIR
 #                             (no network namespace needed; scripts/demo builds it on the host
 #                             before running the proof inside scripts/can-vm)
+#   PROOF_FMU="RUNNER FMU"    the controller is an FMU (issue 38, docs/fmu.md "Demo"): RUNNER is
+#                             cosmic-fmu, FMU the SpeedController test FMU (a PI controller, run
+#                             proportional: speed = command - actual_speed); actual_speed, command
+#                             and speed become typed {value: int32} channels (the same 4 bytes), the
+#                             component speed_controller an `fmus:` entry with a 10 ms step. Nothing
+#                             is generated; the promise counts the step where Fig. 8 has the period
 #   PROOF_SANITIZED=1         the programs are built with a sanitizer (tests/model/CMakeLists.txt
 #                             sets it in an ASan or TSan build): everything is several times slower,
 #                             so the waits below are longer; what the proof checks stays the same
@@ -68,6 +74,9 @@ python=/usr/bin/python3
 [ -x "$python" ] || python=$(command -v python3) || { echo "speed proof: python3 not found" >&2; exit 2; }
 BODY=${PROOF_BODY:-lcm}
 SC=${PROOF_CONTROLLER_DIR:-$WORK/sc}
+read -r FMU_RUNNER FMU_FILE <<<"${PROOF_FMU:-}"
+CONTROLLER=${FMU_RUNNER:+fmu}
+CONTROLLER=${CONTROLLER:-fig8}
 body_segment="lcm:udpm://239.255.76.68:7668?ttl=0"
 # How long to wait for cosmicd, the controller and the chain to carry (WAIT_S), and from the
 # obstacle until the drive hears speed 0 (STOP_S); only a failing run waits that long. The obstacle
@@ -89,19 +98,30 @@ fi
 
 # 1. robot.yaml with its own control socket; for lcm the body bus becomes an LCM group
 #    (real-time declared, as the CAN bus would be).
-"$python" - "$ROBOT" "$WORK/robot-run.yaml" "$WORK/control.sock" "$BODY" <<'PY'
+#    With PROOF_FMU the controller's channels are typed and the controller is the FMU.
+"$python" - "$ROBOT" "$WORK/robot-run.yaml" "$WORK/control.sock" "$BODY" "$CONTROLLER" "${FMU_FILE:-}" <<'PY'
 import re, sys
 text = open(sys.argv[1]).read()
 if sys.argv[4] == "lcm":
   text = re.sub(r"  - name: body-can\n    type: can\n(    .*\n)+?(?=  - name:)",
                 "  - name: body-can\n    type: lcm\n    url: udpm://239.255.76.68:7668?ttl=0\n    latency_bound: 1ms\n    realtime: true\n", text)
 text = re.sub(r"control_socket: .*", "control_socket: " + sys.argv[3], text)
+if sys.argv[5] == "fmu":
+  for channel in ("speed", "command", "actual_speed"):
+    text = re.sub(r"(  - name: %s\n(    .*\n)*?)    payload: 4B\n" % channel,
+                  r"\1    type: {fields: [{name: value, type: int32, unit: mm/s}]}\n", text, count=1)
+  text = re.sub(r"  - name: speed_controller .*\n(    .*\n)+", "", text)
+  text += ("fmus:\n  - name: speed_controller\n    fmu: %s\n    segment: lan\n    step: 10ms\n"
+           "    inputs: {speed: actual_speed.value, setpoint: command.value}\n    outputs: {drive: speed.value}\n"
+           "    parameters: {kp: 1, ki: 0, drive_min: -1000, drive_max: 1000}\n" % sys.argv[6])
 open(sys.argv[2], "w").write(text)
 PY
 "$COSMICCTL" --json check "$WORK/robot-run.yaml" >"$WORK/check.json"
 
 # 2. Generate, fill in Fig. 8, build as its own CMake project.
-if [ "${PROOF_PREBUILT:-0}" = 1 ]; then
+if [ "$CONTROLLER" = fmu ]; then
+  : # nothing to generate: cosmic-fmu runs the FMU the configuration names
+elif [ "${PROOF_PREBUILT:-0}" = 1 ]; then
   [ -x "$SC/build/speed_controller" ] || fail "no controller built in $SC (run the lcm proof first)"
 else
   "$COSMICCTL" gen "$ROBOT" --component speed_controller --output "$SC" 2>"$WORK/gen.log" || fail "gen: $(cat "$WORK/gen.log")"
@@ -123,11 +143,20 @@ PIDS+=($!) NAMES+=(cosmicd) LOGS+=("$WORK/cosmicd.log")
 # to start in the VM, so it asks once the socket is there instead of polling.
 wait_until "$WAIT_S" "cosmicd's control socket" test -S "$WORK/control.sock"
 wait_until "$WAIT_S" "cosmicd" "$COSMICCTL" --socket "$WORK/control.sock" status
-"$SC/build/speed_controller" --check "$WORK/control.sock" >"$WORK/sc.out" 2>&1 &
-PIDS+=($!) NAMES+=(speed_controller) LOGS+=("$WORK/sc.out")
-wait_until "$WAIT_S" "speed_controller ready" grep -q "speed_controller: ready on dds:0" "$WORK/sc.out"
-echo "speed_controller asked cosmicd:"; grep -v ready "$WORK/sc.out" | sed 's/^/  /'
-"$PROBE" --body "$body_segment" --lan dds:0 --count "$COUNT" --ready-s "$WAIT_S" --stop-s "$STOP_S" >"$WORK/probe.out" 2>&1
+if [ "$CONTROLLER" = fmu ]; then
+  "$FMU_RUNNER" --config "$WORK/robot-run.yaml" --name speed_controller --work-dir "$WORK" \
+    --report-interval 200ms >"$WORK/sc.out" 2>&1 &
+  PIDS+=($!) NAMES+=(speed_controller) LOGS+=("$WORK/sc.out")
+  wait_until "$WAIT_S" "the speed_controller FMU stepping" grep -q "initialized on segment lan" "$WORK/sc.out"
+  grep "initialized" "$WORK/sc.out" | sed 's/^.* info //; s/^/  /'
+else
+  "$SC/build/speed_controller" --check "$WORK/control.sock" >"$WORK/sc.out" 2>&1 &
+  PIDS+=($!) NAMES+=(speed_controller) LOGS+=("$WORK/sc.out")
+  wait_until "$WAIT_S" "speed_controller ready" grep -q "speed_controller: ready on dds:0" "$WORK/sc.out"
+  echo "speed_controller asked cosmicd:"; grep -v ready "$WORK/sc.out" | sed 's/^/  /'
+fi
+"$PROBE" --body "$body_segment" --lan dds:0 --count "$COUNT" --ready-s "$WAIT_S" --stop-s "$STOP_S" \
+  --controller "$CONTROLLER" >"$WORK/probe.out" 2>&1
 probe_status=$?
 cat "$WORK/probe.out" | grep -v '^sample' | sed 's/^/probe: /'
 check_running
@@ -135,19 +164,21 @@ check_running
 "$COSMICCTL" --socket "$WORK/control.sock" diagram "$ROBOT" >"$WORK/live.svg" || fail "live diagram"
 grep -q "forwarded" "$WORK/live.svg" || fail "the live diagram has no counters"
 
-# 4. Measured against promised: actual_speed's end-to-end bound + one controller period + speed's.
-"$python" - "$WORK/check.json" "$(tail -1 "$WORK/probe.out")" <<'PY'
+# 4. Measured against promised: actual_speed's end-to-end bound + one controller period (the FMU's
+#    step: an event waits at most one step to be taken, and the step publishes) + speed's.
+"$python" - "$WORK/check.json" "$(tail -1 "$WORK/probe.out")" "$CONTROLLER" <<'PY'
 import json, os, sys
 report = {c["name"]: c for c in json.load(open(sys.argv[1]))["channels"]}
 measured = json.loads(sys.argv[2])
 e2e = lambda n: report[n]["end_to_end"]["latency_s"] * 1e6
-period = 10_000  # speed's period in robot.yaml: the controller publishes at most this late
+period = 10_000  # speed's period in robot.yaml (the FMU's step): the controller publishes at most this late
 promised = e2e("actual_speed") + period + e2e("speed")
 print(f"{'':34} {'p50':>9} {'p99':>9} {'max':>9}")
 print(f"{'measured sensor -> drive (us)':34} {measured['p50_us']:9.0f} {measured['p99_us']:9.0f} {measured['max_us']:9.0f}   ({measured['samples']} samples)")
 print(f"{'promised (us)':34} {'':>9} {'':>9} {promised:9.0f}   = actual_speed {e2e('actual_speed'):.0f} + period {period} + speed {e2e('speed'):.0f}")
-print(f"obstacle: speed 0 sent to the drive {measured['stop_ms']:.0f} ms after the first obstacle event"
-      if measured["obstacle_stop"] else "obstacle: no stop")
+if sys.argv[3] == "fig8":
+  print(f"obstacle: speed 0 sent to the drive {measured['stop_ms']:.0f} ms after the first obstacle event"
+        if measured["obstacle_stop"] else "obstacle: no stop")
 # The verdict on the worst case (a figure, not a pass/fail test: the proof checks that the chain
 # carries every step; timing in the emulated CAN VM is not a host's).
 if measured["max_us"] <= promised:
@@ -173,5 +204,6 @@ stop_cleanly() {  # stop_cleanly INDEX: the program PIDS[INDEX]
   [ "$status" -eq 0 ] || ended "${NAMES[$1]}" "$status" "${LOGS[$1]}"
 }
 stop_cleanly 1  # the controller, then cosmicd
+[ "$CONTROLLER" = fig8 ] || grep "stopped:" "$WORK/sc.out" | sed 's/^.* info fmu /runner: /'
 stop_cleanly 0
 PIDS=()

@@ -14,5 +14,6 @@ extern const char* const lcm_logger;           // Debian's lcm-logger ("" when n
 extern const char* const client_config_dir;    // the build tree's cosmic_client CMake package
 extern const char* const cosmicctl_build_dir;  // where cosmicctl is built
 extern const char* const fmi_test_model;       // the shared library of the tests' FMUs (tests/unit/fmi)
+extern const char* const test_fmu_dir;  // the test FMUs built from tests/fmi_models: NAME-fmi2.fmu, NAME-fmi3.fmu
 
 }  // namespace cosmic::build_paths

@@ -133,4 +133,19 @@ std::vector<std::string> channels_of(const std::vector<FmuVariableMapping>& mapp
 std::vector<std::string> FmuSpec::publishes() const { return channels_of(outputs); }
 std::vector<std::string> FmuSpec::subscribes() const { return channels_of(inputs); }
 
+std::string client_segment(const SegmentSpec& s, unsigned can_node) {
+  switch (s.type) {
+    case SegmentType::dds:
+      return "dds:" + std::to_string(s.dds.domain) +
+             (s.reliability == Reliability::best_effort ? "?reliability=best_effort" : "");
+    case SegmentType::lcm:
+      return "lcm:" + s.lcm.url;
+    case SegmentType::can:
+      return "can:" + s.can.interface + "?node=" + std::to_string(can_node);
+    case SegmentType::replay:
+      break;
+  }
+  return "";
+}
+
 }  // namespace cosmic

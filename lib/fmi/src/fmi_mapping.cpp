@@ -166,3 +166,31 @@ std::string parameter_problem(const Variable& v, const FmuDescription& d, std::s
 }
 
 }  // namespace cosmic::fmi
+
+namespace cosmic::fmi {
+
+Result<VariableValue> parse_value(const Variable& v, const FmuDescription& d, std::string_view text) {
+  if (std::string why = parameter_problem(v, d, text); !why.empty()) return Error{std::move(why)};
+  if (is_float(v.type)) return VariableValue(*parsed_number<double>(text));
+  if (is_integer(v.type)) {
+    const bool is_unsigned = v.type == VariableType::uint8 || v.type == VariableType::uint16 ||
+                             v.type == VariableType::uint32 || v.type == VariableType::uint64;
+    if (is_unsigned) return VariableValue(*parsed_number<std::uint64_t>(text));
+    return VariableValue(*parsed_number<std::int64_t>(text));
+  }
+  switch (v.type) {
+    case VariableType::boolean:
+      return VariableValue(text == "true");
+    case VariableType::enumeration: {
+      if (const auto value = parsed_number<std::int64_t>(text)) return VariableValue(*value);
+      for (const auto& item : *items_of(v, d))
+        if (item.name == text) return VariableValue(item.value);
+      break;
+    }
+    default:
+      break;
+  }
+  return VariableValue(std::string(text));
+}
+
+}  // namespace cosmic::fmi

@@ -488,4 +488,9 @@ struct Config {
   const ChannelSpec* find_channel(const std::string& name) const;
 };
 
+// How a component on `segment` opens it with libcosmic-client's cosmic_open(): "dds:DOMAIN"
+// (with "?reliability=best_effort" on such a segment), "lcm:URL", "can:IFACE?node=N" (TxNode
+// `can_node`); empty for a replay segment, where no component lives.
+std::string client_segment(const SegmentSpec& segment, unsigned can_node);
+
 }  // namespace cosmic

@@ -10,6 +10,7 @@
 
 #include "cosmic/channel_type.hpp"
 #include "cosmic/fmi_description.hpp"
+#include "cosmic/fmi_values.hpp"
 
 namespace cosmic::fmi {
 

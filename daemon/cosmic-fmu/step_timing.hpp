@@ -1,0 +1,39 @@
+// How long the FMU's steps take and whether they end before their deadlines (cosmic-fmu; issue 38,
+// docs/fmu.md "Timing"). A step's time runs from taking the inputs to the last output published;
+// a step is late when it ends after the start of the next one.
+//
+// Written by the step thread, copied by the status thread under the one mutex (record() holds it
+// for a few stores, never across I/O).
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+
+#include "cosmic/mutex.hpp"
+
+namespace cosmic_fmu {
+
+struct StepTimingSnapshot {
+  std::uint64_t steps = 0;
+  std::uint64_t late_steps = 0;
+  std::chrono::nanoseconds worst{0};
+  std::chrono::nanoseconds p50{0};
+  std::chrono::nanoseconds p99{0};
+  std::chrono::nanoseconds latest_lateness{0};  // of the last late step: how far past its deadline it ended
+};
+
+class StepTiming {
+ public:
+  void record(std::chrono::nanoseconds took, bool late, std::chrono::nanoseconds lateness);
+  StepTimingSnapshot snapshot() const;
+
+ private:
+  // The last kKept step times, for the percentiles of what the FMU does now.
+  static constexpr std::size_t kKept = 4096;
+  mutable cosmic::Mutex mutex_;
+  std::array<std::int64_t, kKept> recent_ COSMIC_GUARDED_BY(mutex_){};
+  StepTimingSnapshot totals_ COSMIC_GUARDED_BY(mutex_);
+};
+
+}  // namespace cosmic_fmu
