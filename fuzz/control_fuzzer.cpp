@@ -34,7 +34,19 @@ struct Harness {
                 log, 0x42),
         protocol(
             gateway, [] { return cosmic::parse_config(kConfig, "reload.yaml"); }, cosmic::AccessPolicy{}, log) {
-    gateway.start(cosmic::parse_config(kConfig, "fuzz.yaml").config);
+    gateway.start(with_fmu(cosmic::parse_config(kConfig, "fuzz.yaml").config));
+  }
+  // An FMU of the configuration (set in code: an fmus: entry reads its file), so fmu_report
+  // requests reach every check of a report.
+  static cosmic::Config with_fmu(cosmic::Config config) {
+    cosmic::FmuSpec fmu;
+    fmu.name = "speed_fmu";
+    fmu.fmu = "/fuzz/speed.fmu";
+    fmu.segment = "viz";
+    fmu.inputs = {{"actual_speed", "speed", "v"}};
+    fmu.fmi_version = "2.0";
+    config.fmus.push_back(std::move(fmu));
+    return config;
   }
   SilentLogger log;
   cosmic::Gateway gateway;

@@ -16,6 +16,16 @@ std::string seconds_as_micros(double seconds) {
   return buffer;
 }
 
+std::string nanos_text(const Json& ns) {
+  return ns.is_number() ? cosmic::format_duration(cosmic::Nanos(ns.get<std::int64_t>())) : std::string("-");
+}
+
+std::string age_text(double seconds) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, seconds < 10 ? "%.1fs ago" : "%.0fs ago", seconds);
+  return buffer;
+}
+
 std::string text(const Json& value) { return value.is_string() ? value.get<std::string>() : value.dump(); }
 
 bool is_utf8(const std::string& what, const std::string& text) {

@@ -12,6 +12,10 @@
 namespace cosmicctl {
 
 std::string seconds_as_micros(double seconds);
+// A count of nanoseconds as a duration ("10 ms"); "-" for anything but a number.
+std::string nanos_text(const nlohmann::json& ns);
+// Seconds as a short age: "0.4s ago", "12s ago".
+std::string age_text(double seconds);
 // A JSON value as text: a string as it is, anything else dumped.
 std::string text(const nlohmann::json& value);
 // JSON carries UTF-8 only: other bytes get a clear message (naming `what`) instead of an encoder exception.

@@ -8,7 +8,7 @@
 # unbind, echo) to the channels of the running gateway (`cosmicctl --json channels`, silent when it
 # cannot be reached). Needs nothing from the bash-completion package.
 
-_cosmicctl_commands="bind calibrate channel channels check diagram echo gen peers record reload replay security segments status top types unbind"
+_cosmicctl_commands="bind calibrate channel channels check diagram echo fmus gen peers record reload replay security segments status top types unbind"
 _cosmicctl_global_options="--help --json --socket --version"
 
 # The options of one command (besides the global ones, which may follow it too).

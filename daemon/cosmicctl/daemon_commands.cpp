@@ -9,6 +9,7 @@
 #include "bind_output.hpp"
 #include "commands.hpp"
 #include "control_client.hpp"
+#include "fmu_output.hpp"
 #include "cosmic/report.hpp"
 #include "cosmic/units.hpp"
 
@@ -82,13 +83,6 @@ void print_segments(const Json& r) {
     std::cout << text(s["name"]) << ": authenticated; dropped " << text(refused) << " unauthenticated, "
               << text(s["adapter"].value("replayed", Json(0))) << " replayed\n";
   }
-}
-
-// Seconds as a short age: "0.4s ago", "12s ago".
-std::string age_text(double seconds) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, seconds < 10 ? "%.1fs ago" : "%.0fs ago", seconds);
-  return buffer;
 }
 
 void print_peers(const Json& r) {
@@ -204,6 +198,7 @@ void print_channel(const Json& r) {
     }
   }
   print_runtime(c);
+  if (c.contains("fmus")) print_channel_fmus(c["fmus"]);
   std::cout << "\nadmission:\n";
   // A channel whose events come through other gateways (federation): their hops first.
   if (c["admission"].contains("upstream")) {
@@ -268,6 +263,7 @@ std::vector<CommandRunner> add_daemon_commands(CLI::App& app, const GlobalOption
   simple("segments", "List segments with health, load and counters", print_segments);
   simple("channels", "List channels with verdict, counters and drops by reason", print_channels);
   simple("peers", "List the other gateways of the federation as this one sees them", print_peers);
+  simple("fmus", "List the configuration's FMUs with their runners' last reports (step times, late steps)", print_fmus);
   simple("reload", "Re-read the daemon's configuration file (validated before it is swapped in)", [](const Json& r) {
     std::cout << "reloaded\n";
     print_verdicts(r["channels"]);

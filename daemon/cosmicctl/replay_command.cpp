@@ -28,10 +28,6 @@ struct ReplayOptions {
   std::string stop_name;
 };
 
-std::string nanos_text(const Json& ns) {
-  return ns.is_number() ? cosmic::format_duration(cosmic::Nanos(ns.get<std::int64_t>())) : std::string("-");
-}
-
 void print_replay(const Json& r) {
   print_verdicts(r["channels"]);
   if (r.contains("replaced")) print_replaced(r["replaced"]);

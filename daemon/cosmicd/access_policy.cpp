@@ -35,6 +35,10 @@ cosmic::AccessPolicy make_access_policy(const AccessGroups& groups) {
     return peer.uid == 0 || in_group(peer.uid, peer.gid, groups.read_group) ||
            in_group(peer.uid, peer.gid, groups.admin_group);
   };
+  const std::string reporters = groups.report_group.empty() ? groups.read_group : groups.report_group;
+  policy.may_report = [groups, reporters](const cosmic::PeerCredentials& peer) {
+    return peer.uid == 0 || in_group(peer.uid, peer.gid, reporters) || in_group(peer.uid, peer.gid, groups.admin_group);
+  };
   return policy;
 }
 

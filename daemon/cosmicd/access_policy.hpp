@@ -1,5 +1,7 @@
 // Who may use the control socket: root and members of the read group may read; root and members
-// of the admin group may also bind, unbind and reload. Decided from SO_PEERCRED per request.
+// of the admin group may also bind, unbind and reload; root, members of the admin group and of the
+// report group (the read group unless one is named) may send FMU runners' reports (fmu_report).
+// Decided from SO_PEERCRED per request.
 #pragma once
 
 #include <string>
@@ -11,6 +13,7 @@ namespace cosmicd {
 struct AccessGroups {
   std::string read_group = "cosmic";
   std::string admin_group = "cosmic-admin";
+  std::string report_group;  // empty: the read group
 };
 
 cosmic::AccessPolicy make_access_policy(const AccessGroups& groups);

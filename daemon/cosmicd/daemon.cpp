@@ -345,6 +345,8 @@ class Daemon {
       }
       if (std::chrono::steady_clock::now() - last_health >= std::chrono::milliseconds(250)) {
         gateway_.refresh_health();
+        // An FMU whose runner reports a step overrun flags its output channels as a miss would.
+        gateway_.set_reported_violations(protocol_->fmu_overruns(std::chrono::steady_clock::now()));
         gateway_.refresh_runtime(steady_now());
         for (const auto& problem : gateway_.take_thread_problems())
           log_.log(cosmic::LogLevel::warning, "realtime: " + problem);

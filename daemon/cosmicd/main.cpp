@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--admin-group", options.groups.admin_group, "Group allowed to bind, unbind and reload")
       ->capture_default_str();
+  app.add_option("--report-group", options.groups.report_group,
+                 "Group allowed to send FMU runners' reports (fmu_report); default: the read group");
   app.add_option("-l,--log-level", options.log_level, "debug, info, notice, warning or error")
       ->check(CLI::IsMember({"debug", "info", "notice", "warning", "error"}))
       ->capture_default_str();

@@ -342,6 +342,62 @@ TEST(Validity, EndToEndMustStayBelowTempValidity) {
   EXPECT_EQ(only(run({can_segment("can"), dds_segment("lan", 1ms)}, {c})).verdict, Verdict::rejected);
 }
 
+// ---------------------------------------------------------------- an FMU's communication step
+
+// An FMU publishes once per step (docs/fmu.md, "Timing and admission"): checked on its publisher hop.
+TEST(FmuStep, LongerThanTempValidityDegradesTheChannel) {
+  auto c = channel("speed", 1, ChannelClass::srt, {"lan"}, {"viz"}, 8, Nanos(10ms), Nanos(20ms));
+  c.temp_validity = Nanos(15ms);
+  c.fmu_publishers = {{"speed_fmu", "lan", Nanos(20ms)}};
+  auto e = run({dds_segment("lan"), lcm_segment("viz")}, {c});
+  EXPECT_EQ(only(e).verdict, Verdict::degraded);
+  ASSERT_EQ(only(e).reasons.size(), 1u) << reasons_text(only(e));
+  EXPECT_EQ(only(e).reasons[0],
+            "fmu speed_fmu publishes every 20 ms (its step), longer than temp_validity 15 ms: between two steps "
+            "subscribers hold a value older than its validity");
+  const Check* validity = find_check(*find_hop(only(e), "lan"), "fmu_validity");
+  ASSERT_NE(validity, nullptr);
+  EXPECT_FALSE(validity->ok);
+  EXPECT_DOUBLE_EQ(validity->value, 0.020);
+  EXPECT_DOUBLE_EQ(validity->limit, 0.015);
+  EXPECT_EQ(validity->relation, "<=");
+  EXPECT_TRUE(find_check(*find_hop(only(e), "lan"), "fmu_rate")->ok);         // 20 ms >= the period 10 ms
+  EXPECT_EQ(find_check(*find_hop(only(e), "viz"), "fmu_validity"), nullptr);  // the subscriber hop: no FMU
+  // A step longer than the period but within the validity (equal included) is fine.
+  c.fmu_publishers[0].step = Nanos(15ms);
+  e = run({dds_segment("lan"), lcm_segment("viz")}, {c});
+  EXPECT_EQ(only(e).verdict, Verdict::bound) << reasons_text(only(e));
+  EXPECT_TRUE(find_check(*find_hop(only(e), "lan"), "fmu_validity")->ok);
+  // HRT: rejected, as for every failing criterion.
+  c.fmu_publishers[0].step = Nanos(20ms);
+  c.cls = ChannelClass::hrt;
+  c.subscribers = {"lan2"};
+  e = run({dds_segment("lan"), dds_segment("lan2")}, {c});
+  EXPECT_EQ(only(e).verdict, Verdict::rejected) << reasons_text(only(e));
+  EXPECT_TRUE(has_reason(only(e), "fmu speed_fmu publishes every 20 ms (its step), longer than temp_validity"));
+}
+
+TEST(FmuStep, ShorterThanThePeriodRejects) {
+  // A bind at run time (the configuration refuses such a step at load): rate policing would drop
+  // every event beyond the period's.
+  auto c = channel("speed", 1, ChannelClass::nrt, {"lan"}, {"viz"}, 8, Nanos(10ms), std::nullopt);
+  c.fmu_publishers = {{"speed_fmu", "lan", Nanos(5ms)}};
+  const auto e = run({dds_segment("lan"), lcm_segment("viz")}, {c});
+  EXPECT_EQ(only(e).verdict, Verdict::rejected);
+  EXPECT_TRUE(has_reason(only(e),
+                         "fmu speed_fmu publishes every 5 ms (its step), faster than the period 10 ms: rate policing "
+                         "would drop its events"))
+      << reasons_text(only(e));
+  const Check* rate = find_check(*find_hop(only(e), "lan"), "fmu_rate");
+  ASSERT_NE(rate, nullptr);
+  EXPECT_DOUBLE_EQ(rate->value, 0.005);
+  EXPECT_DOUBLE_EQ(rate->limit, 0.010);
+  EXPECT_EQ(find_check(*find_hop(only(e), "lan"), "fmu_validity"), nullptr);  // no temp_validity: nothing to hold
+  // An FMU on a segment the channel is not published from adds nothing.
+  c.fmu_publishers[0].segment = "viz";
+  EXPECT_EQ(only(run({dds_segment("lan"), lcm_segment("viz")}, {c})).verdict, Verdict::bound);
+}
+
 // ---------------------------------------------------------------- omission and real-time
 
 TEST(Omission, SegmentsWithoutRetransmission) {

@@ -96,6 +96,7 @@ class ConfigParser {
                          "a 'channels:' list, a list of channels or one channel map");
       }
       typed_.check(reader_, config_.channels, config_.segments);
+      config_detail::add_fmu_publishers(running.fmus, config_.channels);
       if (config_.channels.empty() && reader_.error_count() == 0) {
         reader_.error_at(*root, "channels", "no channel to bind", "at least one channel definition");
       }

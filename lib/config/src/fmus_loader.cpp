@@ -8,6 +8,7 @@
 
 #include "cosmic/fmi_mapping.hpp"
 #include "cosmic/fmu_archive.hpp"
+#include "cosmic/units.hpp"
 
 namespace cosmic::config_detail {
 namespace {
@@ -99,12 +100,30 @@ class FmusLoader {
     if (reader_.error_count() == errors_before_outputs) check_outputs_complete(node, path, f);
     read_parameters(node, path, d, f);
     if (reader_.error_count() != errors_before) return;
+    check_step_against_periods(node, path, f);
+    if (reader_.error_count() != errors_before) return;
     if (components_.count(f.name) || !names_.insert(f.name).second) {
       reader_.error_at(node["name"], key(path, "name"), "name '" + f.name + "' is taken",
                        "a name not used by a component or another FMU");
       return;
     }
     config_.fmus.push_back(std::move(f));
+    add_fmu_publishers(std::span(&config_.fmus.back(), 1), config_.channels);
+  }
+
+  // The FMU publishes each output channel once per step: a step shorter than a channel's period
+  // would send more than admission granted, and rate policing would drop the excess.
+  void check_step_against_periods(const YAML::Node& node, const std::string& path, const FmuSpec& f) {
+    const bool written = has(node, "step");
+    for (const auto& name : f.publishes()) {
+      const ChannelSpec* channel = config_.find_channel(name);
+      if (!channel->period || f.step >= *channel->period) continue;
+      const std::string step = written ? node["step"].Scalar() : "no step given: the FMU's DefaultExperiment stepSize";
+      reader_.error_at(written ? node["step"] : node, key(path, "step"),
+                       step + " publishes '" + name + "' every " + format_duration(f.step) +
+                           ", faster than its period " + format_duration(*channel->period),
+                       "a step at least the period of every output channel");
+    }
   }
 
   void read_segment(const YAML::Node& node, const std::string& path, FmuSpec& f) {
@@ -329,6 +348,15 @@ class FmusLoader {
 
 void load_fmus(YamlReader& reader, const YAML::Node& root, Config& config, std::vector<std::string>& included) {
   FmusLoader(reader, root, config, included).run();
+}
+
+void add_fmu_publishers(std::span<const FmuSpec> fmus, std::vector<ChannelSpec>& channels) {
+  for (const FmuSpec& f : fmus) {
+    for (const auto& name : f.publishes()) {
+      for (ChannelSpec& channel : channels)
+        if (channel.name == name) channel.fmu_publishers.push_back({f.name, f.segment, f.step});
+    }
+  }
 }
 
 }  // namespace cosmic::config_detail

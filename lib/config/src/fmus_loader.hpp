@@ -6,6 +6,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <span>
 #include <string>
 #include <vector>
 
@@ -18,5 +19,10 @@ namespace cosmic::config_detail {
 // and its binary for this platform found, nothing extracted; the file goes to `included`) and every
 // mapping and parameter checked against it. Every problem goes to `reader` with its location.
 void load_fmus(YamlReader& reader, const YAML::Node& root, Config& config, std::vector<std::string>& included);
+
+// Names each FMU of `fmus` with its segment and step in ChannelSpec::fmu_publishers of the
+// channels among `channels` it publishes (admission judges the step against them): at load, and
+// for channels bound or replaced at run time from the running configuration's FMUs.
+void add_fmu_publishers(std::span<const FmuSpec> fmus, std::vector<ChannelSpec>& channels);
 
 }  // namespace cosmic::config_detail

@@ -104,7 +104,9 @@ ControlProtocol::Answer ControlProtocol::dispatch(const Json& request, const Pee
   const std::string command = request["command"].get<std::string>();
   const auto op = operators_.find(command);
   const bool mutating = is_mutating(command) || op != operators_.end();
-  if (!(mutating ? policy_.may_modify(peer) : policy_.may_read(peer))) {
+  // A runner's report binds nothing, but can flag its FMU's channels violated: a permission of its own.
+  const bool report = command == "fmu_report";
+  if (!(report ? policy_.may_report(peer) : mutating ? policy_.may_modify(peer) : policy_.may_read(peer))) {
     if (const auto count = denials_.deny(peer.uid, command, std::chrono::steady_clock::now())) {
       std::string line = next_log_tag("denied", peer) + " may not run " + printable(command);
       if (*count > 1) {
@@ -114,13 +116,17 @@ ControlProtocol::Answer ControlProtocol::dispatch(const Json& request, const Pee
       log_.log(LogLevel::warning, line);
     }
     return failure("permission_denied", std::string("uid ") + std::to_string(peer.uid) + " may not " +
-                                            (mutating ? "change the gateway (" + command + ")" : "read gateway state"));
+                                            (report     ? std::string("report an FMU's state (fmu_report)")
+                                             : mutating ? "change the gateway (" + command + ")"
+                                                        : std::string("read gateway state")));
   }
   if (command == "status") return status();
   if (command == "segments") return segments();
   if (command == "channels") return channels();
   if (command == "channel") return channel(request);
   const auto now = std::chrono::steady_clock::now();
+  if (report) return fmu_reports_.accept(request, gateway_.config().fmus, now);
+  if (command == "fmus") return fmu_reports_.fmus_answer(gateway_.config().fmus, now);
   echo_->expire(now);
   if (command == "echo_open") return echo_->open(request, now);
   if (command == "echo_read") return echo_->read(request, now);
@@ -128,7 +134,7 @@ ControlProtocol::Answer ControlProtocol::dispatch(const Json& request, const Pee
   if (op != operators_.end()) return op->second(request);
   if (mutating) return mutate(command, request, peer, later);
   if (const auto reader = readers_.find(command); reader != readers_.end()) return reader->second();
-  std::string known = "status, segments, channels, channel, echo_open, echo_read, echo_close";
+  std::string known = "status, segments, channels, channel, fmus, fmu_report, echo_open, echo_read, echo_close";
   for (const auto& [name, answer] : readers_) known += ", " + name;
   for (const auto& [name, answer] : operators_) known += ", " + name;
   return failure("unknown_command", "unknown command '" + printable(command) + "' (" + known +
@@ -357,6 +363,7 @@ Json ControlProtocol::channel_entry(const ChannelReport& verdict, const ChannelS
   entry["deadline_miss"] = stats ? stats->deadline_miss : 0;
   if (verdict.end_to_end.latency) entry["predicted_end_to_end_s"] = to_seconds(*verdict.end_to_end.latency);
   if (verdict.end_to_end.reaction_time) entry["reaction_time_s"] = to_seconds(*verdict.end_to_end.reaction_time);
+  entry["fmus"] = fmu_reports_.channel_part(verdict.name, gateway_.config().fmus, std::chrono::steady_clock::now());
   return entry;
 }
 
@@ -514,7 +521,10 @@ ControlProtocol::Answer ControlProtocol::reload(const Reply& later) {
       return out;
     }
     const BindResult result = gateway_.commit_reload(std::move(*plan));
-    if (result.applied) replays_.clear();  // their segments went with the running configuration
+    if (result.applied) {
+      replays_.clear();                                      // their segments went with the running configuration
+      fmu_reports_.keep_configured(gateway_.config().fmus);  // and the reports of FMUs it no longer has
+    }
     Json out = bind_answer(result);
     if (!result.applied) out["error"] = {{"code", "reload_failed"}, {"message", result.error}};
     return finish("reload", Json{{"command", "reload"}}, std::move(out));

@@ -154,7 +154,7 @@ const ChannelReport* AdmissionReport::find(const std::string& name) const {
 
 Verdict consequence_of(const std::string& check, ChannelClass cls) {
   if (cls == ChannelClass::hrt || check == "frame_fit" || check == "representation" || check == "authentication" ||
-      check == "replay_events")
+      check == "replay_events" || check == "fmu_rate")
     return Verdict::rejected;
   return Verdict::degraded;
 }

@@ -163,6 +163,40 @@ std::string failure_text(const Check& check, const HopReport& h, const SegmentSp
   return "hrt" + on + ", which declares no real-time guarantee (realtime: false)";
 }
 
+// An FMU publishes its output channels once per communication step (docs/fmu.md, "Timing and
+// admission"): no faster than the channel's period (rate policing would drop what comes sooner) and
+// often enough that subscribers never hold a value older than its temp_validity between two steps.
+// The checks go on the FMU's publisher hop; `worsen(verdict, reason)` takes each failure.
+template <typename Worsen>
+void add_fmu_checks(const ChannelSpec& channel, ChannelReport& report, Worsen&& worsen) {
+  for (const FmuPublisher& fmu : channel.fmu_publishers) {
+    const auto hop = std::find_if(report.hops.begin(), report.hops.end(), [&](const HopReport& h) {
+      return h.role == HopRole::publisher && h.segment == fmu.segment;
+    });
+    if (hop == report.hops.end()) continue;  // the configuration lists the FMU's segment among the publishers
+    const std::string publishes = "fmu " + fmu.fmu + " publishes every " + format_duration(fmu.step) + " (its step)";
+    if (channel.period) {
+      const bool ok = fmu.step >= *channel.period;
+      hop->checks.push_back(Check{"fmu_rate", to_seconds(fmu.step), to_seconds(*channel.period), "s", ">=", ok});
+      if (!ok) {
+        worsen(consequence_of("fmu_rate", channel.cls), publishes + ", faster than the period " +
+                                                            format_duration(*channel.period) +
+                                                            ": rate policing would drop its events");
+      }
+    }
+    if (channel.temp_validity) {
+      const bool ok = fmu.step <= *channel.temp_validity;
+      hop->checks.push_back(
+          Check{"fmu_validity", to_seconds(fmu.step), to_seconds(*channel.temp_validity), "s", "<=", ok});
+      if (!ok) {
+        worsen(consequence_of("fmu_validity", channel.cls),
+               publishes + ", longer than temp_validity " + format_duration(*channel.temp_validity) +
+                   ": between two steps subscribers hold a value older than its validity");
+      }
+    }
+  }
+}
+
 }  // namespace
 
 void Judge::judge(const ChannelSpec& channel, ChannelReport& report) const {
@@ -177,6 +211,7 @@ void Judge::judge(const ChannelSpec& channel, ChannelReport& report) const {
       if (!check.ok) worsen(consequence_of(check.check, channel.cls), failure_text(check, h, segment, channel));
     }
   }
+  add_fmu_checks(channel, report, worsen);
   EndToEnd& e2e = report.end_to_end;
   e2e.latency = end_to_end_latency(report);
   e2e.reaction_time = channel.reaction_time;

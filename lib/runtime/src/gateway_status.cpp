@@ -54,12 +54,15 @@ void Gateway::refresh_runtime(Nanos now) {
     const auto previous = runtime_.find(counted.name);
     RuntimeTrack track = previous != runtime_.end() ? previous->second : RuntimeTrack{};
     const auto reason = foreign.find(counted.name);
-    judge(counted, *spec, track, now, reason == foreign.end() ? nullptr : &reason->second);
+    const auto reported = reported_.find(counted.name);
+    judge(counted, *spec, track, now, reason == foreign.end() ? nullptr : &reason->second,
+          reported == reported_.end() ? nullptr : &reported->second);
     next.emplace(counted.name, track);
   };
   // Only channels that ever missed are tracked (every other one is `bound` at run time).
   for (const auto& counted : router_->misses()) judge_bound(counted);
   for (const auto& [name, reason] : foreign) judge_bound(ChannelMisses{name, 0, 0});
+  for (const auto& [name, reason] : reported_) judge_bound(ChannelMisses{name, 0, 0});
   // A tracked channel the router reports no miss for any more (its route was applied afresh) is
   // judged with zero counts: a violation still ends only after a clean interval.
   for (const auto& [name, track] : runtime_) {
@@ -68,25 +71,28 @@ void Gateway::refresh_runtime(Nanos now) {
   runtime_ = std::move(next);
 }
 
-// One channel: a new miss of an HRT hop, or a gap in an end-to-end counter longer than the
-// channel's omission degree (any class: every class declares its omission degree), starts (or
-// extends) a violation episode; a clean interval ends it. SRT and NRT channels count timing misses
-// but keep their state (they were promised no bound).
+// One channel: a new miss of an HRT hop, a gap in an end-to-end counter longer than the
+// channel's omission degree, or a reported reason (any class: every class declares its omission
+// degree, and an FMU publishing it promised its step) starts (or extends) a violation episode; a
+// clean interval ends it. SRT and NRT channels count timing misses but keep their state (they were
+// promised no bound).
 void Gateway::judge(const ChannelMisses& counted, const ChannelSpec& spec, RuntimeTrack& track, Nanos now,
-                    const std::string* foreign) {
+                    const std::string* foreign, const std::string* reported) {
   const std::uint64_t misses = counted.residence_miss + counted.deadline_miss;
   const bool late = spec.cls == ChannelClass::hrt && (misses > track.misses || foreign);
   const bool omitted = counted.omission_excess > track.omission_excess;
-  const bool missed = late || omitted;
-  if (misses > track.misses || foreign || omitted) track.last_miss = now;
+  const bool missed = late || omitted || reported;
+  if (misses > track.misses || foreign || omitted || reported) track.last_miss = now;
   track.misses = misses;
   track.omission_excess = counted.omission_excess;
   if (missed && track.state == RuntimeState::bound) {
     track.state = RuntimeState::violated;
     ++track.violations;
-    std::string line = !late     ? omission_line(spec)
-                       : foreign ? "channel " + spec.name + " violated its admitted bounds: " + *foreign
-                                 : violation_line(spec);
+    const std::string violated = "channel " + spec.name + " violated its admitted bounds: ";
+    std::string line = late && foreign ? violated + *foreign
+                       : late          ? violation_line(spec)
+                       : reported      ? violated + *reported
+                                       : omission_line(spec);
     log_.log(LogLevel::warning, line);
   } else if (!missed && track.state == RuntimeState::violated &&
              now - track.last_miss >= config_.gateway.clean_interval) {

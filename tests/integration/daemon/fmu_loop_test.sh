@@ -143,6 +143,12 @@ grep -q "stopped: $((STEPS + 200)) steps of 10 ms" "$WORK/controller.log" ||
   fail "the controller's last status line: $(tail -n 2 "$WORK/controller.log")"
 field_at_least loop speed lan tx 100 || fail "cosmicd forwarded $(channel_field loop speed lan tx) speed events to the controller"
 field_at_least loop drive viz tx 100 || fail "cosmicd forwarded $(channel_field loop drive viz tx) drive events to the plant"
+# cosmicd keeps each runner's last report (fmu_report; docs/fmu.md, "Timing and admission").
+fmus_show() { ctl loop fmus | grep -Eq "$1"; }
+wait_until 10 "cosmicctl fmus: the plant's last report" \
+  fmus_show "^plant +Plant-fmi3\.fmu +3\.0 +viz +10 ms +stopped +$((STEPS + 200)) " || log "$(ctl loop fmus)"
+wait_until 10 "cosmicctl fmus: the controller's last report" \
+  fmus_show "^controller +SpeedController-fmi2\.fmu +2\.0 +lan +10 ms +stopped +$((STEPS + 200)) " || log "$(ctl loop fmus)"
 
 # 2. Unpaced (--pace free, as against a replay): the steps run back to back, none is late, and the
 #    FMU's time still advances by the step (2000 steps: t = 20 s at the end, in far less wall time).
@@ -167,6 +173,13 @@ EVERY_RC=$?
 grep -q "fmi2DoStep returned Error; the FMU said: step at t=.* failed: the fail input is set" "$WORK/every.log" ||
   fail "the failed step's log: $(tail -n 5 "$WORK/every.log")"
 grep -q "\[Error\] logStatusError: step at t=" "$WORK/every.log" || fail "the FMU's own log lines are not shown"
+every_failed() {
+  ctl loop --json fmus | python3 -c '
+import json, sys
+r = next(f for f in json.load(sys.stdin)["fmus"] if f["name"] == "every")["report"]
+sys.exit(0 if r and r["state"] == "failed" and "the fail input is set" in r["message"] else 1)'
+}
+wait_until 10 "cosmicctl fmus: the EveryType runner failed, with the FMU's words" every_failed
 [ -z "$(find "$WORK" -mindepth 1 -maxdepth 1 -name 'cosmic-fmu-*')" ] || fail "a runner left its work directory behind"
 
 [ "$FAILED" = 0 ] && echo "fmu loop: PASS"

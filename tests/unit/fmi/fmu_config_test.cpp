@@ -9,6 +9,8 @@
 #include "config_test_support.hpp"
 #include "cosmic/build_paths.hpp"
 #include "cosmic/config_loader.hpp"
+#include "cosmic/knowledge_base.hpp"
+#include "cosmic/report.hpp"
 #include "fmu_test_support.hpp"
 
 namespace cosmic {
@@ -74,19 +76,27 @@ class FmuConfig : public testing::Test {
            outputs + "\n" + extra;
   }
 
+  // `document` with the lines after the state channel's class replaced by `lines` up to its
+  // reaction_time (its period, and what else the test gives it).
+  static std::string with_state(std::string document, const std::string& lines) {
+    const std::string was = "    subject: 0x11\n    class: srt\n    period: 10ms\n";
+    document.replace(document.find(was), was.size(), "    subject: 0x11\n    class: srt\n" + lines);
+    return document;
+  }
+
   fs::path dir_;
 };
 
 TEST_F(FmuConfig, AnFmuIsReadAtLoadAndCountsAsAComponent) {
   const ConfigResult r =
-      parse_config(document(plant("    step: 5ms\n    parameters: {gain: 2.5, label: rig}\n")), file());
+      parse_config(document(plant("    step: 20ms\n    parameters: {gain: 2.5, label: rig}\n")), file());
   ASSERT_TRUE(r.ok()) << test::errors_text(r);
   ASSERT_EQ(r.config.fmus.size(), 1u);
   const FmuSpec& f = r.config.fmus[0];
   EXPECT_EQ(f.name, "plant");
   EXPECT_EQ(f.fmu, (dir_ / "plant.fmu").string());
   EXPECT_EQ(f.segment, "lan");
-  EXPECT_EQ(f.step, Nanos(5'000'000));
+  EXPECT_EQ(f.step, Nanos(20'000'000));
   EXPECT_EQ(f.fmi_version, "2.0");
   EXPECT_EQ(f.model_identifier, "Plant");
   EXPECT_EQ(f.inputs, (std::vector<FmuVariableMapping>{{"u", "command", "speed"}, {"mode", "command", "mode"}}));
@@ -165,6 +175,68 @@ TEST_F(FmuConfig, EveryMistakeIsLocated) {
       {"  - {name: plant, fmu: plant.fmu, segment: lan, colour: red}\n", "fmus[0].colour"},
   };
   for (const Case& c : cases) test::expect_refused_with(parse_config(document(c.fmu), file()), c.expected);
+}
+
+// The FMU publishes each output channel once per step (docs/fmu.md, "Timing and admission").
+TEST_F(FmuConfig, AStepShorterThanAnOutputChannelsPeriodIsLocated) {
+  const ConfigResult r = parse_config(document(plant("    step: 5ms\n")), file());
+  ASSERT_EQ(r.errors.size(), 1u) << test::errors_text(r);
+  EXPECT_EQ(r.errors[0].to_string(),
+            file() +
+                ":26:11: fmus[0].step: 5ms publishes 'state' every 5 ms, faster than its period 10 ms (a step at "
+                "least the period of every output channel)");
+  // A step from the FMU's DefaultExperiment (10 ms) is located at the entry.
+  const ConfigResult defaulted = parse_config(with_state(document(plant()), "    period: 20ms\n"), file());
+  ASSERT_EQ(defaulted.errors.size(), 1u) << test::errors_text(defaulted);
+  EXPECT_EQ(defaulted.errors[0].to_string(),
+            file() +
+                ":21:5: fmus[0].step: no step given: the FMU's DefaultExperiment stepSize publishes 'state' every 10 "
+                "ms, faster than its period 20 ms (a step at least the period of every output channel)");
+  // Equal to the period, and longer, are fine; inputs are not published.
+  EXPECT_TRUE(parse_config(document(plant("    step: 10ms\n")), file()).ok());
+  EXPECT_TRUE(parse_config(document(plant("    step: 30ms\n")), file()).ok());
+}
+
+TEST_F(FmuConfig, OutputChannelsNameTheFmuAndAdmissionJudgesItsStep) {
+  // The end-to-end latency (21 ms over the segments' default bounds) within temp_validity, the step not.
+  const std::string text = with_state(document(plant("    step: 40ms\n")),
+                                      "    period: 10ms\n    temp_validity: 30ms\n    omission_degree: 1\n");
+  const ConfigResult r = parse_config(text, file());
+  ASSERT_TRUE(r.ok()) << test::errors_text(r);
+  EXPECT_EQ(r.config.find_channel("state")->fmu_publishers,
+            (std::vector<FmuPublisher>{{"plant", "lan", Nanos(40'000'000)}}));
+  EXPECT_TRUE(r.config.find_channel("command")->fmu_publishers.empty());  // the FMU subscribes it
+  const AdmissionReport report = admit_all(r.config);
+  const ChannelReport* state = report.find("state");
+  ASSERT_NE(state, nullptr);
+  EXPECT_EQ(state->verdict, Verdict::degraded);
+  EXPECT_EQ(state->reasons,
+            std::vector<std::string>{"fmu plant publishes every 40 ms (its step), longer than temp_validity 30 ms: "
+                                     "between two steps subscribers hold a value older than its validity"});
+  // The checks on the FMU's publisher hop carry the numbers (cosmicctl check --json, cosmicctl channel).
+  const HopReport& lan = state->hops[0];
+  ASSERT_EQ(lan.segment, "lan");
+  const auto check = [&](const std::string& name) {
+    const auto it = std::find_if(lan.checks.begin(), lan.checks.end(), [&](const Check& c) { return c.check == name; });
+    return it == lan.checks.end() ? Check{} : *it;
+  };
+  EXPECT_TRUE(check("fmu_rate").ok);
+  EXPECT_DOUBLE_EQ(check("fmu_rate").limit, 0.010);
+  EXPECT_FALSE(check("fmu_validity").ok);
+  EXPECT_DOUBLE_EQ(check("fmu_validity").value, 0.040);
+  EXPECT_DOUBLE_EQ(check("fmu_validity").limit, 0.030);
+  // cosmicctl check's table shows the reason under the channel.
+  const std::string shown = render_text(report);
+  EXPECT_NE(shown.find("    - fmu plant publishes every 40 ms (its step), longer than temp_validity 30 ms"),
+            std::string::npos)
+      << shown;
+  // A channel bound at run time takes the running configuration's FMUs.
+  const ChannelsResult bound = parse_channels(
+      "{name: state, subject: 0x11, class: nrt, period: 10ms, publishers: [lan], subscribers: [viz], type: {fields: "
+      "[{name: ready, type: bool}]}}",
+      "bind.yaml", r.config);
+  ASSERT_TRUE(bound.ok()) << (bound.errors.empty() ? "" : bound.errors[0].to_string());
+  EXPECT_EQ(bound.channels[0].fmu_publishers, r.config.find_channel("state")->fmu_publishers);
 }
 
 // A refused FMU leaves its channels without the segment it would have given them: its own errors

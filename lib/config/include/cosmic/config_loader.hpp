@@ -78,7 +78,8 @@ struct SegmentResult {
 SegmentResult parse_segment(std::string_view text, const std::string& file_name, const Config& running);
 
 // Parses channel definitions for a runtime bind: a document with a `channels:` list, a list of
-// channel maps, or one channel map, validated against the segments of `running`.
+// channel maps, or one channel map, validated against the segments of `running`. A channel one of
+// `running`'s FMUs publishes names it in ChannelSpec::fmu_publishers, as at load.
 ChannelsResult parse_channels(std::string_view text, const std::string& file_name, const Config& running);
 
 }  // namespace cosmic

@@ -15,6 +15,7 @@
 
 #include "cosmic/denial_log.hpp"
 #include "cosmic/config_loader.hpp"
+#include "cosmic/fmu_reports.hpp"
 #include "cosmic/gateway.hpp"
 
 namespace cosmic {
@@ -26,10 +27,12 @@ struct PeerCredentials {
   unsigned gid = 0;
 };
 
-// Decides whether a peer may run a command class; installed by the daemon.
+// Decides whether a peer may run a command class; installed by the daemon. `may_report`: send
+// fmu_report, a runner's report, which binds nothing but can flag an FMU's output channels violated.
 struct AccessPolicy {
   std::function<bool(const PeerCredentials&)> may_read = [](const PeerCredentials&) { return true; };
   std::function<bool(const PeerCredentials&)> may_modify = [](const PeerCredentials&) { return true; };
+  std::function<bool(const PeerCredentials&)> may_report = [](const PeerCredentials&) { return true; };
 };
 
 // Told about every mutating command that changed the gateway (e.g. to persist it). Returns why
@@ -89,6 +92,11 @@ class ControlProtocol {
   }
   // Installs the gate binds pass before their commit (only with an Offload: inline binds commit at once).
   void set_bind_gate(BindGate gate) { gate_ = std::move(gate); }
+  // The output channels whose FMU's runner reports a worst step longer than its step, with the
+  // reason (FmuReports::overruns), for Gateway::set_reported_violations.
+  std::map<std::string, std::string> fmu_overruns(std::chrono::steady_clock::time_point now) const {
+    return fmu_reports_.overruns(gateway_.config().fmus, now);
+  }
 
   static bool is_mutating(std::string_view command);
 
@@ -167,6 +175,7 @@ class ControlProtocol {
   std::map<std::string, RunTimeReplay> replays_;    // by segment name
   std::optional<RunTimeReplay> pending_replay_;     // a replay or replay_stop while its switch runs
   std::unique_ptr<control_detail::EchoTaps> echo_;  // echo_open, echo_read, echo_close
+  FmuReports fmu_reports_;                          // fmu_report, fmus, and each channel's FMU part
 };
 
 }  // namespace cosmic

@@ -36,7 +36,9 @@ const char* to_string(HopRole value);
 // One criterion's number against its limit. `relation` is how value must compare to limit
 // ("<=", "<", ">="); ok says whether it does.
 struct Check {
-  std::string check;  // frame_fit, utilization, response_time, latency, omission, realtime, representation, range
+  // frame_fit, utilization, response_time, latency, omission, realtime, representation, range,
+  // authentication, replay_events, replay_rate, fmu_rate, fmu_validity
+  std::string check;
   double value = 0;
   double limit = 0;
   std::string unit;  // "s", "B", "ratio", "events", "bool"
@@ -145,9 +147,10 @@ struct ChannelReport {
 };
 
 // How a failing criterion ("frame_fit", "latency", ...) affects the verdict of a channel of `cls`:
-// rejected for HRT channels, for a frame that does not fit and for a hop whose representation
-// cannot carry the channel's type ("representation"), degraded otherwise (e.g. "range": the hop
-// saturates values of a field's declared range).
+// rejected for HRT channels, for a frame that does not fit, for a hop whose representation
+// cannot carry the channel's type ("representation") and for an FMU that would publish faster than
+// the period ("fmu_rate"), degraded otherwise (e.g. "range": the hop saturates values of a field's
+// declared range; "fmu_validity": an FMU's step is longer than temp_validity).
 Verdict consequence_of(const std::string& check, ChannelClass cls);
 
 // A rejection of `channel` for one reason, before any hop is judged (already bound, not bound

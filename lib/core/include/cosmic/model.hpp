@@ -268,6 +268,16 @@ struct SecocSpec {
   friend bool operator==(const SecocSpec&, const SecocSpec&) = default;
 };
 
+// An FMU of the configuration that publishes a channel (`fmus:` outputs, docs/fmu.md): it
+// publishes once per communication step, so admission compares its step with the channel's period
+// and temp_validity on the FMU's publisher hop (checks "fmu_rate" and "fmu_validity").
+struct FmuPublisher {
+  std::string fmu;      // the FMU's name
+  std::string segment;  // where its runner lives: one of the channel's publishers
+  Nanos step{0};        // its communication step
+  friend bool operator==(const FmuPublisher&, const FmuPublisher&) = default;
+};
+
 struct ChannelSpec {
   std::string name;
   std::uint64_t subject = 0;
@@ -288,6 +298,9 @@ struct ChannelSpec {
   // with `payload`, which is then the largest of them); empty for an untyped channel.
   std::vector<HopPayload> hop_payloads;
   std::vector<SecocSpec> secoc;  // at most one per segment, each a CAN segment among publishers/subscribers
+  // The FMUs publishing this channel, derived by the configuration from `fmus:` (a bound or
+  // replaced channel from the running configuration's); empty when none does.
+  std::vector<FmuPublisher> fmu_publishers{};
   friend bool operator==(const ChannelSpec&, const ChannelSpec&) = default;
 
   // The most bytes one event takes on `segment`: its hop's own size where the type gives one, else
@@ -418,8 +431,8 @@ struct FmuParameter {
 
 // A co-simulation FMU run as a component on one segment (issue 38, `fmus:`, docs/fmu.md): each step
 // takes its inputs from channel fields and publishes its outputs. It counts as a component that
-// publishes its output channels and subscribes its input channels. The runner (cosmic-fmu) is the
-// next step; the configuration reads and checks the FMU at load.
+// publishes its output channels and subscribes its input channels; each output channel's
+// ChannelSpec::fmu_publishers names it with its step, which admission judges.
 struct FmuSpec {
   std::string name;
   std::string fmu;  // the FMU file, absolute (a relative one is anchored at the configuration)

@@ -208,6 +208,12 @@ class Gateway {
   void refresh_health();
   // Updates the runtime state of every channel from the lanes' miss counters (call periodically).
   void refresh_runtime(Nanos now);
+  // Channels whose bounds do not hold now for a reason reported from outside the gateway, by name,
+  // with the reason (an FMU's runner reporting a worst step beyond its step, cosmic/fmu_reports.hpp).
+  // Each such bound channel, whatever its class, is judged violated at every refresh_runtime() as
+  // for a miss (the reason logged when the episode begins) until it is no longer named and a clean
+  // interval passed. Replaces the previous set. Control thread.
+  void set_reported_violations(std::map<std::string, std::string> reasons) { reported_ = std::move(reasons); }
   std::size_t violated_channels() const;
   // Their names (the federation announces them to gateways downstream).
   std::set<std::string> violated_channel_names() const;
@@ -287,8 +293,9 @@ class Gateway {
   // Makes `report` say `failed`, with the reasons, when a segment refused its channel.
   void mark_refused(ChannelReport& report) const;
   // `foreign`: why the channel's analysis does not hold now (undeclared frames beat it), or null.
+  // `reported`: why its bounds do not hold by a report from outside (set_reported_violations), or null.
   void judge(const ChannelMisses& counted, const ChannelSpec& spec, RuntimeTrack& track, Nanos now,
-             const std::string* foreign);
+             const std::string* foreign, const std::string* reported);
   // HRT channels that frames unknown to admission beat on a CAN bus: name -> reason.
   std::map<std::string, std::string> undeclared_interference() const;
   std::string violation_line(const ChannelSpec& spec) const;
@@ -311,6 +318,7 @@ class Gateway {
   std::unique_ptr<KnowledgeBase> kb_;
   std::unique_ptr<Router> router_;
   std::map<std::string, RuntimeTrack> runtime_;  // by channel name
+  std::map<std::string, std::string> reported_;  // set_reported_violations(): channel -> reason
   RecordHook* record_hook_ = nullptr;
   std::function<bool(const ChannelSpec&)> record_selection_;
   RouteObserver on_routes_;
