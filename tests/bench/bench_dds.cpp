@@ -191,6 +191,21 @@ class ReaderListener : public fdds::DataReaderListener {
   RawSample raw_;
 };
 
+// A writer's or reader's history: KEEP_LAST of depth keep_last, or (keep_last 0) KEEP_ALL of at most
+// max_samples, `allocated` of them allocated up front.
+template <typename Qos>
+void set_history(Qos& qos, int keep_last, std::int32_t max_samples, std::int32_t allocated) {
+  if (keep_last > 0) {
+    qos.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+    qos.history().depth = keep_last;
+  } else {
+    qos.history().kind = fdds::KEEP_ALL_HISTORY_QOS;
+    qos.resource_limits().max_samples = max_samples;
+    qos.resource_limits().allocated_samples = allocated;
+    qos.resource_limits().max_samples_per_instance = max_samples;
+  }
+}
+
 }  // namespace
 
 int dds_pub(const DdsOptions& o) {
@@ -206,17 +221,10 @@ int dds_pub(const DdsOptions& o) {
   if (native) qos.representation().m_value = {fdds::XCDR_DATA_REPRESENTATION};
   qos.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
   qos.reliability().max_blocking_time = eprosima::fastrtps::Duration_t(1, 0);
-  qos.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 50'000'000);
+  if (!o.default_heartbeat)
+    qos.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 50'000'000);
   qos.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
-  if (o.keep_last > 0) {
-    qos.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
-    qos.history().depth = o.keep_last;
-  } else {
-    qos.history().kind = fdds::KEEP_ALL_HISTORY_QOS;
-    qos.resource_limits().max_samples = 5000;
-    qos.resource_limits().allocated_samples = 500;
-    qos.resource_limits().max_samples_per_instance = 5000;
-  }
+  set_history(qos, o.keep_last, 5000, 500);
   qos.publish_mode().kind = fdds::SYNCHRONOUS_PUBLISH_MODE;
   qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
   WriterListener listener;
@@ -297,10 +305,7 @@ int dds_sub(const DdsOptions& o) {
   fdds::DataReaderQos qos = fdds::DATAREADER_QOS_DEFAULT;
   qos.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
   qos.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
-  qos.history().kind = fdds::KEEP_ALL_HISTORY_QOS;
-  qos.resource_limits().max_samples = 100000;
-  qos.resource_limits().allocated_samples = 1000;
-  qos.resource_limits().max_samples_per_instance = 100000;
+  set_history(qos, o.keep_last, 100000, 1000);
   qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
   fdds::DataReader* reader = subscriber->create_datareader(
       p.topic, qos, &listener, fdds::StatusMask::data_available() << fdds::StatusMask::subscription_matched());

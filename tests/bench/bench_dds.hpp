@@ -25,7 +25,10 @@ struct DdsOptions {
   double rate = 0;
   double max_rate = 0;  // 0: catch up after a stall at full speed
   std::uint64_t warmup = 200;
-  int keep_last = 0;  // 0: KEEP_ALL
+  int keep_last = 0;  // the writer's or reader's history: 0 KEEP_ALL, else KEEP_LAST of this depth
+  // dds-pub: Fast DDS's own heartbeat period (3 s) instead of the peer's 50 ms, as a writer
+  // with default QoS announces its samples (scripts/bench's relay-rates section).
+  bool default_heartbeat = false;
   bool wait_go = false;
   double match_timeout = 20;
   double stall = 5;

@@ -8,9 +8,11 @@
 //   cosmic-bench-peer lcm-sub --url U --channel C --count N [--timeout S] [--idle S] [--envelope]
 //                             [--dump FILE]
 //   cosmic-bench-peer dds-pub --domain D --topic T --count N --size B [--rate HZ] [--warmup W]
-//                             [--max-rate HZ] [--keep-last DEPTH] [--wait-go] [--match-timeout S] [--stall S]
+//                             [--max-rate HZ] [--keep-last DEPTH] [--default-heartbeat] [--wait-go]
+//                             [--match-timeout S] [--stall S]
 //                             [--native TYPE] [--pki DIR --identity NAME [--governance FILE]]
 //   cosmic-bench-peer dds-sub --domain D --topic T --count N [--timeout S] [--idle S] [--dump FILE]
+//                             [--keep-last DEPTH]
 //                             [--native TYPE] [--pki DIR --identity NAME [--governance FILE]]
 //
 // Payload of every event (size >= 16): bytes 0..7 = CLOCK_MONOTONIC ns when the publisher hands
@@ -33,7 +35,10 @@
 // measured events at --rate (0: as fast as possible); with --max-rate (the channel's contract) a
 // publisher the machine held up catches up no faster than that rate. dds-pub waits until a reader matched
 // (exit 2 after --match-timeout), and with --wait-go prints WAITING on stderr and reads one line
-// on stdin before sending (the caller first checks the far side has matched us too).
+// on stdin before sending (the caller first checks the far side has matched us too). dds-pub's
+// writer is reliable, KEEP_ALL or --keep-last DEPTH, synchronous, heartbeat every 50 ms (Fast
+// DDS's default, 3 s, with --default-heartbeat); dds-sub's reader is reliable, KEEP_ALL or
+// --keep-last DEPTH.
 //
 // Receivers print READY (lcm-sub, once subscribed) or MATCHED (dds-sub, once its reader matched a
 // writer) on stderr. They stop when all N measured events arrived, after --idle seconds without
@@ -364,12 +369,14 @@ int main(int argc, char** argv) {
   dp->add_option("--max-rate", dd.max_rate, "the channel's max_rate: catch up after a stall no faster than this");
   dp->add_option("--warmup", dd.warmup, "warm-up events");
   dp->add_option("--keep-last", dd.keep_last, "KEEP_LAST depth (default KEEP_ALL)");
+  dp->add_flag("--default-heartbeat", dd.default_heartbeat, "Fast DDS's default heartbeat period (3 s), not 50 ms");
   dp->add_flag("--wait-go", dd.wait_go, "after matching, wait for a line on stdin");
   dp->add_option("--match-timeout", dd.match_timeout, "seconds to wait for a reader");
   dp->add_option("--stall", dd.stall, "give up (exit 5) when no write succeeds for this many seconds");
   CLI::App* ds = app.add_subcommand("dds-sub", "receive on DDS");
   dds_common(ds);
   ds->add_option("--timeout", dd.timeout, "seconds");
+  ds->add_option("--keep-last", dd.keep_last, "KEEP_LAST depth (default KEEP_ALL)");
   ds->add_option("--idle", dd.idle, "seconds without events that end the run");
   ds->add_option("--dump", dd.dump, "write 'index sent_ns recv_ns latency_us' per event to this file");
   CLI11_PARSE(app, argc, argv);
