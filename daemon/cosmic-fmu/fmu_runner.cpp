@@ -38,20 +38,6 @@ void sleep_until(Clock::time_point when) {
 
 }  // namespace
 
-const char* to_string(RunnerState state) {
-  switch (state) {
-    case RunnerState::starting:
-      return "starting";
-    case RunnerState::running:
-      return "running";
-    case RunnerState::stopped:
-      return "stopped";
-    case RunnerState::failed:
-      return "failed";
-  }
-  return "unknown";
-}
-
 cosmic::Result<std::unique_ptr<FmuRunner>> FmuRunner::open(const cosmic::Config& config, const cosmic::FmuSpec& spec,
                                                            const RunnerOptions& options, cosmic::Logger& log) {
   auto work = WorkDirectory::make(options.work_parent, spec.name);
@@ -71,7 +57,8 @@ cosmic::Result<std::unique_ptr<FmuRunner>> FmuRunner::open(const cosmic::Config&
   if (!stepper) return stepper.error();
   runner->stepper_ = std::move(stepper.value());
   if (auto started = runner->stepper_->start(); !started)
-    return cosmic::Error{"initialization failed: " + started.error().text};
+    return cosmic::Error{"initialization failed: " + started.error().text + "\n" +
+                         runner->instance_->recent_log_text()};
   if (auto joined = runner->join_channels(); !joined) return joined.error();
   if (!options.trace_file.empty()) {
     runner->trace_.open(options.trace_file, std::ios::trunc);
@@ -123,21 +110,32 @@ cosmic::Result<void> FmuRunner::join_channels() {
   return {};
 }
 
-void FmuRunner::wait_until_carried() {
-  for (std::size_t i = 0; i < output_channels_.size(); ++i) {
-    try {
-      output_channels_[i]->wait_ready(options_.ready_timeout);
-    } catch (const std::exception& e) {
-      log_.log(cosmic::LogLevel::warning, std::string("stepping anyway: ") + e.what());
+// One deadline for every output channel, looked at in slices so that a stop is not held up by a
+// gateway that is not there.
+void FmuRunner::wait_until_carried(const std::atomic<bool>& stop) {
+  constexpr std::chrono::milliseconds kSlice{100};
+  const auto deadline = Clock::now() + options_.ready_timeout;
+  for (cosmic::client::Channel* channel : output_channels_) {
+    for (;;) {
+      if (stop.load(std::memory_order_relaxed)) return;
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+      try {
+        channel->wait_ready(std::clamp(left, std::chrono::milliseconds{0}, kSlice));
+        break;
+      } catch (const std::exception& e) {
+        if (left > kSlice) continue;
+        log_.log(cosmic::LogLevel::warning, std::string("stepping anyway: ") + e.what());
+        return;
+      }
     }
   }
 }
 
 cosmic::Result<void> FmuRunner::run(const std::atomic<bool>& stop) {
-  wait_until_carried();
+  wait_until_carried(stop);
   set_state(RunnerState::running);
   const auto step = std::chrono::duration_cast<Clock::duration>(spec_.step);
-  const Clock::time_point start = Clock::now();
+  Clock::time_point start = Clock::now();
   for (std::uint64_t k = 0; !stop.load(std::memory_order_relaxed) && (options_.steps == 0 || k < options_.steps); ++k) {
     const Clock::time_point begin_at = start + step * static_cast<Clock::rep>(k);
     if (options_.paced) {
@@ -153,6 +151,16 @@ cosmic::Result<void> FmuRunner::run(const std::atomic<bool>& stop) {
     const Clock::time_point deadline = begin_at + step;
     const bool late = options_.paced && ended > deadline;
     timing_.record(ended - began, late, late ? ended - deadline : Clock::duration{});
+    // A late step slips the schedule: the next step starts now, the ones after it a step apart. Run
+    // back to back instead, the missed steps would publish faster than the step, which is the
+    // output channels' admitted period.
+    if (late) start = ended - step * static_cast<Clock::rep>(k + 1);
+    if (instance_->ended()) {
+      log_.log(cosmic::LogLevel::info,
+               "fmu " + spec_.name + " ended the simulation at t=" +
+                   cosmic::shortest_number_text(static_cast<double>(k + 1) * stepper_->step_seconds()) + " s");
+      break;
+    }
   }
   if (auto ended = instance_->terminate(); !ended) {
     set_state(RunnerState::failed, ended.error().text + "\n" + instance_->recent_log_text());
@@ -206,9 +214,9 @@ void FmuRunner::set_state(RunnerState state, std::string message) {
   message_ = std::move(message);
 }
 
-RunnerStatus FmuRunner::status() const {
+RunnerStatus FmuRunner::status(bool take_window) const {
   RunnerStatus out;
-  out.timing = timing_.snapshot();
+  out.timing = timing_.snapshot(take_window);
   out.publish_errors = publish_errors_.load(std::memory_order_relaxed);
   cosmic::LockGuard lock(status_mutex_);
   out.state = state_;

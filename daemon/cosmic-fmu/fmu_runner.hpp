@@ -1,8 +1,9 @@
 // cosmic-fmu's runner: one `fmus:` entry of a gateway configuration run as a component (issue 38,
 // docs/fmu.md). It extracts the FMU into a private directory, instantiates and initializes it, joins
 // its input and output channels on its segment with libcosmic-client, then steps it: paced in real
-// time (step k starts at start + k*step; a step that ends after the next one's start is late) or as
-// fast as it goes.
+// time (step k starts at start + k*step; a step that ends after the next one's start is late, and
+// the schedule then slips so that the steps after it keep their spacing) or as fast as it goes. An
+// FMU that asks to end the simulation (FMI 3.0) ends the run as a stop does.
 //
 // Threads: run() on the caller's thread (the step thread, named "fmu-step"); the client's receive
 // threads hand input events to the stepper's latches; status() from any thread (the reporter's).
@@ -20,6 +21,8 @@
 #include "cosmic/fmu_stepper.hpp"
 #include "cosmic/log.hpp"
 #include "cosmic/model.hpp"
+#include "cosmic/pi_mutex.hpp"
+#include "runner_status.hpp"
 #include "step_timing.hpp"
 #include "work_directory.hpp"
 
@@ -34,18 +37,6 @@ struct RunnerOptions {
   unsigned can_node = 0;                            // the TxNode on a CAN segment
 };
 
-enum class RunnerState { starting, running, stopped, failed };
-const char* to_string(RunnerState state);
-
-struct RunnerStatus {
-  RunnerState state = RunnerState::starting;
-  StepTimingSnapshot timing;
-  std::vector<cosmic::fmi::InputCounters> inputs;
-  std::vector<cosmic::fmi::OutputCounters> outputs;
-  std::uint64_t publish_errors = 0;
-  std::string message;  // why it failed, with the FMU's last messages
-};
-
 class FmuRunner {
  public:
   // Everything up to the first step: extracted, instantiated, parameters set, initialized, channels
@@ -58,7 +49,8 @@ class FmuRunner {
   // then steps until `stop` is set or the step count is reached. An error: a step failed (the FMU's
   // log is in status().message).
   cosmic::Result<void> run(const std::atomic<bool>& stop);
-  RunnerStatus status() const;
+  // `take_window`: the report's worst step starts again from now (StepTiming::snapshot).
+  RunnerStatus status(bool take_window = false) const;
   const cosmic::FmuSpec& spec() const { return spec_; }
 
  private:
@@ -70,7 +62,7 @@ class FmuRunner {
   void publish_outputs();
   void trace_header();
   void trace_step(std::uint64_t index);
-  void wait_until_carried();
+  void wait_until_carried(const std::atomic<bool>& stop);
   void set_state(RunnerState state, std::string message = {});
 
   const cosmic::Config& config_;
@@ -86,9 +78,9 @@ class FmuRunner {
   std::vector<cosmic::client::Channel*> output_channels_;  // by the stepper's output index
   std::vector<cosmic::client::Subscription> subscriptions_;
   std::ofstream trace_;
-  StepTiming timing_;
+  mutable StepTiming timing_;  // snapshot(take_window) restarts the reported window
   std::atomic<std::uint64_t> publish_errors_{0};
-  mutable cosmic::Mutex status_mutex_;
+  mutable cosmic::PiMutex status_mutex_;  // the step thread may run SCHED_FIFO, the reporter does not
   RunnerState state_ COSMIC_GUARDED_BY(status_mutex_) = RunnerState::starting;
   std::string message_ COSMIC_GUARDED_BY(status_mutex_);
   std::vector<cosmic::fmi::InputCounters> inputs_ COSMIC_GUARDED_BY(status_mutex_);

@@ -95,9 +95,11 @@ int run(const Arguments& args, cosmic::Nanos report_interval, cosmic::Nanos read
   options.trace_file = args.trace;
   options.can_node = args.can_node >= 0 ? static_cast<unsigned>(args.can_node) : default_can_node(config, *spec);
 
+  const std::string socket = args.no_report ? "" : !args.socket.empty() ? args.socket : config.gateway.control_socket;
   auto runner = cosmic_fmu::FmuRunner::open(config, *spec, options, log);
   if (!runner) {
     log.log(cosmic::LogLevel::error, "fmu " + spec->name + " (" + spec->fmu + "): " + runner.error().text);
+    cosmic_fmu::report_failure(socket, *spec, runner.error().text);
     return 1;
   }
   log.log(cosmic::LogLevel::info, "fmu " + spec->name + ": FMI " + spec->fmi_version + " model " +
@@ -106,10 +108,17 @@ int run(const Arguments& args, cosmic::Nanos report_interval, cosmic::Nanos read
   cosmic::Result<void> result = cosmic::Result<void>{};
   {
     cosmic_fmu::ReporterOptions reporting;
-    reporting.socket = args.no_report ? "" : !args.socket.empty() ? args.socket : config.gateway.control_socket;
+    reporting.socket = socket;
     reporting.interval = std::chrono::duration_cast<std::chrono::milliseconds>(report_interval);
     cosmic_fmu::StatusReporter reporter(*runner.value(), reporting, log);
     apply_step_policy(args, log);
+    // SIGINT and SIGTERM come to this thread alone from now on (main() blocked them before any other
+    // thread existed, and threads inherit the mask): its sleep until the next step ends at once.
+    sigset_t stop_signals;
+    ::sigemptyset(&stop_signals);
+    ::sigaddset(&stop_signals, SIGINT);
+    ::sigaddset(&stop_signals, SIGTERM);
+    ::pthread_sigmask(SIG_UNBLOCK, &stop_signals, nullptr);
     result = runner.value()->run(g_stop);
     log.log(result ? cosmic::LogLevel::info : cosmic::LogLevel::error,
             "fmu " + spec->name + " " + cosmic_fmu::summary_line(spec->step, runner.value()->status()));
@@ -166,5 +175,13 @@ int main(int argc, char** argv) {
   stop.sa_handler = on_stop_signal;  // no SA_RESTART: the step loop's sleep returns at once
   ::sigaction(SIGINT, &stop, nullptr);
   ::sigaction(SIGTERM, &stop, nullptr);
+  // Blocked until the step thread steps (run() unblocks them there): every thread started before
+  // (the client's, the reporter) inherits the block, so none of them takes a stop signal that the
+  // step thread's sleep would then not see. One that comes earlier waits, and stops the first step.
+  sigset_t stop_signals;
+  ::sigemptyset(&stop_signals);
+  ::sigaddset(&stop_signals, SIGINT);
+  ::sigaddset(&stop_signals, SIGTERM);
+  ::pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
   return run(args, report_interval, ready_timeout);
 }

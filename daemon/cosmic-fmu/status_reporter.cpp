@@ -6,52 +6,8 @@
 #include <cstdio>
 
 #include "control_client.hpp"
-#include "cosmic/units.hpp"
 
 namespace cosmic_fmu {
-namespace {
-
-std::string millis(std::chrono::nanoseconds d) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3g ms", static_cast<double>(d.count()) / 1e6);
-  return text;
-}
-
-}  // namespace
-
-nlohmann::json report_request(const std::string& name, std::chrono::nanoseconds step, const RunnerStatus& s) {
-  nlohmann::json skipped = nlohmann::json::object();
-  for (const auto& in : s.inputs) skipped[in.channel] = in.skipped;
-  return {{"command", "fmu_report"},
-          {"name", name},
-          {"state", to_string(s.state)},
-          {"step_ns", step.count()},
-          {"steps", s.timing.steps},
-          {"late_steps", s.timing.late_steps},
-          {"worst_step_ns", s.timing.worst.count()},
-          {"p99_step_ns", s.timing.p99.count()},
-          {"skipped", skipped},
-          {"message", s.message}};
-}
-
-std::string summary_line(std::chrono::nanoseconds step, const RunnerStatus& s) {
-  std::string line = std::string(to_string(s.state)) + ": " + std::to_string(s.timing.steps) + " steps of " +
-                     cosmic::format_duration(step) + ", " + std::to_string(s.timing.late_steps) +
-                     " late, step time p50 " + millis(s.timing.p50) + " p99 " + millis(s.timing.p99) + " worst " +
-                     millis(s.timing.worst);
-  std::uint64_t skipped = 0, undecodable = 0, clipped = 0;
-  for (const auto& in : s.inputs) {
-    skipped += in.skipped;
-    undecodable += in.decode_errors;
-  }
-  for (const auto& out : s.outputs) clipped += out.clipped;
-  line += "; input events skipped " + std::to_string(skipped);
-  if (undecodable != 0) line += ", undecodable " + std::to_string(undecodable);
-  if (clipped != 0) line += "; output values clipped " + std::to_string(clipped);
-  if (s.publish_errors != 0) line += "; publish errors " + std::to_string(s.publish_errors);
-  return line;
-}
-
 StatusReporter::StatusReporter(const FmuRunner& runner, ReporterOptions options, cosmic::Logger& log)
     : runner_(runner), options_(std::move(options)), log_(log) {
   thread_ = std::thread([this] {
@@ -74,7 +30,7 @@ void StatusReporter::loop() {
   cosmic::UniqueLock lock(mutex_);
   while (!stopping_) {
     lock.unlock();
-    const RunnerStatus status = runner_.status();
+    const RunnerStatus status = runner_.status(/*take_window=*/true);
     send(status);
     if (std::chrono::steady_clock::now() >= next_log && status.state == RunnerState::running) {
       log_.log(cosmic::LogLevel::info, summary_line(runner_.spec().step, status));
@@ -84,7 +40,15 @@ void StatusReporter::loop() {
     if (!stopping_) lock.wait_for(wake_, options_.interval);
   }
   lock.unlock();
-  send(runner_.status());  // the last word: stopped or failed, with the final counters
+  send(runner_.status(/*take_window=*/true));  // the last word: stopped or failed, with the final counters
+}
+
+void report_failure(const std::string& socket, const cosmic::FmuSpec& spec, const std::string& message) {
+  if (socket.empty()) return;
+  RunnerStatus failed;
+  failed.state = RunnerState::failed;
+  failed.message = message;
+  (void)cosmicctl::request(socket, report_request(spec.name, spec.step, failed), 1000);  // best effort, once
 }
 
 void StatusReporter::send(const RunnerStatus& status) {

@@ -27,10 +27,8 @@ struct ReporterOptions {
   std::chrono::milliseconds log_interval{10'000};
 };
 
-// The `fmu_report` request for `status` (what the runner sends; unit-tested).
-nlohmann::json report_request(const std::string& name, std::chrono::nanoseconds step, const RunnerStatus& status);
-// The one-line summary for STATUS= and the log: "running: 1234 steps, 0 late, worst 0.41 ms of 10 ms ...".
-std::string summary_line(std::chrono::nanoseconds step, const RunnerStatus& status);
+// One `failed` report for an FMU that failed before it stepped (no StatusReporter exists yet).
+void report_failure(const std::string& socket, const cosmic::FmuSpec& spec, const std::string& message);
 
 class StatusReporter {
  public:

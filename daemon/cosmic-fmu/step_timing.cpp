@@ -10,18 +10,21 @@ void StepTiming::record(std::chrono::nanoseconds took, bool late, std::chrono::n
   recent_[totals_.steps % kKept] = took.count();
   ++totals_.steps;
   totals_.worst = std::max(totals_.worst, took);
+  totals_.worst_recent = std::max(totals_.worst_recent, took);
   if (late) {
     ++totals_.late_steps;
     totals_.latest_lateness = lateness;
   }
 }
 
-StepTimingSnapshot StepTiming::snapshot() const {
+StepTimingSnapshot StepTiming::snapshot(bool take_window) {
   std::vector<std::int64_t> kept;
+  kept.reserve(kKept);  // allocated before the lock: the step thread never waits for an allocation
   StepTimingSnapshot out;
   {
     cosmic::LockGuard lock(mutex_);
     out = totals_;
+    if (take_window) totals_.worst_recent = std::chrono::nanoseconds{0};
     kept.assign(recent_.begin(),
                 recent_.begin() + static_cast<std::ptrdiff_t>(std::min<std::uint64_t>(totals_.steps, kKept)));
   }

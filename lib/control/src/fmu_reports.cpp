@@ -147,9 +147,12 @@ const FmuReport* FmuReports::find(const std::string& fmu) const {
 
 std::optional<std::string> FmuReports::overrun(const FmuSpec& fmu, Clock::time_point now) const {
   const FmuReport* r = find(fmu.name);
-  if (r == nullptr || report_stale(*r, now) || r->worst_step_ns <= r->step_ns) return std::nullopt;
+  // Judged against the configured step, not the one the report names (a runner still on an older
+  // configuration, or any sender, does not choose the step it is held to).
+  const auto step = static_cast<std::uint64_t>(fmu.step.count());
+  if (r == nullptr || report_stale(*r, now) || r->worst_step_ns <= step) return std::nullopt;
   return "fmu " + fmu.name + "'s worst step " + format_duration(nanos(r->worst_step_ns)) + " exceeds its step " +
-         format_duration(nanos(r->step_ns));
+         format_duration(fmu.step);
 }
 
 Json FmuReports::fmus_answer(const std::vector<FmuSpec>& fmus, Clock::time_point now) const {

@@ -1,6 +1,7 @@
 // Variable values and their conversion to and from channel fields (cosmic/fmi_values.hpp).
 #include "cosmic/fmi_values.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -103,16 +104,46 @@ std::string to_string(const VariableValue& value) {
   return std::visit(Text{}, value);
 }
 
-VariableValue to_variable(const Variable& v, const TypeField& field, const FieldValue& value) {
-  if (field.type.kind == FieldType::Kind::string) return value.text;
+std::optional<VariableValue> to_variable(const Variable& v, const FmuDescription& d, const TypeField& field,
+                                         const FieldValue& value, bool& clipped) {
+  if (field.type.kind == FieldType::Kind::string) return VariableValue(value.text);
   const ScalarKind kind = field.type.scalar;
-  if (is_float(v.type)) return scalar_as_double(kind, value.scalar);
-  if (v.type == VariableType::boolean) return value.scalar.unsigned_integer != 0;
+  if (is_float(v.type)) return VariableValue(scalar_as_double(kind, value.scalar));
+  if (v.type == VariableType::boolean) return VariableValue(value.scalar.unsigned_integer != 0);
   // Integers and enumerations: the configuration let only integer (and enumeration) fields through.
-  if (is_unsigned(v.type)) {
-    return is_signed_integer(kind) ? static_cast<std::uint64_t>(value.scalar.integer) : value.scalar.unsigned_integer;
+  const bool negative = is_signed_integer(kind) && value.scalar.integer < 0;
+  if (v.type == VariableType::enumeration) {
+    const TypeDefinition* t = d.find_type(v.declared_type);
+    const std::int64_t n =
+        is_signed_integer(kind) ? value.scalar.integer : static_cast<std::int64_t>(value.scalar.unsigned_integer);
+    const bool item = t != nullptr && std::any_of(t->items.begin(), t->items.end(),
+                                                  [&](const EnumerationItem& i) { return i.value == n; });
+    if (!item || (!is_signed_integer(kind) && value.scalar.unsigned_integer > 0x7fffffffffffffffull))
+      return std::nullopt;
+    return VariableValue(n);
   }
-  return is_signed_integer(kind) ? value.scalar.integer : static_cast<std::int64_t>(value.scalar.unsigned_integer);
+  const auto limits = integer_limits(v.type, d.version);
+  const double lowest = std::max(v.min.value_or(limits.first), limits.first);
+  const double highest = std::min(v.max.value_or(limits.second), limits.second);
+  if (is_unsigned(v.type)) {
+    std::uint64_t n = negative                  ? 0
+                      : is_signed_integer(kind) ? static_cast<std::uint64_t>(value.scalar.integer)
+                                                : value.scalar.unsigned_integer;
+    const auto low = static_cast<std::uint64_t>(std::max(lowest, 0.0));
+    const std::uint64_t high = highest >= 0x1p64 ? ~std::uint64_t{0} : static_cast<std::uint64_t>(highest);
+    if (negative || n < low || n > high) clipped = true;
+    return VariableValue(std::clamp(n, low, high));
+  }
+  std::int64_t n = is_signed_integer(kind) ? value.scalar.integer
+                   : value.scalar.unsigned_integer > 0x7fffffffffffffffull
+                       ? std::numeric_limits<std::int64_t>::max()
+                       : static_cast<std::int64_t>(value.scalar.unsigned_integer);
+  if (!is_signed_integer(kind) && value.scalar.unsigned_integer > 0x7fffffffffffffffull) clipped = true;
+  const auto low = static_cast<std::int64_t>(std::max(lowest, -0x1p63));
+  const std::int64_t high =
+      highest >= 0x1p63 ? std::numeric_limits<std::int64_t>::max() : static_cast<std::int64_t>(highest);
+  if (n < low || n > high) clipped = true;
+  return VariableValue(std::clamp(n, low, high));
 }
 
 FieldValue to_field(const TypeField& field, const VariableValue& value, bool& clipped) {

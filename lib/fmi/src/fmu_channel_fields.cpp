@@ -34,9 +34,17 @@ class Reader {
          std::vector<FieldValue>& slots)
       : bytes_(bytes), fields_(fields), slots_(slots) {}
 
+  // A record's fields. A conditional field (present_when) its selector does not select keeps its
+  // place (zero bits) but is absent: its slots say so, and the FMU's variable keeps its value.
   bool fields(const std::vector<TypeField>& list) {
-    for (const TypeField& f : list)
+    selectors_.clear();
+    for (const TypeField& f : list) {
+      const bool is_scalar = f.type.kind == FieldType::Kind::scalar || f.type.kind == FieldType::Kind::enumeration;
+      const std::size_t at = at_;
       if (!field(f.type, &f)) return false;
+      if (is_scalar) selectors_.emplace_back(&f, read_scalar(f.type.scalar, bytes_.data() + at));
+      if (f.present_when && !selected(*f.present_when)) mark_absent(&f);
+    }
     return true;
   }
   std::size_t at() const { return at_; }
@@ -48,7 +56,7 @@ class Reader {
       case FieldType::Kind::enumeration: {
         const std::size_t n = scalar_size(type.scalar);
         if (bytes_.size() - at_ < n) return false;
-        if (FieldValue* slot = slot_of(named)) slot->scalar = read_scalar(type.scalar, bytes_.data() + at_);
+        for_slots(named, [&](FieldValue& slot) { slot.scalar = read_scalar(type.scalar, bytes_.data() + at_); });
         at_ += n;
         return true;
       }
@@ -56,8 +64,9 @@ class Reader {
         if (bytes_.size() - at_ < 4) return false;
         const std::uint32_t n = read_count(bytes_, at_);
         if (bytes_.size() - at_ - 4 < n) return false;
-        if (FieldValue* slot = slot_of(named))
-          slot->text.assign(reinterpret_cast<const char*>(bytes_.data() + at_ + 4), n);
+        for_slots(named, [&](FieldValue& slot) {
+          slot.text.assign(reinterpret_cast<const char*>(bytes_.data() + at_ + 4), n);
+        });
         at_ += 4 + n;
         return true;
       }
@@ -69,8 +78,12 @@ class Reader {
         at_ += 4;
         return elements(type.element.at(0), n);
       }
-      case FieldType::Kind::record:
-        return fields(type.fields);
+      case FieldType::Kind::record: {
+        auto outer = std::move(selectors_);  // a nested record selects among its own fields
+        const bool ok = fields(type.fields);
+        selectors_ = std::move(outer);
+        return ok;
+      }
     }
     return false;
   }
@@ -85,16 +98,31 @@ class Reader {
       if (!field(element, nullptr)) return false;
     return true;
   }
-  FieldValue* slot_of(const TypeField* named) {
-    if (named == nullptr) return nullptr;
-    const auto it = std::find(fields_.begin(), fields_.end(), named);
-    return it == fields_.end() ? nullptr : &slots_[static_cast<std::size_t>(it - fields_.begin())];
+  // Every slot that maps `named` (two variables may take one field) gets its value.
+  template <typename Assign>
+  void for_slots(const TypeField* named, Assign assign) {
+    if (named == nullptr) return;
+    for (std::size_t i = 0; i < fields_.size(); ++i)
+      if (fields_[i] == named) assign(slots_[i]);
+  }
+  bool selected(const FieldPresence& presence) const {
+    for (const auto& [f, value] : selectors_) {
+      if (f->name != presence.selector) continue;
+      const std::int64_t v =
+          is_signed_integer(f->type.scalar) ? value.integer : static_cast<std::int64_t>(value.unsigned_integer);
+      return v == presence.value;
+    }
+    return true;  // no such selector in this record: the configuration's type check rules it out
+  }
+  void mark_absent(const TypeField* f) {
+    for_slots(f, [](FieldValue& slot) { slot.present = false; });
   }
 
   std::span<const std::uint8_t> bytes_;
   const std::vector<const TypeField*>& fields_;
   std::vector<FieldValue>& slots_;
   std::size_t at_ = 0;
+  std::vector<std::pair<const TypeField*, ScalarValue>> selectors_;  // this record's scalars read so far
 };
 
 void append_count(std::vector<std::uint8_t>& out, std::uint32_t n) {
@@ -164,6 +192,7 @@ Result<ChannelFields> ChannelFields::make(const ChannelType& type, const std::ve
 Result<void> ChannelFields::read(std::span<const std::uint8_t> event, std::vector<FieldValue>& slots) const {
   if (auto sound = check_compact(*type_, event); !sound) return sound.error();
   slots.resize(slot_fields_.size());
+  for (FieldValue& slot : slots) slot.present = true;
   Reader reader(event, slot_fields_, slots);
   if (!reader.fields(type_->fields)) return Error{"the event ends inside a field"};
   return {};

@@ -90,7 +90,9 @@ if [ -f "$DEST$FMU_UNIT" ]; then
     fail "cosmic-fmu@.service does not read cosmicd's configuration $config: $fmu_start"
   grep -qE -- "--name %i( |\$)" <<<"$fmu_start" || fail "cosmic-fmu@.service does not run the fmus: entry named by its instance: $fmu_start"
   fmu_user=$(sed -n 's/^User=//p' "$DEST$FMU_UNIT")
-  [ "$fmu_user" = "$user" ] || fail "cosmic-fmu@.service runs as '$fmu_user', not as cosmicd's user $user"
+  # Not cosmicd's user (a member of cosmic-admin): an FMU is a third-party binary in-process.
+  [ -n "$fmu_user" ] && [ "$fmu_user" != "$user" ] || fail "cosmic-fmu@.service runs as '$fmu_user', not as a user of its own"
+  grep -qE "^u $fmu_user " "$DEST/usr/lib/sysusers.d/cosmic.conf" || fail "User=$fmu_user is not created by the sysusers file"
   fmu_runtime=$(sed -n 's/^RuntimeDirectory=//p' "$DEST$FMU_UNIT")
   [ "$fmu_runtime" = "cosmic-fmu/%i" ] || fail "cosmic-fmu@.service: RuntimeDirectory=$fmu_runtime, not one per instance"
   grep -qx "ExecPaths=/run/$fmu_runtime" "$DEST$FMU_UNIT" ||
@@ -195,6 +197,8 @@ if systemd-sysusers --root="$SROOT" cosmic.conf >"$WORK/sysusers.out" 2>&1; then
   [ -z "$fmu_group" ] || fmu_gid=$(awk -F: -v g="$fmu_group" '$1 == g { print $3 }' "$SROOT/etc/group")
   [ -n "$socket_gid" ] && { [ "$fmu_gid" = "$socket_gid" ] || grep -qE "^cosmic:x:[0-9]+:(.*,)?$fmu_user(,|\$)" "$SROOT/etc/group"; } ||
     fail "cosmic-fmu@.service (User=$fmu_user, Group=$fmu_group) is not in the group cosmic of the control socket: its reports would be refused"
+  grep -qE "^cosmic-admin:x:[0-9]+:(.*,)?$fmu_user(,|\$)" "$SROOT/etc/group" &&
+    fail "cosmic-fmu@.service's user $fmu_user is in cosmic-admin: an FMU could bind, unbind and reload the gateway"
 else
   fail "systemd-sysusers --root failed"
   sed 's/^/    /' "$WORK/sysusers.out" >&2

@@ -93,6 +93,12 @@ TEST(ChannelFields, WritesAWholeEventWithUnmappedFieldsZero) {
   EXPECT_TRUE(check_compact(type, event));
 }
 
+FmuDescription description_of(FmiVersion version) {
+  FmuDescription d;
+  d.version = version;
+  return d;
+}
+
 Variable variable(VariableType type) {
   Variable v;
   v.name = "x";
@@ -133,12 +139,90 @@ TEST(FmiValues, SixtyFourBitIntegersCrossExactly) {
   EXPECT_FALSE(clipped);
   FieldValue field;
   field.scalar.unsigned_integer = big - 1;
-  EXPECT_EQ(
-      std::get<std::uint64_t>(to_variable(variable(VariableType::uint64), bounded_field(ScalarKind::uint64), field)),
-      big - 1);
+  const FmuDescription fmi3 = description_of(FmiVersion::fmi3);
+  EXPECT_EQ(std::get<std::uint64_t>(
+                *to_variable(variable(VariableType::uint64), fmi3, bounded_field(ScalarKind::uint64), field, clipped)),
+            big - 1);
   field.scalar.integer = -5;
-  EXPECT_EQ(std::get<double>(to_variable(variable(VariableType::float64), bounded_field(ScalarKind::int32), field)),
+  EXPECT_EQ(std::get<double>(
+                *to_variable(variable(VariableType::float64), fmi3, bounded_field(ScalarKind::int32), field, clipped)),
             -5.0);
+  EXPECT_FALSE(clipped);
+}
+
+// A field's declared range is what admission checked; an event may still hold more (a DBC raw
+// value, another publisher): the variable gets its nearest value, never a wrapped one.
+TEST(FmiValues, AnInputBeyondTheVariablesRangeIsSaturatedNotWrapped) {
+  const FmuDescription fmi3 = description_of(FmiVersion::fmi3);
+  FieldValue field;
+  field.scalar.integer = 300;
+  bool clipped = false;
+  EXPECT_EQ(std::get<std::int64_t>(
+                *to_variable(variable(VariableType::int8), fmi3, bounded_field(ScalarKind::int16), field, clipped)),
+            127);
+  EXPECT_TRUE(clipped);
+  clipped = false;
+  field.scalar.integer = -1;
+  EXPECT_EQ(std::get<std::uint64_t>(
+                *to_variable(variable(VariableType::uint32), fmi3, bounded_field(ScalarKind::int16), field, clipped)),
+            0u);
+  EXPECT_TRUE(clipped);
+  clipped = false;
+  Variable declared = variable(VariableType::int32);
+  declared.min = -10;
+  declared.max = 10;
+  field.scalar.integer = 11;
+  EXPECT_EQ(std::get<std::int64_t>(*to_variable(declared, fmi3, bounded_field(ScalarKind::int32), field, clipped)), 10);
+  EXPECT_TRUE(clipped);
+}
+
+TEST(FmiValues, AnEnumerationValueThatIsNoItemIsNotGiven) {
+  FmuDescription d = description_of(FmiVersion::fmi2);
+  TypeDefinition gear;
+  gear.name = "Gear";
+  gear.type = VariableType::enumeration;
+  gear.items = {{"park", 0}, {"drive", 2}};
+  d.type_definitions = {gear};
+  Variable v = variable(VariableType::enumeration);
+  v.declared_type = "Gear";
+  FieldValue field;
+  field.scalar.unsigned_integer = 2;
+  bool clipped = false;
+  EXPECT_EQ(std::get<std::int64_t>(*to_variable(v, d, bounded_field(ScalarKind::uint8), field, clipped)), 2);
+  field.scalar.unsigned_integer = 1;
+  EXPECT_FALSE(to_variable(v, d, bounded_field(ScalarKind::uint8), field, clipped));
+}
+
+TEST(ChannelFields, TwoVariablesMayTakeOneField) {
+  const ChannelType type = state_type();
+  auto fields = ChannelFields::make(type, {"pose.v", "pose.v"});
+  ASSERT_TRUE(fields);
+  std::vector<FieldValue> slots;
+  ASSERT_TRUE(fields.value().read(state_event(3.5, 1, "", 0, false), slots));
+  EXPECT_EQ(slots[0].scalar.real, 3.5);
+  EXPECT_EQ(slots[1].scalar.real, 3.5);
+}
+
+// A DBC multiplexed signal: its place is zero while its selector does not select it, and then it
+// is absent, not 0.
+TEST(ChannelFields, AConditionalFieldIsAbsentWhileItsSelectorDoesNotSelectIt) {
+  ChannelType type;  // as a DBC message with a multiplexed signal gives it (channel_type_from_dbc)
+  TypeField mode;
+  mode.name = "mode";
+  mode.type.scalar = ScalarKind::uint8;
+  TypeField code;
+  code.name = "code";
+  code.type.scalar = ScalarKind::uint16;
+  code.present_when = FieldPresence{"mode", 1};
+  type.fields = {mode, code};
+  auto fields = ChannelFields::make(type, {"code"});
+  ASSERT_TRUE(fields);
+  std::vector<FieldValue> slots;
+  ASSERT_TRUE(fields.value().read(std::vector<std::uint8_t>{1, 0x34, 0x12}, slots));
+  EXPECT_TRUE(slots[0].present);
+  EXPECT_EQ(slots[0].scalar.unsigned_integer, 0x1234u);
+  ASSERT_TRUE(fields.value().read(std::vector<std::uint8_t>{0, 0, 0}, slots));
+  EXPECT_FALSE(slots[0].present);
 }
 
 TEST(FmiValues, ParametersParseAsTheirTypes) {

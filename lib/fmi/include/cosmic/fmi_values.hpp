@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -33,11 +34,17 @@ std::string to_string(const VariableValue& value);
 struct FieldValue {
   ScalarValue scalar;
   std::string text;
+  bool present = true;  // false: a conditional field its selector does not select (read() only)
 };
 
 // The field's value as the input variable takes it (float fields and integer fields to floats,
-// integer and enumeration fields to integers, bool, string). The configuration checked the pair.
-VariableValue to_variable(const Variable& variable, const TypeField& field, const FieldValue& value);
+// integer and enumeration fields to integers, bool, string). The configuration checked the pair
+// against the field's declared range, which events need not keep (a DBC signal's raw values, another
+// publisher): a whole number beyond the variable's range (declared, else its type's) is saturated
+// and `clipped` set; a value of an Enumeration variable that is none of its items gives nullopt
+// (the caller keeps the variable as it was and counts the event as undecodable).
+std::optional<VariableValue> to_variable(const Variable& variable, const FmuDescription& description,
+                                         const TypeField& field, const FieldValue& value, bool& clipped);
 
 // The output variable's value as the field holds it. A float into an integer field is rounded to
 // nearest; a value the field cannot hold (beyond its kind's or declared range, NaN, a string longer

@@ -50,12 +50,17 @@ class FmuInstance {
   virtual Result<void> do_step(double time, double step) = 0;
   // Terminates the instance (once; the destructor does it when nobody did).
   virtual Result<void> terminate() = 0;
+  // Whether the FMU asked to end the simulation (FMI 3.0 fmi3DoStep's terminateSimulation): the
+  // step it asked in succeeded, and the importer terminates it and stops.
+  bool ended() const { return ended_; }
 
   const std::deque<FmuLogLine>& recent_log() const { return log_; }
   // The kept messages as lines "[Error] logStatusError: ..." (for an error report).
   std::string recent_log_text() const;
-  // Called by the FMU's logger callback (the version's own trampoline).
-  void keep_log(FmuLogLine line);
+  // Called by the FMU's logger callback (the version's own trampoline). The message is kept as
+  // valid UTF-8 of at most kMaxLogLineBytes (an FMU may log Latin-1, or be cut inside a character):
+  // other bytes become '?'. Never throws (it runs inside the FMU's C frames).
+  void keep_log(FmuLogLine line) noexcept;
 
  protected:
   // "; the FMU said: <its last message>" (or that it logged nothing), for a failed call's error.
@@ -63,8 +68,12 @@ class FmuInstance {
 
   FmuInstance() = default;
 
+ protected:
+  void mark_ended() { ended_ = true; }
+
  private:
   std::deque<FmuLogLine> log_;
+  bool ended_ = false;
 };
 
 struct InstanceOptions {

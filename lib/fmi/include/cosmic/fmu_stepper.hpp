@@ -18,6 +18,7 @@
 #include "cosmic/fmu_instance.hpp"
 #include "cosmic/model.hpp"
 #include "cosmic/mutex.hpp"
+#include "cosmic/pi_mutex.hpp"
 
 namespace cosmic::fmi {
 
@@ -31,7 +32,9 @@ class InputLatch {
   bool take(std::vector<std::uint8_t>& event, std::uint64_t& arrived);
 
  private:
-  Mutex mutex_;
+  // Priority-inheriting: the step thread may run SCHED_FIFO (cosmic-fmu --priority), the client's
+  // receive threads time-shared; a receive thread holding the latch is lifted while it copies.
+  PiMutex mutex_;
   std::vector<std::uint8_t> pending_ COSMIC_GUARDED_BY(mutex_);
   std::uint64_t arrived_ COSMIC_GUARDED_BY(mutex_) = 0;
 };
@@ -41,7 +44,9 @@ struct InputCounters {
   std::string channel;
   std::uint64_t taken = 0;          // events the steps used
   std::uint64_t skipped = 0;        // events a newer one replaced before a step took it
-  std::uint64_t decode_errors = 0;  // events that were not one event of the channel's type
+  std::uint64_t decode_errors = 0;  // events that were not one event of the channel's type, or held an
+                                    // enumeration value that is none of the variable's items (not set)
+  std::uint64_t clipped = 0;        // values beyond their variable's range, saturated (counted per value)
 };
 struct OutputCounters {
   std::string channel;

@@ -40,7 +40,10 @@ void fmi2_log(fmi2ComponentEnvironment environment, fmi2String, fmi2Status statu
     std::vsnprintf(text, sizeof text, message, arguments);
     va_end(arguments);
   }
-  static_cast<FmuInstance*>(environment)->keep_log({fmi2_status_name(status), category ? category : "", text});
+  try {  // nothing may leave a callback through the FMU's C frames
+    static_cast<FmuInstance*>(environment)->keep_log({fmi2_status_name(status), category ? category : "", text});
+  } catch (...) {
+  }
 }
 #pragma GCC diagnostic pop
 
@@ -130,7 +133,7 @@ class Fmi2Instance final : public FmuInstance {
       const fmi2String string = text->c_str();
       s = f_.set_string(component_, &vr, 1, &string);
     }
-    return checked(s, "fmi2Set of '" + v.name + "'");
+    return checked(s, "fmi2Set", &v);
   }
 
   Result<VariableValue> get(const Variable& v) override {
@@ -154,7 +157,7 @@ class Fmi2Instance final : public FmuInstance {
       s = f_.get_integer(component_, &vr, 1, &integer);
       out = std::int64_t{integer};
     }
-    if (auto ok = checked(s, "fmi2Get of '" + v.name + "'"); !ok) return ok.error();
+    if (auto ok = checked(s, "fmi2Get", &v); !ok) return ok.error();
     return out;
   }
 
@@ -181,12 +184,15 @@ class Fmi2Instance final : public FmuInstance {
 
  private:
   // OK and Warning go on; Discard, Error and Fatal stop the runner (a co-simulation step discarded
-  // is one the runner cannot repeat: it has no earlier state to go back to).
-  Result<void> checked(fmi2Status s, const std::string& call) {
+  // is one the runner cannot repeat: it has no earlier state to go back to). After Discard the FMU
+  // may still be terminated; after Error or Fatal not (and after Fatal not even freed). The error's
+  // text is built only on failure: the step thread allocates nothing for a call that went well.
+  Result<void> checked(fmi2Status s, const char* call, const Variable* variable = nullptr) {
     if (s == fmi2OK || s == fmi2Warning) return {};
-    failed_ = true;
+    failed_ = failed_ || s != fmi2Discard;
     fatal_ = fatal_ || s == fmi2Fatal;
-    return Error{call + " returned " + fmi2_status_name(s) + last_words()};
+    const std::string what = variable ? std::string(call) + " of '" + variable->name + "'" : std::string(call);
+    return Error{what + " returned " + fmi2_status_name(s) + last_words()};
   }
 
   std::shared_ptr<SharedLibrary> library_;

@@ -1,5 +1,7 @@
 // An FMI 3.0 co-simulation instance (cosmic/fmu_instance.hpp; FMI 3.0.1 sections 2.3 and 4), without
 // event mode: after initialization the FMU is in step mode.
+#include <filesystem>
+
 #include "cosmic/fmi3_api.h"
 #include "fmu_library.hpp"
 
@@ -24,8 +26,11 @@ const char* fmi3_status_name(fmi3Status s) {
 
 void fmi3_log(fmi3InstanceEnvironment environment, fmi3Status status, fmi3String category, fmi3String message) {
   if (environment == nullptr) return;
-  static_cast<FmuInstance*>(environment)
-      ->keep_log({fmi3_status_name(status), category ? category : "", message ? message : ""});
+  try {  // nothing may leave a callback through the FMU's C frames
+    static_cast<FmuInstance*>(environment)
+        ->keep_log({fmi3_status_name(status), category ? category : "", message ? message : ""});
+  } catch (...) {
+  }
 }
 
 // One type's get and set functions.
@@ -107,22 +112,25 @@ class Fmi3Instance final : public FmuInstance {
   }
 
   Result<void> create(const OpenedFmu& fmu, const InstanceOptions& options) {
-    const std::string resources =
-        fmu.resources.empty() || fmu.resources.back() == '/' ? fmu.resources : fmu.resources + "/";
-    instance_ = f_.instantiate(options.instance_name.c_str(), fmu.description.instantiation_token.c_str(),
-                               resources.c_str(), false, options.logging_on, /*eventModeUsed=*/false,
-                               /*earlyReturnAllowed=*/false, nullptr, 0, this, fmi3_log, nullptr);
+    // The FMU's resources directory with its trailing '/', or NULL when it has none (FMI 3.0 2.3.1).
+    std::error_code ignored;
+    const bool has_resources = !fmu.resources.empty() && !std::filesystem::is_empty(fmu.resources, ignored);
+    const std::string resources = has_resources && fmu.resources.back() != '/' ? fmu.resources + "/" : fmu.resources;
+    instance_ =
+        f_.instantiate(options.instance_name.c_str(), fmu.description.instantiation_token.c_str(),
+                       has_resources ? resources.c_str() : nullptr, false, options.logging_on, /*eventModeUsed=*/false,
+                       /*earlyReturnAllowed=*/false, nullptr, 0, this, fmi3_log, nullptr);
     if (instance_ == nullptr) return Error{"fmi3InstantiateCoSimulation refused" + last_words()};
     return {};
   }
 
   Result<void> set(const Variable& v, const VariableValue& value) override {
-    return checked(set_value(v, value), "fmi3Set of '" + v.name + "'");
+    return checked(set_value(v, value), "fmi3Set", &v);
   }
 
   Result<VariableValue> get(const Variable& v) override {
     VariableValue out;
-    if (auto ok = checked(get_value(v, out), "fmi3Get of '" + v.name + "'"); !ok) return ok.error();
+    if (auto ok = checked(get_value(v, out), "fmi3Get", &v); !ok) return ok.error();
     return out;
   }
 
@@ -143,10 +151,9 @@ class Fmi3Instance final : public FmuInstance {
                           "fmi3DoStep");
         !ok)
       return ok;
-    if (terminate) {
-      failed_ = true;
-      return Error{"fmi3DoStep at t=" + shortest_number_text(time) + " asked to end the simulation" + last_words()};
-    }
+    // terminateSimulation: the step succeeded and the FMU is done; the runner publishes this step's
+    // outputs, terminates the FMU (fmi3Terminate, as the standard asks) and stops.
+    if (terminate) mark_ended();
     return {};
   }
 
@@ -262,11 +269,14 @@ class Fmi3Instance final : public FmuInstance {
     }
   }
 
-  Result<void> checked(fmi3Status s, const std::string& call) {
+  // As Fmi2Instance::checked: Discard still lets the FMU be terminated, Error and Fatal do not; the
+  // error's text is built only on failure.
+  Result<void> checked(fmi3Status s, const char* call, const Variable* variable = nullptr) {
     if (s == fmi3OK || s == fmi3Warning) return {};
-    failed_ = true;
+    failed_ = failed_ || s != fmi3Discard;
     fatal_ = fatal_ || s == fmi3Fatal;
-    return Error{call + " returned " + fmi3_status_name(s) + last_words()};
+    const std::string what = variable ? std::string(call) + " of '" + variable->name + "'" : std::string(call);
+    return Error{what + " returned " + fmi3_status_name(s) + last_words()};
   }
 
   std::shared_ptr<SharedLibrary> library_;

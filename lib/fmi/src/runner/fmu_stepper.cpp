@@ -104,10 +104,20 @@ Result<void> FmuStepper::take_inputs() {
       continue;
     }
     ++in.counters.taken;
+    bool undecodable = false;
     for (std::size_t slot = 0; slot < in.variables.size(); ++slot) {
+      if (!in.values[slot].present) continue;  // a conditional field not selected: the variable keeps its value
       const Variable& v = *in.variables[slot];
-      if (auto set = instance_.set(v, to_variable(v, in.fields.field(slot), in.values[slot])); !set) return set;
+      bool clipped = false;
+      const auto value = to_variable(v, description_, in.fields.field(slot), in.values[slot], clipped);
+      if (!value) {
+        undecodable = true;  // an enumeration value that is none of the variable's items
+        continue;
+      }
+      if (clipped) ++in.counters.clipped;
+      if (auto set = instance_.set(v, *value); !set) return set;
     }
+    if (undecodable) ++in.counters.decode_errors;
   }
   return {};
 }
