@@ -29,6 +29,9 @@ inline constexpr std::int64_t kMaxBlockingNs = 100'000;
 inline constexpr std::int64_t kMinHeartbeatNs = 5'000'000;
 inline constexpr std::int64_t kMaxHeartbeatNs = 100'000'000;
 
+// NACK suppression of reliable writers (dds_qos.cpp says why): a fifth of the shortest heartbeat.
+inline constexpr std::int64_t kNackSuppressionNs = 1'000'000;
+
 // KEEP_LAST depth of a channel: max(1, omission_degree + 1), capped at kMaxHistoryDepth.
 // A channel that tolerates `omission_degree` consecutive losses is served by keeping that many
 // samples plus the newest one: a reliable writer can still repair a burst of that length, while
