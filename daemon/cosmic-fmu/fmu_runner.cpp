@@ -176,8 +176,7 @@ cosmic::Result<void> FmuRunner::one_step(std::uint64_t index) {
   if (trace_.is_open()) trace_step(index);
   {
     cosmic::LockGuard lock(status_mutex_);
-    inputs_ = stepper_->input_counters();
-    outputs_ = stepper_->output_counters();
+    stepper_->copy_counters(inputs_, outputs_);  // numbers only after the first step: no allocation
   }
   return {};
 }

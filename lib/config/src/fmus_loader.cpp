@@ -7,6 +7,7 @@
 #include <set>
 
 #include "cosmic/fmi_mapping.hpp"
+#include "cosmic/fmu_channel_fields.hpp"
 #include "cosmic/fmu_archive.hpp"
 #include "cosmic/units.hpp"
 
@@ -20,18 +21,6 @@ std::string listed(const std::vector<std::string>& names) {
   for (std::size_t i = 0; i < names.size() && i < kListedNames; ++i) out += (i == 0 ? "" : ", ") + names[i];
   if (names.size() > kListedNames) out += ", ... (" + std::to_string(names.size()) + " in all)";
   return out.empty() ? "(none)" : out;
-}
-
-// The field at a dotted path through nested records; null when there is none.
-const TypeField* field_at(const std::vector<TypeField>& fields, const std::string& path) {
-  const std::size_t dot = path.find('.');
-  const std::string head = path.substr(0, dot);
-  for (const TypeField& f : fields) {
-    if (f.name != head) continue;
-    if (dot == std::string::npos) return &f;
-    return f.type.kind == FieldType::Kind::record ? field_at(f.type.fields, path.substr(dot + 1)) : nullptr;
-  }
-  return nullptr;
 }
 
 // The always-present fields an event needs, as dotted paths: records are entered; conditional
@@ -243,7 +232,7 @@ class FmusLoader {
                        "a channel with a type (yaml-reference.md, `type`): an FMU variable maps to one of its fields");
       return nullptr;
     }
-    const TypeField* field = field_at(channel->type->fields, m.field);
+    const TypeField* field = fmi::field_at_path(channel->type->fields, m.field);
     if (field == nullptr) {
       std::vector<std::string> fields;
       leaves(channel->type->fields, "", fields);

@@ -9,17 +9,6 @@
 namespace cosmic::fmi {
 namespace {
 
-const TypeField* field_at_path(const std::vector<TypeField>& fields, std::string_view path) {
-  const std::size_t dot = path.find('.');
-  const std::string_view head = path.substr(0, dot);
-  for (const TypeField& f : fields) {
-    if (f.name != head) continue;
-    if (dot == std::string_view::npos) return &f;
-    return f.type.kind == FieldType::Kind::record ? field_at_path(f.type.fields, path.substr(dot + 1)) : nullptr;
-  }
-  return nullptr;
-}
-
 std::uint32_t read_count(std::span<const std::uint8_t> bytes, std::size_t at) {
   std::uint32_t n = 0;
   std::memcpy(&n, bytes.data() + at, sizeof n);  // the layout is little-endian, as this host
@@ -174,6 +163,17 @@ void append_fields(const std::vector<TypeField>& list, const std::vector<const T
 }
 
 }  // namespace
+
+const TypeField* field_at_path(const std::vector<TypeField>& fields, std::string_view path) {
+  const std::size_t dot = path.find('.');
+  const std::string_view head = path.substr(0, dot);
+  for (const TypeField& f : fields) {
+    if (f.name != head) continue;
+    if (dot == std::string_view::npos) return &f;
+    return f.type.kind == FieldType::Kind::record ? field_at_path(f.type.fields, path.substr(dot + 1)) : nullptr;
+  }
+  return nullptr;
+}
 
 Result<ChannelFields> ChannelFields::make(const ChannelType& type, const std::vector<std::string>& paths) {
   ChannelFields out(type);

@@ -334,6 +334,15 @@ TEST_F(Stepper, EachStepTakesTheNewestEventAndCountsTheSkippedOnes) {
   EXPECT_EQ(in[0].taken, 1u);
   EXPECT_EQ(in[0].skipped, 2u);
   EXPECT_EQ(s.output_counters()[0].events, 3u);
+  std::vector<InputCounters> copied_in;
+  std::vector<OutputCounters> copied_out;
+  s.copy_counters(copied_in, copied_out);
+  EXPECT_EQ(copied_in[0].channel, "drive");
+  EXPECT_EQ(copied_in[0].skipped, 2u);
+  ASSERT_TRUE(s.step(3));
+  s.copy_counters(copied_in, copied_out);  // the second time: numbers only
+  EXPECT_EQ(copied_out[0].channel, "speed");
+  EXPECT_EQ(copied_out[0].events, 4u);
 }
 
 TEST_F(Stepper, AnEventThatIsNotOfTheTypeIsCountedAndChangesNothing) {

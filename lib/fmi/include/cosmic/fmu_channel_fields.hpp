@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "cosmic/channel_type.hpp"
@@ -15,6 +16,10 @@
 #include "cosmic/result.hpp"
 
 namespace cosmic::fmi {
+
+// The field at a dotted path through nested records ("pose.v"); null when there is none. The
+// configuration checks mappings with it, ChannelFields finds them with it.
+const TypeField* field_at_path(const std::vector<TypeField>& fields, std::string_view path);
 
 class ChannelFields {
  public:

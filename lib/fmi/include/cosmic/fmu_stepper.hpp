@@ -77,6 +77,9 @@ class FmuStepper {
 
   std::vector<InputCounters> input_counters() const;
   std::vector<OutputCounters> output_counters() const;
+  // The counters into the caller's vectors: the channel names copied once, the numbers at every
+  // call, so a step that calls it allocates nothing after the first.
+  void copy_counters(std::vector<InputCounters>& inputs, std::vector<OutputCounters>& outputs) const;
   double step_seconds() const { return step_seconds_; }
   FmuInstance& instance() { return instance_; }
 

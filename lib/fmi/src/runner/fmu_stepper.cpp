@@ -150,4 +150,20 @@ std::vector<OutputCounters> FmuStepper::output_counters() const {
   return out;
 }
 
+void FmuStepper::copy_counters(std::vector<InputCounters>& inputs, std::vector<OutputCounters>& outputs) const {
+  if (inputs.size() != inputs_.size()) inputs = input_counters();
+  if (outputs.size() != outputs_.size()) outputs = output_counters();
+  for (std::size_t i = 0; i < inputs_.size(); ++i) {
+    const InputCounters& c = inputs_[i].counters;
+    inputs[i].taken = c.taken;
+    inputs[i].skipped = c.skipped;
+    inputs[i].decode_errors = c.decode_errors;
+    inputs[i].clipped = c.clipped;
+  }
+  for (std::size_t i = 0; i < outputs_.size(); ++i) {
+    outputs[i].events = outputs_[i].counters.events;
+    outputs[i].clipped = outputs_[i].counters.clipped;
+  }
+}
+
 }  // namespace cosmic::fmi
