@@ -14,22 +14,68 @@ EgressLane::EgressLane(LaneContext& context, std::size_t segment, std::size_t by
 
 EgressLane::~EgressLane() { deactivate(); }
 
-bool EgressLane::push(LaneItem&& item) noexcept {
+bool EgressLane::push(LaneItem&& item) noexcept { return offer(std::move(item), false); }
+
+bool EgressLane::push_or_send(LaneItem&& item) noexcept { return offer(std::move(item), true); }
+
+bool EgressLane::offer(LaneItem&& item, bool may_send_here) noexcept {
   const std::size_t size = item.payload->bytes().size();
+  bool send_here = false;
+  bool wake = true;
   {
     PiLock lock(mutex_);
-    if (!active_ || count_ == ring_.size() || bytes_ + size > byte_budget_) return false;
+    if (!active_) return false;
     item.generation = generation_;
-    ring_[(head_ + count_) % ring_.size()] = std::move(item);
-    bytes_ += size;
-    ++count_;
+    send_here = may_send_here && direct_allowed_ && !sending_ && count_ == 0;
+    if (send_here) {
+      sending_ = true;
+      direct_sending_ = true;
+      in_hand_.store(1, std::memory_order_relaxed);  // a send that hangs shows as queued (watchdog)
+    } else {
+      if (count_ == ring_.size() || bytes_ + size > byte_budget_) return false;
+      ring_[(head_ + count_) % ring_.size()] = std::move(item);
+      bytes_ += size;
+      ++count_;
+      // An ingress thread's send in progress wakes the lane's thread when it ends.
+      wake = !direct_sending_;
+    }
   }
-  wake_.notify_one();
+  if (!send_here) {
+    if (wake) wake_.notify_one();
+    return true;
+  }
+  forward(item);
+  end_direct_send();
   return true;
+}
+
+void EgressLane::end_direct_send() noexcept {
+  bool wake = false;
+  {
+    PiLock lock(mutex_);
+    sending_ = false;
+    direct_sending_ = false;
+    in_hand_.store(0, std::memory_order_relaxed);
+    // The lane's thread for what queued meanwhile; deactivate() waiting for this send.
+    wake = count_ > 0 || !direct_allowed_;
+  }
+  if (wake) wake_.notify_all();
+}
+
+void EgressLane::wait_for_direct_send() noexcept {
+  for (;;) {
+    const std::uint32_t seen = wake_.current();
+    {
+      PiLock lock(mutex_);
+      if (!direct_sending_) return;
+    }
+    wake_.wait(seen);
+  }
 }
 
 std::size_t EgressLane::pop_batch(std::span<LaneItem> out) noexcept {
   PiLock lock(mutex_);
+  if (direct_sending_) return 0;  // it hands over to this thread when its send returns
   std::size_t n = 0;
   for (; n < out.size() && count_ > 0; ++n) {
     out[n] = std::move(ring_[head_]);
@@ -37,6 +83,8 @@ std::size_t EgressLane::pop_batch(std::span<LaneItem> out) noexcept {
     head_ = (head_ + 1) % ring_.size();
     --count_;
   }
+  // The lane's thread keeps sending until it finds the ring empty: then an ingress thread may.
+  sending_ = n > 0;
   in_hand_.store(n, std::memory_order_relaxed);  // still counted as queued until handed over
   return n;
 }
@@ -81,6 +129,7 @@ void EgressLane::activate(SegmentAdapter* adapter, const ThreadPolicy& policy, b
       head_ = 0;
     }
     active_ = true;
+    direct_allowed_ = threaded;
     current_generation_.store(generation_, std::memory_order_release);
   }
   adapter_.store(adapter, std::memory_order_release);
@@ -90,6 +139,12 @@ void EgressLane::activate(SegmentAdapter* adapter, const ThreadPolicy& policy, b
 }
 
 void EgressLane::deactivate() {
+  {
+    PiLock lock(mutex_);
+    direct_allowed_ = false;
+  }
+  // The adapter may be going away after this returns: an ingress thread's send ends first.
+  wait_for_direct_send();
   if (thread_.joinable()) {
     running_.store(false, std::memory_order_release);
     wake_.notify_all();
@@ -106,6 +161,7 @@ void EgressLane::deactivate() {
       --count_;
     }
     bytes_ = 0;
+    sending_ = false;
   }
   adapter_.store(nullptr, std::memory_order_release);
   for (auto& item : dropped) discard(item);

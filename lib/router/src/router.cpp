@@ -274,6 +274,17 @@ bool Router::admit(ChannelState& channel, SegmentCounters& counters, const Inbou
   return true;
 }
 
+namespace {
+// Whether the gateway also receives the channel on subscriber segment `segment`: its own reader
+// is there, and a transport may hand what is sent to it within the send (Fast DDS delivers to a
+// matched reader of the same process on the writing thread). Such a send never runs on a
+// receive thread: that receive would run inside this one, and two of them in opposite directions
+// would each wait for the reader the other is in.
+bool sends_back_in_process(const Route& route, std::size_t segment) {
+  return std::find(route.publishers.begin(), route.publishers.end(), segment) != route.publishers.end();
+}
+}  // namespace
+
 // Copies the payload once and queues the event on the lane of each subscriber segment.
 void Router::enqueue(const std::shared_ptr<ChannelState>& channel, std::size_t segment, const InboundEvent& event) {
   const Route& route = channel->route;
@@ -301,10 +312,17 @@ void Router::enqueue(const std::shared_ptr<ChannelState>& channel, std::size_t s
   }
   // Counted before the lanes can send it (see EgressLane::forward), taken back if none took it.
   channel->forwarded.fetch_add(1, std::memory_order_relaxed);
+  // A thread that carries this class alone sends to the last hop itself when that lane is idle
+  // (EgressLane::push_or_send), after the other hops' lanes have their copies: they send
+  // meanwhile on their own threads, and no hop waits for another hop's send.
+  const std::size_t last = route.subscribers.back();
+  const bool may_send_here = event.receiver_class == route.spec.cls && !sends_back_in_process(route, last);
   bool queued = false;
   for (std::uint32_t hop = 0; hop < fanout; ++hop) {
     const std::size_t s = route.subscribers[hop];
-    if (lane(s, route.spec.cls).push(LaneItem{channel, buffer, header, event.received_at, hop, 0})) {
+    LaneItem item{channel, buffer, header, event.received_at, hop, 0};
+    EgressLane& to = lane(s, route.spec.cls);
+    if (may_send_here && hop + 1 == fanout ? to.push_or_send(std::move(item)) : to.push(std::move(item))) {
       queued = true;
     } else {
       channel->counters[s].drop(DropReason::queue_full);

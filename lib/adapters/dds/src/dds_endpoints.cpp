@@ -112,6 +112,9 @@ void DdsAdapter::deliver(ReaderEntry& entry, const dds::SampleInfo& info) {
       break;
   }
   event.received_at = arrival_on_steady_clock(info.reception_timestamp);
+  // This thread is a receive thread of the channel's class participant, which carries that class
+  // alone: the router may send the event on from here (cosmic/event.hpp).
+  event.receiver_class = entry.spec.cls;
   sink_->on_event(event);
 }
 

@@ -3,8 +3,10 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 
+#include "cosmic/channel_class.hpp"
 #include "cosmic/units.hpp"
 
 namespace cosmic {
@@ -48,6 +50,13 @@ struct InboundEvent {
   // What the wire format it came in carries of its identity; the router's loop and duplicate
   // checks ask it (see FormatIdentity).
   FormatIdentity identity{};
+  // Set by an adapter whose receive threads each carry the channels of one class only (DDS: a
+  // participant per class) to that class. The router may then hand an event of that class to its
+  // egress transport on this very thread when the egress lane is idle, sparing the wake-up of the
+  // lane's thread (EgressLane::push_or_send): a thread that also carries a higher class must
+  // never wait for a lower class's send, so unset (CAN, LCM: one receive thread for every class)
+  // every event waits for its lane's thread.
+  std::optional<ChannelClass> receiver_class{};
 };
 
 // Handed by the router to an adapter (router thread).

@@ -12,13 +12,13 @@
 #include <string>
 #include <vector>
 
+#include "cosmic/channel_class.hpp"
 #include "cosmic/channel_type.hpp"
 #include "cosmic/secret_key.hpp"
 #include "cosmic/units.hpp"
 
 namespace cosmic {
 
-enum class ChannelClass { hrt, srt, nrt };
 enum class SegmentType { can, dds, lcm, replay };
 enum class Reliability { reliable, best_effort };
 enum class LcmEncoding { envelope, raw };

@@ -4,7 +4,8 @@
 //
 // Threads: start/configure/stop are called by the control thread, send() by the egress lane
 // threads of this segment (one per class, so send() may run on up to three threads at once, each
-// for channels of its own class), health()/statistics() by any thread.
+// for channels of its own class; a lane may instead let a receive thread of its class make the
+// send, never two senders of one class at once), health()/statistics() by any thread.
 //
 // send() contract: it returns within a bounded, short time (microseconds; a transport that can
 // block, like a reliable DDS writer, is given a small blocking bound) and never waits on another
@@ -51,8 +52,8 @@ enum class InboundProblem { decode_error, unknown_channel, own_echo, unauthentic
 
 // Implemented by the router, one per segment. Called from adapter threads; never blocks long:
 // the router does its ingress work on the calling thread and hands the event to the egress
-// lanes (one hand-off), so the adapter should call it straight from the thread that read the
-// network.
+// lanes (one hand-off; or sends it on this thread, see InboundEvent::receiver_class), so the
+// adapter should call it straight from the thread that read the network.
 class EventSink {
  public:
   virtual void on_event(const InboundEvent& event) = 0;

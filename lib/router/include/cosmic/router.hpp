@@ -7,7 +7,8 @@
 // channel's reaction_time (see EgressStats).
 //
 // Threads: inbox(i).on_event() is called from adapter threads and does the ingress work on that
-// thread (one hand-off to the lane thread after it); apply(), set_segment(), snapshot() and
+// thread (one hand-off to the lane thread after it, or, for a thread of the event's class alone
+// and an idle lane, the send itself: InboundEvent::receiver_class); apply(), set_segment(), snapshot() and
 // stop() from the control thread. The route table is an immutable snapshot swapped atomically:
 // no lock is held across any I/O. The router does not own the adapters: the caller keeps an
 // adapter alive until set_segment(index, ..., nullptr) has returned (which waits for the send in
