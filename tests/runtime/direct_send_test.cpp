@@ -25,6 +25,10 @@ namespace {
 constexpr std::uint64_t kDirectSendSelf = 0xBBBB;
 constexpr auto kDirectSendPatience = std::chrono::seconds(20);
 
+// The router's clock in these tests: it moves only when a test or a send moves it.
+std::atomic<std::int64_t> fake_now_ns{1'000'000'000};
+Nanos fake_now() { return Nanos(fake_now_ns.load()); }
+
 // Records each send with its thread; a closed gate holds every send until it opens.
 class RecordingTransport final : public SegmentAdapter {
  public:
@@ -41,6 +45,7 @@ class RecordingTransport final : public SegmentAdapter {
     changed_.notify_all();
     changed_.wait(lock, [&] { return gate_open_; });
     sent_.push_back({event.payload.empty() ? std::uint8_t{0} : event.payload[0], std::this_thread::get_id()});
+    fake_now_ns += send_cost_ns.load();
     changed_.notify_all();
     return SendStatus::sent;
   }
@@ -48,6 +53,8 @@ class RecordingTransport final : public SegmentAdapter {
   AdapterStatistics statistics() const override { return {}; }
   std::optional<std::size_t> matched_peers(ChannelId) const override { return std::nullopt; }
   void stop() override {}
+
+  std::atomic<std::int64_t> send_cost_ns{0};  // how far each send moves the fake clock
 
   void close_gate() {
     std::lock_guard lock(mutex_);
@@ -97,7 +104,7 @@ class DirectSendTest : public ::testing::Test {
   void start(std::uint32_t fanout = 1, bool both_ways = false) {
     RouterLimits limits;
     limits.threaded = true;
-    router = std::make_unique<Router>(GatewayIdentity{kDirectSendSelf, "test"}, 3, limits);
+    router = std::make_unique<Router>(GatewayIdentity{kDirectSendSelf, "test"}, 3, limits, fake_now);
     router->set_segment(0, "in", &in);
     router->set_segment(1, "out", &out);
     router->set_segment(2, "also", &also);
@@ -118,7 +125,7 @@ class DirectSendTest : public ::testing::Test {
   // As an adapter's receive thread delivers it; `receiver`: InboundEvent::receiver_class.
   void deliver(std::uint8_t tag, std::optional<ChannelClass> receiver) {
     const std::vector<std::uint8_t> payload{tag};
-    InboundEvent event{1, EventHeader{}, payload, steady_now()};
+    InboundEvent event{1, EventHeader{}, payload, fake_now()};
     event.receiver_class = receiver;
     router->inbox(0).on_event(event);
   }
@@ -210,6 +217,33 @@ TEST_F(DirectSendTest, AHopWhereTheGatewayAlsoReceivesTheChannelIsLeftToItsLane)
   deliver(1, ChannelClass::nrt);
   ASSERT_TRUE(out.wait_sent(1));
   EXPECT_NE(out.sent()[0].thread, std::this_thread::get_id());
+}
+
+// A lane whose sends take much of the time hands every event to its own thread, so that the
+// ingress thread goes back to receiving (two threads on two CPUs); once sending is light again,
+// ingress threads send for themselves again.
+TEST_F(DirectSendTest, ALaneBusySendingTakesTheSendsAwayFromTheReceiveThreadUntilItIsIdleAgain) {
+  start();
+  out.send_cost_ns = 1'000'000;  // back-to-back sends of 1 ms: the lane sends all the time
+  std::uint8_t tag = 0;
+  std::size_t direct = 0;
+  for (int i = 0; i < 7; ++i) {
+    deliver(++tag, ChannelClass::nrt);
+    ASSERT_TRUE(out.wait_sent(tag));
+    if (out.sent().back().thread == std::this_thread::get_id()) ++direct;
+  }
+  EXPECT_EQ(direct, 6u) << "the first window (5 ms of sending) ends loaded at the 6th send";
+  EXPECT_NE(out.sent().back().thread, std::this_thread::get_id());
+  // Light sending: 0 ms per send, 1 ms apart.
+  out.send_cost_ns = 0;
+  bool direct_again = false;
+  for (int i = 0; i < 100 && !direct_again; ++i) {
+    fake_now_ns += 1'000'000;
+    deliver(++tag, ChannelClass::nrt);
+    ASSERT_TRUE(out.wait_sent(tag));
+    direct_again = out.sent().back().thread == std::this_thread::get_id();
+  }
+  EXPECT_TRUE(direct_again) << "the lane stayed loaded after its sends became light";
 }
 
 bool sleeping(pid_t tid) {

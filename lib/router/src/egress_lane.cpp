@@ -26,7 +26,8 @@ bool EgressLane::offer(LaneItem&& item, bool may_send_here) noexcept {
     PiLock lock(mutex_);
     if (!active_) return false;
     item.generation = generation_;
-    send_here = may_send_here && direct_allowed_ && !sending_ && count_ == 0;
+    send_here =
+        may_send_here && direct_allowed_ && !sending_ && count_ == 0 && !loaded_.load(std::memory_order_relaxed);
     if (send_here) {
       sending_ = true;
       direct_sending_ = true;
@@ -44,9 +45,25 @@ bool EgressLane::offer(LaneItem&& item, bool may_send_here) noexcept {
     if (wake) wake_.notify_one();
     return true;
   }
+  const Nanos started = context_.clock();
   forward(item);
+  note_send(started, context_.clock());
   end_direct_send();
   return true;
+}
+
+void EgressLane::note_send(Nanos started, Nanos ended) noexcept {
+  duty_busy_ += ended - started;
+  const Nanos span = ended - duty_window_start_;
+  if (span < kDutyWindow) return;
+  const std::int64_t percent = duty_busy_.count() * 100 / span.count();
+  if (percent >= kLoadedPercent) {
+    loaded_.store(true, std::memory_order_relaxed);
+  } else if (percent <= kUnloadedPercent) {
+    loaded_.store(false, std::memory_order_relaxed);
+  }
+  duty_window_start_ = ended;
+  duty_busy_ = Nanos(0);
 }
 
 void EgressLane::end_direct_send() noexcept {
@@ -130,6 +147,10 @@ void EgressLane::activate(SegmentAdapter* adapter, const ThreadPolicy& policy, b
     }
     active_ = true;
     direct_allowed_ = threaded;
+    // No sender runs now (deactivate() ended them): the duty starts afresh.
+    duty_window_start_ = Nanos(0);
+    duty_busy_ = Nanos(0);
+    loaded_.store(false, std::memory_order_relaxed);
     current_generation_.store(generation_, std::memory_order_release);
   }
   adapter_.store(adapter, std::memory_order_release);
@@ -196,7 +217,9 @@ void EgressLane::worker(const ThreadPolicy& policy) {
     if (!running_.load(std::memory_order_acquire)) break;
     const std::size_t n = pop_batch(std::span(batch.data(), batch_limit()));
     if (n > 0) {
+      const Nanos started = context_.clock();
       hand_over(std::span(batch.data(), n));
+      note_send(started, context_.clock());
       continue;
     }
     wake_.wait(seen);

@@ -12,6 +12,12 @@
 // its event itself (push_or_send). Whoever sends holds `sending_` (set under the mutex, never a
 // lock across the send), so events leave in the order they were taken and the adapter, the
 // scratch buffers and the counters see one thread of this lane at a time.
+//
+// An ingress thread that sends for itself also receives for itself: at a rate where sending takes
+// a large part of the time, the two are better done by two threads on two CPUs (at saturation
+// one thread doing both delivered a third of what two did, scripts/bench relay-rates). So the lane
+// measures how much of the time it spends sending, whoever sends, and while that is high
+// (kLoadedPercent, until it falls to kUnloadedPercent) every event goes to the lane's thread.
 #pragma once
 
 #include <array>
@@ -80,7 +86,13 @@ class EgressLane {
  private:
   // At most this many queued events go to the adapter at once (SegmentAdapter::send_batch).
   static constexpr std::size_t kSendBatch = 16;
+  // The send duty is judged over windows of at least this long.
+  static constexpr Nanos kDutyWindow{5'000'000};
+  static constexpr std::int64_t kLoadedPercent = 30;
+  static constexpr std::int64_t kUnloadedPercent = 15;
   bool offer(LaneItem&& item, bool may_send_here) noexcept COSMIC_EXCLUDES(mutex_);
+  // Counts a send from `started` to `ended` into the send duty (by the sender holding `sending_`).
+  void note_send(Nanos started, Nanos ended) noexcept;
   // The end of an ingress thread's own send: the lane's thread takes over what queued meanwhile.
   void end_direct_send() noexcept COSMIC_EXCLUDES(mutex_);
   // Until no ingress thread is sending (deactivate(), after forbidding new ones).
@@ -130,6 +142,12 @@ class EgressLane {
   // batch (the adapter reads them all in one send_batch); each grows to the largest message it
   // has held and is then reused. Only the lane's thread (or run_once's caller) touches them.
   std::array<std::vector<std::uint8_t>, kSendBatch> scratch_;
+
+  // The current window of the send duty; only the sender holding `sending_` touches it (handed
+  // from sender to sender under mutex_).
+  Nanos duty_window_start_{0};
+  Nanos duty_busy_{0};
+  std::atomic<bool> loaded_{false};  // sends took kLoadedPercent of a window: no direct sends
 
   std::atomic<SegmentAdapter*> adapter_{nullptr};
   std::atomic<std::uint64_t> current_generation_{0};
