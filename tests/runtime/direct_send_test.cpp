@@ -227,13 +227,15 @@ TEST_F(DirectSendTest, ALaneBusySendingTakesTheSendsAwayFromTheReceiveThreadUnti
   out.send_cost_ns = 1'000'000;  // back-to-back sends of 1 ms: the lane sends all the time
   std::uint8_t tag = 0;
   std::size_t direct = 0;
-  for (int i = 0; i < 7; ++i) {
+  bool handed_over = false;
+  for (int i = 0; i < 100 && !handed_over; ++i) {
     deliver(++tag, ChannelClass::nrt);
     ASSERT_TRUE(out.wait_sent(tag));
-    if (out.sent().back().thread == std::this_thread::get_id()) ++direct;
+    handed_over = out.sent().back().thread != std::this_thread::get_id();
+    if (!handed_over) ++direct;
   }
-  EXPECT_EQ(direct, 6u) << "the first window (5 ms of sending) ends loaded at the 6th send";
-  EXPECT_NE(out.sent().back().thread, std::this_thread::get_id());
+  EXPECT_TRUE(handed_over) << "the receive thread kept sending all the time";
+  EXPECT_GE(direct, 5u) << "a window of the duty is several sends long";
   // Light sending: 0 ms per send, 1 ms apart.
   out.send_cost_ns = 0;
   bool direct_again = false;
