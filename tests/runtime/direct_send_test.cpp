@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <sstream>
@@ -35,6 +36,7 @@ class RecordingTransport final : public SegmentAdapter {
   struct Sent {
     std::uint8_t first_byte = 0;
     std::thread::id thread;
+    bool watched = false;  // the watched flag (watch()) was set when this send ended
   };
 
   Status start(EventSink&) override { return Status::success(); }
@@ -43,8 +45,11 @@ class RecordingTransport final : public SegmentAdapter {
     std::unique_lock lock(mutex_);
     ++entered_;
     changed_.notify_all();
-    changed_.wait(lock, [&] { return gate_open_; });
-    sent_.push_back({event.payload.empty() ? std::uint8_t{0} : event.payload[0], std::this_thread::get_id()});
+    // A send held for ever would hang the test instead of failing it.
+    if (!changed_.wait_for(lock, kDirectSendPatience, [&] { return gate_open_; }))
+      ADD_FAILURE() << "a send waited at the closed gate for " << kDirectSendPatience.count() << " s";
+    sent_.push_back({event.payload.empty() ? std::uint8_t{0} : event.payload[0], std::this_thread::get_id(),
+                     watched_ != nullptr && watched_->load()});
     fake_now_ns += send_cost_ns.load();
     changed_.notify_all();
     return SendStatus::sent;
@@ -55,6 +60,11 @@ class RecordingTransport final : public SegmentAdapter {
   void stop() override {}
 
   std::atomic<std::int64_t> send_cost_ns{0};  // how far each send moves the fake clock
+
+  void watch(const std::atomic<bool>* flag) {
+    std::lock_guard lock(mutex_);
+    watched_ = flag;
+  }
 
   void close_gate() {
     std::lock_guard lock(mutex_);
@@ -83,6 +93,7 @@ class RecordingTransport final : public SegmentAdapter {
   mutable std::mutex mutex_;
   std::condition_variable changed_;
   bool gate_open_ = true;
+  const std::atomic<bool>* watched_ = nullptr;
   std::size_t entered_ = 0;
   std::vector<Sent> sent_;
 };
@@ -115,17 +126,22 @@ class DirectSendTest : public ::testing::Test {
     std::vector<std::size_t> publishers{0};
     if (both_ways) publishers.push_back(1);
     routes.push_back(Route{1, nrt_channel("a"), publishers, subscribers, Nanos(0)});
+    routes.push_back(Route{2, nrt_channel("b"), {0}, {2}, Nanos(0)});  // channel b: to "also" alone
     router->apply(std::move(routes));
   }
+
+  // A second of the fake clock between tests: a send duty an earlier test left loaded (this
+  // thread's own is thread_local) is judged over it, and loaded no longer.
+  void SetUp() override { fake_now_ns += 1'000'000'000; }
 
   void TearDown() override {
     if (router) router->stop();
   }
 
   // As an adapter's receive thread delivers it; `receiver`: InboundEvent::receiver_class.
-  void deliver(std::uint8_t tag, std::optional<ChannelClass> receiver) {
+  void deliver(std::uint8_t tag, std::optional<ChannelClass> receiver, ChannelId channel = 1) {
     const std::vector<std::uint8_t> payload{tag};
-    InboundEvent event{1, EventHeader{}, payload, fake_now()};
+    InboundEvent event{channel, EventHeader{}, payload, fake_now()};
     event.receiver_class = receiver;
     router->inbox(0).on_event(event);
   }
@@ -135,6 +151,44 @@ class DirectSendTest : public ::testing::Test {
   RecordingTransport also;
   std::unique_ptr<Router> router;
 };
+
+bool sleeping(pid_t tid) {
+  std::ifstream stat("/proc/self/task/" + std::to_string(tid) + "/stat");
+  std::string line;
+  std::getline(stat, line);
+  const auto close = line.rfind(')');
+  return close != std::string::npos && close + 2 < line.size() && line[close + 2] == 'S';
+}
+
+// Whether a thread of this process has this name.
+bool thread_named(const std::string& name) {
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::ifstream comm(task.path() / "comm");
+    std::string line;
+    if (std::getline(comm, line) && line == name) return true;
+  }
+  return false;
+}
+
+// The tid of this process's thread of that name, or 0.
+pid_t thread_id_named(const std::string& name) {
+  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
+    std::ifstream comm(task.path() / "comm");
+    std::string line;
+    if (std::getline(comm, line) && line == name) return static_cast<pid_t>(std::stoi(task.path().filename()));
+  }
+  return 0;
+}
+
+bool wait_until_sleeping(const std::string& thread) {
+  const auto deadline = std::chrono::steady_clock::now() + kDirectSendPatience;
+  for (;;) {
+    const pid_t tid = thread_id_named(thread);
+    if (tid != 0 && sleeping(tid)) return true;
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::yield();
+  }
+}
 
 TEST_F(DirectSendTest, AThreadOfTheChannelsClassSendsToAnIdleLaneItself) {
   start();
@@ -147,12 +201,19 @@ TEST_F(DirectSendTest, AThreadOfTheChannelsClassSendsToAnIdleLaneItself) {
   EXPECT_EQ(router->queued(), 0u);
 }
 
-TEST_F(DirectSendTest, AThreadThatMayCarryAnotherClassLeavesTheSendToTheLane) {
+// Each on an idle lane (a fresh router): only the class check keeps the send from this thread.
+TEST_F(DirectSendTest, AThreadThatMayCarryEveryClassLeavesTheSendToTheLane) {
   start();
-  deliver(1, std::nullopt);       // CAN, LCM: one receive thread for every class
-  deliver(2, ChannelClass::hrt);  // a thread of another class
-  ASSERT_TRUE(out.wait_sent(2));
-  for (const auto& s : out.sent()) EXPECT_NE(s.thread, std::this_thread::get_id());
+  deliver(1, std::nullopt);  // CAN, LCM: one receive thread for every class
+  ASSERT_TRUE(out.wait_sent(1));
+  EXPECT_NE(out.sent()[0].thread, std::this_thread::get_id());
+}
+
+TEST_F(DirectSendTest, AThreadOfAnotherClassLeavesTheSendToTheLane) {
+  start();
+  deliver(1, ChannelClass::hrt);
+  ASSERT_TRUE(out.wait_sent(1));
+  EXPECT_NE(out.sent()[0].thread, std::this_thread::get_id());
 }
 
 // Events queued while an ingress thread sends go out after its event, on the lane's thread.
@@ -160,6 +221,7 @@ TEST_F(DirectSendTest, WhatQueuesBehindADirectSendFollowsItInOrder) {
   start();
   out.close_gate();
   std::thread receiver([&] { deliver(1, ChannelClass::nrt); });
+  const std::thread::id receiver_id = receiver.get_id();
   ASSERT_TRUE(out.wait_entered(1));
   deliver(2, ChannelClass::nrt);  // the lane is busy: queued, not sent here
   deliver(3, std::nullopt);
@@ -172,6 +234,8 @@ TEST_F(DirectSendTest, WhatQueuesBehindADirectSendFollowsItInOrder) {
   EXPECT_EQ(sent[0].first_byte, 1);
   EXPECT_EQ(sent[1].first_byte, 2);
   EXPECT_EQ(sent[2].first_byte, 3);
+  EXPECT_EQ(sent[0].thread, receiver_id);
+  EXPECT_NE(sent[1].thread, receiver_id) << "the direct sender hands what queued to the lane";
   EXPECT_NE(sent[1].thread, std::this_thread::get_id());
   EXPECT_EQ(sent[1].thread, sent[2].thread) << "both went to the lane's thread";
 }
@@ -224,22 +288,24 @@ TEST_F(DirectSendTest, AHopWhereTheGatewayAlsoReceivesTheChannelIsLeftToItsLane)
 // ingress threads send for themselves again.
 TEST_F(DirectSendTest, ALaneBusySendingTakesTheSendsAwayFromTheReceiveThreadUntilItIsIdleAgain) {
   start();
-  out.send_cost_ns = 1'000'000;  // back-to-back sends of 1 ms: the lane sends all the time
+  out.send_cost_ns = 150'000;  // back to back, each below a slow send: the lane sends all the time
   std::uint8_t tag = 0;
   std::size_t direct = 0;
   bool handed_over = false;
-  for (int i = 0; i < 100 && !handed_over; ++i) {
+  for (int i = 0; i < 200 && !handed_over; ++i) {
     deliver(++tag, ChannelClass::nrt);
     ASSERT_TRUE(out.wait_sent(tag));
     handed_over = out.sent().back().thread != std::this_thread::get_id();
     if (!handed_over) ++direct;
   }
   EXPECT_TRUE(handed_over) << "the receive thread kept sending all the time";
-  EXPECT_GE(direct, 5u) << "a window of the duty is several sends long";
-  // Light sending: 0 ms per send, 1 ms apart.
+  EXPECT_GE(direct, 60u) << "a window of the duty (10 ms) is about 67 of these sends";
+  // Light sending: none of the time, 1 ms apart. The clock moves only while the lane's thread
+  // sleeps, so that no send of its measures the test's step.
   out.send_cost_ns = 0;
   bool direct_again = false;
   for (int i = 0; i < 100 && !direct_again; ++i) {
+    ASSERT_TRUE(wait_until_sleeping("nrt:out"));
     fake_now_ns += 1'000'000;
     deliver(++tag, ChannelClass::nrt);
     ASSERT_TRUE(out.wait_sent(tag));
@@ -248,12 +314,37 @@ TEST_F(DirectSendTest, ALaneBusySendingTakesTheSendsAwayFromTheReceiveThreadUnti
   EXPECT_TRUE(direct_again) << "the lane stayed loaded after its sends became light";
 }
 
-bool sleeping(pid_t tid) {
-  std::ifstream stat("/proc/self/task/" + std::to_string(tid) + "/stat");
-  std::string line;
-  std::getline(stat, line);
-  const auto close = line.rfind(')');
-  return close != std::string::npos && close + 2 < line.size() && line[close + 2] == 'S';
+// One send that takes long (a congested network, a blocking transport) ends the receive thread's
+// sending for this lane at once: the next events go to the lane's thread.
+TEST_F(DirectSendTest, OneSlowSendHandsTheLaneBackToItsThread) {
+  start();
+  out.send_cost_ns = 300'000;
+  deliver(1, ChannelClass::nrt);
+  ASSERT_EQ(out.sent().size(), 1u);
+  EXPECT_EQ(out.sent()[0].thread, std::this_thread::get_id());
+  out.send_cost_ns = 0;
+  deliver(2, ChannelClass::nrt);
+  ASSERT_TRUE(out.wait_sent(2));
+  EXPECT_NE(out.sent()[1].thread, std::this_thread::get_id());
+}
+
+// A receive thread that feeds two lanes, each busy sending less than half the time, sends nearly
+// all the time: it is judged by the sum, and the lanes' threads take the sends over.
+TEST_F(DirectSendTest, AReceiveThreadIsJudgedByAllTheSendsItMakes) {
+  start();
+  out.send_cost_ns = 150'000;  // below a slow send
+  also.send_cost_ns = 150'000;
+  std::uint8_t tag = 0;
+  bool handed_over = false;
+  for (int i = 0; i < 200 && !handed_over; ++i) {
+    fake_now_ns += 17'000;
+    const bool to_out = i % 2 == 0;
+    deliver(++tag, ChannelClass::nrt, to_out ? 1 : 2);
+    RecordingTransport& to = to_out ? out : also;
+    ASSERT_TRUE(to.wait_sent(static_cast<std::size_t>(i / 2 + 1)));
+    handed_over = to.sent().back().thread != std::this_thread::get_id();
+  }
+  EXPECT_TRUE(handed_over) << "each lane sends 45% of the time, this thread 90%: it must hand over";
 }
 
 // Taking a segment's adapter away waits for an ingress thread's send to it: the caller may free
@@ -265,21 +356,28 @@ TEST_F(DirectSendTest, TakingTheAdapterAwayWaitsForASendInProgress) {
   ASSERT_TRUE(out.wait_entered(1));
   std::atomic<pid_t> remover_tid{0};
   std::atomic<bool> removed{false};
+  out.watch(&removed);
   std::thread remover([&] {
     remover_tid = static_cast<pid_t>(::syscall(SYS_gettid));
     router->set_segment(1, "out", nullptr);
     removed = true;
   });
-  // Until the remover sleeps (waiting for the send), or returned early (the failure).
+  // Until the remover sleeps in the NRT lane (its HRT and SRT lanes' threads are gone, the NRT
+  // lane's thread not yet: deactivate() waits for the send before it joins that thread), or
+  // returned early (the failure).
+  const auto in_nrt_lane = [&] {
+    return remover_tid != 0 && !thread_named("hrt:out") && !thread_named("srt:out") && thread_named("nrt:out") &&
+           sleeping(remover_tid);
+  };
   const auto deadline = std::chrono::steady_clock::now() + kDirectSendPatience;
-  while ((remover_tid == 0 || !sleeping(remover_tid)) && !removed && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::yield();
+  while (!in_nrt_lane() && !removed && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
   EXPECT_FALSE(removed) << "set_segment returned while a send to the adapter was in progress";
   out.open_gate();
   receiver.join();
   remover.join();
   EXPECT_TRUE(removed);
-  EXPECT_EQ(out.sent().size(), 1u);
+  ASSERT_EQ(out.sent().size(), 1u);
+  EXPECT_FALSE(out.sent()[0].watched) << "set_segment had returned when the send ended";
   deliver(2, ChannelClass::nrt);  // no adapter now: dropped, never sent to the old one
   EXPECT_EQ(out.sent().size(), 1u);
 }

@@ -103,6 +103,20 @@ TEST(PlacementTest, NrtLanesYieldOnlyWhileAHigherClassIsTimeShared) {
   EXPECT_EQ(nrt_nice(80, 60), sched_fifo_permitted(80) ? 0 : 10);
 }
 
+// A receive thread may send a class's events itself (EgressLane::push_or_send) only where that
+// ranks the work above no higher class: time-shared (any SCHED_FIFO lane preempts it), or
+// running exactly as that class's lanes do.
+TEST(PlacementTest, AReceiveThreadDoesALanesWorkOnlyWhereItRanksNoHigher) {
+  const ThreadPolicy nrt_lane{"nrt", 0, 10, {}};
+  EXPECT_TRUE(may_do_lane_work(ThreadPolicy{"rx", 0, 0, {}}, nrt_lane)) << "time-shared";
+  EXPECT_FALSE(may_do_lane_work(ThreadPolicy{"rx", 70, 0, {}}, nrt_lane))
+      << "SCHED_FIFO 70 would write NRT events above SRT lanes";
+  const ThreadPolicy srt_lane{"srt", 60, 0, {1}};
+  EXPECT_TRUE(may_do_lane_work(ThreadPolicy{"rx", 60, 0, {1}}, srt_lane));
+  EXPECT_FALSE(may_do_lane_work(ThreadPolicy{"rx", 60, 0, {0}}, srt_lane)) << "another CPU";
+  EXPECT_FALSE(may_do_lane_work(ThreadPolicy{"rx", 61, 0, {1}}, srt_lane)) << "a higher priority";
+}
+
 TEST(PlacementTest, PlaceProcessThreadsMovesEveryThreadThatExists) {
   if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "needs two CPUs";
   const std::vector<int> everywhere = cpus_of(0);

@@ -14,6 +14,11 @@
 #include <thread>
 
 namespace cosmic {
+
+bool may_do_lane_work(const ThreadPolicy& thread, const ThreadPolicy& lane) {
+  if (thread.fifo_priority == 0) return true;
+  return thread.fifo_priority == lane.fifo_priority && thread.cpus == lane.cpus;
+}
 namespace {
 cpu_set_t cpu_set_of(const std::vector<int>& cpus) {
   cpu_set_t set;

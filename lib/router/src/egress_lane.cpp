@@ -18,16 +18,26 @@ bool EgressLane::push(LaneItem&& item) noexcept { return offer(std::move(item), 
 
 bool EgressLane::push_or_send(LaneItem&& item) noexcept { return offer(std::move(item), true); }
 
+namespace {
+// The sends the calling ingress thread made itself, over every lane (send_duty.hpp).
+thread_local SendDuty this_thread_sends;
+}  // namespace
+
 bool EgressLane::offer(LaneItem&& item, bool may_send_here) noexcept {
   const std::size_t size = item.payload->bytes().size();
+  Nanos now{0};
+  if (may_send_here) {
+    now = context_.clock();
+    this_thread_sends.note_idle(now);
+    may_send_here = !this_thread_sends.loaded() && !loaded_.load(std::memory_order_relaxed);
+  }
   bool send_here = false;
   bool wake = true;
   {
     PiLock lock(mutex_);
     if (!active_) return false;
     item.generation = generation_;
-    send_here =
-        may_send_here && direct_allowed_ && !sending_ && count_ == 0 && !loaded_.load(std::memory_order_relaxed);
+    send_here = may_send_here && direct_allowed_ && !sending_ && count_ == 0;
     if (send_here) {
       sending_ = true;
       direct_sending_ = true;
@@ -45,25 +55,17 @@ bool EgressLane::offer(LaneItem&& item, bool may_send_here) noexcept {
     if (wake) wake_.notify_one();
     return true;
   }
-  const Nanos started = context_.clock();
   forward(item);
-  note_send(started, context_.clock());
+  const Nanos ended = context_.clock();
+  this_thread_sends.note(now, ended);
+  note_send(now, ended);
   end_direct_send();
   return true;
 }
 
 void EgressLane::note_send(Nanos started, Nanos ended) noexcept {
-  duty_busy_ += ended - started;
-  const Nanos span = ended - duty_window_start_;
-  if (span < kDutyWindow) return;
-  const std::int64_t percent = duty_busy_.count() * 100 / span.count();
-  if (percent >= kLoadedPercent) {
-    loaded_.store(true, std::memory_order_relaxed);
-  } else if (percent <= kUnloadedPercent) {
-    loaded_.store(false, std::memory_order_relaxed);
-  }
-  duty_window_start_ = ended;
-  duty_busy_ = Nanos(0);
+  duty_.note(started, ended);
+  loaded_.store(duty_.loaded(), std::memory_order_relaxed);
 }
 
 void EgressLane::end_direct_send() noexcept {
@@ -138,6 +140,8 @@ void EgressLane::activate(SegmentAdapter* adapter, const ThreadPolicy& policy, b
   }
   std::vector<LaneItem> ring;
   if (current != want) ring.resize(want);
+  // Before the lane accepts events: an ingress thread may send the first one at once.
+  adapter_.store(adapter, std::memory_order_release);
   {
     PiLock lock(mutex_);
     // deactivate() emptied the ring and head_ may point anywhere in it: a new depth starts afresh.
@@ -148,12 +152,10 @@ void EgressLane::activate(SegmentAdapter* adapter, const ThreadPolicy& policy, b
     active_ = true;
     direct_allowed_ = threaded;
     // No sender runs now (deactivate() ended them): the duty starts afresh.
-    duty_window_start_ = Nanos(0);
-    duty_busy_ = Nanos(0);
+    duty_ = SendDuty{};
     loaded_.store(false, std::memory_order_relaxed);
     current_generation_.store(generation_, std::memory_order_release);
   }
-  adapter_.store(adapter, std::memory_order_release);
   if (!threaded) return;
   running_.store(true, std::memory_order_release);
   thread_ = std::thread([this, policy] { worker(policy); });

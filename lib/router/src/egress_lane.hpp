@@ -15,9 +15,13 @@
 //
 // An ingress thread that sends for itself also receives for itself: at a rate where sending takes
 // a large part of the time, the two are better done by two threads on two CPUs (at saturation
-// one thread doing both delivered 22k-56k events/s, two 55k-59k: scripts/bench relay-rates). So the lane
-// measures how much of the time it spends sending, whoever sends, and while that is high
-// (kLoadedPercent, until it falls to kUnloadedPercent) every event goes to the lane's thread.
+// one thread doing both delivered 22k-56k events/s, two 55k-59k: scripts/bench relay-rates). So
+// the lane measures how much of the time it spends sending, whoever sends, and each ingress
+// thread how much it spends in its own sends (send_duty.hpp); while either is loaded, every event
+// goes to the lane's thread. An ingress thread that sends waits for the transport's send()
+// (bounded by its contract, cosmic/segment_adapter.hpp); the next events for it wait in the
+// network or the transport meanwhile, where residence does not count them (it counts from the
+// adapter's arrival time): one slow send (SendDuty::kSlowSend) hands the lane back to its thread.
 #pragma once
 
 #include <array>
@@ -35,6 +39,7 @@
 #include "cosmic/thread_annotations.hpp"
 #include "cosmic/thread_policy.hpp"
 #include "payload_pool.hpp"
+#include "send_duty.hpp"
 #include "wake_signal.hpp"
 
 namespace cosmic {
@@ -86,15 +91,8 @@ class EgressLane {
  private:
   // At most this many queued events go to the adapter at once (SegmentAdapter::send_batch).
   static constexpr std::size_t kSendBatch = 16;
-  // The send duty is judged over windows of at least this long. A send's time is wall time, with
-  // the preemptions by the threads it wakes: DDS -> cosmicd -> DDS, sends took a median 19% of
-  // the windows at 10 kHz, 32% (at most 82%) at 20 kHz and 56% at saturation (2 CPUs), so a lane
-  // takes its sends over at 60% and hands them back at 35%.
-  static constexpr Nanos kDutyWindow{10'000'000};
-  static constexpr std::int64_t kLoadedPercent = 60;
-  static constexpr std::int64_t kUnloadedPercent = 35;
   bool offer(LaneItem&& item, bool may_send_here) noexcept COSMIC_EXCLUDES(mutex_);
-  // Counts a send from `started` to `ended` into the send duty (by the sender holding `sending_`).
+  // Counts a send from `started` to `ended` into the lane's send duty (by the sender holding `sending_`).
   void note_send(Nanos started, Nanos ended) noexcept;
   // The end of an ingress thread's own send: the lane's thread takes over what queued meanwhile.
   void end_direct_send() noexcept COSMIC_EXCLUDES(mutex_);
@@ -141,20 +139,22 @@ class EgressLane {
   std::atomic<std::size_t> in_hand_{0};
   std::uint64_t generation_ COSMIC_GUARDED_BY(mutex_) = 0;
 
-  // Where this lane's thread writes typed events in their hop's form, one buffer per event of a
+  // Where this lane's sender writes typed events in their hop's form, one buffer per event of a
   // batch (the adapter reads them all in one send_batch); each grows to the largest message it
-  // has held and is then reused. Only the lane's thread (or run_once's caller) touches them.
+  // has held and is then reused. Only the sender holding `sending_` (or run_once's caller)
+  // touches them.
   std::array<std::vector<std::uint8_t>, kSendBatch> scratch_;
 
-  // The current window of the send duty; only the sender holding `sending_` touches it (handed
-  // from sender to sender under mutex_).
-  Nanos duty_window_start_{0};
-  Nanos duty_busy_{0};
-  std::atomic<bool> loaded_{false};  // sends took kLoadedPercent of a window: no direct sends
+  // Only the sender holding `sending_` touches it (handed from sender to sender under mutex_);
+  // `loaded_` is its verdict for every ingress thread to read.
+  SendDuty duty_;
+  std::atomic<bool> loaded_{false};
 
   std::atomic<SegmentAdapter*> adapter_{nullptr};
   std::atomic<std::uint64_t> current_generation_{0};
-  WakeSignal wake_;  // notified by every push and by deactivate
+  // Notified by a push (but for one behind an ingress thread's send, which notifies when it ends:
+  // the lane's thread and deactivate() waiting for that send) and by deactivate.
+  WakeSignal wake_;
   std::atomic<bool> running_{false};
   std::thread thread_;
 };

@@ -63,6 +63,9 @@ Status DdsAdapter::start(EventSink& sink) {
     attach_fastdds_log(log_);
     log_attached_ = true;
   }
+  // The NRT participant's threads run as the receive threads: a SCHED_FIFO receive thread
+  // (gateway.realtime.priorities.receive) would write NRT events above the SRT lanes.
+  nrt_receivers_send_ = may_do_lane_work(sink.receive_thread_policy(), sink.class_thread_policy(ChannelClass::nrt));
   try {
     if (Status st = open_participant(ChannelClass::nrt, sink.receive_thread_policy(), "rx:" + segment_.name); !st.ok) {
       return fail(st.error);

@@ -196,12 +196,17 @@ class DdsAdapter final : public DdsSegmentAdapter {
   // Serialises start/configure/stop (control thread); never taken on a send or receive path.
   Mutex control_mutex_;
   EventSink* sink_ = nullptr;
+  // Whether the NRT participant's threads may send an NRT event on themselves
+  // (InboundEvent::receiver_class): they run as the receive threads do, not as the NRT lanes, and
+  // may do a lane's work only where that puts it above no higher class. Set by start() before
+  // the participant's threads exist.
+  bool nrt_receivers_send_ = false;
   std::array<ClassParticipant, 3> classes_;  // indexed by ChannelClass; entries point into it
   bool log_attached_ = false;
 
-  // send() (lane threads, components' threads) reads the table without holding a lock across the
-  // write; configure()/stop() replace it (cosmic/snapshot_table.hpp) and delete the DataWriters of
-  // a replaced table only after its last send has ended.
+  // send() (lane threads, receive threads of the class, components' threads) reads the table without holding a lock
+  // across the write; configure()/stop() replace it (cosmic/snapshot_table.hpp) and delete the DataWriters of a
+  // replaced table only after its last send has ended.
   SnapshotTable<WriterTable> writers_;
   // Readers: only the control thread changes this table; matched_endpoints() reads it shared.
   mutable SharedMutex readers_mutex_;

@@ -113,8 +113,9 @@ void DdsAdapter::deliver(ReaderEntry& entry, const dds::SampleInfo& info) {
   }
   event.received_at = arrival_on_steady_clock(info.reception_timestamp);
   // This thread is a receive thread of the channel's class participant, which carries that class
-  // alone: the router may send the event on from here (cosmic/event.hpp).
-  event.receiver_class = entry.spec.cls;
+  // alone: the router may send the event on from here (cosmic/event.hpp); NRT only where the
+  // receive threads' scheduling allows it (cosmic/thread_policy.hpp: may_do_lane_work).
+  if (entry.spec.cls != ChannelClass::nrt || nrt_receivers_send_) event.receiver_class = entry.spec.cls;
   sink_->on_event(event);
 }
 

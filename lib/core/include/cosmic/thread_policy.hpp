@@ -14,6 +14,11 @@ struct ThreadPolicy {
   std::vector<int> cpus;  // empty: any CPU
 };
 
+// Whether a thread that runs as `thread` may do the work of a class whose egress lanes run as
+// `lane` (send its events) without ranking that work above a higher class: `thread` is
+// time-shared (any SCHED_FIFO lane preempts it), or it runs as the lanes do (priority and CPUs).
+bool may_do_lane_work(const ThreadPolicy& thread, const ThreadPolicy& lane);
+
 // Applies `policy` to the calling thread. Returns what could not be applied (e.g. "SCHED_FIFO 80:
 // Operation not permitted"); the thread runs on with what it got.
 std::vector<std::string> apply_thread_policy(const ThreadPolicy& policy);
