@@ -288,7 +288,7 @@ TEST_F(DirectSendTest, AHopWhereTheGatewayAlsoReceivesTheChannelIsLeftToItsLane)
 // ingress threads send for themselves again.
 TEST_F(DirectSendTest, ALaneBusySendingTakesTheSendsAwayFromTheReceiveThreadUntilItIsIdleAgain) {
   start();
-  out.send_cost_ns = 150'000;  // back to back, each below a slow send: the lane sends all the time
+  out.send_cost_ns = 150'000;  // back to back, each below the residence bound: the lane sends all the time
   std::uint8_t tag = 0;
   std::size_t direct = 0;
   bool handed_over = false;
@@ -318,7 +318,7 @@ TEST_F(DirectSendTest, ALaneBusySendingTakesTheSendsAwayFromTheReceiveThreadUnti
 // sending for this lane at once: the next events go to the lane's thread.
 TEST_F(DirectSendTest, OneSlowSendHandsTheLaneBackToItsThread) {
   start();
-  out.send_cost_ns = 300'000;
+  out.send_cost_ns = 1'000'000;  // the residence bound (RouterLimits' default)
   deliver(1, ChannelClass::nrt);
   ASSERT_EQ(out.sent().size(), 1u);
   EXPECT_EQ(out.sent()[0].thread, std::this_thread::get_id());
@@ -332,7 +332,7 @@ TEST_F(DirectSendTest, OneSlowSendHandsTheLaneBackToItsThread) {
 // all the time: it is judged by the sum, and the lanes' threads take the sends over.
 TEST_F(DirectSendTest, AReceiveThreadIsJudgedByAllTheSendsItMakes) {
   start();
-  out.send_cost_ns = 150'000;  // below a slow send
+  out.send_cost_ns = 150'000;  // below the residence bound
   also.send_cost_ns = 150'000;
   std::uint8_t tag = 0;
   bool handed_over = false;

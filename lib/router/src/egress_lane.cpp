@@ -57,14 +57,18 @@ bool EgressLane::offer(LaneItem&& item, bool may_send_here) noexcept {
   }
   forward(item);
   const Nanos ended = context_.clock();
-  this_thread_sends.note(now, ended);
+  this_thread_sends.note(now, ended, slow_send());
   note_send(now, ended);
   end_direct_send();
   return true;
 }
 
+Nanos EgressLane::slow_send() const noexcept {
+  return Nanos(context_.residence_bound_ns.load(std::memory_order_relaxed));
+}
+
 void EgressLane::note_send(Nanos started, Nanos ended) noexcept {
-  duty_.note(started, ended);
+  duty_.note(started, ended, slow_send());
   loaded_.store(duty_.loaded(), std::memory_order_relaxed);
 }
 

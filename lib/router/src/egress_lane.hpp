@@ -2,7 +2,8 @@
 // that hands them to that segment's adapter. Each (segment, class) has its own lane and thread,
 // so a slow or blocking transport delays only its own lanes, and a lower class never holds up a
 // higher one: the higher class's thread runs at a higher priority (gateway.realtime), and it
-// never waits for a lower class's queue.
+// never waits for a lower class's queue. An ingress thread of the lane's class may send in the
+// thread's place while the lane is idle and light (below); a slow send hands the lane back.
 //
 // Threads: push() and push_or_send() from ingress (adapter) threads; the lane thread pops and
 // sends; activate(), deactivate() and size() from the control thread; run_once() instead of the
@@ -21,7 +22,8 @@
 // goes to the lane's thread. An ingress thread that sends waits for the transport's send()
 // (bounded by its contract, cosmic/segment_adapter.hpp); the next events for it wait in the
 // network or the transport meanwhile, where residence does not count them (it counts from the
-// adapter's arrival time): one slow send (SendDuty::kSlowSend) hands the lane back to its thread.
+// adapter's arrival time): one send as long as the residence bound hands the lane back to its
+// thread.
 #pragma once
 
 #include <array>
@@ -94,6 +96,8 @@ class EgressLane {
   bool offer(LaneItem&& item, bool may_send_here) noexcept COSMIC_EXCLUDES(mutex_);
   // Counts a send from `started` to `ended` into the lane's send duty (by the sender holding `sending_`).
   void note_send(Nanos started, Nanos ended) noexcept;
+  // A send this long loads its sender at once: the residence bound (gateway.residence_bound).
+  Nanos slow_send() const noexcept;
   // The end of an ingress thread's own send: the lane's thread takes over what queued meanwhile.
   void end_direct_send() noexcept COSMIC_EXCLUDES(mutex_);
   // Until no ingress thread is sending (deactivate(), after forbidding new ones).

@@ -279,7 +279,12 @@ namespace {
 // is there, and a transport may hand what is sent to it within the send (Fast DDS delivers to a
 // matched reader of the same process on the writing thread). Such a send never runs on a
 // receive thread: that receive would run inside this one, and two of them in opposite directions
-// would each wait for the reader the other is in.
+// would each wait for the reader the other is in. (During a reload a route may still lead to a
+// segment whose reader of the channel is new: the DDS adapter drops a sample of its own writer as
+// own_echo before the router, so that nests once and goes no further. Two DDS segments on one
+// domain, which the configuration refuses unless their discovery servers differ, would match
+// each other's endpoints in-process only if those servers were connected: one network configured
+// as two, which this does not guard against.)
 bool sends_back_in_process(const Route& route, std::size_t segment) {
   return std::find(route.publishers.begin(), route.publishers.end(), segment) != route.publishers.end();
 }

@@ -6,8 +6,8 @@
 // A send's time is wall time, with the preemptions by the threads it wakes: DDS -> cosmicd -> DDS
 // (scripts/bench relay-rates, 2 CPUs), direct sends took a median 19% of 10 ms windows at 10 kHz,
 // 32% (at most 82%) at 20 kHz and 56% at saturation. So a sender is loaded from 60% until it falls
-// to 35%, and at once by one send of 200 us or more (a congested network, a blocking transport:
-// the receive thread must not wait for it again).
+// to 35%, and at once by one send as long as the residence bound (gateway.residence_bound: a
+// congested network, a blocking transport; the receive thread must not wait for it again).
 //
 // Not thread-safe: one thread at a time (the lane hands it from sender to sender under its mutex).
 #pragma once
@@ -23,14 +23,13 @@ class SendDuty {
   static constexpr Nanos kWindow{10'000'000};
   static constexpr std::int64_t kLoadedPercent = 60;
   static constexpr std::int64_t kUnloadedPercent = 35;
-  static constexpr Nanos kSlowSend{200'000};
 
-  // Counts one send (or one batch) from `started` to `ended`.
-  void note(Nanos started, Nanos ended) noexcept {
+  // Counts one send (or one batch) from `started` to `ended`; one of `slow` or longer loads.
+  void note(Nanos started, Nanos ended, Nanos slow) noexcept {
     busy_ += ended - started;
     judge(ended);
     // After judging: a window that ends with a slow send does not clear it.
-    if (ended - started >= kSlowSend) loaded_ = true;
+    if (ended - started >= slow) loaded_ = true;
   }
   // Without a send at `now`: a window that has passed is judged by the sends it had (none while
   // a loaded sender leaves them to others), so a sender that stopped sending is loaded no longer.

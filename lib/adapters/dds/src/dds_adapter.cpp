@@ -12,9 +12,9 @@
 // Threads and locks:
 // - control_mutex_ serialises start/configure/stop (control thread).
 // - writers_ is the channel -> writer table as a snapshot (cosmic/snapshot_table.hpp): send()
-//   (lane threads) takes the current table under a priority-inheriting mutex (a pointer copy) and
-//   writes with no table lock held; configure()/stop() build the next table outside any lock,
-//   swap it in, and delete the DataWriters it no longer holds after the last send on the old
+//   (lane threads, or a receive thread of the class in its lane's place) takes the current table under a
+//   priority-inheriting mutex (a pointer copy) and writes with no table lock held; configure()/stop() build the next
+//   table outside any lock, swap it in, and delete the DataWriters it no longer holds after the last send on the old
 //   table has ended. DDS entities are created before and deleted after the swap, so the router
 //   never waits for Fast DDS discovery work.
 // - Each writer has its own sample in its topic's format (dds_sample_format: envelope or opaque),

@@ -80,8 +80,9 @@ struct WriterEntry : dds::DataWriterListener {
   dds::DataWriter* writer = nullptr;
   // Guards format's sample, which every send of this channel fills. Held across write(), which
   // takes Fast DDS's own lock of this same writer anyway: only sends of this one channel can wait
-  // for it (the router sends a channel from its class's lane alone), never another channel, class
-  // or segment. Priority-inheriting, as every lock a forwarding thread takes.
+  // for it (the router sends a channel to a segment from one sender at a time: its class's lane,
+  // or a receive thread of that class in the lane's place), never another channel, class or
+  // segment. Priority-inheriting, as every lock a forwarding thread takes.
   PiMutex sample_mutex;
   std::unique_ptr<DdsSampleFormat> format COSMIC_GUARDED_BY(sample_mutex);
   std::atomic<bool> refusal_logged{false};  // one log line for events the format cannot carry

@@ -3,8 +3,8 @@
 // Internal to the DDS adapter; fuzzed alone (fuzz/dds_opaque_fuzzer.cpp).
 //
 // Ownership and threads: a participant owns its registered OpaqueType (through TypeSupport);
-// Fast DDS calls serialize() on the writing thread (an egress lane) and deserialize() on the
-// reader's take() (a Fast DDS receive thread), each on the caller's own sample.
+// Fast DDS calls serialize() on the writing thread (an egress lane, or a receive thread in its place) and deserialize()
+// on the reader's take() (a Fast DDS receive thread), each on the caller's own sample.
 #pragma once
 
 #include <cstdint>

@@ -18,7 +18,8 @@ namespace cosmic::dds_detail {
 // Largest history depth of a channel endpoint.
 inline constexpr std::int32_t kMaxHistoryDepth = 32;
 
-// Longest time DataWriter::write() may block the calling egress lane (every writer is reliable;
+// Longest time DataWriter::write() may block the calling egress lane (or the receive thread
+// sending in its place) (every writer is reliable;
 // with KEEP_LAST it only waits for the writer's own mutex and history, never for
 // acknowledgements). On timeout send() answers queue_full instead of stalling every other
 // channel of its class behind this one. 100 us is a fraction of the shortest latency bound a

@@ -5,7 +5,8 @@
 // Internal to the DDS adapter.
 //
 // Threads: each WriterEntry/ReaderEntry owns one format object and calls it under its own
-// mutex (writer: the egress lane's send(); reader: Fast DDS's receive thread).
+// mutex (writer: the egress lane's send(), or a receive thread's in its place; reader: Fast DDS's
+// receive thread).
 #pragma once
 
 #include <cstdint>

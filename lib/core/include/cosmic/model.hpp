@@ -337,7 +337,8 @@ struct CpuPlacement {
   std::vector<int> hrt;      // the HRT egress lanes and the HRT DDS participants' threads
   std::vector<int> srt;      // the SRT egress lanes and the SRT DDS participants' threads
   std::vector<int> nrt;      // the NRT egress lanes
-  std::vector<int> receive;  // the receive threads: CAN, LCM and the NRT DDS participants'
+  std::vector<int> receive;  // the receive threads: CAN, LCM and the NRT DDS participants' (these
+                             // also send NRT events to idle lanes while time-shared)
   std::vector<int> other;    // every other thread (control, metrics, logging, discovery)
   bool any() const { return !hrt.empty() || !srt.empty() || !nrt.empty() || !receive.empty() || !other.empty(); }
   const std::vector<int>& of(ChannelClass cls) const {

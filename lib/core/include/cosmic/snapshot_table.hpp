@@ -12,7 +12,8 @@
 // close (a DDS DataWriter, a socket) is closed on the control thread, never on a forwarding thread
 // that happened to read last.
 //
-// Threads: read() from any thread (the egress lanes, a component's threads); publish() and retire()
+// Threads: read() from any thread (the egress lanes, receive threads sending in their place, a
+// component's threads); publish() and retire()
 // from one control thread at a time.
 #pragma once
 

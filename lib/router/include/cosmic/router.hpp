@@ -2,9 +2,10 @@
 // admitted contract (ingress_check), applies duplicate, validity and rate policies, and queues
 // them on the egress lanes of the channel's subscriber segments: one lane per (segment, class),
 // each served by its own thread, so no segment and no lower class delays a higher class
-// elsewhere. Every forwarded event's residence is measured (from the kernel's arrival to the
-// return of send()) and compared with gateway.residence_bound, and its age at egress with the
-// channel's reaction_time (see EgressStats).
+// elsewhere. A receive thread that carries one class alone sends to an idle lane itself, in the
+// lane thread's place (one wake-up fewer; EgressLane::push_or_send says when). Every forwarded event's residence is
+// measured (from the kernel's arrival to the return of send()) and compared with gateway.residence_bound, and its age
+// at egress with the channel's reaction_time (see EgressStats).
 //
 // Threads: inbox(i).on_event() is called from adapter threads and does the ingress work on that
 // thread (one hand-off to the lane thread after it, or, for a thread of the event's class alone
