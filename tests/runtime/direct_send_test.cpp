@@ -58,6 +58,8 @@ class RecordingTransport final : public SegmentAdapter {
   AdapterStatistics statistics() const override { return {}; }
   std::optional<std::size_t> matched_peers(ChannelId) const override { return std::nullopt; }
   void stop() override {}
+  bool batches_sends() const override { return batches; }
+  bool batches = false;  // as LCM and CAN, which hand what queued over in one sendmmsg
 
   std::atomic<std::int64_t> send_cost_ns{0};  // how far each send moves the fake clock
 
@@ -205,6 +207,15 @@ TEST_F(DirectSendTest, AThreadOfTheChannelsClassSendsToAnIdleLaneItself) {
 TEST_F(DirectSendTest, AThreadThatMayCarryEveryClassLeavesTheSendToTheLane) {
   start();
   deliver(1, std::nullopt);  // CAN, LCM: one receive thread for every class
+  ASSERT_TRUE(out.wait_sent(1));
+  EXPECT_NE(out.sent()[0].thread, std::this_thread::get_id());
+}
+
+// An adapter that batches sends is left to its lane's thread, which hands it what queued at once.
+TEST_F(DirectSendTest, AnAdapterThatBatchesSendsIsLeftToItsLane) {
+  out.batches = true;
+  start();
+  deliver(1, ChannelClass::nrt);
   ASSERT_TRUE(out.wait_sent(1));
   EXPECT_NE(out.sent()[0].thread, std::this_thread::get_id());
 }
