@@ -162,16 +162,6 @@ bool sleeping(pid_t tid) {
   return close != std::string::npos && close + 2 < line.size() && line[close + 2] == 'S';
 }
 
-// Whether a thread of this process has this name.
-bool thread_named(const std::string& name) {
-  for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
-    std::ifstream comm(task.path() / "comm");
-    std::string line;
-    if (std::getline(comm, line) && line == name) return true;
-  }
-  return false;
-}
-
 // The tid of this process's thread of that name, or 0.
 pid_t thread_id_named(const std::string& name) {
   for (const auto& task : std::filesystem::directory_iterator("/proc/self/task")) {
@@ -377,8 +367,8 @@ TEST_F(DirectSendTest, TakingTheAdapterAwayWaitsForASendInProgress) {
   // lane's thread not yet: deactivate() waits for the send before it joins that thread), or
   // returned early (the failure).
   const auto in_nrt_lane = [&] {
-    return remover_tid != 0 && !thread_named("hrt:out") && !thread_named("srt:out") && thread_named("nrt:out") &&
-           sleeping(remover_tid);
+    return remover_tid != 0 && thread_id_named("hrt:out") == 0 && thread_id_named("srt:out") == 0 &&
+           thread_id_named("nrt:out") != 0 && sleeping(remover_tid);
   };
   const auto deadline = std::chrono::steady_clock::now() + kDirectSendPatience;
   while (!in_nrt_lane() && !removed && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
