@@ -7,6 +7,17 @@ FAILED=0
 cleanup() {
   for pid in "${PIDS[@]}"; do kill "$pid" 2>/dev/null || true; done
   for pid in "${PIDS[@]}"; do wait "$pid" 2>/dev/null || true; done
+  [ "$FAILED" = 0 ] || show_daemon_logs
+}
+
+# After a failure: what each daemon logged above debug, the last lines (a CI run keeps no files).
+show_daemon_logs() {
+  local f
+  for f in "$WORK"/*.log; do
+    [ -f "$f" ] || continue
+    log "--- $(basename "$f"), without debug lines, last 40:"
+    grep -v '^[0-9-]* [0-9:.]* debug ' "$f" | tail -n 40 >&2
+  done
 }
 
 log() { printf '%s\n' "$*" >&2; }

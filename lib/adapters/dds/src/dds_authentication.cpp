@@ -83,6 +83,12 @@ bool ParticipantAuthentications::authorized(const rtps::GuidPrefix_t& prefix) co
   return authorized_.count(prefix) != 0;
 }
 
+ParticipantAuthentications::State ParticipantAuthentications::state(const rtps::GuidPrefix_t& prefix) const {
+  std::lock_guard lock(mutex_);
+  if (authorized_.count(prefix) != 0) return State::authorized;
+  return refused_.count(rtps::GUID_t(prefix, rtps::c_EntityId_RTPSParticipant)) != 0 ? State::refused : State::pending;
+}
+
 std::string ParticipantAuthentications::claimed_subject(const rtps::GuidPrefix_t& prefix) const {
   std::lock_guard lock(mutex_);
   const auto claim = claims_.find(prefix);

@@ -43,6 +43,9 @@ class ParticipantAuthentications {
   void authenticated(const eprosima::fastrtps::rtps::ParticipantAuthenticationInfo& info);
 
   bool authorized(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) const;
+  // Authorized, refused (counted as unauthenticated and not authorized since), or not decided yet.
+  enum class State { pending, authorized, refused };
+  State state(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) const;
   // The subject the participant claims in its identity token (unproven), empty when none.
   std::string claimed_subject(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) const;
   // `unauthenticated` (participants refused) and `last_unauthenticated` (the last one's GUID).

@@ -3,6 +3,7 @@
 #include <pthread.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <mutex>
 #include <sstream>
@@ -20,6 +21,7 @@
 
 #include "cosmic/certificate_subject.hpp"
 #include "cosmic/dds_names.hpp"
+#include "cosmic/held_announcements.hpp"
 #include "cosmic_dds_idl/FederationPubSubTypes.h"
 #include "dds_authentication.hpp"
 #include "dds_qos.hpp"
@@ -33,6 +35,9 @@ using eprosima::fastrtps::types::ReturnCode_t;
 constexpr const char* kTopic = kFederationTopicName;
 // Messages queued between two take() calls; beyond it a flood is dropped and counted.
 constexpr std::size_t kMaxQueued = 4096;
+// An announcement whose sender has not authenticated in this time is reported as refused (and
+// stays held: a handshake Fast DDS completes later still releases it).
+constexpr Nanos kHoldReportAfter = std::chrono::seconds(10);
 
 eprosima::fastrtps::Duration_t duration_of(Nanos value) {
   return eprosima::fastrtps::Duration_t(static_cast<std::int32_t>(value.count() / 1'000'000'000),
@@ -62,6 +67,14 @@ eprosima::fastrtps::rtps::GuidPrefix_t prefix_of(const dds::InstanceHandle_t& ha
   for (std::size_t i = 0; i < prefix.size; ++i) prefix.value[i] = handle.value[i];
   return prefix;
 }
+
+eprosima::fastrtps::rtps::GuidPrefix_t guid_prefix(const ParticipantKey& key) {
+  eprosima::fastrtps::rtps::GuidPrefix_t prefix;
+  std::copy(key.begin(), key.end(), std::begin(prefix.value));
+  return prefix;
+}
+
+Nanos steady_now() { return std::chrono::duration_cast<Nanos>(std::chrono::steady_clock::now().time_since_epoch()); }
 
 std::string prefix_text(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) {
   std::ostringstream out;
@@ -148,6 +161,11 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
 
   std::vector<FederationMessage> take() override {
     std::lock_guard lock(mutex_);
+    if (held_.size() != 0) {
+      const auto state_of = [this](const ParticipantKey& key) { return sender_state(guid_prefix(key)); };
+      const auto judge = [this](const ParticipantKey& key, FederationMessage& m) { authenticate(guid_prefix(key), m); };
+      for (FederationMessage& m : held_.release(steady_now(), state_of, judge)) queue_.push_back(std::move(m));
+    }
     std::vector<FederationMessage> out;
     out.swap(queue_);
     return out;
@@ -244,28 +262,52 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
       if (from_prefix(info.publication_handle, own_prefix_)) continue;
       FederationMessage m;
       m.source = handle_text(info.publication_handle);
+      const bool secure = segment_.dds.security.has_value();
       if (info.valid_data) {
         m.key = sample.gateway();
         m.body = std::move(sample.body());
-        if (segment_.dds.security) authenticate(prefix_of(info.publication_handle), m);
+        if (secure) {
+          hold(std::move(m), prefix_of(info.publication_handle));
+          continue;
+        }
       } else {
         m.kind = info.instance_state == dds::NOT_ALIVE_DISPOSED_INSTANCE_STATE ? FederationMessage::Kind::withdrawn
                                                                                : FederationMessage::Kind::lost;
       }
       std::lock_guard lock(mutex_);
+      if (secure) held_.forget(m.source);
       queue(std::move(m));
     }
   }
 
-  // On a secure segment: the sender's subject, or why its announcement does not count. Its
-  // participant authenticated (the handshake proved it holds the certificate behind its GUID), and
-  // with gateway.federation.peers its GUID prefix is one a listed subject gives.
+  SenderAuthentication sender_state(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) const {
+    using State = dds_detail::ParticipantAuthentications::State;
+    switch (authentications_.state(prefix)) {
+      case State::authorized:
+        return SenderAuthentication::authorized;
+      case State::refused:
+        return SenderAuthentication::refused;
+      case State::pending:
+        break;
+    }
+    return SenderAuthentication::pending;
+  }
+
+  // On a secure segment every announcement waits in held_ until take() finds its participant's
+  // authentication decided (held_announcements.hpp says why); then authenticate() judges it.
+  void hold(FederationMessage m, const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) {
+    ParticipantKey key;
+    std::copy(std::begin(prefix.value), std::end(prefix.value), key.begin());
+    std::lock_guard lock(mutex_);
+    ++counters_.received;
+    if (!held_.hold(std::move(m), key, "participant " + prefix_text(prefix), steady_now())) ++counters_.dropped;
+  }
+
+  // The sender's subject, or why its announcement does not count; its participant authenticated
+  // (the handshake proved it holds the certificate behind its GUID). With gateway.federation.peers
+  // its GUID prefix must be one a listed subject gives.
   void authenticate(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix, FederationMessage& m) const {
     const std::string participant = "participant " + prefix_text(prefix);
-    if (!authentications_.authorized(prefix)) {
-      m.refusal = participant + " has not authenticated";
-      return;
-    }
     const std::string claim = authentications_.claimed_subject(prefix);
     if (federation_.peers.empty()) {
       m.subject = proven(claim, prefix);
@@ -314,6 +356,7 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
 
   mutable std::mutex mutex_;
   std::vector<FederationMessage> queue_;
+  HeldAnnouncements held_{kMaxQueued, kHoldReportAfter};  // secure segments only
   FederationLinkCounters counters_;
 };
 
