@@ -78,11 +78,6 @@ void ParticipantAuthentications::authenticated(const rtps::ParticipantAuthentica
   log_.log(LogLevel::warning, line);
 }
 
-bool ParticipantAuthentications::authorized(const rtps::GuidPrefix_t& prefix) const {
-  std::lock_guard lock(mutex_);
-  return authorized_.count(prefix) != 0;
-}
-
 ParticipantAuthentications::State ParticipantAuthentications::state(const rtps::GuidPrefix_t& prefix) const {
   std::lock_guard lock(mutex_);
   if (authorized_.count(prefix) != 0) return State::authorized;

@@ -42,7 +42,6 @@ class ParticipantAuthentications {
   void discovered(const eprosima::fastrtps::rtps::ParticipantDiscoveryInfo& info);
   void authenticated(const eprosima::fastrtps::rtps::ParticipantAuthenticationInfo& info);
 
-  bool authorized(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) const;
   // Authorized, refused (counted as unauthenticated and not authorized since), or not decided yet.
   enum class State { pending, authorized, refused };
   State state(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) const;
