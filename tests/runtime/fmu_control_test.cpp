@@ -189,6 +189,10 @@ TEST_F(FmuControl, EachRefusedReportKeepsNothing) {
       {with("worst_step_ns", 1.5), "bad_request", "\"worst_step_ns\" must be a whole number >= 0, not 1.5"},
       {with("step_ns", "10ms"), "bad_request", "\"step_ns\" must be a whole number >= 0, not \"10ms\""},
       {with("step_ns", 0), "bad_request", "\"step_ns\" must be > 0"},
+      // A duration beyond what a signed 64-bit count of nanoseconds holds (cosmicctl would print it
+      // negative, and an overrun check would compare a wrapped value).
+      {with("worst_step_ns", std::uint64_t{9'223'372'036'854'775'808u}), "bad_request",
+       "\"worst_step_ns\" must be at most 9223372036854775807 ns, not 9223372036854775808"},
       {with("skipped", Json::array()), "bad_request", "\"skipped\" must be an object of input: count, not array"},
       {with("skipped", {{"wheel", 1}}), "bad_request",
        "\"skipped\" counts 'wheel', none of the FMU's inputs (actual_speed, speed)"},

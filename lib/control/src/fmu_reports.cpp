@@ -35,6 +35,15 @@ std::optional<std::string> read_count(const Json& request, const std::string& ke
          (text.size() > kQuoted ? "..." : "");
 }
 
+// request[key] as a count of nanoseconds a duration holds (at most about 292 years), or why not.
+std::optional<std::string> read_duration(const Json& request, const std::string& key, std::uint64_t& out) {
+  if (auto why = read_count(request, key, out)) return why;
+  constexpr auto kLongest = static_cast<std::uint64_t>(std::numeric_limits<Nanos::rep>::max());
+  if (out > kLongest)
+    return "\"" + key + "\" must be at most " + std::to_string(kLongest) + " ns, not " + std::to_string(out);
+  return std::nullopt;
+}
+
 // The names a report's `skipped` may count under: the FMU's input variables and input channels.
 std::set<std::string> input_names(const FmuSpec& fmu) {
   std::set<std::string> names;
@@ -68,13 +77,15 @@ std::optional<std::string> read_report(const Json& request, const FmuSpec& fmu, 
   report.state = request["state"].get<std::string>();
   if (std::find(std::begin(kStates), std::end(kStates), report.state) == std::end(kStates))
     return "unknown state " + quote_name(report.state) + " (starting, running, stopped or failed)";
-  const std::pair<const char*, std::uint64_t*> counts[] = {{"step_ns", &report.step_ns},
-                                                           {"steps", &report.steps},
-                                                           {"late_steps", &report.late_steps},
-                                                           {"worst_step_ns", &report.worst_step_ns},
-                                                           {"p99_step_ns", &report.p99_step_ns}};
+  const std::pair<const char*, std::uint64_t*> counts[] = {{"steps", &report.steps},
+                                                           {"late_steps", &report.late_steps}};
   for (const auto& [key, out] : counts) {
     if (auto why = read_count(request, key, *out)) return why;
+  }
+  const std::pair<const char*, std::uint64_t*> durations[] = {
+      {"step_ns", &report.step_ns}, {"worst_step_ns", &report.worst_step_ns}, {"p99_step_ns", &report.p99_step_ns}};
+  for (const auto& [key, out] : durations) {
+    if (auto why = read_duration(request, key, *out)) return why;
   }
   if (report.step_ns == 0) return "\"step_ns\" must be > 0";
   if (auto why = read_skipped(request, fmu, report)) return why;
