@@ -323,6 +323,41 @@ TEST(DdsAdapter, NeverReceivesItsOwnPublications) {
   for (const auto& e : a.sink.events()) EXPECT_EQ(e.header.origin, kSelfId);
 }
 
+// Each participant's receive threads carry one class, so the adapter tells the router which
+// (InboundEvent::receiver_class) and the router may send the event on from that thread. Not for
+// NRT while those threads run SCHED_FIFO (gateway.realtime.priorities.receive) and the NRT lanes
+// are time-shared: the receive thread would write NRT events above the SRT lanes.
+TEST(DdsAdapter, EventsCarryTheClassTheirReceiveThreadMaySendOn) {
+  Fixture writer(dds_segment(58));
+  Fixture reader(dds_segment(58));
+  reader.sink.set_receive_thread_policy(ThreadPolicy{"ignored", 2, 0, {}});
+  ASSERT_TRUE(writer.adapter->start(writer.sink).ok);
+  ASSERT_TRUE(reader.adapter->start(reader.sink).ok);
+  ChannelBinding srt_out = binding(3, "cam.srt", HopRole::subscriber);
+  ChannelBinding srt_in = binding(3, "cam.srt", HopRole::publisher);
+  srt_out.spec.cls = srt_in.spec.cls = ChannelClass::srt;
+  ChannelBinding nrt_out = binding(4, "log.nrt", HopRole::subscriber);
+  ChannelBinding nrt_in = binding(4, "log.nrt", HopRole::publisher);
+  nrt_out.spec.cls = nrt_in.spec.cls = ChannelClass::nrt;
+  const ChannelBinding outs[] = {srt_out, nrt_out};
+  const ChannelBinding ins[] = {srt_in, nrt_in};
+  ASSERT_TRUE(writer.adapter->configure(outs).ok);
+  ASSERT_TRUE(reader.adapter->configure(ins).ok);
+  for (const ChannelId id : {ChannelId{3}, ChannelId{4}}) {
+    ASSERT_TRUE(writer.matched(id, HopRole::subscriber));
+    ASSERT_TRUE(reader.matched(id, HopRole::publisher));
+  }
+
+  std::vector<std::uint8_t> storage;
+  ASSERT_EQ(writer.adapter->send(outbound(3, 1, storage)), SendStatus::sent);
+  ASSERT_EQ(writer.adapter->send(outbound(4, 1, storage)), SendStatus::sent);
+  ASSERT_TRUE(reader.sink.wait_count(3, 1, kWait));
+  ASSERT_TRUE(reader.sink.wait_count(4, 1, kWait));
+  EXPECT_EQ(reader.sink.events_on(3)[0].receiver_class, ChannelClass::srt);
+  EXPECT_FALSE(reader.sink.events_on(4)[0].receiver_class.has_value())
+      << "a SCHED_FIFO receive thread must not write time-shared NRT events";
+}
+
 // ---- QoS on the wire --------------------------------------------------------------------------
 
 // What a channel's writer offers is what a default reader of any vendor accepts: reliable,

@@ -164,7 +164,8 @@ void RecordingSink::on_event(const InboundEvent& event) {
   {
     std::lock_guard lock(mutex_);
     events_.push_back(Event{event.channel, event.header,
-                            std::vector<std::uint8_t>(event.payload.begin(), event.payload.end()), event.received_at});
+                            std::vector<std::uint8_t>(event.payload.begin(), event.payload.end()), event.received_at,
+                            event.receiver_class});
   }
   cv_.notify_all();
 }

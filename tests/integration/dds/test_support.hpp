@@ -11,6 +11,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -70,6 +71,7 @@ class RecordingSink final : public EventSink {
     EventHeader header;
     std::vector<std::uint8_t> payload;
     Nanos received_at;
+    std::optional<ChannelClass> receiver_class;
   };
   void on_event(const InboundEvent& event) override;
   void on_problem(ChannelId channel, InboundProblem problem) override;
