@@ -103,6 +103,12 @@ void FederationMember::hear(cosmic::Nanos now) {
   std::string refusal;
   for (const cosmic::FederationMessage& message : link_->take()) {
     changed |= view_->apply(message, now, &refusal);
+    // Its sender's handshake is slow: reported once per waiting announcement, which may still count.
+    if (message.awaiting_authentication) {
+      log_.log(cosmic::LogLevel::warning, "federation: gateway " + cosmic::gateway_id_text(message.key) + ": " +
+                                              message.refusal + "; counted as refused until then");
+      continue;
+    }
     // A gateway the link refuses (authenticated, not listed) is logged once, with its subject.
     if (!message.refusal.empty() && refused_writers_logged_.size() < kMaxRefusedWritersLogged) {
       if (refused_writers_logged_.insert(message.source).second) {

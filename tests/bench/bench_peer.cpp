@@ -175,7 +175,8 @@ void Recorder::wait(double timeout_s, double idle_s) {
 }
 
 int Recorder::report() {
-  std::lock_guard lock(mutex_);  // record() may still run on the transport's thread
+  const std::int64_t cpu_now = process_cpu_ns();  // before the sorting and the dump below
+  std::lock_guard lock(mutex_);                   // record() may still run on the transport's thread
   if (!dump_path.empty()) {
     if (FILE* f = std::fopen(dump_path.c_str(), "w")) {
       for (const auto& t : trace_)
@@ -202,8 +203,7 @@ int Recorder::report() {
       count_, received_, count_ - received_, duplicates_, malformed_, q(0.50), q(0.90), q(0.99), q(0.999),
       lat.empty() ? 0.0 : static_cast<double>(lat.back()) / 1e3, mean, span,
       span > 0 ? static_cast<double>(received_ - 1) / span : 0.0, warmup_received_,
-      received_ > 0 ? static_cast<double>(process_cpu_ns() - first_cpu_ns_) / 1e3 / static_cast<double>(received_)
-                    : 0.0);
+      received_ > 0 ? static_cast<double>(cpu_now - first_cpu_ns_) / 1e3 / static_cast<double>(received_) : 0.0);
   std::fflush(stdout);
   return received_ > 0 ? 0 : 1;
 }

@@ -193,6 +193,8 @@ TEST_F(FmuControl, EachRefusedReportKeepsNothing) {
       // negative, and an overrun check would compare a wrapped value).
       {with("worst_step_ns", std::uint64_t{9'223'372'036'854'775'808u}), "bad_request",
        "\"worst_step_ns\" must be at most 9223372036854775807 ns, not 9223372036854775808"},
+      {with("p99_step_ns", std::uint64_t{18'446'744'073'709'551'615u}), "bad_request",
+       "\"p99_step_ns\" must be at most 9223372036854775807 ns, not 18446744073709551615"},
       {with("skipped", Json::array()), "bad_request", "\"skipped\" must be an object of input: count, not array"},
       {with("skipped", {{"wheel", 1}}), "bad_request",
        "\"skipped\" counts 'wheel', none of the FMU's inputs (actual_speed, speed)"},
@@ -207,6 +209,9 @@ TEST_F(FmuControl, EachRefusedReportKeepsNothing) {
     EXPECT_EQ(fmu_entry("speed_fmu")["report"]["worst_step_ns"], 412'000) << c.request;  // the accepted one
   }
   EXPECT_TRUE(fmu_entry("plant")["report"].is_null());
+  // The longest duration itself is a duration.
+  EXPECT_EQ(call(with("worst_step_ns", std::uint64_t{9'223'372'036'854'775'807u}))["ok"], true);
+  EXPECT_EQ(fmu_entry("speed_fmu")["report"]["worst_step_ns"], 9'223'372'036'854'775'807);
 }
 
 // A report binds nothing but can flag channels violated: its own permission (AccessPolicy::may_report).

@@ -77,13 +77,20 @@ TEST(HeldAnnouncements, UndecidedTooLongIsReportedOnceAndStillReleasedWhenAuthor
   ASSERT_EQ(report.size(), 1u);
   EXPECT_EQ(report[0].refusal,
             "participant A has not authenticated in 10 s (its announcement waits for the handshake)");
+  EXPECT_TRUE(report[0].awaiting_authentication);
+  EXPECT_EQ(report[0].source, "w-a") << "the view and the log name the writer and the gateway";
+  EXPECT_EQ(report[0].key, 7u);
   EXPECT_TRUE(held.release(20s, senders.state_of(), senders.judge()).empty()) << "reported once";
+  held.hold(announcement("w-a", "newer"), kA, "participant A", 21s);
+  EXPECT_TRUE(held.release(40s, senders.state_of(), senders.judge()).empty()) << "a replacement is not reported again";
 
   senders.states[kA] = SenderAuthentication::authorized;
   const auto out = held.release(30s, senders.state_of(), senders.judge());
   ASSERT_EQ(out.size(), 1u);
   EXPECT_TRUE(out[0].refusal.empty());
   EXPECT_EQ(out[0].subject, "/O=cosmic/CN=gateway-a");
+  EXPECT_EQ(out[0].body, "newer");
+  EXPECT_FALSE(out[0].awaiting_authentication);
 }
 
 TEST(HeldAnnouncements, ANewerAnnouncementOfTheSameWriterReplacesTheHeldOne) {
@@ -134,6 +141,12 @@ TEST(HeldAnnouncements, AFloodOfWritersIsBounded) {
   EXPECT_FALSE(held.hold(announcement("w3", ""), kA, "participant A", 0s));
   EXPECT_TRUE(held.hold(announcement("w2", "newer"), kA, "participant A", 0s)) << "a held writer may still replace";
   EXPECT_EQ(held.size(), 2u);
+  Senders senders;
+  senders.states[kA] = SenderAuthentication::authorized;
+  const auto out = held.release(1s, senders.state_of(), senders.judge());
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[1].body, "newer");
+  EXPECT_TRUE(held.hold(announcement("w3", ""), kA, "participant A", 2s)) << "released ones free their places";
 }
 
 }  // namespace

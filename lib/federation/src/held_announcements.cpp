@@ -9,10 +9,9 @@ bool HeldAnnouncements::hold(FederationMessage message, const ParticipantKey& pa
                              Nanos now) {
   const auto same_writer = [&](const Held& h) { return h.message.source == message.source; };
   if (auto it = std::find_if(held_.begin(), held_.end(), same_writer); it != held_.end()) {
-    // Newer from the same writer: it replaces the held one and waits where that one waited.
+    // Newer from the same writer (so the same participant): it replaces the held one and waits
+    // where that one waited.
     it->message = std::move(message);
-    it->participant = participant;
-    it->participant_text = std::move(participant_text);
     return true;
   }
   if (held_.size() >= capacity_) return false;
@@ -43,6 +42,7 @@ std::vector<FederationMessage> HeldAnnouncements::release(Nanos now, const State
     if (!held.reported && now - held.since >= report_after_) {
       held.reported = true;
       FederationMessage report = held.message;
+      report.awaiting_authentication = true;
       report.refusal = held.participant_text + " has not authenticated in " +
                        std::to_string(std::chrono::duration_cast<std::chrono::seconds>(report_after_).count()) +
                        " s (its announcement waits for the handshake)";

@@ -135,8 +135,8 @@ channels:
 YAML
 }
 passes_at_least() { [ "$(segment_adapter_field g lidar-replay passes)" -ge "$1" ]; }
-# One pass first: how many of the 40 events lie at or after 195 ms. About 20 (10 ms apart), but the
-# recording holds the times the recording gateway received them, which a loaded machine bunches.
+# One pass first: how many of the 40 events lie at or after 195 ms. About 20 (sent 10 ms apart), but
+# the recording holds the times the recording gateway received them, which a loaded machine bunches.
 offset_config "$WORK/once.yaml" false
 start_daemon g "$WORK/once.yaml" || exit 1
 wait_until 20 "one pass" passes_at_least 1
@@ -144,8 +144,10 @@ per_pass=$(segment_adapter_field g lidar-replay received)
 kill -TERM "$PID_g"
 wait "$PID_g" 2>/dev/null
 PIDS=()
-[ "$per_pass" -ge 1 ] && [ "$per_pass" -lt 40 ] ||
-  fail "a pass from 195 ms on replayed $per_pass events, want some but not all 40"
+# 195 ms into a recording of about 390 ms leaves about half of it; a bunched recording moves that
+# (23-24 seen under load), an offset that missed (0 ms, or 195 ms divided by the speed) leaves 38-40.
+[ "$per_pass" -ge 10 ] && [ "$per_pass" -le 30 ] ||
+  fail "a pass from 195 ms on replayed $per_pass events, want 10-30 of the 40"
 offset_config "$WORK/loop.yaml" true
 start_daemon g "$WORK/loop.yaml" || exit 1
 wait_until 20 "three passes" passes_at_least 3

@@ -328,8 +328,8 @@ TEST(DdsAdapter, NeverReceivesItsOwnPublications) {
 // NRT while those threads run SCHED_FIFO (gateway.realtime.priorities.receive) and the NRT lanes
 // are time-shared: the receive thread would write NRT events above the SRT lanes.
 TEST(DdsAdapter, EventsCarryTheClassTheirReceiveThreadMaySendOn) {
-  Fixture writer(dds_segment(58));
-  Fixture reader(dds_segment(58));
+  Fixture writer(dds_segment(59));
+  Fixture reader(dds_segment(59));
   reader.sink.set_receive_thread_policy(ThreadPolicy{"ignored", 2, 0, {}});
   ASSERT_TRUE(writer.adapter->start(writer.sink).ok);
   ASSERT_TRUE(reader.adapter->start(reader.sink).ok);

@@ -11,7 +11,6 @@
 #include <map>
 #include <mutex>
 #include <optional>
-#include <optional>
 #include <string>
 #include <thread>
 #include <vector>

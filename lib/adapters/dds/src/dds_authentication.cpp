@@ -36,6 +36,7 @@ void ParticipantAuthentications::discovered(const rtps::ParticipantDiscoveryInfo
   if (info.status == rtps::ParticipantDiscoveryInfo::REMOVED_PARTICIPANT ||
       info.status == rtps::ParticipantDiscoveryInfo::DROPPED_PARTICIPANT) {
     authorized_.erase(prefix);
+    refused_now_.erase(prefix);
     claims_.erase(prefix);
     return;
   }
@@ -51,9 +52,11 @@ void ParticipantAuthentications::authenticated(const rtps::ParticipantAuthentica
   std::unique_lock lock(mutex_);
   if (info.status == rtps::ParticipantAuthenticationInfo::AUTHORIZED_PARTICIPANT) {
     authorized_.insert(info.guid.guidPrefix);
+    refused_now_.erase(info.guid.guidPrefix);
     return;
   }
   authorized_.erase(info.guid.guidPrefix);
+  if (refused_now_.size() < kMaxRemembered) refused_now_.insert(info.guid.guidPrefix);
   if (!refused_.insert(info.guid).second) return;  // another of this segment's participants counted it
   refused_order_.push_back(info.guid);
   if (refused_order_.size() > kMaxRemembered) {
@@ -81,7 +84,7 @@ void ParticipantAuthentications::authenticated(const rtps::ParticipantAuthentica
 ParticipantAuthentications::State ParticipantAuthentications::state(const rtps::GuidPrefix_t& prefix) const {
   std::lock_guard lock(mutex_);
   if (authorized_.count(prefix) != 0) return State::authorized;
-  return refused_.count(rtps::GUID_t(prefix, rtps::c_EntityId_RTPSParticipant)) != 0 ? State::refused : State::pending;
+  return refused_now_.count(prefix) != 0 ? State::refused : State::pending;
 }
 
 std::string ParticipantAuthentications::claimed_subject(const rtps::GuidPrefix_t& prefix) const {

@@ -42,7 +42,8 @@ class ParticipantAuthentications {
   void discovered(const eprosima::fastrtps::rtps::ParticipantDiscoveryInfo& info);
   void authenticated(const eprosima::fastrtps::rtps::ParticipantAuthenticationInfo& info);
 
-  // Authorized, refused (counted as unauthenticated and not authorized since), or not decided yet.
+  // This participant's last decision since it was discovered: authorized, refused, or none yet
+  // (pending; also after it was dropped or removed, until its next handshake ends).
   enum class State { pending, authorized, refused };
   State state(const eprosima::fastrtps::rtps::GuidPrefix_t& prefix) const;
   // The subject the participant claims in its identity token (unproven), empty when none.
@@ -60,6 +61,7 @@ class ParticipantAuthentications {
   const bool log_refusals_;
   mutable std::mutex mutex_;
   std::set<eprosima::fastrtps::rtps::GuidPrefix_t> authorized_;
+  std::set<eprosima::fastrtps::rtps::GuidPrefix_t> refused_now_;  // refused since discovered (bounded)
   std::map<eprosima::fastrtps::rtps::GuidPrefix_t, Claim> claims_;
   // The participants counted as refused, oldest first (bounded: a flood of new GUIDs is each counted).
   std::deque<eprosima::fastrtps::rtps::GUID_t> refused_order_;

@@ -33,7 +33,8 @@ namespace dds = eprosima::fastdds::dds;
 using eprosima::fastrtps::types::ReturnCode_t;
 
 constexpr const char* kTopic = kFederationTopicName;
-// Messages queued between two take() calls; beyond it a flood is dropped and counted.
+// Messages queued between two take() calls, and announcements held for their senders'
+// authentication (secure segments); beyond either a flood is dropped and counted.
 constexpr std::size_t kMaxQueued = 4096;
 // An announcement whose sender has not authenticated in this time is reported as refused (and
 // stays held: a handshake Fast DDS completes later still releases it).
@@ -334,8 +335,12 @@ class DdsFederationLink final : public FederationLink, private dds::DataReaderLi
   void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& status) override {
     if (status.current_count_change == 0 || from_prefix(status.last_publication_handle, own_prefix_)) return;
     const auto kind = status.current_count_change < 0 ? FederationMessage::Kind::lost : FederationMessage::Kind::alive;
+    const std::string source = handle_text(status.last_publication_handle);
     std::lock_guard lock(mutex_);
-    queue(FederationMessage{kind, handle_text(status.last_publication_handle), 0, {}});
+    // A writer gone takes what it left held with it: released after its `lost`, it would revive a
+    // gateway whose writer no longer exists.
+    if (kind == FederationMessage::Kind::lost) held_.forget(source);
+    queue(FederationMessage{kind, source, 0, {}});
   }
 
   SegmentSpec segment_;

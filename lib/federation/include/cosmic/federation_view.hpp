@@ -37,9 +37,12 @@ struct FederationMessage {
   // On a secure federation segment (docs/federation.md): the certificate subject the sender
   // authenticated with, as the transport proved it (empty: not secure, or nothing proves one), and
   // why the transport refuses the sender (an authenticated gateway gateway.federation.peers does not
-  // list): such an announcement is counted as refused and never applied.
+  // list, a participant that did not authenticate): such an announcement is counted as refused and
+  // never applied. `awaiting_authentication`: the refusal only reports that the sender's handshake
+  // has not ended yet; the transport still holds the announcement and delivers it again once it does.
   std::string subject{};
   std::string refusal{};
+  bool awaiting_authentication = false;
 };
 
 enum class PeerState { alive, lost, left };
