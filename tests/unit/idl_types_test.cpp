@@ -523,6 +523,13 @@ TEST(IdlTypes, LimitsKeepHostileInputCheap) {
   const IdlTypeFile many = parse_idl_types(bad);
   EXPECT_EQ(many.errors.size(), 101u);
   EXPECT_EQ(many.errors.back().message, "200 more errors not reported");
+  // Also when an included file is read while its includer's errors still wait to be reported
+  // (fuzz_idl_types found 102 and more).
+  const std::string bad_include = bad;
+  const IdlIncludeLoader load = [&](std::string_view) -> std::optional<std::string> { return bad_include; };
+  const IdlTypeFile nested = parse_idl_types(bad.substr(0, 8 * 150) + "#include \"bad.idl\"\n" + bad, load);
+  EXPECT_EQ(nested.errors.size(), 101u);
+  EXPECT_NE(nested.errors.back().message.find("more errors not reported"), std::string::npos);
 }
 
 // Bytes by hand, little-endian.

@@ -37,6 +37,9 @@ struct Shared {
   std::size_t total_bytes = 0;
   std::size_t declarations = 0;
   std::size_t unreported = 0;
+  // Errors kept by every file's parser, passed on or still pending: an included file is parsed
+  // while its includer's errors wait, so the limit counts both.
+  std::size_t reported = 0;
 };
 
 // "a struct", "a constant", ... for a Symbol's kind.

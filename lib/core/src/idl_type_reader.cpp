@@ -53,7 +53,8 @@ Token FileParser::advance() {
 }
 
 void FileParser::error(int line, int column, std::string message) {
-  if (shared_.out.errors.size() + errors_.size() < kMaxReportedTextErrors) {
+  if (shared_.reported < kMaxReportedTextErrors) {
+    ++shared_.reported;
     errors_.push_back(IdlError{file_, line, column, std::move(message)});
   } else {
     ++shared_.unreported;
@@ -379,7 +380,7 @@ const IdlTypedef* IdlTypeFile::find_typedef(std::string_view name) const { retur
 const IdlConstant* IdlTypeFile::find_constant(std::string_view name) const { return idl_find_named(constants, name); }
 
 IdlTypeFile parse_idl_types(std::string_view text, const IdlIncludeLoader& load) {
-  idl_detail::Shared shared{{}, load, {}, {}, {}, text.size(), 0, 0};
+  idl_detail::Shared shared{{}, load, {}, {}, {}, text.size(), 0, 0, 0};
   if (text.size() > kIdlMaxTextBytes) {
     shared.out.errors.push_back(IdlError{"", 0, 0,
                                          "the IDL file has " + std::to_string(text.size()) +
